@@ -1,0 +1,29 @@
+// 8-bit RGB images, and the files synthvis reads and writes (PNG, binary PPM).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "synthvis/result.h"
+
+namespace sv {
+
+// A display-ready image: 8-bit sRGB-encoded (or display-gamma) RGB, rows top to bottom.
+struct Image {
+  int width = 0;
+  int height = 0;
+  std::vector<uint8_t> rgb;  // width·height·3
+
+  const uint8_t* pixel(int x, int y) const { return &rgb[(size_t(y) * width + x) * 3]; }
+  uint8_t* pixel(int x, int y) { return &rgb[(size_t(y) * width + x) * 3]; }
+};
+
+// Writes by extension: .png (8-bit RGB) or .ppm (binary P6). Errors name the file.
+Status writeImage(const Image& image, const std::string& path);
+Status writePng(const Image& image, const std::string& path);
+Status writePpm(const Image& image, const std::string& path);
+// Reads an 8-bit or 16-bit PNG of any colour type into 8-bit RGB (alpha dropped).
+Result<Image> readPng(const std::string& path);
+
+}  // namespace sv

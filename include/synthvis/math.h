@@ -1,0 +1,68 @@
+// Small vector and matrix types shared by every stage.
+//
+// Conventions: right-handed world, camera looks down −Z (as glTF and OpenGL), matrices are
+// column-major (m[col][row], as glTF stores them) and act on column vectors: p' = M·p.
+#pragma once
+
+#include <array>
+#include <cmath>
+
+namespace sv {
+
+struct Vec2 {
+  float x = 0, y = 0;
+};
+
+struct Vec3 {
+  float x = 0, y = 0, z = 0;
+  friend Vec3 operator+(Vec3 a, Vec3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+  friend Vec3 operator-(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+  friend Vec3 operator*(Vec3 a, float s) { return {a.x * s, a.y * s, a.z * s}; }
+  friend Vec3 operator*(float s, Vec3 a) { return a * s; }
+  friend Vec3 operator*(Vec3 a, Vec3 b) { return {a.x * b.x, a.y * b.y, a.z * b.z}; }
+  friend Vec3 operator-(Vec3 a) { return {-a.x, -a.y, -a.z}; }
+  friend bool operator==(Vec3 a, Vec3 b) = default;
+};
+
+struct Vec4 {
+  float x = 0, y = 0, z = 0, w = 0;
+  friend bool operator==(Vec4 a, Vec4 b) = default;
+};
+
+inline float dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline Vec3 cross(Vec3 a, Vec3 b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+inline float length(Vec3 a) { return std::sqrt(dot(a, a)); }
+// Returns `a` scaled to unit length, or `a` unchanged when it has zero length.
+inline Vec3 normalize(Vec3 a) {
+  float l = length(a);
+  return l > 0 ? a * (1.0f / l) : a;
+}
+
+// 4×4 matrix, column-major: m[c][r] is row r of column c.
+struct Mat4 {
+  std::array<std::array<float, 4>, 4> m{{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}}};
+
+  static Mat4 identity() { return {}; }
+  static Mat4 translation(Vec3 t);
+  static Mat4 scaling(Vec3 s);
+  // Rotation by `radians` about the unit `axis` (right-handed).
+  static Mat4 rotation(Vec3 axis, float radians);
+  // OpenGL-style perspective projection: vertical field of view in radians, clip z ∈ [−w, w].
+  static Mat4 perspective(float yfov, float aspect, float znear, float zfar);
+  // View matrix of a camera at `eye` looking at `target`.
+  static Mat4 lookAt(Vec3 eye, Vec3 target, Vec3 up);
+  // Column-major 16 floats, as glTF and the JSON scene format store them.
+  static Mat4 fromColumnMajor(const float* v);
+
+  friend Mat4 operator*(const Mat4& a, const Mat4& b);
+  Vec4 operator*(Vec4 v) const;
+  Vec3 transformPoint(Vec3 p) const;     // w = 1, no divide
+  Vec3 transformDirection(Vec3 d) const;  // w = 0
+  // The inverse transpose of the upper 3×3, for normals. Returns identity when singular.
+  Mat4 normalMatrix() const;
+  friend bool operator==(const Mat4& a, const Mat4& b) = default;
+};
+
+}  // namespace sv

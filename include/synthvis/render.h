@@ -1,0 +1,62 @@
+// Rendering a scene to an image: the public entry point of the library.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "synthvis/image.h"
+#include "synthvis/result.h"
+#include "synthvis/scene.h"
+
+namespace sv {
+
+inline constexpr int kMaxRasterSize = 8192;  // width and height, each
+inline constexpr int kMaxThreads = 256;
+
+// Everything that configures a frame (STYLE.md habit 10). Built by the CLI, passed by reference.
+struct RenderOptions {
+  int width = 1280;
+  int height = 720;
+  int threads = 0;             // worker threads in all; 0 = one per hardware thread
+  bool cullBackFaces = true;   // for materials that are not double-sided
+  int camera = 0;              // index into Scene::cameras (a default camera if there is none)
+  bool debugOverdraw = false;  // instead of colours, count the triangles covering each pixel
+};
+
+// Checks sizes and counts; the error names the option.
+Status validate(const RenderOptions& options);
+
+// What one frame did. Window counts are per quadtree level (64 … 4 pixels, then pixel tests).
+struct FrameStats {
+  uint64_t trianglesIn = 0;
+  uint64_t culledFacing = 0, culledOutside = 0, culledDegenerate = 0, culledInvalid = 0;
+  uint64_t drawn = 0;
+  uint64_t windows[6] = {};
+  uint64_t fullWindows = 0, partialBlocks = 0, fragments = 0;
+  double vertexMs = 0, setupMs = 0, rasterMs = 0, resolveMs = 0, totalMs = 0;
+
+  uint64_t culled() const { return culledFacing + culledOutside + culledDegenerate + culledInvalid; }
+  // One line: triangles in / culled / drawn, windows per level, milliseconds.
+  std::string summary() const;
+};
+
+// Renders scenes; keeps its threads and buffers from frame to frame.
+class Renderer {
+ public:
+  explicit Renderer(const RenderOptions& options);  // options must pass validate()
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  // Renders `scene` into `image`. Identical bytes for any thread count.
+  Status render(const scene::Scene& scene, Image& image, FrameStats* stats = nullptr);
+
+  const RenderOptions& options() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace sv

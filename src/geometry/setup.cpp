@@ -1,0 +1,262 @@
+// Triangle setup without perspective divide.
+//
+// Based on: SPEC §2 (seed 000 §1, seed 004 eqs. 1–7); Olano & Greer 1997 (2D homogeneous
+// rasterization); the fixed-point edge setup of zeux/meshoptimizer's rasterizer and Mesa
+// llvmpipe's lp_setup_tri.c (for the idea of snapping, not their code).
+//
+// Symbols. Each vertex k is taken to homogeneous *pixel* coordinates V_k = (X_k, Y_k, W_k) with
+// X = (x_clip + w)·width/2, Y = (w − y_clip)·height/2 (y grows downward), W = w. For a pixel
+// position p = (x, y, 1), write p = Σ λ_k V_k. Then, with adj_k = V_i × V_j ((k, i, j) cyclic) and
+// det = V_0 · adj_0,
+//     λ_k(p) = adj_k · p / det                                                       (SPEC §2)
+// are linear in (x, y): the *edge functions*. For a point P of the triangle with 3D barycentric
+// weights β_k, λ_k = β_k / w_P, so "all λ_k ≥ 0" holds exactly on the part of the triangle in front
+// of the eye (w_P > 0): triangles crossing the eye plane need no clipping (SPEC §2, "clipping
+// reduces to culling"). Parameters follow from the same λ:
+//     1/w = Σ λ_k,    z/w = Σ λ_k Z_k,    f/w = Σ λ_k f_k,    f = (f/w) / (1/w).
+// The near plane z ≥ −w is one more edge: Σ λ_k (Z_k + W_k) = (z_P + w_P)/w_P ≥ 0.
+//
+// Exactness. The inside test uses integer edges. For an edge whose two vertices are in front of the
+// eye and within the guard band, the edge is rebuilt from the vertices' projections snapped to
+// 1/256 px: A = y_i − y_j, B = x_j − x_i, C = x_i·y_j − x_j·y_i, exact in int64 (budget in setup.h);
+// adj_k = w_i·w_j·(that edge), so the sign — and the inside test — is unchanged by the divide.
+// Other edges (a vertex behind the eye or far outside the screen, and the near/far planes) are the
+// homogeneous cross products in double, scaled by a power of two and rounded to the same integer
+// form. Either way an edge depends only on its two vertices and is computed in a canonical order,
+// so the neighbour across a shared edge gets exactly the negated coefficients: shared edges are
+// watertight.
+#include "geometry/setup.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+
+namespace sv::geometry {
+namespace {
+
+constexpr double kGuardBand = double(1 << kGuardBandLog2);  // pixels
+constexpr int64_t kHalfPixel = kSubPixelScale / 2;
+constexpr int kHomogeneousCoefBits = 23;  // max(|A|, |B|) of a rounded homogeneous edge ≤ 2^23
+constexpr double kMaxHomogeneousC = 70368744177664.0;  // 2^46: beyond it the line misses the raster
+
+struct HomVertex {
+  double x, y, w;
+};
+
+HomVertex cross(const HomVertex& a, const HomVertex& b) {
+  return {a.y * b.w - a.w * b.y, a.w * b.x - a.x * b.w, a.x * b.y - a.y * b.x};
+}
+double dot(const HomVertex& a, const HomVertex& b) { return a.x * b.x + a.y * b.y + a.w * b.w; }
+
+bool lexLess(const HomVertex& a, const HomVertex& b) {
+  if (a.x != b.x) return a.x < b.x;
+  if (a.y != b.y) return a.y < b.y;
+  return a.w < b.w;
+}
+
+// V_i × V_j computed in a canonical vertex order, so that V_j × V_i is exactly its negation.
+HomVertex canonicalCross(const HomVertex& a, const HomVertex& b) {
+  if (lexLess(b, a)) {
+    HomVertex c = cross(b, a);
+    return {-c.x, -c.y, -c.w};
+  }
+  return cross(a, b);
+}
+
+// The fill rule, owned here alone (STYLE.md habit 8). Raster y grows downward. A pixel centre
+// exactly on an edge belongs to the triangle that lies to the right of the edge (A > 0: a *left*
+// edge) or, for a horizontal edge, below it (A = 0, B > 0: a *top* edge) — the top-left rule.
+// It is antisymmetric: (A, B) and (−A, −B) never both own the centre, and one of them always
+// does, so two triangles sharing an edge neither both draw nor both miss a pixel on it.
+bool ownsBoundary(int64_t a, int64_t b) { return a > 0 || (a == 0 && b > 0); }
+
+// Turns e(x_f, y_f) = a·x_f + b·y_f + c in sub-pixel units (inside ≥ 0) into per-pixel form at
+// pixel centres, with the fill rule folded in: "e ≥ 0" becomes "e > 0" for edges that do not own
+// their boundary, i.e. c − 1 on integers.
+EdgeFunction toPixelEdge(int64_t a, int64_t b, int64_t c) {
+  EdgeFunction e;
+  e.c = a * kHalfPixel + b * kHalfPixel + c - (ownsBoundary(a, b) ? 0 : 1);
+  e.stepX = a * kSubPixelScale;
+  e.stepY = b * kSubPixelScale;
+  return e;
+}
+
+// Rounds a homogeneous edge a·x + b·y + c (x, y in pixels) to integer sub-pixel form. The scale is
+// a power of two chosen from max(|a|, |b|) alone, and rounding is symmetric about zero, so the
+// negated input gives exactly the negated output.
+EdgeFunction roundHomogeneousEdge(const HomVertex& e) {
+  double a = e.x / kSubPixelScale, b = e.y / kSubPixelScale;
+  double m = std::max(std::fabs(a), std::fabs(b));
+  if (m == 0) {
+    // A line at infinity: the sign of c decides for the whole plane.
+    return toPixelEdge(0, 0, e.w > 0 ? 1 : (e.w < 0 ? -1 : 0));
+  }
+  int exponent;
+  std::frexp(m, &exponent);  // m ∈ [2^(exponent−1), 2^exponent)
+  double scale = std::ldexp(1.0, kHomogeneousCoefBits - exponent);
+  double cs = std::clamp(e.w * scale, -kMaxHomogeneousC, kMaxHomogeneousC);
+  return toPixelEdge(std::llround(a * scale), std::llround(b * scale), std::llround(cs));
+}
+
+// Clip-space outcodes: a triangle whose three vertices are all outside the same plane of the view
+// volume cannot show a pixel, whatever the signs of w.
+unsigned outcode(const ClipVertex& v) {
+  unsigned code = 0;
+  if (v.x < -v.w) code |= 1;
+  if (v.x > v.w) code |= 2;
+  if (v.y < -v.w) code |= 4;
+  if (v.y > v.w) code |= 8;
+  if (v.z < -v.w) code |= 16;
+  if (v.z > v.w) code |= 32;
+  return code;
+}
+
+int64_t floorDiv(int64_t a, int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
+
+Plane makePlane(const HomVertex adj[3], double invDet, const double f[3], double px, double py) {
+  double a = (f[0] * adj[0].x + f[1] * adj[1].x + f[2] * adj[2].x) * invDet;
+  double b = (f[0] * adj[0].y + f[1] * adj[1].y + f[2] * adj[2].y) * invDet;
+  double c = (f[0] * adj[0].w + f[1] * adj[1].w + f[2] * adj[2].w) * invDet;
+  return {static_cast<float>(a * px + b * py + c), static_cast<float>(a), static_cast<float>(b)};
+}
+
+}  // namespace
+
+SetupOutcome setupTriangle(const ClipVertex& v0, const ClipVertex& v1, const ClipVertex& v2,
+                           const Viewport& viewport, CullMode cull, TriangleSetup& out) {
+  const ClipVertex* v[3] = {&v0, &v1, &v2};
+
+  // Step 1: reject non-finite input before any arithmetic (RASTER-NOTES pitfall 8).
+  for (const ClipVertex* p : v)
+    if (!std::isfinite(p->x) || !std::isfinite(p->y) || !std::isfinite(p->z) ||
+        !std::isfinite(p->w))
+      return SetupOutcome::culledInvalid;
+
+  // Step 2: trivial reject against the view volume.
+  if ((outcode(v0) & outcode(v1) & outcode(v2)) != 0) return SetupOutcome::culledOutside;
+  // No point of the triangle is in front of the eye (w > 0) when no vertex is.
+  if (v0.w <= 0 && v1.w <= 0 && v2.w <= 0) return SetupOutcome::culledOutside;
+
+  // Step 3: homogeneous pixel coordinates; snap those in front of the eye and inside the guard band.
+  const double halfW = 0.5 * viewport.width, halfH = 0.5 * viewport.height;
+  HomVertex hv[3];
+  int64_t sx[3], sy[3];
+  bool snapped[3];
+  bool allSnapped = true, needNear = false, needFar = false;
+  for (int k = 0; k < 3; ++k) {
+    const ClipVertex& c = *v[k];
+    hv[k] = {(double(c.x) + c.w) * halfW, (double(c.w) - c.y) * halfH, double(c.w)};
+    needNear |= c.z < -c.w;
+    needFar |= c.z > c.w;
+    snapped[k] = false;
+    if (c.w > 0) {
+      double px = hv[k].x / hv[k].w, py = hv[k].y / hv[k].w;
+      if (std::fabs(px) < kGuardBand && std::fabs(py) < kGuardBand) {
+        sx[k] = std::llrint(px * kSubPixelScale);  // 24.8
+        sy[k] = std::llrint(py * kSubPixelScale);
+        snapped[k] = true;
+        // The planes use the snapped position, so attributes agree with the edges.
+        hv[k].x = double(sx[k]) / kSubPixelScale * hv[k].w;
+        hv[k].y = double(sy[k]) / kSubPixelScale * hv[k].w;
+      }
+    }
+    allSnapped &= snapped[k];
+  }
+
+  // Step 4: adjugate rows (unnormalized edge functions) and the determinant. det's sign is the
+  // triangle's facing: det = w0·w1·w2·(twice the signed raster area) when all w > 0.
+  HomVertex adj[3];
+  for (int k = 0; k < 3; ++k) adj[k] = canonicalCross(hv[(k + 1) % 3], hv[(k + 2) % 3]);
+  double det = dot(hv[0], adj[0]);
+  int64_t intEdge[3][3];
+  for (int k = 0; k < 3; ++k) {
+    int i = (k + 1) % 3, j = (k + 2) % 3;
+    if (snapped[i] && snapped[j]) {
+      intEdge[k][0] = sy[i] - sy[j];
+      intEdge[k][1] = sx[j] - sx[i];
+      intEdge[k][2] = sx[i] * sy[j] - sx[j] * sy[i];
+    }
+  }
+  int orientation;  // sign of det
+  if (allSnapped) {
+    // Exact: twice the signed area of the snapped triangle, in (1/256 px)².
+    int64_t area2 = intEdge[0][0] * sx[0] + intEdge[0][1] * sy[0] + intEdge[0][2];
+    orientation = (area2 > 0) - (area2 < 0);
+  } else {
+    orientation = (det > 0) - (det < 0);
+  }
+  if (orientation == 0 || det == 0 || !std::isfinite(det)) return SetupOutcome::culledDegenerate;
+
+  // Step 5: facing. Counter-clockwise in NDC (y up) is clockwise on the raster (y down): det < 0.
+  bool front = orientation < 0;
+  if ((cull == CullMode::back && !front) || (cull == CullMode::front && front))
+    return SetupOutcome::culledFacing;
+
+  // Step 6: bounding box of pixel centres. Only snapped triangles have a trustworthy one: with a
+  // vertex behind the eye the projected corners do not bound the triangle (pitfall 7), so the
+  // subdivision starts from the whole raster, as SPEC §3 does.
+  int64_t minX = 0, minY = 0, maxX = viewport.width - 1, maxY = viewport.height - 1;
+  if (allSnapped) {
+    int64_t x0 = std::min({sx[0], sx[1], sx[2]}), x1 = std::max({sx[0], sx[1], sx[2]});
+    int64_t y0 = std::min({sy[0], sy[1], sy[2]}), y1 = std::max({sy[0], sy[1], sy[2]});
+    // Pixel px's centre is at 256·px + 128.
+    minX = std::max<int64_t>(minX, -floorDiv(kHalfPixel - x0, kSubPixelScale));
+    maxX = std::min<int64_t>(maxX, floorDiv(x1 - kHalfPixel, kSubPixelScale));
+    minY = std::max<int64_t>(minY, -floorDiv(kHalfPixel - y0, kSubPixelScale));
+    maxY = std::min<int64_t>(maxY, floorDiv(y1 - kHalfPixel, kSubPixelScale));
+  }
+  if (minX > maxX || minY > maxY) return SetupOutcome::culledOutside;
+
+  // Step 7: edges, oriented so that inside is ≥ 0.
+  int edgeCount = 0;
+  for (int k = 0; k < 3; ++k) {
+    int i = (k + 1) % 3, j = (k + 2) % 3;
+    if (snapped[i] && snapped[j]) {
+      out.edges[edgeCount++] = toPixelEdge(orientation * intEdge[k][0], orientation * intEdge[k][1],
+                                           orientation * intEdge[k][2]);
+    } else {
+      HomVertex e = {orientation * adj[k].x, orientation * adj[k].y, orientation * adj[k].w};
+      out.edges[edgeCount++] = roundHomogeneousEdge(e);
+    }
+  }
+  // The near (z ≥ −w) and far (z ≤ w) planes as edges (SPEC §2), only when some vertex is beyond.
+  auto planeEdge = [&](double sign) {
+    double f[3];
+    for (int k = 0; k < 3; ++k) f[k] = double(v[k]->w) + sign * v[k]->z;
+    HomVertex e = {0, 0, 0};
+    for (int k = 0; k < 3; ++k) {
+      e.x += f[k] * adj[k].x;
+      e.y += f[k] * adj[k].y;
+      e.w += f[k] * adj[k].w;
+    }
+    out.edges[edgeCount++] =
+        roundHomogeneousEdge({orientation * e.x, orientation * e.y, orientation * e.w});
+  };
+  if (needNear) planeEdge(+1);
+  if (needFar) planeEdge(-1);
+  out.edgeCount = static_cast<uint8_t>(edgeCount);
+
+  // Step 8: parameter planes relative to the bounding box corner, in double, stored as float.
+  out.minX = static_cast<int32_t>(minX);
+  out.minY = static_cast<int32_t>(minY);
+  out.maxX = static_cast<int32_t>(maxX);
+  out.maxY = static_cast<int32_t>(maxY);
+  out.refX = out.minX;
+  out.refY = out.minY;
+  const double invDet = 1.0 / det;
+  const double px = out.refX + 0.5, py = out.refY + 0.5;
+  const double one[3] = {1, 1, 1};
+  double f[3];
+  for (int k = 0; k < 3; ++k) f[k] = 0.5 * (double(v[k]->z) + v[k]->w);  // window depth 0…1
+  out.depth = makePlane(adj, invDet, f, px, py);
+  out.invW = makePlane(adj, invDet, one, px, py);
+  for (int k = 0; k < 3; ++k) f[k] = v[k]->r;
+  out.red = makePlane(adj, invDet, f, px, py);
+  for (int k = 0; k < 3; ++k) f[k] = v[k]->g;
+  out.green = makePlane(adj, invDet, f, px, py);
+  for (int k = 0; k < 3; ++k) f[k] = v[k]->b;
+  out.blue = makePlane(adj, invDet, f, px, py);
+  return SetupOutcome::drawn;
+}
+
+}  // namespace sv::geometry

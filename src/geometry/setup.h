@@ -1,0 +1,85 @@
+// Triangle setup: clip-space vertices → edge functions and rational parameter functions.
+//
+// Based on: SPEC §2 (seeds 000, 004): projective transform without perspective divide;
+// Olano & Greer 1997, "Triangle scan conversion using 2D homogeneous coordinates".
+//
+// The output, TriangleSetup, is the plain draw packet the rasterizer consumes: it knows nothing of
+// scenes, meshes or materials.
+#pragma once
+
+#include <cstdint>
+
+namespace sv::geometry {
+
+// ---- Fixed-point budget (RASTER-NOTES.md pitfall 1) ------------------------------------------
+// Positions are snapped to 1/256 pixel (24.8). Exact integer edges are used for vertices in front
+// of the eye whose projection lies within the guard band |x|, |y| < 2^15 px; the raster itself is at
+// most 8192 × 8192 (2^13). Budget, with F = 8 sub-pixel bits:
+//   snapped coordinate           |x_f| < 2^(15+8)            = 2^23
+//   edge coefficient A = y_i − y_j  |A| < 2^24;  per-pixel step 2^8·A < 2^32
+//   constant C = x_i·y_j − x_j·y_i  |C| < 2^47
+//   value anywhere on the raster |C| + |A|·2^21 + |B|·2^21 < 2^47 + 2^46 < 2^48
+// Homogeneous edges (for vertices behind the eye or outside the guard band) are scaled so that
+// max(|A|, |B|) ≤ 2^23 and |C| is clamped to 2^46 (beyond which the line cannot cross the raster),
+// which keeps them inside the same budget. Everything fits int64_t with 15 bits to spare.
+inline constexpr int kSubPixelBits = 8;
+inline constexpr int kSubPixelScale = 1 << kSubPixelBits;
+inline constexpr int kMaxRasterLog2 = 13;
+inline constexpr int kMaxRasterSize = 1 << kMaxRasterLog2;
+inline constexpr int kGuardBandLog2 = 15;
+inline constexpr int kMaxEdges = 5;  // three sides, the near plane and the far plane
+static_assert(kGuardBandLog2 + kSubPixelBits + 1 + kSubPixelBits + kMaxRasterLog2 + 1 < 62,
+              "edge values must fit int64_t");
+
+// A vertex after the projective transform (SPEC §2): homogeneous clip coordinates (OpenGL
+// convention: visible when −w ≤ x, y, z ≤ w) and the parameters to interpolate.
+struct ClipVertex {
+  float x, y, z, w;
+  float r, g, b, a;  // linear colour
+};
+
+// e(px, py) = c + stepX·px + stepY·py at the centre of pixel (px, py); the pixel is inside the
+// edge's half-plane iff e ≥ 0. The fill rule is already folded into c (see setup.cpp).
+struct EdgeFunction {
+  int64_t c;
+  int64_t stepX;
+  int64_t stepY;
+};
+
+// A parameter as a linear function of the pixel position: value = c0 + dx·(px − refX) +
+// dy·(py − refY) at the centre of pixel (px, py), evaluated in float in exactly this order.
+struct Plane {
+  float c0, dx, dy;
+};
+
+enum class CullMode : uint8_t { none, back, front };
+
+struct Viewport {
+  int width = 0;   // 1 … kMaxRasterSize
+  int height = 0;  // 1 … kMaxRasterSize
+};
+
+struct TriangleSetup {
+  EdgeFunction edges[kMaxEdges];
+  uint8_t edgeCount;
+  int32_t minX, minY, maxX, maxY;  // inclusive pixel bounding box, clipped to the raster
+  int32_t refX, refY;              // origin of the planes (= minX, minY)
+  // Depth in [0, 1] (window z, linear in screen space); 1/w; colour/w (perspective-correct colour
+  // is the ratio colour/w ÷ 1/w, SPEC §2's shared denominator).
+  Plane depth, invW, red, green, blue;
+};
+
+enum class SetupOutcome : uint8_t {
+  drawn,
+  culledFacing,      // back (or front) face
+  culledOutside,     // no pixel centre of the raster can be covered
+  culledDegenerate,  // zero area, or its plane passes through the eye
+  culledInvalid,     // NaN or infinite coordinates
+};
+
+// Sets up one triangle for `viewport`. Returns `drawn` and fills `out`, or a culling reason.
+// Front faces are counter-clockwise in normalized device coordinates (the OpenGL default).
+SetupOutcome setupTriangle(const ClipVertex& v0, const ClipVertex& v1, const ClipVertex& v2,
+                           const Viewport& viewport, CullMode cull, TriangleSetup& out);
+
+}  // namespace sv::geometry

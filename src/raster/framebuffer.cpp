@@ -1,0 +1,25 @@
+#include "raster/framebuffer.h"
+
+namespace sv::raster {
+
+void FrameBuffer::resize(int width, int height) {
+  int tx = (width + kTileSize - 1) >> kTileLog2, ty = (height + kTileSize - 1) >> kTileLog2;
+  if (tx * ty != tilesX_ * tilesY_ || !depth_) {
+    depth_ = hwy::AllocateAligned<float>(size_t(tx) * ty * kTilePixels);
+    color_ = hwy::AllocateAligned<uint16_t>(size_t(tx) * ty * kTilePixels * kColorChannels);
+  }
+  width_ = width;
+  height_ = height;
+  tilesX_ = tx;
+  tilesY_ = ty;
+}
+
+float FrameBuffer::depthAt(int x, int y) const {
+  return depth_[size_t(tileOf(x, y)) * kTilePixels + depthOffset(x, y)];
+}
+
+uint16_t FrameBuffer::colorAt(int x, int y, int channel) const {
+  return color_[size_t(tileOf(x, y)) * kTilePixels * kColorChannels + colorOffset(x, y, channel)];
+}
+
+}  // namespace sv::raster

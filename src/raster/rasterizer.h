@@ -1,0 +1,55 @@
+// Rasterization of set-up triangles into one screen tile by recursive 2×2 subdivision.
+//
+// Based on: SPEC §3.1–§3.3 (seed 000 eqs. 1–9, seed 004 eqs. 8–14), §3.5 (levels unrolled, the four
+// children tested together in SIMD lanes), §4 (Z-buffer).
+#pragma once
+
+#include <cstdint>
+
+#include "geometry/setup.h"
+
+namespace sv::raster {
+
+// Windows are counted by size: 64, 32, 16, 8, 4 pixels, and 1 (pixel centres tested in leaves).
+inline constexpr int kStatLevels = 6;
+
+struct RasterStats {
+  uint64_t windows[kStatLevels] = {};  // windows tested per level (each child of a split counts)
+  uint64_t fullWindows = 0;            // covered windows filled without further subdivision
+  uint64_t partialBlocks = 0;          // 4×4 leaves tested pixel by pixel
+  uint64_t fragments = 0;              // pixels that passed coverage and reached the depth test
+
+  void add(const RasterStats& o) {
+    for (int i = 0; i < kStatLevels; ++i) windows[i] += o.windows[i];
+    fullWindows += o.fullWindows;
+    partialBlocks += o.partialBlocks;
+    fragments += o.fragments;
+  }
+};
+
+// What a covered pixel does.
+enum class ShadeMode : uint8_t {
+  gouraud,   // depth test "less", perspective-correct Gouraud colour (SPEC §4, §8)
+  overdraw,  // no depth test; the red channel counts the triangles covering the pixel
+};
+
+// One tile's work: triangles in submission order, given as lists of indices into `setups`.
+struct TileWork {
+  int tileX = 0, tileY = 0;  // tile coordinates (pixel origin = 64·tileX, 64·tileY)
+  float* depth = nullptr;     // the tile's buffers, laid out as FrameBuffer describes
+  uint16_t* color = nullptr;
+  bool clear = false;  // clear the tile before drawing
+  float clearDepth = 1.0f;
+  uint16_t clearColor[3] = {0, 0, 0};
+  const geometry::TriangleSetup* setups = nullptr;
+  const uint32_t* const* lists = nullptr;  // listCount lists, drawn one after the other
+  const uint32_t* listSizes = nullptr;
+  int listCount = 0;
+  ShadeMode shade = ShadeMode::gouraud;
+};
+
+// Draws the tile's triangles as `work.shade` says. Runs the best SIMD
+// target the CPU has (Highway runtime dispatch, chosen once per call).
+void rasterizeTile(const TileWork& work, RasterStats& stats);
+
+}  // namespace sv::raster

@@ -1,0 +1,54 @@
+// One frame from clip-space packets to a filled frame buffer: setup and binning in parallel chunks,
+// then the tiles in parallel (SPEC §1 stages 3–4, §3.4, §6).
+#pragma once
+
+#include <vector>
+
+#include "core/thread_pool.h"
+#include "geometry/setup.h"
+#include "raster/binner.h"
+#include "raster/framebuffer.h"
+#include "raster/rasterizer.h"
+#include "synthvis/render.h"
+
+namespace sv::render {
+
+// A run of triangles that share a culling mode.
+struct DrawCall {
+  uint32_t firstTriangle = 0;
+  uint32_t triangleCount = 0;
+  geometry::CullMode cull = geometry::CullMode::back;
+};
+
+// The plain input of a frame: vertices after the projective transform and triangles indexing them.
+struct DrawPackets {
+  std::vector<geometry::ClipVertex> vertices;
+  std::vector<uint32_t> indices;  // 3 per triangle, each < vertices.size()
+  std::vector<DrawCall> calls;    // in submission order
+};
+
+struct FrameSettings {
+  int width = 0, height = 0;
+  float clearColor[3] = {0, 0, 0};  // linear
+  raster::ShadeMode shade = raster::ShadeMode::gouraud;
+};
+
+class FrameRenderer {
+ public:
+  explicit FrameRenderer(int threads) : pool_(threads) {}
+
+  // Clears the frame buffer and draws `packets` into it; adds to `stats`.
+  void render(const DrawPackets& packets, const FrameSettings& settings, FrameStats& stats);
+
+  const raster::FrameBuffer& frameBuffer() const { return fb_; }
+  core::ThreadPool& pool() { return pool_; }
+
+ private:
+  core::ThreadPool pool_;
+  raster::FrameBuffer fb_;
+  raster::Binner binner_;
+  std::vector<geometry::TriangleSetup> setups_;
+  std::vector<raster::RasterStats> tileStats_;
+};
+
+}  // namespace sv::render

@@ -1,0 +1,157 @@
+// The one place that wires a frame together (STYLE.md habit 1): scene → vertex stage → setup and
+// binning → tiles → resolve.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fmt/format.h>
+#include <limits>
+#include <thread>
+
+#include "geometry/vertex_stage.h"
+#include "output/resolve.h"
+#include "render/frame_renderer.h"
+#include "synthvis/render.h"
+
+namespace sv {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+int resolveThreads(int requested) {
+  if (requested > 0) return requested;
+  return std::clamp(int(std::thread::hardware_concurrency()), 1, kMaxThreads);
+}
+
+// A camera for scenes that have none: looks at the centre of the scene's bounds from the front
+// and a little above, far enough to see all of it.
+scene::Camera defaultCamera(const scene::Scene& s) {
+  Vec3 lo{std::numeric_limits<float>::max(), std::numeric_limits<float>::max(),
+          std::numeric_limits<float>::max()};
+  Vec3 hi = -lo;
+  bool any = false;
+  for (const auto& inst : s.instances)
+    for (const Vec3& p : s.meshes[inst.mesh].positions) {
+      const Vec3 w = inst.transform.transformPoint(p);
+      if (!std::isfinite(w.x) || !std::isfinite(w.y) || !std::isfinite(w.z)) continue;
+      lo = {std::min(lo.x, w.x), std::min(lo.y, w.y), std::min(lo.z, w.z)};
+      hi = {std::max(hi.x, w.x), std::max(hi.y, w.y), std::max(hi.z, w.z)};
+      any = true;
+    }
+  scene::Camera cam;
+  if (!any) return cam;
+  const Vec3 centre = (lo + hi) * 0.5f;
+  const float radius = std::max(0.5f * length(hi - lo), 1e-3f);
+  const float distance = radius / std::sin(0.5f * cam.yfovDegrees * 3.14159265f / 180.0f);
+  cam.target = centre;
+  cam.position = centre + normalize(Vec3{0, 0.35f, 1}) * distance;
+  cam.znear = std::max(distance - radius, distance * 1e-3f) * 0.5f;
+  cam.zfar = (distance + radius) * 2;
+  return cam;
+}
+
+}  // namespace
+
+Status validate(const RenderOptions& o) {
+  if (o.width < 1 || o.width > kMaxRasterSize || o.height < 1 || o.height > kMaxRasterSize)
+    return Error{"", "", fmt::format("image size {}x{} is out of range (1…{} each)", o.width,
+                                     o.height, kMaxRasterSize)};
+  if (o.threads < 0 || o.threads > kMaxThreads)
+    return Error{"", "", fmt::format("thread count {} is out of range (0…{})", o.threads,
+                                     kMaxThreads)};
+  if (o.camera < 0) return Error{"", "", "camera index must not be negative"};
+  return {};
+}
+
+std::string FrameStats::summary() const {
+  return fmt::format(
+      "triangles in {} / culled {} (facing {}, outside {}, degenerate {}, invalid {}) / drawn {} | "
+      "windows 64:{} 32:{} 16:{} 8:{} 4:{} px-tests:{} full:{} | {:.2f} ms (vertex {:.2f}, setup "
+      "{:.2f}, raster {:.2f}, resolve {:.2f})",
+      trianglesIn, culled(), culledFacing, culledOutside, culledDegenerate, culledInvalid, drawn,
+      windows[0], windows[1], windows[2], windows[3], windows[4], windows[5], fullWindows, totalMs,
+      vertexMs, setupMs, rasterMs, resolveMs);
+}
+
+struct Renderer::Impl {
+  explicit Impl(const RenderOptions& o)
+      : options(o), frame(resolveThreads(o.threads)), gamma(output::GammaTables::srgb()) {}
+  RenderOptions options;
+  render::FrameRenderer frame;
+  output::GammaTables gamma;
+  render::DrawPackets packets;
+};
+
+Renderer::Renderer(const RenderOptions& options) : impl_(std::make_unique<Impl>(options)) {}
+Renderer::~Renderer() = default;
+const RenderOptions& Renderer::options() const { return impl_->options; }
+
+Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* statsOut) {
+  if (Status s = validate(impl_->options); !s) return s;
+  if (Status s = scene::validate(scene, ""); !s) return s;
+  const RenderOptions& o = impl_->options;
+  FrameStats stats;
+  const auto start = Clock::now();
+
+  // Stage 2–3: camera, then every instance's vertices to clip space.
+  scene::Camera cam;
+  if (!scene.cameras.empty()) {
+    if (o.camera >= int(scene.cameras.size()))
+      return Error{"", "", fmt::format("camera {} does not exist (the scene has {})", o.camera,
+                                       scene.cameras.size())};
+    cam = scene.cameras[o.camera];
+  } else {
+    cam = defaultCamera(scene);
+  }
+  const float aspect = float(o.width) / float(o.height);
+  const Mat4 viewProj =
+      Mat4::perspective(cam.yfovDegrees * 3.14159265358979f / 180.0f, aspect, cam.znear, cam.zfar) *
+      Mat4::lookAt(cam.position, cam.target, cam.up);
+
+  auto t0 = Clock::now();
+  render::DrawPackets& p = impl_->packets;
+  p.vertices.clear();
+  p.indices.clear();
+  p.calls.clear();
+  const scene::Material defaultMaterial;
+  for (const auto& inst : scene.instances) {
+    const scene::Mesh& mesh = scene.meshes[inst.mesh];
+    const scene::Material& mat = mesh.material >= 0 ? scene.materials[mesh.material] : defaultMaterial;
+    const uint32_t base = static_cast<uint32_t>(p.vertices.size());
+    geometry::transformVertices(mesh, mat, inst.transform, viewProj, scene.light, p.vertices);
+    render::DrawCall call;
+    call.firstTriangle = static_cast<uint32_t>(p.indices.size() / 3);
+    call.triangleCount = static_cast<uint32_t>(mesh.triangleCount());
+    call.cull = o.cullBackFaces && !mat.doubleSided ? geometry::CullMode::back
+                                                      : geometry::CullMode::none;
+    for (uint32_t i : mesh.indices) p.indices.push_back(base + i);
+    p.calls.push_back(call);
+  }
+  stats.vertexMs = msSince(t0);
+
+  // Stage 3–4: setup, binning, tiles.
+  render::FrameSettings fs;
+  fs.width = o.width;
+  fs.height = o.height;
+  fs.clearColor[0] = scene.background.x;
+  fs.clearColor[1] = scene.background.y;
+  fs.clearColor[2] = scene.background.z;
+  fs.shade = o.debugOverdraw ? raster::ShadeMode::overdraw : raster::ShadeMode::gouraud;
+  impl_->frame.render(p, fs, stats);
+
+  // Stage 5: display.
+  t0 = Clock::now();
+  if (o.debugOverdraw) {
+    output::resolveOverdraw(impl_->frame.frameBuffer(), image, impl_->frame.pool());
+  } else {
+    output::resolve(impl_->frame.frameBuffer(), impl_->gamma, image, impl_->frame.pool());
+  }
+  stats.resolveMs = msSince(t0);
+  stats.totalMs = msSince(start);
+  if (statsOut) *statsOut = stats;
+  return {};
+}
+
+}  // namespace sv

@@ -1,0 +1,182 @@
+// Triangle setup (SPEC §2) against independent evaluations: exact point-in-triangle with the
+// top-left rule, perspective-correct parameters against ray–plane intersection, the near plane.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "support/raster_harness.h"
+#include "synthvis/math.h"
+
+namespace sv {
+namespace {
+
+using geometry::ClipVertex;
+using geometry::TriangleSetup;
+using test::pixelVertex;
+
+bool edgeInside(const TriangleSetup& t, int x, int y) {
+  for (int k = 0; k < t.edgeCount; ++k)
+    if (t.edges[k].c + t.edges[k].stepX * x + t.edges[k].stepY * y < 0) return false;
+  return true;
+}
+
+// Independent inside test on a 1/256 grid: orientation by exact integer cross products; a centre
+// on an edge belongs to the triangle if that edge is a left edge (inside towards +x) or a top edge
+// (horizontal, inside towards +y, y down).
+bool exactInside(const int64_t vx[3], const int64_t vy[3], int px, int py) {
+  const int64_t cx = int64_t(px) * 256 + 128, cy = int64_t(py) * 256 + 128;
+  const __int128 area = __int128(vx[1] - vx[0]) * (vy[2] - vy[0]) - __int128(vy[1] - vy[0]) * (vx[2] - vx[0]);
+  if (area == 0) return false;
+  for (int k = 0; k < 3; ++k) {
+    const int i = (k + 1) % 3, j = (k + 2) % 3;
+    __int128 e = __int128(vx[j] - vx[i]) * (cy - vy[i]) - __int128(vy[j] - vy[i]) * (cx - vx[i]);
+    if (area < 0) e = -e;
+    if (e < 0) return false;
+    if (e == 0) {
+      // Inward normal of edge i→j: perpendicular (−dy, dx) oriented like the area.
+      int64_t nx = -(vy[j] - vy[i]), ny = vx[j] - vx[i];
+      if (area < 0) nx = -nx, ny = -ny;
+      if (!(nx > 0 || (nx == 0 && ny > 0))) return false;
+    }
+  }
+  return true;
+}
+
+TEST(Setup, IntegerEdgesAgreeWithExactPointInTriangleIncludingTies) {
+  std::mt19937 rng(7);
+  const int w = 64, h = 64;
+  // Vertices on a coarse sub-pixel grid (multiples of 1/8 px) so that many centres fall exactly on
+  // edges and ties are exercised.
+  std::uniform_int_distribution<int> coord(-40 * 8, 100 * 8);
+  for (int n = 0; n < 400; ++n) {
+    int64_t vx[3], vy[3];
+    ClipVertex v[3];
+    for (int k = 0; k < 3; ++k) {
+      const int gx = coord(rng), gy = coord(rng);
+      vx[k] = gx * 32;  // 1/8 px in 1/256 units
+      vy[k] = gy * 32;
+      v[k] = pixelVertex(gx / 8.0, gy / 8.0, w, h);
+    }
+    TriangleSetup t;
+    const auto outcome = geometry::setupTriangle(v[0], v[1], v[2], {w, h}, geometry::CullMode::none, t);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const bool expected = exactInside(vx, vy, x, y);
+        const bool got = outcome == geometry::SetupOutcome::drawn && edgeInside(t, x, y) &&
+                         x >= t.minX && x <= t.maxX && y >= t.minY && y <= t.maxY;
+        ASSERT_EQ(got, expected) << "triangle " << n << " pixel " << x << "," << y;
+      }
+  }
+}
+
+TEST(Setup, IncrementalChildValuesEqualDirectEvaluation) {
+  // The kernel carries e at a window's top-left pixel centre and steps it by sX·h, sY·h (seed 000
+  // eq. 1); this must equal evaluating the edge directly at the child's corner.
+  TriangleSetup t;
+  ASSERT_EQ(geometry::setupTriangle(pixelVertex(3.3, 2.1, 256, 256), pixelVertex(250.7, 40.2, 256, 256),
+                                    pixelVertex(30.9, 251.4, 256, 256), {256, 256},
+                                    geometry::CullMode::none, t),
+            geometry::SetupOutcome::drawn);
+  for (int k = 0; k < 3; ++k) {
+    const auto& e = t.edges[k];
+    int64_t tl = e.c;  // window (0,0) of size 256
+    int x = 0, y = 0;
+    for (int h = 128; h >= 1; h /= 2) {  // walk to child (1,0), then (0,1), alternately
+      if ((h & 1) || h % 4 == 0) {
+        tl += e.stepX * h;
+        x += h;
+      } else {
+        tl += e.stepY * h;
+        y += h;
+      }
+      EXPECT_EQ(tl, e.c + e.stepX * x + e.stepY * y);
+    }
+  }
+}
+
+TEST(Setup, FacingFollowsCounterClockwiseFrontFaces) {
+  const int w = 32, h = 32;
+  // Counter-clockwise in NDC (y up) = clockwise on the raster (y down): (0,0) (10,0) (0,10) on the
+  // raster is clockwise there, so counter-clockwise in NDC: a front face.
+  const ClipVertex a = pixelVertex(0, 10, w, h), b = pixelVertex(10, 10, w, h), c = pixelVertex(0, 0, w, h);
+  TriangleSetup t;
+  EXPECT_EQ(geometry::setupTriangle(a, b, c, {w, h}, geometry::CullMode::back, t),
+            geometry::SetupOutcome::drawn);
+  EXPECT_EQ(geometry::setupTriangle(a, c, b, {w, h}, geometry::CullMode::back, t),
+            geometry::SetupOutcome::culledFacing);
+  EXPECT_EQ(geometry::setupTriangle(a, c, b, {w, h}, geometry::CullMode::front, t),
+            geometry::SetupOutcome::drawn);
+}
+
+// A quad tilted in depth, seen in perspective; colour red = the object-space coordinate u ∈ [0,1]
+// across it. The rendered value at a pixel must equal u at the ray–plane intersection.
+TEST(Setup, ColourIsPerspectiveCorrectAgainstRayPlaneIntersection) {
+  const int w = 128, h = 128;
+  const float fov = 1.0f;
+  const Mat4 proj = Mat4::perspective(fov, 1.0f, 0.1f, 50.0f);
+  // Plane through P0 with axes U (u direction) and V; points P0 + u·U + v·V, u, v ∈ [0,1].
+  const Vec3 p0{-2, -1.5f, -2}, U{4, 0, -10}, V{0, 3, 0};
+  auto corner = [&](float u, float v) {
+    const Vec3 p = p0 + U * u + V * v;
+    const Vec4 c = proj * Vec4{p.x, p.y, p.z, 1};
+    return ClipVertex{c.x, c.y, c.z, c.w, u, v, 0, 1};
+  };
+  render::DrawPackets pk;
+  test::addTriangle(pk, corner(0, 0), corner(1, 0), corner(1, 1));
+  test::addTriangle(pk, corner(0, 0), corner(1, 1), corner(0, 1));
+  render::FrameSettings s;
+  s.width = w;
+  s.height = h;
+  const test::Frame f = test::renderQuadtree(pk, s);
+  const Vec3 n = cross(U, V);
+  int checked = 0;
+  double worst = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      // The eye ray through the pixel centre.
+      const double t = std::tan(fov / 2);
+      const double rx = ((x + 0.5) / w * 2 - 1) * t, ry = (1 - (y + 0.5) / h * 2) * t, rz = -1;
+      const double denom = n.x * rx + n.y * ry + n.z * rz;
+      const double s0 = (n.x * p0.x + n.y * p0.y + n.z * p0.z) / denom;
+      const double px = rx * s0 - p0.x, py = ry * s0 - p0.y, pz = rz * s0 - p0.z;
+      // Solve p = u·U + v·V (U and V are orthogonal here).
+      const double u = (px * U.x + py * U.y + pz * U.z) / dot(U, U);
+      const double v = (px * V.x + py * V.y + pz * V.z) / dot(V, V);
+      if (u < 0.01 || u > 0.99 || v < 0.01 || v > 0.99) continue;
+      const double got = f.channel(x, y, 0) / 65535.0;
+      worst = std::max(worst, std::fabs(got - u));
+      ++checked;
+    }
+  EXPECT_GT(checked, 1000);
+  EXPECT_LT(worst, 2e-4);  // 16-bit storage is 1.5e-5; the rest is float interpolation
+}
+
+TEST(Setup, NearPlaneBecomesAnEdgeOnlyWhenAVertexIsInFrontOfIt) {
+  const int w = 64, h = 64;
+  TriangleSetup t;
+  const ClipVertex a = pixelVertex(5, 5, w, h, 0.5f), b = pixelVertex(60, 5, w, h, 0.5f);
+  ASSERT_EQ(geometry::setupTriangle(a, b, pixelVertex(5, 60, w, h, 0.5f), {w, h},
+                                    geometry::CullMode::none, t),
+            geometry::SetupOutcome::drawn);
+  EXPECT_EQ(t.edgeCount, 3);
+  // Third vertex nearer than the near plane (window depth < 0): four edges, and the pixels near
+  // that vertex are cut away.
+  ASSERT_EQ(geometry::setupTriangle(a, b, pixelVertex(5, 60, w, h, -0.5f), {w, h},
+                                    geometry::CullMode::none, t),
+            geometry::SetupOutcome::drawn);
+  EXPECT_EQ(t.edgeCount, 4);
+  EXPECT_TRUE(edgeInside(t, 20, 10));
+  EXPECT_FALSE(edgeInside(t, 6, 55));
+}
+
+TEST(Setup, TriangleEntirelyBehindTheEyeIsCulled) {
+  const ClipVertex a{0, 0, 0.5f, -1, 1, 1, 1, 1}, b{1, 0, 0.5f, -1, 1, 1, 1, 1},
+      c{0, 1, 0.5f, -2, 1, 1, 1, 1};
+  TriangleSetup t;
+  EXPECT_NE(geometry::setupTriangle(a, b, c, {64, 64}, geometry::CullMode::none, t),
+            geometry::SetupOutcome::drawn);
+}
+
+}  // namespace
+}  // namespace sv

@@ -1,0 +1,102 @@
+#include "support/raster_harness.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace sv::test {
+
+geometry::ClipVertex pixelVertex(double x, double y, int width, int height, float z, float w,
+                                 float r, float g, float b) {
+  // Inverse of setup's X = (x_clip + w)·width/2, Y = (w − y_clip)·height/2.
+  const double xc = (2.0 * x / width - 1.0) * w;
+  const double yc = (1.0 - 2.0 * y / height) * w;
+  const double zc = (2.0 * z - 1.0) * w;
+  return {float(xc), float(yc), float(zc), w, r, g, b, 1};
+}
+
+void addTriangle(render::DrawPackets& p, const geometry::ClipVertex& a,
+                 const geometry::ClipVertex& b, const geometry::ClipVertex& c,
+                 geometry::CullMode cull) {
+  const uint32_t base = uint32_t(p.vertices.size());
+  p.vertices.insert(p.vertices.end(), {a, b, c});
+  p.indices.insert(p.indices.end(), {base, base + 1, base + 2});
+  const uint32_t tri = uint32_t(p.indices.size() / 3 - 1);
+  if (!p.calls.empty() && p.calls.back().cull == cull &&
+      p.calls.back().firstTriangle + p.calls.back().triangleCount == tri) {
+    ++p.calls.back().triangleCount;
+  } else {
+    p.calls.push_back({tri, 1, cull});
+  }
+}
+
+Frame renderQuadtree(const render::DrawPackets& p, const render::FrameSettings& s, int threads,
+                     FrameStats* stats) {
+  render::FrameRenderer r(threads);
+  FrameStats local;
+  r.render(p, s, stats ? *stats : local);
+  const raster::FrameBuffer& fb = r.frameBuffer();
+  Frame f{s.width, s.height, {}, {}};
+  f.depth.resize(size_t(s.width) * s.height);
+  f.color.resize(f.depth.size() * 3);
+  for (int y = 0; y < s.height; ++y)
+    for (int x = 0; x < s.width; ++x) {
+      f.depth[size_t(y) * s.width + x] = fb.depthAt(x, y);
+      for (int ch = 0; ch < 3; ++ch) f.color[(size_t(y) * s.width + x) * 3 + ch] = fb.colorAt(x, y, ch);
+    }
+  return f;
+}
+
+namespace {
+float evalPlane(const geometry::Plane& p, float x, float y) { return (p.c0 + p.dx * x) + p.dy * y; }
+}  // namespace
+
+Frame renderReference(const render::DrawPackets& p, const render::FrameSettings& s) {
+  const bool count = s.shade == raster::ShadeMode::overdraw;
+  Frame f{s.width, s.height, {}, {}};
+  f.depth.assign(size_t(s.width) * s.height, 1.0f);
+  f.color.resize(f.depth.size() * 3);
+  for (size_t i = 0; i < f.depth.size(); ++i)
+    for (int ch = 0; ch < 3; ++ch)
+      f.color[i * 3 + ch] =
+          count ? 0 : uint16_t(std::lround(std::clamp(s.clearColor[ch], 0.0f, 1.0f) * 65535.0f));
+  const geometry::Viewport vp{s.width, s.height};
+  size_t callIndex = 0;
+  for (uint32_t tri = 0; tri < p.indices.size() / 3; ++tri) {
+    while (callIndex < p.calls.size() &&
+           tri >= p.calls[callIndex].firstTriangle + p.calls[callIndex].triangleCount)
+      ++callIndex;
+    const geometry::CullMode cull =
+        callIndex < p.calls.size() ? p.calls[callIndex].cull : geometry::CullMode::none;
+    geometry::TriangleSetup t;
+    const uint32_t* idx = &p.indices[size_t(tri) * 3];
+    if (geometry::setupTriangle(p.vertices[idx[0]], p.vertices[idx[1]], p.vertices[idx[2]], vp,
+                                cull, t) != geometry::SetupOutcome::drawn)
+      continue;
+    // Every pixel of the raster, not just the bounding box: the box is part of what is tested.
+    for (int y = 0; y < s.height; ++y)
+      for (int x = 0; x < s.width; ++x) {
+        bool inside = true;
+        for (int k = 0; k < t.edgeCount && inside; ++k)
+          inside = t.edges[k].c + t.edges[k].stepX * x + t.edges[k].stepY * y >= 0;
+        if (!inside) continue;
+        const size_t i = size_t(y) * s.width + x;
+        if (count) {
+          ++f.color[i * 3];
+          continue;
+        }
+        const float fx = float(x - t.refX), fy = float(y - t.refY);
+        const float z = evalPlane(t.depth, fx, fy);
+        if (!(z < f.depth[i])) continue;
+        f.depth[i] = z;
+        const float w = 1.0f / evalPlane(t.invW, fx, fy);
+        const geometry::Plane* planes[3] = {&t.red, &t.green, &t.blue};
+        for (int ch = 0; ch < 3; ++ch) {
+          const float c = std::min(std::max(evalPlane(*planes[ch], fx, fy) * w, 0.0f), 1.0f);
+          f.color[i * 3 + ch] = uint16_t(int32_t(c * 65535.0f + 0.5f));
+        }
+      }
+  }
+  return f;
+}
+
+}  // namespace sv::test

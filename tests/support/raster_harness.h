@@ -1,0 +1,40 @@
+// Test support: triangles placed in pixel coordinates, the renderer under test driven directly
+// with clip-space packets, and an independent brute-force reference rasterizer.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "render/frame_renderer.h"
+
+namespace sv::test {
+
+// A clip-space vertex that lands on raster position (x, y) (pixels, y down) with window depth z,
+// scaled by w (w > 0 leaves the projection unchanged; w < 0 puts the vertex behind the eye).
+geometry::ClipVertex pixelVertex(double x, double y, int width, int height, float z = 0.5f,
+                                 float w = 1.0f, float r = 1, float g = 1, float b = 1);
+
+// Adds a triangle (no culling) to `p`.
+void addTriangle(render::DrawPackets& p, const geometry::ClipVertex& a,
+                 const geometry::ClipVertex& b, const geometry::ClipVertex& c,
+                 geometry::CullMode cull = geometry::CullMode::none);
+
+// What a frame holds, in plain row-major arrays.
+struct Frame {
+  int width = 0, height = 0;
+  std::vector<float> depth;
+  std::vector<uint16_t> color;  // 3 per pixel
+  uint16_t channel(int x, int y, int ch) const { return color[(size_t(y) * width + x) * 3 + ch]; }
+  bool operator==(const Frame&) const = default;
+};
+
+// Renders with the quadtree rasterizer and copies the frame buffer out.
+Frame renderQuadtree(const render::DrawPackets& p, const render::FrameSettings& s, int threads = 1,
+                     FrameStats* stats = nullptr);
+
+// The brute-force reference (RASTER-NOTES "hierarchy = flat"): for every pixel and every triangle
+// in submission order, test the pixel centre against each edge function directly, then the same
+// depth test and colour expressions as the kernel, in scalar code.
+Frame renderReference(const render::DrawPackets& p, const render::FrameSettings& s);
+
+}  // namespace sv::test
