@@ -206,6 +206,12 @@ SetupOutcome setupTriangle(const ClipVertex& v0, const ClipVertex& v1, const Cli
     maxY = std::min<int64_t>(maxY, floorDiv(y1 - kHalfPixel, kSubPixelScale));
   }
   if (minX > maxX || minY > maxY) return SetupOutcome::culledOutside;
+  out.small = false;
+  if (allSnapped && !needNear && !needFar) {
+    const int64_t ex = std::max({sx[0], sx[1], sx[2]}) - std::min({sx[0], sx[1], sx[2]});
+    const int64_t ey = std::max({sy[0], sy[1], sy[2]}) - std::min({sy[0], sy[1], sy[2]});
+    out.small = std::max(ex, ey) <= int64_t(kSmallExtent) * kSubPixelScale;
+  }
 
   // Step 7: edges, oriented so that inside is ≥ 0.
   int edgeCount = 0;

@@ -39,6 +39,10 @@ class FrameBuffer {
 
   float* tileDepth(int tile) { return depth_.get() + size_t(tile) * kTilePixels; }
   uint16_t* tileColor(int tile) { return color_.get() + size_t(tile) * kTilePixels * kColorChannels; }
+  const float* tileDepth(int tile) const { return depth_.get() + size_t(tile) * kTilePixels; }
+  const uint16_t* tileColor(int tile) const {
+    return color_.get() + size_t(tile) * kTilePixels * kColorChannels;
+  }
 
   // Offsets of pixel (x, y) inside its tile's depth and colour arrays.
   static size_t depthOffset(int x, int y);

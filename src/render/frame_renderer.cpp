@@ -9,8 +9,8 @@ namespace {
 // Triangles are processed in batches (bounded memory for the setup records, and bins that stay in
 // cache), each batch set up in fixed-size chunks. Both sizes are constants, not functions of the
 // thread count, so the draw order inside every tile — and so the image — never depends on threads.
-constexpr uint32_t kBatchTriangles = 1u << 16;
-constexpr uint32_t kChunkTriangles = 1u << 11;
+constexpr uint32_t kBatchTriangles = 1u << 14;
+constexpr uint32_t kChunkTriangles = 1u << 10;
 constexpr int kChunksPerBatch = kBatchTriangles / kChunkTriangles;
 
 using Clock = std::chrono::steady_clock;

@@ -1,0 +1,38 @@
+// Seeded, deterministic benchmark scenes exactly as shared BENCH.md defines them.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "synthvis/scene.h"
+
+namespace sv::scene {
+
+enum class SubmitOrder { random, frontToBack, backToFront };
+
+// Parses "random", "f2b", "b2f".
+Result<SubmitOrder> parseSubmitOrder(const std::string& text);
+const char* submitOrderName(SubmitOrder order);
+
+// BENCH.md `tris`: random triangles for raw rasterization and fill.
+struct TrisParams {
+  int count = 10000;
+  double area = 100;  // mean projected area in pixels
+  double depth = 0;   // 0: centroids over the whole screen; else a centred region of area count·area/depth
+  SubmitOrder order = SubmitOrder::random;
+  uint64_t seed = 1;
+  int width = 1920;  // the raster the areas refer to
+  int height = 1080;
+};
+
+// What the generator realized (BENCH.md asks for both).
+struct TrisStats {
+  double meanArea = 0;         // mean projected area of the triangles, pixels
+  double depthComplexity = 0;  // total on-screen area / region area
+};
+
+// One camera (60° vertical field of view, looking down −Z, near 0.1), one unlit double-sided mesh
+// of unshared vertices with random colours; triangles in the requested order.
+Scene generateTris(const TrisParams& params, TrisStats* stats = nullptr);
+
+}  // namespace sv::scene
