@@ -57,7 +57,12 @@ struct Mat4 {
   static Mat4 fromColumnMajor(const float* v);
 
   friend Mat4 operator*(const Mat4& a, const Mat4& b);
-  Vec4 operator*(Vec4 v) const;
+  Vec4 operator*(Vec4 v) const {
+    return {m[0][0] * v.x + m[1][0] * v.y + m[2][0] * v.z + m[3][0] * v.w,
+            m[0][1] * v.x + m[1][1] * v.y + m[2][1] * v.z + m[3][1] * v.w,
+            m[0][2] * v.x + m[1][2] * v.y + m[2][2] * v.z + m[3][2] * v.w,
+            m[0][3] * v.x + m[1][3] * v.y + m[2][3] * v.z + m[3][3] * v.w};
+  }
   Vec3 transformPoint(Vec3 p) const;     // w = 1, no divide
   Vec3 transformDirection(Vec3 d) const;  // w = 0
   // The inverse transpose of the upper 3×3, for normals. Returns identity when singular.

@@ -69,13 +69,6 @@ Mat4 operator*(const Mat4& a, const Mat4& b) {
   return r;
 }
 
-Vec4 Mat4::operator*(Vec4 v) const {
-  return {m[0][0] * v.x + m[1][0] * v.y + m[2][0] * v.z + m[3][0] * v.w,
-          m[0][1] * v.x + m[1][1] * v.y + m[2][1] * v.z + m[3][1] * v.w,
-          m[0][2] * v.x + m[1][2] * v.y + m[2][2] * v.z + m[3][2] * v.w,
-          m[0][3] * v.x + m[1][3] * v.y + m[2][3] * v.z + m[3][3] * v.w};
-}
-
 Vec3 Mat4::transformPoint(Vec3 p) const {
   Vec4 r = (*this) * Vec4{p.x, p.y, p.z, 1};
   return {r.x, r.y, r.z};

@@ -76,8 +76,8 @@ bool ownsBoundary(int64_t a, int64_t b) { return a > 0 || (a == 0 && b > 0); }
 EdgeFunction toPixelEdge(int64_t a, int64_t b, int64_t c) {
   EdgeFunction e;
   e.c = a * kHalfPixel + b * kHalfPixel + c - (ownsBoundary(a, b) ? 0 : 1);
-  e.stepX = a * kSubPixelScale;
-  e.stepY = b * kSubPixelScale;
+  e.a = static_cast<int32_t>(a);
+  e.b = static_cast<int32_t>(b);
   return e;
 }
 
@@ -113,23 +113,49 @@ unsigned outcode(const ClipVertex& v) {
 
 int64_t floorDiv(int64_t a, int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
 
-Plane makePlane(const HomVertex adj[3], double invDet, const double f[3], double px, double py) {
-  double a = (f[0] * adj[0].x + f[1] * adj[1].x + f[2] * adj[2].x) * invDet;
-  double b = (f[0] * adj[0].y + f[1] * adj[1].y + f[2] * adj[2].y) * invDet;
-  double c = (f[0] * adj[0].w + f[1] * adj[1].w + f[2] * adj[2].w) * invDet;
+// The plane of a parameter with per-vertex values f_k, given the three edge functions
+// g_k(p) = gx_k·x + gy_k·y + gc_k (x, y in pixels) with λ_k = g_k(p)·scale; evaluated relative to
+// the centre of pixel (px0, py0) − 0.5.
+Plane makePlane(const double g[3][3], const double f[3], double scale, double px, double py) {
+  const double a = (f[0] * g[0][0] + f[1] * g[1][0] + f[2] * g[2][0]) * scale;
+  const double b = (f[0] * g[0][1] + f[1] * g[1][1] + f[2] * g[2][1]) * scale;
+  const double c = (f[0] * g[0][2] + f[1] * g[1][2] + f[2] * g[2][2]) * scale;
   return {static_cast<float>(a * px + b * py + c), static_cast<float>(a), static_cast<float>(b)};
 }
 
 }  // namespace
 
+ScreenVertex snapVertex(const ClipVertex& c, const Viewport& viewport) {
+  ScreenVertex s;
+  if (!(c.w > 0) || !std::isfinite(c.x) || !std::isfinite(c.y) || !std::isfinite(c.w)) return s;
+  const double invW = 1.0 / c.w;
+  const double px = (double(c.x) + c.w) * (0.5 * viewport.width) * invW;
+  const double py = (double(c.w) - c.y) * (0.5 * viewport.height) * invW;
+  if (std::fabs(px) < kGuardBand && std::fabs(py) < kGuardBand) {
+    s.x = static_cast<int32_t>(std::lrint(px * kSubPixelScale));  // 24.8
+    s.y = static_cast<int32_t>(std::lrint(py * kSubPixelScale));
+    s.snapped = true;
+  }
+  return s;
+}
+
 SetupOutcome setupTriangle(const ClipVertex& v0, const ClipVertex& v1, const ClipVertex& v2,
                            const Viewport& viewport, CullMode cull, TriangleSetup& out) {
+  const ScreenVertex s0 = snapVertex(v0, viewport), s1 = snapVertex(v1, viewport),
+                     s2 = snapVertex(v2, viewport);
   const ClipVertex* v[3] = {&v0, &v1, &v2};
+  const ScreenVertex* s[3] = {&s0, &s1, &s2};
+  return setupTriangle(v, s, viewport, cull, out);
+}
+
+SetupOutcome setupTriangle(const ClipVertex* const v[3], const ScreenVertex* const sv[3],
+                           const Viewport& viewport, CullMode cull, TriangleSetup& out) {
+  const ClipVertex &v0 = *v[0], &v1 = *v[1], &v2 = *v[2];
 
   // Step 1: reject non-finite input before any arithmetic (RASTER-NOTES pitfall 8).
-  for (const ClipVertex* p : v)
-    if (!std::isfinite(p->x) || !std::isfinite(p->y) || !std::isfinite(p->z) ||
-        !std::isfinite(p->w))
+  for (int k = 0; k < 3; ++k)
+    if (!std::isfinite(v[k]->x) || !std::isfinite(v[k]->y) || !std::isfinite(v[k]->z) ||
+        !std::isfinite(v[k]->w))
       return SetupOutcome::culledInvalid;
 
   // Step 2: trivial reject against the view volume.
@@ -137,58 +163,52 @@ SetupOutcome setupTriangle(const ClipVertex& v0, const ClipVertex& v1, const Cli
   // No point of the triangle is in front of the eye (w > 0) when no vertex is.
   if (v0.w <= 0 && v1.w <= 0 && v2.w <= 0) return SetupOutcome::culledOutside;
 
-  // Step 3: homogeneous pixel coordinates; snap those in front of the eye and inside the guard band.
-  const double halfW = 0.5 * viewport.width, halfH = 0.5 * viewport.height;
-  HomVertex hv[3];
-  int64_t sx[3], sy[3];
-  bool snapped[3];
-  bool allSnapped = true, needNear = false, needFar = false;
+  const bool allSnapped = sv[0]->snapped && sv[1]->snapped && sv[2]->snapped;
+  bool needNear = false, needFar = false;
   for (int k = 0; k < 3; ++k) {
-    const ClipVertex& c = *v[k];
-    hv[k] = {(double(c.x) + c.w) * halfW, (double(c.w) - c.y) * halfH, double(c.w)};
-    needNear |= c.z < -c.w;
-    needFar |= c.z > c.w;
-    snapped[k] = false;
-    if (c.w > 0) {
-      double px = hv[k].x / hv[k].w, py = hv[k].y / hv[k].w;
-      if (std::fabs(px) < kGuardBand && std::fabs(py) < kGuardBand) {
-        sx[k] = std::llrint(px * kSubPixelScale);  // 24.8
-        sy[k] = std::llrint(py * kSubPixelScale);
-        snapped[k] = true;
-        // The planes use the snapped position, so attributes agree with the edges.
-        hv[k].x = double(sx[k]) / kSubPixelScale * hv[k].w;
-        hv[k].y = double(sy[k]) / kSubPixelScale * hv[k].w;
-      }
-    }
-    allSnapped &= snapped[k];
+    needNear |= v[k]->z < -v[k]->w;
+    needFar |= v[k]->z > v[k]->w;
+  }
+  int64_t sx[3], sy[3];
+  for (int k = 0; k < 3; ++k) {
+    sx[k] = sv[k]->x;
+    sy[k] = sv[k]->y;
   }
 
-  // Step 4: adjugate rows (unnormalized edge functions) and the determinant. det's sign is the
-  // triangle's facing: det = w0·w1·w2·(twice the signed raster area) when all w > 0.
-  HomVertex adj[3];
-  for (int k = 0; k < 3; ++k) adj[k] = canonicalCross(hv[(k + 1) % 3], hv[(k + 2) % 3]);
-  double det = dot(hv[0], adj[0]);
-  int64_t intEdge[3][3];
+  // Step 3: integer edges where both vertices are snapped: A = y_i − y_j, B = x_j − x_i,
+  // C = x_i·y_j − x_j·y_i in 24.8 (exact; budget in setup.h).
+  int64_t intEdge[3][3] = {};
   for (int k = 0; k < 3; ++k) {
-    int i = (k + 1) % 3, j = (k + 2) % 3;
-    if (snapped[i] && snapped[j]) {
+    const int i = (k + 1) % 3, j = (k + 2) % 3;
+    if (sv[i]->snapped && sv[j]->snapped) {
       intEdge[k][0] = sy[i] - sy[j];
       intEdge[k][1] = sx[j] - sx[i];
       intEdge[k][2] = sx[i] * sy[j] - sx[j] * sy[i];
     }
   }
-  int orientation;  // sign of det
+
+  // Step 4: orientation (the sign of det, which is the facing) and, for triangles with a vertex
+  // behind the eye or outside the guard band, the homogeneous adjugate rows.
+  int orientation;
+  int64_t area2 = 0;  // twice the signed snapped area, (1/256 px)²
+  HomVertex hv[3], adj[3];
+  double det = 0;
   if (allSnapped) {
-    // Exact: twice the signed area of the snapped triangle, in (1/256 px)².
-    int64_t area2 = intEdge[0][0] * sx[0] + intEdge[0][1] * sy[0] + intEdge[0][2];
+    area2 = intEdge[0][0] * sx[0] + intEdge[0][1] * sy[0] + intEdge[0][2];
     orientation = (area2 > 0) - (area2 < 0);
   } else {
-    orientation = (det > 0) - (det < 0);
+    const double halfW = 0.5 * viewport.width, halfH = 0.5 * viewport.height;
+    for (int k = 0; k < 3; ++k)
+      hv[k] = {(double(v[k]->x) + v[k]->w) * halfW, (double(v[k]->w) - v[k]->y) * halfH,
+               double(v[k]->w)};
+    for (int k = 0; k < 3; ++k) adj[k] = canonicalCross(hv[(k + 1) % 3], hv[(k + 2) % 3]);
+    det = dot(hv[0], adj[0]);
+    orientation = std::isfinite(det) ? (det > 0) - (det < 0) : 0;
   }
-  if (orientation == 0 || det == 0 || !std::isfinite(det)) return SetupOutcome::culledDegenerate;
+  if (orientation == 0) return SetupOutcome::culledDegenerate;
 
   // Step 5: facing. Counter-clockwise in NDC (y up) is clockwise on the raster (y down): det < 0.
-  bool front = orientation < 0;
+  const bool front = orientation < 0;
   if ((cull == CullMode::back && !front) || (cull == CullMode::front && front))
     return SetupOutcome::culledFacing;
 
@@ -196,72 +216,88 @@ SetupOutcome setupTriangle(const ClipVertex& v0, const ClipVertex& v1, const Cli
   // vertex behind the eye the projected corners do not bound the triangle (pitfall 7), so the
   // subdivision starts from the whole raster, as SPEC §3 does.
   int64_t minX = 0, minY = 0, maxX = viewport.width - 1, maxY = viewport.height - 1;
+  out.small = false;
   if (allSnapped) {
-    int64_t x0 = std::min({sx[0], sx[1], sx[2]}), x1 = std::max({sx[0], sx[1], sx[2]});
-    int64_t y0 = std::min({sy[0], sy[1], sy[2]}), y1 = std::max({sy[0], sy[1], sy[2]});
+    const int64_t x0 = std::min({sx[0], sx[1], sx[2]}), x1 = std::max({sx[0], sx[1], sx[2]});
+    const int64_t y0 = std::min({sy[0], sy[1], sy[2]}), y1 = std::max({sy[0], sy[1], sy[2]});
     // Pixel px's centre is at 256·px + 128.
     minX = std::max<int64_t>(minX, -floorDiv(kHalfPixel - x0, kSubPixelScale));
     maxX = std::min<int64_t>(maxX, floorDiv(x1 - kHalfPixel, kSubPixelScale));
     minY = std::max<int64_t>(minY, -floorDiv(kHalfPixel - y0, kSubPixelScale));
     maxY = std::min<int64_t>(maxY, floorDiv(y1 - kHalfPixel, kSubPixelScale));
+    out.small = !needNear && !needFar &&
+                std::max(x1 - x0, y1 - y0) <= int64_t(kSmallExtent) * kSubPixelScale;
   }
   if (minX > maxX || minY > maxY) return SetupOutcome::culledOutside;
-  out.small = false;
-  if (allSnapped && !needNear && !needFar) {
-    const int64_t ex = std::max({sx[0], sx[1], sx[2]}) - std::min({sx[0], sx[1], sx[2]});
-    const int64_t ey = std::max({sy[0], sy[1], sy[2]}) - std::min({sy[0], sy[1], sy[2]});
-    out.small = std::max(ex, ey) <= int64_t(kSmallExtent) * kSubPixelScale;
-  }
 
   // Step 7: edges, oriented so that inside is ≥ 0.
   int edgeCount = 0;
   for (int k = 0; k < 3; ++k) {
-    int i = (k + 1) % 3, j = (k + 2) % 3;
-    if (snapped[i] && snapped[j]) {
+    const int i = (k + 1) % 3, j = (k + 2) % 3;
+    if (sv[i]->snapped && sv[j]->snapped) {
       out.edges[edgeCount++] = toPixelEdge(orientation * intEdge[k][0], orientation * intEdge[k][1],
                                            orientation * intEdge[k][2]);
     } else {
-      HomVertex e = {orientation * adj[k].x, orientation * adj[k].y, orientation * adj[k].w};
-      out.edges[edgeCount++] = roundHomogeneousEdge(e);
+      out.edges[edgeCount++] = roundHomogeneousEdge(
+          {orientation * adj[k].x, orientation * adj[k].y, orientation * adj[k].w});
     }
   }
-  // The near (z ≥ −w) and far (z ≤ w) planes as edges (SPEC §2), only when some vertex is beyond.
+  // Step 8: parameter planes, λ_k = g_k(p)·scale. Snapped triangles use the integer edges:
+  // adj_k = w_i·w_j·(edge k), det = w0·w1·w2·area2, so λ_k = edge_k(p) / (w_k·area2) — the
+  // screen-space form of the same functions, cheaper and consistent with the coverage test.
+  double g[3][3];
+  double scale;
+  double invW[3];
+  if (allSnapped) {
+    for (int k = 0; k < 3; ++k) {
+      // edge in pixel units: A·256·x + B·256·y + C  (x_f = 256·x)
+      g[k][0] = double(intEdge[k][0]) * kSubPixelScale;
+      g[k][1] = double(intEdge[k][1]) * kSubPixelScale;
+      g[k][2] = double(intEdge[k][2]);
+      invW[k] = 1.0 / v[k]->w;
+    }
+    scale = 1.0 / double(area2);
+  } else {
+    for (int k = 0; k < 3; ++k) {
+      g[k][0] = adj[k].x;
+      g[k][1] = adj[k].y;
+      g[k][2] = adj[k].w;
+      invW[k] = 1.0;
+    }
+    scale = 1.0 / det;
+  }
+  // The near (z ≥ −w) and far (z ≤ w) planes as edges (SPEC §2), only when some vertex is beyond:
+  // Σ λ_k (w_k ± z_k) ≥ 0.
   auto planeEdge = [&](double sign) {
-    double f[3];
-    for (int k = 0; k < 3; ++k) f[k] = double(v[k]->w) + sign * v[k]->z;
     HomVertex e = {0, 0, 0};
     for (int k = 0; k < 3; ++k) {
-      e.x += f[k] * adj[k].x;
-      e.y += f[k] * adj[k].y;
-      e.w += f[k] * adj[k].w;
+      const double f = (double(v[k]->w) + sign * v[k]->z) * invW[k];
+      e.x += f * g[k][0];
+      e.y += f * g[k][1];
+      e.w += f * g[k][2];
     }
-    out.edges[edgeCount++] =
-        roundHomogeneousEdge({orientation * e.x, orientation * e.y, orientation * e.w});
+    const double o = scale > 0 ? 1 : -1;  // orient so that inside is ≥ 0
+    out.edges[edgeCount++] = roundHomogeneousEdge({o * e.x, o * e.y, o * e.w});
   };
   if (needNear) planeEdge(+1);
   if (needFar) planeEdge(-1);
   out.edgeCount = static_cast<uint8_t>(edgeCount);
 
-  // Step 8: parameter planes relative to the bounding box corner, in double, stored as float.
-  out.minX = static_cast<int32_t>(minX);
-  out.minY = static_cast<int32_t>(minY);
-  out.maxX = static_cast<int32_t>(maxX);
-  out.maxY = static_cast<int32_t>(maxY);
-  out.refX = out.minX;
-  out.refY = out.minY;
-  const double invDet = 1.0 / det;
-  const double px = out.refX + 0.5, py = out.refY + 0.5;
-  const double one[3] = {1, 1, 1};
+  out.minX = static_cast<int16_t>(minX);
+  out.minY = static_cast<int16_t>(minY);
+  out.maxX = static_cast<int16_t>(maxX);
+  out.maxY = static_cast<int16_t>(maxY);
+  const double px = double(minX) + 0.5, py = double(minY) + 0.5;
   double f[3];
-  for (int k = 0; k < 3; ++k) f[k] = 0.5 * (double(v[k]->z) + v[k]->w);  // window depth 0…1
-  out.depth = makePlane(adj, invDet, f, px, py);
-  out.invW = makePlane(adj, invDet, one, px, py);
-  for (int k = 0; k < 3; ++k) f[k] = v[k]->r;
-  out.red = makePlane(adj, invDet, f, px, py);
-  for (int k = 0; k < 3; ++k) f[k] = v[k]->g;
-  out.green = makePlane(adj, invDet, f, px, py);
-  for (int k = 0; k < 3; ++k) f[k] = v[k]->b;
-  out.blue = makePlane(adj, invDet, f, px, py);
+  for (int k = 0; k < 3; ++k) f[k] = 0.5 * (double(v[k]->z) + v[k]->w) * invW[k];  // depth 0…1
+  out.depth = makePlane(g, f, scale, px, py);
+  out.invW = makePlane(g, invW, scale, px, py);
+  for (int k = 0; k < 3; ++k) f[k] = v[k]->r * invW[k];
+  out.red = makePlane(g, f, scale, px, py);
+  for (int k = 0; k < 3; ++k) f[k] = v[k]->g * invW[k];
+  out.green = makePlane(g, f, scale, px, py);
+  for (int k = 0; k < 3; ++k) f[k] = v[k]->b * invW[k];
+  out.blue = makePlane(g, f, scale, px, py);
   return SetupOutcome::drawn;
 }
 

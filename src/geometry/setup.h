@@ -42,11 +42,13 @@ struct ClipVertex {
 };
 
 // e(px, py) = c + stepX·px + stepY·py at the centre of pixel (px, py); the pixel is inside the
-// edge's half-plane iff e ≥ 0. The fill rule is already folded into c (see setup.cpp).
+// edge's half-plane iff e ≥ 0. The fill rule is already folded into c (see setup.cpp). The steps
+// are 256·a and 256·b, with a, b the coefficients per sub-pixel unit (|a|, |b| < 2^24).
 struct EdgeFunction {
   int64_t c;
-  int64_t stepX;
-  int64_t stepY;
+  int32_t a, b;
+  int64_t stepX() const { return int64_t(a) * kSubPixelScale; }
+  int64_t stepY() const { return int64_t(b) * kSubPixelScale; }
 };
 
 // A parameter as a linear function of the pixel position: value = c0 + dx·(px − refX) +
@@ -62,18 +64,29 @@ struct Viewport {
   int height = 0;  // 1 … kMaxRasterSize
 };
 
+// 144 bytes: the record the tiles read for every triangle, so kept small (cache misses on it are
+// a large part of the cost of small triangles).
 struct TriangleSetup {
   EdgeFunction edges[kMaxEdges];
+  // Depth in [0, 1] (window z, linear in screen space); 1/w; colour/w (perspective-correct colour
+  // is the ratio colour/w ÷ 1/w, SPEC §2's shared denominator). Origin: pixel (minX, minY).
+  Plane depth, invW, red, green, blue;
+  int16_t minX, minY, maxX, maxY;  // inclusive pixel bounding box, clipped to the raster
   uint8_t edgeCount;
   // True when the triangle is small (three integer edges, bounding box ≤ kSmallExtent pixels):
   // then |e| < 2^29 within 96 px of its vertices, and the rasterizer may step in int32.
   bool small;
-  int32_t minX, minY, maxX, maxY;  // inclusive pixel bounding box, clipped to the raster
-  int32_t refX, refY;              // origin of the planes (= minX, minY)
-  // Depth in [0, 1] (window z, linear in screen space); 1/w; colour/w (perspective-correct colour
-  // is the ratio colour/w ÷ 1/w, SPEC §2's shared denominator).
-  Plane depth, invW, red, green, blue;
 };
+
+// The per-vertex part of setup, done once per vertex: the position on the raster snapped to
+// 24.8 fixed point, valid (`snapped`) when the vertex is in front of the eye (w > 0) and inside
+// the guard band. Shared vertices are thus snapped identically for all their triangles.
+struct ScreenVertex {
+  int32_t x = 0, y = 0;  // 24.8
+  bool snapped = false;
+};
+
+ScreenVertex snapVertex(const ClipVertex& v, const Viewport& viewport);
 
 enum class SetupOutcome : uint8_t {
   drawn,
@@ -86,6 +99,9 @@ enum class SetupOutcome : uint8_t {
 // Sets up one triangle for `viewport`. Returns `drawn` and fills `out`, or a culling reason.
 // Front faces are counter-clockwise in normalized device coordinates (the OpenGL default).
 SetupOutcome setupTriangle(const ClipVertex& v0, const ClipVertex& v1, const ClipVertex& v2,
+                           const Viewport& viewport, CullMode cull, TriangleSetup& out);
+// The same, with the vertices' ScreenVertex already computed by snapVertex.
+SetupOutcome setupTriangle(const ClipVertex* const v[3], const ScreenVertex* const s[3],
                            const Viewport& viewport, CullMode cull, TriangleSetup& out);
 
 }  // namespace sv::geometry

@@ -6,15 +6,14 @@
 namespace sv::geometry {
 
 void transformVertices(const scene::Mesh& mesh, const scene::Material& material, const Mat4& model,
-                       const Mat4& viewProj, const scene::Light& light,
-                       std::vector<ClipVertex>& out) {
+                       const Mat4& viewProj, const scene::Light& light, size_t begin, size_t end,
+                       ClipVertex* out) {
   const Mat4 mvp = viewProj * model;
   const Mat4 normalToWorld = model.normalMatrix();
   const bool lit = light.enabled && !material.unlit && !mesh.normals.empty();
   const Vec3 toLight = normalize(-light.direction);
   const Vec4 base = material.baseColor;
-  out.reserve(out.size() + mesh.positions.size());
-  for (size_t i = 0; i < mesh.positions.size(); ++i) {
+  for (size_t i = begin; i < end; ++i) {
     const Vec3 p = mesh.positions[i];
     const Vec4 c = mvp * Vec4{p.x, p.y, p.z, 1};
     Vec4 color = base;
@@ -29,9 +28,9 @@ void transformVertices(const scene::Mesh& mesh, const scene::Material& material,
       intensity = Vec3{light.ambient, light.ambient, light.ambient} +
                   light.color * ((1 - light.ambient) * diffuse);
     }
-    out.push_back({c.x, c.y, c.z, c.w, std::clamp(color.x * intensity.x, 0.0f, 1.0f),
-                   std::clamp(color.y * intensity.y, 0.0f, 1.0f),
-                   std::clamp(color.z * intensity.z, 0.0f, 1.0f), std::clamp(color.w, 0.0f, 1.0f)});
+    *out++ = {c.x, c.y, c.z, c.w, std::clamp(color.x * intensity.x, 0.0f, 1.0f),
+              std::clamp(color.y * intensity.y, 0.0f, 1.0f),
+              std::clamp(color.z * intensity.z, 0.0f, 1.0f), std::clamp(color.w, 0.0f, 1.0f)};
   }
 }
 

@@ -75,7 +75,7 @@ HWY_INLINE void shadeBlock(const TriangleSetup& t, uint32_t mask, int gx, int gy
   const hn::Rebind<uint16_t, decltype(df)> du;
   const size_t n = hn::Lanes(df);
   const auto maskVec = hn::Set(di, static_cast<int32_t>(mask));
-  const auto dx0 = hn::Set(di, gx - t.refX), dy0 = hn::Set(di, gy - t.refY);
+  const auto dx0 = hn::Set(di, gx - t.minX), dy0 = hn::Set(di, gy - t.minY);
   const auto zero = hn::Zero(df), one = hn::Set(df, 1.0f);
   const auto scale = hn::Set(df, 65535.0f), half = hn::Set(df, 0.5f);
   for (size_t i = 0; i < size_t(kBlockPixels); i += n) {
@@ -112,8 +112,8 @@ class TriangleRaster {
   TriangleRaster(const TriangleSetup& t, const TileContext& ctx) : t_(t), ctx_(ctx) {
     for (int k = 0; k < E; ++k) {
       const auto& e = t.edges[k];
-      sX_[k] = T(e.stepX);
-      sY_[k] = T(e.stepY);
+      sX_[k] = T(e.stepX());
+      sY_[k] = T(e.stepY());
       pos_[k] = std::max<T>(sX_[k], 0) + std::max<T>(sY_[k], 0);
       neg_[k] = std::min<T>(sX_[k], 0) + std::min<T>(sY_[k], 0);
       // e at the 16 pixel centres of a block, relative to its top-left one.
@@ -152,7 +152,7 @@ class TriangleRaster {
     unsigned active = 0;
     for (int k = 0; k < E; ++k) {
       const auto& e = t_.edges[k];
-      tl[k] = T(e.c + e.stepX * (ctx_.originX + lx) + e.stepY * (ctx_.originY + ly));
+      tl[k] = T(e.c + e.stepX() * (ctx_.originX + lx) + e.stepY() * (ctx_.originY + ly));
       if (tl[k] + pos_[k] * T(n - 1) < 0) return;             // d < 0: outside
       if (tl[k] + neg_[k] * T(n - 1) < 0) active |= 1u << k;  // d < 2ε: the edge crosses
     }

@@ -47,6 +47,17 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
         std::lround(std::clamp(settings.clearColor[ch], 0.0f, 1.0f) * 65535.0f));
   if (settings.shade == raster::ShadeMode::overdraw) std::fill_n(clear16, 3, uint16_t(0));
 
+  // Stage 3a: snap every vertex once (shared vertices then agree in all their triangles).
+  auto t0 = Clock::now();
+  constexpr size_t kSnapChunk = 1 << 14;
+  screen_.resize(packets.vertices.size());
+  pool_.parallelFor((packets.vertices.size() + kSnapChunk - 1) / kSnapChunk, [&](size_t c, int) {
+    const size_t end = std::min(packets.vertices.size(), (c + 1) * kSnapChunk);
+    for (size_t i = c * kSnapChunk; i < end; ++i)
+      screen_[i] = geometry::snapVertex(packets.vertices[i], viewport);
+  });
+  stats.setupMs += msSince(t0);
+
   setups_.resize(kBatchTriangles);
   tileStats_.assign(size_t(tiles), raster::RasterStats{});
   std::vector<SetupCounts> counts(kChunksPerBatch);
@@ -57,8 +68,8 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
     const uint32_t batchEnd = std::min(triangleCount, batch + kBatchTriangles);
     const int chunks = int((batchEnd - batch + kChunkTriangles - 1) / kChunkTriangles);
 
-    // Stage 3: setup and binning, chunk by chunk.
-    auto t0 = Clock::now();
+    // Stage 3b: setup and binning, chunk by chunk.
+    t0 = Clock::now();
     binner_.reset(std::max(chunks, 1), fb_.tilesX(), fb_.tilesY());
     pool_.parallelFor(size_t(chunks), [&](size_t chunk, int) {
       SetupCounts c;
@@ -69,8 +80,10 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
         const DrawCall* call = cursor.find(tri);
         const uint32_t* idx = &packets.indices[size_t(tri) * 3];
         geometry::TriangleSetup& s = setups_[tri - batch];
-        switch (geometry::setupTriangle(packets.vertices[idx[0]], packets.vertices[idx[1]],
-                                        packets.vertices[idx[2]], viewport,
+        const geometry::ClipVertex* v[3] = {&packets.vertices[idx[0]], &packets.vertices[idx[1]],
+                                            &packets.vertices[idx[2]]};
+        const geometry::ScreenVertex* sv[3] = {&screen_[idx[0]], &screen_[idx[1]], &screen_[idx[2]]};
+        switch (geometry::setupTriangle(v, sv, viewport,
                                         call ? call->cull : geometry::CullMode::none, s)) {
           case geometry::SetupOutcome::drawn:
             ++c.drawn;

@@ -48,6 +48,7 @@ class FrameRenderer {
   raster::FrameBuffer fb_;
   raster::Binner binner_;
   std::vector<geometry::TriangleSetup> setups_;
+  std::vector<geometry::ScreenVertex> screen_;  // snapVertex of every packet vertex
   std::vector<raster::RasterStats> tileStats_;
 };
 

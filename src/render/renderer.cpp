@@ -116,19 +116,44 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
   p.indices.clear();
   p.calls.clear();
   const scene::Material defaultMaterial;
+  auto materialOf = [&](const scene::Mesh& mesh) -> const scene::Material& {
+    return mesh.material >= 0 ? scene.materials[mesh.material] : defaultMaterial;
+  };
+  // Lay out every instance's vertices and triangles, then transform the vertices in parallel
+  // chunks (each chunk writes its own range).
+  struct VertexJob {
+    const scene::Instance* instance;
+    size_t begin, end, out;
+  };
+  constexpr size_t kVertexChunk = 1 << 14;
+  std::vector<VertexJob> jobs;
+  size_t vertexCount = 0;
   for (const auto& inst : scene.instances) {
     const scene::Mesh& mesh = scene.meshes[inst.mesh];
-    const scene::Material& mat = mesh.material >= 0 ? scene.materials[mesh.material] : defaultMaterial;
-    const uint32_t base = static_cast<uint32_t>(p.vertices.size());
-    geometry::transformVertices(mesh, mat, inst.transform, viewProj, scene.light, p.vertices);
+    const scene::Material& mat = materialOf(mesh);
+    // Indices are 32-bit; a frame of more vertices or triangles than that cannot be expressed.
+    if (vertexCount + mesh.positions.size() > (size_t(1) << 31) ||
+        p.indices.size() + mesh.indices.size() > (size_t(1) << 31))
+      return Error{"", "", "scene too large for one frame (over 2^31 vertices or indices)"};
+    for (size_t b = 0; b < mesh.positions.size(); b += kVertexChunk)
+      jobs.push_back({&inst, b, std::min(mesh.positions.size(), b + kVertexChunk), vertexCount + b});
     render::DrawCall call;
     call.firstTriangle = static_cast<uint32_t>(p.indices.size() / 3);
     call.triangleCount = static_cast<uint32_t>(mesh.triangleCount());
     call.cull = o.cullBackFaces && !mat.doubleSided ? geometry::CullMode::back
                                                       : geometry::CullMode::none;
+    const uint32_t base = static_cast<uint32_t>(vertexCount);
     for (uint32_t i : mesh.indices) p.indices.push_back(base + i);
     p.calls.push_back(call);
+    vertexCount += mesh.positions.size();
   }
+  p.vertices.resize(vertexCount);
+  impl_->frame.pool().parallelFor(jobs.size(), [&](size_t j, int) {
+    const VertexJob& job = jobs[j];
+    const scene::Mesh& mesh = scene.meshes[job.instance->mesh];
+    geometry::transformVertices(mesh, materialOf(mesh), job.instance->transform, viewProj,
+                                scene.light, job.begin, job.end, p.vertices.data() + job.out);
+  });
   stats.vertexMs = msSince(t0);
 
   // Stage 3–4: setup, binning, tiles.

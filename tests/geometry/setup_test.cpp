@@ -17,7 +17,7 @@ using test::pixelVertex;
 
 bool edgeInside(const TriangleSetup& t, int x, int y) {
   for (int k = 0; k < t.edgeCount; ++k)
-    if (t.edges[k].c + t.edges[k].stepX * x + t.edges[k].stepY * y < 0) return false;
+    if (t.edges[k].c + t.edges[k].stepX() * x + t.edges[k].stepY() * y < 0) return false;
   return true;
 }
 
@@ -84,13 +84,13 @@ TEST(Setup, IncrementalChildValuesEqualDirectEvaluation) {
     int x = 0, y = 0;
     for (int h = 128; h >= 1; h /= 2) {  // walk to child (1,0), then (0,1), alternately
       if ((h & 1) || h % 4 == 0) {
-        tl += e.stepX * h;
+        tl += e.stepX() * h;
         x += h;
       } else {
-        tl += e.stepY * h;
+        tl += e.stepY() * h;
         y += h;
       }
-      EXPECT_EQ(tl, e.c + e.stepX * x + e.stepY * y);
+      EXPECT_EQ(tl, e.c + e.stepX() * x + e.stepY() * y);
     }
   }
 }

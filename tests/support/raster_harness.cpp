@@ -77,14 +77,14 @@ Frame renderReference(const render::DrawPackets& p, const render::FrameSettings&
       for (int x = 0; x < s.width; ++x) {
         bool inside = true;
         for (int k = 0; k < t.edgeCount && inside; ++k)
-          inside = t.edges[k].c + t.edges[k].stepX * x + t.edges[k].stepY * y >= 0;
+          inside = t.edges[k].c + t.edges[k].stepX() * x + t.edges[k].stepY() * y >= 0;
         if (!inside) continue;
         const size_t i = size_t(y) * s.width + x;
         if (count) {
           ++f.color[i * 3];
           continue;
         }
-        const float fx = float(x - t.refX), fy = float(y - t.refY);
+        const float fx = float(x - t.minX), fy = float(y - t.minY);
         const float z = evalPlane(t.depth, fx, fy);
         if (!(z < f.depth[i])) continue;
         f.depth[i] = z;

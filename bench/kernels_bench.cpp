@@ -1,0 +1,131 @@
+// Google Benchmark kernels (STYLE.md habit 13): seeded inputs, work-normalized rates.
+//   setup per triangle            → triangles/s
+//   one tile, small triangles      → triangles/s (coverage + depth + Gouraud)
+//   one tile, large triangles      → pixels/s (fills)
+//   whole frame, BENCH.md tris     → triangles/s
+#include <benchmark/benchmark.h>
+
+#include <random>
+
+#include "raster/framebuffer.h"
+#include "raster/rasterizer.h"
+#include "render/frame_renderer.h"
+#include "synthvis/generators.h"
+
+namespace sv {
+namespace {
+
+geometry::ClipVertex at(double x, double y, int w, int h, float z) {
+  return {float(2 * x / w - 1), float(1 - 2 * y / h), 2 * z - 1, 1, 0.5f, 0.6f, 0.7f, 1};
+}
+
+// Triangles of about `area` px² inside a 64×64 tile at the origin of a 64×64 raster.
+std::vector<geometry::TriangleSetup> tileTriangles(double area, int count) {
+  std::mt19937 rng(42);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<geometry::TriangleSetup> out;
+  const double leg = std::sqrt(2 * area);
+  while (int(out.size()) < count) {
+    const double x = u(rng) * 64, y = u(rng) * 64, a = u(rng) * 6.283;
+    geometry::TriangleSetup t;
+    if (geometry::setupTriangle(at(x, y, 64, 64, float(u(rng))),
+                                at(x + leg * std::cos(a), y + leg * std::sin(a), 64, 64, 0.5f),
+                                at(x + leg * std::cos(a + 1.571), y + leg * std::sin(a + 1.571), 64,
+                                   64, 0.5f),
+                                {64, 64}, geometry::CullMode::none, t) == geometry::SetupOutcome::drawn)
+      out.push_back(t);
+  }
+  return out;
+}
+
+void rasterTile(benchmark::State& state, double area) {
+  const int count = int(state.range(0));
+  const auto tris = tileTriangles(area, count);
+  std::vector<uint32_t> list(tris.size());
+  for (size_t i = 0; i < list.size(); ++i) list[i] = uint32_t(i);
+  raster::FrameBuffer fb;
+  fb.resize(64, 64);
+  const uint32_t* lists[1] = {list.data()};
+  const uint32_t sizes[1] = {uint32_t(list.size())};
+  raster::TileWork w;
+  w.depth = fb.tileDepth(0);
+  w.color = fb.tileColor(0);
+  w.clear = true;
+  w.setups = tris.data();
+  w.lists = lists;
+  w.listSizes = sizes;
+  w.listCount = 1;
+  raster::RasterStats stats;
+  for (auto _ : state) raster::rasterizeTile(w, stats);
+  state.counters["triangles/s"] =
+      benchmark::Counter(double(count) * state.iterations(), benchmark::Counter::kIsRate);
+  state.counters["pixels/s"] = benchmark::Counter(
+      double(stats.fragments), benchmark::Counter::kIsRate);
+}
+
+void BM_TileSmallTriangles(benchmark::State& s) { rasterTile(s, 10); }
+void BM_TileMediumTriangles(benchmark::State& s) { rasterTile(s, 100); }
+void BM_TileLargeTriangles(benchmark::State& s) { rasterTile(s, 1000); }
+BENCHMARK(BM_TileSmallTriangles)->Arg(1000);
+BENCHMARK(BM_TileMediumTriangles)->Arg(200);
+BENCHMARK(BM_TileLargeTriangles)->Arg(20);
+
+void BM_SetupTriangle(benchmark::State& state) {
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<geometry::ClipVertex> v(3 * 4096);
+  for (size_t i = 0; i < v.size(); i += 3) {
+    const double x = u(rng) * 1920, y = u(rng) * 1080;
+    for (int k = 0; k < 3; ++k) {
+      v[i + k] = at(x + u(rng) * 6, y + u(rng) * 6, 1920, 1080, float(u(rng)));
+      v[i + k].w = float(1 + u(rng));
+      v[i + k].x *= v[i + k].w;
+      v[i + k].y *= v[i + k].w;
+    }
+  }
+  geometry::TriangleSetup t;
+  size_t i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(geometry::setupTriangle(v[i], v[i + 1], v[i + 2], {1920, 1080},
+                                                     geometry::CullMode::none, t));
+    benchmark::DoNotOptimize(t);
+    i = (i + 3) % v.size();
+  }
+  state.counters["triangles/s"] =
+      benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_SetupTriangle);
+
+// BENCH.md tris through setup, binning and tiles (no vertex stage, no resolve), 1 thread.
+void BM_FrameTris(benchmark::State& state) {
+  scene::TrisParams p;
+  p.count = int(state.range(0));
+  p.area = double(state.range(1));
+  const scene::Scene s = scene::generateTris(p);
+  render::DrawPackets packets;
+  const Mat4 vp = Mat4::perspective(60 * 3.14159265f / 180, 1920.0f / 1080, 0.1f, 100) *
+                  Mat4::lookAt({0, 0, 0}, {0, 0, -1}, {0, 1, 0});
+  const auto& m = s.meshes[0];
+  for (size_t i = 0; i < m.positions.size(); ++i) {
+    const Vec4 c = vp * Vec4{m.positions[i].x, m.positions[i].y, m.positions[i].z, 1};
+    packets.vertices.push_back({c.x, c.y, c.z, c.w, m.colors[i].x, m.colors[i].y, m.colors[i].z, 1});
+  }
+  packets.indices = m.indices;
+  packets.calls.push_back({0, uint32_t(m.triangleCount()), geometry::CullMode::none});
+  render::FrameRenderer fr(1);
+  render::FrameSettings fs;
+  fs.width = 1920;
+  fs.height = 1080;
+  for (auto _ : state) {
+    FrameStats stats;
+    fr.render(packets, fs, stats);
+  }
+  state.counters["triangles/s"] =
+      benchmark::Counter(double(p.count) * state.iterations(), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_FrameTris)->Args({100000, 10})->Args({10000, 1000})->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace sv
+
+BENCHMARK_MAIN();

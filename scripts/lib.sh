@@ -1,0 +1,28 @@
+# Shared by scripts/demo and scripts/test: install what is missing, configure, build.
+# shellcheck shell=bash
+
+SV_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+SV_PACKAGES=(cmake g++ ninja-build pkg-config libgtest-dev libgmock-dev libbenchmark-dev
+  libhwy-dev libtinygltf-dev libtinyobjloader-dev libstb-dev libpng-dev nlohmann-json3-dev
+  libcli11-dev libfmt-dev)
+
+sv_install_packages() {
+  local missing=()
+  for p in "${SV_PACKAGES[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  echo "synthvis: installing ${missing[*]}"
+  local sudo=""
+  [ "$(id -u)" -ne 0 ] && sudo="sudo"
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+}
+
+# sv_build DIR [cmake args...]: configure (once) and build everything in DIR.
+sv_build() {
+  local dir="$1"
+  shift
+  cmake -S "$SV_ROOT" -B "$dir" -G Ninja "$@" >/dev/null
+  cmake --build "$dir" --parallel "$(nproc)"
+}

@@ -1,0 +1,107 @@
+// The command-line tool as a user meets it: malformed input gives one clear line naming the file
+// and the problem, and a non-zero exit — never a crash.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sys/wait.h>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Run {
+  int status = -1;
+  std::string out;  // stdout and stderr together
+};
+
+Run run(const std::string& args) {
+  Run r;
+  const std::string cmd = std::string(SV_CLI) + " " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return r;
+  std::array<char, 4096> buf;
+  size_t n;
+  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), n);
+  const int st = pclose(p);
+  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
+  return r;
+}
+
+fs::path tempDir() {
+  fs::path d = fs::temp_directory_path() / "sv_cli_test";
+  fs::create_directories(d);
+  return d;
+}
+
+std::string write(const std::string& name, const std::string& content) {
+  const fs::path p = tempDir() / name;
+  std::ofstream(p, std::ios::binary) << content;
+  return p.string();
+}
+
+void expectOneLineError(const Run& r, const std::string& file, const std::string& what) {
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
+  EXPECT_EQ(r.out.rfind("synthvis: ", 0), 0u) << r.out;
+  EXPECT_NE(r.out.find(file), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(what), std::string::npos) << r.out;
+}
+
+TEST(Cli, RendersTheDemoSceneAndPrintsOneStatsLine) {
+  const std::string out = (tempDir() / "demo.png").string();
+  const Run r = run("render -o " + out + " --width 96 --height 64 --threads 2");
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_TRUE(fs::exists(out));
+  EXPECT_NE(r.out.find("triangles in"), std::string::npos);
+  EXPECT_NE(r.out.find("windows"), std::string::npos);
+  EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
+}
+
+TEST(Cli, TruncatedJsonNamesFileAndPosition) {
+  const std::string f = write("trunc.json", "{\"synthvis\": 1, \"objects\": [ {\"primitive\": \"box\"");
+  expectOneLineError(run("render " + f + " -o " + (tempDir() / "x.png").string()), f, ":");
+}
+
+TEST(Cli, TruncatedGlbIsAnError) {
+  const std::string f = write("trunc.glb", std::string("glTF\x02\x00\x00\x00\xff\x00\x00\x00", 12));
+  expectOneLineError(run("render " + f + " -o " + (tempDir() / "x.png").string()), f, "");
+}
+
+TEST(Cli, MissingReferencedFileIsNamed) {
+  const std::string f = write("missing_ref.json",
+                              R"({"synthvis": 1, "objects": [{"mesh": "no_such_model.glb"}]})");
+  expectOneLineError(run("render " + f + " -o " + (tempDir() / "x.png").string()), f,
+                     "no_such_model.glb");
+}
+
+TEST(Cli, WrongTypesAreReported) {
+  const std::string f = write("types.json", R"({"synthvis": 1, "background": "blue"})");
+  expectOneLineError(run("render " + f + " -o " + (tempDir() / "x.png").string()), f, "background");
+}
+
+TEST(Cli, MissingSceneFileAndBadOptions) {
+  expectOneLineError(run("render /no/such/scene.json -o x.png"), "/no/such/scene.json", "");
+  const Run big = run("render --width 100000 -o " + (tempDir() / "x.png").string());
+  EXPECT_EQ(big.status, 1) << big.out;
+  EXPECT_NE(big.out.find("out of range"), std::string::npos) << big.out;
+  const Run fmt = run("render -o " + (tempDir() / "x.bmp").string() + " --width 8 --height 8");
+  EXPECT_EQ(fmt.status, 1) << fmt.out;
+  EXPECT_NE(run("render --no-such-flag").status, 0);
+}
+
+TEST(Cli, BenchWritesTheJsonFieldsBenchMdNames) {
+  const std::string json = (tempDir() / "bench.json").string();
+  const Run r = run("bench tris --count 2000 --area 20 --width 320 --height 240 --frames 2 "
+                    "--warmup 1 --json " + json);
+  ASSERT_EQ(r.status, 0) << r.out;
+  std::ifstream f(json);
+  std::string text((std::istreambuf_iterator<char>(f)), {});
+  for (const char* key : {"\"scene\"", "\"renderer\"", "\"width\"", "\"height\"", "\"threads\"",
+                          "\"frames\"", "\"median_ms\"", "\"min_ms\"", "\"max_ms\"", "\"triangles\""})
+    EXPECT_NE(text.find(key), std::string::npos) << key;
+}
+
+}  // namespace

@@ -1,0 +1,52 @@
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <vector>
+
+#include "core/thread_pool.h"
+#include "synthvis/math.h"
+
+namespace sv {
+namespace {
+
+TEST(ThreadPool, RunsEveryItemExactlyOnceForAnyThreadCount) {
+  for (int threads : {1, 2, 3, 8}) {
+    core::ThreadPool pool(threads);
+    for (size_t count : {size_t(0), size_t(1), size_t(7), size_t(1000)}) {
+      std::vector<std::atomic<int>> hits(count);
+      pool.parallelFor(count, [&](size_t i, int worker) {
+        EXPECT_GE(worker, 0);
+        EXPECT_LT(worker, threads);
+        hits[i].fetch_add(1);
+      });
+      for (size_t i = 0; i < count; ++i) EXPECT_EQ(hits[i].load(), 1) << threads << " " << i;
+    }
+  }
+}
+
+TEST(Mat4, NormalMatrixKeepsNormalsPerpendicularUnderNonUniformScale) {
+  const Mat4 m = Mat4::rotation({1, 2, 3}, 0.7f) * Mat4::scaling({3, 0.5f, 2});
+  const Vec3 tangent{1, -1, 0}, normal{1, 1, 0.5f};  // perpendicular: 1 − 1 + 0 = 0
+  const Vec3 t = m.transformDirection(tangent);
+  const Vec3 n = m.normalMatrix().transformDirection(normal);
+  EXPECT_NEAR(dot(t, n), 0.0f, 1e-5f);
+}
+
+TEST(Mat4, PerspectiveMapsNearAndFarToMinusOneAndOne) {
+  const Mat4 p = Mat4::perspective(1.0f, 1.5f, 0.5f, 20.0f);
+  const Vec4 nearPt = p * Vec4{0, 0, -0.5f, 1}, farPt = p * Vec4{0, 0, -20.0f, 1};
+  EXPECT_NEAR(nearPt.z / nearPt.w, -1.0f, 1e-6f);
+  EXPECT_NEAR(farPt.z / farPt.w, 1.0f, 1e-5f);
+}
+
+TEST(Mat4, LookAtPutsTheTargetOnTheNegativeZAxis) {
+  const Mat4 v = Mat4::lookAt({3, 4, 5}, {-1, 2, 0}, {0, 1, 0});
+  const Vec3 t = v.transformPoint({-1, 2, 0});
+  EXPECT_NEAR(t.x, 0, 1e-5f);
+  EXPECT_NEAR(t.y, 0, 1e-5f);
+  EXPECT_NEAR(t.z, -std::sqrt(16.0f + 4 + 25), 1e-4f);
+}
+
+}  // namespace
+}  // namespace sv

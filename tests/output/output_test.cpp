@@ -1,0 +1,74 @@
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "output/resolve.h"
+#include "synthvis/image.h"
+
+namespace sv {
+namespace {
+
+std::string tempPath(const char* name) {
+  return (std::filesystem::temp_directory_path() / name).string();
+}
+
+Image gradient(int w, int h) {
+  Image img{w, h, std::vector<uint8_t>(size_t(w) * h * 3)};
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      uint8_t* p = img.pixel(x, y);
+      p[0] = uint8_t(x * 7);
+      p[1] = uint8_t(y * 13);
+      p[2] = uint8_t(x ^ y);
+    }
+  return img;
+}
+
+TEST(ImageIo, PngRoundTripIsLossless) {
+  const Image img = gradient(37, 19);
+  const std::string path = tempPath("sv_roundtrip.png");
+  ASSERT_TRUE(writePng(img, path).ok());
+  auto back = readPng(path);
+  ASSERT_TRUE(back.ok()) << back.error().str();
+  EXPECT_EQ(back->width, 37);
+  EXPECT_EQ(back->height, 19);
+  EXPECT_EQ(back->rgb, img.rgb);
+}
+
+TEST(ImageIo, PpmHasBinaryP6HeaderAndPixels) {
+  const Image img = gradient(5, 3);
+  const std::string path = tempPath("sv_img.ppm");
+  ASSERT_TRUE(writeImage(img, path).ok());
+  std::ifstream f(path, std::ios::binary);
+  std::string data((std::istreambuf_iterator<char>(f)), {});
+  const std::string header = "P6\n5 3\n255\n";
+  ASSERT_EQ(data.substr(0, header.size()), header);
+  EXPECT_EQ(data.size(), header.size() + 45);
+  EXPECT_EQ(uint8_t(data[header.size() + 3]), img.rgb[3]);
+}
+
+TEST(ImageIo, ErrorsNameTheFile) {
+  auto missing = readPng("/nonexistent/dir/x.png");
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.error().str().find("/nonexistent/dir/x.png"), std::string::npos);
+  const std::string bad = tempPath("sv_not_a_png.png");
+  std::ofstream(bad) << "this is not a png";
+  auto garbage = readPng(bad);
+  ASSERT_FALSE(garbage.ok());
+  EXPECT_NE(garbage.error().str().find(bad), std::string::npos);
+  EXPECT_FALSE(writeImage(gradient(2, 2), tempPath("sv_img.bmp")).ok());
+}
+
+TEST(Gamma, SrgbTablesMatchTheStandardAtKnownPoints) {
+  const auto g = output::GammaTables::srgb();
+  EXPECT_EQ(g.table[0][0], 0);
+  EXPECT_EQ(g.table[1][65535], 255);
+  EXPECT_EQ(g.table[2][32768], 188);  // linear 0.5 → sRGB 0.7354 → 187.5 → 188
+  EXPECT_EQ(g.table[0][int(0.2140 * 65535)], 128);  // sRGB 0.5 ≈ linear 0.2140
+  for (int i = 1; i < 65536; ++i) ASSERT_GE(g.table[0][i], g.table[0][i - 1]);  // monotonic
+}
+
+}  // namespace
+}  // namespace sv

@@ -1,0 +1,132 @@
+// Whole frames through the public API: the demo scene's golden image, thread-count invariance,
+// option validation, and the benchmark generator's stated statistics.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <set>
+
+#include "synthvis/generators.h"
+#include "synthvis/render.h"
+
+namespace sv {
+namespace {
+
+Image renderScene(const scene::Scene& s, int w, int h, int threads, FrameStats* stats = nullptr) {
+  RenderOptions o;
+  o.width = w;
+  o.height = h;
+  o.threads = threads;
+  Renderer r(o);
+  Image img;
+  const Status st = r.render(s, img, stats);
+  EXPECT_TRUE(st.ok()) << st.error().str();
+  return img;
+}
+
+// Golden images are small (STYLE.md habit 12) and looked at by a person when they change:
+// SV_UPDATE_GOLDEN=1 rewrites them instead of comparing.
+TEST(Render, DemoSceneMatchesItsGoldenImage) {
+  const std::string golden = std::string(SV_SOURCE_DIR) + "/tests/golden/demo_128x96.png";
+  const Image img = renderScene(scene::demoScene(), 128, 96, 2);
+  if (std::getenv("SV_UPDATE_GOLDEN")) {
+    ASSERT_TRUE(writePng(img, golden).ok());
+    GTEST_SKIP() << "golden image rewritten: " << golden;
+  }
+  auto ref = readPng(golden);
+  ASSERT_TRUE(ref.ok()) << ref.error().str();
+  ASSERT_EQ(ref->width, img.width);
+  ASSERT_EQ(ref->height, img.height);
+  // Bit-exact on this machine class; allow a few one-step differences should a libm's sin/cos
+  // round the camera matrix differently elsewhere.
+  int differing = 0, worst = 0;
+  for (size_t i = 0; i < img.rgb.size(); ++i) {
+    const int d = std::abs(int(img.rgb[i]) - int(ref->rgb[i]));
+    differing += d != 0;
+    worst = std::max(worst, d);
+  }
+  EXPECT_LE(differing, int(img.rgb.size() / 1000)) << "channels that differ";
+  EXPECT_LE(worst, 2);
+}
+
+TEST(Render, DemoSceneIsNotEmptyAndShowsSeveralColours) {
+  FrameStats stats;
+  const Image img = renderScene(scene::demoScene(), 160, 120, 2, &stats);
+  EXPECT_GT(stats.drawn, 1000u);
+  EXPECT_GT(stats.culledFacing, 0u);  // closed objects: their back faces
+  std::set<uint32_t> colours;
+  for (size_t i = 0; i < img.rgb.size(); i += 3)
+    colours.insert(img.rgb[i] << 16 | img.rgb[i + 1] << 8 | img.rgb[i + 2]);
+  EXPECT_GT(colours.size(), 200u);
+}
+
+TEST(Render, DeterminismOneTwoAndEightThreadsGiveIdenticalBytes) {
+  const scene::Scene demo = scene::demoScene();
+  const Image one = renderScene(demo, 333, 201, 1);
+  EXPECT_EQ(one.rgb, renderScene(demo, 333, 201, 2).rgb);
+  EXPECT_EQ(one.rgb, renderScene(demo, 333, 201, 8).rgb);
+  scene::TrisParams p;
+  p.count = 20000;
+  p.area = 30;
+  p.width = 400;
+  p.height = 300;
+  const scene::Scene tris = scene::generateTris(p);
+  const Image t1 = renderScene(tris, 400, 300, 1);
+  EXPECT_EQ(t1.rgb, renderScene(tris, 400, 300, 2).rgb);
+  EXPECT_EQ(t1.rgb, renderScene(tris, 400, 300, 8).rgb);
+}
+
+TEST(Render, OptionsOutOfRangeAreRejectedWithTheReason) {
+  RenderOptions o;
+  o.width = 0;
+  EXPECT_FALSE(validate(o).ok());
+  o.width = 9000;
+  EXPECT_NE(validate(o).error().str().find("out of range"), std::string::npos);
+  o.width = 64;
+  o.threads = -1;
+  EXPECT_FALSE(validate(o).ok());
+  o.threads = 1;
+  EXPECT_TRUE(validate(o).ok());
+  o.camera = 3;
+  Renderer r(o);
+  Image img;
+  EXPECT_FALSE(r.render(scene::demoScene(), img).ok());
+}
+
+TEST(TrisGenerator, SameSeedSameSceneAndStatisticsWithinFivePercent) {
+  scene::TrisParams p;
+  p.count = 20000;
+  p.area = 100;
+  scene::TrisStats a, b;
+  const scene::Scene s1 = scene::generateTris(p, &a), s2 = scene::generateTris(p, &b);
+  ASSERT_EQ(s1.meshes[0].positions.size(), s2.meshes[0].positions.size());
+  EXPECT_EQ(s1.meshes[0].positions[12345], s2.meshes[0].positions[12345]);
+  EXPECT_NEAR(a.meanArea, 100, 5);
+  p.depth = 4;
+  scene::TrisStats d;
+  scene::generateTris(p, &d);
+  EXPECT_NEAR(d.depthComplexity, 4, 0.2);
+  p.seed = 2;
+  EXPECT_NE(scene::generateTris(p).meshes[0].positions[0], s1.meshes[0].positions[0]);
+}
+
+TEST(TrisGenerator, RenderedAreaMatchesTheRequestedArea) {
+  scene::TrisParams p;
+  p.count = 2000;
+  p.area = 50;
+  p.width = 640;
+  p.height = 480;
+  RenderOptions o;
+  o.width = 640;
+  o.height = 480;
+  o.threads = 2;
+  o.debugOverdraw = true;  // counts covered pixels
+  Renderer r(o);
+  Image img;
+  FrameStats stats;
+  ASSERT_TRUE(r.render(scene::generateTris(p), img, &stats).ok());
+  EXPECT_NEAR(double(stats.fragments) / p.count, 50, 2.5);
+}
+
+}  // namespace
+}  // namespace sv
