@@ -23,14 +23,15 @@ namespace sv::geometry {
 // max(|A|, |B|) ≤ 2^23 and |C| is clamped to 2^46 (beyond which the line cannot cross the raster),
 // which keeps them inside the same budget. Everything fits int64_t with 15 bits to spare.
 inline constexpr int kSubPixelBits = 8;
-inline constexpr int kSmallExtent = 32;  // pixels
+inline constexpr int kSmallExtent = 64;  // pixels
 inline constexpr int kSubPixelScale = 1 << kSubPixelBits;
 inline constexpr int kMaxRasterLog2 = 13;
 inline constexpr int kMaxRasterSize = 1 << kMaxRasterLog2;
 inline constexpr int kGuardBandLog2 = 15;
-inline constexpr int kMaxEdges = 5;
-// Budget of the int32 path: |A|, |B| ≤ 33·2^8 < 2^13.1; the rasterizer's windows stay within 96 px
-// (3 cells of ≤ 32 px) of every vertex, < 2^14.6 sub-pixel units; so |e| ≤ 2·2^13.1·2^14.6 < 2^29.  // three sides, the near plane and the far plane
+inline constexpr int kMaxEdges = 5;  // three sides, the near plane and the far plane
+// Budget of the int32 path: |A|, |B| ≤ 64·2^8 = 2^14; the rasterizer's windows (cells of ≤ 32 px
+// around the box) stay within 97 px of every vertex, < 2^14.6 sub-pixel units; so
+// |e| ≤ 2·2^14·2^14.6 < 2^30.
 static_assert(kGuardBandLog2 + kSubPixelBits + 1 + kSubPixelBits + kMaxRasterLog2 + 1 < 62,
               "edge values must fit int64_t");
 
@@ -74,7 +75,7 @@ struct TriangleSetup {
   int16_t minX, minY, maxX, maxY;  // inclusive pixel bounding box, clipped to the raster
   uint8_t edgeCount;
   // True when the triangle is small (three integer edges, bounding box ≤ kSmallExtent pixels):
-  // then |e| < 2^29 within 96 px of its vertices, and the rasterizer may step in int32.
+  // then |e| < 2^30 within 97 px of its vertices, and the rasterizer may step in int32.
   bool small;
 };
 

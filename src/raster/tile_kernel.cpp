@@ -53,12 +53,41 @@ struct TileContext {
   RasterStats* stats;
 };
 
-// Evaluates a plane at lanes' pixel positions: c0 + dx·X + dy·Y, in this order (the scalar twin in
-// tests/raster does the same, which is what makes every target bit-identical).
-template <class DF, class VF>
-HWY_INLINE VF evalPlane(DF df, const Plane& p, VF x, VF y) {
-  return hn::Add(hn::Add(hn::Set(df, p.c0), hn::Mul(hn::Set(df, p.dx), x)),
-                 hn::Mul(hn::Set(df, p.dy), y));
+// Parameters are evaluated per 4×4 block as base + offset: base = (c0 + dx·X) + dy·Y at the block's
+// top-left pixel (X, Y relative to the plane's origin), offset = dx·lx + dy·ly per lane, computed
+// once per triangle. Every target, and the scalar reference in tests/support, computes exactly
+// these float operations in this order, which is what makes them bit-identical.
+enum PlaneIndex { kDepth, kInvW, kRed, kGreen, kBlue, kPlaneCount };
+
+struct PlaneLanes {
+  alignas(64) float offset[kPlaneCount][kBlockPixels];
+  // The planes' c0, dx, dy side by side, so a block's five bases are one vector expression.
+  alignas(32) float c0[8], dx[8], dy[8];
+};
+
+HWY_INLINE const Plane& planeOf(const TriangleSetup& t, int p) {
+  const Plane* planes[kPlaneCount] = {&t.depth, &t.invW, &t.red, &t.green, &t.blue};
+  return *planes[p];
+}
+
+HWY_INLINE void computePlaneLanes(const TriangleSetup& t, PlaneLanes& out) {
+  for (int p = 0; p < 8; ++p) {
+    const Plane pl = p < kPlaneCount ? planeOf(t, p) : Plane{0, 0, 0};
+    out.c0[p] = pl.c0;
+    out.dx[p] = pl.dx;
+    out.dy[p] = pl.dy;
+  }
+  const hn::CappedTag<float, kBlockPixels> df;
+  const hn::RebindToSigned<decltype(df)> di;
+  for (size_t i = 0; i < size_t(kBlockPixels); i += hn::Lanes(df)) {
+    const auto lx = hn::ConvertTo(df, hn::LoadU(di, kLaneX + i));
+    const auto ly = hn::ConvertTo(df, hn::LoadU(di, kLaneY + i));
+    for (int p = 0; p < kPlaneCount; ++p) {
+      const Plane& pl = planeOf(t, p);
+      hn::StoreU(hn::Add(hn::Mul(hn::Set(df, pl.dx), lx), hn::Mul(hn::Set(df, pl.dy), ly)), df,
+                 out.offset[p] + i);
+    }
+  }
 }
 
 // Overdraw count: +1 in the red channel of every pixel set in `mask` (no depth test).
@@ -68,34 +97,46 @@ HWY_INLINE void countBlock(uint32_t mask, uint16_t* color) {
 
 // Depth test ("less") and Gouraud colour for the pixels of one 4×4 block set in `mask`.
 // (gx, gy) is the block's top-left pixel; `depth` and `color` point at the block's storage.
-HWY_INLINE void shadeBlock(const TriangleSetup& t, uint32_t mask, int gx, int gy, float* depth,
-                           uint16_t* color) {
+HWY_INLINE void shadeBlock(const TriangleSetup& t, const PlaneLanes& lanes, uint32_t mask, int gx,
+                           int gy, float* depth, uint16_t* color) {
   const hn::CappedTag<float, kBlockPixels> df;
   const hn::RebindToSigned<decltype(df)> di;
   const hn::Rebind<uint16_t, decltype(df)> du;
   const size_t n = hn::Lanes(df);
+  // The five bases (c0 + dx·X) + dy·Y at the block's top-left pixel, one lane per plane.
+  alignas(32) float base[8];
+  {
+    const hn::CappedTag<float, 8> d8;
+    const auto bx = hn::Set(d8, float(gx - t.minX)), by = hn::Set(d8, float(gy - t.minY));
+    for (size_t p = 0; p < 8; p += hn::Lanes(d8))
+      hn::Store(hn::Add(hn::Add(hn::Load(d8, lanes.c0 + p), hn::Mul(hn::Load(d8, lanes.dx + p), bx)),
+                        hn::Mul(hn::Load(d8, lanes.dy + p), by)),
+                d8, base + p);
+  }
   const auto maskVec = hn::Set(di, static_cast<int32_t>(mask));
-  const auto dx0 = hn::Set(di, gx - t.minX), dy0 = hn::Set(di, gy - t.minY);
   const auto zero = hn::Zero(df), one = hn::Set(df, 1.0f);
-  const auto scale = hn::Set(df, 65535.0f), half = hn::Set(df, 0.5f);
+  // Float → 16-bit by the magic-number trick: for 0 ≤ v < 2^23, the float v + 2^23 holds
+  // round-to-nearest-even(v) in its low mantissa bits (no range fix-ups needed, unlike ConvertTo).
+  const auto scale = hn::Set(df, 65535.0f), magic = hn::Set(df, 8388608.0f);
+  const auto low16 = hn::Set(di, 0xFFFF);
   for (size_t i = 0; i < size_t(kBlockPixels); i += n) {
     const auto covered = hn::TestBit(maskVec, hn::LoadU(di, kLaneBit + i));
     if (hn::AllFalse(di, covered)) continue;
-    const auto x = hn::ConvertTo(df, hn::Add(dx0, hn::LoadU(di, kLaneX + i)));
-    const auto y = hn::ConvertTo(df, hn::Add(dy0, hn::LoadU(di, kLaneY + i)));
     // SPEC §4: Z-buffer — depth is a §2 parameter, linear in screen space.
-    const auto z = evalPlane(df, t.depth, x, y);
+    const auto z = hn::Add(hn::Set(df, base[kDepth]), hn::LoadU(df, lanes.offset[kDepth] + i));
     const auto zOld = hn::LoadU(df, depth + i);
     const auto pass = hn::And(hn::RebindMask(df, covered), hn::Lt(z, zOld));
     if (hn::AllFalse(df, pass)) continue;
     hn::StoreU(hn::IfThenElse(pass, z, zOld), df, depth + i);
     // SPEC §2: perspective-correct colour = (colour/w) / (1/w).
-    const auto w = hn::Div(one, evalPlane(df, t.invW, x, y));
+    const auto w = hn::Div(
+        one, hn::Add(hn::Set(df, base[kInvW]), hn::LoadU(df, lanes.offset[kInvW] + i)));
     const auto passI = hn::RebindMask(di, pass);
-    const Plane* planes[kColorChannels] = {&t.red, &t.green, &t.blue};
     for (int ch = 0; ch < kColorChannels; ++ch) {
-      const auto c = hn::Min(hn::Max(hn::Mul(evalPlane(df, *planes[ch], x, y), w), zero), one);
-      const auto c16 = hn::ConvertTo(di, hn::Add(hn::Mul(c, scale), half));
+      const auto cw =
+          hn::Add(hn::Set(df, base[kRed + ch]), hn::LoadU(df, lanes.offset[kRed + ch] + i));
+      const auto c = hn::Min(hn::Max(hn::Mul(cw, w), zero), one);
+      const auto c16 = hn::And(hn::BitCast(di, hn::Add(hn::Mul(c, scale), magic)), low16);
       uint16_t* dst = color + ch * kBlockPixels + i;
       const auto old = hn::PromoteTo(di, hn::LoadU(du, dst));
       hn::StoreU(hn::DemoteTo(du, hn::IfThenElse(passI, c16, old)), du, dst);
@@ -110,6 +151,7 @@ template <int E, ShadeMode kShade, class T>
 class TriangleRaster {
  public:
   TriangleRaster(const TriangleSetup& t, const TileContext& ctx) : t_(t), ctx_(ctx) {
+    if constexpr (kShade == ShadeMode::gouraud) computePlaneLanes(t, planeLanes_);
     for (int k = 0; k < E; ++k) {
       const auto& e = t.edges[k];
       sX_[k] = T(e.stepX());
@@ -117,8 +159,18 @@ class TriangleRaster {
       pos_[k] = std::max<T>(sX_[k], 0) + std::max<T>(sY_[k], 0);
       neg_[k] = std::min<T>(sX_[k], 0) + std::min<T>(sY_[k], 0);
       // e at the 16 pixel centres of a block, relative to its top-left one.
-      for (int i = 0; i < kBlockPixels; ++i)
-        leafOffset_[k][i] = sX_[k] * T(kLaneX[i]) + sY_[k] * T(kLaneY[i]);
+      // e at the 16 pixel centres of a block, relative to its top-left one: sX·lx + sY·ly.
+      if constexpr (sizeof(T) == 4) {
+        const hn::CappedTag<T, kBlockPixels> d;
+        for (size_t i = 0; i < size_t(kBlockPixels); i += hn::Lanes(d)) {
+          const auto lx = hn::LoadU(d, kLaneX + i), ly = hn::LoadU(d, kLaneY + i);
+          hn::StoreU(hn::Add(hn::Mul(lx, hn::Set(d, sX_[k])), hn::Mul(ly, hn::Set(d, sY_[k]))),
+                     d, leafOffset_[k] + i);
+        }
+      } else {
+        for (int i = 0; i < kBlockPixels; ++i)
+          leafOffset_[k][i] = sX_[k] * T(kLaneX[i]) + sY_[k] * T(kLaneY[i]);
+      }
     }
   }
 
@@ -149,10 +201,14 @@ class TriangleRaster {
   void visitRoot(int lx, int ly, int log2n, int n) {
     ++ctx_.stats->windows[statLevel(log2n)];
     T tl[kMaxEdges];
-    unsigned active = 0;
     for (int k = 0; k < E; ++k) {
       const auto& e = t_.edges[k];
       tl[k] = T(e.c + e.stepX() * (ctx_.originX + lx) + e.stepY() * (ctx_.originY + ly));
+    }
+    // A root that is already a leaf: its SIMD test decides everything, skip the classification.
+    if (log2n == kBlockLog2) return leaf(lx, ly, tl, (1u << E) - 1);
+    unsigned active = 0;
+    for (int k = 0; k < E; ++k) {
       if (tl[k] + pos_[k] * T(n - 1) < 0) return;             // d < 0: outside
       if (tl[k] + neg_[k] * T(n - 1) < 0) active |= 1u << k;  // d < 2ε: the edge crosses
     }
@@ -240,7 +296,7 @@ class TriangleRaster {
     if constexpr (kShade == ShadeMode::overdraw) {
       countBlock(mask, ctx_.color + block * kColorPerBlock);
     } else {
-      shadeBlock(t_, mask, ctx_.originX + lx, ctx_.originY + ly, ctx_.depth + block * kBlockPixels,
+      shadeBlock(t_, planeLanes_, mask, ctx_.originX + lx, ctx_.originY + ly, ctx_.depth + block * kBlockPixels,
                  ctx_.color + block * kColorPerBlock);
     }
   }
@@ -249,6 +305,7 @@ class TriangleRaster {
   const TileContext& ctx_;
   T sX_[E], sY_[E], pos_[E], neg_[E];
   alignas(64) T leafOffset_[E][kBlockPixels];
+  PlaneLanes planeLanes_;
 };
 
 void clearTile(const TileWork& w) {

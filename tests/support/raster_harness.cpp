@@ -47,7 +47,14 @@ Frame renderQuadtree(const render::DrawPackets& p, const render::FrameSettings& 
 }
 
 namespace {
-float evalPlane(const geometry::Plane& p, float x, float y) { return (p.c0 + p.dx * x) + p.dy * y; }
+// The kernel's evaluation order (tile_kernel.cpp): per 4×4 block a base at its top-left pixel,
+// plus a per-lane offset.
+float evalPlane(const geometry::Plane& p, int x, int y, int minX, int minY) {
+  const float bx = float((x & ~3) - minX), by = float((y & ~3) - minY);
+  const float base = (p.c0 + p.dx * bx) + p.dy * by;
+  const float offset = p.dx * float(x & 3) + p.dy * float(y & 3);
+  return base + offset;
+}
 }  // namespace
 
 Frame renderReference(const render::DrawPackets& p, const render::FrameSettings& s) {
@@ -84,15 +91,15 @@ Frame renderReference(const render::DrawPackets& p, const render::FrameSettings&
           ++f.color[i * 3];
           continue;
         }
-        const float fx = float(x - t.minX), fy = float(y - t.minY);
-        const float z = evalPlane(t.depth, fx, fy);
+        const float z = evalPlane(t.depth, x, y, t.minX, t.minY);
         if (!(z < f.depth[i])) continue;
         f.depth[i] = z;
-        const float w = 1.0f / evalPlane(t.invW, fx, fy);
+        const float w = 1.0f / evalPlane(t.invW, x, y, t.minX, t.minY);
         const geometry::Plane* planes[3] = {&t.red, &t.green, &t.blue};
         for (int ch = 0; ch < 3; ++ch) {
-          const float c = std::min(std::max(evalPlane(*planes[ch], fx, fy) * w, 0.0f), 1.0f);
-          f.color[i * 3 + ch] = uint16_t(int32_t(c * 65535.0f + 0.5f));
+          const float c =
+              std::min(std::max(evalPlane(*planes[ch], x, y, t.minX, t.minY) * w, 0.0f), 1.0f);
+          f.color[i * 3 + ch] = uint16_t(std::nearbyint(c * 65535.0f));  // ties to even
         }
       }
   }
