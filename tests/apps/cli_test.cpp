@@ -12,13 +12,13 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Run {
+struct CliRun {
   int status = -1;
   std::string out;  // stdout and stderr together
 };
 
-Run run(const std::string& args) {
-  Run r;
+CliRun run(const std::string& args) {
+  CliRun r;
   const std::string cmd = std::string(SV_CLI) + " " + args + " 2>&1";
   FILE* p = popen(cmd.c_str(), "r");
   if (!p) return r;
@@ -42,7 +42,7 @@ std::string write(const std::string& name, const std::string& content) {
   return p.string();
 }
 
-void expectOneLineError(const Run& r, const std::string& file, const std::string& what) {
+void expectOneLineError(const CliRun& r, const std::string& file, const std::string& what) {
   EXPECT_EQ(r.status, 1) << r.out;
   EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
   EXPECT_EQ(r.out.rfind("synthvis: ", 0), 0u) << r.out;
@@ -52,7 +52,7 @@ void expectOneLineError(const Run& r, const std::string& file, const std::string
 
 TEST(Cli, RendersTheDemoSceneAndPrintsOneStatsLine) {
   const std::string out = (tempDir() / "demo.png").string();
-  const Run r = run("render -o " + out + " --width 96 --height 64 --threads 2");
+  const CliRun r = run("render -o " + out + " --width 96 --height 64 --threads 2");
   EXPECT_EQ(r.status, 0) << r.out;
   EXPECT_TRUE(fs::exists(out));
   EXPECT_NE(r.out.find("triangles in"), std::string::npos);
@@ -84,17 +84,17 @@ TEST(Cli, WrongTypesAreReported) {
 
 TEST(Cli, MissingSceneFileAndBadOptions) {
   expectOneLineError(run("render /no/such/scene.json -o x.png"), "/no/such/scene.json", "");
-  const Run big = run("render --width 100000 -o " + (tempDir() / "x.png").string());
+  const CliRun big = run("render --width 100000 -o " + (tempDir() / "x.png").string());
   EXPECT_EQ(big.status, 1) << big.out;
   EXPECT_NE(big.out.find("out of range"), std::string::npos) << big.out;
-  const Run fmt = run("render -o " + (tempDir() / "x.bmp").string() + " --width 8 --height 8");
+  const CliRun fmt = run("render -o " + (tempDir() / "x.bmp").string() + " --width 8 --height 8");
   EXPECT_EQ(fmt.status, 1) << fmt.out;
   EXPECT_NE(run("render --no-such-flag").status, 0);
 }
 
 TEST(Cli, BenchWritesTheJsonFieldsBenchMdNames) {
   const std::string json = (tempDir() / "bench.json").string();
-  const Run r = run("bench tris --count 2000 --area 20 --width 320 --height 240 --frames 2 "
+  const CliRun r = run("bench tris --count 2000 --area 20 --width 320 --height 240 --frames 2 "
                     "--warmup 1 --json " + json);
   ASSERT_EQ(r.status, 0) << r.out;
   std::ifstream f(json);

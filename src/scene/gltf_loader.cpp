@@ -1,0 +1,657 @@
+// glTF 2.0 loader (.gltf and .glb) on top of tinygltf.
+// Based on: Khronos, glTF 2.0 Specification, sections 3.5 (nodes and hierarchy), 3.6 (binary
+// data: buffers, buffer views, accessors), 3.7 (meshes), 3.9 (materials), 3.10 (cameras), 4.4 (GLB
+// file format); the KHR_materials_unlit extension.
+//
+// tinygltf parses the JSON and decodes buffers; it does not check that accessors stay inside
+// their buffer views, that indices stay inside their vertex arrays, or that nodes form trees, and
+// version 2.7.0 bounds the GLB BIN chunk without its 8-byte header. So this file checks the GLB
+// container itself before handing it over, and afterwards checks every index and byte range
+// before reading a single element.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <initializer_list>
+#include <limits>
+#include <map>
+#include <new>
+#include <numbers>
+#include <utility>
+
+#include <fmt/format.h>
+#include <tiny_gltf.h>
+
+#include "scene/loader_common.h"
+
+namespace sv::scene {
+namespace detail {
+namespace {
+
+// tinygltf turns "extras" and "extensions" into its own value tree recursively; bounding the
+// nesting depth of the JSON first keeps hostile input from exhausting the stack.
+constexpr int kMaxGltfJsonDepth = 64;
+
+// Extensions whose presence in extensionsRequired we can honour.
+constexpr const char* kSupportedRequiredExtensions[] = {"KHR_materials_unlit",
+                                                        "KHR_mesh_quantization"};
+
+// A problem in the model, reported from deep inside the conversion; caught in convertModel and
+// returned as an Error. It never leaves this file.
+struct GltfProblem {
+  std::string message;
+};
+
+[[noreturn]] void fail(std::string message) { throw GltfProblem{std::move(message)}; }
+
+uint32_t readU32(const std::string& bytes, size_t offset) {
+  unsigned char b[4];
+  std::memcpy(b, bytes.data() + offset, 4);
+  return uint32_t(b[0]) | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24;
+}
+
+// GLB layout (spec 4.4): 12-byte header (magic, version, length), then chunks of
+// (length, type, payload); the first chunk is JSON, an optional second one BIN. Returns an empty
+// string when the container is sound, else the problem.
+std::string glbProblem(const std::string& bytes) {
+  constexpr uint32_t kJson = 0x4E4F534A, kBin = 0x004E4942;
+  if (bytes.size() < 20) return "truncated GLB header";
+  if (readU32(bytes, 4) != 2) return fmt::format("unsupported GLB version {}", readU32(bytes, 4));
+  uint64_t length = readU32(bytes, 8);
+  if (length > bytes.size())
+    return fmt::format("truncated GLB: header says {} bytes, the file has {}", length, bytes.size());
+  uint64_t jsonLength = readU32(bytes, 12);
+  if (readU32(bytes, 16) != kJson) return "the first GLB chunk is not JSON";
+  uint64_t jsonEnd = 20 + jsonLength;
+  if (jsonLength == 0 || jsonEnd > length) return "the GLB JSON chunk runs past the end of the file";
+  if (jsonEnd == length) return {};
+  if (jsonEnd + 8 > length) return "truncated GLB chunk header";
+  uint64_t binLength = readU32(bytes, size_t(jsonEnd));
+  if (readU32(bytes, size_t(jsonEnd) + 4) != kBin) return "the second GLB chunk is not BIN";
+  if (jsonEnd + 8 + binLength > length) return "the GLB BIN chunk runs past the end of the file";
+  if (binLength < 4 || binLength % 4 != 0) return "the GLB BIN chunk length is not a multiple of 4";
+  return {};
+}
+
+// Deepest nesting of [ and { in JSON text, ignoring brackets inside strings.
+bool nestingWithin(const char* text, size_t size, int limit) {
+  int depth = 0;
+  bool inString = false;
+  for (size_t i = 0; i < size; ++i) {
+    char c = text[i];
+    if (inString) {
+      if (c == '\\')
+        ++i;
+      else if (c == '"')
+        inString = false;
+    } else if (c == '"') {
+      inString = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > limit) return false;
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return true;
+}
+
+// --- File access for tinygltf: external buffers only, through readFile's checks. ---
+
+// Images are not used by synthvis yet; refusing them keeps their bytes (and the image decoders)
+// out of reach of the input. A missing image is only a warning for tinygltf.
+bool isImagePath(const std::string& path) {
+  std::string ext = lowerExtension(path);
+  for (const char* image : {".png", ".jpg", ".jpeg", ".ktx2", ".webp", ".bmp", ".gif", ".dds"})
+    if (ext == image) return true;
+  return false;
+}
+
+bool fsFileExists(const std::string& path, void* followReferences) {
+  if (!*static_cast<bool*>(followReferences) || isImagePath(path)) return false;
+  std::error_code ec;
+  return std::filesystem::is_regular_file(path, ec);
+}
+
+// The default expands "~" and environment variables: not something a data file may ask for.
+std::string fsExpandFilePath(const std::string& path, void*) { return path; }
+
+bool fsReadWholeFile(std::vector<unsigned char>* out, std::string* err, const std::string& path,
+                     void* followReferences) {
+  if (!*static_cast<bool*>(followReferences) || isImagePath(path)) {
+    if (err) *err += fmt::format("cannot open '{}'\n", path);
+    return false;
+  }
+  Result<std::string> bytes = readFile(path);
+  if (!bytes) {
+    if (err) *err += bytes.error().str() + "\n";
+    return false;
+  }
+  out->assign(bytes.value().begin(), bytes.value().end());
+  return true;
+}
+
+bool fsWriteWholeFile(std::string*, const std::string&, const std::vector<unsigned char>&, void*) {
+  return false;
+}
+
+bool skipImage(tinygltf::Image*, const int, std::string*, std::string*, int, int,
+               const unsigned char*, int, void*) {
+  return true;
+}
+
+// --- Accessors (spec 3.6.2). ---
+
+int componentSize(int componentType) {
+  switch (componentType) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
+    case TINYGLTF_COMPONENT_TYPE_SHORT:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
+    default: return 0;
+  }
+}
+
+int componentCount(int type) {
+  switch (type) {
+    case TINYGLTF_TYPE_SCALAR: return 1;
+    case TINYGLTF_TYPE_VEC2: return 2;
+    case TINYGLTF_TYPE_VEC3: return 3;
+    case TINYGLTF_TYPE_VEC4: return 4;
+    default: return 0;
+  }
+}
+
+// A checked window onto an accessor's elements: element i starts at data + i·stride and has
+// `components` components of `componentType`, all inside the buffer.
+struct AccessorView {
+  const unsigned char* data = nullptr;
+  size_t count = 0;
+  size_t stride = 0;
+  int componentType = 0;
+  int components = 0;
+  bool normalized = false;
+
+  // Component c of element i as float, with the spec's normalization (3.11) when `normalized`.
+  float get(size_t i, int c) const {
+    const unsigned char* p = data + i * stride + size_t(c) * size_t(componentSize(componentType));
+    switch (componentType) {
+      case TINYGLTF_COMPONENT_TYPE_FLOAT: {
+        float x;
+        std::memcpy(&x, p, 4);
+        return x;
+      }
+      case TINYGLTF_COMPONENT_TYPE_BYTE: {
+        int8_t x;
+        std::memcpy(&x, p, 1);
+        return normalized ? std::max(x / 127.0f, -1.0f) : float(x);
+      }
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? *p / 255.0f : float(*p);
+      case TINYGLTF_COMPONENT_TYPE_SHORT: {
+        int16_t x;
+        std::memcpy(&x, p, 2);
+        return normalized ? std::max(x / 32767.0f, -1.0f) : float(x);
+      }
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+        uint16_t x;
+        std::memcpy(&x, p, 2);
+        return normalized ? x / 65535.0f : float(x);
+      }
+      default: return 0;
+    }
+  }
+  // Element i of a scalar unsigned integer accessor (indices).
+  uint32_t index(size_t i) const {
+    const unsigned char* p = data + i * stride;
+    switch (componentType) {
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return *p;
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+        uint16_t x;
+        std::memcpy(&x, p, 2);
+        return x;
+      }
+      default: {
+        uint32_t x;
+        std::memcpy(&x, p, 4);
+        return x;
+      }
+    }
+  }
+};
+
+class GltfConverter {
+ public:
+  GltfConverter(const tinygltf::Model& model, const LoadOptions& options)
+      : model_(model), options_(options) {}
+
+  Scene convert();
+
+ private:
+  AccessorView accessor(int index, const std::string& where, std::initializer_list<int> types,
+                        std::initializer_list<int> componentTypes) const;
+  void convertMaterials();
+  const std::vector<int>& meshesOf(int gltfMesh);
+  Mesh convertPrimitive(const tinygltf::Primitive& primitive, const std::string& where) const;
+  Mat4 localMatrix(const tinygltf::Node& node, const std::string& where) const;
+  Camera convertCamera(const tinygltf::Node& node, const Mat4& world, const std::string& where) const;
+  void walkNodes();
+
+  const tinygltf::Model& model_;
+  const LoadOptions& options_;
+  Scene scene_;
+  uint64_t triangles_ = 0;
+  std::map<int, std::vector<int>> meshes_;  // glTF mesh → our meshes, one per primitive
+};
+
+AccessorView GltfConverter::accessor(int index, const std::string& where,
+                                     std::initializer_list<int> types,
+                                     std::initializer_list<int> componentTypes) const {
+  if (index < 0 || size_t(index) >= model_.accessors.size())
+    fail(fmt::format("{}: accessor {} does not exist ({} accessors)", where, index,
+                     model_.accessors.size()));
+  const tinygltf::Accessor& a = model_.accessors[size_t(index)];
+  const std::string name = fmt::format("{}: accessors[{}]", where, index);
+  if (a.sparse.isSparse) fail(name + ": sparse accessors are not supported");
+  if (std::find(types.begin(), types.end(), a.type) == types.end())
+    fail(fmt::format("{}: unexpected element type {}", name, a.type));
+  if (std::find(componentTypes.begin(), componentTypes.end(), a.componentType) ==
+      componentTypes.end())
+    fail(fmt::format("{}: unexpected component type {}", name, a.componentType));
+  if (a.bufferView < 0 || size_t(a.bufferView) >= model_.bufferViews.size())
+    fail(fmt::format("{}: bufferView {} does not exist", name, a.bufferView));
+  const tinygltf::BufferView& view = model_.bufferViews[size_t(a.bufferView)];
+  if (view.buffer < 0 || size_t(view.buffer) >= model_.buffers.size())
+    fail(fmt::format("{}: bufferViews[{}] refers to buffer {}, which does not exist", name,
+                     a.bufferView, view.buffer));
+  const std::vector<unsigned char>& buffer = model_.buffers[size_t(view.buffer)].data;
+
+  // Step 1: the buffer view inside its buffer.
+  if (view.byteOffset > buffer.size() || view.byteLength > buffer.size() - view.byteOffset)
+    fail(fmt::format("{}: bufferViews[{}] (offset {}, length {}) lies outside buffers[{}] ({} bytes)",
+                     name, a.bufferView, view.byteOffset, view.byteLength, view.buffer,
+                     buffer.size()));
+
+  // Step 2: the elements inside the buffer view. Element i occupies
+  // [byteOffset + i·stride, byteOffset + i·stride + elementSize).
+  AccessorView out;
+  out.componentType = a.componentType;
+  out.components = componentCount(a.type);
+  out.normalized = a.normalized;
+  out.count = a.count;
+  const size_t elementSize = size_t(componentSize(a.componentType)) * size_t(out.components);
+  out.stride = view.byteStride ? view.byteStride : elementSize;
+  if (view.byteStride && (view.byteStride < elementSize || view.byteStride > 252))
+    fail(fmt::format("{}: byteStride {} is invalid for {}-byte elements", name, view.byteStride,
+                     elementSize));
+  if (a.count > 0) {
+    const size_t room = a.byteOffset <= view.byteLength ? view.byteLength - a.byteOffset : 0;
+    if (a.byteOffset > view.byteLength || room < elementSize ||
+        (a.count - 1) > (room - elementSize) / out.stride)
+      fail(fmt::format("{}: {} elements of {} bytes (stride {}, offset {}) do not fit in "
+                       "bufferViews[{}] ({} bytes)",
+                       name, a.count, elementSize, out.stride, a.byteOffset, a.bufferView,
+                       view.byteLength));
+    out.data = buffer.data() + view.byteOffset + a.byteOffset;
+  }
+  return out;
+}
+
+void GltfConverter::convertMaterials() {
+  for (size_t i = 0; i < model_.materials.size(); ++i) {
+    const tinygltf::Material& gm = model_.materials[i];
+    Material m;
+    m.name = gm.name;
+    const std::vector<double>& f = gm.pbrMetallicRoughness.baseColorFactor;
+    if (f.size() == 4) {
+      for (double x : f)
+        if (!std::isfinite(x))
+          fail(fmt::format("materials[{}]: baseColorFactor is not finite", i));
+      m.baseColor = {float(f[0]), float(f[1]), float(f[2]), float(f[3])};
+    } else if (!f.empty()) {
+      fail(fmt::format("materials[{}]: baseColorFactor must have 4 numbers, has {}", i, f.size()));
+    }
+    m.doubleSided = gm.doubleSided;
+    m.unlit = gm.extensions.count("KHR_materials_unlit") > 0;
+    scene_.materials.push_back(std::move(m));
+  }
+}
+
+Mesh GltfConverter::convertPrimitive(const tinygltf::Primitive& primitive,
+                                     const std::string& where) const {
+  constexpr int kFloat = TINYGLTF_COMPONENT_TYPE_FLOAT;
+  constexpr int kByte = TINYGLTF_COMPONENT_TYPE_BYTE, kUByte = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
+  constexpr int kShort = TINYGLTF_COMPONENT_TYPE_SHORT;
+  constexpr int kUShort = TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
+  constexpr int kUInt = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+  Mesh mesh;
+
+  // Step 1: vertex attributes. Integer types are allowed where KHR_mesh_quantization allows them.
+  auto attribute = [&](const char* name) -> const int* {
+    auto it = primitive.attributes.find(name);
+    return it == primitive.attributes.end() ? nullptr : &it->second;
+  };
+  const int* positionIndex = attribute("POSITION");
+  if (!positionIndex) fail(where + ": has no POSITION attribute");
+  AccessorView positions = accessor(*positionIndex, where + ".attributes.POSITION",
+                                    {TINYGLTF_TYPE_VEC3}, {kFloat, kByte, kUByte, kShort, kUShort});
+  const size_t n = positions.count;
+  if (n > std::numeric_limits<uint32_t>::max()) fail(where + ": too many vertices");
+  mesh.positions.resize(n);
+  for (size_t i = 0; i < n; ++i) mesh.positions[i] = {positions.get(i, 0), positions.get(i, 1), positions.get(i, 2)};
+
+  auto sameCount = [&](const AccessorView& v, const char* name) {
+    if (v.count != n)
+      fail(fmt::format("{}.attributes.{}: {} elements, but POSITION has {}", where, name, v.count, n));
+  };
+  if (const int* index = attribute("NORMAL")) {
+    AccessorView v = accessor(*index, where + ".attributes.NORMAL", {TINYGLTF_TYPE_VEC3},
+                              {kFloat, kByte, kShort});
+    sameCount(v, "NORMAL");
+    mesh.normals.resize(n);
+    for (size_t i = 0; i < n; ++i) mesh.normals[i] = {v.get(i, 0), v.get(i, 1), v.get(i, 2)};
+  }
+  if (const int* index = attribute("COLOR_0")) {
+    AccessorView v = accessor(*index, where + ".attributes.COLOR_0",
+                              {TINYGLTF_TYPE_VEC3, TINYGLTF_TYPE_VEC4}, {kFloat, kUByte, kUShort});
+    sameCount(v, "COLOR_0");
+    // Integer colours are normalized by definition (spec 3.7.2.1), whatever the flag says.
+    v.normalized = true;
+    mesh.colors.resize(n);
+    for (size_t i = 0; i < n; ++i)
+      mesh.colors[i] = {v.get(i, 0), v.get(i, 1), v.get(i, 2), v.components == 4 ? v.get(i, 3) : 1.0f};
+  }
+  if (const int* index = attribute("TEXCOORD_0")) {
+    AccessorView v = accessor(*index, where + ".attributes.TEXCOORD_0", {TINYGLTF_TYPE_VEC2},
+                              {kFloat, kByte, kUByte, kShort, kUShort});
+    sameCount(v, "TEXCOORD_0");
+    mesh.uvs.resize(n);
+    for (size_t i = 0; i < n; ++i) mesh.uvs[i] = {v.get(i, 0), v.get(i, 1)};
+  }
+
+  // Step 2: the index sequence, given or implied (0, 1, 2, …), each checked against n.
+  std::vector<uint32_t> sequence;
+  if (primitive.indices >= 0) {
+    AccessorView v = accessor(primitive.indices, where + ".indices", {TINYGLTF_TYPE_SCALAR},
+                              {kUByte, kUShort, kUInt});
+    sequence.resize(v.count);
+    for (size_t i = 0; i < v.count; ++i) {
+      sequence[i] = v.index(i);
+      if (sequence[i] >= n)
+        fail(fmt::format("{}.indices: index {} at position {} is out of range ({} vertices)", where,
+                         sequence[i], i, n));
+    }
+  } else {
+    sequence.resize(n);
+    for (size_t i = 0; i < n; ++i) sequence[i] = uint32_t(i);
+  }
+
+  // Step 3: triangles from the sequence (spec 3.7.2.1, "Topology types"). An incomplete last
+  // triangle is dropped; strips and fans skip the degenerate triangles used as restarts.
+  const size_t m = sequence.size();
+  std::vector<uint32_t>& out = mesh.indices;
+  auto emit = [&](uint32_t a, uint32_t b, uint32_t c) {
+    if (a != b && b != c && a != c) out.insert(out.end(), {a, b, c});
+  };
+  switch (primitive.mode) {
+    case TINYGLTF_MODE_TRIANGLES:
+      out.reserve(m - m % 3);
+      for (size_t i = 0; i + 2 < m; i += 3) out.insert(out.end(), {sequence[i], sequence[i + 1], sequence[i + 2]});
+      break;
+    case TINYGLTF_MODE_TRIANGLE_STRIP:
+      // Odd triangles swap their first two vertices to keep the winding.
+      for (size_t i = 0; i + 2 < m; ++i)
+        if (i % 2 == 0)
+          emit(sequence[i], sequence[i + 1], sequence[i + 2]);
+        else
+          emit(sequence[i + 1], sequence[i], sequence[i + 2]);
+      break;
+    case TINYGLTF_MODE_TRIANGLE_FAN:
+      for (size_t i = 1; i + 1 < m; ++i) emit(sequence[0], sequence[i], sequence[i + 1]);
+      break;
+    default: break;  // points and lines have no triangles
+  }
+
+  if (primitive.material >= 0 && size_t(primitive.material) >= scene_.materials.size())
+    fail(fmt::format("{}: material {} does not exist ({} materials)", where, primitive.material,
+                     scene_.materials.size()));
+  mesh.material = primitive.material;
+  return mesh;
+}
+
+const std::vector<int>& GltfConverter::meshesOf(int gltfMesh) {
+  auto it = meshes_.find(gltfMesh);
+  if (it != meshes_.end()) return it->second;
+  std::vector<int> ours;
+  const tinygltf::Mesh& gm = model_.meshes[size_t(gltfMesh)];
+  for (size_t k = 0; k < gm.primitives.size(); ++k) {
+    const tinygltf::Primitive& primitive = gm.primitives[k];
+    const std::string where = fmt::format("meshes[{}].primitives[{}]", gltfMesh, k);
+    switch (primitive.mode) {
+      case TINYGLTF_MODE_TRIANGLES:
+      case TINYGLTF_MODE_TRIANGLE_STRIP:
+      case TINYGLTF_MODE_TRIANGLE_FAN: break;
+      case TINYGLTF_MODE_POINTS:
+      case TINYGLTF_MODE_LINE:
+      case TINYGLTF_MODE_LINE_LOOP:
+      case TINYGLTF_MODE_LINE_STRIP: continue;  // nothing to fill
+      default: fail(fmt::format("{}: unknown mode {}", where, primitive.mode));
+    }
+    Mesh mesh = convertPrimitive(primitive, where);
+    mesh.name = gm.primitives.size() == 1 ? gm.name : fmt::format("{}[{}]", gm.name, k);
+    scene_.meshes.push_back(std::move(mesh));
+    ours.push_back(int(scene_.meshes.size() - 1));
+  }
+  return meshes_.emplace(gltfMesh, std::move(ours)).first->second;
+}
+
+Mat4 GltfConverter::localMatrix(const tinygltf::Node& node, const std::string& where) const {
+  auto finite = [&](const std::vector<double>& v, const char* what) {
+    for (double x : v)
+      if (!std::isfinite(x)) fail(fmt::format("{}.{}: not finite", where, what));
+  };
+  if (!node.matrix.empty()) {
+    if (node.matrix.size() != 16)
+      fail(fmt::format("{}.matrix: expected 16 numbers, got {}", where, node.matrix.size()));
+    finite(node.matrix, "matrix");
+    float m[16];
+    for (int i = 0; i < 16; ++i) m[i] = float(node.matrix[size_t(i)]);
+    return Mat4::fromColumnMajor(m);
+  }
+  // T·R·S (spec 3.5.3).
+  Mat4 t, r, s;
+  if (!node.translation.empty()) {
+    if (node.translation.size() != 3) fail(where + ".translation: expected 3 numbers");
+    finite(node.translation, "translation");
+    t = Mat4::translation({float(node.translation[0]), float(node.translation[1]),
+                           float(node.translation[2])});
+  }
+  if (!node.rotation.empty()) {
+    if (node.rotation.size() != 4) fail(where + ".rotation: expected 4 numbers");
+    finite(node.rotation, "rotation");
+    // Unit quaternion (x, y, z, w) to matrix; normalized first, since files often store
+    // quaternions with a little rounding.
+    double x = node.rotation[0], y = node.rotation[1], z = node.rotation[2], w = node.rotation[3];
+    double len = std::sqrt(x * x + y * y + z * z + w * w);
+    if (!(len > 0)) fail(where + ".rotation: zero quaternion");
+    x /= len, y /= len, z /= len, w /= len;
+    r.m[0] = {float(1 - 2 * (y * y + z * z)), float(2 * (x * y + z * w)), float(2 * (x * z - y * w)), 0};
+    r.m[1] = {float(2 * (x * y - z * w)), float(1 - 2 * (x * x + z * z)), float(2 * (y * z + x * w)), 0};
+    r.m[2] = {float(2 * (x * z + y * w)), float(2 * (y * z - x * w)), float(1 - 2 * (x * x + y * y)), 0};
+  }
+  if (!node.scale.empty()) {
+    if (node.scale.size() != 3) fail(where + ".scale: expected 3 numbers");
+    finite(node.scale, "scale");
+    s = Mat4::scaling({float(node.scale[0]), float(node.scale[1]), float(node.scale[2])});
+  }
+  return t * r * s;
+}
+
+Camera GltfConverter::convertCamera(const tinygltf::Node& node, const Mat4& world,
+                                    const std::string& where) const {
+  const tinygltf::Camera& gc = model_.cameras[size_t(node.camera)];
+  const tinygltf::PerspectiveCamera& p = gc.perspective;
+  if (!std::isfinite(p.yfov) || !(p.yfov > 0) || !(p.yfov < std::numbers::pi) ||
+      !std::isfinite(p.znear) || !(p.znear > 0) || !std::isfinite(p.zfar) || p.zfar < 0)
+    fail(fmt::format("{}: cameras[{}] has an invalid perspective (yfov {}, znear {}, zfar {})",
+                     where, node.camera, p.yfov, p.znear, p.zfar));
+  // A glTF camera looks down its local −Z with +Y up (spec 3.10.1).
+  Camera c;
+  c.name = gc.name.empty() ? node.name : gc.name;
+  c.position = world.transformPoint({0, 0, 0});
+  c.target = c.position + normalize(world.transformDirection({0, 0, -1}));
+  c.up = normalize(world.transformDirection({0, 1, 0}));
+  c.yfovDegrees = float(p.yfov * 180 / std::numbers::pi);
+  c.znear = float(p.znear);
+  // zfar 0 means an infinite projection in glTF; synthvis needs a far plane.
+  c.zfar = p.zfar > 0 ? float(p.zfar) : 1000.0f;
+  if (!(c.zfar > c.znear)) c.zfar = c.znear * 1000;
+  return c;
+}
+
+void GltfConverter::walkNodes() {
+  const size_t nodeCount = model_.nodes.size();
+  // Step 1: check child indices and count parents: the hierarchy must be a forest (spec 3.5.1),
+  // which also guarantees the walk below visits each node once and terminates.
+  std::vector<uint8_t> hasParent(nodeCount, 0);
+  for (size_t i = 0; i < nodeCount; ++i)
+    for (int child : model_.nodes[i].children) {
+      if (child < 0 || size_t(child) >= nodeCount)
+        fail(fmt::format("nodes[{}]: child {} does not exist ({} nodes)", i, child, nodeCount));
+      if (hasParent[size_t(child)]++)
+        fail(fmt::format("nodes[{}]: has more than one parent (the node hierarchy must be a tree)",
+                         child));
+    }
+
+  // Step 2: the roots — the default scene's, or every parentless node.
+  std::vector<int> roots;
+  if (model_.defaultScene >= 0) {
+    if (size_t(model_.defaultScene) >= model_.scenes.size())
+      fail(fmt::format("scene {} does not exist ({} scenes)", model_.defaultScene,
+                       model_.scenes.size()));
+    roots = model_.scenes[size_t(model_.defaultScene)].nodes;
+  } else {
+    for (size_t i = 0; i < nodeCount; ++i)
+      if (!hasParent[i]) roots.push_back(int(i));
+  }
+
+  // Step 3: depth-first with an explicit stack (a hostile file may nest nodes very deep).
+  std::vector<uint8_t> visited(nodeCount, 0);
+  std::vector<std::pair<int, Mat4>> stack;
+  for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back({*it, Mat4{}});
+  while (!stack.empty()) {
+    auto [index, parent] = stack.back();
+    stack.pop_back();
+    if (index < 0 || size_t(index) >= nodeCount)
+      fail(fmt::format("scenes[{}]: node {} does not exist", model_.defaultScene, index));
+    if (visited[size_t(index)]++)
+      fail(fmt::format("nodes[{}]: reached twice (the node hierarchy must be a tree)", index));
+    const tinygltf::Node& node = model_.nodes[size_t(index)];
+    const std::string where = fmt::format("nodes[{}]", index);
+    const Mat4 world = parent * localMatrix(node, where);
+
+    if (node.mesh >= 0) {
+      if (size_t(node.mesh) >= model_.meshes.size())
+        fail(fmt::format("{}: mesh {} does not exist ({} meshes)", where, node.mesh,
+                         model_.meshes.size()));
+      for (int mesh : meshesOf(node.mesh)) {
+        uint64_t t = scene_.meshes[size_t(mesh)].triangleCount();
+        if (t > options_.maxTriangles - triangles_)
+          fail(fmt::format("{}: the scene would have more than {} triangles", where,
+                           options_.maxTriangles));
+        triangles_ += t;
+        scene_.instances.push_back({mesh, world});
+      }
+    } else if (node.mesh < -1) {
+      fail(fmt::format("{}: mesh {} does not exist", where, node.mesh));
+    }
+    if (node.camera >= 0) {
+      if (size_t(node.camera) >= model_.cameras.size())
+        fail(fmt::format("{}: camera {} does not exist ({} cameras)", where, node.camera,
+                         model_.cameras.size()));
+      // Orthographic cameras have no equivalent in Camera; they are left out.
+      if (model_.cameras[size_t(node.camera)].type == "perspective")
+        scene_.cameras.push_back(convertCamera(node, world, where));
+    }
+    for (auto child = node.children.rbegin(); child != node.children.rend(); ++child)
+      stack.push_back({*child, world});
+  }
+}
+
+Scene GltfConverter::convert() {
+  for (const std::string& extension : model_.extensionsRequired) {
+    bool supported = false;
+    for (const char* known : kSupportedRequiredExtensions) supported |= extension == known;
+    if (!supported) fail(fmt::format("requires the unsupported extension '{}'", extension));
+  }
+  convertMaterials();
+  walkNodes();
+  return std::move(scene_);
+}
+
+}  // namespace
+}  // namespace detail
+
+Result<Scene> loadGltfFromMemory(const std::string& bytes, const std::string& path,
+                                 const LoadOptions& options) {
+  using namespace detail;
+  try {
+    // Step 1: our own checks of the container and its JSON (see the file comment).
+    const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
+    if (bytes.size() > kMaxFileBytes)
+      return Error{path, "", fmt::format("input is too large ({} bytes)", bytes.size())};
+    const char* json = bytes.data();
+    size_t jsonSize = bytes.size();
+    if (binary) {
+      std::string problem = glbProblem(bytes);
+      if (!problem.empty()) return Error{path, "", problem};
+      json = bytes.data() + 20;
+      jsonSize = readU32(bytes, 12);
+    }
+    if (!nestingWithin(json, jsonSize, kMaxGltfJsonDepth))
+      return Error{path, "",
+                   fmt::format("JSON values are nested more than {} levels deep", kMaxGltfJsonDepth)};
+
+    // Step 2: tinygltf parses, with file access routed through readFile and images skipped.
+    bool follow = options.followReferences;
+    tinygltf::TinyGLTF loader;
+    loader.SetFsCallbacks({&fsFileExists, &fsExpandFilePath, &fsReadWholeFile, &fsWriteWholeFile,
+                           &follow});
+    loader.SetImageLoader(&skipImage, nullptr);
+    tinygltf::Model model;
+    std::string err, warn;
+    const std::string baseDir = directoryOf(path);
+    bool ok = binary ? loader.LoadBinaryFromMemory(
+                           &model, &err, &warn, reinterpret_cast<const unsigned char*>(bytes.data()),
+                           static_cast<unsigned int>(bytes.size()), baseDir)
+                     : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(),
+                                                  static_cast<unsigned int>(bytes.size()), baseDir);
+    if (!ok)
+      return Error{path, "", fmt::format("invalid glTF: {}", err.empty() ? "parse failed" : oneLine(err))};
+
+    // Step 3: the model, checked as it is converted.
+    Scene scene = GltfConverter(model, options).convert();
+    Status valid = validate(scene, path);
+    if (!valid) return valid.error();
+    return scene;
+  } catch (const GltfProblem& p) {
+    return Error{path, "", p.message};
+  } catch (const std::bad_alloc&) {
+    return Error{path, "", "out of memory"};
+  } catch (const std::exception& e) {
+    // tinygltf can throw from std::vector::at on some malformed files.
+    return Error{path, "", fmt::format("invalid glTF: {}", oneLine(e.what()))};
+  }
+}
+
+Result<Scene> loadGltf(const std::string& path) {
+  try {
+    Result<std::string> bytes = detail::readFile(path);
+    if (!bytes) return bytes.error();
+    return loadGltfFromMemory(bytes.value(), path, LoadOptions{});
+  } catch (const std::bad_alloc&) {
+    return Error{path, "", "out of memory"};
+  }
+}
+
+}  // namespace sv::scene

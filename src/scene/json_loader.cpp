@@ -1,0 +1,870 @@
+// The JSON scene format, version 1. Based on: docs/scene-format.md (the reference for every key,
+// default and limit used here).
+//
+// Parsing has two steps. nlohmann::json turns the text into a document (syntax errors carry
+// line:column; a parse callback limits nesting depth and rejects duplicate keys, which nlohmann
+// would silently resolve to the last one). A SceneReader then walks the document, checking every
+// key, type and range before using it, and reports the first problem with its place in the
+// document ("objects[2].transform.translate: expected an array of 3 numbers").
+//
+// Inside this file the walker reports a problem by throwing JsonProblem: it keeps each field
+// read to one line. parseJsonSceneIn catches it, and every other exception, and returns an
+// Error; nothing is thrown past this file.
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <initializer_list>
+#include <map>
+#include <numbers>
+#include <optional>
+#include <set>
+#include <string_view>
+#include <utility>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "scene/loader_common.h"
+#include "scene/primitives.h"
+
+namespace sv::scene {
+namespace detail {
+namespace {
+
+using Json = nlohmann::json;
+
+constexpr int kFormatVersion = 1;
+// Deeper than any valid scene needs (an inline mesh is 4 levels down); guards the recursion-free
+// but memory-hungry parse of "[[[[…" and keeps error paths short.
+constexpr size_t kMaxJsonDepth = 64;
+// Every number must be finite and at most this large in magnitude, so that it converts to float
+// and stays finite through a few products.
+constexpr double kMaxMagnitude = 1e30;
+
+// A problem at a place in the document; see the file comment.
+struct JsonProblem {
+  std::string where;  // "objects[2].transform.translate", or "" for the top level
+  std::string message;
+};
+
+[[noreturn]] void fail(const std::string& where, std::string message) {
+  throw JsonProblem{where, std::move(message)};
+}
+
+std::string member(const std::string& where, std::string_view key) {
+  return where.empty() ? std::string(key) : fmt::format("{}.{}", where, key);
+}
+std::string element(const std::string& where, size_t i) { return fmt::format("{}[{}]", where, i); }
+
+const char* typeName(const Json& v) {
+  switch (v.type()) {
+    case Json::value_t::object: return "an object";
+    case Json::value_t::array: return "an array";
+    case Json::value_t::string: return "a string";
+    case Json::value_t::boolean: return "a boolean";
+    case Json::value_t::null: return "null";
+    case Json::value_t::number_integer:
+    case Json::value_t::number_unsigned: return "an integer";
+    case Json::value_t::number_float: return "a number";
+    default: return "an unsupported value";
+  }
+}
+
+// Levenshtein distance, for "did you mean" hints on misspelt keys.
+size_t editDistance(std::string_view a, std::string_view b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+std::string suggestion(std::string_view key, std::initializer_list<std::string_view> allowed) {
+  std::string_view best;
+  size_t bestDistance = 3;  // more than two edits is a different word, not a typo
+  for (std::string_view candidate : allowed) {
+    size_t d = editDistance(key, candidate);
+    if (d < bestDistance && d < candidate.size()) {
+      best = candidate;
+      bestDistance = d;
+    }
+  }
+  return best.empty() ? std::string() : fmt::format(" (did you mean '{}'?)", best);
+}
+
+// Step 0: the parse callback. nlohmann calls it for every token event; it tracks the path of the
+// current container so that its own errors can say where they are.
+class ParseGuard {
+ public:
+  bool operator()(int /*depth*/, Json::parse_event_t event, Json& parsed) {
+    switch (event) {
+      case Json::parse_event_t::object_start:
+      case Json::parse_event_t::array_start:
+        if (frames_.size() >= kMaxJsonDepth)
+          fail(path(), fmt::format("values are nested more than {} levels deep", kMaxJsonDepth));
+        frames_.push_back({event == Json::parse_event_t::array_start, 0, {}, {}});
+        break;
+      case Json::parse_event_t::key: {
+        Frame& frame = frames_.back();
+        frame.key = parsed.get<std::string>();
+        if (!frame.keys.insert(frame.key).second)
+          fail(path(), fmt::format("duplicate key '{}'", frame.key));
+        break;
+      }
+      case Json::parse_event_t::object_end:
+      case Json::parse_event_t::array_end:
+        frames_.pop_back();
+        finishValue();
+        break;
+      case Json::parse_event_t::value: finishValue(); break;
+    }
+    return true;
+  }
+
+ private:
+  struct Frame {
+    bool array;
+    size_t index;  // arrays: elements completed so far
+    std::string key;  // objects: the key being read
+    std::set<std::string> keys;
+  };
+
+  void finishValue() {
+    if (!frames_.empty() && frames_.back().array) ++frames_.back().index;
+  }
+  // The path of the innermost open container.
+  std::string path() const {
+    std::string p;
+    for (size_t i = 0; i + 1 < frames_.size(); ++i)
+      p = frames_[i].array ? element(p, frames_[i].index) : member(p, frames_[i].key);
+    return p;
+  }
+
+  std::vector<Frame> frames_;
+};
+
+// 1-based "line:column" of the 1-based byte offset nlohmann reports (the byte after the last one
+// it read).
+std::string lineColumn(const std::string& text, size_t byte) {
+  size_t offset = std::min(byte > 0 ? byte - 1 : 0, text.size());
+  size_t line = 1 + size_t(std::count(text.begin(), text.begin() + ptrdiff_t(offset), '\n'));
+  size_t lineStart = text.rfind('\n', offset > 0 ? offset - 1 : 0);
+  lineStart = (lineStart == std::string::npos || offset == 0) ? 0 : lineStart + 1;
+  return fmt::format("{}:{}", line, offset - lineStart + 1);
+}
+
+// "[json.exception.parse_error.101] parse error at line 3, column 4: syntax error …" → the part
+// after the position, which we print in our own "file:line:col: message" form.
+std::string parseErrorMessage(const std::string& what) {
+  size_t column = what.find("column ");
+  size_t colon = what.find(": ", column == std::string::npos ? 0 : column);
+  if (colon != std::string::npos) return oneLine(what.substr(colon + 2));
+  size_t bracket = what.find("] ");
+  return oneLine(bracket == std::string::npos ? what : what.substr(bracket + 2));
+}
+
+// --- Typed readers. Each checks its value completely and fails with the value's place. ---
+
+const Json* find(const Json& object, std::string_view key) {
+  auto it = object.find(key);
+  return it == object.end() ? nullptr : &*it;
+}
+
+// Checks that `v` is an object whose keys are all in `allowed` (a misspelt key is an error, not a
+// silently ignored setting).
+void expectKeys(const Json& v, const std::string& where,
+                std::initializer_list<std::string_view> allowed) {
+  if (!v.is_object()) fail(where, fmt::format("expected an object, got {}", typeName(v)));
+  for (const auto& item : v.items()) {
+    const std::string& key = item.key();
+    if (std::find(allowed.begin(), allowed.end(), key) == allowed.end())
+      fail(where, fmt::format("unknown key '{}'{}", key, suggestion(key, allowed)));
+  }
+}
+
+// Empty when `v` is an acceptable number, else what is wrong with it.
+std::string numberProblem(const Json& v) {
+  if (!v.is_number()) return fmt::format("expected a number, got {}", typeName(v));
+  double d = v.get<double>();
+  if (!std::isfinite(d) || std::fabs(d) > kMaxMagnitude)
+    return fmt::format("{} is out of range (numbers must be finite, magnitude at most 1e30)",
+                       v.dump());
+  return {};
+}
+
+float number(const Json& v, const std::string& where) {
+  std::string problem = numberProblem(v);
+  if (!problem.empty()) fail(where, problem);
+  return static_cast<float>(v.get<double>());
+}
+
+float positive(const Json& v, const std::string& where) {
+  float x = number(v, where);
+  if (!(x > 0)) fail(where, fmt::format("expected a number greater than 0, got {}", v.dump()));
+  return x;
+}
+
+float inRange(const Json& v, const std::string& where, float lo, float hi) {
+  float x = number(v, where);
+  if (x < lo || x > hi) fail(where, fmt::format("{} is out of range {}..{}", v.dump(), lo, hi));
+  return x;
+}
+
+int64_t integer(const Json& v, const std::string& where, int64_t lo, int64_t hi) {
+  if (!v.is_number_integer()) fail(where, fmt::format("expected an integer, got {}", typeName(v)));
+  // Unsigned values beyond int64 are out of every range we accept.
+  bool tooBig = v.is_number_unsigned() && v.get<uint64_t>() > uint64_t(hi);
+  int64_t x = tooBig ? hi : v.get<int64_t>();
+  if (tooBig || x < lo || x > hi) fail(where, fmt::format("{} is out of range {}..{}", v.dump(), lo, hi));
+  return x;
+}
+
+bool boolean(const Json& v, const std::string& where) {
+  if (!v.is_boolean()) fail(where, fmt::format("expected true or false, got {}", typeName(v)));
+  return v.get<bool>();
+}
+
+std::string string(const Json& v, const std::string& where) {
+  if (!v.is_string()) fail(where, fmt::format("expected a string, got {}", typeName(v)));
+  return v.get<std::string>();
+}
+
+const Json& array(const Json& v, const std::string& where) {
+  if (!v.is_array()) fail(where, fmt::format("expected an array, got {}", typeName(v)));
+  return v;
+}
+
+// An array of exactly `n` numbers.
+template <size_t N>
+std::array<float, N> numbers(const Json& v, const std::string& where) {
+  if (!v.is_array() || v.size() != N)
+    fail(where, fmt::format("expected an array of {} numbers, got {}", N,
+                            v.is_array() ? fmt::format("{} elements", v.size()) : typeName(v)));
+  std::array<float, N> out;
+  for (size_t i = 0; i < N; ++i) out[i] = number(v[i], element(where, i));
+  return out;
+}
+
+Vec3 vec3(const Json& v, const std::string& where) {
+  auto a = numbers<3>(v, where);
+  return {a[0], a[1], a[2]};
+}
+
+Vec3 nonZeroVec3(const Json& v, const std::string& where) {
+  Vec3 x = vec3(v, where);
+  if (!(length(x) > 0)) fail(where, "expected a non-zero vector");
+  return x;
+}
+
+// [r, g, b] or (when `alpha`) [r, g, b, a], each in 0..1; alpha defaults to 1.
+Vec4 color(const Json& v, const std::string& where, bool alpha) {
+  bool sizeOk = v.is_array() && (v.size() == 3 || (alpha && v.size() == 4));
+  if (!sizeOk)
+    fail(where, fmt::format("expected a colour [r, g, b{}] with components 0..1, got {}",
+                            alpha ? "(, a)" : "",
+                            v.is_array() ? fmt::format("{} elements", v.size()) : typeName(v)));
+  float c[4] = {1, 1, 1, 1};
+  for (size_t i = 0; i < v.size(); ++i) c[i] = inRange(v[i], element(where, i), 0, 1);
+  return {c[0], c[1], c[2], c[3]};
+}
+
+// A length given as one number for all axes or as an array of `N` numbers, each > 0.
+template <size_t N>
+std::array<float, N> sizes(const Json& v, const std::string& where) {
+  std::array<float, N> out;
+  if (v.is_number()) {
+    out.fill(positive(v, where));
+  } else {
+    if (!v.is_array() || v.size() != N)
+      fail(where, fmt::format("expected a number or an array of {} numbers, got {}", N,
+                              v.is_array() ? fmt::format("{} elements", v.size()) : typeName(v)));
+    for (size_t i = 0; i < N; ++i) out[i] = positive(v[i], element(where, i));
+  }
+  return out;
+}
+
+// A count given as one integer for both axes or as [x, z].
+std::array<int, 2> counts(const Json& v, const std::string& where, int lo, int hi) {
+  if (v.is_array()) {
+    if (v.size() != 2)
+      fail(where, fmt::format("expected an integer or an array of 2 integers, got {} elements",
+                              v.size()));
+    return {int(integer(v[0], element(where, 0), lo, hi)),
+            int(integer(v[1], element(where, 1), lo, hi))};
+  }
+  int n = int(integer(v, where, lo, hi));
+  return {n, n};
+}
+
+Mat4 rotationDegrees(Vec3 axis, float degrees) {
+  return Mat4::rotation(axis, static_cast<float>(degrees * std::numbers::pi / 180.0));
+}
+
+// "transform": {"matrix": [16]} or any of translate / rotate / scale, composed as T·R·S.
+Mat4 readTransform(const Json& v, const std::string& where) {
+  expectKeys(v, where, {"matrix", "translate", "rotate", "scale"});
+  if (const Json* m = find(v, "matrix")) {
+    if (v.size() > 1)
+      fail(where, "'matrix' cannot be combined with 'translate', 'rotate' or 'scale'");
+    std::string w = member(where, "matrix");
+    auto a = numbers<16>(*m, w);
+    // Column-major: elements 3, 7, 11, 15 form the last row. A projective last row would make
+    // positions depend on w, which no stage after the loader expects.
+    if (a[3] != 0 || a[7] != 0 || a[11] != 0 || a[15] != 1)
+      fail(w, "the last row (elements 3, 7, 11, 15) must be 0, 0, 0, 1");
+    return Mat4::fromColumnMajor(a.data());
+  }
+  Mat4 t, r, s;
+  if (const Json* translate = find(v, "translate"))
+    t = Mat4::translation(vec3(*translate, member(where, "translate")));
+  if (const Json* rotate = find(v, "rotate")) {
+    std::string w = member(where, "rotate");
+    if (rotate->is_array()) {
+      // Euler angles in degrees about the fixed world axes, X first, then Y, then Z.
+      Vec3 e = vec3(*rotate, w);
+      r = rotationDegrees({0, 0, 1}, e.z) * rotationDegrees({0, 1, 0}, e.y) *
+          rotationDegrees({1, 0, 0}, e.x);
+    } else {
+      expectKeys(*rotate, w, {"axis", "degrees"});
+      const Json* axis = find(*rotate, "axis");
+      const Json* degrees = find(*rotate, "degrees");
+      if (!axis || !degrees)
+        fail(w, "expected {\"axis\": [x, y, z], \"degrees\": number} or [x, y, z] Euler degrees");
+      r = rotationDegrees(nonZeroVec3(*axis, member(w, "axis")),
+                          number(*degrees, member(w, "degrees")));
+    }
+  }
+  if (const Json* scale = find(v, "scale")) {
+    std::string w = member(where, "scale");
+    Vec3 k = scale->is_number() ? Vec3{1, 1, 1} * number(*scale, w) : vec3(*scale, w);
+    s = Mat4::scaling(k);
+  }
+  return t * r * s;
+}
+
+// Turns a scene document into a Scene.
+class SceneReader {
+ public:
+  SceneReader(const std::string& path, LoadContext& context) : path_(path), context_(context) {}
+
+  Scene read(const Json& root);
+
+ private:
+  Camera readCamera(const Json& v, const std::string& where) const;
+  void readLight(const Json& v, const std::string& where);
+  void readMaterials(const Json& v, const std::string& where);
+  void readObject(const Json& v, const std::string& where);
+  // The object's "material" and "color" keys as a material index (or −1).
+  int readObjectMaterial(const Json& object, const std::string& where);
+  void readPrimitive(const Json& object, const std::string& where);
+  void readInlineMesh(const Json& v, const std::string& where, Mesh& mesh) const;
+  void readMeshFile(const Json& v, const std::string& where, std::optional<int> material,
+                    const Mat4& m);
+  // Charges `triangles` (instanced) to the scene's budget.
+  void addTriangles(uint64_t triangles, const std::string& where);
+
+  const std::string& path_;
+  LoadContext& context_;
+  Scene scene_;
+  uint64_t triangles_ = 0;
+  std::map<std::string, int> materialByName_;
+  // Materials made for objects' "color" overrides, by (base material, colour), to share them.
+  std::map<std::pair<int, std::array<float, 4>>, int> colorMaterials_;
+  // Where a referenced file's meshes were placed in this scene, by (file, material override), so
+  // that further references to it add instances only.
+  std::map<std::pair<std::string, int>, int> placedMeshes_;
+};
+
+Scene SceneReader::read(const Json& root) {
+  if (!root.is_object())
+    fail("", fmt::format("expected a JSON object at the top level, got {}", typeName(root)));
+  // The version comes first, so that a newer file gets a version message rather than complaints
+  // about keys this reader does not know yet.
+  const Json* version = find(root, "synthvis");
+  if (!version)
+    fail("", fmt::format("missing key 'synthvis' (the format version; this reader understands "
+                         "version {})",
+                         kFormatVersion));
+  if (!version->is_number_integer() || version->get<int64_t>() != kFormatVersion)
+    fail("synthvis", fmt::format("unsupported format version {} (this reader understands version {})",
+                                 version->dump(), kFormatVersion));
+  expectKeys(root, "", {"synthvis", "description", "background", "camera", "cameras", "light",
+                        "materials", "objects"});
+
+  if (const Json* description = find(root, "description")) string(*description, "description");
+  if (const Json* background = find(root, "background")) {
+    Vec4 c = color(*background, "background", false);
+    scene_.background = {c.x, c.y, c.z};
+  }
+  const Json* camera = find(root, "camera");
+  const Json* cameras = find(root, "cameras");
+  if (camera && cameras) fail("", "use either 'camera' or 'cameras', not both");
+  if (camera) scene_.cameras.push_back(readCamera(*camera, "camera"));
+  if (cameras) {
+    array(*cameras, "cameras");
+    for (size_t i = 0; i < cameras->size(); ++i)
+      scene_.cameras.push_back(readCamera((*cameras)[i], element("cameras", i)));
+  }
+  if (const Json* light = find(root, "light")) readLight(*light, "light");
+  if (const Json* materials = find(root, "materials")) readMaterials(*materials, "materials");
+  if (const Json* objects = find(root, "objects")) {
+    array(*objects, "objects");
+    for (size_t i = 0; i < objects->size(); ++i) readObject((*objects)[i], element("objects", i));
+  }
+  return std::move(scene_);
+}
+
+Camera SceneReader::readCamera(const Json& v, const std::string& where) const {
+  expectKeys(v, where, {"name", "position", "target", "up", "yfov", "near", "far"});
+  Camera c;
+  if (const Json* x = find(v, "name")) c.name = string(*x, member(where, "name"));
+  if (const Json* x = find(v, "position")) c.position = vec3(*x, member(where, "position"));
+  if (const Json* x = find(v, "target")) c.target = vec3(*x, member(where, "target"));
+  if (const Json* x = find(v, "up")) c.up = nonZeroVec3(*x, member(where, "up"));
+  if (const Json* x = find(v, "yfov")) {
+    c.yfovDegrees = number(*x, member(where, "yfov"));
+    if (!(c.yfovDegrees > 0 && c.yfovDegrees < 180))
+      fail(member(where, "yfov"), fmt::format("{} is out of range (0, 180) degrees", x->dump()));
+  }
+  if (const Json* x = find(v, "near")) c.znear = positive(*x, member(where, "near"));
+  if (const Json* x = find(v, "far")) c.zfar = number(*x, member(where, "far"));
+  if (!(c.zfar > c.znear))
+    fail(where, fmt::format("far ({}) must be greater than near ({})", c.zfar, c.znear));
+  Vec3 view = c.target - c.position;
+  if (!(length(view) > 0)) fail(where, "position and target must differ");
+  if (!(length(cross(view, c.up)) > 0)) fail(where, "up must not be parallel to the view direction");
+  return c;
+}
+
+void SceneReader::readLight(const Json& v, const std::string& where) {
+  expectKeys(v, where, {"direction", "color", "ambient", "enabled"});
+  Light& light = scene_.light;
+  if (const Json* x = find(v, "direction"))
+    light.direction = normalize(nonZeroVec3(*x, member(where, "direction")));
+  if (const Json* x = find(v, "color")) {
+    // Light colours may exceed 1 (a brighter light); they may not be negative.
+    std::string w = member(where, "color");
+    light.color = vec3(*x, w);
+    if (light.color.x < 0 || light.color.y < 0 || light.color.z < 0)
+      fail(w, "components must not be negative");
+  }
+  if (const Json* x = find(v, "ambient")) light.ambient = inRange(*x, member(where, "ambient"), 0, 1);
+  if (const Json* x = find(v, "enabled")) light.enabled = boolean(*x, member(where, "enabled"));
+}
+
+void SceneReader::readMaterials(const Json& v, const std::string& where) {
+  array(v, where);
+  for (size_t i = 0; i < v.size(); ++i) {
+    std::string w = element(where, i);
+    expectKeys(v[i], w, {"name", "color", "doubleSided", "unlit"});
+    Material m;
+    if (const Json* x = find(v[i], "name")) {
+      m.name = string(*x, member(w, "name"));
+      if (!m.name.empty() && !materialByName_.emplace(m.name, int(i)).second)
+        fail(member(w, "name"), fmt::format("duplicate material name '{}'", m.name));
+    }
+    if (const Json* x = find(v[i], "color")) m.baseColor = color(*x, member(w, "color"), true);
+    if (const Json* x = find(v[i], "doubleSided")) m.doubleSided = boolean(*x, member(w, "doubleSided"));
+    if (const Json* x = find(v[i], "unlit")) m.unlit = boolean(*x, member(w, "unlit"));
+    scene_.materials.push_back(std::move(m));
+  }
+}
+
+int SceneReader::readObjectMaterial(const Json& object, const std::string& where) {
+  int material = -1;
+  if (const Json* x = find(object, "material")) {
+    std::string w = member(where, "material");
+    if (x->is_string()) {
+      std::string name = x->get<std::string>();
+      auto it = materialByName_.find(name);
+      if (it == materialByName_.end()) {
+        std::string hint;
+        for (const auto& [known, index] : materialByName_)
+          if (editDistance(name, known) <= 2) hint = fmt::format(" (did you mean '{}'?)", known);
+        fail(w, fmt::format("no material named '{}'{}", name, hint));
+      }
+      material = it->second;
+    } else if (x->is_number_integer()) {
+      int64_t count = int64_t(scene_.materials.size());
+      if (count == 0) fail(w, "there are no materials to refer to");
+      material = int(integer(*x, w, 0, count - 1));
+    } else {
+      fail(w, fmt::format("expected a material name or index, got {}", typeName(*x)));
+    }
+  }
+  if (const Json* x = find(object, "color")) {
+    Vec4 c = color(*x, member(where, "color"), true);
+    auto key = std::make_pair(material, std::array<float, 4>{c.x, c.y, c.z, c.w});
+    auto it = colorMaterials_.find(key);
+    if (it != colorMaterials_.end()) return it->second;
+    // A copy of the named material (or of the default one) with the colour replaced.
+    Material m = material >= 0 ? scene_.materials[size_t(material)] : Material{};
+    m.name = m.name.empty() ? std::string("color") : m.name + "+color";
+    m.baseColor = c;
+    scene_.materials.push_back(std::move(m));
+    material = int(scene_.materials.size() - 1);
+    colorMaterials_.emplace(key, material);
+  }
+  return material;
+}
+
+void SceneReader::addTriangles(uint64_t triangles, const std::string& where) {
+  if (triangles > context_.options.maxTriangles - triangles_)
+    fail(where, fmt::format("the scene would have more than {} triangles",
+                            context_.options.maxTriangles));
+  triangles_ += triangles;
+}
+
+void SceneReader::readObject(const Json& v, const std::string& where) {
+  if (!v.is_object()) fail(where, fmt::format("expected an object, got {}", typeName(v)));
+  const Json* mesh = find(v, "mesh");
+  const Json* primitive = find(v, "primitive");
+  if (mesh && primitive) fail(where, "an object has either 'mesh' or 'primitive', not both");
+  if (!mesh && !primitive) fail(where, "missing key 'mesh' or 'primitive'");
+
+  if (primitive) {
+    // The allowed keys depend on the kind, so readPrimitive checks them.
+    readPrimitive(v, where);
+    return;
+  }
+  expectKeys(v, where, {"name", "mesh", "material", "color", "transform"});
+  Mat4 m;
+  if (const Json* t = find(v, "transform")) m = readTransform(*t, member(where, "transform"));
+  bool overridesMaterial = find(v, "material") || find(v, "color");
+  int material = readObjectMaterial(v, where);
+  std::string w = member(where, "mesh");
+  if (mesh->is_string()) {
+    readMeshFile(*mesh, w, overridesMaterial ? std::optional<int>(material) : std::nullopt, m);
+    return;
+  }
+  if (!mesh->is_object())
+    fail(w, fmt::format("expected a file path or an inline mesh object, got {}", typeName(*mesh)));
+  Mesh inlineMesh;
+  if (const Json* name = find(v, "name")) inlineMesh.name = string(*name, member(where, "name"));
+  readInlineMesh(*mesh, w, inlineMesh);
+  addTriangles(inlineMesh.triangleCount(), where);
+  inlineMesh.material = material;
+  scene_.meshes.push_back(std::move(inlineMesh));
+  scene_.instances.push_back({int(scene_.meshes.size() - 1), m});
+}
+
+void SceneReader::readPrimitive(const Json& v, const std::string& where) {
+  const std::string kindWhere = member(where, "primitive");
+  const std::string kind = string(*find(v, "primitive"), kindWhere);
+  PrimitiveParams p;
+  // Step 1: the kind decides which keys are allowed.
+  if (kind == "box") {
+    p.kind = PrimitiveKind::kBox;
+    expectKeys(v, where, {"name", "primitive", "material", "color", "transform", "size"});
+  } else if (kind == "sphere") {
+    p.kind = PrimitiveKind::kSphere;
+    expectKeys(v, where, {"name", "primitive", "material", "color", "transform", "radius",
+                          "segments", "rings"});
+  } else if (kind == "plane") {
+    p.kind = PrimitiveKind::kPlane;
+    expectKeys(v, where, {"name", "primitive", "material", "color", "transform", "size",
+                          "subdivisions"});
+  } else if (kind == "checker") {
+    p.kind = PrimitiveKind::kChecker;
+    p.size = {8, 1, 8};
+    p.divisionsX = p.divisionsZ = 8;
+    expectKeys(v, where, {"name", "primitive", "material", "color", "transform", "size",
+                          "squares", "colors"});
+  } else if (kind == "cylinder") {
+    p.kind = PrimitiveKind::kCylinder;
+    expectKeys(v, where, {"name", "primitive", "material", "color", "transform", "radius",
+                          "height", "segments", "caps"});
+  } else if (kind == "cone") {
+    p.kind = PrimitiveKind::kCone;
+    expectKeys(v, where, {"name", "primitive", "material", "color", "transform", "radius",
+                          "height", "segments", "caps"});
+  } else if (kind == "torus") {
+    p.kind = PrimitiveKind::kTorus;
+    p.radius = 0.375f;
+    p.segments = 48;
+    p.sides = 24;
+    expectKeys(v, where, {"name", "primitive", "material", "color", "transform", "radius", "tube",
+                          "segments", "sides"});
+  } else {
+    fail(kindWhere, fmt::format("unknown primitive '{}' (expected box, sphere, plane, checker, "
+                                "cylinder, cone or torus)",
+                                kind));
+  }
+
+  // Step 2: the parameters, each with its default already in p.
+  if (const Json* x = find(v, "size")) {
+    std::string w = member(where, "size");
+    if (p.kind == PrimitiveKind::kBox) {
+      auto s = sizes<3>(*x, w);
+      p.size = {s[0], s[1], s[2]};
+    } else {
+      auto s = sizes<2>(*x, w);
+      p.size = {s[0], 1, s[1]};
+    }
+  }
+  if (const Json* x = find(v, "radius")) p.radius = positive(*x, member(where, "radius"));
+  if (const Json* x = find(v, "height")) p.height = positive(*x, member(where, "height"));
+  if (const Json* x = find(v, "tube")) p.tube = positive(*x, member(where, "tube"));
+  if (const Json* x = find(v, "segments"))
+    p.segments = int(integer(*x, member(where, "segments"), kMinSegments, kMaxSegments));
+  p.rings = std::max(kMinRings, p.segments / 2);
+  if (const Json* x = find(v, "rings"))
+    p.rings = int(integer(*x, member(where, "rings"), kMinRings, kMaxSegments));
+  if (const Json* x = find(v, "sides"))
+    p.sides = int(integer(*x, member(where, "sides"), kMinSegments, kMaxSegments));
+  for (const char* key : {"subdivisions", "squares"})
+    if (const Json* x = find(v, key)) {
+      auto n = counts(*x, member(where, key), kMinDivisions, kMaxSegments);
+      p.divisionsX = n[0];
+      p.divisionsZ = n[1];
+    }
+  if (const Json* x = find(v, "caps")) p.caps = boolean(*x, member(where, "caps"));
+  if (const Json* x = find(v, "colors")) {
+    std::string w = member(where, "colors");
+    if (!x->is_array() || x->size() != 2)
+      fail(w, fmt::format("expected an array of 2 colours, got {}",
+                          x->is_array() ? fmt::format("{} elements", x->size()) : typeName(*x)));
+    for (size_t i = 0; i < 2; ++i) p.colors[i] = color((*x)[i], element(w, i), true);
+  }
+
+  Mat4 m;
+  if (const Json* t = find(v, "transform")) m = readTransform(*t, member(where, "transform"));
+  int material = readObjectMaterial(v, where);
+
+  // Step 3: charge the budget before building, so an absurd primitive costs nothing.
+  addTriangles(primitiveTriangleCount(p), where);
+  Mesh mesh = makePrimitive(p);
+  mesh.name = kind;
+  if (const Json* name = find(v, "name")) mesh.name = string(*name, member(where, "name"));
+  mesh.material = material;
+  scene_.meshes.push_back(std::move(mesh));
+  scene_.instances.push_back({int(scene_.meshes.size() - 1), m});
+}
+
+void SceneReader::readInlineMesh(const Json& v, const std::string& where, Mesh& mesh) const {
+  expectKeys(v, where, {"positions", "indices", "normals", "colors", "uvs"});
+  const Json* positions = find(v, "positions");
+  if (!positions) fail(where, "missing key 'positions'");
+
+  // Reads a flat array of numbers in groups of `k`, naming the element at fault only on failure
+  // (formatting a path per element would dominate the cost of large meshes).
+  auto flat = [&](const Json& a, const std::string& w, size_t k, size_t expectedGroups,
+                  auto&& store) {
+    array(a, w);
+    if (a.size() % k != 0 || (expectedGroups != SIZE_MAX && a.size() / k != expectedGroups))
+      fail(w, expectedGroups == SIZE_MAX
+                  ? fmt::format("expected a multiple of {} numbers, got {}", k, a.size())
+                  : fmt::format("expected {} numbers ({} per vertex), got {}", expectedGroups * k,
+                                k, a.size()));
+    float group[4];
+    for (size_t i = 0; i < a.size(); ++i) {
+      std::string problem = numberProblem(a[i]);
+      if (!problem.empty()) fail(element(w, i), problem);
+      group[i % k] = static_cast<float>(a[i].get<double>());
+      if (i % k == k - 1 && !store(group)) fail(element(w, i - k + 1), "value out of range 0..1");
+    }
+  };
+
+  std::string w = member(where, "positions");
+  flat(*positions, w, 3, SIZE_MAX, [&](const float* g) {
+    mesh.positions.push_back({g[0], g[1], g[2]});
+    return true;
+  });
+  const size_t n = mesh.positions.size();
+  if (const Json* x = find(v, "normals"))
+    flat(*x, member(where, "normals"), 3, n, [&](const float* g) {
+      mesh.normals.push_back({g[0], g[1], g[2]});
+      return true;
+    });
+  if (const Json* x = find(v, "uvs"))
+    flat(*x, member(where, "uvs"), 2, n, [&](const float* g) {
+      mesh.uvs.push_back({g[0], g[1]});
+      return true;
+    });
+  if (const Json* x = find(v, "colors")) {
+    // RGB or RGBA per vertex, told apart by the array's length.
+    std::string cw = member(where, "colors");
+    size_t k = (x->is_array() && n > 0 && x->size() == 4 * n) ? 4 : 3;
+    flat(*x, cw, k, n, [&](const float* g) {
+      Vec4 c{g[0], g[1], g[2], k == 4 ? g[3] : 1.0f};
+      for (float component : {c.x, c.y, c.z, c.w})
+        if (component < 0 || component > 1) return false;
+      mesh.colors.push_back(c);
+      return true;
+    });
+  }
+  if (const Json* x = find(v, "indices")) {
+    std::string iw = member(where, "indices");
+    array(*x, iw);
+    if (x->size() % 3 != 0)
+      fail(iw, fmt::format("expected a multiple of 3 indices, got {}", x->size()));
+    mesh.indices.reserve(x->size());
+    for (size_t i = 0; i < x->size(); ++i) {
+      const Json& index = (*x)[i];
+      if (!index.is_number_integer() || index.get<int64_t>() < 0 || index.get<uint64_t>() >= n)
+        fail(element(iw, i), fmt::format("expected a vertex index 0..{}, got {}", n == 0 ? 0 : n - 1,
+                                         index.is_number() ? index.dump() : typeName(index)));
+      mesh.indices.push_back(static_cast<uint32_t>(index.get<uint64_t>()));
+    }
+  } else {
+    // No indices: consecutive vertex triples are the triangles.
+    if (n % 3 != 0)
+      fail(w, fmt::format("without 'indices' the vertex count must be a multiple of 3, got {}", n));
+    mesh.indices.resize(n);
+    for (size_t i = 0; i < n; ++i) mesh.indices[i] = static_cast<uint32_t>(i);
+  }
+}
+
+void SceneReader::readMeshFile(const Json& v, const std::string& where,
+                               std::optional<int> material, const Mat4& m) {
+  const std::string ref = string(v, where);
+  if (ref.empty()) fail(where, "expected a file path, got an empty string");
+  // Untrusted text (fuzzing) must not make the loader touch the file system at all.
+  if (!context_.options.followReferences)
+    fail(where, fmt::format("cannot open '{}' (references to other files are disabled)", ref));
+  const std::string resolved = resolvePath(directoryOf(path_), ref);
+  std::error_code ec;
+  if (!std::filesystem::exists(resolved, ec)) fail(where, fmt::format("cannot open '{}': no such file", ref));
+
+  // Step 1: nesting and cycles. The current file is the last entry of openScenes.
+  const std::string key = canonicalKey(resolved);
+  auto open = std::find(context_.openScenes.begin(), context_.openScenes.end(), key);
+  if (open != context_.openScenes.end()) {
+    std::string cycle;
+    for (auto it = open; it != context_.openScenes.end(); ++it)
+      cycle += std::filesystem::path(*it).filename().string() + " → ";
+    fail(where, fmt::format("'{}' refers back to a scene that is being loaded ({}{})", ref, cycle,
+                            std::filesystem::path(key).filename().string()));
+  }
+  if (context_.openScenes.size() > size_t(std::max(context_.options.maxNesting, 0)))
+    fail(where, fmt::format("cannot load '{}': scene files are nested more than {} deep", ref,
+                            context_.options.maxNesting));
+
+  // Step 2: load it, once per top-level load.
+  auto loaded = context_.loaded.find(key);
+  if (loaded == context_.loaded.end()) {
+    Result<Scene> file = loadFile(resolved, context_);
+    if (!file) fail(where, fmt::format("cannot load '{}': {}", ref, file.error().str()));
+    loaded = context_.loaded.emplace(key, std::move(file.value())).first;
+  }
+  const Scene& file = loaded->second;
+  addTriangles(file.triangleCount(), where);
+
+  // Step 3: place its meshes in this scene once per material override; every further reference
+  // only adds instances.
+  const int overrideKey = material ? *material : -2;
+  auto placed = placedMeshes_.find({key, overrideKey});
+  if (placed == placedMeshes_.end()) {
+    const int meshBase = int(scene_.meshes.size());
+    const int materialBase = int(scene_.materials.size());
+    if (!material) scene_.materials.insert(scene_.materials.end(), file.materials.begin(), file.materials.end());
+    for (Mesh mesh : file.meshes) {
+      mesh.material = material ? *material : mesh.material >= 0 ? mesh.material + materialBase : -1;
+      scene_.meshes.push_back(std::move(mesh));
+    }
+    placed = placedMeshes_.emplace(std::make_pair(key, overrideKey), meshBase).first;
+  }
+  for (const Instance& instance : file.instances)
+    scene_.instances.push_back({instance.mesh + placed->second, m * instance.transform});
+  for (Camera camera : file.cameras) {
+    camera.position = m.transformPoint(camera.position);
+    camera.target = m.transformPoint(camera.target);
+    camera.up = normalize(m.transformDirection(camera.up));
+    scene_.cameras.push_back(std::move(camera));
+  }
+}
+
+// Keeps `key` on the open-scenes stack for the lifetime of the guard.
+class OpenSceneGuard {
+ public:
+  OpenSceneGuard(LoadContext& context, std::string key) : context_(context) {
+    context_.openScenes.push_back(std::move(key));
+  }
+  ~OpenSceneGuard() { context_.openScenes.pop_back(); }
+  OpenSceneGuard(const OpenSceneGuard&) = delete;
+  OpenSceneGuard& operator=(const OpenSceneGuard&) = delete;
+
+ private:
+  LoadContext& context_;
+};
+
+}  // namespace
+
+Result<Scene> parseJsonSceneIn(const std::string& text, const std::string& path,
+                               LoadContext& context) {
+  OpenSceneGuard open(context, canonicalKey(path));
+  try {
+    // Step 1: text → document. Comments are allowed: scene files are written by hand.
+    Json root;
+    ParseGuard guard;
+    try {
+      root = Json::parse(
+          text, [&guard](int depth, Json::parse_event_t event, Json& parsed) {
+            return guard(depth, event, parsed);
+          },
+          /*allow_exceptions=*/true, /*ignore_comments=*/true);
+    } catch (const Json::parse_error& e) {
+      return Error{path, lineColumn(text, e.byte), parseErrorMessage(e.what())};
+    } catch (const Json::out_of_range& e) {
+      // "number overflow parsing '1e999'": nlohmann gives no position, so find the literal.
+      std::string what = e.what();
+      size_t open1 = what.find('\''), close1 = what.rfind('\'');
+      if (open1 != std::string::npos && close1 > open1) {
+        std::string literal = what.substr(open1 + 1, close1 - open1 - 1);
+        size_t at = text.find(literal);
+        return Error{path, at == std::string::npos ? "" : lineColumn(text, at + 1),
+                     fmt::format("number {} is out of range (numbers must be finite)", literal)};
+      }
+      return Error{path, "", parseErrorMessage(what)};
+    }
+
+    // Step 2: document → Scene.
+    Scene scene = SceneReader(path, context).read(root);
+    Status valid = validate(scene, path);
+    if (!valid) return valid.error();
+    return scene;
+  } catch (const JsonProblem& p) {
+    return Error{path, "", p.where.empty() ? p.message : p.where + ": " + p.message};
+  } catch (const std::bad_alloc&) {
+    return Error{path, "", "out of memory"};
+  } catch (const std::exception& e) {
+    // Every value is type-checked before use, so this is a bug; still an error, not a crash.
+    return Error{path, "", oneLine(e.what())};
+  }
+}
+
+}  // namespace detail
+
+Result<Scene> parseJsonScene(const std::string& text, const std::string& path) {
+  return parseJsonScene(text, path, LoadOptions{});
+}
+
+Result<Scene> parseJsonScene(const std::string& text, const std::string& path,
+                             const LoadOptions& options) {
+  try {
+    detail::LoadContext context{options, {}, {}};
+    return detail::parseJsonSceneIn(text, path, context);
+  } catch (const std::bad_alloc&) {
+    return Error{path, "", "out of memory"};
+  }
+}
+
+Result<Scene> loadJsonScene(const std::string& path) {
+  try {
+    Result<std::string> text = detail::readFile(path);
+    if (!text) return text.error();
+    detail::LoadContext context{LoadOptions{}, {}, {}};
+    return detail::parseJsonSceneIn(text.value(), path, context);
+  } catch (const std::bad_alloc&) {
+    return Error{path, "", "out of memory"};
+  }
+}
+
+}  // namespace sv::scene

@@ -1,0 +1,102 @@
+// The scene database's own operations: counting, checking the invariants the loaders promise,
+// and merging one scene into another.
+#include <cmath>
+#include <utility>
+
+#include <fmt/format.h>
+
+#include "synthvis/scene.h"
+
+namespace sv::scene {
+
+size_t Scene::triangleCount() const {
+  size_t n = 0;
+  for (const Instance& instance : instances)
+    if (instance.mesh >= 0 && size_t(instance.mesh) < meshes.size())
+      n += meshes[size_t(instance.mesh)].triangleCount();
+  return n;
+}
+
+namespace {
+
+bool isFinite(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+bool isFinite(const Mat4& m) {
+  for (const auto& column : m.m)
+    for (float x : column)
+      if (!std::isfinite(x)) return false;
+  return true;
+}
+
+// "meshes[3] 'wheel'" — the name helps when a file has hundreds of meshes.
+std::string meshLabel(const Mesh& mesh, size_t i) {
+  return mesh.name.empty() ? fmt::format("meshes[{}]", i)
+                           : fmt::format("meshes[{}] '{}'", i, mesh.name);
+}
+
+}  // namespace
+
+Status validate(const Scene& scene, const std::string& file) {
+  auto fail = [&](std::string message) { return Status(Error{file, "", std::move(message)}); };
+
+  for (size_t i = 0; i < scene.meshes.size(); ++i) {
+    const Mesh& mesh = scene.meshes[i];
+    const size_t n = mesh.positions.size();
+    if (mesh.indices.size() % 3 != 0)
+      return fail(fmt::format("{}: {} indices is not a multiple of 3", meshLabel(mesh, i),
+                              mesh.indices.size()));
+    auto sizeOk = [n](size_t size) { return size == 0 || size == n; };
+    if (!sizeOk(mesh.normals.size()) || !sizeOk(mesh.colors.size()) || !sizeOk(mesh.uvs.size()))
+      return fail(fmt::format(
+          "{}: attribute arrays must be empty or match the {} positions (normals {}, colors {}, "
+          "uvs {})",
+          meshLabel(mesh, i), n, mesh.normals.size(), mesh.colors.size(), mesh.uvs.size()));
+    for (size_t k = 0; k < mesh.indices.size(); ++k)
+      if (mesh.indices[k] >= n)
+        return fail(fmt::format("{}: indices[{}] = {} is out of range ({} vertices)",
+                                meshLabel(mesh, i), k, mesh.indices[k], n));
+    for (size_t k = 0; k < n; ++k)
+      if (!isFinite(mesh.positions[k]))
+        return fail(fmt::format("{}: positions[{}] is not finite", meshLabel(mesh, i), k));
+    if (mesh.material < -1 || (mesh.material >= 0 && size_t(mesh.material) >= scene.materials.size()))
+      return fail(fmt::format("{}: material {} does not exist ({} materials)", meshLabel(mesh, i),
+                              mesh.material, scene.materials.size()));
+  }
+  for (size_t i = 0; i < scene.instances.size(); ++i) {
+    const Instance& instance = scene.instances[i];
+    if (instance.mesh < 0 || size_t(instance.mesh) >= scene.meshes.size())
+      return fail(fmt::format("instances[{}]: mesh {} does not exist ({} meshes)", i,
+                              instance.mesh, scene.meshes.size()));
+    if (!isFinite(instance.transform))
+      return fail(fmt::format("instances[{}]: transform is not finite", i));
+  }
+  for (size_t i = 0; i < scene.cameras.size(); ++i) {
+    const Camera& c = scene.cameras[i];
+    if (!isFinite(c.position) || !isFinite(c.target) || !isFinite(c.up) ||
+        !std::isfinite(c.yfovDegrees) || !std::isfinite(c.znear) || !std::isfinite(c.zfar))
+      return fail(fmt::format("cameras[{}]: not finite", i));
+  }
+  return {};
+}
+
+void appendScene(Scene& scene, Scene other, const Mat4& transform) {
+  const int materialBase = static_cast<int>(scene.materials.size());
+  const int meshBase = static_cast<int>(scene.meshes.size());
+  for (Material& material : other.materials) scene.materials.push_back(std::move(material));
+  for (Mesh& mesh : other.meshes) {
+    if (mesh.material >= 0) mesh.material += materialBase;
+    scene.meshes.push_back(std::move(mesh));
+  }
+  for (const Instance& instance : other.instances)
+    scene.instances.push_back({instance.mesh + meshBase, transform * instance.transform});
+  // Cameras travel with their geometry; the light and background belong to the outer scene
+  // (docs/scene-format.md, "Referenced files").
+  for (Camera camera : other.cameras) {
+    camera.position = transform.transformPoint(camera.position);
+    camera.target = transform.transformPoint(camera.target);
+    camera.up = normalize(transform.transformDirection(camera.up));
+    scene.cameras.push_back(std::move(camera));
+  }
+}
+
+}  // namespace sv::scene

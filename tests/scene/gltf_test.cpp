@@ -1,0 +1,276 @@
+// The glTF 2.0 loader: the sample, node transforms, topology conversion, cameras and materials,
+// and the malformed inputs tinygltf lets through (accessors past their buffers, bad indices,
+// broken hierarchies, truncated GLB containers).
+#include <cmath>
+#include <numbers>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "scene/scene_test_util.h"
+#include "synthvis/scene.h"
+
+namespace sv::scene {
+namespace {
+
+using nlohmann::json;
+using testing::contains;
+using testing::dataPath;
+using testing::GltfBuilder;
+using testing::oneTriangle;
+using testing::sourcePath;
+using testing::TempDir;
+
+Result<Scene> load(const GltfBuilder& b) { return loadGltfFromMemory(b.gltf(), "t.gltf"); }
+
+std::string errorOf(const GltfBuilder& b) {
+  Result<Scene> r = load(b);
+  EXPECT_FALSE(r.ok());
+  return r.ok() ? std::string() : r.error().str();
+}
+
+void expectNear(Vec3 a, Vec3 b, float eps = 1e-5f) {
+  EXPECT_NEAR(a.x, b.x, eps);
+  EXPECT_NEAR(a.y, b.y, eps);
+  EXPECT_NEAR(a.z, b.z, eps);
+}
+
+TEST(Gltf, LoadsTheSamplePyramidWithColoursMaterialAndNodeRotation) {
+  Result<Scene> r = loadScene(sourcePath("scenes/pyramid.gltf"));
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  const Scene& s = r.value();
+  ASSERT_EQ(s.meshes.size(), 1u);
+  const Mesh& m = s.meshes[0];
+  EXPECT_EQ(m.name, "pyramid");
+  EXPECT_EQ(m.triangleCount(), 6u);
+  EXPECT_EQ(m.positions.size(), 16u);
+  EXPECT_EQ(m.normals.size(), 16u);
+  EXPECT_EQ(m.colors.size(), 16u);
+  EXPECT_EQ(m.colors[0], (Vec4{0.9f, 0.2f, 0.15f, 1}));
+  ASSERT_EQ(s.materials.size(), 1u);
+  EXPECT_EQ(s.materials[0].name, "painted");
+  EXPECT_EQ(m.material, 0);
+  // The node turns the pyramid 45° about +Y: the base corner (0.5, 0, 0.5) goes to (√2/2, 0, 0).
+  ASSERT_EQ(s.instances.size(), 1u);
+  expectNear(s.instances[0].transform.transformPoint({0.5f, 0, 0.5f}), {std::sqrt(0.5f), 0, 0});
+  // Every triangle faces where its vertex normals point.
+  for (size_t t = 0; t < m.triangleCount(); ++t) {
+    Vec3 a = m.positions[m.indices[3 * t]], b = m.positions[m.indices[3 * t + 1]],
+         c = m.positions[m.indices[3 * t + 2]];
+    EXPECT_GT(dot(cross(b - a, c - a), m.normals[m.indices[3 * t]]), 0) << "triangle " << t;
+  }
+}
+
+TEST(Gltf, LoadsTheSameModelFromGltfAndGlb) {
+  TempDir dir;
+  GltfBuilder b = oneTriangle();
+  Result<Scene> text = loadScene(dir.write("a.gltf", b.gltf()));
+  Result<Scene> binary = loadScene(dir.write("a.glb", b.glb()));
+  ASSERT_TRUE(text.ok()) << text.error().str();
+  ASSERT_TRUE(binary.ok()) << binary.error().str();
+  EXPECT_EQ(text->meshes[0].positions, binary->meshes[0].positions);
+  EXPECT_EQ(binary->meshes[0].indices, (std::vector<uint32_t>{0, 1, 2}));
+}
+
+TEST(Gltf, RejectsTruncatedGlb) {
+  TempDir dir;
+  const std::string glb = oneTriangle().glb();
+  // Cut inside the BIN chunk, inside the JSON chunk, and inside the header.
+  for (size_t keep : {glb.size() - 5, size_t(40), size_t(10)}) {
+    SCOPED_TRACE(keep);
+    std::string path = dir.write("cut.glb", glb.substr(0, keep));
+    Result<Scene> r = loadScene(path);
+    ASSERT_FALSE(r.ok());
+    EXPECT_TRUE(contains(r.error().str(), path + ": truncated GLB"));
+  }
+}
+
+TEST(Gltf, RejectsBufferViewOutsideItsBuffer) {
+  const std::string path = dataPath("scene/short_buffer.gltf");
+  Result<Scene> r = loadScene(path);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.error().str(), path + ": meshes[0].primitives[0].attributes.POSITION: accessors[0]: "
+                                    "bufferViews[0] (offset 0, length 48) lies outside buffers[0] (36 bytes)");
+}
+
+TEST(Gltf, RejectsAccessorPastTheEndOfItsBufferView) {
+  GltfBuilder b = oneTriangle();
+  b.doc["accessors"][0]["count"] = 4;  // the view holds 3 vertices
+  EXPECT_TRUE(contains(errorOf(b), "accessors[0]: 4 elements of 12 bytes (stride 12, offset 0) do not fit in bufferViews[0] (36 bytes)"));
+  b = oneTriangle();
+  b.doc["accessors"][0]["byteOffset"] = 4;
+  EXPECT_TRUE(contains(errorOf(b), "do not fit"));
+  b = oneTriangle();
+  b.doc["bufferViews"][0]["byteStride"] = 8;  // smaller than a VEC3 of floats
+  EXPECT_TRUE(contains(errorOf(b), "byteStride 8 is invalid for 12-byte elements"));
+  b = oneTriangle();
+  b.doc["accessors"][0]["count"] = uint64_t(1) << 50;  // must not overflow the size arithmetic
+  EXPECT_TRUE(contains(errorOf(b), "do not fit"));
+}
+
+TEST(Gltf, RejectsIndexOutOfRange) {
+  GltfBuilder b;
+  int positions = b.addPositions({0, 0, 0, 1, 0, 0, 0, 1, 0});
+  int indices = b.addIndices({0, 1, 3});
+  b.addNode({{"mesh", b.addMesh({{"attributes", {{"POSITION", positions}}}, {"indices", indices}})}});
+  EXPECT_EQ(errorOf(b), "t.gltf: meshes[0].primitives[0].indices: index 3 at position 2 is out of range (3 vertices)");
+}
+
+TEST(Gltf, RejectsBrokenReferencesAndHierarchies) {
+  struct Row {
+    const char* why;
+    void (*breakIt)(GltfBuilder&);
+    const char* expected;
+  };
+  const Row rows[] = {
+      {"accessor index", [](GltfBuilder& b) { b.doc["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = 9; }, "accessor 9 does not exist"},
+      {"no POSITION", [](GltfBuilder& b) { b.doc["meshes"][0]["primitives"][0]["attributes"] = json::object({{"NORMAL", 0}}); }, "has no POSITION attribute"},
+      {"wrong element type", [](GltfBuilder& b) { b.doc["accessors"][0]["type"] = "VEC2"; }, "unexpected element type"},
+      {"unknown mode", [](GltfBuilder& b) { b.doc["meshes"][0]["primitives"][0]["mode"] = 9; }, "meshes[0].primitives[0]: unknown mode 9"},
+      {"material index", [](GltfBuilder& b) { b.doc["meshes"][0]["primitives"][0]["material"] = 2; }, "material 2 does not exist"},
+      {"node mesh index", [](GltfBuilder& b) { b.doc["nodes"][0]["mesh"] = 7; }, "nodes[0]: mesh 7 does not exist"},
+      {"child index", [](GltfBuilder& b) { b.doc["nodes"][0]["children"] = {5}; }, "nodes[0]: child 5 does not exist"},
+      {"two parents", [](GltfBuilder& b) { b.addNode({{"children", {0}}}); b.addNode({{"children", {0}}}); }, "nodes[0]: has more than one parent"},
+      {"cycle", [](GltfBuilder& b) { b.doc["nodes"][0]["children"] = {0}; b.doc["scene"] = 0; b.doc["scenes"] = {{{"nodes", {0}}}}; }, "nodes[0]: reached twice"},
+      {"scene index", [](GltfBuilder& b) { b.doc["scene"] = 3; }, "scene 3 does not exist"},
+      {"matrix size", [](GltfBuilder& b) { b.doc["nodes"][0]["matrix"] = {1, 0, 0}; }, "nodes[0].matrix: expected 16 numbers, got 3"},
+      {"required extension", [](GltfBuilder& b) { b.doc["extensionsRequired"] = {"KHR_draco_mesh_compression"}; }, "requires the unsupported extension 'KHR_draco_mesh_compression'"},
+      {"sparse accessor", [](GltfBuilder& b) { b.doc["accessors"][0]["sparse"] = {{"count", 1}, {"indices", {{"bufferView", 1}, {"componentType", 5123}}}, {"values", {{"bufferView", 0}}}}; }, "sparse accessors are not supported"},
+  };
+  for (const Row& row : rows) {
+    SCOPED_TRACE(row.why);
+    GltfBuilder b = oneTriangle();
+    row.breakIt(b);
+    std::string error = errorOf(b);
+    EXPECT_TRUE(contains(error, "t.gltf: "));
+    EXPECT_TRUE(contains(error, row.expected));
+  }
+}
+
+TEST(Gltf, TinygltfErrorsBecomeOneLineNamingTheFile) {
+  Result<Scene> r = loadGltfFromMemory("{\"asset\": {\"version\": \"2.0\"}, \"buffers\": [{\"byteLength\": 4}]}", "t.gltf");
+  ASSERT_FALSE(r.ok());
+  EXPECT_TRUE(contains(r.error().str(), "t.gltf: invalid glTF: "));
+  EXPECT_EQ(r.error().str().find('\n'), std::string::npos);
+  EXPECT_TRUE(contains(loadGltfFromMemory("{\"asset\": ", "t.gltf").error().str(), "t.gltf: invalid glTF: "));
+}
+
+TEST(Gltf, AppliesNodeTransformsDownTheHierarchy) {
+  GltfBuilder b = oneTriangle();
+  // Node 1 (root): translate by (10, 0, 0); node 2: scale 2; node 0 (the mesh): matrix moving +Z.
+  b.doc["nodes"][0]["matrix"] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 3, 1};
+  b.addNode({{"translation", {10, 0, 0}}, {"children", {2}}});
+  b.addNode({{"scale", {2, 2, 2}}, {"children", {0}}});
+  Result<Scene> r = load(b);
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  ASSERT_EQ(r->instances.size(), 1u);
+  // (1, 0, 0) → (1, 0, 3) → (2, 0, 6) → (12, 0, 6).
+  expectNear(r->instances[0].transform.transformPoint({1, 0, 0}), {12, 0, 6});
+}
+
+TEST(Gltf, WalksOnlyTheDefaultScene) {
+  GltfBuilder b = oneTriangle();
+  b.addNode({{"mesh", 0}, {"translation", {5, 0, 0}}});
+  b.doc["scenes"] = {{{"nodes", {0}}}, {{"nodes", {1}}}};
+  b.doc["scene"] = 1;
+  Result<Scene> r = load(b);
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  ASSERT_EQ(r->instances.size(), 1u);
+  expectNear(r->instances[0].transform.transformPoint({0, 0, 0}), {5, 0, 0});
+  // Without a default scene every root node is drawn, and a mesh used twice is converted once.
+  b.doc.erase("scene");
+  r = load(b);
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  EXPECT_EQ(r->instances.size(), 2u);
+  EXPECT_EQ(r->meshes.size(), 1u);
+}
+
+TEST(Gltf, ConvertsStripsAndFansAndSkipsPointsAndLines) {
+  GltfBuilder b;
+  int positions = b.addPositions({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 2, 0, 0});
+  b.addNode({{"mesh", b.addMesh({{"attributes", {{"POSITION", positions}}}, {"mode", 5}})}});
+  b.addNode({{"mesh", b.addMesh({{"attributes", {{"POSITION", positions}}}, {"mode", 6}})}});
+  b.addNode({{"mesh", b.addMesh({{"attributes", {{"POSITION", positions}}}, {"mode", 1}})}});
+  b.addNode({{"mesh", b.addMesh({{"attributes", {{"POSITION", positions}}}, {"mode", 0}})}});
+  Result<Scene> r = load(b);
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  ASSERT_EQ(r->meshes.size(), 2u);
+  // Strip 0 1 2 3 4: (0 1 2), (2 1 3) with the odd one's winding restored, (2 3 4).
+  EXPECT_EQ(r->meshes[0].indices, (std::vector<uint32_t>{0, 1, 2, 2, 1, 3, 2, 3, 4}));
+  // Fan: (0 1 2), (0 2 3), (0 3 4).
+  EXPECT_EQ(r->meshes[1].indices, (std::vector<uint32_t>{0, 1, 2, 0, 2, 3, 0, 3, 4}));
+}
+
+TEST(Gltf, ReadsNormalizedIntegerColoursAndTexcoords) {
+  GltfBuilder b = oneTriangle();
+  int colors = b.addAccessor(std::vector<uint8_t>{255, 0, 0, 255, 0, 255, 0, 128, 0, 0, 255, 0}, 5121, "VEC4", 3);
+  b.doc["accessors"][size_t(colors)]["normalized"] = true;
+  int uvs = b.addAccessor(std::vector<uint16_t>{0, 0, 65535, 0, 0, 65535}, 5123, "VEC2", 3);
+  b.doc["accessors"][size_t(uvs)]["normalized"] = true;
+  b.doc["meshes"][0]["primitives"][0]["attributes"]["COLOR_0"] = colors;
+  b.doc["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = uvs;
+  Result<Scene> r = load(b);
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  EXPECT_EQ(r->meshes[0].colors[0], (Vec4{1, 0, 0, 1}));
+  EXPECT_NEAR(r->meshes[0].colors[1].w, 128 / 255.0f, 1e-6f);
+  EXPECT_EQ(r->meshes[0].uvs[1].x, 1.0f);
+}
+
+TEST(Gltf, ReadsMaterialsWithUnlitAndDoubleSided) {
+  GltfBuilder b = oneTriangle();
+  b.doc["materials"] = {{{"name", "flat"},
+                         {"doubleSided", true},
+                         {"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 0.25, 1, 0.75}}}},
+                         {"extensions", {{"KHR_materials_unlit", json::object()}}}}};
+  b.doc["extensionsUsed"] = {"KHR_materials_unlit"};
+  b.doc["extensionsRequired"] = {"KHR_materials_unlit"};
+  b.doc["meshes"][0]["primitives"][0]["material"] = 0;
+  Result<Scene> r = load(b);
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  const Material& m = r->materials[0];
+  EXPECT_EQ(m.name, "flat");
+  EXPECT_EQ(m.baseColor, (Vec4{0.5f, 0.25f, 1, 0.75f}));
+  EXPECT_TRUE(m.doubleSided);
+  EXPECT_TRUE(m.unlit);
+}
+
+TEST(Gltf, ReadsPerspectiveCamerasFromNodes) {
+  GltfBuilder b = oneTriangle();
+  b.doc["cameras"] = {{{"type", "perspective"}, {"name", "eye"},
+                       {"perspective", {{"yfov", std::numbers::pi / 3}, {"znear", 0.5}}}}};
+  // At (0, 2, 10), turned 90° about +Y: looks along −X.
+  b.addNode({{"camera", 0}, {"translation", {0, 2, 10}},
+             {"rotation", {0, std::sin(std::numbers::pi / 4), 0, std::cos(std::numbers::pi / 4)}}});
+  Result<Scene> r = load(b);
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  ASSERT_EQ(r->cameras.size(), 1u);
+  const Camera& c = r->cameras[0];
+  EXPECT_EQ(c.name, "eye");
+  expectNear(c.position, {0, 2, 10});
+  expectNear(c.target, {-1, 2, 10});
+  expectNear(c.up, {0, 1, 0});
+  EXPECT_NEAR(c.yfovDegrees, 60, 1e-4);
+  EXPECT_EQ(c.znear, 0.5f);
+  EXPECT_EQ(c.zfar, 1000.0f);  // absent zfar: infinite in glTF, our default far plane here
+}
+
+TEST(Gltf, ExternalBuffersLoadNextToTheFileUnlessReferencesAreOff) {
+  TempDir dir;
+  GltfBuilder b = oneTriangle();
+  json doc = b.doc;
+  doc["buffers"] = {{{"byteLength", b.buffer.size()}, {"uri", "tri.bin"}}};
+  dir.write("tri.bin", b.buffer);
+  std::string path = dir.write("tri.gltf", doc.dump());
+  Result<Scene> r = loadGltf(path);
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  EXPECT_EQ(r->triangleCount(), 1u);
+
+  LoadOptions closed;
+  closed.followReferences = false;
+  Result<Scene> refused = loadGltfFromMemory(doc.dump(), path, closed);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_TRUE(contains(refused.error().str(), "invalid glTF"));
+}
+
+}  // namespace
+}  // namespace sv::scene
