@@ -16,6 +16,7 @@ namespace {
 using nlohmann::json;
 using testing::contains;
 using testing::dataPath;
+using testing::expectLoadError;
 using testing::GltfBuilder;
 using testing::oneTriangle;
 using testing::sourcePath;

@@ -13,6 +13,7 @@ namespace {
 
 using testing::contains;
 using testing::dataPath;
+using testing::expectLoadError;
 using testing::sourcePath;
 using testing::TempDir;
 
@@ -197,31 +198,19 @@ TEST(JsonScene, SyntaxErrorPointsAtTheOffendingCharacter) {
 }
 
 TEST(JsonScene, RejectsWrongTypeNamingThePath) {
-  const std::string path = dataPath("scene/wrong_type.json");
-  Result<Scene> r = loadScene(path);
-  ASSERT_FALSE(r.ok());
-  EXPECT_EQ(r.error().str(), path + ": objects[2].transform.translate: expected an array of 3 numbers, got a string");
+  expectLoadError("scene/wrong_type.json", "objects[2].transform.translate: expected an array of 3 numbers, got a string");
 }
 
 TEST(JsonScene, RejectsUnknownKeyAndSuggestsTheIntendedOne) {
-  const std::string path = dataPath("scene/unknown_key.json");
-  Result<Scene> r = loadScene(path);
-  ASSERT_FALSE(r.ok());
-  EXPECT_EQ(r.error().str(), path + ": camera: unknown key 'postion' (did you mean 'position'?)");
+  expectLoadError("scene/unknown_key.json", "camera: unknown key 'postion' (did you mean 'position'?)");
 }
 
 TEST(JsonScene, RejectsMissingReferencedFile) {
-  const std::string path = dataPath("scene/missing_mesh.json");
-  Result<Scene> r = loadScene(path);
-  ASSERT_FALSE(r.ok());
-  EXPECT_EQ(r.error().str(), path + ": objects[0].mesh: cannot open 'no_such_model.glb': no such file");
+  expectLoadError("scene/missing_mesh.json", "objects[0].mesh: cannot open 'no_such_model.glb': no such file");
 }
 
 TEST(JsonScene, RejectsOtherFormatVersions) {
-  const std::string path = dataPath("scene/version2.json");
-  Result<Scene> r = loadScene(path);
-  ASSERT_FALSE(r.ok());
-  EXPECT_EQ(r.error().str(), path + ": synthvis: unsupported format version 2 (this reader understands version 1)");
+  expectLoadError("scene/version2.json", "synthvis: unsupported format version 2 (this reader understands version 1)");
   EXPECT_TRUE(contains(errorOf(R"({"objects": []})"), "t.json: missing key 'synthvis'"));
   EXPECT_TRUE(contains(errorOf(R"({"synthvis": "1"})"), "unsupported format version \"1\""));
 }
@@ -237,10 +226,7 @@ TEST(JsonScene, RejectsNonFiniteNumberWithItsPosition) {
 }
 
 TEST(JsonScene, RejectsAbsurdSegments) {
-  const std::string path = dataPath("scene/absurd_segments.json");
-  Result<Scene> r = loadScene(path);
-  ASSERT_FALSE(r.ok());
-  EXPECT_EQ(r.error().str(), path + ": objects[0].segments: 100000000 is out of range 3..4096");
+  expectLoadError("scene/absurd_segments.json", "objects[0].segments: 100000000 is out of range 3..4096");
   EXPECT_TRUE(contains(errorOf(withObjects(R"({"primitive": "torus", "sides": 2})")),
                        "objects[0].sides: 2 is out of range 3..4096"));
   EXPECT_TRUE(contains(errorOf(withObjects(R"({"primitive": "checker", "squares": [4, 0]})")),

@@ -12,6 +12,7 @@ namespace {
 
 using testing::contains;
 using testing::dataPath;
+using testing::expectLoadError;
 using testing::sourcePath;
 using testing::TempDir;
 
@@ -76,10 +77,7 @@ TEST(Obj, ReadsVertexColours) {
 }
 
 TEST(Obj, RejectsAFaceIndexPastTheVertices) {
-  const std::string path = dataPath("scene/bad_index.obj");
-  Result<Scene> r = loadScene(path);
-  ASSERT_FALSE(r.ok());
-  EXPECT_EQ(r.error().str(), path + ": shape '': face 1 uses vertex 4, but there are 3 vertices");
+  expectLoadError("scene/bad_index.obj", "shape '': face 1 uses vertex 4, but there are 3 vertices");
 }
 
 TEST(Obj, RejectsMalformedFacesWithTheLineNumber) {

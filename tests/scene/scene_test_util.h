@@ -59,6 +59,14 @@ inline std::string dataPath(const std::string& relative) {
   return std::string(SV_TEST_DATA_DIR) + "/" + relative;
 }
 
+// Loading the data file `relative` fails with exactly "<its path>: <message>".
+inline void expectLoadError(const std::string& relative, const std::string& message) {
+  const std::string path = dataPath(relative);
+  Result<Scene> r = loadScene(path);
+  ASSERT_FALSE(r.ok()) << path;
+  EXPECT_EQ(r.error().str(), path + ": " + message);
+}
+
 inline std::string base64(const std::string& bytes) {
   static const char* kAlphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
   std::string out;
