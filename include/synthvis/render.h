@@ -34,7 +34,8 @@ struct FrameStats {
   uint64_t drawn = 0;
   uint64_t windows[6] = {};
   uint64_t fullWindows = 0, partialBlocks = 0, fragments = 0;
-  double vertexMs = 0, setupMs = 0, rasterMs = 0, resolveMs = 0, totalMs = 0;
+  // rasterMs: the tile pass, which includes resolving each finished tile into the image.
+  double vertexMs = 0, setupMs = 0, rasterMs = 0, totalMs = 0;
 
   uint64_t culled() const { return culledFacing + culledOutside + culledDegenerate + culledInvalid; }
   // One line: triangles in / culled / drawn, windows per level, milliseconds.

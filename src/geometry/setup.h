@@ -79,9 +79,10 @@ struct TriangleSetup {
   bool small;
 };
 
-// The per-vertex part of setup, done once per vertex: the position on the raster snapped to
+// The per-vertex part of setup: the position on the raster snapped to
 // 24.8 fixed point, valid (`snapped`) when the vertex is in front of the eye (w > 0) and inside
-// the guard band. Shared vertices are thus snapped identically for all their triangles.
+// the guard band. A pure function of the vertex: shared vertices snap identically in all their
+// triangles.
 struct ScreenVertex {
   int32_t x = 0, y = 0;  // 24.8
   bool snapped = false;
@@ -100,9 +101,6 @@ enum class SetupOutcome : uint8_t {
 // Sets up one triangle for `viewport`. Returns `drawn` and fills `out`, or a culling reason.
 // Front faces are counter-clockwise in normalized device coordinates (the OpenGL default).
 SetupOutcome setupTriangle(const ClipVertex& v0, const ClipVertex& v1, const ClipVertex& v2,
-                           const Viewport& viewport, CullMode cull, TriangleSetup& out);
-// The same, with the vertices' ScreenVertex already computed by snapVertex.
-SetupOutcome setupTriangle(const ClipVertex* const v[3], const ScreenVertex* const s[3],
                            const Viewport& viewport, CullMode cull, TriangleSetup& out);
 
 }  // namespace sv::geometry

@@ -1,5 +1,6 @@
 #include "output/resolve.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace sv::output {
@@ -18,50 +19,47 @@ GammaTables GammaTables::srgb() {
 
 namespace {
 
-// Calls fn(rgbOut, tileColor, offset) for every pixel of the raster, where `offset` indexes the
-// pixel's red value in its tile's colour array (green and blue follow at +16, +32). One work item
-// per tile row: each writes its own rows of the image.
+// Calls fn(rgbOut, red, green, blue) for the four pixels of every block row of tile `tile` that lie
+// inside the raster; red/green/blue point at the row's 4 values in the tile's planar colour array.
 template <class Fn>
-void forEachPixel(const raster::FrameBuffer& fb, Image& image, core::ThreadPool& pool, Fn fn) {
+void forEachTileRow(const raster::FrameBuffer& fb, int tile, Image& image, Fn fn) {
   using namespace raster;
-  image.width = fb.width();
-  image.height = fb.height();
-  image.rgb.resize(size_t(image.width) * image.height * 3);
-  pool.parallelFor(size_t(fb.tilesY()), [&](size_t ty, int) {
-    for (int tx = 0; tx < fb.tilesX(); ++tx) {
-      const uint16_t* tile = fb.tileColor(int(ty) * fb.tilesX() + tx);
-      const int x0 = tx * kTileSize, y0 = int(ty) * kTileSize;
-      const int w = std::min(kTileSize, fb.width() - x0), h = std::min(kTileSize, fb.height() - y0);
-      for (int y = 0; y < h; ++y) {
-        uint8_t* row = image.pixel(x0, y0 + y);
-        const size_t rowBase = size_t(y >> kBlockLog2) * kBlocksPerTileSide * kColorPerBlock +
-                               (y & (kBlockSize - 1)) * kBlockSize;
-        for (int x = 0; x < w; ++x) {
-          const size_t offset =
-              rowBase + size_t(x >> kBlockLog2) * kColorPerBlock + (x & (kBlockSize - 1));
-          fn(row + x * 3, tile, offset);
-        }
-      }
-    }
-  });
+  const uint16_t* color = fb.tileColor(tile);
+  const int x0 = (tile % fb.tilesX()) * kTileSize, y0 = (tile / fb.tilesX()) * kTileSize;
+  const int w = std::min(kTileSize, fb.width() - x0), h = std::min(kTileSize, fb.height() - y0);
+  for (int y = 0; y < h; ++y) {
+    uint8_t* row = image.pixel(x0, y0 + y);
+    const uint16_t* src = color + size_t(y >> kBlockLog2) * kBlocksPerTileSide * kColorPerBlock +
+                          (y & (kBlockSize - 1)) * kBlockSize;
+    for (int x = 0; x < w; x += kBlockSize, src += kColorPerBlock, row += 3 * kBlockSize)
+      fn(row, src, std::min(kBlockSize, w - x));
+  }
 }
 
 }  // namespace
 
-void resolve(const raster::FrameBuffer& fb, const GammaTables& gamma, Image& image,
-             core::ThreadPool& pool) {
-  forEachPixel(fb, image, pool, [&](uint8_t* out, const uint16_t* tile, size_t offset) {
-    out[0] = gamma.table[0][tile[offset]];
-    out[1] = gamma.table[1][tile[offset + raster::kBlockPixels]];
-    out[2] = gamma.table[2][tile[offset + 2 * raster::kBlockPixels]];
+void prepareImage(int width, int height, Image& image) {
+  image.width = width;
+  image.height = height;
+  image.rgb.resize(size_t(image.width) * image.height * 3);
+}
+
+void resolveTile(const raster::FrameBuffer& fb, int tile, const GammaTables& gamma, Image& image) {
+  constexpr int g = raster::kBlockPixels, b = 2 * raster::kBlockPixels;
+  forEachTileRow(fb, tile, image, [&](uint8_t* out, const uint16_t* src, int n) {
+    for (int i = 0; i < n; ++i) {
+      out[3 * i] = gamma.table[0][src[i]];
+      out[3 * i + 1] = gamma.table[1][src[g + i]];
+      out[3 * i + 2] = gamma.table[2][src[b + i]];
+    }
   });
 }
 
-void resolveOverdraw(const raster::FrameBuffer& fb, Image& image, core::ThreadPool& pool) {
+void resolveOverdrawTile(const raster::FrameBuffer& fb, int tile, Image& image) {
   static constexpr uint8_t kPalette[6][3] = {{0, 0, 0},     {30, 60, 220}, {0, 200, 220},
                                              {40, 200, 40}, {240, 220, 0}, {230, 30, 30}};
-  forEachPixel(fb, image, pool, [&](uint8_t* out, const uint16_t* tile, size_t offset) {
-    std::copy_n(kPalette[std::min<int>(tile[offset], 5)], 3, out);
+  forEachTileRow(fb, tile, image, [&](uint8_t* out, const uint16_t* src, int n) {
+    for (int i = 0; i < n; ++i) std::copy_n(kPalette[std::min<int>(src[i], 5)], 3, out + 3 * i);
   });
 }
 

@@ -4,7 +4,6 @@
 #include <array>
 #include <cstdint>
 
-#include "core/thread_pool.h"
 #include "raster/framebuffer.h"
 #include "synthvis/image.h"
 
@@ -18,12 +17,15 @@ struct GammaTables {
   static GammaTables srgb();  // the sRGB transfer function (IEC 61966-2-1)
 };
 
-// Crops the frame buffer to its raster, applies the tables and writes `image` (resized).
-void resolve(const raster::FrameBuffer& fb, const GammaTables& gamma, Image& image,
-             core::ThreadPool& pool);
+// Sizes `image` for a width × height raster; call once per frame before resolving its tiles.
+void prepareImage(int width, int height, Image& image);
+
+// Crops tile `tile` to the raster, applies the tables and writes the tile's pixels of `image`.
+// Tiles write disjoint pixels, so different tiles may be resolved on different threads.
+void resolveTile(const raster::FrameBuffer& fb, int tile, const GammaTables& gamma, Image& image);
 
 // For the overdraw count (raster::ShadeMode::overdraw): a false-colour image, black for 0, then
 // blue, cyan, green, yellow, red for 1, 2, 3, 4, ≥5 triangles covering the pixel.
-void resolveOverdraw(const raster::FrameBuffer& fb, Image& image, core::ThreadPool& pool);
+void resolveOverdrawTile(const raster::FrameBuffer& fb, int tile, Image& image);
 
 }  // namespace sv::output

@@ -6,11 +6,15 @@
 namespace sv::render {
 namespace {
 
-// Triangles are processed in batches (bounded memory for the setup records, and bins that stay in
-// cache), each batch set up in fixed-size chunks. Both sizes are constants, not functions of the
-// thread count, so the draw order inside every tile — and so the image — never depends on threads.
-constexpr uint32_t kBatchTriangles = 1u << 14;
-constexpr uint32_t kChunkTriangles = 1u << 10;
+// Triangles are processed in batches (bounded memory for the setup records: 2^18 × 144 bytes), each
+// batch set up in fixed-size chunks. Both sizes are constants, not functions of the thread count,
+// so the draw order inside every tile — and so the image — never depends on threads.
+// Every batch walks the whole frame buffer once (20 MB at 1920×1080, far beyond L2), so batches are
+// large: with 2^14-triangle batches, 100k triangles of 10 px spent over half their tile time
+// waiting for frame-buffer blocks to come back from L3 (perf: the depth load in shadeBlock).
+// Chunks of 2^13 triangles give a tile runs of ~20 contiguous records at 100k triangles of 10 px.
+constexpr uint32_t kBatchTriangles = 1u << 18;
+constexpr uint32_t kChunkTriangles = 1u << 13;
 constexpr int kChunksPerBatch = kBatchTriangles / kChunkTriangles;
 
 using Clock = std::chrono::steady_clock;
@@ -47,18 +51,9 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
         std::lround(std::clamp(settings.clearColor[ch], 0.0f, 1.0f) * 65535.0f));
   if (settings.shade == raster::ShadeMode::overdraw) std::fill_n(clear16, 3, uint16_t(0));
 
-  // Stage 3a: snap every vertex once (shared vertices then agree in all their triangles).
-  auto t0 = Clock::now();
-  constexpr size_t kSnapChunk = 1 << 14;
-  screen_.resize(packets.vertices.size());
-  pool_.parallelFor((packets.vertices.size() + kSnapChunk - 1) / kSnapChunk, [&](size_t c, int) {
-    const size_t end = std::min(packets.vertices.size(), (c + 1) * kSnapChunk);
-    for (size_t i = c * kSnapChunk; i < end; ++i)
-      screen_[i] = geometry::snapVertex(packets.vertices[i], viewport);
-  });
-  stats.setupMs += msSince(t0);
-
   setups_.resize(kBatchTriangles);
+  scratch_.resize(size_t(pool_.threadCount()));
+  for (WorkerScratch& w : scratch_) w.records.resize(kChunkTriangles);
   tileStats_.assign(size_t(tiles), raster::RasterStats{});
   std::vector<SetupCounts> counts(kChunksPerBatch);
   stats.trianglesIn += triangleCount;
@@ -67,11 +62,14 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
   for (uint32_t batch = 0; batch == 0 || batch < triangleCount; batch += kBatchTriangles) {
     const uint32_t batchEnd = std::min(triangleCount, batch + kBatchTriangles);
     const int chunks = int((batchEnd - batch + kChunkTriangles - 1) / kChunkTriangles);
+    const bool lastBatch = batchEnd == triangleCount;
 
-    // Stage 3b: setup and binning, chunk by chunk.
-    t0 = Clock::now();
+    // Stage 3: setup and binning, chunk by chunk.
+    auto t0 = Clock::now();
     binner_.reset(std::max(chunks, 1), fb_.tilesX(), fb_.tilesY());
-    pool_.parallelFor(size_t(chunks), [&](size_t chunk, int) {
+    pool_.parallelFor(size_t(chunks), [&](size_t chunk, int worker) {
+      WorkerScratch& scratch = scratch_[worker];
+      uint32_t n = 0;
       SetupCounts c;
       const uint32_t begin = batch + uint32_t(chunk) * kChunkTriangles;
       const uint32_t end = std::min(batchEnd, begin + kChunkTriangles);
@@ -79,15 +77,13 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
       for (uint32_t tri = begin; tri < end; ++tri) {
         const DrawCall* call = cursor.find(tri);
         const uint32_t* idx = &packets.indices[size_t(tri) * 3];
-        geometry::TriangleSetup& s = setups_[tri - batch];
-        const geometry::ClipVertex* v[3] = {&packets.vertices[idx[0]], &packets.vertices[idx[1]],
-                                            &packets.vertices[idx[2]]};
-        const geometry::ScreenVertex* sv[3] = {&screen_[idx[0]], &screen_[idx[1]], &screen_[idx[2]]};
-        switch (geometry::setupTriangle(v, sv, viewport,
+        geometry::TriangleSetup& s = scratch.records[n];
+        switch (geometry::setupTriangle(packets.vertices[idx[0]], packets.vertices[idx[1]],
+                                        packets.vertices[idx[2]], viewport,
                                         call ? call->cull : geometry::CullMode::none, s)) {
           case geometry::SetupOutcome::drawn:
             ++c.drawn;
-            binner_.bin(int(chunk), tri - batch, s);
+            ++n;
             break;
           case geometry::SetupOutcome::culledFacing: ++c.facing; break;
           case geometry::SetupOutcome::culledOutside: ++c.outside; break;
@@ -95,6 +91,9 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
           case geometry::SetupOutcome::culledInvalid: ++c.invalid; break;
         }
       }
+      const uint32_t storageBase = begin - batch;
+      binner_.binChunk(int(chunk), scratch.records.data(), n, setups_.data() + storageBase,
+                       storageBase, scratch.bins);
       counts[chunk] = c;
     });
     for (int i = 0; i < chunks; ++i) {
@@ -130,6 +129,7 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
       w.listCount = lists;
       w.shade = settings.shade;
       raster::rasterizeTile(w, tileStats_[tile]);
+      if (lastBatch && settings.finishTile) settings.finishTile(int(tile));
     });
     stats.rasterMs += msSince(t0);
   }

@@ -2,6 +2,7 @@
 // then the tiles in parallel (SPEC §1 stages 3–4, §3.4, §6).
 #pragma once
 
+#include <functional>
 #include <vector>
 
 #include "core/thread_pool.h"
@@ -31,6 +32,9 @@ struct FrameSettings {
   int width = 0, height = 0;
   float clearColor[3] = {0, 0, 0};  // linear
   raster::ShadeMode shade = raster::ShadeMode::gouraud;
+  // Called once per tile, on the thread that drew it, right after the tile's last triangle: the
+  // display stage reads the tile while it is still in that core's cache.
+  std::function<void(int tile)> finishTile;
 };
 
 class FrameRenderer {
@@ -47,8 +51,12 @@ class FrameRenderer {
   core::ThreadPool pool_;
   raster::FrameBuffer fb_;
   raster::Binner binner_;
-  std::vector<geometry::TriangleSetup> setups_;
-  std::vector<geometry::ScreenVertex> screen_;  // snapVertex of every packet vertex
+  struct WorkerScratch {
+    std::vector<geometry::TriangleSetup> records;  // one chunk's, in submission order
+    raster::Binner::Scratch bins;
+  };
+  std::vector<geometry::TriangleSetup> setups_;  // the batch's, grouped by tile within each chunk
+  std::vector<WorkerScratch> scratch_;           // one per pool worker
   std::vector<raster::RasterStats> tileStats_;
 };
 

@@ -69,10 +69,10 @@ std::string FrameStats::summary() const {
   return fmt::format(
       "triangles in {} / culled {} (facing {}, outside {}, degenerate {}, invalid {}) / drawn {} | "
       "windows 64:{} 32:{} 16:{} 8:{} 4:{} px-tests:{} full:{} | {:.2f} ms (vertex {:.2f}, setup "
-      "{:.2f}, raster {:.2f}, resolve {:.2f})",
+      "{:.2f}, tiles {:.2f} incl. resolve)",
       trianglesIn, culled(), culledFacing, culledOutside, culledDegenerate, culledInvalid, drawn,
       windows[0], windows[1], windows[2], windows[3], windows[4], windows[5], fullWindows, totalMs,
-      vertexMs, setupMs, rasterMs, resolveMs);
+      vertexMs, setupMs, rasterMs);
 }
 
 struct Renderer::Impl {
@@ -164,16 +164,14 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
   fs.clearColor[1] = scene.background.y;
   fs.clearColor[2] = scene.background.z;
   fs.shade = o.debugOverdraw ? raster::ShadeMode::overdraw : raster::ShadeMode::gouraud;
+  // Stage 5, display: each tile is resolved into the image as soon as it is finished.
+  const raster::FrameBuffer& fb = impl_->frame.frameBuffer();
+  if (o.debugOverdraw)
+    fs.finishTile = [&](int tile) { output::resolveOverdrawTile(fb, tile, image); };
+  else
+    fs.finishTile = [&](int tile) { output::resolveTile(fb, tile, impl_->gamma, image); };
+  output::prepareImage(o.width, o.height, image);
   impl_->frame.render(p, fs, stats);
-
-  // Stage 5: display.
-  t0 = Clock::now();
-  if (o.debugOverdraw) {
-    output::resolveOverdraw(impl_->frame.frameBuffer(), image, impl_->frame.pool());
-  } else {
-    output::resolve(impl_->frame.frameBuffer(), impl_->gamma, image, impl_->frame.pool());
-  }
-  stats.resolveMs = msSince(t0);
   stats.totalMs = msSince(start);
   if (statsOut) *statsOut = stats;
   return {};
