@@ -19,14 +19,14 @@ GammaTables GammaTables::srgb() {
 
 namespace {
 
-// Calls fn(rgbOut, red, green, blue) for the four pixels of every block row of tile `tile` that lie
-// inside the raster; red/green/blue point at the row's 4 values in the tile's planar colour array.
+// Calls fn(rgbOut, src, n) for every row of 4 pixels of a block of the tile that lies (n of them)
+// inside the image; src points at the row's red values in the tile's planar colour array (green
+// and blue follow at +16 and +32).
 template <class Fn>
-void forEachTileRow(const raster::FrameBuffer& fb, int tile, Image& image, Fn fn) {
+void forEachTileRow(const uint16_t* color, int tileX, int tileY, Image& image, Fn fn) {
   using namespace raster;
-  const uint16_t* color = fb.tileColor(tile);
-  const int x0 = (tile % fb.tilesX()) * kTileSize, y0 = (tile / fb.tilesX()) * kTileSize;
-  const int w = std::min(kTileSize, fb.width() - x0), h = std::min(kTileSize, fb.height() - y0);
+  const int x0 = tileX * kTileSize, y0 = tileY * kTileSize;
+  const int w = std::min(kTileSize, image.width - x0), h = std::min(kTileSize, image.height - y0);
   for (int y = 0; y < h; ++y) {
     uint8_t* row = image.pixel(x0, y0 + y);
     const uint16_t* src = color + size_t(y >> kBlockLog2) * kBlocksPerTileSide * kColorPerBlock +
@@ -44,9 +44,10 @@ void prepareImage(int width, int height, Image& image) {
   image.rgb.resize(size_t(image.width) * image.height * 3);
 }
 
-void resolveTile(const raster::FrameBuffer& fb, int tile, const GammaTables& gamma, Image& image) {
+void resolveTile(const uint16_t* color, int tileX, int tileY, const GammaTables& gamma,
+                 Image& image) {
   constexpr int g = raster::kBlockPixels, b = 2 * raster::kBlockPixels;
-  forEachTileRow(fb, tile, image, [&](uint8_t* out, const uint16_t* src, int n) {
+  forEachTileRow(color, tileX, tileY, image, [&](uint8_t* out, const uint16_t* src, int n) {
     for (int i = 0; i < n; ++i) {
       out[3 * i] = gamma.table[0][src[i]];
       out[3 * i + 1] = gamma.table[1][src[g + i]];
@@ -55,10 +56,10 @@ void resolveTile(const raster::FrameBuffer& fb, int tile, const GammaTables& gam
   });
 }
 
-void resolveOverdrawTile(const raster::FrameBuffer& fb, int tile, Image& image) {
+void resolveOverdrawTile(const uint16_t* color, int tileX, int tileY, Image& image) {
   static constexpr uint8_t kPalette[6][3] = {{0, 0, 0},     {30, 60, 220}, {0, 200, 220},
                                              {40, 200, 40}, {240, 220, 0}, {230, 30, 30}};
-  forEachTileRow(fb, tile, image, [&](uint8_t* out, const uint16_t* src, int n) {
+  forEachTileRow(color, tileX, tileY, image, [&](uint8_t* out, const uint16_t* src, int n) {
     for (int i = 0; i < n; ++i) std::copy_n(kPalette[std::min<int>(src[i], 5)], 3, out + 3 * i);
   });
 }

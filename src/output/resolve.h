@@ -20,12 +20,14 @@ struct GammaTables {
 // Sizes `image` for a width × height raster; call once per frame before resolving its tiles.
 void prepareImage(int width, int height, Image& image);
 
-// Crops tile `tile` to the raster, applies the tables and writes the tile's pixels of `image`.
-// Tiles write disjoint pixels, so different tiles may be resolved on different threads.
-void resolveTile(const raster::FrameBuffer& fb, int tile, const GammaTables& gamma, Image& image);
+// Applies the tables to one 64×64 tile's colour (laid out as raster/framebuffer.h describes) and
+// writes the part of it inside `image` (sized by prepareImage) at tile (tileX, tileY). Tiles write
+// disjoint pixels, so different tiles may be resolved on different threads.
+void resolveTile(const uint16_t* color, int tileX, int tileY, const GammaTables& gamma,
+                 Image& image);
 
 // For the overdraw count (raster::ShadeMode::overdraw): a false-colour image, black for 0, then
 // blue, cyan, green, yellow, red for 1, 2, 3, 4, ≥5 triangles covering the pixel.
-void resolveOverdrawTile(const raster::FrameBuffer& fb, int tile, Image& image);
+void resolveOverdrawTile(const uint16_t* color, int tileX, int tileY, Image& image);
 
 }  // namespace sv::output

@@ -14,12 +14,4 @@ void FrameBuffer::resize(int width, int height) {
   tilesY_ = ty;
 }
 
-float FrameBuffer::depthAt(int x, int y) const {
-  return depth_[size_t(tileOf(x, y)) * kTilePixels + depthOffset(x, y)];
-}
-
-uint16_t FrameBuffer::colorAt(int x, int y, int channel) const {
-  return color_[size_t(tileOf(x, y)) * kTilePixels * kColorChannels + colorOffset(x, y, channel)];
-}
-
 }  // namespace sv::raster

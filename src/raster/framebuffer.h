@@ -48,12 +48,7 @@ class FrameBuffer {
   static size_t depthOffset(int x, int y);
   static size_t colorOffset(int x, int y, int channel);
 
-  float depthAt(int x, int y) const;
-  uint16_t colorAt(int x, int y, int channel) const;
-
  private:
-  int tileOf(int x, int y) const { return (y >> kTileLog2) * tilesX_ + (x >> kTileLog2); }
-
   int width_ = 0, height_ = 0, tilesX_ = 0, tilesY_ = 0;
   hwy::AlignedFreeUniquePtr<float[]> depth_;
   hwy::AlignedFreeUniquePtr<uint16_t[]> color_;

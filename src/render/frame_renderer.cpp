@@ -6,16 +6,14 @@
 namespace sv::render {
 namespace {
 
-// Triangles are processed in batches (bounded memory for the setup records: 2^18 × 144 bytes), each
-// batch set up in fixed-size chunks. Both sizes are constants, not functions of the thread count,
-// so the draw order inside every tile — and so the image — never depends on threads.
-// Every batch walks the whole frame buffer once (20 MB at 1920×1080, far beyond L2), so batches are
+// Triangles are processed in batches (bounded memory for the setup records: FrameSettings::
+// batchTriangles × 144 bytes), each batch set up in fixed-size chunks. Neither size depends on the
+// thread count, so the draw order inside every tile — and so the image — never does.
+// Every batch walks the frame buffer once (20 MB at 1920×1080, far beyond L2), so batches are
 // large: with 2^14-triangle batches, 100k triangles of 10 px spent over half their tile time
 // waiting for frame-buffer blocks to come back from L3 (perf: the depth load in shadeBlock).
 // Chunks of 2^13 triangles give a tile runs of ~20 contiguous records at 100k triangles of 10 px.
-constexpr uint32_t kBatchTriangles = 1u << 18;
 constexpr uint32_t kChunkTriangles = 1u << 13;
-constexpr int kChunksPerBatch = kBatchTriangles / kChunkTriangles;
 
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t0) {
@@ -41,32 +39,45 @@ struct CallCursor {
 
 void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& settings,
                            FrameStats& stats) {
-  fb_.resize(settings.width, settings.height);
   const geometry::Viewport viewport{settings.width, settings.height};
   const uint32_t triangleCount = static_cast<uint32_t>(packets.indices.size() / 3);
-  const int tiles = fb_.tileCount();
+  const uint32_t batchTriangles = std::clamp<uint32_t>(settings.batchTriangles, 1, 1u << 24);
+  // One batch: each tile is cleared, drawn and handed on in a per-thread 64×64 buffer. Several: the
+  // tiles persist in a whole-frame buffer from batch to batch.
+  const bool wholeFrame = triangleCount > batchTriangles;
+  const int tilesX = (settings.width + raster::kTileSize - 1) >> raster::kTileLog2;
+  const int tilesY = (settings.height + raster::kTileSize - 1) >> raster::kTileLog2;
+  const int tiles = tilesX * tilesY;
+  if (wholeFrame) fb_.resize(settings.width, settings.height);
   uint16_t clear16[3];
   for (int ch = 0; ch < 3; ++ch)
     clear16[ch] = static_cast<uint16_t>(
         std::lround(std::clamp(settings.clearColor[ch], 0.0f, 1.0f) * 65535.0f));
   if (settings.shade == raster::ShadeMode::overdraw) std::fill_n(clear16, 3, uint16_t(0));
 
-  setups_.resize(kBatchTriangles);
+  const uint32_t firstBatch = std::min(triangleCount, batchTriangles);
+  setups_.resize(std::max<size_t>(setups_.size(), firstBatch));
   scratch_.resize(size_t(pool_.threadCount()));
-  for (WorkerScratch& w : scratch_) w.records.resize(kChunkTriangles);
+  for (WorkerScratch& w : scratch_) {
+    w.records.resize(kChunkTriangles);
+    if (!wholeFrame) w.tile.resize(raster::kTileSize, raster::kTileSize);
+  }
   tileStats_.assign(size_t(tiles), raster::RasterStats{});
-  std::vector<SetupCounts> counts(kChunksPerBatch);
+  const int maxChunks = std::max(1, int((firstBatch + kChunkTriangles - 1) / kChunkTriangles));
+  std::vector<SetupCounts> counts(static_cast<size_t>(maxChunks));
+  std::vector<const uint32_t*> listPtrs(size_t(maxChunks) * pool_.threadCount());
+  std::vector<uint32_t> listSizes(listPtrs.size());
   stats.trianglesIn += triangleCount;
 
   // Always run at least one (empty) batch, so the tiles get cleared.
-  for (uint32_t batch = 0; batch == 0 || batch < triangleCount; batch += kBatchTriangles) {
-    const uint32_t batchEnd = std::min(triangleCount, batch + kBatchTriangles);
+  for (uint32_t batch = 0; batch == 0 || batch < triangleCount; batch += batchTriangles) {
+    const uint32_t batchEnd = std::min(triangleCount, batch + batchTriangles);
     const int chunks = int((batchEnd - batch + kChunkTriangles - 1) / kChunkTriangles);
     const bool lastBatch = batchEnd == triangleCount;
 
     // Stage 3: setup and binning, chunk by chunk.
     auto t0 = Clock::now();
-    binner_.reset(std::max(chunks, 1), fb_.tilesX(), fb_.tilesY());
+    binner_.reset(std::max(chunks, 1), tilesX, tilesY);
     pool_.parallelFor(size_t(chunks), [&](size_t chunk, int worker) {
       WorkerScratch& scratch = scratch_[worker];
       uint32_t n = 0;
@@ -108,19 +119,21 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
     // Stage 4: the tiles, each drawing its lists in chunk order.
     t0 = Clock::now();
     const int lists = binner_.chunkCount();
-    pool_.parallelFor(size_t(tiles), [&](size_t tile, int) {
-      const uint32_t* listPtr[kChunksPerBatch];
-      uint32_t listSize[kChunksPerBatch];
+    pool_.parallelFor(size_t(tiles), [&](size_t tile, int worker) {
+      const uint32_t** listPtr = listPtrs.data() + size_t(worker) * maxChunks;
+      uint32_t* listSize = listSizes.data() + size_t(worker) * maxChunks;
       for (int c = 0; c < lists; ++c) {
         const auto& l = binner_.list(c, int(tile));
         listPtr[c] = l.data();
         listSize[c] = uint32_t(l.size());
       }
       raster::TileWork w;
-      w.tileX = int(tile) % fb_.tilesX();
-      w.tileY = int(tile) / fb_.tilesX();
-      w.depth = fb_.tileDepth(int(tile));
-      w.color = fb_.tileColor(int(tile));
+      w.tileX = int(tile) % tilesX;
+      w.tileY = int(tile) / tilesX;
+      raster::FrameBuffer& buffer = wholeFrame ? fb_ : scratch_[worker].tile;
+      const int index = wholeFrame ? int(tile) : 0;
+      w.depth = buffer.tileDepth(index);
+      w.color = buffer.tileColor(index);
       w.clear = batch == 0;
       std::copy_n(clear16, 3, w.clearColor);
       w.setups = setups_.data();
@@ -129,7 +142,7 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
       w.listCount = lists;
       w.shade = settings.shade;
       raster::rasterizeTile(w, tileStats_[tile]);
-      if (lastBatch && settings.finishTile) settings.finishTile(int(tile));
+      if (lastBatch && settings.finishTile) settings.finishTile(int(tile), w.depth, w.color);
     });
     stats.rasterMs += msSince(t0);
   }

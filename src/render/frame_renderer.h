@@ -32,28 +32,33 @@ struct FrameSettings {
   int width = 0, height = 0;
   float clearColor[3] = {0, 0, 0};  // linear
   raster::ShadeMode shade = raster::ShadeMode::gouraud;
-  // Called once per tile, on the thread that drew it, right after the tile's last triangle: the
-  // display stage reads the tile while it is still in that core's cache.
-  std::function<void(int tile)> finishTile;
+  // Called once per tile, on the thread that drew it, right after the tile's last triangle, with
+  // the tile's depth and colour (laid out as raster/framebuffer.h describes). This is the only way
+  // out of the frame: the storage is reused for the next tile as soon as the call returns.
+  std::function<void(int tile, const float* depth, const uint16_t* color)> finishTile;
+  // Triangles per batch (every batch sets up its triangles, then walks the tiles). Frames of one
+  // batch draw each tile in a small per-thread buffer that never leaves the core's cache; frames of
+  // several keep a whole-frame buffer between batches. Tests lower it to exercise that path.
+  uint32_t batchTriangles = 1u << 18;
 };
 
 class FrameRenderer {
  public:
   explicit FrameRenderer(int threads) : pool_(threads) {}
 
-  // Clears the frame buffer and draws `packets` into it; adds to `stats`.
+  // Draws `packets`, handing every finished tile to settings.finishTile; adds to `stats`.
   void render(const DrawPackets& packets, const FrameSettings& settings, FrameStats& stats);
 
-  const raster::FrameBuffer& frameBuffer() const { return fb_; }
   core::ThreadPool& pool() { return pool_; }
 
  private:
   core::ThreadPool pool_;
-  raster::FrameBuffer fb_;
+  raster::FrameBuffer fb_;  // the whole frame, in frames of several batches
   raster::Binner binner_;
   struct WorkerScratch {
     std::vector<geometry::TriangleSetup> records;  // one chunk's, in submission order
     raster::Binner::Scratch bins;
+    raster::FrameBuffer tile;  // 64×64: the tile being drawn, in frames of one batch
   };
   std::vector<geometry::TriangleSetup> setups_;  // the batch's, grouped by tile within each chunk
   std::vector<WorkerScratch> scratch_;           // one per pool worker

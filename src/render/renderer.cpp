@@ -165,11 +165,15 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
   fs.clearColor[2] = scene.background.z;
   fs.shade = o.debugOverdraw ? raster::ShadeMode::overdraw : raster::ShadeMode::gouraud;
   // Stage 5, display: each tile is resolved into the image as soon as it is finished.
-  const raster::FrameBuffer& fb = impl_->frame.frameBuffer();
+  const int tilesX = (o.width + raster::kTileSize - 1) >> raster::kTileLog2;
   if (o.debugOverdraw)
-    fs.finishTile = [&](int tile) { output::resolveOverdrawTile(fb, tile, image); };
+    fs.finishTile = [&](int tile, const float*, const uint16_t* color) {
+      output::resolveOverdrawTile(color, tile % tilesX, tile / tilesX, image);
+    };
   else
-    fs.finishTile = [&](int tile) { output::resolveTile(fb, tile, impl_->gamma, image); };
+    fs.finishTile = [&](int tile, const float*, const uint16_t* color) {
+      output::resolveTile(color, tile % tilesX, tile / tilesX, impl_->gamma, image);
+    };
   output::prepareImage(o.width, o.height, image);
   impl_->frame.render(p, fs, stats);
   stats.totalMs = msSince(start);

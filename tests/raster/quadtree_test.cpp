@@ -282,6 +282,20 @@ TEST(Determinism, OneTwoAndEightThreadsGiveIdenticalFrames) {
   EXPECT_TRUE(one == test::renderQuadtree(p, gouraudSettings(w, h), 8));
 }
 
+// Frames of several batches keep a whole-frame buffer between batches; frames of one draw each
+// tile in a per-thread buffer. Both give the same frame, and the reference's.
+TEST(Determinism, ManyBatchesGiveTheOneBatchFrame) {
+  const int w = 333, h = 250;
+  const DrawPackets p = randomScene(w, h, 3000, 7, true);
+  const test::Frame one = test::renderQuadtree(p, gouraudSettings(w, h), 2);
+  for (uint32_t batch : {1u, 97u, 1000u}) {
+    FrameSettings s = gouraudSettings(w, h);
+    s.batchTriangles = batch;
+    EXPECT_TRUE(one == test::renderQuadtree(p, s, 2)) << "batches of " << batch;
+  }
+  EXPECT_TRUE(one == test::renderReference(p, gouraudSettings(w, h)));
+}
+
 TEST(Determinism, EverySimdTargetGivesTheScalarTargetsFrame) {
   const int w = 200, h = 150;
   const DrawPackets p = randomScene(w, h, 400, 5, true);

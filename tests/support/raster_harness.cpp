@@ -32,17 +32,24 @@ void addTriangle(render::DrawPackets& p, const geometry::ClipVertex& a,
 Frame renderQuadtree(const render::DrawPackets& p, const render::FrameSettings& s, int threads,
                      FrameStats* stats) {
   render::FrameRenderer r(threads);
-  FrameStats local;
-  r.render(p, s, stats ? *stats : local);
-  const raster::FrameBuffer& fb = r.frameBuffer();
   Frame f{s.width, s.height, {}, {}};
   f.depth.resize(size_t(s.width) * s.height);
   f.color.resize(f.depth.size() * 3);
-  for (int y = 0; y < s.height; ++y)
-    for (int x = 0; x < s.width; ++x) {
-      f.depth[size_t(y) * s.width + x] = fb.depthAt(x, y);
-      for (int ch = 0; ch < 3; ++ch) f.color[(size_t(y) * s.width + x) * 3 + ch] = fb.colorAt(x, y, ch);
-    }
+  render::FrameSettings settings = s;
+  const int tilesX = (s.width + raster::kTileSize - 1) >> raster::kTileLog2;
+  // Tiles are copied out as they are finished (concurrently: each writes its own pixels).
+  settings.finishTile = [&](int tile, const float* depth, const uint16_t* color) {
+    const int x0 = (tile % tilesX) * raster::kTileSize, y0 = (tile / tilesX) * raster::kTileSize;
+    for (int y = y0; y < std::min(s.height, y0 + raster::kTileSize); ++y)
+      for (int x = x0; x < std::min(s.width, x0 + raster::kTileSize); ++x) {
+        const size_t i = size_t(y) * s.width + x;
+        f.depth[i] = depth[raster::FrameBuffer::depthOffset(x, y)];
+        for (int ch = 0; ch < 3; ++ch)
+          f.color[i * 3 + ch] = color[raster::FrameBuffer::colorOffset(x, y, ch)];
+      }
+  };
+  FrameStats local;
+  r.render(p, settings, stats ? *stats : local);
   return f;
 }
 
