@@ -115,9 +115,9 @@ struct SparseProcessor {
     binner.reset(1, tilesX, tilesY);
     binner.binChunk(0, sparse.data(), n, stored.data(), 0, scratch);
     for (int tile = 0; tile < tilesX * tilesY; ++tile) {
-      const auto& list = binner.list(0, tile);
-      const uint32_t* lists[1] = {list.data()};
-      const uint32_t sizes[1] = {uint32_t(list.size())};
+      const raster::Binner::List list = binner.list(0, tile);
+      const uint32_t* lists[1] = {list.data};
+      const uint32_t sizes[1] = {list.size};
       raster::TileWork w;
       w.tileX = tile % tilesX;
       w.tileY = tile / tilesX;

@@ -5,9 +5,8 @@
 namespace sv::raster {
 
 void Binner::reset(int chunks, int tilesX, int tilesY) {
-  const size_t need = size_t(chunks) * tilesX * tilesY;
-  if (lists_.size() < need) lists_.resize(need);
-  for (size_t i = 0; i < need; ++i) lists_[i].clear();
+  if (chunkLists_.size() < size_t(chunks)) chunkLists_.resize(size_t(chunks));
+  for (int c = 0; c < chunks; ++c) chunkLists_[size_t(c)].offsets.clear();
   chunks_ = chunks;
   tilesX_ = tilesX;
   tiles_ = tilesX * tilesY;
@@ -31,14 +30,22 @@ void Binner::binChunk(int chunk, const geometry::TriangleSetup* records, uint32_
     scratch.position[i] = p;
     storage[p] = records[i];
   }
-  std::vector<uint32_t>* base = lists_.data() + size_t(chunk) * tiles_;
-  for (uint32_t i = 0; i < n; ++i) {
-    const geometry::TriangleSetup& t = records[i];
-    const uint32_t index = storageBase + scratch.position[i];
+  // The lists: count the entries per tile, then place them in submission order.
+  ChunkLists& out = chunkLists_[size_t(chunk)];
+  out.offsets.assign(size_t(tiles_) + 1, 0);
+  auto forEachTile = [&](const geometry::TriangleSetup& t, auto fn) {
     const int tx0 = t.minX >> kTileLog2, tx1 = t.maxX >> kTileLog2;
     const int ty0 = t.minY >> kTileLog2, ty1 = t.maxY >> kTileLog2;
     for (int ty = ty0; ty <= ty1; ++ty)
-      for (int tx = tx0; tx <= tx1; ++tx) base[ty * tilesX_ + tx].push_back(index);
+      for (int tx = tx0; tx <= tx1; ++tx) fn(ty * tilesX_ + tx);
+  };
+  for (uint32_t i = 0; i < n; ++i) forEachTile(records[i], [&](int tile) { ++out.offsets[tile + 1]; });
+  for (int k = 0; k < tiles_; ++k) out.offsets[k + 1] += out.offsets[k];
+  out.entries.resize(out.offsets[size_t(tiles_)]);
+  scratch.cursor.assign(out.offsets.begin(), out.offsets.end() - 1);
+  for (uint32_t i = 0; i < n; ++i) {
+    const uint32_t index = storageBase + scratch.position[i];
+    forEachTile(records[i], [&](int tile) { out.entries[scratch.cursor[tile]++] = index; });
   }
 }
 

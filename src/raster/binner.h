@@ -24,7 +24,7 @@ class Binner {
  public:
   // Per-worker temporary arrays for binChunk (kept between calls to avoid reallocation).
   struct Scratch {
-    std::vector<uint32_t> key, position, count;
+    std::vector<uint32_t> key, position, count, cursor;
   };
 
   // Empties all lists for `chunks` chunks over a tilesX × tilesY grid (keeps their capacity).
@@ -36,14 +36,26 @@ class Binner {
   void binChunk(int chunk, const geometry::TriangleSetup* records, uint32_t n,
                 geometry::TriangleSetup* storage, uint32_t storageBase, Scratch& scratch);
 
+  struct List {
+    const uint32_t* data;
+    uint32_t size;
+  };
   int chunkCount() const { return chunks_; }
-  const std::vector<uint32_t>& list(int chunk, int tile) const {
-    return lists_[size_t(chunk) * tiles_ + tile];
+  List list(int chunk, int tile) const {
+    const ChunkLists& c = chunkLists_[size_t(chunk)];
+    if (c.offsets.empty()) return {nullptr, 0};
+    return {c.entries.data() + c.offsets[size_t(tile)], c.offsets[size_t(tile) + 1] - c.offsets[size_t(tile)]};
   }
 
  private:
+  // A chunk's lists, one after the other in tile order: tile t's is entries[offsets[t], offsets[t+1]).
+  // Filled by a counting pass and a placing pass: two flat arrays per chunk instead of a vector per
+  // tile and chunk (the same speed on tris 100k×10, far fewer allocations at 8192² rasters).
+  struct ChunkLists {
+    std::vector<uint32_t> offsets, entries;
+  };
   int chunks_ = 0, tilesX_ = 0, tiles_ = 0;
-  std::vector<std::vector<uint32_t>> lists_;
+  std::vector<ChunkLists> chunkLists_;
 };
 
 }  // namespace sv::raster

@@ -14,6 +14,7 @@ namespace {
 // waiting for frame-buffer blocks to come back from L3 (perf: the depth load in shadeBlock).
 // Chunks of 2^13 triangles give a tile runs of ~20 contiguous records at 100k triangles of 10 px.
 constexpr uint32_t kChunkTriangles = 1u << 13;
+constexpr uint32_t kVertexPrefetch = 8;  // triangles
 
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t0) {
@@ -86,6 +87,11 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
       const uint32_t end = std::min(batchEnd, begin + kChunkTriangles);
       CallCursor cursor{packets.calls};
       for (uint32_t tri = begin; tri < end; ++tri) {
+        // The vertices come from the vertex stage through L3: ask for them a few triangles ahead.
+        if (tri + kVertexPrefetch < end) {
+          const uint32_t* ahead = &packets.indices[size_t(tri + kVertexPrefetch) * 3];
+          for (int k = 0; k < 3; ++k) __builtin_prefetch(&packets.vertices[ahead[k]]);
+        }
         const DrawCall* call = cursor.find(tri);
         const uint32_t* idx = &packets.indices[size_t(tri) * 3];
         geometry::TriangleSetup& s = scratch.records[n];
@@ -123,9 +129,9 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
       const uint32_t** listPtr = listPtrs.data() + size_t(worker) * maxChunks;
       uint32_t* listSize = listSizes.data() + size_t(worker) * maxChunks;
       for (int c = 0; c < lists; ++c) {
-        const auto& l = binner_.list(c, int(tile));
-        listPtr[c] = l.data();
-        listSize[c] = uint32_t(l.size());
+        const raster::Binner::List l = binner_.list(c, int(tile));
+        listPtr[c] = l.data;
+        listSize[c] = l.size;
       }
       raster::TileWork w;
       w.tileX = int(tile) % tilesX;
