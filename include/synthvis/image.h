@@ -25,5 +25,7 @@ Status writePng(const Image& image, const std::string& path);
 Status writePpm(const Image& image, const std::string& path);
 // Reads an 8-bit or 16-bit PNG of any colour type into 8-bit RGB (alpha dropped).
 Result<Image> readPng(const std::string& path);
+// The same from bytes in memory; `name` is used in error messages.
+Result<Image> decodePng(const void* data, size_t size, const std::string& name);
 
 }  // namespace sv

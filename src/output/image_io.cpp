@@ -10,7 +10,9 @@
 namespace sv {
 namespace {
 
-constexpr int kMaxImageSide = 1 << 15;  // refuse absurd sizes before allocating
+// The raster limit (8192², 192 MiB of RGB): a PNG header claiming more is refused before any
+// allocation, so a tiny malicious file cannot ask for gigabytes.
+constexpr int kMaxImageSide = 1 << 13;
 
 bool endsWith(const std::string& s, const char* suffix) {
   const std::string x(suffix);
@@ -63,17 +65,13 @@ Status writePpm(const Image& image, const std::string& path) {
   return {};
 }
 
-Result<Image> readPng(const std::string& path) {
-  png_image png{};
-  png.version = PNG_IMAGE_VERSION;
-  if (!png_image_begin_read_from_file(&png, path.c_str())) {
-    std::string msg = png.message;
-    png_image_free(&png);
-    return Error{path, "", "cannot read PNG: " + msg};
-  }
+namespace {
+
+// Both readers: `png` has begun reading (from a file or from memory); `name` is for messages.
+Result<Image> finishPngRead(png_image& png, const std::string& name) {
   if (png.width == 0 || png.height == 0 || png.width > kMaxImageSide || png.height > kMaxImageSide) {
     png_image_free(&png);
-    return Error{path, "", fmt::format("PNG size {}x{} is out of range", png.width, png.height)};
+    return Error{name, "", fmt::format("PNG size {}x{} is out of range", png.width, png.height)};
   }
   png.format = PNG_FORMAT_RGB;
   Image image;
@@ -83,9 +81,33 @@ Result<Image> readPng(const std::string& path) {
   if (!png_image_finish_read(&png, nullptr, image.rgb.data(), 0, nullptr)) {
     std::string msg = png.message;
     png_image_free(&png);
-    return Error{path, "", "cannot decode PNG: " + msg};
+    return Error{name, "", "cannot decode PNG: " + msg};
   }
   return image;
+}
+
+}  // namespace
+
+Result<Image> readPng(const std::string& path) {
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  if (!png_image_begin_read_from_file(&png, path.c_str())) {
+    std::string msg = png.message;
+    png_image_free(&png);
+    return Error{path, "", "cannot read PNG: " + msg};
+  }
+  return finishPngRead(png, path);
+}
+
+Result<Image> decodePng(const void* data, size_t size, const std::string& name) {
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  if (!png_image_begin_read_from_memory(&png, data, size)) {
+    std::string msg = png.message;
+    png_image_free(&png);
+    return Error{name, "", "cannot read PNG: " + msg};
+  }
+  return finishPngRead(png, name);
 }
 
 }  // namespace sv
