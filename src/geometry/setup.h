@@ -79,16 +79,6 @@ struct TriangleSetup {
   bool small;
 };
 
-// The per-vertex part of setup: the position on the raster snapped to
-// 24.8 fixed point, valid (`snapped`) when the vertex is in front of the eye (w > 0) and inside
-// the guard band. A pure function of the vertex: shared vertices snap identically in all their
-// triangles.
-struct ScreenVertex {
-  int32_t x = 0, y = 0;  // 24.8
-  bool snapped = false;
-};
-
-ScreenVertex snapVertex(const ClipVertex& v, const Viewport& viewport);
 
 enum class SetupOutcome : uint8_t {
   drawn,
