@@ -25,11 +25,17 @@ void Binner::binChunk(int chunk, const geometry::TriangleSetup* records, uint32_
     ++scratch.count[key + 1];
   }
   for (int k = 0; k < tiles_; ++k) scratch.count[k + 1] += scratch.count[k];
+  scratch.order.resize(n);
   for (uint32_t i = 0; i < n; ++i) {
     const uint32_t p = scratch.count[scratch.key[i]]++;
     scratch.position[i] = p;
-    storage[p] = records[i];
+    scratch.order[p] = i;
   }
+  // Copied in storage order: sequential writes to memory that is not in cache (the storage is the
+  // size of a batch) and scattered reads from the chunk's records, which are in L2. (Copying in
+  // record order, with scattered writes, was 62 % of binning; this order makes the whole 100k ×
+  // 10 px frame 4 % faster.)
+  for (uint32_t p = 0; p < n; ++p) storage[p] = records[scratch.order[p]];
   // The lists: count the entries per tile, then place them in submission order.
   ChunkLists& out = chunkLists_[size_t(chunk)];
   out.offsets.assign(size_t(tiles_) + 1, 0);

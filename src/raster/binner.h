@@ -24,7 +24,7 @@ class Binner {
  public:
   // Per-worker temporary arrays for binChunk (kept between calls to avoid reallocation).
   struct Scratch {
-    std::vector<uint32_t> key, position, count, cursor;
+    std::vector<uint32_t> key, position, order, count, cursor;
   };
 
   // Empties all lists for `chunks` chunks over a tilesX × tilesY grid (keeps their capacity).
