@@ -143,7 +143,10 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
     call.cull = o.cullBackFaces && !mat.doubleSided ? geometry::CullMode::back
                                                       : geometry::CullMode::none;
     const uint32_t base = static_cast<uint32_t>(vertexCount);
-    for (uint32_t i : mesh.indices) p.indices.push_back(base + i);
+    const size_t at = p.indices.size();
+    p.indices.resize(at + mesh.indices.size());
+    std::transform(mesh.indices.begin(), mesh.indices.end(), p.indices.begin() + ptrdiff_t(at),
+                   [base](uint32_t i) { return base + i; });
     p.calls.push_back(call);
     vertexCount += mesh.positions.size();
   }
