@@ -2,9 +2,10 @@
 //
 //   synthvis render [SCENE] -o out.png [--width W] [--height H] [--threads T] [--camera I]
 //                   [--no-cull] [--debug-view overdraw]
-//   synthvis bench SCENE [--count N] [--area A] [--depth D] [--order random|f2b|b2f]
-//                  [--shade gouraud] [--width W] [--height H] [--threads T] [--frames F]
-//                  [--warmup W] [--seed S] [--renderer synthvis] [--json FILE] [--image FILE]
+//   synthvis bench SCENE|--suite quick|full [--count N] [--area A] [--depth D] [--layers D]
+//                  [--order random|f2b|b2f] [--shade gouraud] [--width W] [--height H]
+//                  [--threads T] [--frames F] [--warmup W] [--seed S]
+//                  [--renderer synthvis|gl|both] [--json FILE] [--html DIR] [--image FILE]
 //   (shared BENCH.md defines the scenes and the JSON fields)
 //
 // Errors print one line, "synthvis: <file>: <problem>", and exit with status 1 (2 for usage).
@@ -14,7 +15,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "synthvis/bench.h"
+#include "reference/suite.h"
 #include "synthvis/generators.h"
 #include "synthvis/image.h"
 #include "synthvis/render.h"
@@ -68,84 +69,121 @@ int runRender(const RenderArgs& a) {
 
 struct BenchArgs {
   std::string scene;
+  std::string suite;
   sv::scene::TrisParams tris;
+  int layers = 4;
   std::string order = "random";
   std::string shade = "gouraud";
-  std::string renderer = "synthvis";
+  std::string renderer;  // synthvis, gl or both; default synthvis for a scene, both for a suite
   std::string json;
+  std::string html;
   std::string image;
   int frames = 10;
   int warmup = 2;
   sv::RenderOptions options{.width = 1920, .height = 1080, .threads = 2};
 };
 
+// BENCH.md's generators that need features of later issues.
+const char* missingGenerator(const std::string& name) {
+  if (name == "grazing") return "texture (issue 5)";
+  if (name == "freeform" || name == "freeform-one") return "free forms (issue 7)";
+  if (name == "terrain") return "texture and fog";
+  if (name == "volume") return "voxel volumes";
+  if (name == "lights") return "light points";
+  return nullptr;
+}
+
 int runBench(BenchArgs a) {
-  if (a.renderer != "synthvis")
-    return fail({"", "", fmt::format("renderer '{}' is not available in this build (synthvis)",
-                                     a.renderer)});
+  namespace ref = sv::reference;
   if (a.shade != "gouraud")
     return fail({"", "", fmt::format("shading '{}' is not available yet (gouraud)", a.shade)});
   if (sv::Status s = sv::validate(a.options); !s) return fail(s.error());
+  if (a.scene.empty() == a.suite.empty())
+    return fail({"", "", "give either a scene (a generator name or a file) or --suite quick|full"});
+  if (a.renderer.empty()) a.renderer = a.suite.empty() ? "synthvis" : "both";
+  if (a.renderer != "synthvis" && a.renderer != "gl" && a.renderer != "both")
+    return fail({"", "", fmt::format("unknown renderer '{}' (synthvis, gl or both)", a.renderer)});
   auto order = sv::scene::parseSubmitOrder(a.order);
   if (!order) return fail(order.error());
 
-  nlohmann::json row;
-  sv::scene::Scene scene;
-  if (a.scene == "tris") {
-    auto& t = a.tris;
-    if (t.count < 0 || t.count > 20'000'000 || !(t.area > 0 && t.area <= 1e7) || !(t.depth >= 0))
-      return fail({"", "", "tris: count must be 0…2e7, area in (0, 1e7] px, depth ≥ 0"});
-    t.order = order.value();
-    t.width = a.options.width;
-    t.height = a.options.height;
-    sv::scene::TrisStats realized;
-    scene = sv::scene::generateTris(t, &realized);
-    row = {{"count", t.count},         {"area", t.area},
-           {"depth", t.depth},         {"order", a.order},
-           {"seed", t.seed},           {"realized_mean_area", realized.meanArea},
-           {"depth_complexity", realized.depthComplexity}};
-    fmt::print("tris: {} triangles, mean area {:.1f} px (asked {}), depth complexity {:.2f}\n",
-               t.count, realized.meanArea, t.area, realized.depthComplexity);
+  std::vector<ref::BenchCase> cases;
+  if (!a.suite.empty()) {
+    auto c = ref::suiteCases(a.suite);
+    if (!c) return fail(c.error());
+    cases = std::move(c).value();
   } else {
-    auto loaded = sv::scene::loadScene(a.scene);
-    if (!loaded) return fail(loaded.error());
-    scene = std::move(loaded).value();
+    ref::BenchCase c;
+    c.name = a.scene;
+    if (a.scene == "tris") {
+      c.generator = "tris";
+      c.tris = a.tris;
+      c.tris.order = order.value();
+    } else if (a.scene == "layers") {
+      c.generator = "layers";
+      c.layers.layers = a.layers;
+      c.layers.order = order.value();
+      c.layers.seed = a.tris.seed;
+    } else if (const char* needs = missingGenerator(a.scene)) {
+      return fail({"", "", fmt::format("generator '{}' needs {}, not built yet", a.scene, needs)});
+    } else {
+      c.file = a.scene;
+    }
+    cases.push_back(c);
   }
 
-  auto timed = sv::timeFrames(scene, a.options, a.frames, a.warmup);
-  if (!timed) return fail(timed.error());
-  const auto& r = timed.value();
-  const double tris = double(scene.triangleCount());
-  const double area = a.scene == "tris" ? row["realized_mean_area"].get<double>() * tris : 0;
-  row.update({{"scene", a.scene},
-              {"renderer", a.renderer},
-              {"width", a.options.width},
-              {"height", a.options.height},
-              {"threads", a.options.threads},
-              {"frames", a.frames},
-              {"warmup", a.warmup},
-              {"shade", a.shade},
-              {"aa", 0},
-              {"median_ms", r.medianMs},
-              {"min_ms", r.minMs},
-              {"max_ms", r.maxMs},
-              {"median_raster_ms", r.medianRasterMs},
-              {"frame_ms", r.frameMs},
-              {"triangles", scene.triangleCount()},
-              {"triangles_drawn", r.stats.drawn},
-              {"mtri_per_s", tris / r.medianMs / 1e3},
-              {"mpix_per_s", area / r.medianMs / 1e3}});
-  fmt::print("{} {}x{} {} thr: median {:.2f} ms (min {:.2f}, max {:.2f}; setup+raster {:.2f}) | "
-             "{:.2f} Mtri/s | {:.0f} Mpix/s\n",
-             a.renderer, a.options.width, a.options.height, a.options.threads, r.medianMs, r.minMs,
-             r.maxMs, r.medianRasterMs, tris / r.medianMs / 1e3, area / r.medianMs / 1e3);
-  fmt::print("last frame: {}\n", r.stats.summary());
+  ref::BenchSettings settings;
+  settings.options = a.options;
+  settings.frames = a.frames;
+  settings.warmup = a.warmup;
+  settings.synthvis = a.renderer != "gl";
+  settings.reference = a.renderer != "synthvis";
+  ref::BenchRunner runner(settings);
+  if (settings.reference) {
+    if (sv::Status s = runner.startReference(); !s) {
+      // A suite still runs on synthvis alone and says so; asking for gl alone cannot.
+      if (a.renderer == "gl") return fail(s.error());
+      fmt::print("reference: not available: {}\n", s.error().str());
+      settings.reference = false;
+    } else {
+      fmt::print("reference: {} (LP_NUM_THREADS={})\n", runner.referenceDescription(),
+                 a.options.threads);
+    }
+  }
+
+  std::vector<ref::CaseResult> results;
+  nlohmann::json rows = nlohmann::json::array();
+  for (size_t i = 0; i < cases.size(); ++i) {
+    if (cases.size() > 1) fmt::print("[{}/{}] {} …\n", i + 1, cases.size(), cases[i].name);
+    std::fflush(stdout);
+    auto r = runner.run(cases[i]);
+    if (!r) {
+      sv::Error e = r.error();
+      if (e.file.empty() && !cases[i].file.empty()) e.file = cases[i].file;
+      return fail(e);
+    }
+    const ref::CaseResult& cr = r.value();
+    if (!cr.params.contains("file"))
+      fmt::print("{}: {} triangles, mean area {:.1f} px, depth complexity {:.2f}\n", cr.name,
+                 cr.triangles, cr.meanArea, cr.depthComplexity);
+    fmt::print("{}\n", ref::summaryLine(cr));
+    if (settings.synthvis) fmt::print("  synthvis last frame: {}\n", cr.runs[0].stats.summary());
+    for (auto& row : ref::jsonRows(cr, settings)) rows.push_back(row);
+    results.push_back(std::move(r).value());
+  }
+
   if (!a.image.empty())
-    if (sv::Status s = sv::writeImage(r.image, a.image); !s) return fail(s.error());
+    if (sv::Status s = sv::writeImage(results.back().runs[0].image, a.image); !s)
+      return fail(s.error());
   if (!a.json.empty()) {
     std::ofstream out(a.json);
-    out << row.dump(2) << "\n";
+    // One scene on one renderer: an object (BENCH.md); otherwise a list of rows.
+    out << (rows.size() == 1 ? rows[0] : rows).dump(2) << "\n";
     if (!out) return fail({a.json, "", "cannot write"});
+  }
+  if (!a.html.empty()) {
+    if (sv::Status s = ref::writeHtml(a.html, results, settings, runner.referenceDescription()); !s)
+      return fail(s.error());
+    fmt::print("html: {}/index.html\n", a.html);
   }
   return 0;
 }
@@ -171,12 +209,14 @@ int main(int argc, char** argv) {
 
   BenchArgs b;
   CLI::App* bench = app.add_subcommand("bench", "time whole frames of a benchmark scene (BENCH.md)");
-  bench->add_option("scene", b.scene, "generator name (tris) or scene file")->required();
+  bench->add_option("scene", b.scene, "generator (tris, layers) or scene file");
+  bench->add_option("--suite", b.suite, "a named suite of scenes: quick or full");
+  bench->add_option("--layers", b.layers, "layers: depth complexity D")->capture_default_str();
   bench->add_option("--count", b.tris.count, "tris: number of triangles")->capture_default_str();
   bench->add_option("--area", b.tris.area, "tris: mean projected area, pixels")->capture_default_str();
   bench->add_option("--depth", b.tris.depth, "tris: depth complexity (0 = whole screen)")
       ->capture_default_str();
-  bench->add_option("--order", b.order, "tris: random, f2b or b2f")->capture_default_str();
+  bench->add_option("--order", b.order, "tris, layers: random, f2b or b2f")->capture_default_str();
   bench->add_option("--seed", b.tris.seed, "generator seed")->capture_default_str();
   bench->add_option("--shade", b.shade, "gouraud")->capture_default_str();
   bench->add_option("--width", b.options.width, "image width")->capture_default_str();
@@ -184,9 +224,12 @@ int main(int argc, char** argv) {
   bench->add_option("--threads", b.options.threads, "worker threads")->capture_default_str();
   bench->add_option("--frames", b.frames, "timed frames")->capture_default_str();
   bench->add_option("--warmup", b.warmup, "untimed frames first")->capture_default_str();
-  bench->add_option("--renderer", b.renderer, "synthvis")->capture_default_str();
+  bench->add_option("--renderer", b.renderer,
+                    "synthvis, gl (Mesa llvmpipe) or both, alternating frames; default: synthvis "
+                    "for a scene, both for a suite");
   bench->add_option("--json", b.json, "write the results as JSON to this file");
-  bench->add_option("--image", b.image, "write the last frame to this image file");
+  bench->add_option("--html", b.html, "write an HTML page with plots and images to this directory");
+  bench->add_option("--image", b.image, "write the last frame of the last scene to this image file");
 
   try {
     app.parse(argc, argv);

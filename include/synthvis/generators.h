@@ -35,4 +35,19 @@ struct TrisStats {
 // of unshared vertices with random colours; triangles in the requested order.
 Scene generateTris(const TrisParams& params, TrisStats* stats = nullptr);
 
+// BENCH.md `layers`: `layers` parallel screen-filling grids of ≈ 200 px triangles at distances
+// 2 … 20, so every pixel is covered `layers` times; same camera and material as `tris`.
+struct LayersParams {
+  int layers = 4;
+  SubmitOrder order = SubmitOrder::random;
+  uint64_t seed = 1;
+  int width = 1920;
+  int height = 1080;
+};
+Scene generateLayers(const LayersParams& params, TrisStats* stats = nullptr);
+
+// The frame every generated scene shares: one instance of mesh 0 with material 0 (unlit,
+// double-sided, named `name`), the BENCH.md camera, no light, black background. No meshes yet.
+Scene benchCameraScene(const std::string& name);
+
 }  // namespace sv::scene

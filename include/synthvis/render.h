@@ -27,6 +27,10 @@ struct RenderOptions {
 // Checks sizes and counts; the error names the option.
 Status validate(const RenderOptions& options);
 
+// The view-projection matrix a frame uses: the scene's camera `options.camera`, or for a scene
+// without cameras one that frames its bounds; the aspect ratio is width / height.
+Result<Mat4> viewProjection(const scene::Scene& scene, const RenderOptions& options);
+
 // What one frame did. Window counts are per quadtree level (64 … 4 pixels, then pixel tests).
 struct FrameStats {
   uint64_t trianglesIn = 0;

@@ -15,8 +15,11 @@ struct Error {
   std::string message;   // what is wrong, lower case, no trailing period
 
   // "scene.json:12:7: expected number" — the one line the CLI prints.
+  // "file:position: message", "file: message", or just the message when no file is involved
+  // (an option, a renderer).
   std::string str() const {
-    std::string s = file.empty() ? std::string("<input>") : file;
+    if (file.empty()) return message;
+    std::string s = file;
     if (!position.empty()) s += ":" + position;
     return s + ": " + message;
   }

@@ -54,6 +54,22 @@ scene::Camera defaultCamera(const scene::Scene& s) {
 
 }  // namespace
 
+Result<Mat4> viewProjection(const scene::Scene& scene, const RenderOptions& o) {
+  scene::Camera cam;
+  if (!scene.cameras.empty()) {
+    if (o.camera >= int(scene.cameras.size()))
+      return Error{"", "", fmt::format("camera {} does not exist (the scene has {})", o.camera,
+                                       scene.cameras.size())};
+    cam = scene.cameras[size_t(o.camera)];
+  } else {
+    cam = defaultCamera(scene);
+  }
+  const float aspect = float(o.width) / float(o.height);
+  return Mat4::perspective(cam.yfovDegrees * 3.14159265358979f / 180.0f, aspect, cam.znear,
+                           cam.zfar) *
+         Mat4::lookAt(cam.position, cam.target, cam.up);
+}
+
 Status validate(const RenderOptions& o) {
   if (o.width < 1 || o.width > kMaxRasterSize || o.height < 1 || o.height > kMaxRasterSize)
     return Error{"", "", fmt::format("image size {}x{} is out of range (1…{} each)", o.width,
@@ -96,19 +112,9 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
   const auto start = Clock::now();
 
   // Stage 2–3: camera, then every instance's vertices to clip space.
-  scene::Camera cam;
-  if (!scene.cameras.empty()) {
-    if (o.camera >= int(scene.cameras.size()))
-      return Error{"", "", fmt::format("camera {} does not exist (the scene has {})", o.camera,
-                                       scene.cameras.size())};
-    cam = scene.cameras[o.camera];
-  } else {
-    cam = defaultCamera(scene);
-  }
-  const float aspect = float(o.width) / float(o.height);
-  const Mat4 viewProj =
-      Mat4::perspective(cam.yfovDegrees * 3.14159265358979f / 180.0f, aspect, cam.znear, cam.zfar) *
-      Mat4::lookAt(cam.position, cam.target, cam.up);
+  const Result<Mat4> camera = viewProjection(scene, o);
+  if (!camera.ok()) return camera.error();
+  const Mat4& viewProj = camera.value();
 
   auto t0 = Clock::now();
   render::DrawPackets& p = impl_->packets;

@@ -48,6 +48,27 @@ const char* submitOrderName(SubmitOrder order) {
   }
 }
 
+Scene benchCameraScene(const std::string& name) {
+  Scene s;
+  Material mat;
+  mat.name = name;
+  mat.unlit = true;
+  mat.doubleSided = true;
+  s.materials.push_back(mat);
+  s.instances.push_back({0, Mat4{}});
+  Camera cam;
+  cam.name = "bench";
+  cam.position = {0, 0, 0};
+  cam.target = {0, 0, -1};
+  cam.yfovDegrees = 60;
+  cam.znear = 0.1f;
+  cam.zfar = 100;
+  s.cameras.push_back(cam);
+  s.light.enabled = false;
+  s.background = {0, 0, 0};
+  return s;
+}
+
 Scene generateTris(const TrisParams& p, TrisStats* stats) {
   std::mt19937_64 rng(p.seed);
   auto uniform = [&](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
@@ -124,7 +145,7 @@ Scene generateTris(const TrisParams& p, TrisStats* stats) {
     });
   }
 
-  Scene s;
+  Scene s = benchCameraScene("tris");
   Mesh m;
   m.name = "tris";
   m.material = 0;
@@ -141,22 +162,6 @@ Scene generateTris(const TrisParams& p, TrisStats* stats) {
     totalArea += t.area;
   }
   s.meshes.push_back(std::move(m));
-  Material mat;
-  mat.name = "tris";
-  mat.unlit = true;
-  mat.doubleSided = true;
-  s.materials.push_back(mat);
-  s.instances.push_back({0, Mat4{}});
-  Camera cam;
-  cam.name = "bench";
-  cam.position = {0, 0, 0};
-  cam.target = {0, 0, -1};
-  cam.yfovDegrees = 60;
-  cam.znear = 0.1f;
-  cam.zfar = 100;
-  s.cameras.push_back(cam);
-  s.light.enabled = false;
-  s.background = {0, 0, 0};
   if (stats) {
     stats->meanArea = tris.empty() ? 0 : totalArea / double(tris.size());
     stats->depthComplexity = totalArea / (regionW * regionH);

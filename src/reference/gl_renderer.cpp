@@ -1,0 +1,402 @@
+#include "reference/gl_renderer.h"
+
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#if SV_HAVE_GL
+#define GL_GLEXT_PROTOTYPES 1
+#define EGL_EGLEXT_PROTOTYPES 1
+#include <EGL/egl.h>
+#include <EGL/eglext.h>
+#include <GL/gl.h>
+#include <GL/glext.h>
+#endif
+
+namespace sv::reference {
+
+#if SV_HAVE_GL
+
+namespace {
+
+// SPEC §8's Gouraud model as geometry/vertex_stage.cpp computes it, per vertex.
+constexpr const char* kVertexShader = R"(#version 330 core
+layout(location = 0) in vec3 position;
+layout(location = 1) in vec3 normal;
+layout(location = 2) in vec4 color;
+uniform mat4 mvp;
+uniform mat3 normalToWorld;
+uniform vec4 baseColor;
+uniform vec3 toLight;
+uniform vec3 lightColor;
+uniform float ambient;
+uniform bool lit;
+out vec4 vertexColor;
+void main() {
+  gl_Position = mvp * vec4(position, 1.0);
+  vec4 c = baseColor * color;
+  vec3 intensity = vec3(1.0);
+  if (lit) {
+    vec3 n = normalize(normalToWorld * normal);
+    intensity = vec3(ambient) + lightColor * ((1.0 - ambient) * max(0.0, dot(n, toLight)));
+  }
+  vertexColor = clamp(vec4(c.rgb * intensity, c.a), 0.0, 1.0);
+}
+)";
+
+constexpr const char* kFragmentShader = R"(#version 330 core
+in vec4 vertexColor;
+out vec4 fragColor;
+void main() { fragColor = vertexColor; }
+)";
+
+std::string glError(const char* what) {
+  const GLenum e = glGetError();
+  return e == GL_NO_ERROR ? std::string() : fmt::format("{}: OpenGL error 0x{:x}", what, e);
+}
+
+struct Mesh {
+  GLuint vao = 0, buffers[4] = {};
+  GLsizei indexCount = 0;
+  bool hasNormals = false, hasColors = false;
+};
+
+struct Draw {
+  size_t mesh;
+  float mvp[16];
+  float normalToWorld[9];
+  float baseColor[4];
+  bool lit, cull;
+};
+
+}  // namespace
+
+struct GlRenderer::Impl {
+  RenderOptions options;
+  int msaa = 0;
+  EGLDisplay display = EGL_NO_DISPLAY;
+  EGLContext context = EGL_NO_CONTEXT;
+  GLuint program = 0;
+  GLuint fbo = 0, colorRb = 0, depthRb = 0;          // the render target (multisampled if msaa)
+  GLuint resolveFbo = 0, resolveRb = 0;              // single-sampled copy for readback (msaa)
+  GLint uMvp = -1, uNormal = -1, uBase = -1, uToLight = -1, uLightColor = -1, uAmbient = -1,
+        uLit = -1;
+  std::vector<Mesh> meshes;
+  std::vector<Draw> draws;
+  float background[3] = {0, 0, 0};
+  float toLight[3] = {0, 1, 0}, lightColor[3] = {1, 1, 1}, ambient = 1;
+  std::string description;
+
+  ~Impl() {
+    if (display == EGL_NO_DISPLAY) return;
+    if (context != EGL_NO_CONTEXT) {
+      eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, context);
+      freeMeshes();
+      glDeleteProgram(program);
+      glDeleteFramebuffers(1, &fbo);
+      glDeleteFramebuffers(1, &resolveFbo);
+      const GLuint rbs[3] = {colorRb, depthRb, resolveRb};
+      glDeleteRenderbuffers(3, rbs);
+      eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+      eglDestroyContext(display, context);
+    }
+    eglTerminate(display);
+  }
+
+  void freeMeshes() {
+    for (Mesh& m : meshes) {
+      glDeleteVertexArrays(1, &m.vao);
+      glDeleteBuffers(4, m.buffers);
+    }
+    meshes.clear();
+  }
+
+  Status makeCurrent() {
+    if (!eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, context))
+      return Error{"", "", fmt::format("gl: eglMakeCurrent failed (0x{:x})", eglGetError())};
+    return {};
+  }
+};
+
+bool glBuilt() { return true; }
+
+GlRenderer::GlRenderer() : impl_(std::make_unique<Impl>()) {}
+GlRenderer::~GlRenderer() = default;
+const std::string& GlRenderer::description() const { return impl_->description; }
+
+namespace {
+
+Result<GLuint> compile(GLenum type, const char* source) {
+  const GLuint s = glCreateShader(type);
+  glShaderSource(s, 1, &source, nullptr);
+  glCompileShader(s);
+  GLint ok = 0;
+  glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    char log[1024] = {};
+    glGetShaderInfoLog(s, sizeof log, nullptr, log);
+    glDeleteShader(s);
+    return Error{"", "", fmt::format("gl: shader does not compile: {}", log)};
+  }
+  return s;
+}
+
+}  // namespace
+
+Result<std::unique_ptr<GlRenderer>> GlRenderer::create(const RenderOptions& options, int msaa) {
+  if (Status s = validate(options); !s) return s.error();
+  if (msaa != 0 && msaa != 2 && msaa != 4 && msaa != 8 && msaa != 16)
+    return Error{"", "", fmt::format("gl: {} samples per pixel is not supported (0, 2, 4, 8, 16)",
+                                     msaa)};
+  // llvmpipe reads these when the driver loads; keep a user's own choice.
+  const int threads = options.threads > 0 ? options.threads : 0;
+  if (threads > 0) setenv("LP_NUM_THREADS", std::to_string(threads).c_str(), 0);
+  setenv("GALLIUM_DRIVER", "llvmpipe", 0);
+
+  std::unique_ptr<GlRenderer> r(new GlRenderer());
+  Impl& g = *r->impl_;
+  g.options = options;
+  g.msaa = msaa;
+  g.display = eglGetPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+  EGLint major = 0, minor = 0;
+  if (g.display == EGL_NO_DISPLAY || !eglInitialize(g.display, &major, &minor))
+    return Error{"", "", fmt::format("gl: no EGL surfaceless display (0x{:x}); is Mesa's "
+                                     "libegl-mesa0 installed?", eglGetError())};
+  if (!eglBindAPI(EGL_OPENGL_API)) return Error{"", "", "gl: EGL cannot bind OpenGL"};
+  // Surfaceless: no config is needed (EGL_KHR_no_config_context), rendering goes to our own FBO.
+  EGLConfig config = EGL_NO_CONFIG_KHR;
+  const char* extensions = eglQueryString(g.display, EGL_EXTENSIONS);
+  if (!extensions || !std::strstr(extensions, "EGL_KHR_no_config_context")) {
+    const EGLint configAttribs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
+    EGLint configs = 0;
+    if (!eglChooseConfig(g.display, configAttribs, &config, 1, &configs) || configs < 1)
+      return Error{"", "", "gl: no EGL config for desktop OpenGL"};
+  }
+  const EGLint contextAttribs[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, 3,
+                                   EGL_CONTEXT_OPENGL_PROFILE_MASK,
+                                   EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+  g.context = eglCreateContext(g.display, config, EGL_NO_CONTEXT, contextAttribs);
+  if (g.context == EGL_NO_CONTEXT)
+    return Error{"", "", fmt::format("gl: cannot create an OpenGL 3.3 core context (0x{:x})",
+                                     eglGetError())};
+  if (Status s = g.makeCurrent(); !s) return s.error();
+  g.description = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+
+  // Shaders.
+  auto vs = compile(GL_VERTEX_SHADER, kVertexShader);
+  if (!vs.ok()) return vs.error();
+  auto fs = compile(GL_FRAGMENT_SHADER, kFragmentShader);
+  if (!fs.ok()) return fs.error();
+  g.program = glCreateProgram();
+  glAttachShader(g.program, vs.value());
+  glAttachShader(g.program, fs.value());
+  glLinkProgram(g.program);
+  glDeleteShader(vs.value());
+  glDeleteShader(fs.value());
+  GLint linked = 0;
+  glGetProgramiv(g.program, GL_LINK_STATUS, &linked);
+  if (!linked) return Error{"", "", "gl: shader program does not link"};
+  g.uMvp = glGetUniformLocation(g.program, "mvp");
+  g.uNormal = glGetUniformLocation(g.program, "normalToWorld");
+  g.uBase = glGetUniformLocation(g.program, "baseColor");
+  g.uToLight = glGetUniformLocation(g.program, "toLight");
+  g.uLightColor = glGetUniformLocation(g.program, "lightColor");
+  g.uAmbient = glGetUniformLocation(g.program, "ambient");
+  g.uLit = glGetUniformLocation(g.program, "lit");
+
+  // Render target: sRGB colour and 24-bit depth, multisampled when asked.
+  const int w = options.width, h = options.height;
+  glGenFramebuffers(1, &g.fbo);
+  glGenRenderbuffers(1, &g.colorRb);
+  glGenRenderbuffers(1, &g.depthRb);
+  glBindFramebuffer(GL_FRAMEBUFFER, g.fbo);
+  glBindRenderbuffer(GL_RENDERBUFFER, g.colorRb);
+  glRenderbufferStorageMultisample(GL_RENDERBUFFER, msaa, GL_SRGB8_ALPHA8, w, h);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, g.colorRb);
+  glBindRenderbuffer(GL_RENDERBUFFER, g.depthRb);
+  glRenderbufferStorageMultisample(GL_RENDERBUFFER, msaa, GL_DEPTH_COMPONENT24, w, h);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, g.depthRb);
+  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+    return Error{"", "", fmt::format("gl: a {}x{} sRGB framebuffer with {} samples is not "
+                                     "supported", w, h, msaa)};
+  if (msaa) {
+    glGenFramebuffers(1, &g.resolveFbo);
+    glGenRenderbuffers(1, &g.resolveRb);
+    glBindFramebuffer(GL_FRAMEBUFFER, g.resolveFbo);
+    glBindRenderbuffer(GL_RENDERBUFFER, g.resolveRb);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_SRGB8_ALPHA8, w, h);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, g.resolveRb);
+    glBindFramebuffer(GL_FRAMEBUFFER, g.fbo);
+  }
+  glViewport(0, 0, w, h);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glEnable(GL_FRAMEBUFFER_SRGB);
+  glFrontFace(GL_CCW);
+  glCullFace(GL_BACK);
+  if (std::string e = glError("gl: set-up"); !e.empty()) return Error{"", "", e};
+  return r;
+}
+
+Status GlRenderer::load(const scene::Scene& scene) {
+  Impl& g = *impl_;
+  if (Status s = scene::validate(scene, ""); !s) return s;
+  if (Status s = g.makeCurrent(); !s) return s;
+  const Result<Mat4> camera = viewProjection(scene, g.options);
+  if (!camera.ok()) return camera.error();
+  g.freeMeshes();
+  g.draws.clear();
+  for (const scene::Mesh& m : scene.meshes) {
+    Mesh out;
+    glGenVertexArrays(1, &out.vao);
+    glGenBuffers(4, out.buffers);
+    glBindVertexArray(out.vao);
+    auto upload = [](GLenum target, GLuint buffer, const void* data, size_t bytes) {
+      glBindBuffer(target, buffer);
+      glBufferData(target, GLsizeiptr(bytes), data, GL_STATIC_DRAW);
+    };
+    upload(GL_ARRAY_BUFFER, out.buffers[0], m.positions.data(), m.positions.size() * sizeof(Vec3));
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(Vec3), nullptr);
+    glEnableVertexAttribArray(0);
+    out.hasNormals = !m.normals.empty();
+    if (out.hasNormals) {
+      upload(GL_ARRAY_BUFFER, out.buffers[1], m.normals.data(), m.normals.size() * sizeof(Vec3));
+      glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, sizeof(Vec3), nullptr);
+      glEnableVertexAttribArray(1);
+    }
+    out.hasColors = !m.colors.empty();
+    if (out.hasColors) {
+      upload(GL_ARRAY_BUFFER, out.buffers[2], m.colors.data(), m.colors.size() * sizeof(Vec4));
+      glVertexAttribPointer(2, 4, GL_FLOAT, GL_FALSE, sizeof(Vec4), nullptr);
+      glEnableVertexAttribArray(2);
+    }
+    upload(GL_ELEMENT_ARRAY_BUFFER, out.buffers[3], m.indices.data(),
+           m.indices.size() * sizeof(uint32_t));
+    out.indexCount = GLsizei(m.indices.size());
+    g.meshes.push_back(out);
+  }
+  glBindVertexArray(0);
+
+  const scene::Material defaultMaterial;
+  for (const scene::Instance& inst : scene.instances) {
+    const scene::Mesh& mesh = scene.meshes[size_t(inst.mesh)];
+    const scene::Material& mat =
+        mesh.material >= 0 ? scene.materials[size_t(mesh.material)] : defaultMaterial;
+    Draw d;
+    d.mesh = size_t(inst.mesh);
+    const Mat4 mvp = camera.value() * inst.transform;
+    const Mat4 n = inst.transform.normalMatrix();
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r) d.mvp[c * 4 + r] = mvp.m[c][r];
+    for (int c = 0; c < 3; ++c)
+      for (int r = 0; r < 3; ++r) d.normalToWorld[c * 3 + r] = n.m[c][r];
+    d.baseColor[0] = mat.baseColor.x;
+    d.baseColor[1] = mat.baseColor.y;
+    d.baseColor[2] = mat.baseColor.z;
+    d.baseColor[3] = mat.baseColor.w;
+    d.lit = scene.light.enabled && !mat.unlit && !mesh.normals.empty();
+    d.cull = g.options.cullBackFaces && !mat.doubleSided;
+    g.draws.push_back(d);
+  }
+  const Vec3 toLight = normalize(-scene.light.direction);
+  g.toLight[0] = toLight.x;
+  g.toLight[1] = toLight.y;
+  g.toLight[2] = toLight.z;
+  g.lightColor[0] = scene.light.color.x;
+  g.lightColor[1] = scene.light.color.y;
+  g.lightColor[2] = scene.light.color.z;
+  g.ambient = scene.light.ambient;
+  g.background[0] = scene.background.x;
+  g.background[1] = scene.background.y;
+  g.background[2] = scene.background.z;
+  if (std::string e = glError("gl: upload"); !e.empty()) return Error{"", "", e};
+  return {};
+}
+
+Status GlRenderer::render() {
+  Impl& g = *impl_;
+  if (Status s = g.makeCurrent(); !s) return s;
+  glBindFramebuffer(GL_FRAMEBUFFER, g.fbo);
+  // The clear colour is linear, like synthvis's; the sRGB buffer encodes it.
+  glClearColor(g.background[0], g.background[1], g.background[2], 1);
+  glClearDepth(1.0);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  glUseProgram(g.program);
+  glUniform3fv(g.uToLight, 1, g.toLight);
+  glUniform3fv(g.uLightColor, 1, g.lightColor);
+  glUniform1f(g.uAmbient, g.ambient);
+  for (const Draw& d : g.draws) {
+    const Mesh& m = g.meshes[d.mesh];
+    if (d.cull)
+      glEnable(GL_CULL_FACE);
+    else
+      glDisable(GL_CULL_FACE);
+    glUniformMatrix4fv(g.uMvp, 1, GL_FALSE, d.mvp);
+    glUniformMatrix3fv(g.uNormal, 1, GL_FALSE, d.normalToWorld);
+    glUniform4fv(g.uBase, 1, d.baseColor);
+    glUniform1i(g.uLit, d.lit ? 1 : 0);
+    glBindVertexArray(m.vao);
+    // Absent attributes read these constants (a disabled array's current value).
+    if (!m.hasNormals) glVertexAttrib3f(1, 0, 0, 1);
+    if (!m.hasColors) glVertexAttrib4f(2, 1, 1, 1, 1);
+    glDrawElements(GL_TRIANGLES, m.indexCount, GL_UNSIGNED_INT, nullptr);
+  }
+  glBindVertexArray(0);
+  glFinish();
+  if (std::string e = glError("gl: draw"); !e.empty()) return Error{"", "", e};
+  return {};
+}
+
+Status GlRenderer::readImage(Image& image) {
+  Impl& g = *impl_;
+  if (Status s = g.makeCurrent(); !s) return s;
+  const int w = g.options.width, h = g.options.height;
+  GLuint source = g.fbo;
+  if (g.msaa) {
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, g.fbo);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, g.resolveFbo);
+    glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    source = g.resolveFbo;
+  }
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, source);
+  std::vector<uint8_t> rgba(size_t(w) * h * 4);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+  if (std::string e = glError("gl: read-back"); !e.empty()) return Error{"", "", e};
+  image.width = w;
+  image.height = h;
+  image.rgb.resize(size_t(w) * h * 3);
+  // GL's rows go bottom-up; the image's top-down.
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 3; ++c)
+        image.rgb[(size_t(y) * w + x) * 3 + c] = rgba[(size_t(h - 1 - y) * w + x) * 4 + c];
+  return {};
+}
+
+#else  // !SV_HAVE_GL
+
+struct GlRenderer::Impl {
+  std::string description;
+};
+
+bool glBuilt() { return false; }
+
+GlRenderer::GlRenderer() : impl_(std::make_unique<Impl>()) {}
+GlRenderer::~GlRenderer() = default;
+const std::string& GlRenderer::description() const { return impl_->description; }
+
+Result<std::unique_ptr<GlRenderer>> GlRenderer::create(const RenderOptions&, int) {
+  return Error{"", "", "the gl renderer is not in this build: install libegl-dev and libgl-dev "
+                       "(scripts/demo does) and configure again"};
+}
+Status GlRenderer::load(const scene::Scene&) { return Error{"", "", "gl: not built"}; }
+Status GlRenderer::render() { return Error{"", "", "gl: not built"}; }
+Status GlRenderer::readImage(Image&) { return Error{"", "", "gl: not built"}; }
+
+#endif
+
+}  // namespace sv::reference

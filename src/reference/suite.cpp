@@ -1,0 +1,421 @@
+#include "reference/suite.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <optional>
+
+#include <fmt/format.h>
+
+#include "reference/gl_renderer.h"
+
+namespace sv::reference {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double msSince(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+void finish(RendererRun& r) {
+  r.medianMs = median(r.frameMs);
+  r.minMs = r.frameMs.empty() ? 0 : *std::min_element(r.frameMs.begin(), r.frameMs.end());
+  r.maxMs = r.frameMs.empty() ? 0 : *std::max_element(r.frameMs.begin(), r.frameMs.end());
+}
+
+BenchCase trisCase(int count, double area) {
+  BenchCase c;
+  c.generator = "tris";
+  c.tris.count = count;
+  c.tris.area = area;
+  const std::string n = count % 1000000 == 0 ? fmt::format("{}M", count / 1000000)
+                                             : fmt::format("{}k", count / 1000);
+  c.name = fmt::format("tris-{}-a{}", n, area);
+  return c;
+}
+
+BenchCase layersCase(int layers, scene::SubmitOrder order) {
+  BenchCase c;
+  c.generator = "layers";
+  c.layers.layers = layers;
+  c.layers.order = order;
+  c.name = fmt::format("layers-d{}-{}", layers, scene::submitOrderName(order));
+  return c;
+}
+
+}  // namespace
+
+Result<std::vector<BenchCase>> suiteCases(const std::string& suite) {
+  using scene::SubmitOrder;
+  std::vector<BenchCase> cases;
+  if (suite == "quick") {
+    for (int count : {10000, 100000})
+      for (double area : {10.0, 100.0, 1000.0}) cases.push_back(trisCase(count, area));
+    cases.push_back(layersCase(4, SubmitOrder::random));
+  } else if (suite == "full") {
+    for (int count : {10000, 100000, 1000000})
+      for (double area : {10.0, 100.0, 1000.0})
+        if (double(count) * area <= 1e8) cases.push_back(trisCase(count, area));
+    for (int d : {1, 2, 4, 8, 16})
+      for (SubmitOrder o : {SubmitOrder::random, SubmitOrder::frontToBack, SubmitOrder::backToFront})
+        cases.push_back(layersCase(d, o));
+  } else {
+    return Error{"", "", fmt::format("unknown suite '{}' (quick or full)", suite)};
+  }
+  return cases;
+}
+
+Result<CaseScene> makeScene(const BenchCase& c, const RenderOptions& options) {
+  CaseScene out;
+  scene::TrisStats realized;
+  if (c.generator == "tris") {
+    scene::TrisParams t = c.tris;
+    if (t.count < 0 || t.count > 20'000'000 || !(t.area > 0 && t.area <= 1e7) || !(t.depth >= 0))
+      return Error{"", "", "tris: count must be 0…2e7, area in (0, 1e7] px, depth ≥ 0"};
+    t.width = options.width;
+    t.height = options.height;
+    out.scene = scene::generateTris(t, &realized);
+    out.params = {{"count", t.count}, {"area", t.area}, {"depth", t.depth},
+                  {"order", scene::submitOrderName(t.order)}, {"seed", t.seed}};
+  } else if (c.generator == "layers") {
+    scene::LayersParams l = c.layers;
+    if (l.layers < 1 || l.layers > 64) return Error{"", "", "layers: D must be 1…64"};
+    l.width = options.width;
+    l.height = options.height;
+    out.scene = scene::generateLayers(l, &realized);
+    out.params = {{"layers", l.layers}, {"order", scene::submitOrderName(l.order)},
+                  {"seed", l.seed}};
+  } else if (c.generator.empty()) {
+    auto loaded = scene::loadScene(c.file);
+    if (!loaded) return loaded.error();
+    out.scene = std::move(loaded).value();
+    out.params = {{"file", c.file}};
+    return out;
+  } else {
+    return Error{"", "", fmt::format("no generator '{}'", c.generator)};
+  }
+  out.meanArea = realized.meanArea;
+  out.depthComplexity = realized.depthComplexity;
+  out.params["realized_mean_area"] = realized.meanArea;
+  out.params["depth_complexity"] = realized.depthComplexity;
+  return out;
+}
+
+struct BenchRunner::Impl {
+  BenchSettings settings;
+  std::unique_ptr<GlRenderer> gl;
+  std::string glDescription;
+};
+
+BenchRunner::BenchRunner(const BenchSettings& settings) : impl_(std::make_unique<Impl>()) {
+  impl_->settings = settings;
+}
+BenchRunner::~BenchRunner() = default;
+const std::string& BenchRunner::referenceDescription() const { return impl_->glDescription; }
+
+Status BenchRunner::startReference() {
+  auto gl = GlRenderer::create(impl_->settings.options, 0);
+  if (!gl.ok()) return gl.error();
+  impl_->gl = std::move(gl).value();
+  impl_->glDescription = impl_->gl->description();
+  return {};
+}
+
+Result<CaseResult> BenchRunner::run(const BenchCase& c) {
+  const BenchSettings& s = impl_->settings;
+  if (s.frames < 1 || s.frames > 100000 || s.warmup < 0 || s.warmup > 100000)
+    return Error{"", "", "frames must be 1…100000 and warmup 0…100000"};
+  auto made = makeScene(c, s.options);
+  if (!made.ok()) return made.error();
+  const scene::Scene& sc = made.value().scene;
+
+  CaseResult r;
+  r.name = c.name;
+  r.params = made.value().params;
+  r.triangles = sc.triangleCount();
+  r.meanArea = made.value().meanArea;
+  r.depthComplexity = made.value().depthComplexity;
+  std::optional<RendererRun> ours, ref;
+  if (s.synthvis) ours = RendererRun{"synthvis", "synthvis", {}, 0, 0, 0, {}, {}};
+  Renderer renderer(s.options);
+  if (impl_->gl) {
+    if (Status st = impl_->gl->load(sc); !st) return st.error();
+    ref = RendererRun{"gl", impl_->glDescription, {}, 0, 0, 0, {}, {}};
+  }
+  // A/B, frame by frame.
+  for (int i = 0; i < s.warmup + s.frames; ++i) {
+    if (ours) {
+      const auto t0 = Clock::now();
+      if (Status st = renderer.render(sc, ours->image, &ours->stats); !st) return st.error();
+      const double ms = msSince(t0);
+      if (i >= s.warmup) ours->frameMs.push_back(ms);
+    }
+    if (ref) {
+      const auto t0 = Clock::now();
+      if (Status st = impl_->gl->render(); !st) return st.error();
+      const double ms = msSince(t0);
+      if (i >= s.warmup) ref->frameMs.push_back(ms);
+    }
+  }
+  if (ours) {
+    finish(*ours);
+    r.runs.push_back(std::move(*ours));
+  }
+  if (ref) {
+    finish(*ref);
+    if (Status st = impl_->gl->readImage(ref->image); !st) return st.error();
+    if (!r.runs.empty()) r.psnrDb = psnr(r.runs[0].image, ref->image);
+    r.runs.push_back(std::move(*ref));
+  }
+  return r;
+}
+
+double psnr(const Image& a, const Image& b) {
+  if (a.width != b.width || a.height != b.height || a.rgb.size() != b.rgb.size() || a.rgb.empty())
+    return 0;
+  double sum = 0;
+  for (size_t i = 0; i < a.rgb.size(); ++i) {
+    const double d = double(a.rgb[i]) - double(b.rgb[i]);
+    sum += d * d;
+  }
+  if (sum == 0) return std::numeric_limits<double>::infinity();
+  const double mse = sum / double(a.rgb.size());
+  return 10 * std::log10(255.0 * 255.0 / mse);
+}
+
+nlohmann::json jsonRows(const CaseResult& r, const BenchSettings& s) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (const RendererRun& run : r.runs) {
+    nlohmann::json row = r.params;
+    const double pixels = r.meanArea * double(r.triangles);
+    row.update({{"scene", r.name},
+                {"renderer", run.renderer},
+                {"renderer_description", run.description},
+                {"width", s.options.width},
+                {"height", s.options.height},
+                {"threads", s.options.threads},
+                {"frames", s.frames},
+                {"warmup", s.warmup},
+                {"shade", "gouraud"},
+                {"aa", 0},
+                {"median_ms", run.medianMs},
+                {"min_ms", run.minMs},
+                {"max_ms", run.maxMs},
+                {"frame_ms", run.frameMs},
+                {"triangles", r.triangles},
+                {"mtri_per_s", run.medianMs > 0 ? double(r.triangles) / run.medianMs / 1e3 : 0},
+                {"mpix_per_s", run.medianMs > 0 ? pixels / run.medianMs / 1e3 : 0}});
+    if (run.renderer == "synthvis") row["triangles_drawn"] = run.stats.drawn;
+    if (r.runs.size() > 1)
+      row["psnr_db"] = std::isinf(r.psnrDb) ? nlohmann::json(999.0) : nlohmann::json(r.psnrDb);
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+std::string summaryLine(const CaseResult& r) {
+  const double pixels = r.meanArea * double(r.triangles);
+  std::string line = fmt::format("{:<22} {:>9} tris", r.name, r.triangles);
+  for (const RendererRun& run : r.runs)
+    line += fmt::format("  {} {:8.2f} ms ({:6.2f} Mtri/s, {:5.0f} Mpix/s)", run.renderer,
+                        run.medianMs, double(r.triangles) / run.medianMs / 1e3,
+                        pixels / run.medianMs / 1e3);
+  if (r.runs.size() > 1)
+    line += fmt::format("  ratio {:5.2f}x  psnr {}", r.runs[1].medianMs / r.runs[0].medianMs,
+                        std::isinf(r.psnrDb) ? std::string("identical")
+                                             : fmt::format("{:.1f} dB", r.psnrDb));
+  return line;
+}
+
+namespace {
+
+std::string escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    if (c == '<') out += "&lt;";
+    else if (c == '>') out += "&gt;";
+    else if (c == '&') out += "&amp;";
+    else if (c == '"') out += "&quot;";
+    else out += c;
+  }
+  return out;
+}
+
+// Horizontal bars: reference time / synthvis time per case, with a line at 1×.
+std::string ratioSvg(const std::vector<CaseResult>& results) {
+  const int rowH = 26, left = 190, width = 720, top = 40;
+  double maxRatio = 1;
+  for (const auto& r : results)
+    if (r.runs.size() > 1) maxRatio = std::max(maxRatio, r.runs[1].medianMs / r.runs[0].medianMs);
+  maxRatio = std::ceil(maxRatio);
+  const int height = top + rowH * int(results.size()) + 40;
+  const double scale = (width - left - 60) / maxRatio;
+  std::string svg = fmt::format(
+      "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{}\" height=\"{}\" font-family=\"sans-serif\" "
+      "font-size=\"12\">\n<text x=\"10\" y=\"22\" font-size=\"15\">Speed-up of synthvis over the gl "
+      "reference (median ms/frame of gl ÷ synthvis)</text>\n",
+      width, height);
+  for (int k = 0; k <= int(maxRatio); ++k) {
+    const double x = left + k * scale;
+    svg += fmt::format("<line x1=\"{0:.1f}\" y1=\"{1}\" x2=\"{0:.1f}\" y2=\"{2}\" stroke=\"{3}\"/>"
+                       "<text x=\"{0:.1f}\" y=\"{4}\" text-anchor=\"middle\">{5}×</text>\n",
+                       x, top - 4, height - 30, k == 1 ? "#c33" : "#ddd", height - 14, k);
+  }
+  for (size_t i = 0; i < results.size(); ++i) {
+    const auto& r = results[i];
+    const int y = top + rowH * int(i);
+    svg += fmt::format("<text x=\"{}\" y=\"{}\" text-anchor=\"end\">{}</text>\n", left - 8,
+                       y + rowH / 2 + 4, escape(r.name));
+    if (r.runs.size() < 2) continue;
+    const double ratio = r.runs[1].medianMs / r.runs[0].medianMs;
+    svg += fmt::format("<rect x=\"{}\" y=\"{}\" width=\"{:.1f}\" height=\"{}\" fill=\"#3a6ea5\"/>"
+                       "<text x=\"{:.1f}\" y=\"{}\">{:.2f}×</text>\n",
+                       left, y + 4, ratio * scale, rowH - 8, left + ratio * scale + 4,
+                       y + rowH / 2 + 4, ratio);
+  }
+  return svg + "</svg>\n";
+}
+
+// ms/frame against a case property (log-log), one series per renderer.
+std::string timeSvg(const std::vector<CaseResult>& results, const std::string& title,
+                    const std::string& xLabel, double (*xOf)(const CaseResult&)) {
+  const int width = 520, height = 340, left = 60, right = 20, top = 40, bottom = 50;
+  double x0 = std::numeric_limits<double>::max(), x1 = 0, y0 = x0, y1 = 0;
+  for (const auto& r : results) {
+    const double x = xOf(r);
+    if (!(x > 0)) continue;
+    x0 = std::min(x0, x);
+    x1 = std::max(x1, x);
+    for (const auto& run : r.runs) {
+      y0 = std::min(y0, run.medianMs);
+      y1 = std::max(y1, run.medianMs);
+    }
+  }
+  std::string svg = fmt::format(
+      "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{}\" height=\"{}\" font-family=\"sans-serif\" "
+      "font-size=\"12\">\n<text x=\"10\" y=\"22\" font-size=\"15\">{}</text>\n",
+      width, height, escape(title));
+  if (x1 <= 0) return svg + "<text x=\"60\" y=\"120\">no cases</text></svg>\n";
+  const double lx0 = std::floor(std::log10(x0)), lx1 = std::max(lx0 + 1, std::ceil(std::log10(x1)));
+  const double ly0 = std::floor(std::log10(y0)), ly1 = std::max(ly0 + 1, std::ceil(std::log10(y1)));
+  auto px = [&](double x) { return left + (std::log10(x) - lx0) / (lx1 - lx0) * (width - left - right); };
+  auto py = [&](double y) { return height - bottom - (std::log10(y) - ly0) / (ly1 - ly0) * (height - top - bottom); };
+  for (double e = lx0; e <= lx1; ++e)
+    svg += fmt::format("<line x1=\"{0:.1f}\" y1=\"{1}\" x2=\"{0:.1f}\" y2=\"{2}\" stroke=\"#ddd\"/>"
+                       "<text x=\"{0:.1f}\" y=\"{3}\" text-anchor=\"middle\">{4:g}</text>\n",
+                       px(std::pow(10, e)), top, height - bottom, height - bottom + 16, std::pow(10, e));
+  for (double e = ly0; e <= ly1; ++e)
+    svg += fmt::format("<line x1=\"{0}\" y1=\"{1:.1f}\" x2=\"{2}\" y2=\"{1:.1f}\" stroke=\"#ddd\"/>"
+                       "<text x=\"{3}\" y=\"{4:.1f}\" text-anchor=\"end\">{5:g} ms</text>\n",
+                       left, py(std::pow(10, e)), width - right, left - 4, py(std::pow(10, e)) + 4,
+                       std::pow(10, e));
+  svg += fmt::format("<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">{}</text>\n",
+                     (left + width - right) / 2, height - 12, escape(xLabel));
+  const char* colours[2] = {"#3a6ea5", "#d9822b"};
+  for (int k = 0; k < 2; ++k) {
+    for (const auto& r : results) {
+      if (int(r.runs.size()) <= k || !(xOf(r) > 0)) continue;
+      svg += fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"4\" fill=\"{}\"><title>{} {}: "
+                         "{:.2f} ms</title></circle>\n",
+                         px(xOf(r)), py(r.runs[size_t(k)].medianMs), colours[k], escape(r.name),
+                         r.runs[size_t(k)].renderer, r.runs[size_t(k)].medianMs);
+    }
+    svg += fmt::format("<circle cx=\"{}\" cy=\"{}\" r=\"4\" fill=\"{}\"/><text x=\"{}\" y=\"{}\">{}</text>\n",
+                       left + 10 + 110 * k, top - 6, colours[k], left + 18 + 110 * k, top - 2,
+                       k == 0 ? "synthvis" : "gl (llvmpipe)");
+  }
+  return svg + "</svg>\n";
+}
+
+Status writeText(const std::filesystem::path& p, const std::string& text) {
+  std::ofstream out(p, std::ios::binary);
+  out << text;
+  if (!out) return Error{p.string(), "", "cannot write"};
+  return {};
+}
+
+}  // namespace
+
+Status writeHtml(const std::string& dir, const std::vector<CaseResult>& results,
+                 const BenchSettings& s, const std::string& referenceDescription) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) return Error{dir, "", "cannot create the directory: " + ec.message()};
+  const fs::path d(dir);
+  std::vector<CaseResult> tris, layers;
+  for (const auto& r : results) {
+    if (r.params.contains("count")) tris.push_back(r);
+    if (r.params.contains("layers")) layers.push_back(r);
+  }
+  if (Status st = writeText(d / "ratio.svg", ratioSvg(results)); !st) return st;
+  auto byTriangles = [](const CaseResult& r) { return double(r.triangles); };
+  auto byArea = [](const CaseResult& r) { return r.meanArea; };
+  auto byDepth = [](const CaseResult& r) { return r.depthComplexity; };
+  if (Status st = writeText(d / "time-triangles.svg",
+                            timeSvg(tris, "tris: ms/frame vs triangle count", "triangles", byTriangles));
+      !st)
+    return st;
+  if (Status st = writeText(d / "time-area.svg",
+                            timeSvg(tris, "tris: ms/frame vs mean triangle area", "mean area, px", byArea));
+      !st)
+    return st;
+  if (Status st = writeText(d / "time-depth.svg", timeSvg(layers, "layers: ms/frame vs depth complexity",
+                                                           "depth complexity", byDepth));
+      !st)
+    return st;
+
+  std::string html = fmt::format(
+      "<!doctype html>\n<html><head><meta charset=\"utf-8\"><title>synthvis bench</title>\n"
+      "<style>body{{font-family:sans-serif;margin:2em}}table{{border-collapse:collapse}}"
+      "td,th{{border:1px solid #ccc;padding:3px 8px;text-align:right}}td:first-child{{text-align:left}}"
+      "img{{max-width:480px;border:1px solid #ccc}}figure{{display:inline-block;margin:4px}}</style>"
+      "</head><body>\n<h1>synthvis bench</h1>\n<p>{}×{}, {} threads, {} timed frames after {} warm-up, "
+      "synthvis and the reference alternating frame by frame. Reference: {}.</p>\n",
+      s.options.width, s.options.height, s.options.threads, s.frames, s.warmup,
+      escape(referenceDescription.empty() ? std::string("not run") : referenceDescription));
+  html += "<p><img src=\"ratio.svg\" style=\"max-width:none;border:0\"></p>\n<p>"
+          "<img src=\"time-triangles.svg\" style=\"border:0\"><img src=\"time-area.svg\" style=\"border:0\">"
+          "<img src=\"time-depth.svg\" style=\"border:0\"></p>\n";
+  html += "<table><tr><th>scene</th><th>triangles</th><th>mean area px</th><th>depth complexity</th>"
+          "<th>synthvis ms</th><th>gl ms</th><th>ratio</th><th>synthvis Mtri/s</th>"
+          "<th>synthvis Mpix/s</th><th>PSNR dB</th></tr>\n";
+  for (const auto& r : results) {
+    const auto& a = r.runs[0];
+    const bool both = r.runs.size() > 1;
+    html += fmt::format("<tr><td>{}</td><td>{}</td><td>{:.1f}</td><td>{:.2f}</td><td>{:.2f}</td><td>{}</td>"
+                        "<td>{}</td><td>{:.2f}</td><td>{:.0f}</td><td>{}</td></tr>\n",
+                        escape(r.name), r.triangles, r.meanArea, r.depthComplexity, a.medianMs,
+                        both ? fmt::format("{:.2f}", r.runs[1].medianMs) : "–",
+                        both ? fmt::format("{:.2f}×", r.runs[1].medianMs / a.medianMs) : "–",
+                        double(r.triangles) / a.medianMs / 1e3,
+                        r.meanArea * double(r.triangles) / a.medianMs / 1e3,
+                        !both ? "–" : std::isinf(r.psnrDb) ? "identical" : fmt::format("{:.1f}", r.psnrDb));
+  }
+  html += "</table>\n<h2>Images</h2>\n";
+  for (const auto& r : results) {
+    html += fmt::format("<h3>{}</h3>\n", escape(r.name));
+    for (const auto& run : r.runs) {
+      const std::string file = fmt::format("{}-{}.png", r.name, run.renderer);
+      if (Status st = writePng(run.image, (d / file).string()); !st) return st;
+      html += fmt::format("<figure><img src=\"{}\"><figcaption>{} — {:.2f} ms</figcaption></figure>\n",
+                          escape(file), escape(run.renderer == "gl" ? run.description : run.renderer),
+                          run.medianMs);
+    }
+  }
+  html += "</body></html>\n";
+  return writeText(d / "index.html", html);
+}
+
+}  // namespace sv::reference

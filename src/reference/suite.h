@@ -1,0 +1,97 @@
+// `synthvis bench`: BENCH.md scenes timed on synthvis and, in the same run, on the OpenGL
+// reference (Mesa llvmpipe), frames interleaved A/B; medians, ratios, throughput, PSNR between the
+// two images; JSON rows as BENCH.md names them, and an HTML page with plots.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "synthvis/generators.h"
+#include "synthvis/image.h"
+#include "synthvis/render.h"
+#include "synthvis/result.h"
+#include "synthvis/scene.h"
+
+namespace sv::reference {
+
+// A scene to time: a generator with its parameters, or a scene file.
+struct BenchCase {
+  std::string name;       // e.g. "tris-100k-a10", or the file's path
+  std::string generator;  // "tris", "layers", or empty for a file
+  scene::TrisParams tris;
+  scene::LayersParams layers;
+  std::string file;
+};
+
+// The cases of a named suite: "quick" (≤ 5 min on 2 cores with the reference) or "full".
+Result<std::vector<BenchCase>> suiteCases(const std::string& suite);
+
+// The case's scene, its parameters as JSON, and what the generator realized.
+struct CaseScene {
+  scene::Scene scene;
+  nlohmann::json params;
+  double meanArea = 0, depthComplexity = 0;  // 0 for files
+};
+Result<CaseScene> makeScene(const BenchCase& c, const RenderOptions& options);
+
+// One renderer's timing of one case.
+struct RendererRun {
+  std::string renderer;     // "synthvis" or "gl"
+  std::string description;  // e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
+  std::vector<double> frameMs;
+  double medianMs = 0, minMs = 0, maxMs = 0;
+  FrameStats stats;  // synthvis only
+  Image image;       // the last frame
+};
+
+struct CaseResult {
+  std::string name;
+  nlohmann::json params;
+  uint64_t triangles = 0;
+  double meanArea = 0, depthComplexity = 0;
+  std::vector<RendererRun> runs;  // synthvis first if it ran, then the reference if it ran
+  double psnrDb = 0;              // between the two images; +∞ if identical; 0 if one renderer
+};
+
+struct BenchSettings {
+  RenderOptions options;
+  int frames = 10, warmup = 2;
+  bool synthvis = true;   // time synthvis
+  bool reference = true;  // time the gl reference (after startReference)
+};
+
+// Renders, per case, warm-up frames then timed frames, alternating synthvis and the reference
+// frame by frame so that drift of the machine hits both alike. `progress` gets one line per case.
+// If the reference cannot start, the error says why (the caller decides whether that is fatal).
+class BenchRunner {
+ public:
+  explicit BenchRunner(const BenchSettings& settings);
+  ~BenchRunner();
+  // Starts the reference; call before run() when settings.reference is set.
+  Status startReference();
+  const std::string& referenceDescription() const;
+  Result<CaseResult> run(const BenchCase& c);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Peak signal-to-noise ratio of two same-sized 8-bit images, dB (+∞ when equal).
+double psnr(const Image& a, const Image& b);
+
+// BENCH.md's JSON rows for one case: one per renderer, `psnr_db` against the other.
+nlohmann::json jsonRows(const CaseResult& r, const BenchSettings& s);
+
+// One line per renderer and case, as the CLI prints them.
+std::string summaryLine(const CaseResult& r);
+
+// Writes DIR/index.html (table, plots, the two images of every case side by side), the plots
+// DIR/ratio.svg and DIR/time.svg, and the images DIR/<case>-<renderer>.png.
+Status writeHtml(const std::string& dir, const std::vector<CaseResult>& results,
+                 const BenchSettings& s, const std::string& referenceDescription);
+
+}  // namespace sv::reference
