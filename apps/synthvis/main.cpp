@@ -6,6 +6,8 @@
 //                  [--order random|f2b|b2f] [--shade gouraud] [--width W] [--height H]
 //                  [--threads T] [--frames F] [--warmup W] [--seed S]
 //                  [--renderer synthvis|gl|both] [--json FILE] [--html DIR] [--image FILE]
+//   synthvis gen tris|layers -o scene.glb [--count N] [--area A] [--depth D] [--layers D]
+//                [--order O] [--seed S] [--width W] [--height H]
 //   (shared BENCH.md defines the scenes and the JSON fields)
 //
 // Errors print one line, "synthvis: <file>: <problem>", and exit with status 1 (2 for usage).
@@ -188,6 +190,44 @@ int runBench(BenchArgs a) {
   return 0;
 }
 
+struct GenArgs {
+  std::string kind;
+  std::string output;
+  sv::scene::TrisParams tris;
+  int layers = 4;
+  std::string order = "random";
+  int width = 1920, height = 1080;
+};
+
+// `synthvis gen KIND -o scene.glb`: a BENCH.md scene as glTF, for other renderers.
+int runGen(const GenArgs& a) {
+  auto order = sv::scene::parseSubmitOrder(a.order);
+  if (!order) return fail(order.error());
+  if (const char* needs = missingGenerator(a.kind))
+    return fail({"", "", fmt::format("generator '{}' needs {}, not built yet", a.kind, needs)});
+  if (a.width < 1 || a.width > sv::kMaxRasterSize || a.height < 1 || a.height > sv::kMaxRasterSize)
+    return fail({"", "", "width and height must be 1…8192"});
+  sv::reference::BenchCase c;
+  c.generator = a.kind;
+  c.tris = a.tris;
+  c.tris.order = order.value();
+  c.layers.layers = a.layers;
+  c.layers.order = order.value();
+  c.layers.seed = a.tris.seed;
+  if (a.kind != "tris" && a.kind != "layers")
+    return fail({"", "", fmt::format("unknown generator '{}' (tris, layers)", a.kind)});
+  sv::RenderOptions o;
+  o.width = a.width;
+  o.height = a.height;
+  auto made = sv::reference::makeScene(c, o);
+  if (!made) return fail(made.error());
+  if (sv::Status s = sv::scene::saveGltf(made.value().scene, a.output); !s) return fail(s.error());
+  fmt::print("{}: {} {} triangles, mean area {:.1f} px at {}x{}, depth complexity {:.2f}\n",
+             a.output, a.kind, made.value().scene.triangleCount(), made.value().meanArea, a.width,
+             a.height, made.value().depthComplexity);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -231,6 +271,20 @@ int main(int argc, char** argv) {
   bench->add_option("--html", b.html, "write an HTML page with plots and images to this directory");
   bench->add_option("--image", b.image, "write the last frame of the last scene to this image file");
 
+  GenArgs g;
+  CLI::App* gen = app.add_subcommand("gen", "write a BENCH.md scene as glTF (.glb or .gltf)");
+  gen->add_option("kind", g.kind, "generator: tris or layers")->required();
+  gen->add_option("-o,--output", g.output, "output file (.glb or .gltf)")->required();
+  gen->add_option("--count", g.tris.count, "tris: number of triangles")->capture_default_str();
+  gen->add_option("--area", g.tris.area, "tris: mean projected area, pixels")->capture_default_str();
+  gen->add_option("--depth", g.tris.depth, "tris: depth complexity (0 = whole screen)")
+      ->capture_default_str();
+  gen->add_option("--layers", g.layers, "layers: depth complexity D")->capture_default_str();
+  gen->add_option("--order", g.order, "random, f2b or b2f")->capture_default_str();
+  gen->add_option("--seed", g.tris.seed, "generator seed")->capture_default_str();
+  gen->add_option("--width", g.width, "the raster the areas refer to")->capture_default_str();
+  gen->add_option("--height", g.height, "the raster the areas refer to")->capture_default_str();
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -238,5 +292,6 @@ int main(int argc, char** argv) {
   }
   if (*render) return runRender(r);
   if (*bench) return runBench(b);
+  if (*gen) return runGen(g);
   return 0;
 }

@@ -110,6 +110,10 @@ Result<Scene> loadGltfFromMemory(const std::string& bytes, const std::string& pa
 Result<Scene> parseObj(const std::string& text, const std::string& path,
                        const LoadOptions& options = {});
 
+// Writes `scene` as glTF 2.0: binary for a path ending in .glb, text with the buffer embedded for
+// .gltf. loadGltf reads it back to the same meshes, materials, instances and cameras.
+Status saveGltf(const Scene& scene, const std::string& path);
+
 // The built-in demo scene (scenes/demo.json compiled into the binary).
 Scene demoScene();
 // The text of the built-in demo scene.

@@ -290,7 +290,7 @@ std::string ratioSvg(const std::vector<CaseResult>& results) {
 // ms/frame against a case property (log-log), one series per renderer.
 std::string timeSvg(const std::vector<CaseResult>& results, const std::string& title,
                     const std::string& xLabel, double (*xOf)(const CaseResult&)) {
-  const int width = 520, height = 340, left = 60, right = 20, top = 40, bottom = 50;
+  const int width = 520, height = 350, left = 60, right = 45, top = 60, bottom = 50;
   double x0 = std::numeric_limits<double>::max(), x1 = 0, y0 = x0, y1 = 0;
   for (const auto& r : results) {
     const double x = xOf(r);
@@ -332,7 +332,7 @@ std::string timeSvg(const std::vector<CaseResult>& results, const std::string& t
                          r.runs[size_t(k)].renderer, r.runs[size_t(k)].medianMs);
     }
     svg += fmt::format("<circle cx=\"{}\" cy=\"{}\" r=\"4\" fill=\"{}\"/><text x=\"{}\" y=\"{}\">{}</text>\n",
-                       left + 10 + 110 * k, top - 6, colours[k], left + 18 + 110 * k, top - 2,
+                       left + 10 + 110 * k, top - 22, colours[k], left + 18 + 110 * k, top - 18,
                        k == 0 ? "synthvis" : "gl (llvmpipe)");
   }
   return svg + "</svg>\n";

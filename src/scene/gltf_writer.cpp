@@ -1,0 +1,162 @@
+// Writing a Scene as glTF 2.0 (.glb, or .gltf with the buffer embedded), so that generated
+// benchmark scenes can be rendered by other tools (`synthvis gen`).
+//
+// What is written is what the loader reads back (docs/scene-format.md, "glTF and OBJ files"):
+// one glTF mesh per Mesh (POSITION with min/max, NORMAL, COLOR_0 as float VEC4, TEXCOORD_0,
+// 32-bit indices), one material per Material (baseColorFactor, doubleSided,
+// KHR_materials_unlit), one node per Instance (its matrix), one node per Camera (camera-to-world
+// matrix, looking down −Z with +Y up; yfov in radians).
+#include <cmath>
+#include <cstring>
+
+#include <fmt/format.h>
+#include <tiny_gltf.h>
+
+#include "synthvis/scene.h"
+
+namespace sv::scene {
+namespace {
+
+// Appends `count` elements of `bytes` each to the buffer as a new view + accessor.
+int addAccessor(tinygltf::Model& model, const void* data, size_t count, size_t bytes, int type,
+                int componentType, int target) {
+  auto& buffer = model.buffers[0].data;
+  while (buffer.size() % 4) buffer.push_back(0);
+  tinygltf::BufferView view;
+  view.buffer = 0;
+  view.byteOffset = buffer.size();
+  view.byteLength = count * bytes;
+  view.target = target;
+  const auto* p = static_cast<const unsigned char*>(data);
+  buffer.insert(buffer.end(), p, p + count * bytes);
+  model.bufferViews.push_back(view);
+  tinygltf::Accessor a;
+  a.bufferView = int(model.bufferViews.size()) - 1;
+  a.count = count;
+  a.type = type;
+  a.componentType = componentType;
+  model.accessors.push_back(a);
+  return int(model.accessors.size()) - 1;
+}
+
+std::vector<double> columnMajor(const Mat4& m) {
+  std::vector<double> v;
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r) v.push_back(m.m[size_t(c)][size_t(r)]);
+  return v;
+}
+
+}  // namespace
+
+Status saveGltf(const Scene& scene, const std::string& path) {
+  if (Status s = validate(scene, path); !s) return s;
+  const bool binary = path.size() >= 4 && path.compare(path.size() - 4, 4, ".glb") == 0;
+  const bool text = path.size() >= 5 && path.compare(path.size() - 5, 5, ".gltf") == 0;
+  if (!binary && !text) return Error{path, "", "the file name must end in .glb or .gltf"};
+
+  tinygltf::Model model;
+  model.asset.version = "2.0";
+  model.asset.generator = "synthvis";
+  model.buffers.resize(1);
+  bool unlitUsed = false;
+  for (const Material& m : scene.materials) {
+    tinygltf::Material out;
+    out.name = m.name;
+    out.pbrMetallicRoughness.baseColorFactor = {m.baseColor.x, m.baseColor.y, m.baseColor.z,
+                                                m.baseColor.w};
+    out.pbrMetallicRoughness.metallicFactor = 0;
+    out.doubleSided = m.doubleSided;
+    if (m.unlit) {
+      out.extensions["KHR_materials_unlit"] = tinygltf::Value(tinygltf::Value::Object());
+      unlitUsed = true;
+    }
+    model.materials.push_back(out);
+  }
+  if (unlitUsed) model.extensionsUsed.push_back("KHR_materials_unlit");
+
+  for (const Mesh& m : scene.meshes) {
+    tinygltf::Primitive prim;
+    prim.mode = TINYGLTF_MODE_TRIANGLES;
+    prim.material = m.material;
+    const int pos = addAccessor(model, m.positions.data(), m.positions.size(), sizeof(Vec3),
+                                TINYGLTF_TYPE_VEC3, TINYGLTF_COMPONENT_TYPE_FLOAT,
+                                TINYGLTF_TARGET_ARRAY_BUFFER);
+    // The specification requires bounds on POSITION.
+    Vec3 lo{0, 0, 0}, hi{0, 0, 0};
+    for (size_t i = 0; i < m.positions.size(); ++i) {
+      const Vec3 p = m.positions[i];
+      lo = i ? Vec3{std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)} : p;
+      hi = i ? Vec3{std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)} : p;
+    }
+    model.accessors[size_t(pos)].minValues = {lo.x, lo.y, lo.z};
+    model.accessors[size_t(pos)].maxValues = {hi.x, hi.y, hi.z};
+    prim.attributes["POSITION"] = pos;
+    if (!m.normals.empty())
+      prim.attributes["NORMAL"] = addAccessor(model, m.normals.data(), m.normals.size(),
+                                              sizeof(Vec3), TINYGLTF_TYPE_VEC3,
+                                              TINYGLTF_COMPONENT_TYPE_FLOAT,
+                                              TINYGLTF_TARGET_ARRAY_BUFFER);
+    if (!m.colors.empty())
+      prim.attributes["COLOR_0"] = addAccessor(model, m.colors.data(), m.colors.size(),
+                                               sizeof(Vec4), TINYGLTF_TYPE_VEC4,
+                                               TINYGLTF_COMPONENT_TYPE_FLOAT,
+                                               TINYGLTF_TARGET_ARRAY_BUFFER);
+    if (!m.uvs.empty())
+      prim.attributes["TEXCOORD_0"] = addAccessor(model, m.uvs.data(), m.uvs.size(),
+                                                  sizeof(m.uvs[0]), TINYGLTF_TYPE_VEC2,
+                                                  TINYGLTF_COMPONENT_TYPE_FLOAT,
+                                                  TINYGLTF_TARGET_ARRAY_BUFFER);
+    prim.indices = addAccessor(model, m.indices.data(), m.indices.size(), sizeof(uint32_t),
+                               TINYGLTF_TYPE_SCALAR, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
+                               TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+    tinygltf::Mesh out;
+    out.name = m.name;
+    out.primitives.push_back(prim);
+    model.meshes.push_back(out);
+  }
+
+  tinygltf::Scene root;
+  for (const Instance& inst : scene.instances) {
+    tinygltf::Node node;
+    node.mesh = inst.mesh;
+    node.matrix = columnMajor(inst.transform);
+    model.nodes.push_back(node);
+    root.nodes.push_back(int(model.nodes.size()) - 1);
+  }
+  for (const Camera& c : scene.cameras) {
+    tinygltf::Camera cam;
+    cam.type = "perspective";
+    cam.name = c.name;
+    cam.perspective.yfov = c.yfovDegrees * 3.14159265358979 / 180.0;
+    cam.perspective.znear = c.znear;
+    cam.perspective.zfar = c.zfar;
+    model.cameras.push_back(cam);
+    // Camera to world: right, up, back (the view looks down −Z), position.
+    const Vec3 forward = normalize(c.target - c.position);
+    const Vec3 right = normalize(cross(forward, c.up));
+    const Vec3 up = cross(right, forward);
+    Mat4 m;
+    m.m[0] = {right.x, right.y, right.z, 0};
+    m.m[1] = {up.x, up.y, up.z, 0};
+    m.m[2] = {-forward.x, -forward.y, -forward.z, 0};
+    m.m[3] = {c.position.x, c.position.y, c.position.z, 1};
+    tinygltf::Node node;
+    node.name = c.name;
+    node.camera = int(model.cameras.size()) - 1;
+    node.matrix = columnMajor(m);
+    model.nodes.push_back(node);
+    root.nodes.push_back(int(model.nodes.size()) - 1);
+  }
+  model.scenes.push_back(root);
+  model.defaultScene = 0;
+  model.buffers[0].uri.clear();
+
+  tinygltf::TinyGLTF writer;
+  // .gltf: the buffer goes into the file as a data: URI.
+  if (!writer.WriteGltfSceneToFile(&model, path, /*embedImages=*/true, /*embedBuffers=*/true,
+                                   /*prettyPrint=*/!binary, /*writeBinary=*/binary))
+    return Error{path, "", "cannot write"};
+  return {};
+}
+
+}  // namespace sv::scene
