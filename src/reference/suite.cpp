@@ -1,6 +1,7 @@
 #include "reference/suite.h"
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -181,6 +182,17 @@ Result<CaseResult> BenchRunner::run(const BenchCase& c) {
   return r;
 }
 
+namespace {
+// Pixels drawn per frame: the generator's realized area, or for files the fragments synthvis
+// counted (the same triangles' covered pixel centres).
+double pixelsOf(const CaseResult& r) {
+  if (r.meanArea > 0) return r.meanArea * double(r.triangles);
+  for (const RendererRun& run : r.runs)
+    if (run.renderer == "synthvis") return double(run.stats.fragments);
+  return 0;
+}
+}  // namespace
+
 double psnr(const Image& a, const Image& b) {
   if (a.width != b.width || a.height != b.height || a.rgb.size() != b.rgb.size() || a.rgb.empty())
     return 0;
@@ -198,7 +210,7 @@ nlohmann::json jsonRows(const CaseResult& r, const BenchSettings& s) {
   nlohmann::json rows = nlohmann::json::array();
   for (const RendererRun& run : r.runs) {
     nlohmann::json row = r.params;
-    const double pixels = r.meanArea * double(r.triangles);
+    const double pixels = pixelsOf(r);
     row.update({{"scene", r.name},
                 {"renderer", run.renderer},
                 {"renderer_description", run.description},
@@ -225,7 +237,7 @@ nlohmann::json jsonRows(const CaseResult& r, const BenchSettings& s) {
 }
 
 std::string summaryLine(const CaseResult& r) {
-  const double pixels = r.meanArea * double(r.triangles);
+  const double pixels = pixelsOf(r);
   std::string line = fmt::format("{:<22} {:>9} tris", r.name, r.triangles);
   for (const RendererRun& run : r.runs)
     line += fmt::format("  {} {:8.2f} ms ({:6.2f} Mtri/s, {:5.0f} Mpix/s)", run.renderer,
@@ -338,6 +350,18 @@ std::string timeSvg(const std::vector<CaseResult>& results, const std::string& t
   return svg + "</svg>\n";
 }
 
+// A case name as a file name inside the page's directory: "scenes/a b.json" → "scenes-a-b-json".
+std::string fileSlug(const std::string& name) {
+  std::string out;
+  for (char c : name) {
+    const bool keep = std::isalnum(static_cast<unsigned char>(c)) || c == '_';
+    if (keep) out += c;
+    else if (!out.empty() && out.back() != '-') out += '-';
+  }
+  while (!out.empty() && out.back() == '-') out.pop_back();
+  return out.empty() ? "scene" : out;
+}
+
 Status writeText(const std::filesystem::path& p, const std::string& text) {
   std::ofstream out(p, std::ios::binary);
   out << text;
@@ -400,14 +424,14 @@ Status writeHtml(const std::string& dir, const std::vector<CaseResult>& results,
                         both ? fmt::format("{:.2f}", r.runs[1].medianMs) : "–",
                         both ? fmt::format("{:.2f}×", r.runs[1].medianMs / a.medianMs) : "–",
                         double(r.triangles) / a.medianMs / 1e3,
-                        r.meanArea * double(r.triangles) / a.medianMs / 1e3,
+                        pixelsOf(r) / a.medianMs / 1e3,
                         !both ? "–" : std::isinf(r.psnrDb) ? "identical" : fmt::format("{:.1f}", r.psnrDb));
   }
   html += "</table>\n<h2>Images</h2>\n";
   for (const auto& r : results) {
     html += fmt::format("<h3>{}</h3>\n", escape(r.name));
     for (const auto& run : r.runs) {
-      const std::string file = fmt::format("{}-{}.png", r.name, run.renderer);
+      const std::string file = fmt::format("{}-{}.png", fileSlug(r.name), run.renderer);
       if (Status st = writePng(run.image, (d / file).string()); !st) return st;
       html += fmt::format("<figure><img src=\"{}\"><figcaption>{} — {:.2f} ms</figcaption></figure>\n",
                           escape(file), escape(run.renderer == "gl" ? run.description : run.renderer),

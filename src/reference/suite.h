@@ -90,7 +90,8 @@ nlohmann::json jsonRows(const CaseResult& r, const BenchSettings& s);
 std::string summaryLine(const CaseResult& r);
 
 // Writes DIR/index.html (table, plots, the two images of every case side by side), the plots
-// DIR/ratio.svg and DIR/time.svg, and the images DIR/<case>-<renderer>.png.
+// DIR/ratio.svg and DIR/time-{triangles,area,depth}.svg, and the images
+// DIR/<case>-<renderer>.png (the case name reduced to letters, digits, '_' and '-').
 Status writeHtml(const std::string& dir, const std::vector<CaseResult>& results,
                  const BenchSettings& s, const std::string& referenceDescription);
 

@@ -128,5 +128,46 @@ TEST(TrisGenerator, RenderedAreaMatchesTheRequestedArea) {
   EXPECT_NEAR(double(stats.fragments) / p.count, 50, 2.5);
 }
 
+TEST(LayersGenerator, SameSeedSameSceneAndStatistics) {
+  scene::LayersParams p;
+  p.layers = 3;
+  scene::TrisStats a, b;
+  const scene::Scene s1 = scene::generateLayers(p, &a), s2 = scene::generateLayers(p, &b);
+  ASSERT_EQ(s1.meshes[0].positions.size(), s2.meshes[0].positions.size());
+  EXPECT_EQ(s1.meshes[0].positions, s2.meshes[0].positions);
+  EXPECT_EQ(s1.meshes[0].colors, s2.meshes[0].colors);
+  EXPECT_NEAR(a.meanArea, 200, 10);  // BENCH.md: mean area 200 px, within 5 %
+  EXPECT_NEAR(a.depthComplexity, 3, 0.15);
+  p.seed = 2;
+  EXPECT_NE(scene::generateLayers(p).meshes[0].positions, s1.meshes[0].positions);
+}
+
+// BENCH.md: "every pixel is covered D times" — counted by the renderer, in every order.
+TEST(LayersGenerator, EveryPixelIsCoveredDTimes) {
+  for (auto order : {scene::SubmitOrder::random, scene::SubmitOrder::frontToBack,
+                     scene::SubmitOrder::backToFront}) {
+    scene::LayersParams p;
+    p.layers = 3;
+    p.order = order;
+    p.width = 320;
+    p.height = 200;
+    RenderOptions o;
+    o.width = p.width;
+    o.height = p.height;
+    o.threads = 2;
+    o.debugOverdraw = true;
+    Renderer r(o);
+    Image img;
+    FrameStats stats;
+    ASSERT_TRUE(r.render(scene::generateLayers(p), img, &stats).ok());
+    EXPECT_EQ(stats.fragments, uint64_t(3) * 320 * 200) << scene::submitOrderName(order);
+    // The overdraw palette's colour for 3: green (40, 200, 40), at every pixel.
+    size_t wrong = 0;
+    for (size_t i = 0; i < img.rgb.size(); i += 3)
+      wrong += !(img.rgb[i] == 40 && img.rgb[i + 1] == 200 && img.rgb[i + 2] == 40);
+    EXPECT_EQ(wrong, 0u) << scene::submitOrderName(order);
+  }
+}
+
 }  // namespace
 }  // namespace sv
