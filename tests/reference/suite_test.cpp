@@ -5,7 +5,6 @@
 
 #include <gtest/gtest.h>
 
-#include "reference/gl_renderer.h"
 #include "reference/suite.h"
 
 namespace sv::reference {
@@ -65,42 +64,6 @@ TEST(BenchRunner, JsonRowsCarryBenchMdFields) {
     EXPECT_TRUE(rows[0].contains(key)) << key;
   EXPECT_EQ(rows[0]["renderer"], "synthvis");
   EXPECT_EQ(rows[0]["triangles"], 300);
-}
-
-// The reference draws the same triangles: PSNR ≥ 40 dB against synthvis (issue 3's bar), on a
-// lit mesh scene and on the no-AA Gouraud bench scenes.
-TEST(GlReference, DrawsWhatSynthvisDraws) {
-  if (!glBuilt()) GTEST_SKIP() << "the gl reference is not in this build";
-  BenchSettings s = smallSettings();
-  s.reference = true;
-  BenchRunner runner(s);
-  if (Status st = runner.startReference(); !st)
-    GTEST_SKIP() << "the gl reference cannot start here: " << st.error().str();
-  BenchCase tris;
-  tris.name = "tris";
-  tris.generator = "tris";
-  tris.tris.count = 2000;
-  tris.tris.area = 60;
-  BenchCase layers;
-  layers.name = "layers";
-  layers.generator = "layers";
-  layers.layers.layers = 3;
-  for (const BenchCase& c : {tris, layers}) {
-    auto r = runner.run(c);
-    ASSERT_TRUE(r.ok()) << r.error().str();
-    ASSERT_EQ(r->runs.size(), 2u);
-    EXPECT_EQ(r->runs[1].renderer, "gl");
-    EXPECT_GE(r->psnrDb, 40.0) << c.name;
-  }
-  // A lit scene with cameras, culling and the background: the demo scene through a file.
-  const std::string demo = (std::filesystem::temp_directory_path() / "sv_suite_demo.glb").string();
-  ASSERT_TRUE(scene::saveGltf(scene::demoScene(), demo).ok());
-  BenchCase file;
-  file.name = "demo";
-  file.file = demo;
-  auto r = runner.run(file);
-  ASSERT_TRUE(r.ok()) << r.error().str();
-  EXPECT_GE(r->psnrDb, 40.0);
 }
 
 TEST(Html, WritesPageImagesAndPlots) {
