@@ -1,6 +1,7 @@
 // Google Benchmark kernels (STYLE.md habit 13): seeded inputs, work-normalized rates.
 //   setup per triangle            → triangles/s
-//   one tile, small triangles      → triangles/s (coverage + depth + Gouraud)
+//   one tile, small triangles      → triangles/s (coverage + depth + Gouraud), windows/s (coverage
+//                                    tests: windows classified plus leaf pixel-centre tests)
 //   one tile, large triangles      → pixels/s (fills)
 //   whole frame, BENCH.md tris     → triangles/s
 #include <benchmark/benchmark.h>
@@ -61,6 +62,10 @@ void rasterTile(benchmark::State& state, double area) {
       benchmark::Counter(double(count) * state.iterations(), benchmark::Counter::kIsRate);
   state.counters["pixels/s"] = benchmark::Counter(
       double(stats.fragments), benchmark::Counter::kIsRate);
+  // Coverage tests: every window classified, every 4×4 leaf's 16 pixel-centre tests.
+  uint64_t windows = 0;
+  for (uint64_t w : stats.windows) windows += w;
+  state.counters["windows/s"] = benchmark::Counter(double(windows), benchmark::Counter::kIsRate);
 }
 
 void BM_TileSmallTriangles(benchmark::State& s) { rasterTile(s, 10); }
