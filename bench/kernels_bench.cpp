@@ -64,7 +64,7 @@ void rasterTile(benchmark::State& state, double area) {
       double(stats.fragments), benchmark::Counter::kIsRate);
   // Coverage tests: every window classified, every 4×4 leaf's 16 pixel-centre tests.
   uint64_t windows = 0;
-  for (uint64_t w : stats.windows) windows += w;
+  for (uint64_t n : stats.windows) windows += n;
   state.counters["windows/s"] = benchmark::Counter(double(windows), benchmark::Counter::kIsRate);
 }
 
