@@ -4,7 +4,7 @@
 //                   [--no-cull] [--debug-view overdraw]
 //   synthvis bench SCENE|--suite quick|full [--count N] [--area A] [--depth D] [--layers D]
 //                  [--order random|f2b|b2f] [--shade gouraud] [--width W] [--height H]
-//                  [--threads T] [--frames F] [--warmup W] [--seed S]
+//                  [--threads T] [--frames F] [--warmup W] [--seed S] [--aa S]
 //                  [--renderer synthvis|gl|both] [--json FILE] [--html DIR] [--image FILE]
 //   synthvis gen tris|layers -o scene.glb [--count N] [--area A] [--depth D] [--layers D]
 //                [--order O] [--seed S] [--width W] [--height H]
@@ -82,6 +82,7 @@ struct BenchArgs {
   std::string image;
   int frames = 10;
   int warmup = 2;
+  int aa = 0;
   sv::RenderOptions options{.width = 1920, .height = 1080, .threads = 2};
 };
 
@@ -107,6 +108,12 @@ int runBench(BenchArgs a) {
     return fail({"", "", fmt::format("unknown renderer '{}' (synthvis, gl or both)", a.renderer)});
   auto order = sv::scene::parseSubmitOrder(a.order);
   if (!order) return fail(order.error());
+  if (a.aa != 0 && a.aa != 2 && a.aa != 4 && a.aa != 8 && a.aa != 16)
+    return fail({"", "", fmt::format("--aa {}: samples per pixel must be 0, 2, 4, 8 or 16", a.aa)});
+  // synthvis's anti-aliasing is issue 4; until then only the reference can multisample.
+  if (a.aa != 0 && a.renderer != "gl")
+    return fail({"", "", "--aa: synthvis has no anti-aliasing yet; use --renderer gl to time the "
+                         "reference's multisampling"});
 
   std::vector<ref::BenchCase> cases;
   if (!a.suite.empty()) {
@@ -137,6 +144,7 @@ int runBench(BenchArgs a) {
   settings.options = a.options;
   settings.frames = a.frames;
   settings.warmup = a.warmup;
+  settings.aa = a.aa;
   settings.synthvis = a.renderer != "gl";
   settings.reference = a.renderer != "synthvis";
   ref::BenchRunner runner(settings);
@@ -264,6 +272,8 @@ int main(int argc, char** argv) {
   bench->add_option("--threads", b.options.threads, "worker threads")->capture_default_str();
   bench->add_option("--frames", b.frames, "timed frames")->capture_default_str();
   bench->add_option("--warmup", b.warmup, "untimed frames first")->capture_default_str();
+  bench->add_option("--aa", b.aa, "samples per pixel (0 = none; gl reference only for now)")
+      ->capture_default_str();
   bench->add_option("--renderer", b.renderer,
                     "synthvis, gl (Mesa llvmpipe) or both, alternating frames; default: synthvis "
                     "for a scene, both for a suite");

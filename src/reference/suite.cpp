@@ -126,7 +126,7 @@ BenchRunner::~BenchRunner() = default;
 const std::string& BenchRunner::referenceDescription() const { return impl_->glDescription; }
 
 Status BenchRunner::startReference() {
-  auto gl = GlRenderer::create(impl_->settings.options, 0);
+  auto gl = GlRenderer::create(impl_->settings.options, impl_->settings.aa);
   if (!gl.ok()) return gl.error();
   impl_->gl = std::move(gl).value();
   impl_->glDescription = impl_->gl->description();
@@ -220,7 +220,7 @@ nlohmann::json jsonRows(const CaseResult& r, const BenchSettings& s) {
                 {"frames", s.frames},
                 {"warmup", s.warmup},
                 {"shade", "gouraud"},
-                {"aa", 0},
+                {"aa", s.aa},
                 {"median_ms", run.medianMs},
                 {"min_ms", run.minMs},
                 {"max_ms", run.maxMs},
@@ -416,16 +416,22 @@ Status writeHtml(const std::string& dir, const std::vector<CaseResult>& results,
           "<th>synthvis ms</th><th>gl ms</th><th>ratio</th><th>synthvis Mtri/s</th>"
           "<th>synthvis Mpix/s</th><th>PSNR dB</th></tr>\n";
   for (const auto& r : results) {
-    const auto& a = r.runs[0];
-    const bool both = r.runs.size() > 1;
-    html += fmt::format("<tr><td>{}</td><td>{}</td><td>{:.1f}</td><td>{:.2f}</td><td>{:.2f}</td><td>{}</td>"
-                        "<td>{}</td><td>{:.2f}</td><td>{:.0f}</td><td>{}</td></tr>\n",
-                        escape(r.name), r.triangles, r.meanArea, r.depthComplexity, a.medianMs,
-                        both ? fmt::format("{:.2f}", r.runs[1].medianMs) : "–",
-                        both ? fmt::format("{:.2f}×", r.runs[1].medianMs / a.medianMs) : "–",
-                        double(r.triangles) / a.medianMs / 1e3,
-                        pixelsOf(r) / a.medianMs / 1e3,
-                        !both ? "–" : std::isinf(r.psnrDb) ? "identical" : fmt::format("{:.1f}", r.psnrDb));
+    const RendererRun* ours = nullptr;
+    const RendererRun* gl = nullptr;
+    for (const RendererRun& run : r.runs) (run.renderer == "gl" ? gl : ours) = &run;
+    auto ms = [](const RendererRun* run) {
+      return run ? fmt::format("{:.2f}", run->medianMs) : std::string("–");
+    };
+    auto rate = [&](double work) {
+      return ours ? fmt::format("{:.2f}", work / ours->medianMs / 1e3) : std::string("–");
+    };
+    html += fmt::format(
+        "<tr><td>{}</td><td>{}</td><td>{:.1f}</td><td>{:.2f}</td><td>{}</td><td>{}</td><td>{}</td>"
+        "<td>{}</td><td>{}</td><td>{}</td></tr>\n",
+        escape(r.name), r.triangles, r.meanArea, r.depthComplexity, ms(ours), ms(gl),
+        ours && gl ? fmt::format("{:.2f}×", gl->medianMs / ours->medianMs) : "–",
+        rate(double(r.triangles)), rate(pixelsOf(r)),
+        !(ours && gl) ? "–" : std::isinf(r.psnrDb) ? "identical" : fmt::format("{:.1f}", r.psnrDb));
   }
   html += "</table>\n<h2>Images</h2>\n";
   for (const auto& r : results) {

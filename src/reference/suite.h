@@ -59,6 +59,7 @@ struct CaseResult {
 struct BenchSettings {
   RenderOptions options;
   int frames = 10, warmup = 2;
+  int aa = 0;             // samples per pixel: 0 = none; the gl reference multisamples (2…16)
   bool synthvis = true;   // time synthvis
   bool reference = true;  // time the gl reference (after startReference)
 };
