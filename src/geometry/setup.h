@@ -7,6 +7,7 @@
 // scenes, meshes or materials.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 
 namespace sv::geometry {
@@ -80,7 +81,7 @@ struct TriangleSetup {
 };
 
 
-enum class SetupOutcome : uint8_t {
+enum class SetupOutcome : uint8_t {  // numbered from 0, in this order
   drawn,
   culledFacing,      // back (or front) face
   culledOutside,     // no pixel centre of the raster can be covered
@@ -92,5 +93,14 @@ enum class SetupOutcome : uint8_t {
 // Front faces are counter-clockwise in normalized device coordinates (the OpenGL default).
 SetupOutcome setupTriangle(const ClipVertex& v0, const ClipVertex& v1, const ClipVertex& v2,
                            const Viewport& viewport, CullMode cull, TriangleSetup& out);
+
+// The same for `count` triangles (indices: 3 per triangle into `vertices`), several at once in
+// SIMD lanes (setup_batch.cpp); records bit-identical to setupTriangle's. The drawn triangles'
+// records go to out[0, returned count) in order; outcomes[o] is incremented per triangle with
+// outcome o.
+inline constexpr int kSetupOutcomes = 5;
+size_t setupTriangles(const ClipVertex* vertices, const uint32_t* indices, size_t count,
+                      const Viewport& viewport, CullMode cull, TriangleSetup* out,
+                      uint64_t outcomes[kSetupOutcomes]);
 
 }  // namespace sv::geometry

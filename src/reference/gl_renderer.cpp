@@ -1,11 +1,11 @@
 #include "reference/gl_renderer.h"
 
+#include <fmt/format.h>
+
 #include <cstdlib>
 #include <cstring>
 #include <string>
 #include <vector>
-
-#include <fmt/format.h>
 
 #if SV_HAVE_GL
 #define GL_GLEXT_PROTOTYPES 1
@@ -80,8 +80,8 @@ struct GlRenderer::Impl {
   EGLDisplay display = EGL_NO_DISPLAY;
   EGLContext context = EGL_NO_CONTEXT;
   GLuint program = 0;
-  GLuint fbo = 0, colorRb = 0, depthRb = 0;          // the render target (multisampled if msaa)
-  GLuint resolveFbo = 0, resolveRb = 0;              // single-sampled copy for readback (msaa)
+  GLuint fbo = 0, colorRb = 0, depthRb = 0;  // the render target (multisampled if msaa)
+  GLuint resolveFbo = 0, resolveRb = 0;      // single-sampled copy for readback (msaa)
   GLint uMvp = -1, uNormal = -1, uBase = -1, uToLight = -1, uLightColor = -1, uAmbient = -1,
         uLit = -1;
   std::vector<Mesh> meshes;
@@ -149,8 +149,8 @@ Result<GLuint> compile(GLenum type, const char* source) {
 Result<std::unique_ptr<GlRenderer>> GlRenderer::create(const RenderOptions& options, int msaa) {
   if (Status s = validate(options); !s) return s.error();
   if (msaa != 0 && msaa != 2 && msaa != 4 && msaa != 8 && msaa != 16)
-    return Error{"", "", fmt::format("gl: {} samples per pixel is not supported (0, 2, 4, 8, 16)",
-                                     msaa)};
+    return Error{"", "",
+                 fmt::format("gl: {} samples per pixel is not supported (0, 2, 4, 8, 16)", msaa)};
   // llvmpipe reads these when the driver loads; keep a user's own choice.
   const int threads = options.threads > 0 ? options.threads : 0;
   if (threads > 0) setenv("LP_NUM_THREADS", std::to_string(threads).c_str(), 0);
@@ -163,8 +163,10 @@ Result<std::unique_ptr<GlRenderer>> GlRenderer::create(const RenderOptions& opti
   g.display = eglGetPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
   EGLint major = 0, minor = 0;
   if (g.display == EGL_NO_DISPLAY || !eglInitialize(g.display, &major, &minor))
-    return Error{"", "", fmt::format("gl: no EGL surfaceless display (0x{:x}); is Mesa's "
-                                     "libegl-mesa0 installed?", eglGetError())};
+    return Error{"", "",
+                 fmt::format("gl: no EGL surfaceless display (0x{:x}); is Mesa's "
+                             "libegl-mesa0 installed?",
+                             eglGetError())};
   if (!eglBindAPI(EGL_OPENGL_API)) return Error{"", "", "gl: EGL cannot bind OpenGL"};
   // Surfaceless: no config is needed (EGL_KHR_no_config_context), rendering goes to our own FBO.
   EGLConfig config = EGL_NO_CONFIG_KHR;
@@ -175,13 +177,18 @@ Result<std::unique_ptr<GlRenderer>> GlRenderer::create(const RenderOptions& opti
     if (!eglChooseConfig(g.display, configAttribs, &config, 1, &configs) || configs < 1)
       return Error{"", "", "gl: no EGL config for desktop OpenGL"};
   }
-  const EGLint contextAttribs[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, 3,
+  const EGLint contextAttribs[] = {EGL_CONTEXT_MAJOR_VERSION,
+                                   3,
+                                   EGL_CONTEXT_MINOR_VERSION,
+                                   3,
                                    EGL_CONTEXT_OPENGL_PROFILE_MASK,
-                                   EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+                                   EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+                                   EGL_NONE};
   g.context = eglCreateContext(g.display, config, EGL_NO_CONTEXT, contextAttribs);
   if (g.context == EGL_NO_CONTEXT)
-    return Error{"", "", fmt::format("gl: cannot create an OpenGL 3.3 core context (0x{:x})",
-                                     eglGetError())};
+    return Error{
+        "", "",
+        fmt::format("gl: cannot create an OpenGL 3.3 core context (0x{:x})", eglGetError())};
   if (Status s = g.makeCurrent(); !s) return s.error();
   g.description = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
 
@@ -220,8 +227,10 @@ Result<std::unique_ptr<GlRenderer>> GlRenderer::create(const RenderOptions& opti
   glRenderbufferStorageMultisample(GL_RENDERBUFFER, msaa, GL_DEPTH_COMPONENT24, w, h);
   glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, g.depthRb);
   if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-    return Error{"", "", fmt::format("gl: a {}x{} sRGB framebuffer with {} samples is not "
-                                     "supported", w, h, msaa)};
+    return Error{"", "",
+                 fmt::format("gl: a {}x{} sRGB framebuffer with {} samples is not "
+                             "supported",
+                             w, h, msaa)};
   if (msaa) {
     glGenFramebuffers(1, &g.resolveFbo);
     glGenRenderbuffers(1, &g.resolveRb);
@@ -390,8 +399,9 @@ GlRenderer::~GlRenderer() = default;
 const std::string& GlRenderer::description() const { return impl_->description; }
 
 Result<std::unique_ptr<GlRenderer>> GlRenderer::create(const RenderOptions&, int) {
-  return Error{"", "", "the gl renderer is not in this build: install libegl-dev and libgl-dev "
-                       "(scripts/demo does) and configure again"};
+  return Error{"", "",
+               "the gl renderer is not in this build: install libegl-dev and libgl-dev "
+               "(scripts/demo does) and configure again"};
 }
 Status GlRenderer::load(const scene::Scene&) { return Error{"", "", "gl: not built"}; }
 Status GlRenderer::render() { return Error{"", "", "gl: not built"}; }

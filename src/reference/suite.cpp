@@ -1,5 +1,7 @@
 #include "reference/suite.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cctype>
 #include <chrono>
@@ -8,8 +10,6 @@
 #include <fstream>
 #include <limits>
 #include <optional>
-
-#include <fmt/format.h>
 
 #include "reference/gl_renderer.h"
 
@@ -40,8 +40,8 @@ BenchCase trisCase(int count, double area) {
   c.generator = "tris";
   c.tris.count = count;
   c.tris.area = area;
-  const std::string n = count % 1000000 == 0 ? fmt::format("{}M", count / 1000000)
-                                             : fmt::format("{}k", count / 1000);
+  const std::string n =
+      count % 1000000 == 0 ? fmt::format("{}M", count / 1000000) : fmt::format("{}k", count / 1000);
   c.name = fmt::format("tris-{}-a{}", n, area);
   return c;
 }
@@ -69,7 +69,8 @@ Result<std::vector<BenchCase>> suiteCases(const std::string& suite) {
       for (double area : {10.0, 100.0, 1000.0})
         if (double(count) * area <= 1e8) cases.push_back(trisCase(count, area));
     for (int d : {1, 2, 4, 8, 16})
-      for (SubmitOrder o : {SubmitOrder::random, SubmitOrder::frontToBack, SubmitOrder::backToFront})
+      for (SubmitOrder o :
+           {SubmitOrder::random, SubmitOrder::frontToBack, SubmitOrder::backToFront})
         cases.push_back(layersCase(d, o));
   } else {
     return Error{"", "", fmt::format("unknown suite '{}' (quick or full)", suite)};
@@ -87,16 +88,19 @@ Result<CaseScene> makeScene(const BenchCase& c, const RenderOptions& options) {
     t.width = options.width;
     t.height = options.height;
     out.scene = scene::generateTris(t, &realized);
-    out.params = {{"count", t.count}, {"area", t.area}, {"depth", t.depth},
-                  {"order", scene::submitOrderName(t.order)}, {"seed", t.seed}};
+    out.params = {{"count", t.count},
+                  {"area", t.area},
+                  {"depth", t.depth},
+                  {"order", scene::submitOrderName(t.order)},
+                  {"seed", t.seed}};
   } else if (c.generator == "layers") {
     scene::LayersParams l = c.layers;
     if (l.layers < 1 || l.layers > 64) return Error{"", "", "layers: D must be 1…64"};
     l.width = options.width;
     l.height = options.height;
     out.scene = scene::generateLayers(l, &realized);
-    out.params = {{"layers", l.layers}, {"order", scene::submitOrderName(l.order)},
-                  {"seed", l.seed}};
+    out.params = {
+        {"layers", l.layers}, {"order", scene::submitOrderName(l.order)}, {"seed", l.seed}};
   } else if (c.generator.empty()) {
     auto loaded = scene::loadScene(c.file);
     if (!loaded) return loaded.error();
@@ -240,13 +244,13 @@ std::string summaryLine(const CaseResult& r) {
   const double pixels = pixelsOf(r);
   std::string line = fmt::format("{:<22} {:>9} tris", r.name, r.triangles);
   for (const RendererRun& run : r.runs)
-    line += fmt::format("  {} {:8.2f} ms ({:6.2f} Mtri/s, {:5.0f} Mpix/s)", run.renderer,
-                        run.medianMs, double(r.triangles) / run.medianMs / 1e3,
-                        pixels / run.medianMs / 1e3);
+    line +=
+        fmt::format("  {} {:8.2f} ms ({:6.2f} Mtri/s, {:5.0f} Mpix/s)", run.renderer, run.medianMs,
+                    double(r.triangles) / run.medianMs / 1e3, pixels / run.medianMs / 1e3);
   if (r.runs.size() > 1)
-    line += fmt::format("  ratio {:5.2f}x  psnr {}", r.runs[1].medianMs / r.runs[0].medianMs,
-                        std::isinf(r.psnrDb) ? std::string("identical")
-                                             : fmt::format("{:.1f} dB", r.psnrDb));
+    line += fmt::format(
+        "  ratio {:5.2f}x  psnr {}", r.runs[1].medianMs / r.runs[0].medianMs,
+        std::isinf(r.psnrDb) ? std::string("identical") : fmt::format("{:.1f} dB", r.psnrDb));
   return line;
 }
 
@@ -255,11 +259,16 @@ namespace {
 std::string escape(const std::string& s) {
   std::string out;
   for (char c : s) {
-    if (c == '<') out += "&lt;";
-    else if (c == '>') out += "&gt;";
-    else if (c == '&') out += "&amp;";
-    else if (c == '"') out += "&quot;";
-    else out += c;
+    if (c == '<')
+      out += "&lt;";
+    else if (c == '>')
+      out += "&gt;";
+    else if (c == '&')
+      out += "&amp;";
+    else if (c == '"')
+      out += "&quot;";
+    else
+      out += c;
   }
   return out;
 }
@@ -274,15 +283,18 @@ std::string ratioSvg(const std::vector<CaseResult>& results) {
   const int height = top + rowH * int(results.size()) + 40;
   const double scale = (width - left - 60) / maxRatio;
   std::string svg = fmt::format(
-      "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{}\" height=\"{}\" font-family=\"sans-serif\" "
-      "font-size=\"12\">\n<text x=\"10\" y=\"22\" font-size=\"15\">Speed-up of synthvis over the gl "
+      "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{}\" height=\"{}\" "
+      "font-family=\"sans-serif\" "
+      "font-size=\"12\">\n<text x=\"10\" y=\"22\" font-size=\"15\">Speed-up of synthvis over the "
+      "gl "
       "reference (median ms/frame of gl ÷ synthvis)</text>\n",
       width, height);
   for (int k = 0; k <= int(maxRatio); ++k) {
     const double x = left + k * scale;
-    svg += fmt::format("<line x1=\"{0:.1f}\" y1=\"{1}\" x2=\"{0:.1f}\" y2=\"{2}\" stroke=\"{3}\"/>"
-                       "<text x=\"{0:.1f}\" y=\"{4}\" text-anchor=\"middle\">{5}×</text>\n",
-                       x, top - 4, height - 30, k == 1 ? "#c33" : "#ddd", height - 14, k);
+    svg += fmt::format(
+        "<line x1=\"{0:.1f}\" y1=\"{1}\" x2=\"{0:.1f}\" y2=\"{2}\" stroke=\"{3}\"/>"
+        "<text x=\"{0:.1f}\" y=\"{4}\" text-anchor=\"middle\">{5}×</text>\n",
+        x, top - 4, height - 30, k == 1 ? "#c33" : "#ddd", height - 14, k);
   }
   for (size_t i = 0; i < results.size(); ++i) {
     const auto& r = results[i];
@@ -291,10 +303,10 @@ std::string ratioSvg(const std::vector<CaseResult>& results) {
                        y + rowH / 2 + 4, escape(r.name));
     if (r.runs.size() < 2) continue;
     const double ratio = r.runs[1].medianMs / r.runs[0].medianMs;
-    svg += fmt::format("<rect x=\"{}\" y=\"{}\" width=\"{:.1f}\" height=\"{}\" fill=\"#3a6ea5\"/>"
-                       "<text x=\"{:.1f}\" y=\"{}\">{:.2f}×</text>\n",
-                       left, y + 4, ratio * scale, rowH - 8, left + ratio * scale + 4,
-                       y + rowH / 2 + 4, ratio);
+    svg += fmt::format(
+        "<rect x=\"{}\" y=\"{}\" width=\"{:.1f}\" height=\"{}\" fill=\"#3a6ea5\"/>"
+        "<text x=\"{:.1f}\" y=\"{}\">{:.2f}×</text>\n",
+        left, y + 4, ratio * scale, rowH - 8, left + ratio * scale + 4, y + rowH / 2 + 4, ratio);
   }
   return svg + "</svg>\n";
 }
@@ -315,37 +327,46 @@ std::string timeSvg(const std::vector<CaseResult>& results, const std::string& t
     }
   }
   std::string svg = fmt::format(
-      "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{}\" height=\"{}\" font-family=\"sans-serif\" "
+      "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{}\" height=\"{}\" "
+      "font-family=\"sans-serif\" "
       "font-size=\"12\">\n<text x=\"10\" y=\"22\" font-size=\"15\">{}</text>\n",
       width, height, escape(title));
   if (x1 <= 0) return svg + "<text x=\"60\" y=\"120\">no cases</text></svg>\n";
   const double lx0 = std::floor(std::log10(x0)), lx1 = std::max(lx0 + 1, std::ceil(std::log10(x1)));
   const double ly0 = std::floor(std::log10(y0)), ly1 = std::max(ly0 + 1, std::ceil(std::log10(y1)));
-  auto px = [&](double x) { return left + (std::log10(x) - lx0) / (lx1 - lx0) * (width - left - right); };
-  auto py = [&](double y) { return height - bottom - (std::log10(y) - ly0) / (ly1 - ly0) * (height - top - bottom); };
+  auto px = [&](double x) {
+    return left + (std::log10(x) - lx0) / (lx1 - lx0) * (width - left - right);
+  };
+  auto py = [&](double y) {
+    return height - bottom - (std::log10(y) - ly0) / (ly1 - ly0) * (height - top - bottom);
+  };
   for (double e = lx0; e <= lx1; ++e)
-    svg += fmt::format("<line x1=\"{0:.1f}\" y1=\"{1}\" x2=\"{0:.1f}\" y2=\"{2}\" stroke=\"#ddd\"/>"
-                       "<text x=\"{0:.1f}\" y=\"{3}\" text-anchor=\"middle\">{4:g}</text>\n",
-                       px(std::pow(10, e)), top, height - bottom, height - bottom + 16, std::pow(10, e));
+    svg += fmt::format(
+        "<line x1=\"{0:.1f}\" y1=\"{1}\" x2=\"{0:.1f}\" y2=\"{2}\" stroke=\"#ddd\"/>"
+        "<text x=\"{0:.1f}\" y=\"{3}\" text-anchor=\"middle\">{4:g}</text>\n",
+        px(std::pow(10, e)), top, height - bottom, height - bottom + 16, std::pow(10, e));
   for (double e = ly0; e <= ly1; ++e)
-    svg += fmt::format("<line x1=\"{0}\" y1=\"{1:.1f}\" x2=\"{2}\" y2=\"{1:.1f}\" stroke=\"#ddd\"/>"
-                       "<text x=\"{3}\" y=\"{4:.1f}\" text-anchor=\"end\">{5:g} ms</text>\n",
-                       left, py(std::pow(10, e)), width - right, left - 4, py(std::pow(10, e)) + 4,
-                       std::pow(10, e));
+    svg += fmt::format(
+        "<line x1=\"{0}\" y1=\"{1:.1f}\" x2=\"{2}\" y2=\"{1:.1f}\" stroke=\"#ddd\"/>"
+        "<text x=\"{3}\" y=\"{4:.1f}\" text-anchor=\"end\">{5:g} ms</text>\n",
+        left, py(std::pow(10, e)), width - right, left - 4, py(std::pow(10, e)) + 4,
+        std::pow(10, e));
   svg += fmt::format("<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">{}</text>\n",
                      (left + width - right) / 2, height - 12, escape(xLabel));
   const char* colours[2] = {"#3a6ea5", "#d9822b"};
   for (int k = 0; k < 2; ++k) {
     for (const auto& r : results) {
       if (int(r.runs.size()) <= k || !(xOf(r) > 0)) continue;
-      svg += fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"4\" fill=\"{}\"><title>{} {}: "
-                         "{:.2f} ms</title></circle>\n",
-                         px(xOf(r)), py(r.runs[size_t(k)].medianMs), colours[k], escape(r.name),
-                         r.runs[size_t(k)].renderer, r.runs[size_t(k)].medianMs);
+      svg += fmt::format(
+          "<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"4\" fill=\"{}\"><title>{} {}: "
+          "{:.2f} ms</title></circle>\n",
+          px(xOf(r)), py(r.runs[size_t(k)].medianMs), colours[k], escape(r.name),
+          r.runs[size_t(k)].renderer, r.runs[size_t(k)].medianMs);
     }
-    svg += fmt::format("<circle cx=\"{}\" cy=\"{}\" r=\"4\" fill=\"{}\"/><text x=\"{}\" y=\"{}\">{}</text>\n",
-                       left + 10 + 110 * k, top - 22, colours[k], left + 18 + 110 * k, top - 18,
-                       k == 0 ? "synthvis" : "gl (llvmpipe)");
+    svg += fmt::format(
+        "<circle cx=\"{}\" cy=\"{}\" r=\"4\" fill=\"{}\"/><text x=\"{}\" y=\"{}\">{}</text>\n",
+        left + 10 + 110 * k, top - 22, colours[k], left + 18 + 110 * k, top - 18,
+        k == 0 ? "synthvis" : "gl (llvmpipe)");
   }
   return svg + "</svg>\n";
 }
@@ -355,8 +376,10 @@ std::string fileSlug(const std::string& name) {
   std::string out;
   for (char c : name) {
     const bool keep = std::isalnum(static_cast<unsigned char>(c)) || c == '_';
-    if (keep) out += c;
-    else if (!out.empty() && out.back() != '-') out += '-';
+    if (keep)
+      out += c;
+    else if (!out.empty() && out.back() != '-')
+      out += '-';
   }
   while (!out.empty() && out.back() == '-') out.pop_back();
   return out.empty() ? "scene" : out;
@@ -387,34 +410,43 @@ Status writeHtml(const std::string& dir, const std::vector<CaseResult>& results,
   auto byTriangles = [](const CaseResult& r) { return double(r.triangles); };
   auto byArea = [](const CaseResult& r) { return r.meanArea; };
   auto byDepth = [](const CaseResult& r) { return r.depthComplexity; };
-  if (Status st = writeText(d / "time-triangles.svg",
-                            timeSvg(tris, "tris: ms/frame vs triangle count", "triangles", byTriangles));
+  if (Status st =
+          writeText(d / "time-triangles.svg",
+                    timeSvg(tris, "tris: ms/frame vs triangle count", "triangles", byTriangles));
       !st)
     return st;
-  if (Status st = writeText(d / "time-area.svg",
-                            timeSvg(tris, "tris: ms/frame vs mean triangle area", "mean area, px", byArea));
+  if (Status st =
+          writeText(d / "time-area.svg",
+                    timeSvg(tris, "tris: ms/frame vs mean triangle area", "mean area, px", byArea));
       !st)
     return st;
-  if (Status st = writeText(d / "time-depth.svg", timeSvg(layers, "layers: ms/frame vs depth complexity",
-                                                           "depth complexity", byDepth));
+  if (Status st = writeText(
+          d / "time-depth.svg",
+          timeSvg(layers, "layers: ms/frame vs depth complexity", "depth complexity", byDepth));
       !st)
     return st;
 
   std::string html = fmt::format(
       "<!doctype html>\n<html><head><meta charset=\"utf-8\"><title>synthvis bench</title>\n"
       "<style>body{{font-family:sans-serif;margin:2em}}table{{border-collapse:collapse}}"
-      "td,th{{border:1px solid #ccc;padding:3px 8px;text-align:right}}td:first-child{{text-align:left}}"
-      "img{{max-width:480px;border:1px solid #ccc}}figure{{display:inline-block;margin:4px}}</style>"
-      "</head><body>\n<h1>synthvis bench</h1>\n<p>{}×{}, {} threads, {} timed frames after {} warm-up, "
+      "td,th{{border:1px solid #ccc;padding:3px "
+      "8px;text-align:right}}td:first-child{{text-align:left}}"
+      "img{{max-width:480px;border:1px solid "
+      "#ccc}}figure{{display:inline-block;margin:4px}}</style>"
+      "</head><body>\n<h1>synthvis bench</h1>\n<p>{}×{}, {} threads, {} timed frames after {} "
+      "warm-up, "
       "synthvis and the reference alternating frame by frame. Reference: {}.</p>\n",
       s.options.width, s.options.height, s.options.threads, s.frames, s.warmup,
       escape(referenceDescription.empty() ? std::string("not run") : referenceDescription));
-  html += "<p><img src=\"ratio.svg\" style=\"max-width:none;border:0\"></p>\n<p>"
-          "<img src=\"time-triangles.svg\" style=\"border:0\"><img src=\"time-area.svg\" style=\"border:0\">"
-          "<img src=\"time-depth.svg\" style=\"border:0\"></p>\n";
-  html += "<table><tr><th>scene</th><th>triangles</th><th>mean area px</th><th>depth complexity</th>"
-          "<th>synthvis ms</th><th>gl ms</th><th>ratio</th><th>synthvis Mtri/s</th>"
-          "<th>synthvis Mpix/s</th><th>PSNR dB</th></tr>\n";
+  html +=
+      "<p><img src=\"ratio.svg\" style=\"max-width:none;border:0\"></p>\n<p>"
+      "<img src=\"time-triangles.svg\" style=\"border:0\"><img src=\"time-area.svg\" "
+      "style=\"border:0\">"
+      "<img src=\"time-depth.svg\" style=\"border:0\"></p>\n";
+  html +=
+      "<table><tr><th>scene</th><th>triangles</th><th>mean area px</th><th>depth complexity</th>"
+      "<th>synthvis ms</th><th>gl ms</th><th>ratio</th><th>synthvis Mtri/s</th>"
+      "<th>synthvis Mpix/s</th><th>PSNR dB</th></tr>\n";
   for (const auto& r : results) {
     const RendererRun* ours = nullptr;
     const RendererRun* gl = nullptr;
@@ -431,7 +463,9 @@ Status writeHtml(const std::string& dir, const std::vector<CaseResult>& results,
         escape(r.name), r.triangles, r.meanArea, r.depthComplexity, ms(ours), ms(gl),
         ours && gl ? fmt::format("{:.2f}×", gl->medianMs / ours->medianMs) : "–",
         rate(double(r.triangles)), rate(pixelsOf(r)),
-        !(ours && gl) ? "–" : std::isinf(r.psnrDb) ? "identical" : fmt::format("{:.1f}", r.psnrDb));
+        !(ours && gl)          ? "–"
+        : std::isinf(r.psnrDb) ? "identical"
+                               : fmt::format("{:.1f}", r.psnrDb));
   }
   html += "</table>\n<h2>Images</h2>\n";
   for (const auto& r : results) {
@@ -439,9 +473,10 @@ Status writeHtml(const std::string& dir, const std::vector<CaseResult>& results,
     for (const auto& run : r.runs) {
       const std::string file = fmt::format("{}-{}.png", fileSlug(r.name), run.renderer);
       if (Status st = writePng(run.image, (d / file).string()); !st) return st;
-      html += fmt::format("<figure><img src=\"{}\"><figcaption>{} — {:.2f} ms</figcaption></figure>\n",
-                          escape(file), escape(run.renderer == "gl" ? run.description : run.renderer),
-                          run.medianMs);
+      html +=
+          fmt::format("<figure><img src=\"{}\"><figcaption>{} — {:.2f} ms</figcaption></figure>\n",
+                      escape(file), escape(run.renderer == "gl" ? run.description : run.renderer),
+                      run.medianMs);
     }
   }
   html += "</body></html>\n";

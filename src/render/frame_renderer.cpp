@@ -14,7 +14,6 @@ namespace {
 // waiting for frame-buffer blocks to come back from L3 (perf: the depth load in shadeBlock).
 // Chunks of 2^13 triangles give a tile runs of ~20 contiguous records at 100k triangles of 10 px.
 constexpr uint32_t kChunkTriangles = 1u << 13;
-constexpr uint32_t kVertexPrefetch = 8;  // triangles
 
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t0) {
@@ -81,33 +80,27 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
     binner_.reset(std::max(chunks, 1), tilesX, tilesY);
     pool_.parallelFor(size_t(chunks), [&](size_t chunk, int worker) {
       WorkerScratch& scratch = scratch_[worker];
-      uint32_t n = 0;
-      SetupCounts c;
       const uint32_t begin = batch + uint32_t(chunk) * kChunkTriangles;
       const uint32_t end = std::min(batchEnd, begin + kChunkTriangles);
+      // Runs of triangles that share a draw call (a culling mode), set up several at a time.
+      uint64_t outcomes[geometry::kSetupOutcomes] = {};
+      uint32_t n = 0;
       CallCursor cursor{packets.calls};
-      for (uint32_t tri = begin; tri < end; ++tri) {
-        // The vertices come from the vertex stage through L3: ask for them a few triangles ahead.
-        if (tri + kVertexPrefetch < end) {
-          const uint32_t* ahead = &packets.indices[size_t(tri + kVertexPrefetch) * 3];
-          for (int k = 0; k < 3; ++k) __builtin_prefetch(&packets.vertices[ahead[k]]);
-        }
+      for (uint32_t tri = begin; tri < end;) {
         const DrawCall* call = cursor.find(tri);
-        const uint32_t* idx = &packets.indices[size_t(tri) * 3];
-        geometry::TriangleSetup& s = scratch.records[n];
-        switch (geometry::setupTriangle(packets.vertices[idx[0]], packets.vertices[idx[1]],
-                                        packets.vertices[idx[2]], viewport,
-                                        call ? call->cull : geometry::CullMode::none, s)) {
-          case geometry::SetupOutcome::drawn:
-            ++c.drawn;
-            ++n;
-            break;
-          case geometry::SetupOutcome::culledFacing: ++c.facing; break;
-          case geometry::SetupOutcome::culledOutside: ++c.outside; break;
-          case geometry::SetupOutcome::culledDegenerate: ++c.degenerate; break;
-          case geometry::SetupOutcome::culledInvalid: ++c.invalid; break;
-        }
+        const uint32_t runEnd =
+            call ? std::min(end, call->firstTriangle + call->triangleCount) : tri + 1;
+        n += uint32_t(geometry::setupTriangles(
+            packets.vertices.data(), &packets.indices[size_t(tri) * 3], runEnd - tri, viewport,
+            call ? call->cull : geometry::CullMode::none, scratch.records.data() + n, outcomes));
+        tri = runEnd;
       }
+      SetupCounts c;
+      c.drawn = outcomes[int(geometry::SetupOutcome::drawn)];
+      c.facing = outcomes[int(geometry::SetupOutcome::culledFacing)];
+      c.outside = outcomes[int(geometry::SetupOutcome::culledOutside)];
+      c.degenerate = outcomes[int(geometry::SetupOutcome::culledDegenerate)];
+      c.invalid = outcomes[int(geometry::SetupOutcome::culledInvalid)];
       const uint32_t storageBase = begin - batch;
       binner_.binChunk(int(chunk), scratch.records.data(), n, setups_.data() + storageBase,
                        storageBase, scratch.bins);

@@ -25,10 +25,13 @@ float srgbToLinear(double v) {
 
 Scene generateLayers(const LayersParams& p, TrisStats* stats) {
   std::mt19937_64 rng(p.seed);
-  auto uniform = [&](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
+  auto uniform = [&](double a, double b) {
+    return std::uniform_real_distribution<double>(a, b)(rng);
+  };
   const double w = p.width, h = p.height, aspect = w / h;
   const double tanHalf = std::tan(30.0 * kPi / 180.0);
-  const int cols = std::max(1, int(std::lround(w / 20))), rows = std::max(1, int(std::lround(h / 20)));
+  const int cols = std::max(1, int(std::lround(w / 20))),
+            rows = std::max(1, int(std::lround(h / 20)));
   const double cellW = w / cols, cellH = h / rows;
 
   struct Tri {
@@ -43,8 +46,8 @@ Scene generateLayers(const LayersParams& p, TrisStats* stats) {
     const double z = p.layers == 1 ? 2.0 : 2.0 + 18.0 * layer / (p.layers - 1);
     // Pixel (px, py) at view distance z (camera at the origin looking down −Z).
     auto world = [&](double px, double py) {
-      return Vec3{float((2 * px / w - 1) * z * tanHalf * aspect), float((1 - 2 * py / h) * z * tanHalf),
-                  float(-z)};
+      return Vec3{float((2 * px / w - 1) * z * tanHalf * aspect),
+                  float((1 - 2 * py / h) * z * tanHalf), float(-z)};
     };
     std::vector<double> gx(size_t(cols + 1) * (rows + 1)), gy(gx.size());
     for (int j = 0; j <= rows; ++j)
@@ -56,7 +59,9 @@ Scene generateLayers(const LayersParams& p, TrisStats* stats) {
         gy[size_t(j) * (cols + 1) + i] = py;
       }
     auto color = [&] {
-      auto ch = [&] { return srgbToLinear(std::uniform_int_distribution<int>(64, 255)(rng) / 255.0); };
+      auto ch = [&] {
+        return srgbToLinear(std::uniform_int_distribution<int>(64, 255)(rng) / 255.0);
+      };
       const float r = ch(), g = ch(), b = ch();
       return Vec4{r, g, b, 1};
     };
@@ -77,10 +82,14 @@ Scene generateLayers(const LayersParams& p, TrisStats* stats) {
       }
   }
   switch (p.order) {
-    case SubmitOrder::random: std::shuffle(tris.begin(), tris.end(), rng); break;
-    case SubmitOrder::frontToBack: break;  // generated nearest first
+    case SubmitOrder::random:
+      std::shuffle(tris.begin(), tris.end(), rng);
+      break;
+    case SubmitOrder::frontToBack:
+      break;  // generated nearest first
     case SubmitOrder::backToFront:
-      std::stable_sort(tris.begin(), tris.end(), [](const Tri& a, const Tri& b) { return a.layer > b.layer; });
+      std::stable_sort(tris.begin(), tris.end(),
+                       [](const Tri& a, const Tri& b) { return a.layer > b.layer; });
       break;
   }
 

@@ -6,11 +6,11 @@
 // 32-bit indices), one material per Material (baseColorFactor, doubleSided,
 // KHR_materials_unlit), one node per Instance (its matrix), one node per Camera (camera-to-world
 // matrix, looking down −Z with +Y up; yfov in radians).
-#include <cmath>
-#include <cstring>
-
 #include <fmt/format.h>
 #include <tiny_gltf.h>
+
+#include <cmath>
+#include <cstring>
 
 #include "synthvis/scene.h"
 
@@ -78,9 +78,9 @@ Status saveGltf(const Scene& scene, const std::string& path) {
     tinygltf::Primitive prim;
     prim.mode = TINYGLTF_MODE_TRIANGLES;
     prim.material = m.material;
-    const int pos = addAccessor(model, m.positions.data(), m.positions.size(), sizeof(Vec3),
-                                TINYGLTF_TYPE_VEC3, TINYGLTF_COMPONENT_TYPE_FLOAT,
-                                TINYGLTF_TARGET_ARRAY_BUFFER);
+    const int pos =
+        addAccessor(model, m.positions.data(), m.positions.size(), sizeof(Vec3), TINYGLTF_TYPE_VEC3,
+                    TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
     // The specification requires bounds on POSITION.
     Vec3 lo{0, 0, 0}, hi{0, 0, 0};
     for (size_t i = 0; i < m.positions.size(); ++i) {
@@ -92,20 +92,17 @@ Status saveGltf(const Scene& scene, const std::string& path) {
     model.accessors[size_t(pos)].maxValues = {hi.x, hi.y, hi.z};
     prim.attributes["POSITION"] = pos;
     if (!m.normals.empty())
-      prim.attributes["NORMAL"] = addAccessor(model, m.normals.data(), m.normals.size(),
-                                              sizeof(Vec3), TINYGLTF_TYPE_VEC3,
-                                              TINYGLTF_COMPONENT_TYPE_FLOAT,
-                                              TINYGLTF_TARGET_ARRAY_BUFFER);
+      prim.attributes["NORMAL"] =
+          addAccessor(model, m.normals.data(), m.normals.size(), sizeof(Vec3), TINYGLTF_TYPE_VEC3,
+                      TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
     if (!m.colors.empty())
-      prim.attributes["COLOR_0"] = addAccessor(model, m.colors.data(), m.colors.size(),
-                                               sizeof(Vec4), TINYGLTF_TYPE_VEC4,
-                                               TINYGLTF_COMPONENT_TYPE_FLOAT,
-                                               TINYGLTF_TARGET_ARRAY_BUFFER);
+      prim.attributes["COLOR_0"] =
+          addAccessor(model, m.colors.data(), m.colors.size(), sizeof(Vec4), TINYGLTF_TYPE_VEC4,
+                      TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
     if (!m.uvs.empty())
-      prim.attributes["TEXCOORD_0"] = addAccessor(model, m.uvs.data(), m.uvs.size(),
-                                                  sizeof(m.uvs[0]), TINYGLTF_TYPE_VEC2,
-                                                  TINYGLTF_COMPONENT_TYPE_FLOAT,
-                                                  TINYGLTF_TARGET_ARRAY_BUFFER);
+      prim.attributes["TEXCOORD_0"] =
+          addAccessor(model, m.uvs.data(), m.uvs.size(), sizeof(m.uvs[0]), TINYGLTF_TYPE_VEC2,
+                      TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
     prim.indices = addAccessor(model, m.indices.data(), m.indices.size(), sizeof(uint32_t),
                                TINYGLTF_TYPE_SCALAR, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
                                TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);

@@ -3,7 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <limits>
 #include <random>
+
+#include "hwy/targets.h"
 
 #include "support/raster_harness.h"
 #include "synthvis/math.h"
@@ -176,6 +180,77 @@ TEST(Setup, TriangleEntirelyBehindTheEyeIsCulled) {
   TriangleSetup t;
   EXPECT_NE(geometry::setupTriangle(a, b, c, {64, 64}, geometry::CullMode::none, t),
             geometry::SetupOutcome::drawn);
+}
+
+// setupTriangles (SIMD lanes) must give setupTriangle's records bit for bit, on every SIMD target,
+// in every regime: small and large, culled either way, degenerate, behind and across the eye,
+// beyond the far plane, outside the guard band, NaN and infinite.
+TEST(Setup, BatchedSetupEqualsOneByOneOnEveryTarget) {
+  const int w = 1000, h = 700;
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<float> u(0, 1);
+  std::vector<ClipVertex> v;
+  auto add = [&](ClipVertex a) { v.push_back(a); };
+  for (int t = 0; t < 4000; ++t) {
+    const int regime = t % 10;
+    const double cx = u(rng) * w, cy = u(rng) * h, size = regime < 4 ? 1 + u(rng) * 20 : u(rng) * 900;
+    for (int k = 0; k < 3; ++k) {
+      ClipVertex c = pixelVertex(cx + (u(rng) - 0.5) * size, cy + (u(rng) - 0.5) * size, w, h,
+                                 u(rng), 0.2f + 3 * u(rng), u(rng), u(rng), u(rng));
+      if (regime == 5 && k == 0) c.w = -c.w;                          // behind the eye
+      if (regime == 6 && k == 1) c.z = -2 * c.w;                      // before the near plane
+      if (regime == 7 && k == 2) c.z = 2 * c.w;                       // beyond the far plane
+      if (regime == 8 && k == 0) c.x = c.w * 200;                     // outside the guard band
+      if (regime == 9 && k == 1 && t % 20 == 9) c.y = std::numeric_limits<float>::quiet_NaN();
+      if (regime == 9 && k == 1 && t % 20 == 19) c.w = std::numeric_limits<float>::infinity();
+      add(c);
+    }
+    if (regime == 3) v[v.size() - 1] = v[v.size() - 2];  // degenerate
+  }
+  std::vector<uint32_t> indices(v.size());
+  for (size_t i = 0; i < indices.size(); ++i) indices[i] = uint32_t(i);
+  const size_t count = v.size() / 3;
+  int targets = 0;
+  for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
+    hwy::SetSupportedTargetsForTest(target);
+    for (geometry::CullMode cull :
+         {geometry::CullMode::none, geometry::CullMode::back, geometry::CullMode::front}) {
+      std::vector<TriangleSetup> one, batch(count);
+      uint64_t oneOutcomes[geometry::kSetupOutcomes] = {}, batchOutcomes[geometry::kSetupOutcomes] = {};
+      for (size_t t = 0; t < count; ++t) {
+        TriangleSetup s;
+        const auto o = geometry::setupTriangle(v[3 * t], v[3 * t + 1], v[3 * t + 2], {w, h}, cull, s);
+        ++oneOutcomes[int(o)];
+        if (o == geometry::SetupOutcome::drawn) one.push_back(s);
+      }
+      const size_t n = geometry::setupTriangles(v.data(), indices.data(), count, {w, h}, cull,
+                                                batch.data(), batchOutcomes);
+      ASSERT_EQ(n, one.size()) << hwy::TargetName(target);
+      for (int o = 0; o < geometry::kSetupOutcomes; ++o)
+        EXPECT_EQ(batchOutcomes[o], oneOutcomes[o]) << "outcome " << o;
+      for (size_t i = 0; i < n; ++i) {
+        const TriangleSetup &a = one[i], &b = batch[i];
+        ASSERT_EQ(a.edgeCount, b.edgeCount) << i;
+        for (int k = 0; k < a.edgeCount; ++k) {
+          ASSERT_EQ(a.edges[k].c, b.edges[k].c) << i;
+          ASSERT_EQ(a.edges[k].a, b.edges[k].a) << i;
+          ASSERT_EQ(a.edges[k].b, b.edges[k].b) << i;
+        }
+        const geometry::Plane* pa[] = {&a.depth, &a.invW, &a.red, &a.green, &a.blue};
+        const geometry::Plane* pb[] = {&b.depth, &b.invW, &b.red, &b.green, &b.blue};
+        for (int p = 0; p < 5; ++p)
+          ASSERT_EQ(0, std::memcmp(pa[p], pb[p], sizeof(geometry::Plane))) << i << " plane " << p;
+        ASSERT_EQ(a.minX, b.minX);
+        ASSERT_EQ(a.minY, b.minY);
+        ASSERT_EQ(a.maxX, b.maxX);
+        ASSERT_EQ(a.maxY, b.maxY);
+        ASSERT_EQ(a.small, b.small);
+      }
+    }
+    ++targets;
+  }
+  hwy::SetSupportedTargetsForTest(0);
+  EXPECT_GE(targets, 1);
 }
 
 }  // namespace

@@ -3,9 +3,9 @@
 // In its own executable because Mesa's driver leaks a few hundred bytes that LeakSanitizer cannot
 // attribute (the driver is unloaded by then): leak checking is off for this test only
 // (tests/reference/CMakeLists.txt); AddressSanitizer's other checks stay on.
-#include <filesystem>
-
 #include <gtest/gtest.h>
+
+#include <filesystem>
 
 #include "reference/gl_renderer.h"
 #include "reference/suite.h"

@@ -1,11 +1,11 @@
 // The bench harness (src/reference): suites, PSNR, JSON rows, HTML, and the gl reference drawing
 // the same picture as synthvis.
-#include <cmath>
-#include <filesystem>
+#include "reference/suite.h"
 
 #include <gtest/gtest.h>
 
-#include "reference/suite.h"
+#include <cmath>
+#include <filesystem>
 
 namespace sv::reference {
 namespace {

@@ -1,0 +1,223 @@
+// Triangle setup for runs of triangles, several at once in SIMD lanes (RASTER-NOTES: "make small
+// triangles cheap: SIMD setup across several triangles").
+//
+// The common case — every vertex finite, in front of the eye, inside the guard band and between
+// the near and far planes — is computed in double lanes with exactly the operations, in exactly
+// the order, of setupTriangle in setup.cpp, so every record is bit-identical to the scalar one
+// (tests/geometry/setup_test.cpp compares them). The integer quantities of setup.cpp (snapped
+// coordinates, edge coefficients, the doubled area, the fill-rule constant) are exact in double:
+// |x_f|, |y_f| < 2^23, so products are < 2^46 and every sum < 2^50 < 2^53. Lanes outside the
+// common case, and the tail of a run, go through setupTriangle itself.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "geometry/setup_batch.cpp"
+#include <algorithm>
+#include <cstring>
+
+#include "geometry/setup.h"
+#include "hwy/foreach_target.h"  // IWYU pragma: keep
+#include "hwy/highway.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace sv::geometry {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+constexpr int kMaxLanes = 16;
+
+size_t SetupTriangles(const ClipVertex* vertices, const uint32_t* indices, size_t count,
+                      const Viewport& viewport, CullMode cull, TriangleSetup* out,
+                      uint64_t* outcomes) {
+  const hn::ScalableTag<double> d;
+  const size_t N = hn::Lanes(d);
+  size_t drawn = 0;
+  size_t t = 0;
+  if (N >= 2 && N <= size_t(kMaxLanes)) {
+    alignas(64) double in[3][7][kMaxLanes];  // vertex k, component x y z w r g b, lane
+    alignas(64) double o[64][kMaxLanes];     // results, per lane
+    const auto zero = hn::Zero(d), one = hn::Set(d, 1.0), half = hn::Set(d, 0.5);
+    const auto sub = hn::Set(d, double(kSubPixelScale)),
+               halfPixel = hn::Set(d, double(kSubPixelScale / 2));
+    const auto guard = hn::Set(d, double(1 << kGuardBandLog2));
+    const auto halfW = hn::Set(d, 0.5 * viewport.width), halfH = hn::Set(d, 0.5 * viewport.height);
+    const auto small = hn::Set(d, double(kSmallExtent) * kSubPixelScale);
+    const auto maxX = hn::Set(d, double(viewport.width - 1)),
+               maxY = hn::Set(d, double(viewport.height - 1));
+    const auto inv256 = hn::Set(d, 1.0 / kSubPixelScale);
+    for (; t + N <= count; t += N) {
+      for (size_t l = 0; l < N; ++l)
+        for (int k = 0; k < 3; ++k) {
+          const ClipVertex& v = vertices[indices[(t + l) * 3 + size_t(k)]];
+          const float c[7] = {v.x, v.y, v.z, v.w, v.r, v.g, v.b};
+          for (int q = 0; q < 7; ++q) in[k][q][l] = double(c[q]);
+        }
+      // Step 1 (setup.cpp steps 1–3 and snapVertex): the common case, and the snapped positions.
+      auto common = hn::Eq(zero, zero);
+      hn::Vec<decltype(d)> sx[3], sy[3], x[3], y[3], z[3], w[3];
+      auto outLeft = common, outRight = common, outBottom = common, outTop = common;
+      for (int k = 0; k < 3; ++k) {
+        x[k] = hn::Load(d, in[k][0]);
+        y[k] = hn::Load(d, in[k][1]);
+        z[k] = hn::Load(d, in[k][2]);
+        w[k] = hn::Load(d, in[k][3]);
+        common = hn::And(common, hn::And(hn::And(hn::IsFinite(x[k]), hn::IsFinite(y[k])),
+                                         hn::And(hn::IsFinite(z[k]), hn::IsFinite(w[k]))));
+        common = hn::And(common, hn::Gt(w[k], zero));
+        // Between the near and far planes: no extra edges.
+        common = hn::And(common, hn::And(hn::Ge(z[k], hn::Neg(w[k])), hn::Le(z[k], w[k])));
+        outLeft = hn::And(outLeft, hn::Lt(x[k], hn::Neg(w[k])));
+        outRight = hn::And(outRight, hn::Gt(x[k], w[k]));
+        outBottom = hn::And(outBottom, hn::Lt(y[k], hn::Neg(w[k])));
+        outTop = hn::And(outTop, hn::Gt(y[k], w[k]));
+        const auto invW = hn::Div(one, w[k]);
+        const auto px = hn::Mul(hn::Mul(hn::Add(x[k], w[k]), halfW), invW);
+        const auto py = hn::Mul(hn::Mul(hn::Sub(w[k], y[k]), halfH), invW);
+        common = hn::And(common, hn::And(hn::Lt(hn::Abs(px), guard), hn::Lt(hn::Abs(py), guard)));
+        sx[k] = hn::Round(hn::Mul(px, sub));  // lrint: to nearest, ties to even
+        sy[k] = hn::Round(hn::Mul(py, sub));
+      }
+      const auto outside = hn::Or(hn::Or(outLeft, outRight), hn::Or(outBottom, outTop));
+      // Steps 3–4: integer edges A = y_i − y_j, B = x_j − x_i, C = x_i·y_j − x_j·y_i; the doubled
+      // area.
+      hn::Vec<decltype(d)> A[3], B[3], C[3];
+      for (int k = 0; k < 3; ++k) {
+        const int i = (k + 1) % 3, j = (k + 2) % 3;
+        A[k] = hn::Sub(sy[i], sy[j]);
+        B[k] = hn::Sub(sx[j], sx[i]);
+        C[k] = hn::Sub(hn::Mul(sx[i], sy[j]), hn::Mul(sx[j], sy[i]));
+      }
+      const auto area2 = hn::Add(hn::Add(hn::Mul(A[0], sx[0]), hn::Mul(B[0], sy[0])), C[0]);
+      const auto positive = hn::Gt(area2, zero), negative = hn::Lt(area2, zero);
+      const auto orient = hn::IfThenElse(positive, one, hn::IfThenElseZero(negative, hn::Neg(one)));
+      // Step 5: facing (front = clockwise on the raster = negative area).
+      const auto degenerate = hn::Not(hn::Or(positive, negative));
+      auto facing = hn::Eq(one, zero);
+      if (cull == CullMode::back) facing = positive;
+      if (cull == CullMode::front) facing = negative;
+      // Step 6: the bounding box of pixel centres (pixel p's centre is at 256·p + 128).
+      const auto x0 = hn::Min(hn::Min(sx[0], sx[1]), sx[2]),
+                 x1 = hn::Max(hn::Max(sx[0], sx[1]), sx[2]);
+      const auto y0 = hn::Min(hn::Min(sy[0], sy[1]), sy[2]),
+                 y1 = hn::Max(hn::Max(sy[0], sy[1]), sy[2]);
+      const auto bx0 = hn::Max(zero, hn::Neg(hn::Floor(hn::Mul(hn::Sub(halfPixel, x0), inv256))));
+      const auto bx1 = hn::Min(maxX, hn::Floor(hn::Mul(hn::Sub(x1, halfPixel), inv256)));
+      const auto by0 = hn::Max(zero, hn::Neg(hn::Floor(hn::Mul(hn::Sub(halfPixel, y0), inv256))));
+      const auto by1 = hn::Min(maxY, hn::Floor(hn::Mul(hn::Sub(y1, halfPixel), inv256)));
+      const auto empty = hn::Or(hn::Gt(bx0, bx1), hn::Gt(by0, by1));
+      const auto isSmall = hn::Le(hn::Max(hn::Sub(x1, x0), hn::Sub(y1, y0)), small);
+      // Step 7: oriented edges with the fill rule folded in (setup.cpp, toPixelEdge).
+      int r = 0;
+      for (int k = 0; k < 3; ++k) {
+        const auto a = hn::Mul(orient, A[k]), b = hn::Mul(orient, B[k]), c = hn::Mul(orient, C[k]);
+        const auto owns = hn::Or(hn::Gt(a, zero), hn::And(hn::Eq(a, zero), hn::Gt(b, zero)));
+        const auto e = hn::Sub(hn::Add(hn::Add(hn::Mul(a, halfPixel), hn::Mul(b, halfPixel)), c),
+                               hn::IfThenElseZero(hn::Not(owns), one));
+        hn::Store(e, d, o[r++]);
+        hn::Store(a, d, o[r++]);
+        hn::Store(b, d, o[r++]);
+      }
+      // Step 8: parameter planes λ_k = edge_k(p) / (w_k·area2), relative to (minX, minY) + ½.
+      hn::Vec<decltype(d)> g[3][3], invW[3];
+      for (int k = 0; k < 3; ++k) {
+        g[k][0] = hn::Mul(A[k], sub);
+        g[k][1] = hn::Mul(B[k], sub);
+        g[k][2] = C[k];
+        invW[k] = hn::Div(one, w[k]);
+      }
+      const auto scale = hn::Div(one, area2);
+      const auto px0 = hn::Add(bx0, half), py0 = hn::Add(by0, half);
+      auto plane = [&](const hn::Vec<decltype(d)> f[3]) {
+        const auto a = hn::Mul(hn::Add(hn::Add(hn::Mul(f[0], g[0][0]), hn::Mul(f[1], g[1][0])),
+                                       hn::Mul(f[2], g[2][0])),
+                               scale);
+        const auto b = hn::Mul(hn::Add(hn::Add(hn::Mul(f[0], g[0][1]), hn::Mul(f[1], g[1][1])),
+                                       hn::Mul(f[2], g[2][1])),
+                               scale);
+        const auto c = hn::Mul(hn::Add(hn::Add(hn::Mul(f[0], g[0][2]), hn::Mul(f[1], g[1][2])),
+                                       hn::Mul(f[2], g[2][2])),
+                               scale);
+        hn::Store(hn::Add(hn::Add(hn::Mul(a, px0), hn::Mul(b, py0)), c), d, o[r++]);
+        hn::Store(a, d, o[r++]);
+        hn::Store(b, d, o[r++]);
+      };
+      hn::Vec<decltype(d)> f[3];
+      for (int k = 0; k < 3; ++k) f[k] = hn::Mul(hn::Mul(half, hn::Add(z[k], w[k])), invW[k]);
+      plane(f);
+      plane(invW);
+      for (int ch = 0; ch < 3; ++ch) {
+        for (int k = 0; k < 3; ++k) f[k] = hn::Mul(hn::Load(d, in[k][4 + ch]), invW[k]);
+        plane(f);
+      }
+      hn::Store(bx0, d, o[r++]);
+      hn::Store(by0, d, o[r++]);
+      hn::Store(bx1, d, o[r++]);
+      hn::Store(by1, d, o[r++]);
+      // Outcome code per lane, in setup.cpp's order: outside (outcodes), degenerate, facing,
+      // outside (empty box), drawn; 9 for lanes left to the scalar path.
+      auto code = hn::Set(d, double(SetupOutcome::drawn));
+      code = hn::IfThenElse(empty, hn::Set(d, double(SetupOutcome::culledOutside)), code);
+      code = hn::IfThenElse(facing, hn::Set(d, double(SetupOutcome::culledFacing)), code);
+      code = hn::IfThenElse(degenerate, hn::Set(d, double(SetupOutcome::culledDegenerate)), code);
+      code = hn::IfThenElse(outside, hn::Set(d, double(SetupOutcome::culledOutside)), code);
+      code = hn::IfThenElse(common, code, hn::Set(d, 9.0));
+      hn::Store(code, d, o[r++]);
+      hn::Store(hn::IfThenElseZero(isSmall, one), d, o[r++]);
+
+      for (size_t l = 0; l < N; ++l) {
+        const int outcome = int(o[r - 2][l]);
+        if (outcome == 9) {
+          const uint32_t* idx = indices + (t + l) * 3;
+          const SetupOutcome so = setupTriangle(vertices[idx[0]], vertices[idx[1]],
+                                                vertices[idx[2]], viewport, cull, out[drawn]);
+          ++outcomes[int(so)];
+          drawn += so == SetupOutcome::drawn;
+          continue;
+        }
+        ++outcomes[outcome];
+        if (outcome != int(SetupOutcome::drawn)) continue;
+        TriangleSetup& s = out[drawn++];
+        int q = 0;
+        for (int k = 0; k < 3; ++k) {
+          s.edges[k].c = int64_t(o[q++][l]);
+          s.edges[k].a = int32_t(o[q++][l]);
+          s.edges[k].b = int32_t(o[q++][l]);
+        }
+        for (Plane* p : {&s.depth, &s.invW, &s.red, &s.green, &s.blue}) {
+          p->c0 = float(o[q++][l]);
+          p->dx = float(o[q++][l]);
+          p->dy = float(o[q++][l]);
+        }
+        s.minX = int16_t(o[q++][l]);
+        s.minY = int16_t(o[q++][l]);
+        s.maxX = int16_t(o[q++][l]);
+        s.maxY = int16_t(o[q++][l]);
+        s.edgeCount = 3;
+        s.small = o[r - 1][l] != 0;
+      }
+    }
+  }
+  for (; t < count; ++t) {
+    const uint32_t* idx = indices + t * 3;
+    const SetupOutcome so = setupTriangle(vertices[idx[0]], vertices[idx[1]], vertices[idx[2]],
+                                          viewport, cull, out[drawn]);
+    ++outcomes[int(so)];
+    drawn += so == SetupOutcome::drawn;
+  }
+  return drawn;
+}
+
+}  // namespace HWY_NAMESPACE
+}  // namespace sv::geometry
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace sv::geometry {
+HWY_EXPORT(SetupTriangles);
+
+size_t setupTriangles(const ClipVertex* vertices, const uint32_t* indices, size_t count,
+                      const Viewport& viewport, CullMode cull, TriangleSetup* out,
+                      uint64_t outcomes[kSetupOutcomes]) {
+  return HWY_DYNAMIC_DISPATCH(SetupTriangles)(vertices, indices, count, viewport, cull, out,
+                                              outcomes);
+}
+}  // namespace sv::geometry
+#endif
