@@ -8,15 +8,19 @@
 //                  [--renderer synthvis|gl|both] [--json FILE] [--html DIR] [--image FILE]
 //   synthvis gen tris|layers -o scene.glb [--count N] [--area A] [--depth D] [--layers D]
 //                [--order O] [--seed S] [--width W] [--height H]
+//   synthvis truth [SCENE] -o truth.png [--samples 256] [--width W] [--height H] [--threads T]
+//   synthvis compare IMAGE.png REFERENCE.png
 //   (shared BENCH.md defines the scenes and the JSON fields)
 //
 // Errors print one line, "synthvis: <file>: <problem>", and exit with status 1 (2 for usage).
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <cstdio>
 #include <fmt/format.h>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "reference/ground_truth.h"
 #include "reference/suite.h"
 #include "synthvis/generators.h"
 #include "synthvis/image.h"
@@ -236,6 +240,55 @@ int runGen(const GenArgs& a) {
   return 0;
 }
 
+struct TruthArgs {
+  std::string scene;
+  std::string output = "truth.png";
+  int samples = 256;
+  bool noCull = false;
+  sv::RenderOptions options;
+};
+
+// `synthvis truth [SCENE] -o truth.png --samples 256`: the ground-truth image (src/reference).
+int runTruth(const TruthArgs& a) {
+  const int side = int(std::lround(std::sqrt(double(a.samples))));
+  if (side < 1 || side > 32 || side * side != a.samples)
+    return fail({"", "", fmt::format("--samples {}: must be a square from 1 to 1024", a.samples)});
+  sv::reference::GroundTruthOptions g;
+  g.options = a.options;
+  g.options.cullBackFaces = !a.noCull;
+  g.samplesPerSide = side;
+  sv::scene::Scene scene;
+  if (a.scene.empty()) {
+    scene = sv::scene::demoScene();
+  } else {
+    auto loaded = sv::scene::loadScene(a.scene);
+    if (!loaded) return fail(loaded.error());
+    scene = std::move(loaded).value();
+  }
+  fmt::print("{}: {}x{}, {} samples per pixel…\n", a.output, g.options.width, g.options.height,
+             a.samples);
+  std::fflush(stdout);
+  auto image = sv::reference::renderGroundTruth(scene, g);
+  if (!image) return fail(image.error());
+  if (sv::Status s = sv::writeImage(image.value(), a.output); !s) return fail(s.error());
+  return 0;
+}
+
+// `synthvis compare IMAGE REFERENCE`: differences in linear light, all pixels and edge pixels.
+int runCompare(const std::string& imagePath, const std::string& referencePath) {
+  auto a = sv::readPng(imagePath);
+  if (!a) return fail(a.error());
+  auto b = sv::readPng(referencePath);
+  if (!b) return fail(b.error());
+  auto d = sv::reference::compareImages(a.value(), b.value());
+  if (!d) return fail({imagePath, "", d.error().message});
+  const auto& r = d.value();
+  fmt::print("all pixels ({}): RMSE {:.6f}, PSNR {:.2f} dB | edge pixels ({}): RMSE {:.6f}, "
+             "PSNR {:.2f} dB (linear light)\n",
+             r.pixels, r.rmse, r.psnrDb, r.edgePixels, r.edgeRmse, r.edgePsnrDb);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -295,6 +348,25 @@ int main(int argc, char** argv) {
   gen->add_option("--width", g.width, "the raster the areas refer to")->capture_default_str();
   gen->add_option("--height", g.height, "the raster the areas refer to")->capture_default_str();
 
+  TruthArgs tr;
+  CLI::App* truth = app.add_subcommand(
+      "truth", "render the ground-truth image: brute force, n×n samples per pixel, box filter");
+  truth->add_option("scene", tr.scene, "scene file; default: built-in demo");
+  truth->add_option("-o,--output", tr.output, "output image (.png or .ppm)")->capture_default_str();
+  truth->add_option("--samples", tr.samples, "samples per pixel, a square (1…1024)")
+      ->capture_default_str();
+  truth->add_option("--width", tr.options.width, "image width in pixels")->capture_default_str();
+  truth->add_option("--height", tr.options.height, "image height in pixels")->capture_default_str();
+  truth->add_option("--threads", tr.options.threads, "worker threads (0 = all)")->capture_default_str();
+  truth->add_option("--camera", tr.options.camera, "index of the scene camera")->capture_default_str();
+  truth->add_flag("--no-cull", tr.noCull, "draw back faces of single-sided materials too");
+
+  std::string compareImage, compareReference;
+  CLI::App* compare = app.add_subcommand(
+      "compare", "RMSE and PSNR of IMAGE against REFERENCE in linear light, all and edge pixels");
+  compare->add_option("image", compareImage, "PNG image")->required();
+  compare->add_option("reference", compareReference, "PNG reference, e.g. from `truth`")->required();
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -303,5 +375,7 @@ int main(int argc, char** argv) {
   if (*render) return runRender(r);
   if (*bench) return runBench(b);
   if (*gen) return runGen(g);
+  if (*truth) return runTruth(tr);
+  if (*compare) return runCompare(compareImage, compareReference);
   return 0;
 }

@@ -141,4 +141,16 @@ TEST(Cli, GenWritesAGlbThatRenders) {
   expectOneLineError(run("bench --suite huge"), "", "unknown suite");
 }
 
+TEST(Cli, TruthAndCompare) {
+  const std::string truth = (tempDir() / "truth.png").string();
+  const std::string ours = (tempDir() / "ours.png").string();
+  ASSERT_EQ(run("truth -o " + truth + " --width 64 --height 48 --samples 16").status, 0);
+  ASSERT_EQ(run("render -o " + ours + " --width 64 --height 48").status, 0);
+  const CliRun c = run("compare " + ours + " " + truth);
+  EXPECT_EQ(c.status, 0) << c.out;
+  EXPECT_NE(c.out.find("edge pixels"), std::string::npos) << c.out;
+  expectOneLineError(run("truth -o " + truth + " --samples 3"), "", "must be a square");
+  expectOneLineError(run("compare " + ours + " /no/such.png"), "/no/such.png", "");
+}
+
 }  // namespace

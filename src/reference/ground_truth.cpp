@@ -1,0 +1,215 @@
+#include "reference/ground_truth.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "core/thread_pool.h"
+#include "geometry/vertex_stage.h"
+
+namespace sv::reference {
+namespace {
+
+// One triangle in 2D homogeneous form: with V_k = (x_k, y_k, w_k) in clip space and p = (X, Y, 1)
+// in normalized device coordinates, λ_k(p) = adj_k · p / det are β_k / w_P (3D barycentrics over
+// the point's w), so "all λ_k ≥ 0" is "inside and in front of the eye", z_ndc = Σ λ_k z_k and a
+// vertex attribute interpolates perspective-correctly as Σ λ_k f_k / Σ λ_k.
+struct Tri {
+  double adj[3][3];  // rows adj_k / det
+  double z[3];
+  double color[3][3];
+  int x0, y0, x1, y1;  // pixel box to sample (inclusive), clipped to the raster
+};
+
+double linearFromSrgb(uint8_t v) {
+  const double s = v / 255.0;
+  return s <= 0.04045 ? s / 12.92 : std::pow((s + 0.055) / 1.055, 2.4);
+}
+
+uint8_t srgbFromLinear(double l) {
+  l = std::clamp(l, 0.0, 1.0);
+  const double e = l <= 0.0031308 ? 12.92 * l : 1.055 * std::pow(l, 1.0 / 2.4) - 0.055;
+  return uint8_t(std::lround(e * 255.0));
+}
+
+}  // namespace
+
+Result<Image> renderGroundTruth(const scene::Scene& scene, const GroundTruthOptions& g) {
+  const RenderOptions& o = g.options;
+  if (Status s = validate(o); !s) return s.error();
+  if (Status s = scene::validate(scene, ""); !s) return s.error();
+  if (g.samplesPerSide < 1 || g.samplesPerSide > 32)
+    return Error{"", "", fmt::format("{} samples per side is out of range (1…32)", g.samplesPerSide)};
+  const Result<Mat4> camera = viewProjection(scene, o);
+  if (!camera.ok()) return camera.error();
+  const int W = o.width, H = o.height, n = g.samplesPerSide, S = n * n;
+
+  // The same clip-space vertices and lit colours as synthvis's vertex stage.
+  std::vector<Tri> tris;
+  const scene::Material defaultMaterial;
+  for (const scene::Instance& inst : scene.instances) {
+    const scene::Mesh& mesh = scene.meshes[size_t(inst.mesh)];
+    const scene::Material& mat =
+        mesh.material >= 0 ? scene.materials[size_t(mesh.material)] : defaultMaterial;
+    std::vector<geometry::ClipVertex> v(mesh.positions.size());
+    geometry::transformVertices(mesh, mat, inst.transform, camera.value(), scene.light, 0,
+                                v.size(), v.data());
+    const bool cullBack = o.cullBackFaces && !mat.doubleSided;
+    for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+      const geometry::ClipVertex* c[3] = {&v[mesh.indices[t]], &v[mesh.indices[t + 1]],
+                                          &v[mesh.indices[t + 2]]};
+      double V[3][3];
+      bool finite = true;
+      for (int k = 0; k < 3; ++k) {
+        V[k][0] = c[k]->x;
+        V[k][1] = c[k]->y;
+        V[k][2] = c[k]->w;
+        finite &= std::isfinite(c[k]->x) && std::isfinite(c[k]->y) && std::isfinite(c[k]->z) &&
+                  std::isfinite(c[k]->w);
+      }
+      if (!finite) continue;
+      Tri tri;
+      double adj[3][3];
+      for (int k = 0; k < 3; ++k) {
+        const double* a = V[(k + 1) % 3];
+        const double* b = V[(k + 2) % 3];
+        adj[k][0] = a[1] * b[2] - a[2] * b[1];
+        adj[k][1] = a[2] * b[0] - a[0] * b[2];
+        adj[k][2] = a[0] * b[1] - a[1] * b[0];
+      }
+      const double det = V[0][0] * adj[0][0] + V[0][1] * adj[0][1] + V[0][2] * adj[0][2];
+      if (!(std::fabs(det) > 0) || !std::isfinite(det)) continue;
+      // Counter-clockwise in normalized device coordinates is the front (det > 0).
+      if (cullBack && det < 0) continue;
+      for (int k = 0; k < 3; ++k) {
+        for (int q = 0; q < 3; ++q) tri.adj[k][q] = adj[k][q] / det;
+        tri.z[k] = c[k]->z;
+        tri.color[k][0] = c[k]->r;
+        tri.color[k][1] = c[k]->g;
+        tri.color[k][2] = c[k]->b;
+      }
+      // The box: from the projected vertices when all are in front of the eye, else everything.
+      tri.x0 = 0, tri.y0 = 0, tri.x1 = W - 1, tri.y1 = H - 1;
+      if (c[0]->w > 0 && c[1]->w > 0 && c[2]->w > 0) {
+        double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+        for (int k = 0; k < 3; ++k) {
+          const double px = (c[k]->x / double(c[k]->w) + 1) * 0.5 * W;
+          const double py = (1 - c[k]->y / double(c[k]->w)) * 0.5 * H;
+          lo[0] = std::min(lo[0], px), hi[0] = std::max(hi[0], px);
+          lo[1] = std::min(lo[1], py), hi[1] = std::max(hi[1], py);
+        }
+        tri.x0 = int(std::clamp(std::floor(lo[0]), 0.0, double(W - 1)));
+        tri.x1 = int(std::clamp(std::floor(hi[0]), 0.0, double(W - 1)));
+        tri.y0 = int(std::clamp(std::floor(lo[1]), 0.0, double(H - 1)));
+        tri.y1 = int(std::clamp(std::floor(hi[1]), 0.0, double(H - 1)));
+        if (hi[0] < 0 || lo[0] > W || hi[1] < 0 || lo[1] > H) continue;
+      }
+      tris.push_back(tri);
+    }
+  }
+
+  // Bands of rows in parallel; each keeps its samples' depth and colour.
+  constexpr int kBand = 4;
+  const int bands = (H + kBand - 1) / kBand;
+  std::vector<double> linear(size_t(W) * H * 3);
+  const double background[3] = {scene.background.x, scene.background.y, scene.background.z};
+  core::ThreadPool pool(o.threads > 0 ? o.threads : 1);
+  pool.parallelFor(size_t(bands), [&](size_t band, int) {
+    const int yb0 = int(band) * kBand, yb1 = std::min(H, yb0 + kBand);
+    const size_t samples = size_t(yb1 - yb0) * W * S;
+    std::vector<float> depth(samples, std::numeric_limits<float>::infinity());
+    std::vector<float> color(samples * 3);
+    for (size_t i = 0; i < samples; ++i)
+      for (int ch = 0; ch < 3; ++ch) color[i * 3 + ch] = float(background[ch]);
+    for (const Tri& t : tris) {
+      const int ty0 = std::max(t.y0, yb0), ty1 = std::min(t.y1, yb1 - 1);
+      for (int y = ty0; y <= ty1; ++y)
+        for (int x = t.x0; x <= t.x1; ++x)
+          for (int sy = 0; sy < n; ++sy)
+            for (int sx = 0; sx < n; ++sx) {
+              const double X = 2 * (x + (sx + 0.5) / n) / W - 1;
+              const double Y = 1 - 2 * (y + (sy + 0.5) / n) / H;
+              double l[3], sum = 0;
+              bool inside = true;
+              for (int k = 0; k < 3; ++k) {
+                l[k] = t.adj[k][0] * X + t.adj[k][1] * Y + t.adj[k][2];
+                inside &= l[k] >= 0;
+                sum += l[k];
+              }
+              if (!inside || !(sum > 0)) continue;
+              const double z = l[0] * t.z[0] + l[1] * t.z[1] + l[2] * t.z[2];  // z / w
+              if (z < -1 || z > 1) continue;                                   // near, far
+              const size_t s = (size_t(y - yb0) * W + x) * S + size_t(sy * n + sx);
+              const float zf = float(0.5 * (z + 1));
+              if (!(zf < depth[s])) continue;
+              depth[s] = zf;
+              for (int ch = 0; ch < 3; ++ch)
+                color[s * 3 + ch] = float(
+                    std::clamp((l[0] * t.color[0][ch] + l[1] * t.color[1][ch] +
+                                l[2] * t.color[2][ch]) / sum, 0.0, 1.0));
+            }
+    }
+    // The 1×1 box filter, in linear light.
+    for (int y = yb0; y < yb1; ++y)
+      for (int x = 0; x < W; ++x)
+        for (int ch = 0; ch < 3; ++ch) {
+          double acc = 0;
+          const size_t base = (size_t(y - yb0) * W + x) * S;
+          for (int s = 0; s < S; ++s) acc += color[(base + size_t(s)) * 3 + ch];
+          linear[(size_t(y) * W + x) * 3 + ch] = acc / S;
+        }
+  });
+  Image image;
+  image.width = W;
+  image.height = H;
+  image.rgb.resize(linear.size());
+  for (size_t i = 0; i < linear.size(); ++i) image.rgb[i] = srgbFromLinear(linear[i]);
+  return image;
+}
+
+Result<ImageDifference> compareImages(const Image& a, const Image& b) {
+  if (a.width != b.width || a.height != b.height || a.rgb.size() != b.rgb.size())
+    return Error{"", "", fmt::format("the images differ in size ({}x{} and {}x{})", a.width,
+                                     a.height, b.width, b.height)};
+  if (a.rgb.empty()) return Error{"", "", "the images are empty"};
+  double lut[256];
+  for (int i = 0; i < 256; ++i) lut[i] = linearFromSrgb(uint8_t(i));
+  ImageDifference d;
+  double sum = 0, edgeSum = 0;
+  const int W = a.width, H = a.height;
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const size_t i = (size_t(y) * W + x) * 3;
+      bool edge = false;
+      for (int dy = -1; dy <= 1 && !edge; ++dy)
+        for (int dx = -1; dx <= 1 && !edge; ++dx) {
+          const int nx = x + dx, ny = y + dy;
+          if (nx < 0 || ny < 0 || nx >= W || ny >= H) continue;
+          const size_t j = (size_t(ny) * W + nx) * 3;
+          for (int ch = 0; ch < 3; ++ch) edge |= std::abs(int(b.rgb[i + ch]) - int(b.rgb[j + ch])) > 1;
+        }
+      double e = 0;
+      for (int ch = 0; ch < 3; ++ch) {
+        const double diff = lut[a.rgb[i + ch]] - lut[b.rgb[i + ch]];
+        e += diff * diff;
+      }
+      sum += e;
+      if (edge) {
+        edgeSum += e;
+        ++d.edgePixels;
+      }
+    }
+  d.pixels = size_t(W) * H;
+  auto psnr = [](double rmse) {
+    return rmse > 0 ? 20 * std::log10(1.0 / rmse) : std::numeric_limits<double>::infinity();
+  };
+  d.rmse = std::sqrt(sum / double(d.pixels * 3));
+  d.psnrDb = psnr(d.rmse);
+  d.edgeRmse = d.edgePixels ? std::sqrt(edgeSum / double(d.edgePixels * 3)) : 0;
+  d.edgePsnrDb = psnr(d.edgeRmse);
+  return d;
+}
+
+}  // namespace sv::reference
