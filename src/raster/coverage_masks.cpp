@@ -1,0 +1,98 @@
+// Based on: SPEC §5 (seed 000: masks from a table indexed by distance and slope); Schilling 1991
+// (A new simple and efficient antialiasing with subpixel masks); Microsoft, D3D11 standard
+// multisample patterns (D3D11_STANDARD_MULTISAMPLE_PATTERN) for 8 and 16 samples.
+#include "raster/coverage_masks.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace sv::raster {
+namespace {
+
+SamplePattern fromSixteenths(std::initializer_list<std::array<int, 2>> points, double shift) {
+  SamplePattern p;
+  for (const auto& q : points) p.offsets.push_back({q[0] / 16.0 + shift, q[1] / 16.0 + shift});
+  p.count = int(p.offsets.size());
+  return p;
+}
+
+SamplePattern jittered8x8() {
+  SamplePattern p;
+  uint32_t state = 0x9E3779B9u;  // fixed: the pattern is part of the format
+  auto next = [&] {
+    state = state * 1664525u + 1013904223u;  // Numerical Recipes LCG
+    return (state >> 8) % 30;
+  };
+  for (int j = 0; j < 8; ++j)
+    for (int i = 0; i < 8; ++i) {
+      const uint32_t u = 1 + next(), v = 1 + next();  // 1…30 of 32 steps inside the cell
+      p.offsets.push_back({(32.0 * i + u) / 256.0 - 0.5, (32.0 * j + v) / 256.0 - 0.5});
+    }
+  p.count = 64;
+  return p;
+}
+
+// The side a tie (v = 0) belongs to: antisymmetric in the normal, like setup.cpp's fill rule.
+bool ownsTie(double nx, double ny) { return nx > 0 || (nx == 0 && ny > 0); }
+
+}  // namespace
+
+const SamplePattern* samplePattern(int count) {
+  static const SamplePattern one{1, {{0.0, 0.0}}};
+  static const SamplePattern four =
+      fromSixteenths({{-2, -6}, {6, -2}, {-6, 2}, {2, 6}}, 0.0);  // rotated grid
+  static const SamplePattern eight = fromSixteenths(
+      {{1, -3}, {-1, 3}, {5, 1}, {-3, -5}, {-5, 5}, {-7, -1}, {3, -7}, {7, 7}}, 0.0);
+  static const SamplePattern sixteen = fromSixteenths(
+      {{1, 1}, {-1, -3}, {-3, 2}, {4, -1}, {-5, -2}, {2, 5}, {5, 3}, {3, -5}, {-2, 6}, {0, -7},
+       {-4, -6}, {-6, 4}, {-8, 0}, {7, -4}, {6, 7}, {-7, -8}},
+      1.0 / 32);
+  static const SamplePattern sixtyFour = jittered8x8();
+  switch (count) {
+    case 1: return &one;
+    case 4: return &four;
+    case 8: return &eight;
+    case 16: return &sixteen;
+    case 64: return &sixtyFour;
+    default: return nullptr;
+  }
+}
+
+EdgeMaskTable::EdgeMaskTable(const SamplePattern& pattern)
+    : count_(pattern.count),
+      all_(pattern.count >= 64 ? ~uint64_t(0) : (uint64_t(1) << pattern.count) - 1),
+      table_(size_t(4) * kSlopeSteps * kDistanceSteps) {
+  for (int q = 0; q < 4; ++q)
+    for (int i = 0; i < kSlopeSteps; ++i)
+      for (int j = 0; j < kDistanceSteps; ++j) {
+        // The cell's centre; all dyadic, so the reversed edge's values are exact negations.
+        const double t = (i + 0.5) / kSlopeSteps;
+        const double nx = (q & 1) ? -t : t, ny = (q & 2) ? -(1 - t) : (1 - t);
+        const double d = (j + 0.5) / kDistanceSteps - 0.5;
+        uint64_t m = 0;
+        for (int s = 0; s < count_; ++s) {
+          const auto& o = pattern.offsets[size_t(s)];
+          const double v = nx * o[0] + ny * o[1] + d;
+          if (v > 0 || (v == 0 && ownsTie(nx, ny))) m |= uint64_t(1) << s;
+        }
+        table_[(size_t(q) * kSlopeSteps + size_t(i)) * kDistanceSteps + size_t(j)] = m;
+      }
+}
+
+uint64_t EdgeMaskTable::mask(double a, double b, double c) const {
+  const double norm = std::fabs(a) + std::fabs(b);
+  const double d = c / norm;
+  if (d >= 0.5) return all_;  // every sample is within ½ (L1) of the centre
+  if (d <= -0.5) return 0;
+  const int quadrant = int(a < 0 || (a == 0 && b < 0)) | int(b < 0 || (b == 0 && a < 0)) << 1;
+  const int slope = std::min(kSlopeSteps - 1, int(std::fabs(a) / norm * kSlopeSteps));
+  // Distance cells mirror around 0 so that −d finds the mirrored cell; d = 0 goes by the tie rule.
+  int distance;
+  if (d > 0 || (d == 0 && ownsTie(a, b)))
+    distance = std::min(kDistanceSteps - 1, kDistanceSteps / 2 + int(d * kDistanceSteps));
+  else
+    distance = std::max(0, kDistanceSteps / 2 - 1 - int(-d * kDistanceSteps));
+  return entry(quadrant, slope, distance);
+}
+
+}  // namespace sv::raster

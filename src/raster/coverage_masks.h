@@ -1,0 +1,75 @@
+// Sub-pixel coverage masks from tables (SPEC §5, seed 000) — the first part of anti-aliasing
+// (issue 4). Not yet used by the tile kernel; tests/raster/coverage_masks_test.cpp pins down the
+// properties the kernel will rely on.
+//
+// A pixel carries N sample positions (a documented pattern per N). For one edge the mask of the
+// samples inside it is read from a table indexed by the edge's slope and its distance to the pixel
+// centre — the normalized a and c of SPEC §3.3 — and the signs of A and B; a polygon's mask is the
+// AND of its edges' masks.
+//
+// Symbols. An edge is e(x, y) = a·x + b·y + c in pixel units with (x, y) relative to the pixel
+// centre; inside is e ≥ 0. Normalized by |a| + |b| (SPEC §3.3): the slope t = |a| / (|a| + |b|)
+// ∈ [0, 1] and the distance d = c / (|a| + |b|). A sample s = (sx, sy) ∈ (−½, ½)² is inside iff
+// v = ±t·sx ± (1 − t)·sy + d ≥ 0, so |d| ≥ ½ decides the whole pixel and the table covers
+// d ∈ (−½, ½) in kDistanceSteps cells and t ∈ [0, 1] in kSlopeSteps cells, per sign quadrant.
+//
+// Precision. Each entry is the exact mask at its cell's centre; within a cell v moves by less than
+// kMaxError = 1/(2·kSlopeSteps) + 1/(2·kDistanceSteps) = 3/128 (|∂v/∂t| = |sx ∓ sy| < 1), so a
+// sample's bit is exact unless it lies within kMaxError (L1-normalized pixels) of the edge.
+//
+// Complementarity (RASTER-NOTES pitfall 4). The cell centres are dyadic, so the reversed edge's
+// entry is computed from exactly negated values; ties (v = 0) go to the side whose normal has
+// nx > 0. Hence mask(e) AND mask(−e) = 0 and mask(e) OR mask(−e) = all samples, for every entry:
+// shared edges of a mesh sum to full coverage, no seams.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace sv::raster {
+
+// Sample offsets from the pixel centre, in pixels, each coordinate in (−½, ½) and a multiple of
+// 1/256 (exact in binary, which the complementarity argument needs).
+struct SamplePattern {
+  int count = 0;
+  std::vector<std::array<double, 2>> offsets;
+};
+
+// The patterns: 1 (the centre), 4 (rotated grid), 8 and 16 (the standard Direct3D multisample
+// positions; 16 is n-rooks — one sample per row and column of its 16×16 grid — shifted by 1/32 px
+// so that no sample lies on the pixel's border), 64 (an 8×8 grid jittered within its cells by a
+// fixed seeded sequence, positions on a 1/256 grid). Returns nullptr for other counts.
+const SamplePattern* samplePattern(int count);
+
+class EdgeMaskTable {
+ public:
+  static constexpr int kSlopeSteps = 32;
+  static constexpr int kDistanceSteps = 64;
+  static constexpr double kMaxError = 0.5 / kSlopeSteps + 0.5 / kDistanceSteps;
+
+  explicit EdgeMaskTable(const SamplePattern& pattern);
+
+  int sampleCount() const { return count_; }
+  uint64_t allSamples() const { return all_; }
+
+  // The mask of the samples inside a·x + b·y + c ≥ 0 (pixel units, relative to the pixel centre).
+  // (a, b) must not be (0, 0).
+  uint64_t mask(double a, double b, double c) const;
+
+  // The table itself: entry(quadrant, slope, distance); quadrant bit 0 = a negative, bit 1 = b
+  // negative (a zero coefficient counts with the sign of the other one, so that reversing an edge
+  // flips both bits).
+  uint64_t entry(int quadrant, int slope, int distance) const {
+    return table_[(size_t(quadrant) * kSlopeSteps + size_t(slope)) * kDistanceSteps +
+                  size_t(distance)];
+  }
+
+ private:
+  int count_;
+  uint64_t all_;
+  std::vector<uint64_t> table_;
+};
+
+}  // namespace sv::raster
