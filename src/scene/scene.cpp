@@ -1,6 +1,8 @@
 // The scene database's own operations: counting, checking the invariants the loaders promise,
 // and merging one scene into another.
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include <fmt/format.h>
@@ -28,6 +30,8 @@ bool isFinite(const Mat4& m) {
   return true;
 }
 
+constexpr float kMaxFloat = std::numeric_limits<float>::max();
+
 // "meshes[3] 'wheel'" — the name helps when a file has hundreds of meshes.
 std::string meshLabel(const Mesh& mesh, size_t i) {
   return mesh.name.empty() ? fmt::format("meshes[{}]", i)
@@ -51,13 +55,26 @@ Status validate(const Scene& scene, const std::string& file) {
           "{}: attribute arrays must be empty or match the {} positions (normals {}, colors {}, "
           "uvs {})",
           meshLabel(mesh, i), n, mesh.normals.size(), mesh.colors.size(), mesh.uvs.size()));
-    for (size_t k = 0; k < mesh.indices.size(); ++k)
-      if (mesh.indices[k] >= n)
-        return fail(fmt::format("{}: indices[{}] = {} is out of range ({} vertices)",
-                                meshLabel(mesh, i), k, mesh.indices[k], n));
-    for (size_t k = 0; k < n; ++k)
-      if (!isFinite(mesh.positions[k]))
-        return fail(fmt::format("{}: positions[{}] is not finite", meshLabel(mesh, i), k));
+    // The renderer validates every frame: two branch-free reductions (they vectorize) in the
+    // common case, the offender searched for only when one fails. (perf: the early-exit loops were
+    // 2.5 % of a tris 100k × 10 px frame, on one thread while the others wait.)
+    uint32_t maxIndex = 0;
+    for (uint32_t index : mesh.indices) maxIndex = std::max(maxIndex, index);
+    if (!mesh.indices.empty() && maxIndex >= n) {
+      size_t k = 0;
+      while (mesh.indices[k] < n) ++k;
+      return fail(fmt::format("{}: indices[{}] = {} is out of range ({} vertices)",
+                              meshLabel(mesh, i), k, mesh.indices[k], n));
+    }
+    bool finite = true;
+    for (const Vec3& p : mesh.positions)
+      finite &= std::fabs(p.x) <= kMaxFloat && std::fabs(p.y) <= kMaxFloat &&
+                std::fabs(p.z) <= kMaxFloat;  // false for NaN and ±∞
+    if (!finite) {
+      for (size_t k = 0; k < n; ++k)
+        if (!isFinite(mesh.positions[k]))
+          return fail(fmt::format("{}: positions[{}] is not finite", meshLabel(mesh, i), k));
+    }
     if (mesh.material < -1 || (mesh.material >= 0 && size_t(mesh.material) >= scene.materials.size()))
       return fail(fmt::format("{}: material {} does not exist ({} materials)", meshLabel(mesh, i),
                               mesh.material, scene.materials.size()));
