@@ -19,33 +19,15 @@
 #include "raster/framebuffer.h"
 #include "raster/rasterizer.h"
 #include "render/frame_renderer.h"
-#include "synthvis/generators.h"
+#include "bench_scenes.h"
 
 namespace sv {
 namespace {
 
 constexpr int kWidth = 1920, kHeight = 1080;
 
-render::DrawPackets trisPackets(int count, double area) {
-  scene::TrisParams p;
-  p.count = count;
-  p.area = area;
-  const scene::Scene s = scene::generateTris(p);
-  render::DrawPackets packets;
-  const Mat4 vp = Mat4::perspective(60 * 3.14159265f / 180, float(kWidth) / kHeight, 0.1f, 100) *
-                  Mat4::lookAt({0, 0, 0}, {0, 0, -1}, {0, 1, 0});
-  const auto& m = s.meshes[0];
-  for (size_t i = 0; i < m.positions.size(); ++i) {
-    const Vec4 c = vp * Vec4{m.positions[i].x, m.positions[i].y, m.positions[i].z, 1};
-    packets.vertices.push_back({c.x, c.y, c.z, c.w, m.colors[i].x, m.colors[i].y, m.colors[i].z, 1});
-  }
-  packets.indices = m.indices;
-  packets.calls.push_back({0, uint32_t(m.triangleCount()), geometry::CullMode::none});
-  return packets;
-}
-
 void BM_Tiles(benchmark::State& state) {
-  const render::DrawPackets packets = trisPackets(int(state.range(0)), double(state.range(1)));
+  const render::DrawPackets packets = bench::trisPackets(int(state.range(0)), double(state.range(1)), kWidth, kHeight);
   render::FrameRenderer fr(2);
   render::FrameSettings fs;
   fs.width = kWidth;
@@ -134,7 +116,7 @@ struct SparseProcessor {
 };
 
 void BM_Interleave(benchmark::State& state) {
-  const render::DrawPackets packets = trisPackets(int(state.range(0)), double(state.range(1)));
+  const render::DrawPackets packets = bench::trisPackets(int(state.range(0)), double(state.range(1)), kWidth, kHeight);
   const geometry::Viewport viewport{kWidth, kHeight};
   const size_t count = packets.indices.size() / 3;
   std::vector<geometry::TriangleSetup> dense(count);

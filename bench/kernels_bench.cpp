@@ -11,7 +11,7 @@
 #include "raster/framebuffer.h"
 #include "raster/rasterizer.h"
 #include "render/frame_renderer.h"
-#include "synthvis/generators.h"
+#include "bench_scenes.h"
 
 namespace sv {
 namespace {
@@ -103,20 +103,7 @@ BENCHMARK(BM_SetupTriangle);
 
 // BENCH.md tris through setup, binning and tiles (no vertex stage, no resolve), 1 thread.
 void BM_FrameTris(benchmark::State& state) {
-  scene::TrisParams p;
-  p.count = int(state.range(0));
-  p.area = double(state.range(1));
-  const scene::Scene s = scene::generateTris(p);
-  render::DrawPackets packets;
-  const Mat4 vp = Mat4::perspective(60 * 3.14159265f / 180, 1920.0f / 1080, 0.1f, 100) *
-                  Mat4::lookAt({0, 0, 0}, {0, 0, -1}, {0, 1, 0});
-  const auto& m = s.meshes[0];
-  for (size_t i = 0; i < m.positions.size(); ++i) {
-    const Vec4 c = vp * Vec4{m.positions[i].x, m.positions[i].y, m.positions[i].z, 1};
-    packets.vertices.push_back({c.x, c.y, c.z, c.w, m.colors[i].x, m.colors[i].y, m.colors[i].z, 1});
-  }
-  packets.indices = m.indices;
-  packets.calls.push_back({0, uint32_t(m.triangleCount()), geometry::CullMode::none});
+  const render::DrawPackets packets = bench::trisPackets(int(state.range(0)), double(state.range(1)));
   render::FrameRenderer fr(1);
   render::FrameSettings fs;
   fs.width = 1920;
@@ -126,7 +113,8 @@ void BM_FrameTris(benchmark::State& state) {
     fr.render(packets, fs, stats);
   }
   state.counters["triangles/s"] =
-      benchmark::Counter(double(p.count) * state.iterations(), benchmark::Counter::kIsRate);
+      benchmark::Counter(double(packets.indices.size() / 3) * state.iterations(),
+                         benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_FrameTris)->Args({100000, 10})->Args({10000, 1000})->Unit(benchmark::kMillisecond);
 

@@ -10,16 +10,13 @@
 #include <cmath>
 #include <random>
 
+#include "scene/generator_common.h"
 #include "synthvis/generators.h"
 
 namespace sv::scene {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-
-float srgbToLinear(double v) {
-  return float(v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4));
-}
 
 }  // namespace
 
@@ -58,13 +55,6 @@ Scene generateLayers(const LayersParams& p, TrisStats* stats) {
         gx[size_t(j) * (cols + 1) + i] = px;
         gy[size_t(j) * (cols + 1) + i] = py;
       }
-    auto color = [&] {
-      auto ch = [&] {
-        return srgbToLinear(std::uniform_int_distribution<int>(64, 255)(rng) / 255.0);
-      };
-      const float r = ch(), g = ch(), b = ch();
-      return Vec4{r, g, b, 1};
-    };
     for (int j = 0; j < rows; ++j)
       for (int i = 0; i < cols; ++i) {
         const size_t a = size_t(j) * (cols + 1) + i, b = a + 1, c = a + cols + 1, d = c + 1;
@@ -73,7 +63,7 @@ Scene generateLayers(const LayersParams& p, TrisStats* stats) {
           tri.layer = layer;
           for (int k = 0; k < 3; ++k) {
             tri.v[k] = world(gx[t[k]], gy[t[k]]);
-            tri.c[k] = color();
+            tri.c[k] = detail::randomBenchColor(rng);
           }
           totalArea += 0.5 * std::fabs((gx[t[1]] - gx[t[0]]) * (gy[t[2]] - gy[t[0]]) -
                                        (gx[t[2]] - gx[t[0]]) * (gy[t[1]] - gy[t[0]]));

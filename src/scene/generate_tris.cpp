@@ -10,6 +10,7 @@
 #include <numeric>
 #include <random>
 
+#include "scene/generator_common.h"
 #include "synthvis/generators.h"
 
 namespace sv::scene {
@@ -26,10 +27,6 @@ Dvec operator*(Dvec a, double s) { return {a.x * s, a.y * s, a.z * s}; }
 double dotd(Dvec a, Dvec b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 Dvec crossd(Dvec a, Dvec b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
 Dvec unit(Dvec a) { return a * (1.0 / std::sqrt(dotd(a, a))); }
-
-float srgbToLinear(double v) {
-  return float(v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4));
-}
 
 }  // namespace
 
@@ -136,8 +133,10 @@ Scene generateTris(const TrisParams& p, TrisStats* stats) {
     }
     t.area = area;
     t.distance = distance;
-    for (auto& c : t.c)
-      for (float& ch : c) ch = srgbToLinear(std::uniform_int_distribution<int>(64, 255)(rng) / 255.0);
+    for (auto& c : t.c) {
+      const Vec4 v = detail::randomBenchColor(rng);
+      c[0] = v.x, c[1] = v.y, c[2] = v.z;
+    }
   }
   if (p.order != SubmitOrder::random) {
     std::stable_sort(tris.begin(), tris.end(), [&](const Tri& a, const Tri& b) {

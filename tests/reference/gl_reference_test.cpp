@@ -9,19 +9,12 @@
 
 #include "reference/gl_renderer.h"
 #include "reference/suite.h"
+#include "small_settings.h"
 
 namespace sv::reference {
 namespace {
 
-BenchSettings smallSettings() {
-  BenchSettings s;
-  s.options.width = 320;
-  s.options.height = 240;
-  s.options.threads = 2;
-  s.frames = 2;
-  s.warmup = 1;
-  return s;
-}
+using testing::smallSettings;
 
 // The reference draws the same triangles: PSNR ≥ 40 dB against synthvis (issue 3's bar), on a
 // lit mesh scene and on the no-AA Gouraud bench scenes.

@@ -1,6 +1,7 @@
 // The bench harness (src/reference): suites, PSNR, JSON rows, HTML, and the gl reference drawing
 // the same picture as synthvis.
 #include "reference/suite.h"
+#include "small_settings.h"
 
 #include <gtest/gtest.h>
 
@@ -10,13 +11,9 @@
 namespace sv::reference {
 namespace {
 
+// Without the gl reference: these tests are about the harness.
 BenchSettings smallSettings() {
-  BenchSettings s;
-  s.options.width = 320;
-  s.options.height = 240;
-  s.options.threads = 2;
-  s.frames = 2;
-  s.warmup = 1;
+  BenchSettings s = testing::smallSettings();
   s.reference = false;
   return s;
 }

@@ -1,0 +1,23 @@
+// Shared by the BENCH.md scene generators (generate_*.cpp).
+#pragma once
+
+#include <cmath>
+#include <random>
+
+#include "synthvis/math.h"
+
+namespace sv::scene::detail {
+
+// BENCH.md's random vertex colour: each channel a display value uniform in [64, 255], stored as
+// linear light (the sRGB decoding of IEC 61966-2-1).
+template <class Rng>
+Vec4 randomBenchColor(Rng& rng) {
+  auto channel = [&] {
+    const double v = std::uniform_int_distribution<int>(64, 255)(rng) / 255.0;
+    return float(v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4));
+  };
+  const float r = channel(), g = channel(), b = channel();
+  return {r, g, b, 1};
+}
+
+}  // namespace sv::scene::detail
