@@ -1,7 +1,7 @@
 // synthvis — command-line front end.
 //
 //   synthvis render [SCENE] -o out.png [--width W] [--height H] [--threads T] [--camera I]
-//                   [--no-cull] [--debug-view overdraw]
+//                   [--no-cull] [--debug-view overdraw] [--gamma G]
 //   synthvis bench SCENE|--suite quick|full [--count N] [--area A] [--depth D] [--layers D]
 //                  [--order random|f2b|b2f] [--shade gouraud] [--width W] [--height H]
 //                  [--threads T] [--frames F] [--warmup W] [--seed S] [--aa S]
@@ -307,6 +307,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   render->add_flag("--no-cull", r.noCull, "draw back faces of single-sided materials too");
   render->add_option("--debug-view", r.debugView, "false-colour diagnostic image: overdraw");
+  render->add_option("--gamma", r.options.gamma,
+                     "display gamma G (encoded = linear^(1/G)); default 0 = sRGB")
+      ->capture_default_str();
 
   BenchArgs b;
   CLI::App* bench = app.add_subcommand("bench", "time whole frames of a benchmark scene (BENCH.md)");

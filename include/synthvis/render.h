@@ -22,6 +22,9 @@ struct RenderOptions {
   bool cullBackFaces = true;   // for materials that are not double-sided
   int camera = 0;              // index into Scene::cameras (a default camera if there is none)
   bool debugOverdraw = false;  // instead of colours, count the triangles covering each pixel
+  // Output transfer function (SPEC §8): 0 = sRGB (IEC 61966-2-1); otherwise a display gamma G,
+  // encoded value = linear^(1/G), G in [0.5, 5].
+  double gamma = 0;
 };
 
 // Checks sizes and counts; the error names the option.

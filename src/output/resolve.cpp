@@ -17,6 +17,16 @@ GammaTables GammaTables::srgb() {
   return g;
 }
 
+GammaTables GammaTables::power(double gamma) {
+  GammaTables g;
+  for (int i = 0; i < 65536; ++i) {
+    const double e = std::pow(i / 65535.0, 1.0 / gamma);
+    const auto v = static_cast<uint8_t>(std::lround(std::clamp(e, 0.0, 1.0) * 255.0));
+    g.table[0][i] = g.table[1][i] = g.table[2][i] = v;
+  }
+  return g;
+}
+
 namespace {
 
 // Calls fn(rgbOut, src, n) for every row of 4 pixels of a block of the tile that lies (n of them)

@@ -15,6 +15,8 @@ struct GammaTables {
   std::array<std::array<uint8_t, 65536>, 3> table;
 
   static GammaTables srgb();  // the sRGB transfer function (IEC 61966-2-1)
+  // A display gamma: encoded = linear^(1/gamma), rounded to 8 bits.
+  static GammaTables power(double gamma);
 };
 
 // Sizes `image` for a width × height raster; call once per frame before resolving its tiles.

@@ -78,6 +78,8 @@ Status validate(const RenderOptions& o) {
     return Error{"", "", fmt::format("thread count {} is out of range (0…{})", o.threads,
                                      kMaxThreads)};
   if (o.camera < 0) return Error{"", "", "camera index must not be negative"};
+  if (o.gamma != 0 && !(o.gamma >= 0.5 && o.gamma <= 5))
+    return Error{"", "", fmt::format("gamma {} is out of range (0.5…5, or 0 for sRGB)", o.gamma)};
   return {};
 }
 
@@ -93,7 +95,9 @@ std::string FrameStats::summary() const {
 
 struct Renderer::Impl {
   explicit Impl(const RenderOptions& o)
-      : options(o), frame(resolveThreads(o.threads)), gamma(output::GammaTables::srgb()) {}
+      : options(o),
+        frame(resolveThreads(o.threads)),
+        gamma(o.gamma == 0 ? output::GammaTables::srgb() : output::GammaTables::power(o.gamma)) {}
   RenderOptions options;
   render::FrameRenderer frame;
   output::GammaTables gamma;

@@ -91,6 +91,8 @@ TEST(Cli, MissingSceneFileAndBadOptions) {
   const CliRun fmt = run("render -o " + (tempDir() / "x.bmp").string() + " --width 8 --height 8");
   EXPECT_EQ(fmt.status, 1) << fmt.out;
   EXPECT_NE(run("render --no-such-flag").status, 0);
+  expectOneLineError(run("render --gamma 9 -o " + (tempDir() / "x.png").string()), "",
+                     "gamma 9 is out of range");
 }
 
 TEST(Cli, BenchWritesTheJsonFieldsBenchMdNames) {

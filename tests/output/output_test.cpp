@@ -61,6 +61,16 @@ TEST(ImageIo, ErrorsNameTheFile) {
   EXPECT_FALSE(writeImage(gradient(2, 2), tempPath("sv_img.bmp")).ok());
 }
 
+TEST(Gamma, DisplayGammaTables) {
+  const auto g = output::GammaTables::power(2.2);
+  EXPECT_EQ(g.table[0][0], 0);
+  EXPECT_EQ(g.table[1][65535], 255);
+  EXPECT_EQ(g.table[2][32768], 186);  // 0.5^(1/2.2) = 0.7297 → 186.1
+  const auto linear = output::GammaTables::power(1.0);
+  EXPECT_EQ(linear.table[0][32768], 128);  // 0.50001 → 127.5 → 128
+  for (int i = 1; i < 65536; ++i) ASSERT_GE(g.table[0][i], g.table[0][i - 1]);
+}
+
 TEST(Gamma, SrgbTablesMatchTheStandardAtKnownPoints) {
   const auto g = output::GammaTables::srgb();
   EXPECT_EQ(g.table[0][0], 0);
