@@ -3,11 +3,15 @@
 //   one tile, small triangles      → triangles/s (coverage + depth + Gouraud), windows/s (coverage
 //                                    tests: windows classified plus leaf pixel-centre tests)
 //   one tile, large triangles      → pixels/s (fills)
+//   setup, SIMD lanes              → triangles/s
+//   edge-mask table look-up (AA)   → masks/s
 //   whole frame, BENCH.md tris     → triangles/s
 #include <benchmark/benchmark.h>
 
+#include <array>
 #include <random>
 
+#include "raster/coverage_masks.h"
 #include "raster/framebuffer.h"
 #include "raster/rasterizer.h"
 #include "render/frame_renderer.h"
@@ -100,6 +104,48 @@ void BM_SetupTriangle(benchmark::State& state) {
       benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_SetupTriangle);
+
+// The same triangles through setupTriangles, several at a time in SIMD lanes.
+void BM_SetupTrianglesBatched(benchmark::State& state) {
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<geometry::ClipVertex> v(3 * 4096);
+  for (size_t i = 0; i < v.size(); i += 3) {
+    const double x = u(rng) * 1920, y = u(rng) * 1080;
+    for (int k = 0; k < 3; ++k) v[i + k] = at(x + u(rng) * 6, y + u(rng) * 6, 1920, 1080, float(u(rng)));
+  }
+  std::vector<uint32_t> indices(v.size());
+  for (size_t i = 0; i < indices.size(); ++i) indices[i] = uint32_t(i);
+  std::vector<geometry::TriangleSetup> out(v.size() / 3);
+  uint64_t outcomes[geometry::kSetupOutcomes] = {};
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(geometry::setupTriangles(v.data(), indices.data(), out.size(),
+                                                      {1920, 1080}, geometry::CullMode::none,
+                                                      out.data(), outcomes));
+  }
+  state.counters["triangles/s"] = benchmark::Counter(double(out.size()) * state.iterations(),
+                                                     benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_SetupTrianglesBatched);
+
+// Anti-aliasing (issue 4): one edge's sub-pixel mask from the table, N samples.
+void BM_EdgeMaskLookup(benchmark::State& state) {
+  const raster::EdgeMaskTable table(*raster::samplePattern(int(state.range(0))));
+  std::mt19937 rng(2);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<std::array<double, 3>> edges(4096);
+  for (auto& e : edges) e = {u(rng), u(rng), u(rng) * 0.7};
+  size_t i = 0;
+  uint64_t acc = 0;
+  for (auto _ : state) {
+    const auto& e = edges[i++ & 4095];
+    acc ^= table.mask(e[0], e[1], e[2]);
+  }
+  benchmark::DoNotOptimize(acc);
+  state.counters["masks/s"] =
+      benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_EdgeMaskLookup)->Arg(4)->Arg(16)->Arg(64);
 
 // BENCH.md tris through setup, binning and tiles (no vertex stage, no resolve), 1 thread.
 void BM_FrameTris(benchmark::State& state) {
