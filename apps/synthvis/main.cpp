@@ -5,7 +5,8 @@
 //   synthvis bench SCENE|--suite quick|full [--count N] [--area A] [--depth D] [--layers D]
 //                  [--order random|f2b|b2f] [--shade gouraud] [--width W] [--height H]
 //                  [--threads T] [--frames F] [--warmup W] [--seed S] [--aa S]
-//                  [--renderer synthvis|gl|both] [--json FILE] [--html DIR] [--image FILE]
+//                  [--renderer synthvis|gl|both] [--gl-readback] [--json FILE] [--html DIR]
+//                  [--image FILE]
 //   synthvis gen tris|layers -o scene.glb [--count N] [--area A] [--depth D] [--layers D]
 //                [--order O] [--seed S] [--width W] [--height H]
 //   synthvis truth [SCENE] -o truth.png [--samples 256] [--width W] [--height H] [--threads T]
@@ -87,6 +88,7 @@ struct BenchArgs {
   int frames = 10;
   int warmup = 2;
   int aa = 0;
+  bool glReadback = false;
   sv::RenderOptions options{.width = 1920, .height = 1080, .threads = 2};
 };
 
@@ -149,6 +151,7 @@ int runBench(BenchArgs a) {
   settings.frames = a.frames;
   settings.warmup = a.warmup;
   settings.aa = a.aa;
+  settings.referenceReadback = a.glReadback;
   settings.synthvis = a.renderer != "gl";
   settings.reference = a.renderer != "synthvis";
   ref::BenchRunner runner(settings);
@@ -330,6 +333,8 @@ int main(int argc, char** argv) {
   bench->add_option("--warmup", b.warmup, "untimed frames first")->capture_default_str();
   bench->add_option("--aa", b.aa, "samples per pixel (0 = none; gl reference only for now)")
       ->capture_default_str();
+  bench->add_flag("--gl-readback", b.glReadback,
+                  "count the gl reference's read-back of the image in its frame time");
   bench->add_option("--renderer", b.renderer,
                     "synthvis, gl (Mesa llvmpipe) or both, alternating frames; default: synthvis "
                     "for a scene, both for a suite");

@@ -169,6 +169,8 @@ Result<CaseResult> BenchRunner::run(const BenchCase& c) {
     if (ref) {
       const auto t0 = Clock::now();
       if (Status st = impl_->gl->render(); !st) return st.error();
+      if (s.referenceReadback)
+        if (Status st = impl_->gl->readImage(ref->image); !st) return st.error();
       const double ms = msSince(t0);
       if (i >= s.warmup) ref->frameMs.push_back(ms);
     }
@@ -225,6 +227,7 @@ nlohmann::json jsonRows(const CaseResult& r, const BenchSettings& s) {
                 {"warmup", s.warmup},
                 {"shade", "gouraud"},
                 {"aa", s.aa},
+                {"readback_timed", run.renderer == "synthvis" || s.referenceReadback},
                 {"median_ms", run.medianMs},
                 {"min_ms", run.minMs},
                 {"max_ms", run.maxMs},

@@ -61,6 +61,9 @@ struct BenchSettings {
   int aa = 0;             // samples per pixel: 0 = none; the gl reference multisamples (2…16)
   bool synthvis = true;   // time synthvis
   bool reference = true;  // time the gl reference (after startReference)
+  // Count the gl reference's read-back (glReadPixels into an 8-bit image in memory) in its frame
+  // time: synthvis's frame always ends with the image in memory.
+  bool referenceReadback = false;
 };
 
 // Renders, per case, warm-up frames then timed frames, alternating synthvis and the reference
