@@ -2,6 +2,7 @@
 // top-left rule, perspective-correct parameters against ray–plane intersection, the near plane.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -180,6 +181,43 @@ TEST(Setup, TriangleEntirelyBehindTheEyeIsCulled) {
   TriangleSetup t;
   EXPECT_NE(geometry::setupTriangle(a, b, c, {64, 64}, geometry::CullMode::none, t),
             geometry::SetupOutcome::drawn);
+}
+
+// The fixed-point budget at the largest raster (RASTER-NOTES pitfall 1): on 8192×8192, with
+// vertices far outside the raster (inside the guard band), the int64 edge functions still give
+// the exact inside test at pixels anywhere on the raster, corners included.
+TEST(Setup, EdgesAreExactOnTheLargestRaster) {
+  const int w = 8192, h = 8192;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> coord(-6000, 14000);
+  std::uniform_int_distribution<int> pixel(0, w - 1);
+  int tested = 0;
+  for (int n = 0; n < 300; ++n) {
+    ClipVertex v[3];
+    int64_t vx[3], vy[3];
+    for (int k = 0; k < 3; ++k) {
+      v[k] = pixelVertex(coord(rng), coord(rng), w, h);
+      // The snapping rule of setup.h: the projection rounded to 1/256 px.
+      const double px = (double(v[k].x) + v[k].w) * (0.5 * w) / v[k].w;
+      const double py = (double(v[k].w) - v[k].y) * (0.5 * h) / v[k].w;
+      vx[k] = std::llrint(px * 256);
+      vy[k] = std::llrint(py * 256);
+    }
+    TriangleSetup t;
+    if (geometry::setupTriangle(v[0], v[1], v[2], {w, h}, geometry::CullMode::none, t) !=
+        geometry::SetupOutcome::drawn)
+      continue;
+    ASSERT_FALSE(t.small);
+    std::vector<std::array<int, 2>> pixels = {{0, 0}, {w - 1, 0}, {0, h - 1}, {w - 1, h - 1}};
+    for (int i = 0; i < 400; ++i) pixels.push_back({pixel(rng), pixel(rng)});
+    for (const auto& [x, y] : pixels) {
+      const bool inBox = x >= t.minX && x <= t.maxX && y >= t.minY && y <= t.maxY;
+      ASSERT_EQ(inBox && edgeInside(t, x, y), exactInside(vx, vy, x, y))
+          << "triangle " << n << " pixel " << x << "," << y;
+      ++tested;
+    }
+  }
+  EXPECT_GT(tested, 50000);
 }
 
 // setupTriangles (SIMD lanes) must give setupTriangle's records bit for bit, on every SIMD target,
