@@ -1,7 +1,7 @@
 // synthvis — command-line front end.
 //
 //   synthvis render [SCENE] -o out.png [--width W] [--height H] [--threads T] [--camera I]
-//                   [--no-cull] [--debug-view overdraw] [--gamma G]
+//                   [--no-cull] [--debug-view overdraw] [--gamma G] [--supersample K]
 //   synthvis bench SCENE|--suite quick|full [--count N] [--area A] [--depth D] [--layers D]
 //                  [--order random|f2b|b2f] [--shade gouraud] [--width W] [--height H]
 //                  [--threads T] [--frames F] [--warmup W] [--seed S] [--aa S]
@@ -310,6 +310,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   render->add_flag("--no-cull", r.noCull, "draw back faces of single-sided materials too");
   render->add_option("--debug-view", r.debugView, "false-colour diagnostic image: overdraw");
+  render->add_option("--supersample", r.options.supersample,
+                     "render k×k samples per pixel and average them (1, 2, 4, 8)")
+      ->capture_default_str();
   render->add_option("--gamma", r.options.gamma,
                      "display gamma G (encoded = linear^(1/G)); default 0 = sRGB")
       ->capture_default_str();
@@ -332,6 +335,9 @@ int main(int argc, char** argv) {
   bench->add_option("--frames", b.frames, "timed frames")->capture_default_str();
   bench->add_option("--warmup", b.warmup, "untimed frames first")->capture_default_str();
   bench->add_option("--aa", b.aa, "samples per pixel (0 = none; gl reference only for now)")
+      ->capture_default_str();
+  bench->add_option("--supersample", b.options.supersample,
+                    "synthvis: k×k samples per pixel, averaged (1, 2, 4, 8)")
       ->capture_default_str();
   bench->add_flag("--gl-readback", b.glReadback,
                   "count the gl reference's read-back of the image in its frame time");

@@ -66,6 +66,27 @@ void resolveTile(const uint16_t* color, int tileX, int tileY, const GammaTables&
   });
 }
 
+void resolveTile(const uint16_t* color, int tileX, int tileY, int factor, const GammaTables& gamma,
+                 Image& image) {
+  if (factor == 1) return resolveTile(color, tileX, tileY, gamma, image);
+  using raster::FrameBuffer;
+  // The tile covers image pixels [x0, x0 + 64/factor) × [y0, …) of the smaller image.
+  const int side = raster::kTileSize / factor;
+  const int x0 = tileX * side, y0 = tileY * side;
+  const int w = std::min(side, image.width - x0), h = std::min(side, image.height - y0);
+  const uint32_t count = uint32_t(factor * factor);
+  for (int v = 0; v < h; ++v)
+    for (int u = 0; u < w; ++u) {
+      uint32_t sum[3] = {0, 0, 0};
+      for (int sy = 0; sy < factor; ++sy)
+        for (int sx = 0; sx < factor; ++sx)
+          for (int ch = 0; ch < 3; ++ch)
+            sum[ch] += color[FrameBuffer::colorOffset(u * factor + sx, v * factor + sy, ch)];
+      uint8_t* out = image.pixel(x0 + u, y0 + v);
+      for (int ch = 0; ch < 3; ++ch) out[ch] = gamma.table[size_t(ch)][(sum[ch] + count / 2) / count];
+    }
+}
+
 void resolveOverdrawTile(const uint16_t* color, int tileX, int tileY, Image& image) {
   static constexpr uint8_t kPalette[6][3] = {{0, 0, 0},     {30, 60, 220}, {0, 200, 220},
                                              {40, 200, 40}, {240, 220, 0}, {230, 30, 30}};

@@ -27,6 +27,10 @@ void prepareImage(int width, int height, Image& image);
 // disjoint pixels, so different tiles may be resolved on different threads.
 void resolveTile(const uint16_t* color, int tileX, int tileY, const GammaTables& gamma,
                  Image& image);
+// The same for a raster `factor` times larger than the image (factor 2, 4 or 8 divides the tile):
+// each image pixel is the rounded mean of its factor × factor samples in linear light.
+void resolveTile(const uint16_t* color, int tileX, int tileY, int factor, const GammaTables& gamma,
+                 Image& image);
 
 // For the overdraw count (raster::ShadeMode::overdraw): a false-colour image, black for 0, then
 // blue, cyan, green, yellow, red for 1, 2, 3, 4, ≥5 triangles covering the pixel.

@@ -78,6 +78,15 @@ Status validate(const RenderOptions& o) {
     return Error{"", "", fmt::format("thread count {} is out of range (0…{})", o.threads,
                                      kMaxThreads)};
   if (o.camera < 0) return Error{"", "", "camera index must not be negative"};
+  if (o.supersample != 1 && o.supersample != 2 && o.supersample != 4 && o.supersample != 8)
+    return Error{"", "", fmt::format("supersampling {} is not supported (1, 2, 4 or 8)",
+                                     o.supersample)};
+  if (o.supersample > 1 && (o.width * o.supersample > kMaxRasterSize ||
+                            o.height * o.supersample > kMaxRasterSize))
+    return Error{"", "", fmt::format("supersampling {}x{} by {} exceeds the {}-pixel raster",
+                                     o.width, o.height, o.supersample, kMaxRasterSize)};
+  if (o.supersample > 1 && o.debugOverdraw)
+    return Error{"", "", "the overdraw view counts triangles per pixel; it cannot be supersampled"};
   if (o.gamma != 0 && !(o.gamma >= 0.5 && o.gamma <= 5))
     return Error{"", "", fmt::format("gamma {} is out of range (0.5…5, or 0 for sRGB)", o.gamma)};
   return {};
@@ -169,23 +178,25 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
   });
   stats.vertexMs = msSince(t0);
 
-  // Stage 3–4: setup, binning, tiles.
+  // Stage 3–4: setup, binning, tiles (on the k-times larger raster when supersampling).
+  const int k = o.supersample;
   render::FrameSettings fs;
-  fs.width = o.width;
-  fs.height = o.height;
+  fs.width = o.width * k;
+  fs.height = o.height * k;
   fs.clearColor[0] = scene.background.x;
   fs.clearColor[1] = scene.background.y;
   fs.clearColor[2] = scene.background.z;
   fs.shade = o.debugOverdraw ? raster::ShadeMode::overdraw : raster::ShadeMode::gouraud;
-  // Stage 5, display: each tile is resolved into the image as soon as it is finished.
-  const int tilesX = (o.width + raster::kTileSize - 1) >> raster::kTileLog2;
+  // Stage 5, display: each tile is resolved into the image as soon as it is finished (k divides
+  // the 64-pixel tile, so a pixel's k×k samples always lie in one tile).
+  const int tilesX = (fs.width + raster::kTileSize - 1) >> raster::kTileLog2;
   if (o.debugOverdraw)
     fs.finishTile = [&](int tile, const float*, const uint16_t* color) {
       output::resolveOverdrawTile(color, tile % tilesX, tile / tilesX, image);
     };
   else
     fs.finishTile = [&](int tile, const float*, const uint16_t* color) {
-      output::resolveTile(color, tile % tilesX, tile / tilesX, impl_->gamma, image);
+      output::resolveTile(color, tile % tilesX, tile / tilesX, k, impl_->gamma, image);
     };
   output::prepareImage(o.width, o.height, image);
   impl_->frame.render(p, fs, stats);

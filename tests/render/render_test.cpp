@@ -2,6 +2,8 @@
 // option validation, and the benchmark generator's stated statistics.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <cstdlib>
 #include <filesystem>
 #include <set>
@@ -126,6 +128,44 @@ TEST(TrisGenerator, RenderedAreaMatchesTheRequestedArea) {
   FrameStats stats;
   ASSERT_TRUE(r.render(scene::generateTris(p), img, &stats).ok());
   EXPECT_NEAR(double(stats.fragments) / p.count, 50, 2.5);
+}
+
+// Supersampling: a quad whose edge crosses column 10 at x = 10.5 covers half of that column's
+// samples at k = 2, 4, 8 (linear 0.5 → sRGB 188), all of column 9 and none of 11.
+TEST(Render, SupersamplingAveragesSamplesInLinearLight) {
+  const int w = 40, h = 8;
+  scene::Scene s = scene::benchCameraScene("quad");
+  const double tanHalf = std::tan(30.0 * 3.14159265358979 / 180), aspect = double(w) / h;
+  auto at = [&](double px, double py) {
+    return Vec3{float((2 * px / w - 1) * 2 * tanHalf * aspect), float((1 - 2 * py / h) * 2 * tanHalf),
+                -2.0f};
+  };
+  scene::Mesh m;
+  m.positions = {at(-5, -5), at(10.5, -5), at(10.5, h + 5), at(-5, h + 5)};
+  m.indices = {0, 1, 2, 0, 2, 3};
+  m.material = 0;  // unlit white, double-sided
+  s.meshes.push_back(m);
+  for (int k : {2, 4, 8}) {
+    RenderOptions o;
+    o.width = w;
+    o.height = h;
+    o.threads = 2;
+    o.supersample = k;
+    Renderer r(o);
+    Image img;
+    ASSERT_TRUE(r.render(s, img).ok());
+    for (int y = 0; y < h; ++y) {
+      EXPECT_EQ(img.pixel(9, y)[0], 255) << k;
+      EXPECT_NEAR(img.pixel(10, y)[1], 188, 1) << k;
+      EXPECT_EQ(img.pixel(11, y)[2], 0) << k;
+    }
+  }
+  RenderOptions bad;
+  bad.supersample = 3;
+  EXPECT_FALSE(validate(bad).ok());
+  bad.supersample = 8;
+  bad.width = 2000;
+  EXPECT_FALSE(validate(bad).ok());  // 16 000 px wide inside
 }
 
 TEST(LayersGenerator, SameSeedSameSceneAndStatistics) {
