@@ -10,7 +10,7 @@
 //   synthvis gen tris|layers -o scene.glb [--count N] [--area A] [--depth D] [--layers D]
 //                [--order O] [--seed S] [--width W] [--height H]
 //   synthvis truth [SCENE] -o truth.png [--samples 256] [--width W] [--height H] [--threads T]
-//   synthvis compare IMAGE.png REFERENCE.png
+//   synthvis truth … [--edges MASK.png]; synthvis compare IMAGE.png REFERENCE.png [--edges MASK.png]
 //   (shared BENCH.md defines the scenes and the JSON fields)
 //
 // Errors print one line, "synthvis: <file>: <problem>", and exit with status 1 (2 for usage).
@@ -246,6 +246,7 @@ int runGen(const GenArgs& a) {
 struct TruthArgs {
   std::string scene;
   std::string output = "truth.png";
+  std::string edges;
   int samples = 256;
   bool noCull = false;
   sv::RenderOptions options;
@@ -271,19 +272,29 @@ int runTruth(const TruthArgs& a) {
   fmt::print("{}: {}x{}, {} samples per pixel…\n", a.output, g.options.width, g.options.height,
              a.samples);
   std::fflush(stdout);
-  auto image = sv::reference::renderGroundTruth(scene, g);
+  sv::Image edges;
+  auto image = sv::reference::renderGroundTruth(scene, g, &edges);
   if (!image) return fail(image.error());
   if (sv::Status s = sv::writeImage(image.value(), a.output); !s) return fail(s.error());
+  if (!a.edges.empty())
+    if (sv::Status s = sv::writeImage(edges, a.edges); !s) return fail(s.error());
   return 0;
 }
 
 // `synthvis compare IMAGE REFERENCE`: differences in linear light, all pixels and edge pixels.
-int runCompare(const std::string& imagePath, const std::string& referencePath) {
+int runCompare(const std::string& imagePath, const std::string& referencePath,
+               const std::string& edgesPath) {
   auto a = sv::readPng(imagePath);
   if (!a) return fail(a.error());
   auto b = sv::readPng(referencePath);
   if (!b) return fail(b.error());
-  auto d = sv::reference::compareImages(a.value(), b.value());
+  sv::Result<sv::Image> mask = sv::Image{};
+  if (!edgesPath.empty()) {
+    mask = sv::readPng(edgesPath);
+    if (!mask) return fail(mask.error());
+  }
+  auto d = sv::reference::compareImages(a.value(), b.value(),
+                                        edgesPath.empty() ? nullptr : &mask.value());
   if (!d) return fail({imagePath, "", d.error().message});
   const auto& r = d.value();
   fmt::print("all pixels ({}): RMSE {:.6f}, PSNR {:.2f} dB | edge pixels ({}): RMSE {:.6f}, "
@@ -374,12 +385,15 @@ int main(int argc, char** argv) {
   truth->add_option("--threads", tr.options.threads, "worker threads (0 = all)")->capture_default_str();
   truth->add_option("--camera", tr.options.camera, "index of the scene camera")->capture_default_str();
   truth->add_flag("--no-cull", tr.noCull, "draw back faces of single-sided materials too");
+  truth->add_option("--edges", tr.edges, "also write the edge mask (pixels an edge crosses)");
 
-  std::string compareImage, compareReference;
+  std::string compareImage, compareReference, compareEdges;
   CLI::App* compare = app.add_subcommand(
       "compare", "RMSE and PSNR of IMAGE against REFERENCE in linear light, all and edge pixels");
   compare->add_option("image", compareImage, "PNG image")->required();
   compare->add_option("reference", compareReference, "PNG reference, e.g. from `truth`")->required();
+  compare->add_option("--edges", compareEdges, "edge mask from `truth --edges` (default: pixels "
+                                               "whose neighbours differ in the reference)");
 
   try {
     app.parse(argc, argv);
@@ -390,6 +404,6 @@ int main(int argc, char** argv) {
   if (*bench) return runBench(b);
   if (*gen) return runGen(g);
   if (*truth) return runTruth(tr);
-  if (*compare) return runCompare(compareImage, compareReference);
+  if (*compare) return runCompare(compareImage, compareReference, compareEdges);
   return 0;
 }

@@ -36,7 +36,8 @@ uint8_t srgbFromLinear(double l) {
 
 }  // namespace
 
-Result<Image> renderGroundTruth(const scene::Scene& scene, const GroundTruthOptions& g) {
+Result<Image> renderGroundTruth(const scene::Scene& scene, const GroundTruthOptions& g,
+                                Image* edges) {
   const RenderOptions& o = g.options;
   if (Status s = validate(o); !s) return s.error();
   if (Status s = scene::validate(scene, ""); !s) return s.error();
@@ -114,6 +115,7 @@ Result<Image> renderGroundTruth(const scene::Scene& scene, const GroundTruthOpti
   constexpr int kBand = 4;
   const int bands = (H + kBand - 1) / kBand;
   std::vector<double> linear(size_t(W) * H * 3);
+  std::vector<uint8_t> edge(size_t(W) * H);
   const double background[3] = {scene.background.x, scene.background.y, scene.background.z};
   core::ThreadPool pool(o.threads > 0 ? o.threads : 1);
   pool.parallelFor(size_t(bands), [&](size_t band, int) {
@@ -121,9 +123,11 @@ Result<Image> renderGroundTruth(const scene::Scene& scene, const GroundTruthOpti
     const size_t samples = size_t(yb1 - yb0) * W * S;
     std::vector<float> depth(samples, std::numeric_limits<float>::infinity());
     std::vector<float> color(samples * 3);
+    std::vector<int32_t> id(samples, -1);  // the triangle each sample shows; −1: background
     for (size_t i = 0; i < samples; ++i)
       for (int ch = 0; ch < 3; ++ch) color[i * 3 + ch] = float(background[ch]);
-    for (const Tri& t : tris) {
+    for (size_t ti = 0; ti < tris.size(); ++ti) {
+      const Tri& t = tris[ti];
       const int ty0 = std::max(t.y0, yb0), ty1 = std::min(t.y1, yb1 - 1);
       for (int y = ty0; y <= ty1; ++y)
         for (int x = t.x0; x <= t.x1; ++x)
@@ -145,13 +149,21 @@ Result<Image> renderGroundTruth(const scene::Scene& scene, const GroundTruthOpti
               const float zf = float(0.5 * (z + 1));
               if (!(zf < depth[s])) continue;
               depth[s] = zf;
+              id[s] = int32_t(ti);
               for (int ch = 0; ch < 3; ++ch)
                 color[s * 3 + ch] = float(
                     std::clamp((l[0] * t.color[0][ch] + l[1] * t.color[1][ch] +
                                 l[2] * t.color[2][ch]) / sum, 0.0, 1.0));
             }
     }
-    // The 1×1 box filter, in linear light.
+    // The 1×1 box filter, in linear light; and the edge mask.
+    for (int y = yb0; y < yb1; ++y)
+      for (int x = 0; x < W; ++x) {
+        const size_t base = (size_t(y - yb0) * W + x) * S;
+        bool mixed = false;
+        for (int s = 1; s < S; ++s) mixed |= id[base + size_t(s)] != id[base];
+        edge[size_t(y) * W + x] = mixed;
+      }
     for (int y = yb0; y < yb1; ++y)
       for (int x = 0; x < W; ++x)
         for (int ch = 0; ch < 3; ++ch) {
@@ -166,13 +178,23 @@ Result<Image> renderGroundTruth(const scene::Scene& scene, const GroundTruthOpti
   image.height = H;
   image.rgb.resize(linear.size());
   for (size_t i = 0; i < linear.size(); ++i) image.rgb[i] = srgbFromLinear(linear[i]);
+  if (edges) {
+    edges->width = W;
+    edges->height = H;
+    edges->rgb.assign(size_t(W) * H * 3, 0);
+    for (size_t i = 0; i < edge.size(); ++i)
+      if (edge[i]) std::fill_n(edges->rgb.begin() + ptrdiff_t(i * 3), 3, uint8_t(255));
+  }
   return image;
 }
 
-Result<ImageDifference> compareImages(const Image& a, const Image& b) {
+Result<ImageDifference> compareImages(const Image& a, const Image& b, const Image* mask) {
   if (a.width != b.width || a.height != b.height || a.rgb.size() != b.rgb.size())
     return Error{"", "", fmt::format("the images differ in size ({}x{} and {}x{})", a.width,
                                      a.height, b.width, b.height)};
+  if (mask && (mask->width != a.width || mask->height != a.height))
+    return Error{"", "", fmt::format("the edge mask is {}x{}, the images {}x{}", mask->width,
+                                     mask->height, a.width, a.height)};
   if (a.rgb.empty()) return Error{"", "", "the images are empty"};
   double lut[256];
   for (int i = 0; i < 256; ++i) lut[i] = linearFromSrgb(uint8_t(i));
@@ -182,8 +204,8 @@ Result<ImageDifference> compareImages(const Image& a, const Image& b) {
   for (int y = 0; y < H; ++y)
     for (int x = 0; x < W; ++x) {
       const size_t i = (size_t(y) * W + x) * 3;
-      bool edge = false;
-      for (int dy = -1; dy <= 1 && !edge; ++dy)
+      bool edge = mask && (mask->rgb[i] | mask->rgb[i + 1] | mask->rgb[i + 2]) != 0;
+      for (int dy = -1; dy <= 1 && !edge && !mask; ++dy)
         for (int dx = -1; dx <= 1 && !edge; ++dx) {
           const int nx = x + dx, ny = y + dy;
           if (nx < 0 || ny < 0 || nx >= W || ny >= H) continue;

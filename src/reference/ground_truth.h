@@ -22,17 +22,22 @@ struct GroundTruthOptions {
 };
 
 // Renders `scene`; the image is 8-bit sRGB like synthvis's. Slow by design: every sample of every
-// pixel a triangle's box covers is tested against it.
-Result<Image> renderGroundTruth(const scene::Scene& scene, const GroundTruthOptions& options);
+// pixel a triangle's box covers is tested against it. With `edges`, also writes the edge mask:
+// white where the pixel's samples do not all show the same triangle (or all the background) —
+// the pixels an edge crosses, where anti-aliasing matters.
+Result<Image> renderGroundTruth(const scene::Scene& scene, const GroundTruthOptions& options,
+                                Image* edges = nullptr);
 
 // Differences between two same-sized sRGB images, measured in linear light (each channel decoded
-// to [0, 1]). "Edge pixels" are those whose 3×3 neighbourhood in `reference` is not uniform (any
-// channel of a neighbour differs by more than one 8-bit level) — where anti-aliasing matters.
+// to [0, 1]). "Edge pixels" are the non-black pixels of `edgeMask` (from renderGroundTruth) when
+// one is given; otherwise those whose 3×3 neighbourhood in `reference` is not uniform (a
+// neighbour's channel differs by more than one 8-bit level), which also counts steep shading.
 struct ImageDifference {
   double rmse = 0, psnrDb = 0;          // over all pixels and channels
   double edgeRmse = 0, edgePsnrDb = 0;  // over edge pixels only
   size_t pixels = 0, edgePixels = 0;
 };
-Result<ImageDifference> compareImages(const Image& image, const Image& reference);
+Result<ImageDifference> compareImages(const Image& image, const Image& reference,
+                                      const Image* edgeMask = nullptr);
 
 }  // namespace sv::reference

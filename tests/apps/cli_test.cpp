@@ -146,9 +146,12 @@ TEST(Cli, GenWritesAGlbThatRenders) {
 TEST(Cli, TruthAndCompare) {
   const std::string truth = (tempDir() / "truth.png").string();
   const std::string ours = (tempDir() / "ours.png").string();
-  ASSERT_EQ(run("truth -o " + truth + " --width 64 --height 48 --samples 16").status, 0);
-  ASSERT_EQ(run("render -o " + ours + " --width 64 --height 48").status, 0);
-  const CliRun c = run("compare " + ours + " " + truth);
+  const std::string edges = (tempDir() / "edges.png").string();
+  ASSERT_EQ(run("truth -o " + truth + " --edges " + edges + " --width 64 --height 48 --samples 16")
+                .status,
+            0);
+  ASSERT_EQ(run("render -o " + ours + " --width 64 --height 48 --supersample 2").status, 0);
+  const CliRun c = run("compare " + ours + " " + truth + " --edges " + edges);
   EXPECT_EQ(c.status, 0) << c.out;
   EXPECT_NE(c.out.find("edge pixels"), std::string::npos) << c.out;
   expectOneLineError(run("truth -o " + truth + " --samples 3"), "", "must be a square");

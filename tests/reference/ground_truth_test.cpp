@@ -33,8 +33,15 @@ TEST(GroundTruth, CoverageOfAnEdgePixelIsTheAreaInside) {
   g.options.width = 40;
   g.options.height = 8;
   g.options.threads = 2;
-  auto img = renderGroundTruth(quadScene(40, 8, 10.5), g);
+  Image edges;
+  auto img = renderGroundTruth(quadScene(40, 8, 10.5), g, &edges);
   ASSERT_TRUE(img.ok()) << img.error().str();
+  // The edge mask: only column 10 is crossed by an edge (the quad's inner diagonal aside).
+  for (int y = 0; y < 8; ++y) {
+    EXPECT_EQ(edges.pixel(10, y)[0], 255);
+    EXPECT_EQ(edges.pixel(20, y)[0], 0);
+    EXPECT_EQ(edges.pixel(30, y)[0], 0);
+  }
   // Column 9 fully inside, 10 half (linear 0.5 → sRGB 188), 11 outside.
   for (int y = 0; y < 8; ++y) {
     EXPECT_EQ(img->pixel(9, y)[0], 255);
