@@ -74,12 +74,27 @@ int runRender(const RenderArgs& a) {
   return 0;
 }
 
-struct BenchArgs {
-  std::string scene;
-  std::string suite;
+// The parameters of BENCH.md's generators, shared by `bench` and `gen`.
+struct GeneratorArgs {
   sv::scene::TrisParams tris;
   int layers = 4;
   std::string order = "random";
+};
+
+void addGeneratorOptions(CLI::App* app, GeneratorArgs& g) {
+  app->add_option("--count", g.tris.count, "tris: number of triangles")->capture_default_str();
+  app->add_option("--area", g.tris.area, "tris: mean projected area, pixels")->capture_default_str();
+  app->add_option("--depth", g.tris.depth, "tris: depth complexity (0 = whole screen)")
+      ->capture_default_str();
+  app->add_option("--layers", g.layers, "layers: depth complexity D")->capture_default_str();
+  app->add_option("--order", g.order, "tris, layers: random, f2b or b2f")->capture_default_str();
+  app->add_option("--seed", g.tris.seed, "generator seed")->capture_default_str();
+}
+
+struct BenchArgs {
+  std::string scene;
+  std::string suite;
+  GeneratorArgs generator;
   std::string shade = "gouraud";
   std::string renderer;  // synthvis, gl or both; default synthvis for a scene, both for a suite
   std::string json;
@@ -102,6 +117,26 @@ const char* missingGenerator(const std::string& name) {
   return nullptr;
 }
 
+// The case for generator `kind` (tris or layers) with the given parameters; an error names a
+// generator that needs a later feature, or an unknown one.
+sv::Result<sv::reference::BenchCase> generatorCase(const std::string& kind, const GeneratorArgs& g) {
+  if (const char* needs = missingGenerator(kind))
+    return sv::Error{"", "", fmt::format("generator '{}' needs {}, not built yet", kind, needs)};
+  if (kind != "tris" && kind != "layers")
+    return sv::Error{"", "", fmt::format("unknown generator '{}' (tris, layers)", kind)};
+  auto order = sv::scene::parseSubmitOrder(g.order);
+  if (!order) return order.error();
+  sv::reference::BenchCase c;
+  c.name = kind;
+  c.generator = kind;
+  c.tris = g.tris;
+  c.tris.order = order.value();
+  c.layers.layers = g.layers;
+  c.layers.order = order.value();
+  c.layers.seed = g.tris.seed;
+  return c;
+}
+
 int runBench(BenchArgs a) {
   namespace ref = sv::reference;
   if (a.shade != "gouraud")
@@ -112,8 +147,8 @@ int runBench(BenchArgs a) {
   if (a.renderer.empty()) a.renderer = a.suite.empty() ? "synthvis" : "both";
   if (a.renderer != "synthvis" && a.renderer != "gl" && a.renderer != "both")
     return fail({"", "", fmt::format("unknown renderer '{}' (synthvis, gl or both)", a.renderer)});
-  auto order = sv::scene::parseSubmitOrder(a.order);
-  if (!order) return fail(order.error());
+  if (auto order = sv::scene::parseSubmitOrder(a.generator.order); !order)
+    return fail(order.error());
   if (a.aa != 0 && a.aa != 2 && a.aa != 4 && a.aa != 8 && a.aa != 16)
     return fail({"", "", fmt::format("--aa {}: samples per pixel must be 0, 2, 4, 8 or 16", a.aa)});
   // synthvis's anti-aliasing is issue 4; until then only the reference can multisample.
@@ -128,19 +163,12 @@ int runBench(BenchArgs a) {
     cases = std::move(c).value();
   } else {
     ref::BenchCase c;
-    c.name = a.scene;
-    if (a.scene == "tris") {
-      c.generator = "tris";
-      c.tris = a.tris;
-      c.tris.order = order.value();
-    } else if (a.scene == "layers") {
-      c.generator = "layers";
-      c.layers.layers = a.layers;
-      c.layers.order = order.value();
-      c.layers.seed = a.tris.seed;
-    } else if (const char* needs = missingGenerator(a.scene)) {
-      return fail({"", "", fmt::format("generator '{}' needs {}, not built yet", a.scene, needs)});
+    if (a.scene == "tris" || a.scene == "layers" || missingGenerator(a.scene)) {
+      auto g = generatorCase(a.scene, a.generator);
+      if (!g) return fail(g.error());
+      c = g.value();
     } else {
+      c.name = a.scene;
       c.file = a.scene;
     }
     cases.push_back(c);
@@ -208,33 +236,20 @@ int runBench(BenchArgs a) {
 struct GenArgs {
   std::string kind;
   std::string output;
-  sv::scene::TrisParams tris;
-  int layers = 4;
-  std::string order = "random";
+  GeneratorArgs generator;
   int width = 1920, height = 1080;
 };
 
 // `synthvis gen KIND -o scene.glb`: a BENCH.md scene as glTF, for other renderers.
 int runGen(const GenArgs& a) {
-  auto order = sv::scene::parseSubmitOrder(a.order);
-  if (!order) return fail(order.error());
-  if (const char* needs = missingGenerator(a.kind))
-    return fail({"", "", fmt::format("generator '{}' needs {}, not built yet", a.kind, needs)});
   if (a.width < 1 || a.width > sv::kMaxRasterSize || a.height < 1 || a.height > sv::kMaxRasterSize)
     return fail({"", "", "width and height must be 1…8192"});
-  sv::reference::BenchCase c;
-  c.generator = a.kind;
-  c.tris = a.tris;
-  c.tris.order = order.value();
-  c.layers.layers = a.layers;
-  c.layers.order = order.value();
-  c.layers.seed = a.tris.seed;
-  if (a.kind != "tris" && a.kind != "layers")
-    return fail({"", "", fmt::format("unknown generator '{}' (tris, layers)", a.kind)});
+  auto c = generatorCase(a.kind, a.generator);
+  if (!c) return fail(c.error());
   sv::RenderOptions o;
   o.width = a.width;
   o.height = a.height;
-  auto made = sv::reference::makeScene(c, o);
+  auto made = sv::reference::makeScene(c.value(), o);
   if (!made) return fail(made.error());
   if (sv::Status s = sv::scene::saveGltf(made.value().scene, a.output); !s) return fail(s.error());
   fmt::print("{}: {} {} triangles, mean area {:.1f} px at {}x{}, depth complexity {:.2f}\n",
@@ -332,13 +347,7 @@ int main(int argc, char** argv) {
   CLI::App* bench = app.add_subcommand("bench", "time whole frames of a benchmark scene (BENCH.md)");
   bench->add_option("scene", b.scene, "generator (tris, layers) or scene file");
   bench->add_option("--suite", b.suite, "a named suite of scenes: quick or full");
-  bench->add_option("--layers", b.layers, "layers: depth complexity D")->capture_default_str();
-  bench->add_option("--count", b.tris.count, "tris: number of triangles")->capture_default_str();
-  bench->add_option("--area", b.tris.area, "tris: mean projected area, pixels")->capture_default_str();
-  bench->add_option("--depth", b.tris.depth, "tris: depth complexity (0 = whole screen)")
-      ->capture_default_str();
-  bench->add_option("--order", b.order, "tris, layers: random, f2b or b2f")->capture_default_str();
-  bench->add_option("--seed", b.tris.seed, "generator seed")->capture_default_str();
+  addGeneratorOptions(bench, b.generator);
   bench->add_option("--shade", b.shade, "gouraud")->capture_default_str();
   bench->add_option("--width", b.options.width, "image width")->capture_default_str();
   bench->add_option("--height", b.options.height, "image height")->capture_default_str();
@@ -363,13 +372,7 @@ int main(int argc, char** argv) {
   CLI::App* gen = app.add_subcommand("gen", "write a BENCH.md scene as glTF (.glb or .gltf)");
   gen->add_option("kind", g.kind, "generator: tris or layers")->required();
   gen->add_option("-o,--output", g.output, "output file (.glb or .gltf)")->required();
-  gen->add_option("--count", g.tris.count, "tris: number of triangles")->capture_default_str();
-  gen->add_option("--area", g.tris.area, "tris: mean projected area, pixels")->capture_default_str();
-  gen->add_option("--depth", g.tris.depth, "tris: depth complexity (0 = whole screen)")
-      ->capture_default_str();
-  gen->add_option("--layers", g.layers, "layers: depth complexity D")->capture_default_str();
-  gen->add_option("--order", g.order, "random, f2b or b2f")->capture_default_str();
-  gen->add_option("--seed", g.tris.seed, "generator seed")->capture_default_str();
+  addGeneratorOptions(gen, g.generator);
   gen->add_option("--width", g.width, "the raster the areas refer to")->capture_default_str();
   gen->add_option("--height", g.height, "the raster the areas refer to")->capture_default_str();
 
