@@ -129,6 +129,7 @@ Plane makePlane(const double g[3][3], const double f[3], double scale, double px
 struct ScreenVertex {
   int32_t x = 0, y = 0;  // 24.8
   bool snapped = false;
+  double invW = 0;  // 1/w, kept for the parameter planes when snapped
 };
 
 // Always inlined into setup: called out of line, its 12-byte result went back through the stack
@@ -140,6 +141,7 @@ struct ScreenVertex {
   const double invW = 1.0 / c.w;
   const double px = (double(c.x) + c.w) * (0.5 * viewport.width) * invW;
   const double py = (double(c.w) - c.y) * (0.5 * viewport.height) * invW;
+  s.invW = invW;
   if (std::fabs(px) < kGuardBand && std::fabs(py) < kGuardBand) {
     s.x = static_cast<int32_t>(std::lrint(px * kSubPixelScale));  // 24.8
     s.y = static_cast<int32_t>(std::lrint(py * kSubPixelScale));
@@ -263,7 +265,7 @@ SetupOutcome setupTriangle(const ClipVertex& v0, const ClipVertex& v1, const Cli
       g[k][0] = double(intEdge[k][0]) * kSubPixelScale;
       g[k][1] = double(intEdge[k][1]) * kSubPixelScale;
       g[k][2] = double(intEdge[k][2]);
-      invW[k] = 1.0 / v[k]->w;
+      invW[k] = sv[k]->invW;
     }
     scale = 1.0 / double(area2);
   } else {

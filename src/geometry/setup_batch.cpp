@@ -52,7 +52,7 @@ size_t SetupTriangles(const ClipVertex* vertices, const uint32_t* indices, size_
         }
       // Step 1 (setup.cpp steps 1–3 and snapVertex): the common case, and the snapped positions.
       auto common = hn::Eq(zero, zero);
-      hn::Vec<decltype(d)> sx[3], sy[3], x[3], y[3], z[3], w[3];
+      hn::Vec<decltype(d)> sx[3], sy[3], x[3], y[3], z[3], w[3], invW[3];
       auto outLeft = common, outRight = common, outBottom = common, outTop = common;
       for (int k = 0; k < 3; ++k) {
         x[k] = hn::Load(d, in[k][0]);
@@ -68,9 +68,9 @@ size_t SetupTriangles(const ClipVertex* vertices, const uint32_t* indices, size_
         outRight = hn::And(outRight, hn::Gt(x[k], w[k]));
         outBottom = hn::And(outBottom, hn::Lt(y[k], hn::Neg(w[k])));
         outTop = hn::And(outTop, hn::Gt(y[k], w[k]));
-        const auto invW = hn::Div(one, w[k]);
-        const auto px = hn::Mul(hn::Mul(hn::Add(x[k], w[k]), halfW), invW);
-        const auto py = hn::Mul(hn::Mul(hn::Sub(w[k], y[k]), halfH), invW);
+        invW[k] = hn::Div(one, w[k]);  // the snapping's and, in step 8, the planes' 1/w
+        const auto px = hn::Mul(hn::Mul(hn::Add(x[k], w[k]), halfW), invW[k]);
+        const auto py = hn::Mul(hn::Mul(hn::Sub(w[k], y[k]), halfH), invW[k]);
         common = hn::And(common, hn::And(hn::Lt(hn::Abs(px), guard), hn::Lt(hn::Abs(py), guard)));
         sx[k] = hn::Round(hn::Mul(px, sub));  // lrint: to nearest, ties to even
         sy[k] = hn::Round(hn::Mul(py, sub));
@@ -116,12 +116,11 @@ size_t SetupTriangles(const ClipVertex* vertices, const uint32_t* indices, size_
         hn::Store(b, d, o[r++]);
       }
       // Step 8: parameter planes λ_k = edge_k(p) / (w_k·area2), relative to (minX, minY) + ½.
-      hn::Vec<decltype(d)> g[3][3], invW[3];
+      hn::Vec<decltype(d)> g[3][3];
       for (int k = 0; k < 3; ++k) {
         g[k][0] = hn::Mul(A[k], sub);
         g[k][1] = hn::Mul(B[k], sub);
         g[k][2] = C[k];
-        invW[k] = hn::Div(one, w[k]);
       }
       const auto scale = hn::Div(one, area2);
       const auto px0 = hn::Add(bx0, half), py0 = hn::Add(by0, half);

@@ -163,7 +163,6 @@ class TriangleRaster {
       sY_[k] = T(e.stepY());
       pos_[k] = std::max<T>(sX_[k], 0) + std::max<T>(sY_[k], 0);
       neg_[k] = std::min<T>(sX_[k], 0) + std::min<T>(sY_[k], 0);
-      // e at the 16 pixel centres of a block, relative to its top-left one.
       // e at the 16 pixel centres of a block, relative to its top-left one: sX·lx + sY·ly.
       if constexpr (sizeof(T) == 4) {
         const hn::CappedTag<T, kBlockPixels> d;
