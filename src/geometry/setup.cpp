@@ -223,7 +223,7 @@ SetupOutcome setupTriangle(const ClipVertex& v0, const ClipVertex& v1, const Cli
   if ((cull == CullMode::back && !front) || (cull == CullMode::front && front))
     return SetupOutcome::culledFacing;
 
-  // Step 6: bounding box of pixel centres. Only snapped triangles have a trustworthy one: with a
+  // Step 6: bounding box of the pixels reached (centres, or squares with an aperture). Only snapped triangles have a trustworthy one: with a
   // vertex behind the eye the projected corners do not bound the triangle (pitfall 7), so the
   // subdivision starts from the whole raster, as SPEC §3 does.
   int64_t minX = 0, minY = 0, maxX = viewport.width - 1, maxY = viewport.height - 1;
@@ -231,11 +231,12 @@ SetupOutcome setupTriangle(const ClipVertex& v0, const ClipVertex& v1, const Cli
   if (allSnapped) {
     const int64_t x0 = std::min({sx[0], sx[1], sx[2]}), x1 = std::max({sx[0], sx[1], sx[2]});
     const int64_t y0 = std::min({sy[0], sy[1], sy[2]}), y1 = std::max({sy[0], sy[1], sy[2]});
-    // Pixel px's centre is at 256·px + 128.
-    minX = std::max<int64_t>(minX, -floorDiv(kHalfPixel - x0, kSubPixelScale));
-    maxX = std::min<int64_t>(maxX, floorDiv(x1 - kHalfPixel, kSubPixelScale));
-    minY = std::max<int64_t>(minY, -floorDiv(kHalfPixel - y0, kSubPixelScale));
-    maxY = std::min<int64_t>(maxY, floorDiv(y1 - kHalfPixel, kSubPixelScale));
+    // Pixel px's centre is at 256·px + 128; its square spans [256·px, 256·px + 256).
+    const int64_t low = boxInsetLow(viewport), high = boxInsetHigh(viewport);
+    minX = std::max<int64_t>(minX, -floorDiv(low - x0, kSubPixelScale));
+    maxX = std::min<int64_t>(maxX, floorDiv(x1 - high, kSubPixelScale));
+    minY = std::max<int64_t>(minY, -floorDiv(low - y0, kSubPixelScale));
+    maxY = std::min<int64_t>(maxY, floorDiv(y1 - high, kSubPixelScale));
     out.small = !needNear && !needFar &&
                 std::max(x1 - x0, y1 - y0) <= int64_t(kSmallExtent) * kSubPixelScale;
   }

@@ -64,7 +64,17 @@ enum class CullMode : uint8_t { none, back, front };
 struct Viewport {
   int width = 0;   // 1 … kMaxRasterSize
   int height = 0;  // 1 … kMaxRasterSize
+  // Anti-aliasing (SPEC §3.2, aperture α = β = 1): a triangle reaches every pixel whose square it
+  // touches — where its sub-pixel samples lie — rather than only those whose centre it covers.
+  // Widens the bounding box (and so the binning) by up to one pixel on each side.
+  bool pixelAperture = false;
 };
+
+// The bounding box of pixels a triangle can reach spans [ceil((x0 − low)/256), floor((x1 − high)/
+// 256)] for snapped extremes x0, x1 (24.8): centres at 256·p + 128 give low = high = 128; pixel
+// squares [256·p, 256·p + 256) with samples strictly inside give low = 255, high = 1.
+inline int boxInsetLow(const Viewport& v) { return v.pixelAperture ? kSubPixelScale - 1 : kSubPixelScale / 2; }
+inline int boxInsetHigh(const Viewport& v) { return kSubPixelScale - boxInsetLow(v); }
 
 // 144 bytes: the record the tiles read for every triangle, so kept small (cache misses on it are
 // a large part of the cost of small triangles).

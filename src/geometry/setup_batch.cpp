@@ -43,6 +43,8 @@ size_t SetupTriangles(const ClipVertex* vertices, const uint32_t* indices, size_
     const auto maxX = hn::Set(d, double(viewport.width - 1)),
                maxY = hn::Set(d, double(viewport.height - 1));
     const auto inv256 = hn::Set(d, 1.0 / kSubPixelScale);
+    const auto insetLow = hn::Set(d, double(boxInsetLow(viewport))),
+               insetHigh = hn::Set(d, double(boxInsetHigh(viewport)));
     for (; t + N <= count; t += N) {
       for (size_t l = 0; l < N; ++l)
         for (int k = 0; k < 3; ++k) {
@@ -93,15 +95,15 @@ size_t SetupTriangles(const ClipVertex* vertices, const uint32_t* indices, size_
       auto facing = hn::Eq(one, zero);
       if (cull == CullMode::back) facing = positive;
       if (cull == CullMode::front) facing = negative;
-      // Step 6: the bounding box of pixel centres (pixel p's centre is at 256·p + 128).
+      // Step 6: the bounding box of the pixels reached (setup.h, boxInsetLow).
       const auto x0 = hn::Min(hn::Min(sx[0], sx[1]), sx[2]),
                  x1 = hn::Max(hn::Max(sx[0], sx[1]), sx[2]);
       const auto y0 = hn::Min(hn::Min(sy[0], sy[1]), sy[2]),
                  y1 = hn::Max(hn::Max(sy[0], sy[1]), sy[2]);
-      const auto bx0 = hn::Max(zero, hn::Neg(hn::Floor(hn::Mul(hn::Sub(halfPixel, x0), inv256))));
-      const auto bx1 = hn::Min(maxX, hn::Floor(hn::Mul(hn::Sub(x1, halfPixel), inv256)));
-      const auto by0 = hn::Max(zero, hn::Neg(hn::Floor(hn::Mul(hn::Sub(halfPixel, y0), inv256))));
-      const auto by1 = hn::Min(maxY, hn::Floor(hn::Mul(hn::Sub(y1, halfPixel), inv256)));
+      const auto bx0 = hn::Max(zero, hn::Neg(hn::Floor(hn::Mul(hn::Sub(insetLow, x0), inv256))));
+      const auto bx1 = hn::Min(maxX, hn::Floor(hn::Mul(hn::Sub(x1, insetHigh), inv256)));
+      const auto by0 = hn::Max(zero, hn::Neg(hn::Floor(hn::Mul(hn::Sub(insetLow, y0), inv256))));
+      const auto by1 = hn::Min(maxY, hn::Floor(hn::Mul(hn::Sub(y1, insetHigh), inv256)));
       const auto empty = hn::Or(hn::Gt(bx0, bx1), hn::Gt(by0, by1));
       const auto isSmall = hn::Le(hn::Max(hn::Sub(x1, x0), hn::Sub(y1, y0)), small);
       // Step 7: oriented edges with the fill rule folded in (setup.cpp, toPixelEdge).

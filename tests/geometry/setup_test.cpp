@@ -223,6 +223,44 @@ TEST(Setup, EdgesAreExactOnTheLargestRaster) {
 // setupTriangles (SIMD lanes) must give setupTriangle's records bit for bit, on every SIMD target,
 // in every regime: small and large, culled either way, degenerate, behind and across the eye,
 // beyond the far plane, outside the guard band, NaN and infinite.
+// SPEC §3.2 with the pixel aperture: the box holds exactly the pixels whose square [p, p + 1)
+// the vertices' extent reaches, so no pixel with a covered sample is left out of binning.
+TEST(Setup, ApertureBoxSpansEveryPixelSquareTheTriangleReaches) {
+  const int w = 64, h = 48;
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<int> coord(-300, 64 * 256 + 300);
+  for (int t = 0; t < 2000; ++t) {
+    int64_t x[3], y[3];
+    ClipVertex v[3];
+    for (int k = 0; k < 3; ++k) {
+      x[k] = coord(rng) % (w * 256);
+      y[k] = coord(rng) % (h * 256);
+      if (t % 3 == 0) x[k] = x[k] / 256 * 256;  // on pixel borders
+      v[k] = pixelVertex(x[k] / 256.0, y[k] / 256.0, w, h);
+    }
+    TriangleSetup point, aperture;
+    const auto o1 = geometry::setupTriangle(v[0], v[1], v[2], {w, h, false}, geometry::CullMode::none, point);
+    const auto o2 = geometry::setupTriangle(v[0], v[1], v[2], {w, h, true}, geometry::CullMode::none, aperture);
+    if (o2 != geometry::SetupOutcome::drawn) {
+      EXPECT_NE(o1, geometry::SetupOutcome::drawn) << t;  // the aperture only ever adds pixels
+      continue;
+    }
+    auto floorDiv = [](int64_t a) { return a >= 0 ? a / 256 : -((-a + 255) / 256); };
+    const int64_t x0 = std::min({x[0], x[1], x[2]}), x1 = std::max({x[0], x[1], x[2]});
+    const int64_t y0 = std::min({y[0], y[1], y[2]}), y1 = std::max({y[0], y[1], y[2]});
+    EXPECT_EQ(aperture.minX, std::max<int64_t>(0, floorDiv(x0))) << t;
+    EXPECT_EQ(aperture.maxX, std::min<int64_t>(w - 1, -floorDiv(-x1) - 1)) << t;
+    EXPECT_EQ(aperture.minY, std::max<int64_t>(0, floorDiv(y0))) << t;
+    EXPECT_EQ(aperture.maxY, std::min<int64_t>(h - 1, -floorDiv(-y1) - 1)) << t;
+    if (o1 == geometry::SetupOutcome::drawn) {
+      EXPECT_LE(aperture.minX, point.minX);
+      EXPECT_GE(aperture.maxX, point.maxX);
+      EXPECT_LE(aperture.minY, point.minY);
+      EXPECT_GE(aperture.maxY, point.maxY);
+    }
+  }
+}
+
 TEST(Setup, BatchedSetupEqualsOneByOneOnEveryTarget) {
   const int w = 1000, h = 700;
   std::mt19937 rng(17);
@@ -251,17 +289,19 @@ TEST(Setup, BatchedSetupEqualsOneByOneOnEveryTarget) {
   int targets = 0;
   for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
     hwy::SetSupportedTargetsForTest(target);
-    for (geometry::CullMode cull :
-         {geometry::CullMode::none, geometry::CullMode::back, geometry::CullMode::front}) {
+    for (int mode = 0; mode < 4; ++mode) {
+      // Every culling mode with point sampling, and back-face culling with the pixel aperture.
+      const geometry::CullMode cull = mode == 3 ? geometry::CullMode::back : geometry::CullMode(mode);
+      const geometry::Viewport vp{w, h, mode == 3};
       std::vector<TriangleSetup> one, batch(count);
       uint64_t oneOutcomes[geometry::kSetupOutcomes] = {}, batchOutcomes[geometry::kSetupOutcomes] = {};
       for (size_t t = 0; t < count; ++t) {
         TriangleSetup s;
-        const auto o = geometry::setupTriangle(v[3 * t], v[3 * t + 1], v[3 * t + 2], {w, h}, cull, s);
+        const auto o = geometry::setupTriangle(v[3 * t], v[3 * t + 1], v[3 * t + 2], vp, cull, s);
         ++oneOutcomes[int(o)];
         if (o == geometry::SetupOutcome::drawn) one.push_back(s);
       }
-      const size_t n = geometry::setupTriangles(v.data(), indices.data(), count, {w, h}, cull,
+      const size_t n = geometry::setupTriangles(v.data(), indices.data(), count, vp, cull,
                                                 batch.data(), batchOutcomes);
       ASSERT_EQ(n, one.size()) << hwy::TargetName(target);
       for (int o = 0; o < geometry::kSetupOutcomes; ++o)
