@@ -61,9 +61,12 @@ const SamplePattern* samplePattern(int count) {
 EdgeMaskTable::EdgeMaskTable(const SamplePattern& pattern)
     : count_(pattern.count),
       all_(pattern.count >= 64 ? ~uint64_t(0) : (uint64_t(1) << pattern.count) - 1),
-      table_(size_t(4) * kSlopeSteps * kDistanceSteps) {
+      table_(size_t(kRows) * kRowEntries) {
   for (int q = 0; q < 4; ++q)
-    for (int i = 0; i < kSlopeSteps; ++i)
+    for (int i = 0; i < kSlopeSteps; ++i) {
+      uint64_t* row = table_.data() + size_t(rowIndex(q, i)) * kRowEntries;
+      row[0] = 0;
+      row[kRowEntries - 1] = all_;
       for (int j = 0; j < kDistanceSteps; ++j) {
         // The cell's centre; all dyadic, so the reversed edge's values are exact negations.
         const double t = (i + 0.5) / kSlopeSteps;
@@ -75,12 +78,16 @@ EdgeMaskTable::EdgeMaskTable(const SamplePattern& pattern)
           const double v = nx * o[0] + ny * o[1] + d;
           if (v > 0 || (v == 0 && ownsTie(nx, ny))) m |= uint64_t(1) << s;
         }
-        table_[(size_t(q) * kSlopeSteps + size_t(i)) * kDistanceSteps + size_t(j)] = m;
+        row[1 + j] = m;
       }
+    }
+  uint64_t* constant = table_.data() + size_t(kConstantRow) * kRowEntries;
+  for (int j = 0; j < kRowEntries; ++j) constant[j] = j < kRowEntries / 2 ? 0 : all_;
 }
 
 uint64_t EdgeMaskTable::mask(double a, double b, double c) const {
   const double norm = std::fabs(a) + std::fabs(b);
+  if (norm == 0) return c > 0 ? all_ : 0;
   const double d = c / norm;
   if (d >= 0.5) return all_;  // every sample is within ½ (L1) of the centre
   if (d <= -0.5) return 0;
@@ -93,6 +100,29 @@ uint64_t EdgeMaskTable::mask(double a, double b, double c) const {
   else
     distance = std::max(0, kDistanceSteps / 2 - 1 - int(-d * kDistanceSteps));
   return entry(quadrant, slope, distance);
+}
+
+CoverageTables::CoverageTables(const SamplePattern& p)
+    : samples(p.count), words(p.count > 32 ? 2 : 1), pattern(&p), table(p) {
+  for (int w = 0; w < words; ++w) {
+    word[w].resize(size_t(EdgeMaskTable::kRows) * EdgeMaskTable::kRowEntries);
+    for (int r = 0; r < EdgeMaskTable::kRows; ++r)
+      for (int j = 0; j < EdgeMaskTable::kRowEntries; ++j)
+        word[w][size_t(r) * EdgeMaskTable::kRowEntries + size_t(j)] =
+            uint32_t(table.row(r)[j] >> (32 * w));
+  }
+}
+
+const CoverageTables* CoverageTables::forCount(int samples) {
+  static const CoverageTables four(*samplePattern(4)), eight(*samplePattern(8)),
+      sixteen(*samplePattern(16)), sixtyFour(*samplePattern(64));
+  switch (samples) {
+    case 4: return &four;
+    case 8: return &eight;
+    case 16: return &sixteen;
+    case 64: return &sixtyFour;
+    default: return nullptr;
+  }
 }
 
 }  // namespace sv::raster

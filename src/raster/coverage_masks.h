@@ -1,6 +1,5 @@
-// Sub-pixel coverage masks from tables (SPEC §5, seed 000) — the first part of anti-aliasing
-// (issue 4). Not yet used by the tile kernel; tests/raster/coverage_masks_test.cpp pins down the
-// properties the kernel will rely on.
+// Sub-pixel coverage masks from tables (SPEC §5, seed 000), read by the tile kernel when
+// anti-aliasing; tests/raster/coverage_masks_test.cpp pins down the properties it relies on.
 //
 // A pixel carries N sample positions (a documented pattern per N). For one edge the mask of the
 // samples inside it is read from a table indexed by the edge's slope and its distance to the pixel
@@ -48,6 +47,10 @@ class EdgeMaskTable {
   static constexpr int kSlopeSteps = 32;
   static constexpr int kDistanceSteps = 64;
   static constexpr double kMaxError = 0.5 / kSlopeSteps + 0.5 / kDistanceSteps;
+  // A row holds one (quadrant, slope): [0] = no sample (d ≤ −½), [1 + j] = distance cell j,
+  // [kRowEntries − 1] = every sample (d ≥ ½) — so the kernel indexes it without range checks.
+  static constexpr int kRowEntries = kDistanceSteps + 2;
+  static constexpr int kRows = 4 * kSlopeSteps + 1;  // the last row: constant edges, below
 
   explicit EdgeMaskTable(const SamplePattern& pattern);
 
@@ -55,21 +58,43 @@ class EdgeMaskTable {
   uint64_t allSamples() const { return all_; }
 
   // The mask of the samples inside a·x + b·y + c ≥ 0 (pixel units, relative to the pixel centre).
-  // (a, b) must not be (0, 0).
+  // (a, b) = (0, 0) is a constant edge: every sample when c > 0, none otherwise (the tie rule of a
+  // zero normal gives the boundary to neither side).
   uint64_t mask(double a, double b, double c) const;
 
-  // The table itself: entry(quadrant, slope, distance); quadrant bit 0 = a negative, bit 1 = b
-  // negative (a zero coefficient counts with the sign of the other one, so that reversing an edge
-  // flips both bits).
+  // The table itself: entry(quadrant, slope, distance cell); quadrant bit 0 = a negative, bit 1 =
+  // b negative (a zero coefficient counts with the sign of the other one, so that reversing an
+  // edge flips both bits).
   uint64_t entry(int quadrant, int slope, int distance) const {
-    return table_[(size_t(quadrant) * kSlopeSteps + size_t(slope)) * kDistanceSteps +
-                  size_t(distance)];
+    return table_[size_t(rowIndex(quadrant, slope)) * kRowEntries + 1 + size_t(distance)];
   }
+  static int rowIndex(int quadrant, int slope) { return quadrant * kSlopeSteps + slope; }
+  // The row for (0, 0): entries up to the d = 0 cell (index kRowEntries/2 − 1) are empty, the rest
+  // full, so an integer edge value E gives every sample iff E > 0 (tests/raster shows the index).
+  static constexpr int kConstantRow = kRows - 1;
+  // Row r's kRowEntries masks, for the kernel.
+  const uint64_t* row(int r) const { return table_.data() + size_t(r) * kRowEntries; }
 
  private:
   int count_;
   uint64_t all_;
   std::vector<uint64_t> table_;
+};
+
+// The tables the tile kernel gathers from, per sample count: the EdgeMaskTable's rows as 32-bit
+// words (word w holds samples 32·w … 32·w + 31; one word up to 32 samples, two for 64).
+struct CoverageTables {
+  int samples = 0;
+  int words = 0;
+  const SamplePattern* pattern = nullptr;
+  EdgeMaskTable table;
+  std::vector<uint32_t> word[2];  // kRows × kRowEntries each
+
+  // Built once per count on first use (thread-safe); nullptr for a count without a pattern.
+  static const CoverageTables* forCount(int samples);
+
+ private:
+  explicit CoverageTables(const SamplePattern& p);
 };
 
 }  // namespace sv::raster

@@ -7,6 +7,10 @@
 // the rasterizer's leaf, is one contiguous run of 16 values, one or a few SIMD vectors.
 // Colour is planar per block (16 R, 16 G, 16 B, as uint16 linear light 0…65535), so the kernels never
 // interleave; output applies gamma through look-up tables (SPEC §8).
+// With N samples per pixel (anti-aliasing, SPEC §5) a block holds N such *sample planes* one after
+// the other: plane s is the 16 pixels' sample s, laid out exactly as a 1-sample block. The kernel
+// then tests depth and writes colour one plane — 16 pixels — per vector, and the resolve sums the
+// planes. Memory per pixel: N × (4 bytes of depth + 6 of colour).
 #pragma once
 
 #include <cstddef>
@@ -28,42 +32,51 @@ inline constexpr int kColorPerBlock = kBlockPixels * kColorChannels;
 
 class FrameBuffer {
  public:
-  // Allocates for a width × height raster (1 … 8192 each; checked by the caller).
-  void resize(int width, int height);
+  // Allocates for a width × height raster (1 … 8192 each; checked by the caller) of `samples`
+  // samples per pixel (1 … 64).
+  void resize(int width, int height, int samples = 1);
 
   int width() const { return width_; }
   int height() const { return height_; }
+  int samples() const { return samples_; }
   int tilesX() const { return tilesX_; }
   int tilesY() const { return tilesY_; }
   int tileCount() const { return tilesX_ * tilesY_; }
 
-  float* tileDepth(int tile) { return depth_.get() + size_t(tile) * kTilePixels; }
-  uint16_t* tileColor(int tile) { return color_.get() + size_t(tile) * kTilePixels * kColorChannels; }
-  const float* tileDepth(int tile) const { return depth_.get() + size_t(tile) * kTilePixels; }
+  float* tileDepth(int tile) { return depth_.get() + size_t(tile) * kTilePixels * samples_; }
+  uint16_t* tileColor(int tile) {
+    return color_.get() + size_t(tile) * kTilePixels * kColorChannels * samples_;
+  }
+  const float* tileDepth(int tile) const {
+    return depth_.get() + size_t(tile) * kTilePixels * samples_;
+  }
   const uint16_t* tileColor(int tile) const {
-    return color_.get() + size_t(tile) * kTilePixels * kColorChannels;
+    return color_.get() + size_t(tile) * kTilePixels * kColorChannels * samples_;
   }
 
-  // Offsets of pixel (x, y) inside its tile's depth and colour arrays.
-  static size_t depthOffset(int x, int y);
-  static size_t colorOffset(int x, int y, int channel);
+  // Offsets of sample s of pixel (x, y) inside its tile's depth and colour arrays, for a buffer of
+  // `samples` samples per pixel.
+  static size_t depthOffset(int x, int y, int samples = 1, int s = 0);
+  static size_t colorOffset(int x, int y, int channel, int samples = 1, int s = 0);
 
  private:
-  int width_ = 0, height_ = 0, tilesX_ = 0, tilesY_ = 0;
+  int width_ = 0, height_ = 0, samples_ = 1, tilesX_ = 0, tilesY_ = 0;
+  size_t capacity_ = 0;  // pixels × samples allocated
   hwy::AlignedFreeUniquePtr<float[]> depth_;
   hwy::AlignedFreeUniquePtr<uint16_t[]> color_;
 };
 
-inline size_t FrameBuffer::depthOffset(int x, int y) {
+inline size_t FrameBuffer::depthOffset(int x, int y, int samples, int s) {
   int lx = x & (kTileSize - 1), ly = y & (kTileSize - 1);
   int block = (ly >> kBlockLog2) * kBlocksPerTileSide + (lx >> kBlockLog2);
-  return size_t(block) * kBlockPixels + (ly & (kBlockSize - 1)) * kBlockSize + (lx & (kBlockSize - 1));
+  return (size_t(block) * samples + size_t(s)) * kBlockPixels + (ly & (kBlockSize - 1)) * kBlockSize +
+         (lx & (kBlockSize - 1));
 }
 
-inline size_t FrameBuffer::colorOffset(int x, int y, int channel) {
+inline size_t FrameBuffer::colorOffset(int x, int y, int channel, int samples, int s) {
   int lx = x & (kTileSize - 1), ly = y & (kTileSize - 1);
   int block = (ly >> kBlockLog2) * kBlocksPerTileSide + (lx >> kBlockLog2);
-  return size_t(block) * kColorPerBlock + channel * kBlockPixels +
+  return (size_t(block) * samples + size_t(s)) * kColorPerBlock + channel * kBlockPixels +
          (ly & (kBlockSize - 1)) * kBlockSize + (lx & (kBlockSize - 1));
 }
 

@@ -7,6 +7,7 @@
 #include <cstdint>
 
 #include "geometry/setup.h"
+#include "raster/coverage_masks.h"
 
 namespace sv::raster {
 
@@ -17,7 +18,8 @@ struct RasterStats {
   uint64_t windows[kStatLevels] = {};  // windows tested per level (each child of a split counts)
   uint64_t fullWindows = 0;            // covered windows filled without further subdivision
   uint64_t partialBlocks = 0;          // 4×4 leaves tested pixel by pixel
-  uint64_t fragments = 0;              // pixels that passed coverage and reached the depth test
+  uint64_t fragments = 0;              // pixels that passed coverage (some sample, with
+                                       // anti-aliasing) and reached the depth test
 
   void add(const RasterStats& o) {
     for (int i = 0; i < kStatLevels; ++i) windows[i] += o.windows[i];
@@ -46,6 +48,11 @@ struct TileWork {
   const uint32_t* listSizes = nullptr;
   int listCount = 0;
   ShadeMode shade = ShadeMode::gouraud;
+  // Anti-aliasing (SPEC §5): N = coverage->samples samples per pixel, each triangle's sub-pixel
+  // mask per pixel from the tables, depth tested per sample, colour shaded once per pixel at its
+  // centre. The triangles must be set up with Viewport::pixelAperture and the buffers hold N sample
+  // planes (framebuffer.h). nullptr: point sampling at pixel centres. Gouraud only.
+  const CoverageTables* coverage = nullptr;
 };
 
 // Draws the tile's triangles as `work.shade` says. Runs the best SIMD

@@ -18,6 +18,16 @@
 //
 // Departure from the seed: the last two levels (2×2 and 1×1 windows) are unrolled into one 4×4 leaf
 // whose 16 pixel centres are tested at once in SIMD lanes; the result is the same set of pixels.
+//
+// Anti-aliasing (SPEC §3.2 aperture α = β = 1, §5 masks). With N samples per pixel the windows are
+// the pixel *squares* rather than their centres: in the geometric edge value E = e + bias (e with
+// the fill rule's −1 taken back out) and N1 = |sX| + |sY| = 256·S, S = |a| + |b|, a pixel lies
+// wholly outside the edge iff E ≤ −N1/2 and wholly inside iff E ≥ N1/2 (every sample is within ½
+// of the centre in the L1 norm), so the window tests gain the constants H − 1 + bias and −H + bias
+// (H = N1/2 = 128·S). A leaf pixel reads each crossing edge's mask from the row (sign quadrant,
+// slope ⌊32·|a|/S⌋) of coverage_masks.h at distance cell q = ⌊|E| / (4·S)⌋ = ⌊64·|E|/N1⌋, mirrored
+// for negative E exactly as EdgeMaskTable::mask does, so reversed edges read complementary masks;
+// q is estimated in float and corrected exactly in integers. The pixel's mask is the AND.
 
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "raster/tile_kernel.cpp"
@@ -56,6 +66,8 @@ struct TileContext {
   float* depth;
   uint16_t* color;
   RasterStats* stats;
+  const CoverageTables* coverage;  // anti-aliasing, or nullptr
+  int samples;                     // per pixel: 1, or coverage->samples
 };
 
 // Parameters are evaluated per 4×4 block as base + offset: base = (c0 + dx·X) + dy·Y at the block's
@@ -100,6 +112,30 @@ HWY_INLINE void countBlock(uint32_t mask, uint16_t* color) {
   for (; mask; mask &= mask - 1) ++color[std::countr_zero(mask)];
 }
 
+// The five plane values (c0 + dx·X) + dy·Y at a block's top-left pixel (gx, gy), one lane per plane.
+HWY_INLINE void blockBases(const TriangleSetup& t, const PlaneLanes& lanes, int gx, int gy,
+                           float* base) {
+  const hn::CappedTag<float, 8> d8;
+  const auto bx = hn::Set(d8, float(gx - t.minX)), by = hn::Set(d8, float(gy - t.minY));
+  for (size_t p = 0; p < 8; p += hn::Lanes(d8))
+    hn::Store(hn::Add(hn::Add(hn::Load(d8, lanes.c0 + p), hn::Mul(hn::Load(d8, lanes.dx + p), bx)),
+                      hn::Mul(hn::Load(d8, lanes.dy + p), by)),
+              d8, base + p);
+}
+
+// Perspective-correct colour channel ch = (colour/w)·w, clamped to [0, 1], as 16-bit linear light
+// in int32 lanes. Float → 16-bit by the magic-number trick: for 0 ≤ v < 2^23, the float v + 2^23
+// holds round-to-nearest-even(v) in its low mantissa bits (no range fix-ups, unlike ConvertTo).
+template <class DF, class V>
+HWY_INLINE auto colorLanes(DF df, const PlaneLanes& lanes, const float* base, int ch, size_t i,
+                           V w) {
+  const hn::RebindToSigned<DF> di;
+  const auto cw = hn::Add(hn::Set(df, base[kRed + ch]), hn::LoadU(df, lanes.offset[kRed + ch] + i));
+  const auto c = hn::Min(hn::Max(hn::Mul(cw, w), hn::Zero(df)), hn::Set(df, 1.0f));
+  return hn::And(hn::BitCast(di, hn::Add(hn::Mul(c, hn::Set(df, 65535.0f)), hn::Set(df, 8388608.0f))),
+                 hn::Set(di, 0xFFFF));
+}
+
 // Depth test ("less") and Gouraud colour for the pixels of one 4×4 block set in `mask`.
 // (gx, gy) is the block's top-left pixel; `depth` and `color` point at the block's storage.
 HWY_INLINE void shadeBlock(const TriangleSetup& t, const PlaneLanes& lanes, uint32_t mask, int gx,
@@ -108,22 +144,10 @@ HWY_INLINE void shadeBlock(const TriangleSetup& t, const PlaneLanes& lanes, uint
   const hn::RebindToSigned<decltype(df)> di;
   const hn::Rebind<uint16_t, decltype(df)> du;
   const size_t n = hn::Lanes(df);
-  // The five bases (c0 + dx·X) + dy·Y at the block's top-left pixel, one lane per plane.
   alignas(32) float base[8];
-  {
-    const hn::CappedTag<float, 8> d8;
-    const auto bx = hn::Set(d8, float(gx - t.minX)), by = hn::Set(d8, float(gy - t.minY));
-    for (size_t p = 0; p < 8; p += hn::Lanes(d8))
-      hn::Store(hn::Add(hn::Add(hn::Load(d8, lanes.c0 + p), hn::Mul(hn::Load(d8, lanes.dx + p), bx)),
-                        hn::Mul(hn::Load(d8, lanes.dy + p), by)),
-                d8, base + p);
-  }
+  blockBases(t, lanes, gx, gy, base);
   const auto maskVec = hn::Set(di, static_cast<int32_t>(mask));
-  const auto zero = hn::Zero(df), one = hn::Set(df, 1.0f);
-  // Float → 16-bit by the magic-number trick: for 0 ≤ v < 2^23, the float v + 2^23 holds
-  // round-to-nearest-even(v) in its low mantissa bits (no range fix-ups needed, unlike ConvertTo).
-  const auto scale = hn::Set(df, 65535.0f), magic = hn::Set(df, 8388608.0f);
-  const auto low16 = hn::Set(di, 0xFFFF);
+  const auto one = hn::Set(df, 1.0f);
   for (size_t i = 0; i < size_t(kBlockPixels); i += n) {
     const auto covered = hn::TestBit(maskVec, hn::LoadU(di, kLaneBit + i));
     if (hn::AllFalse(di, covered)) continue;
@@ -138,13 +162,60 @@ HWY_INLINE void shadeBlock(const TriangleSetup& t, const PlaneLanes& lanes, uint
         one, hn::Add(hn::Set(df, base[kInvW]), hn::LoadU(df, lanes.offset[kInvW] + i)));
     const auto passI = hn::RebindMask(di, pass);
     for (int ch = 0; ch < kColorChannels; ++ch) {
-      const auto cw =
-          hn::Add(hn::Set(df, base[kRed + ch]), hn::LoadU(df, lanes.offset[kRed + ch] + i));
-      const auto c = hn::Min(hn::Max(hn::Mul(cw, w), zero), one);
-      const auto c16 = hn::And(hn::BitCast(di, hn::Add(hn::Mul(c, scale), magic)), low16);
       uint16_t* dst = color + ch * kBlockPixels + i;
       const auto old = hn::PromoteTo(di, hn::LoadU(du, dst));
-      hn::StoreU(hn::DemoteTo(du, hn::IfThenElse(passI, c16, old)), du, dst);
+      hn::StoreU(hn::DemoteTo(du, hn::IfThenElse(passI, colorLanes(df, lanes, base, ch, i, w), old)),
+                 du, dst);
+    }
+  }
+}
+
+// The same with N samples per pixel (SPEC §5): masks[w][p] holds pixel p's samples 32·w … 32·w + 31
+// (masks == nullptr: every sample of every pixel). Depth is tested per sample at its position,
+// z_s = z(centre) + sampleDepth[s]; colour is shaded once per pixel, at its centre, and written to
+// the samples that pass. `depth` and `color` point at the block's first sample plane.
+HWY_INLINE void shadeBlockSamples(const TriangleSetup& t, const PlaneLanes& lanes,
+                                  const float* sampleDepth, int samples,
+                                  const uint32_t (*masks)[kBlockPixels], int gx, int gy,
+                                  float* depth, uint16_t* color) {
+  const hn::CappedTag<float, kBlockPixels> df;
+  const hn::RebindToSigned<decltype(df)> di;
+  const hn::RebindToUnsigned<decltype(df)> du32;
+  const hn::Rebind<uint16_t, decltype(df)> du;
+  const size_t n = hn::Lanes(df);
+  alignas(32) float base[8];
+  blockBases(t, lanes, gx, gy, base);
+  // Outside the triangle (a pixel it only partly covers) 1/w is extrapolated and may reach 0.
+  const auto one = hn::Set(df, 1.0f), tiny = hn::Set(df, 1e-30f);
+  for (size_t i = 0; i < size_t(kBlockPixels); i += n) {
+    auto m0 = hn::Set(du32, ~0u), m1 = m0;
+    if (masks) {
+      m0 = hn::LoadU(du32, masks[0] + i);
+      m1 = samples > 32 ? hn::LoadU(du32, masks[1] + i) : hn::Zero(du32);
+      if (hn::AllTrue(du32, hn::Eq(hn::Or(m0, m1), hn::Zero(du32)))) continue;
+    }
+    const auto zPix = hn::Add(hn::Set(df, base[kDepth]), hn::LoadU(df, lanes.offset[kDepth] + i));
+    const auto w = hn::Div(
+        one, hn::Max(hn::Add(hn::Set(df, base[kInvW]), hn::LoadU(df, lanes.offset[kInvW] + i)),
+                     tiny));
+    hn::Vec<decltype(di)> c16[kColorChannels];
+    for (int ch = 0; ch < kColorChannels; ++ch) c16[ch] = colorLanes(df, lanes, base, ch, i, w);
+    for (int s = 0; s < samples; ++s) {
+      const auto covered =
+          hn::RebindMask(df, hn::TestBit(s < 32 ? m0 : m1, hn::Set(du32, 1u << (s & 31))));
+      if (hn::AllFalse(df, covered)) continue;
+      float* zPlane = depth + size_t(s) * kBlockPixels + i;
+      const auto z = hn::Add(zPix, hn::Set(df, sampleDepth[s]));
+      const auto zOld = hn::LoadU(df, zPlane);
+      const auto pass = hn::And(covered, hn::Lt(z, zOld));
+      if (hn::AllFalse(df, pass)) continue;
+      hn::StoreU(hn::IfThenElse(pass, z, zOld), df, zPlane);
+      const auto passI = hn::RebindMask(di, pass);
+      for (int ch = 0; ch < kColorChannels; ++ch) {
+        uint16_t* dst = color + size_t(s) * kColorPerBlock + ch * kBlockPixels + i;
+        const auto old = hn::PromoteTo(di, hn::LoadU(du, dst));
+        hn::StoreU(hn::DemoteTo(du, hn::IfThenElse(passI, c16[ch], old)), du, dst);
+      }
     }
   }
 }
@@ -152,11 +223,13 @@ HWY_INLINE void shadeBlock(const TriangleSetup& t, const PlaneLanes& lanes, uint
 // One triangle in one tile. T is the type edge values are stepped in: int64_t always works
 // (geometry/setup.h's budget); int32_t is used for small triangles, whose values provably fit, and
 // doubles the lanes per vector.
-template <int E, ShadeMode kShade, class T>
+// kAA: anti-aliased (ctx.coverage set): pixel-square windows and sub-pixel masks in the leaves.
+template <int E, ShadeMode kShade, class T, bool kAA = false>
 class TriangleRaster {
  public:
   TriangleRaster(const TriangleSetup& t, const TileContext& ctx) : t_(t), ctx_(ctx) {
     if constexpr (kShade == ShadeMode::gouraud) computePlaneLanes(t, planeLanes_);
+    if constexpr (kAA) setUpSamples();
     for (int k = 0; k < E; ++k) {
       const auto& e = t.edges[k];
       sX_[k] = T(e.stepX());
@@ -207,6 +280,47 @@ class TriangleRaster {
  private:
   static int statLevel(int log2n) { return kTileLog2 - log2n; }
 
+  // Over a window of m + 1 pixels a side whose top-left value is tl, tl + maxOffset(k, m) < 0 iff
+  // the window lies wholly outside edge k, and tl + minOffset(k, m) ≥ 0 iff wholly inside: the
+  // extreme pixel centre, and with anti-aliasing its square (the constants above).
+  T maxOffset(int k, T m) const {
+    if constexpr (kAA) return pos_[k] * m + rejectOffset_[k];
+    return pos_[k] * m;
+  }
+  T minOffset(int k, T m) const {
+    if constexpr (kAA) return neg_[k] * m + acceptOffset_[k];
+    return neg_[k] * m;
+  }
+
+  // Anti-aliasing, per triangle: per edge the mask-table row, the aperture constants and the
+  // divisor S of the distance cell; per sample the depth offset from the pixel centre.
+  void setUpSamples() {
+    const CoverageTables& cov = *ctx_.coverage;
+    for (int k = 0; k < E; ++k) {
+      const int64_t a = t_.edges[k].a, b = t_.edges[k].b;
+      const bool owns = a > 0 || (a == 0 && b > 0);  // setup.cpp's fill rule, taken back out
+      const int64_t S = std::abs(a) + std::abs(b);
+      const int64_t bias = owns ? 0 : 1, half = 128 * S;
+      rejectOffset_[k] = T(bias + half - 1);
+      acceptOffset_[k] = T(bias - half);
+      bias_[k] = T(bias);
+      int row = EdgeMaskTable::kConstantRow;
+      if (S != 0) {
+        const int quadrant = int(a < 0 || (a == 0 && b < 0)) | int(b < 0 || (b == 0 && a < 0)) << 1;
+        row = EdgeMaskTable::rowIndex(
+            quadrant, int(std::min<int64_t>(EdgeMaskTable::kSlopeSteps - 1,
+                                            EdgeMaskTable::kSlopeSteps * std::abs(a) / S)));
+      }
+      rowOffset_[k] = row * EdgeMaskTable::kRowEntries;
+      divisor_[k] = int32_t(std::max<int64_t>(S, 1));  // S < 2^25 (setup.h budget)
+      reciprocal_[k] = 1.0f / float(divisor_[k]);
+    }
+    const auto& offsets = cov.pattern->offsets;
+    for (int s = 0; s < cov.samples; ++s)
+      sampleDepth_[s] = t_.depth.dx * float(offsets[size_t(s)][0]) +
+                        t_.depth.dy * float(offsets[size_t(s)][1]);
+  }
+
   // Classifies a root window by the coverage function of each edge, then fills, tests or splits.
   void visitRoot(int lx, int ly, int log2n, int n) {
     ++ctx_.stats->windows[statLevel(log2n)];
@@ -219,8 +333,8 @@ class TriangleRaster {
     if (log2n == kBlockLog2) return leaf(lx, ly, tl, (1u << E) - 1);
     unsigned active = 0;
     for (int k = 0; k < E; ++k) {
-      if (tl[k] + pos_[k] * T(n - 1) < 0) return;             // d < 0: outside
-      if (tl[k] + neg_[k] * T(n - 1) < 0) active |= 1u << k;  // d < 2ε: the edge crosses
+      if (tl[k] + maxOffset(k, T(n - 1)) < 0) return;             // d < 0: outside
+      if (tl[k] + minOffset(k, T(n - 1)) < 0) active |= 1u << k;  // d < 2ε: the edge crosses
     }
     descend(lx, ly, log2n, tl, active);
   }
@@ -245,8 +359,8 @@ class TriangleRaster {
       if (!(active & (1u << k))) continue;
       const auto stepX = hn::Set(d, sX_[k] * h), stepY = hn::Set(d, sY_[k] * h);
       const auto base = hn::Set(d, tl[k]);
-      const auto dMax = hn::Set(d, pos_[k] * (h - 1));
-      const auto dMin = hn::Set(d, neg_[k] * (h - 1));
+      const auto dMax = hn::Set(d, maxOffset(k, h - 1));
+      const auto dMin = hn::Set(d, minOffset(k, h - 1));
       for (size_t i = 0; i < 4; i += lanes) {
         // The children's offsets {0, sX·h, sY·h, (sX + sY)·h}, built from constant lane masks:
         // filled in a local array with scalar stores and read back as a vector, they stalled on
@@ -278,6 +392,7 @@ class TriangleRaster {
   // A 4×4 leaf crossed by the `active` edges: the last two levels of the subdivision unrolled —
   // all 16 pixel centres tested at once in SIMD lanes.
   void leaf(int lx, int ly, const T* tl, unsigned active) {
+    if constexpr (kAA) return leafSamples(lx, ly, tl, active);
     const hn::CappedTag<T, kBlockPixels> d;
     const size_t lanes = hn::Lanes(d);
     const auto minusOne = hn::Set(d, T(-1));
@@ -298,10 +413,78 @@ class TriangleRaster {
     if (mask) shade(lx, ly, mask);
   }
 
+  // An anti-aliased leaf: per pixel, the AND of the crossing edges' masks from the table.
+  void leafSamples(int lx, int ly, const T* tl, unsigned active) {
+    const hn::CappedTag<int32_t, kBlockPixels> di;
+    const hn::Rebind<float, decltype(di)> df;
+    const size_t lanes = hn::Lanes(di);
+    const CoverageTables& cov = *ctx_.coverage;
+    const int32_t* word0 = reinterpret_cast<const int32_t*>(cov.word[0].data());
+    const int32_t* word1 = reinterpret_cast<const int32_t*>(cov.word[1].data());
+    // int64 edges: |E|/4 (capped) and the sign per pixel in scalar code first (these are the
+    // large triangles' leaves, few); int32 edges go straight from the vector below.
+    alignas(64) int32_t quarter[E][kBlockPixels], positive[E][kBlockPixels];
+    if constexpr (sizeof(T) == 8) {
+      for (int k = 0; k < E; ++k) {
+        if (!(active & (1u << k))) continue;
+        for (int p = 0; p < kBlockPixels; ++p) {
+          const T e = tl[k] + leafOffset_[k][p];
+          const T geometric = e + bias_[k];
+          positive[k][p] = e >= 0 ? -1 : 0;
+          quarter[k][p] = int32_t(std::min<T>((geometric < 0 ? -geometric : geometric) >> 2,
+                                              T(32) * divisor_[k]));
+        }
+      }
+    }
+    alignas(64) uint32_t masks[2][kBlockPixels];
+    const auto zero = hn::Zero(di), minusOne = hn::Set(di, -1);
+    int covered = 0;
+    for (size_t i = 0; i < size_t(kBlockPixels); i += lanes) {
+      auto m0 = hn::Set(di, -1), m1 = m0;
+      for (int k = 0; k < E; ++k) {
+        if (!(active & (1u << k))) continue;
+        const auto S = hn::Set(di, divisor_[k]);
+        hn::Vec<decltype(di)> a;
+        hn::Mask<decltype(di)> inside;  // e ≥ 0: the side of the edge the cell index counts up
+        if constexpr (sizeof(T) == 4) {
+          const auto e = hn::Add(hn::Set(di, tl[k]), hn::LoadU(di, leafOffset_[k] + i));
+          inside = hn::Gt(e, minusOne);
+          a = hn::Min(hn::ShiftRight<2>(hn::Abs(hn::Add(e, hn::Set(di, bias_[k])))),
+                      hn::Set(di, 32 * divisor_[k]));
+        } else {
+          inside = hn::Lt(hn::LoadU(di, positive[k] + i), zero);
+          a = hn::LoadU(di, quarter[k] + i);
+        }
+        // q = ⌊a / S⌋: the float estimate is within one of it (a < 2^30), then corrected exactly.
+        auto q = hn::ConvertTo(di, hn::Mul(hn::ConvertTo(df, a), hn::Set(df, reciprocal_[k])));
+        const auto r = hn::Sub(a, hn::Mul(q, S));
+        q = hn::Add(q, hn::VecFromMask(di, hn::Lt(r, zero)));               // − 1
+        q = hn::Sub(q, hn::VecFromMask(di, hn::Gt(r, hn::Sub(S, hn::Set(di, 1)))));  // + 1
+        // Row entry: 1 + (32 + q) on the inside, 1 + (31 − q) mirrored (EdgeMaskTable::mask).
+        const auto idx = hn::IfThenElse(inside, hn::Add(q, hn::Set(di, rowOffset_[k] + 33)),
+                                        hn::Sub(hn::Set(di, rowOffset_[k] + 32), q));
+        m0 = hn::And(m0, hn::GatherIndex(di, word0, idx));
+        if (cov.words == 2) m1 = hn::And(m1, hn::GatherIndex(di, word1, idx));
+      }
+      if (cov.words == 1) m1 = zero;
+      hn::StoreU(m0, di, reinterpret_cast<int32_t*>(masks[0] + i));
+      hn::StoreU(m1, di, reinterpret_cast<int32_t*>(masks[1] + i));
+      covered += int(hn::CountTrue(di, hn::Ne(hn::Or(m0, m1), zero)));
+    }
+    ++ctx_.stats->partialBlocks;
+    ctx_.stats->windows[kStatLevels - 1] += kBlockPixels;
+    if (covered) shadeSamples(lx, ly, masks, covered);
+  }
+
   void fill(int lx, int ly, int n) {
     ++ctx_.stats->fullWindows;
     for (int by = ly; by < ly + n; by += kBlockSize)
-      for (int bx = lx; bx < lx + n; bx += kBlockSize) shade(bx, by, 0xFFFF);
+      for (int bx = lx; bx < lx + n; bx += kBlockSize) {
+        if constexpr (kAA)
+          shadeSamples(bx, by, nullptr, kBlockPixels);
+        else
+          shade(bx, by, 0xFFFF);
+      }
   }
 
   void shade(int lx, int ly, uint32_t mask) {
@@ -315,23 +498,39 @@ class TriangleRaster {
     }
   }
 
+  void shadeSamples(int lx, int ly, const uint32_t (*masks)[kBlockPixels], int pixels) {
+    ctx_.stats->fragments += uint64_t(pixels);
+    const size_t block = size_t(ly >> kBlockLog2) * kBlocksPerTileSide + (lx >> kBlockLog2);
+    const size_t planes = block * size_t(ctx_.samples);
+    shadeBlockSamples(t_, planeLanes_, sampleDepth_, ctx_.samples, masks, ctx_.originX + lx,
+                      ctx_.originY + ly, ctx_.depth + planes * kBlockPixels,
+                      ctx_.color + planes * kColorPerBlock);
+  }
+
   const TriangleSetup& t_;
   const TileContext& ctx_;
   T sX_[E], sY_[E], pos_[E], neg_[E];
   alignas(64) T leafOffset_[E][kBlockPixels];
   PlaneLanes planeLanes_;
+  // Anti-aliasing only (setUpSamples).
+  T rejectOffset_[E], acceptOffset_[E], bias_[E];
+  int32_t rowOffset_[E], divisor_[E];
+  float reciprocal_[E];
+  float sampleDepth_[64];
 };
 
 void clearTile(const TileWork& w) {
-  std::fill(w.depth, w.depth + kTilePixels, w.clearDepth);
-  for (int b = 0; b < kTilePixels / kBlockPixels; ++b)
+  const int planes = kTilePixels / kBlockPixels * (w.coverage ? w.coverage->samples : 1);
+  std::fill(w.depth, w.depth + size_t(planes) * kBlockPixels, w.clearDepth);
+  for (int b = 0; b < planes; ++b)
     for (int ch = 0; ch < kColorChannels; ++ch)
       std::fill_n(w.color + b * kColorPerBlock + ch * kBlockPixels, kBlockPixels, w.clearColor[ch]);
 }
 
-template <ShadeMode kShade>
+template <ShadeMode kShade, bool kAA>
 void drawLists(const TileWork& w, RasterStats& stats) {
-  const TileContext ctx{w.tileX * kTileSize, w.tileY * kTileSize, w.depth, w.color, &stats};
+  const TileContext ctx{w.tileX * kTileSize, w.tileY * kTileSize, w.depth, w.color, &stats,
+                        w.coverage, w.coverage ? w.coverage->samples : 1};
   // Setup records are read in bin order, scattered over the batch: fetch a few ahead, the loop is
   // otherwise bound by their cache misses. (Before records were grouped by tile this was half the
   // tile time on 10-px triangles; now 2 ahead measures the same as 1 and better than 4 or 8.)
@@ -347,13 +546,13 @@ void drawLists(const TileWork& w, RasterStats& stats) {
       const TriangleSetup& t = w.setups[list[i]];
       // Specialize on the edge count once per triangle (STYLE.md habit 6).
       if (t.small) {
-        TriangleRaster<3, kShade, int32_t>(t, ctx).draw();
+        TriangleRaster<3, kShade, int32_t, kAA>(t, ctx).draw();
         continue;
       }
       switch (t.edgeCount) {
-        case 3: TriangleRaster<3, kShade, int64_t>(t, ctx).draw(); break;
-        case 4: TriangleRaster<4, kShade, int64_t>(t, ctx).draw(); break;
-        default: TriangleRaster<5, kShade, int64_t>(t, ctx).draw(); break;
+        case 3: TriangleRaster<3, kShade, int64_t, kAA>(t, ctx).draw(); break;
+        case 4: TriangleRaster<4, kShade, int64_t, kAA>(t, ctx).draw(); break;
+        default: TriangleRaster<5, kShade, int64_t, kAA>(t, ctx).draw(); break;
       }
     }
   }
@@ -362,9 +561,11 @@ void drawLists(const TileWork& w, RasterStats& stats) {
 void RasterizeTile(const TileWork& w, RasterStats& stats) {
   if (w.clear) clearTile(w);
   if (w.shade == ShadeMode::overdraw)
-    drawLists<ShadeMode::overdraw>(w, stats);
+    drawLists<ShadeMode::overdraw, false>(w, stats);
+  else if (w.coverage)
+    drawLists<ShadeMode::gouraud, true>(w, stats);
   else
-    drawLists<ShadeMode::gouraud>(w, stats);
+    drawLists<ShadeMode::gouraud, false>(w, stats);
 }
 
 }  // namespace HWY_NAMESPACE

@@ -39,7 +39,10 @@ struct CallCursor {
 
 void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& settings,
                            FrameStats& stats) {
-  const geometry::Viewport viewport{settings.width, settings.height};
+  const raster::CoverageTables* coverage =
+      settings.samples > 1 ? raster::CoverageTables::forCount(settings.samples) : nullptr;
+  const int samples = coverage ? coverage->samples : 1;
+  const geometry::Viewport viewport{settings.width, settings.height, coverage != nullptr};
   const uint32_t triangleCount = static_cast<uint32_t>(packets.indices.size() / 3);
   const uint32_t batchTriangles = std::clamp<uint32_t>(settings.batchTriangles, 1, 1u << 24);
   // One batch: each tile is cleared, drawn and handed on in a per-thread 64×64 buffer. Several: the
@@ -48,7 +51,7 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
   const int tilesX = (settings.width + raster::kTileSize - 1) >> raster::kTileLog2;
   const int tilesY = (settings.height + raster::kTileSize - 1) >> raster::kTileLog2;
   const int tiles = tilesX * tilesY;
-  if (wholeFrame) fb_.resize(settings.width, settings.height);
+  if (wholeFrame) fb_.resize(settings.width, settings.height, samples);
   uint16_t clear16[3];
   for (int ch = 0; ch < 3; ++ch)
     clear16[ch] = static_cast<uint16_t>(
@@ -60,7 +63,7 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
   scratch_.resize(size_t(pool_.threadCount()));
   for (WorkerScratch& w : scratch_) {
     w.records.resize(kChunkTriangles);
-    if (!wholeFrame) w.tile.resize(raster::kTileSize, raster::kTileSize);
+    if (!wholeFrame) w.tile.resize(raster::kTileSize, raster::kTileSize, samples);
   }
   tileStats_.assign(size_t(tiles), raster::RasterStats{});
   const int maxChunks = std::max(1, int((firstBatch + kChunkTriangles - 1) / kChunkTriangles));
@@ -140,6 +143,7 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
       w.listSizes = listSize;
       w.listCount = lists;
       w.shade = settings.shade;
+      w.coverage = coverage;
       raster::rasterizeTile(w, tileStats_[tile]);
       if (lastBatch && settings.finishTile) settings.finishTile(int(tile), w.depth, w.color);
     });

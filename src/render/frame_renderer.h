@@ -32,8 +32,11 @@ struct FrameSettings {
   int width = 0, height = 0;
   float clearColor[3] = {0, 0, 0};  // linear
   raster::ShadeMode shade = raster::ShadeMode::gouraud;
+  // Samples per pixel: 1 (point sampling at centres) or 4, 8, 16, 64 (anti-aliasing with sub-pixel
+  // masks, SPEC §5; Gouraud only). finishTile then receives `samples` sample planes per block.
+  int samples = 1;
   // Called once per tile, on the thread that drew it, right after the tile's last triangle, with
-  // the tile's depth and colour (laid out as raster/framebuffer.h describes). This is the only way
+  // the tile's depth and colour (laid out as raster/framebuffer.h describes, `samples` per pixel). This is the only way
   // out of the frame: the storage is reused for the next tile as soon as the call returns.
   std::function<void(int tile, const float* depth, const uint16_t* color)> finishTile;
   // Triangles per batch (every batch sets up its triangles, then walks the tiles). Frames of one

@@ -32,8 +32,9 @@ void addTriangle(render::DrawPackets& p, const geometry::ClipVertex& a,
 Frame renderQuadtree(const render::DrawPackets& p, const render::FrameSettings& s, int threads,
                      FrameStats* stats) {
   render::FrameRenderer r(threads);
-  Frame f{s.width, s.height, {}, {}};
-  f.depth.resize(size_t(s.width) * s.height);
+  const int n = s.samples;
+  Frame f{s.width, s.height, n, {}, {}};
+  f.depth.resize(size_t(s.width) * s.height * n);
   f.color.resize(f.depth.size() * 3);
   render::FrameSettings settings = s;
   const int tilesX = (s.width + raster::kTileSize - 1) >> raster::kTileLog2;
@@ -42,10 +43,12 @@ Frame renderQuadtree(const render::DrawPackets& p, const render::FrameSettings& 
     const int x0 = (tile % tilesX) * raster::kTileSize, y0 = (tile / tilesX) * raster::kTileSize;
     for (int y = y0; y < std::min(s.height, y0 + raster::kTileSize); ++y)
       for (int x = x0; x < std::min(s.width, x0 + raster::kTileSize); ++x) {
-        const size_t i = size_t(y) * s.width + x;
-        f.depth[i] = depth[raster::FrameBuffer::depthOffset(x, y)];
-        for (int ch = 0; ch < 3; ++ch)
-          f.color[i * 3 + ch] = color[raster::FrameBuffer::colorOffset(x, y, ch)];
+        for (int k = 0; k < n; ++k) {
+          const size_t i = (size_t(y) * s.width + x) * n + k;
+          f.depth[i] = depth[raster::FrameBuffer::depthOffset(x, y, n, k)];
+          for (int ch = 0; ch < 3; ++ch)
+            f.color[i * 3 + ch] = color[raster::FrameBuffer::colorOffset(x, y, ch, n, k)];
+        }
       }
   };
   FrameStats local;
@@ -64,16 +67,25 @@ float evalPlane(const geometry::Plane& p, int x, int y, int minX, int minY) {
 }
 }  // namespace
 
+uint16_t Frame::resolved(int x, int y, int ch) const {
+  uint32_t sum = 0;
+  for (int k = 0; k < samples; ++k) sum += channel(x, y, ch, k);
+  return uint16_t((sum + uint32_t(samples) / 2) / uint32_t(samples));
+}
+
 Frame renderReference(const render::DrawPackets& p, const render::FrameSettings& s) {
   const bool count = s.shade == raster::ShadeMode::overdraw;
-  Frame f{s.width, s.height, {}, {}};
-  f.depth.assign(size_t(s.width) * s.height, 1.0f);
+  const int n = s.samples;
+  const raster::SamplePattern* pattern = raster::samplePattern(n);
+  const raster::EdgeMaskTable table(*pattern);
+  Frame f{s.width, s.height, n, {}, {}};
+  f.depth.assign(size_t(s.width) * s.height * n, 1.0f);
   f.color.resize(f.depth.size() * 3);
   for (size_t i = 0; i < f.depth.size(); ++i)
     for (int ch = 0; ch < 3; ++ch)
       f.color[i * 3 + ch] =
           count ? 0 : uint16_t(std::lround(std::clamp(s.clearColor[ch], 0.0f, 1.0f) * 65535.0f));
-  const geometry::Viewport vp{s.width, s.height};
+  const geometry::Viewport vp{s.width, s.height, n > 1};
   size_t callIndex = 0;
   for (uint32_t tri = 0; tri < p.indices.size() / 3; ++tri) {
     while (callIndex < p.calls.size() &&
@@ -86,27 +98,48 @@ Frame renderReference(const render::DrawPackets& p, const render::FrameSettings&
     if (geometry::setupTriangle(p.vertices[idx[0]], p.vertices[idx[1]], p.vertices[idx[2]], vp,
                                 cull, t) != geometry::SetupOutcome::drawn)
       continue;
+    float sampleDepth[64];
+    for (int k = 0; k < n; ++k)
+      sampleDepth[k] = t.depth.dx * float(pattern->offsets[size_t(k)][0]) +
+                       t.depth.dy * float(pattern->offsets[size_t(k)][1]);
     // Every pixel of the raster, not just the bounding box: the box is part of what is tested.
     for (int y = 0; y < s.height; ++y)
       for (int x = 0; x < s.width; ++x) {
-        bool inside = true;
-        for (int k = 0; k < t.edgeCount && inside; ++k)
-          inside = t.edges[k].c + t.edges[k].stepX() * x + t.edges[k].stepY() * y >= 0;
-        if (!inside) continue;
+        uint64_t mask = table.allSamples();
+        for (int k = 0; k < t.edgeCount && mask; ++k) {
+          const geometry::EdgeFunction& e = t.edges[k];
+          const int64_t value = e.c + e.stepX() * x + e.stepY() * y;
+          if (n == 1) {
+            mask = value >= 0;
+          } else {
+            // The geometric value: setup folds the fill rule in as −1 on edges not owning ties.
+            const bool owns = e.a > 0 || (e.a == 0 && e.b > 0);
+            mask &= table.mask(e.a, e.b, double(value + (owns ? 0 : 1)) / 256.0);
+          }
+        }
+        if (!mask) continue;
         const size_t i = size_t(y) * s.width + x;
         if (count) {
           ++f.color[i * 3];
           continue;
         }
-        const float z = evalPlane(t.depth, x, y, t.minX, t.minY);
-        if (!(z < f.depth[i])) continue;
-        f.depth[i] = z;
-        const float w = 1.0f / evalPlane(t.invW, x, y, t.minX, t.minY);
+        const float zCentre = evalPlane(t.depth, x, y, t.minX, t.minY);
+        const float invW = evalPlane(t.invW, x, y, t.minX, t.minY);
+        const float w = 1.0f / (n > 1 ? std::max(invW, 1e-30f) : invW);
+        uint16_t c16[3];
         const geometry::Plane* planes[3] = {&t.red, &t.green, &t.blue};
         for (int ch = 0; ch < 3; ++ch) {
           const float c =
               std::min(std::max(evalPlane(*planes[ch], x, y, t.minX, t.minY) * w, 0.0f), 1.0f);
-          f.color[i * 3 + ch] = uint16_t(std::nearbyint(c * 65535.0f));  // ties to even
+          c16[ch] = uint16_t(std::nearbyint(c * 65535.0f));  // ties to even
+        }
+        for (int k = 0; k < n; ++k) {
+          if (!(mask >> k & 1)) continue;
+          const size_t j = i * n + k;
+          const float z = n > 1 ? zCentre + sampleDepth[k] : zCentre;
+          if (!(z < f.depth[j])) continue;
+          f.depth[j] = z;
+          for (int ch = 0; ch < 3; ++ch) f.color[j * 3 + ch] = c16[ch];
         }
       }
   }

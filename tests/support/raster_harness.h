@@ -21,10 +21,14 @@ void addTriangle(render::DrawPackets& p, const geometry::ClipVertex& a,
 
 // What a frame holds, in plain row-major arrays.
 struct Frame {
-  int width = 0, height = 0;
-  std::vector<float> depth;
-  std::vector<uint16_t> color;  // 3 per pixel
-  uint16_t channel(int x, int y, int ch) const { return color[(size_t(y) * width + x) * 3 + ch]; }
+  int width = 0, height = 0, samples = 1;
+  std::vector<float> depth;     // per sample: index (y·width + x)·samples + s
+  std::vector<uint16_t> color;  // 3 per sample
+  uint16_t channel(int x, int y, int ch, int s = 0) const {
+    return color[((size_t(y) * width + x) * samples + s) * 3 + ch];
+  }
+  // The mean of the pixel's samples, as the box resolve computes it (rounded).
+  uint16_t resolved(int x, int y, int ch) const;
   bool operator==(const Frame&) const = default;
 };
 
@@ -34,7 +38,9 @@ Frame renderQuadtree(const render::DrawPackets& p, const render::FrameSettings& 
 
 // The brute-force reference (RASTER-NOTES "hierarchy = flat"): for every pixel and every triangle
 // in submission order, test the pixel centre against each edge function directly, then the same
-// depth test and colour expressions as the kernel, in scalar code.
+// depth test and colour expressions as the kernel, in scalar code. With s.samples > 1 the pixel's
+// mask is the AND of EdgeMaskTable::mask over the edges (in double, independent of the kernel's
+// integer cell index), and depth is tested per sample.
 Frame renderReference(const render::DrawPackets& p, const render::FrameSettings& s);
 
 }  // namespace sv::test
