@@ -2,9 +2,11 @@
 //
 //   synthvis render [SCENE] -o out.png [--width W] [--height H] [--threads T] [--camera I]
 //                   [--no-cull] [--debug-view overdraw] [--gamma G] [--supersample K]
+//                   [--aa 1|4|8|16|64] [--filter box|tent3]
 //   synthvis bench SCENE|--suite quick|full [--count N] [--area A] [--depth D] [--layers D]
 //                  [--order random|f2b|b2f] [--shade gouraud] [--width W] [--height H]
-//                  [--threads T] [--frames F] [--warmup W] [--seed S] [--aa S]
+//                  [--threads T] [--frames F] [--warmup W] [--seed S] [--aa S] [--gl-aa S]
+//                  [--filter box|tent3]
 //                  [--renderer synthvis|gl|both] [--gl-readback] [--json FILE] [--html DIR]
 //                  [--image FILE]
 //   synthvis gen tris|layers -o scene.glb [--count N] [--area A] [--depth D] [--layers D]
@@ -35,10 +37,18 @@ int fail(const sv::Error& e) {
   return 1;
 }
 
+// --filter box|tent3.
+sv::Result<sv::RenderOptions::Filter> parseFilter(const std::string& name) {
+  if (name == "box") return sv::RenderOptions::Filter::box;
+  if (name == "tent3") return sv::RenderOptions::Filter::tent3;
+  return sv::Error{"", "", fmt::format("unknown filter '{}' (box or tent3)", name)};
+}
+
 struct RenderArgs {
   std::string scene;
   std::string output = "out.png";
   std::string debugView;
+  std::string filter = "box";
   bool noCull = false;
   sv::RenderOptions options;
 };
@@ -46,6 +56,9 @@ struct RenderArgs {
 int runRender(const RenderArgs& a) {
   sv::RenderOptions o = a.options;
   o.cullBackFaces = !a.noCull;
+  auto filter = parseFilter(a.filter);
+  if (!filter) return fail(filter.error());
+  o.filter = filter.value();
   if (!a.debugView.empty()) {
     if (a.debugView != "overdraw")
       return fail({"", "", fmt::format("unknown debug view '{}' (available: overdraw)", a.debugView)});
@@ -102,7 +115,9 @@ struct BenchArgs {
   std::string image;
   int frames = 10;
   int warmup = 2;
-  int aa = 0;
+  int aa = 1;
+  int glAa = -1;  // -1: as --aa, capped at llvmpipe's 4
+  std::string filter = "box";
   bool glReadback = false;
   sv::RenderOptions options{.width = 1920, .height = 1080, .threads = 2};
 };
@@ -139,6 +154,11 @@ sv::Result<sv::reference::BenchCase> generatorCase(const std::string& kind, cons
 
 int runBench(BenchArgs a) {
   namespace ref = sv::reference;
+  a.options.samples = a.aa == 0 ? 1 : a.aa;
+  if (auto f = parseFilter(a.filter); !f)
+    return fail(f.error());
+  else
+    a.options.filter = f.value();
   if (a.shade != "gouraud")
     return fail({"", "", fmt::format("shading '{}' is not available yet (gouraud)", a.shade)});
   if (sv::Status s = sv::validate(a.options); !s) return fail(s.error());
@@ -149,12 +169,10 @@ int runBench(BenchArgs a) {
     return fail({"", "", fmt::format("unknown renderer '{}' (synthvis, gl or both)", a.renderer)});
   if (auto order = sv::scene::parseSubmitOrder(a.generator.order); !order)
     return fail(order.error());
-  if (a.aa != 0 && a.aa != 2 && a.aa != 4 && a.aa != 8 && a.aa != 16)
-    return fail({"", "", fmt::format("--aa {}: samples per pixel must be 0, 2, 4, 8 or 16", a.aa)});
-  // synthvis's anti-aliasing is issue 4; until then only the reference can multisample.
-  if (a.aa != 0 && a.renderer != "gl")
-    return fail({"", "", "--aa: synthvis has no anti-aliasing yet; use --renderer gl to time the "
-                         "reference's multisampling"});
+  if (a.glAa == -1) a.glAa = a.aa >= 2 ? std::min(a.aa, 4) : 0;
+  if (a.glAa != 0 && a.glAa != 2 && a.glAa != 4 && a.glAa != 8 && a.glAa != 16)
+    return fail({"", "", fmt::format("--gl-aa {}: the reference's samples per pixel must be 0, 2, "
+                                     "4, 8 or 16", a.glAa)});
 
   std::vector<ref::BenchCase> cases;
   if (!a.suite.empty()) {
@@ -178,7 +196,7 @@ int runBench(BenchArgs a) {
   settings.options = a.options;
   settings.frames = a.frames;
   settings.warmup = a.warmup;
-  settings.aa = a.aa;
+  settings.referenceMsaa = a.glAa;
   settings.referenceReadback = a.glReadback;
   settings.synthvis = a.renderer != "gl";
   settings.reference = a.renderer != "synthvis";
@@ -339,6 +357,11 @@ int main(int argc, char** argv) {
   render->add_option("--supersample", r.options.supersample,
                      "render k×k samples per pixel and average them (1, 2, 4, 8)")
       ->capture_default_str();
+  render->add_option("--aa", r.options.samples,
+                     "anti-aliasing: samples per pixel, 1 (none), 4, 8, 16 or 64")
+      ->capture_default_str();
+  render->add_option("--filter", r.filter, "resolve filter: box or tent3 (3x3 triangle)")
+      ->capture_default_str();
   render->add_option("--gamma", r.options.gamma,
                      "display gamma G (encoded = linear^(1/G)); default 0 = sRGB")
       ->capture_default_str();
@@ -354,7 +377,11 @@ int main(int argc, char** argv) {
   bench->add_option("--threads", b.options.threads, "worker threads")->capture_default_str();
   bench->add_option("--frames", b.frames, "timed frames")->capture_default_str();
   bench->add_option("--warmup", b.warmup, "untimed frames first")->capture_default_str();
-  bench->add_option("--aa", b.aa, "samples per pixel (0 = none; gl reference only for now)")
+  bench->add_option("--aa", b.aa, "synthvis: samples per pixel (1, 4, 8, 16, 64)")
+      ->capture_default_str();
+  bench->add_option("--gl-aa", b.glAa,
+                    "the gl reference's multisamples (0, 2, 4, 8, 16); default: as --aa, at most 4");
+  bench->add_option("--filter", b.filter, "synthvis resolve filter: box or tent3")
       ->capture_default_str();
   bench->add_option("--supersample", b.options.supersample,
                     "synthvis: k×k samples per pixel, averaged (1, 2, 4, 8)")

@@ -29,6 +29,14 @@ struct RenderOptions {
   // pixel is the average of its k×k samples in linear light (the 1×1 box filter). The baseline
   // synthvis's own anti-aliasing (issue 4) is measured against.
   int supersample = 1;
+  // Anti-aliasing (SPEC §5): samples per pixel, 1 (point sampling at pixel centres) or 4, 8, 16,
+  // 64 — sub-pixel masks from tables (patterns in docs/quality.md), depth per sample, colour shaded
+  // once per pixel. Frame-buffer memory per pixel: samples × 10 bytes (whole frame only in frames
+  // of more than 2^18 triangles; otherwise per 64×64 tile and thread).
+  int samples = 1;
+  // The resolve filter (SPEC §5): the 1×1 box (each pixel the mean of its own samples), or the
+  // 3×3 triangle filter of seed 002 over the box-resolved frame, in linear light.
+  enum class Filter { box, tent3 } filter = Filter::box;
 };
 
 // Checks sizes and counts; the error names the option.

@@ -1,6 +1,7 @@
 #include "output/resolve.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 namespace sv::output {
@@ -66,14 +67,47 @@ void resolveTile(const uint16_t* color, int tileX, int tileY, const GammaTables&
   });
 }
 
-void resolveTile(const uint16_t* color, int tileX, int tileY, int factor, const GammaTables& gamma,
-                 Image& image) {
-  if (factor == 1) return resolveTile(color, tileX, tileY, gamma, image);
+namespace {
+
+// Calls sink(x, y, mean) for every pixel of an N-sample tile inside the image, mean[ch] being the
+// rounded mean of its samples (linear, 16-bit). Sums run over a block's sample planes, 16 pixels
+// at a time (vectorized by the compiler).
+template <class Sink>
+void forEachSampleMean(const uint16_t* color, int tileX, int tileY, int samples, int width,
+                       int height, Sink sink) {
+  using namespace raster;
+  const int x0 = tileX * kTileSize, y0 = tileY * kTileSize;
+  const int w = std::min(kTileSize, width - x0), h = std::min(kTileSize, height - y0);
+  const uint32_t half = uint32_t(samples) / 2;
+  const int shift = std::countr_zero(unsigned(samples));  // samples is a power of two
+  for (int by = 0; by < h; by += kBlockSize)
+    for (int bx = 0; bx < w; bx += kBlockSize) {
+      const uint16_t* block =
+          color + size_t((by >> kBlockLog2) * kBlocksPerTileSide + (bx >> kBlockLog2)) * samples *
+                      kColorPerBlock;
+      uint32_t sum[kColorPerBlock] = {};
+      for (int s = 0; s < samples; ++s)
+        for (int i = 0; i < kColorPerBlock; ++i) sum[i] += block[s * kColorPerBlock + i];
+      for (int py = 0; py < std::min(kBlockSize, h - by); ++py)
+        for (int px = 0; px < std::min(kBlockSize, w - bx); ++px) {
+          const int p = py * kBlockSize + px;
+          const uint16_t mean[3] = {uint16_t((sum[p] + half) >> shift),
+                                    uint16_t((sum[kBlockPixels + p] + half) >> shift),
+                                    uint16_t((sum[2 * kBlockPixels + p] + half) >> shift)};
+          sink(x0 + bx + px, y0 + by + py, mean);
+        }
+    }
+}
+
+// The same for a raster `factor` times larger than the image (supersampling).
+template <class Sink>
+void forEachBlockMean(const uint16_t* color, int tileX, int tileY, int factor, int width,
+                      int height, Sink sink) {
   using raster::FrameBuffer;
   // The tile covers image pixels [x0, x0 + 64/factor) × [y0, …) of the smaller image.
   const int side = raster::kTileSize / factor;
   const int x0 = tileX * side, y0 = tileY * side;
-  const int w = std::min(side, image.width - x0), h = std::min(side, image.height - y0);
+  const int w = std::min(side, width - x0), h = std::min(side, height - y0);
   const uint32_t count = uint32_t(factor * factor);
   for (int v = 0; v < h; ++v)
     for (int u = 0; u < w; ++u) {
@@ -82,9 +116,64 @@ void resolveTile(const uint16_t* color, int tileX, int tileY, int factor, const 
         for (int sx = 0; sx < factor; ++sx)
           for (int ch = 0; ch < 3; ++ch)
             sum[ch] += color[FrameBuffer::colorOffset(u * factor + sx, v * factor + sy, ch)];
-      uint8_t* out = image.pixel(x0 + u, y0 + v);
-      for (int ch = 0; ch < 3; ++ch) out[ch] = gamma.table[size_t(ch)][(sum[ch] + count / 2) / count];
+      const uint16_t mean[3] = {uint16_t((sum[0] + count / 2) / count),
+                                uint16_t((sum[1] + count / 2) / count),
+                                uint16_t((sum[2] + count / 2) / count)};
+      sink(x0 + u, y0 + v, mean);
     }
+}
+
+}  // namespace
+
+void resolveSampleTile(const uint16_t* color, int tileX, int tileY, int samples,
+                       const GammaTables& gamma, Image& image) {
+  forEachSampleMean(color, tileX, tileY, samples, image.width, image.height,
+                    [&](int x, int y, const uint16_t* mean) {
+                      uint8_t* out = image.pixel(x, y);
+                      for (int ch = 0; ch < 3; ++ch) out[ch] = gamma.table[size_t(ch)][mean[ch]];
+                    });
+}
+
+void resolveTileLinear(const uint16_t* color, int tileX, int tileY, int factor, int samples,
+                       LinearImage& linear) {
+  auto store = [&](int x, int y, const uint16_t* mean) {
+    std::copy_n(mean, 3, linear.rgb.data() + (size_t(y) * size_t(linear.width) + size_t(x)) * 3);
+  };
+  if (factor > 1)
+    forEachBlockMean(color, tileX, tileY, factor, linear.width, linear.height, store);
+  else
+    forEachSampleMean(color, tileX, tileY, samples, linear.width, linear.height, store);
+}
+
+void tentFilterRows(const LinearImage& linear, const GammaTables& gamma, int rowBegin, int rowEnd,
+                    Image& image) {
+  const int w = linear.width, h = linear.height;
+  auto at = [&](int x, int y, int ch) -> uint32_t {
+    x = std::clamp(x, 0, w - 1);
+    y = std::clamp(y, 0, h - 1);
+    return linear.rgb[(size_t(y) * size_t(w) + size_t(x)) * 3 + size_t(ch)];
+  };
+  for (int y = rowBegin; y < rowEnd; ++y)
+    for (int x = 0; x < w; ++x) {
+      uint8_t* out = image.pixel(x, y);
+      for (int ch = 0; ch < 3; ++ch) {
+        // SPEC §5 (seed 002): the 3×3 triangle filter, [1 2 1] ⊗ [1 2 1] / 16.
+        const uint32_t sum = at(x - 1, y - 1, ch) + 2 * at(x, y - 1, ch) + at(x + 1, y - 1, ch) +
+                             2 * at(x - 1, y, ch) + 4 * at(x, y, ch) + 2 * at(x + 1, y, ch) +
+                             at(x - 1, y + 1, ch) + 2 * at(x, y + 1, ch) + at(x + 1, y + 1, ch);
+        out[ch] = gamma.table[size_t(ch)][(sum + 8) >> 4];
+      }
+    }
+}
+
+void resolveTile(const uint16_t* color, int tileX, int tileY, int factor, const GammaTables& gamma,
+                 Image& image) {
+  if (factor == 1) return resolveTile(color, tileX, tileY, gamma, image);
+  forEachBlockMean(color, tileX, tileY, factor, image.width, image.height,
+                   [&](int x, int y, const uint16_t* mean) {
+                     uint8_t* out = image.pixel(x, y);
+                     for (int ch = 0; ch < 3; ++ch) out[ch] = gamma.table[size_t(ch)][mean[ch]];
+                   });
 }
 
 void resolveOverdrawTile(const uint16_t* color, int tileX, int tileY, Image& image) {

@@ -3,6 +3,7 @@
 
 #include <array>
 #include <cstdint>
+#include <vector>
 
 #include "raster/framebuffer.h"
 #include "synthvis/image.h"
@@ -31,6 +32,36 @@ void resolveTile(const uint16_t* color, int tileX, int tileY, const GammaTables&
 // each image pixel is the rounded mean of its factor × factor samples in linear light.
 void resolveTile(const uint16_t* color, int tileX, int tileY, int factor, const GammaTables& gamma,
                  Image& image);
+
+// A tile of N samples per pixel (anti-aliasing; N = 4, 8, 16 or 64, sample planes as
+// raster/framebuffer.h describes): each image pixel is the rounded mean of its samples in linear
+// light — the 1×1 box filter of SPEC §5.
+void resolveSampleTile(const uint16_t* color, int tileX, int tileY, int samples,
+                       const GammaTables& gamma, Image& image);
+
+// Linear colour of a whole frame, 3 × uint16 per pixel, row-major: the box-resolved frame buffer
+// that the 3×3 tent filter reads across tile borders.
+struct LinearImage {
+  int width = 0, height = 0;
+  std::vector<uint16_t> rgb;
+  void resize(int w, int h) {
+    width = w;
+    height = h;
+    rgb.resize(size_t(w) * size_t(h) * 3);
+  }
+};
+
+// Box-resolves one tile into `linear` (sized for the image) instead of the display image, for any
+// of the layouts above: `factor` × `factor` pixels per image pixel (supersampling) or `samples`
+// samples per pixel (one of the two is 1).
+void resolveTileLinear(const uint16_t* color, int tileX, int tileY, int factor, int samples,
+                       LinearImage& linear);
+
+// The 3×3 triangle (tent) filter of seed 002 (SPEC §5) over the box-resolved frame, weights
+// [1 2 1]ᵀ[1 2 1] / 16 in linear light, edges clamped; then gamma. Writes rows [rowBegin, rowEnd)
+// of `image` (sized by prepareImage), so that bands of rows can go to different threads.
+void tentFilterRows(const LinearImage& linear, const GammaTables& gamma, int rowBegin, int rowEnd,
+                    Image& image);
 
 // For the overdraw count (raster::ShadeMode::overdraw): a false-colour image, black for 0, then
 // blue, cyan, green, yellow, red for 1, 2, 3, 4, ≥5 triangles covering the pixel.

@@ -130,7 +130,7 @@ BenchRunner::~BenchRunner() = default;
 const std::string& BenchRunner::referenceDescription() const { return impl_->glDescription; }
 
 Status BenchRunner::startReference() {
-  auto gl = GlRenderer::create(impl_->settings.options, impl_->settings.aa);
+  auto gl = GlRenderer::create(impl_->settings.options, impl_->settings.referenceMsaa);
   if (!gl.ok()) return gl.error();
   impl_->gl = std::move(gl).value();
   impl_->glDescription = impl_->gl->description();
@@ -226,7 +226,8 @@ nlohmann::json jsonRows(const CaseResult& r, const BenchSettings& s) {
                 {"frames", s.frames},
                 {"warmup", s.warmup},
                 {"shade", "gouraud"},
-                {"aa", s.aa},
+                {"aa", run.renderer == "synthvis" ? s.options.samples : std::max(1, s.referenceMsaa)},
+                {"filter", s.options.filter == RenderOptions::Filter::tent3 ? "tent3" : "box"},
                 {"readback_timed", run.renderer == "synthvis" || s.referenceReadback},
                 {"median_ms", run.medianMs},
                 {"min_ms", run.minMs},

@@ -58,7 +58,9 @@ struct CaseResult {
 struct BenchSettings {
   RenderOptions options;
   int frames = 10, warmup = 2;
-  int aa = 0;             // samples per pixel: 0 = none; the gl reference multisamples (2…16)
+  // The gl reference's multisampling (0 = none, 2…16; llvmpipe takes at most 4). synthvis's own
+  // samples per pixel are options.samples.
+  int referenceMsaa = 0;
   bool synthvis = true;   // time synthvis
   bool reference = true;  // time the gl reference (after startReference)
   // Count the gl reference's read-back (glReadPixels into an 8-bit image in memory) in its frame

@@ -87,6 +87,15 @@ Status validate(const RenderOptions& o) {
                                      o.width, o.height, o.supersample, kMaxRasterSize)};
   if (o.supersample > 1 && o.debugOverdraw)
     return Error{"", "", "the overdraw view counts triangles per pixel; it cannot be supersampled"};
+  if (o.samples != 1 && o.samples != 4 && o.samples != 8 && o.samples != 16 && o.samples != 64)
+    return Error{"", "", fmt::format("{} samples per pixel is not supported (1, 4, 8, 16 or 64)",
+                                     o.samples)};
+  if (o.samples > 1 && o.supersample > 1)
+    return Error{"", "", "anti-aliasing and supersampling are alternatives; choose one"};
+  if (o.samples > 1 && o.debugOverdraw)
+    return Error{"", "", "the overdraw view counts triangles per pixel; it cannot be anti-aliased"};
+  if (o.filter != RenderOptions::Filter::box && o.debugOverdraw)
+    return Error{"", "", "the overdraw view cannot be filtered"};
   if (o.gamma != 0 && !(o.gamma >= 0.5 && o.gamma <= 5))
     return Error{"", "", fmt::format("gamma {} is out of range (0.5…5, or 0 for sRGB)", o.gamma)};
   return {};
@@ -111,6 +120,7 @@ struct Renderer::Impl {
   render::FrameRenderer frame;
   output::GammaTables gamma;
   render::DrawPackets packets;
+  output::LinearImage linear;  // the box-resolved frame, for the tent filter
 };
 
 Renderer::Renderer(const RenderOptions& options) : impl_(std::make_unique<Impl>(options)) {}
@@ -187,12 +197,26 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
   fs.clearColor[1] = scene.background.y;
   fs.clearColor[2] = scene.background.z;
   fs.shade = o.debugOverdraw ? raster::ShadeMode::overdraw : raster::ShadeMode::gouraud;
+  fs.samples = o.samples;
   // Stage 5, display: each tile is resolved into the image as soon as it is finished (k divides
-  // the 64-pixel tile, so a pixel's k×k samples always lie in one tile).
+  // the 64-pixel tile, so a pixel's k×k samples always lie in one tile) — or, for the tent filter,
+  // which reads across tile borders, into a linear frame that is filtered once all tiles are in.
   const int tilesX = (fs.width + raster::kTileSize - 1) >> raster::kTileLog2;
+  const bool tent = o.filter == RenderOptions::Filter::tent3;
+  output::LinearImage& linear = impl_->linear;
+  if (tent) linear.resize(o.width, o.height);
   if (o.debugOverdraw)
     fs.finishTile = [&](int tile, const float*, const uint16_t* color) {
       output::resolveOverdrawTile(color, tile % tilesX, tile / tilesX, image);
+    };
+  else if (tent)
+    fs.finishTile = [&](int tile, const float*, const uint16_t* color) {
+      output::resolveTileLinear(color, tile % tilesX, tile / tilesX, k, o.samples, linear);
+    };
+  else if (o.samples > 1)
+    fs.finishTile = [&](int tile, const float*, const uint16_t* color) {
+      output::resolveSampleTile(color, tile % tilesX, tile / tilesX, o.samples, impl_->gamma,
+                                image);
     };
   else
     fs.finishTile = [&](int tile, const float*, const uint16_t* color) {
@@ -200,6 +224,15 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
     };
   output::prepareImage(o.width, o.height, image);
   impl_->frame.render(p, fs, stats);
+  if (tent) {
+    t0 = Clock::now();
+    constexpr int kBand = 16;  // rows per task
+    impl_->frame.pool().parallelFor(size_t((o.height + kBand - 1) / kBand), [&](size_t band, int) {
+      const int y0 = int(band) * kBand;
+      output::tentFilterRows(linear, impl_->gamma, y0, std::min(o.height, y0 + kBand), image);
+    });
+    stats.rasterMs += msSince(t0);
+  }
   stats.totalMs = msSince(start);
   if (statsOut) *statsOut = stats;
   return {};

@@ -93,6 +93,10 @@ TEST(Cli, MissingSceneFileAndBadOptions) {
   EXPECT_NE(run("render --no-such-flag").status, 0);
   expectOneLineError(run("render --gamma 9 -o " + (tempDir() / "x.png").string()), "",
                      "gamma 9 is out of range");
+  expectOneLineError(run("render --aa 3 -o " + (tempDir() / "x.png").string()), "",
+                     "3 samples per pixel is not supported");
+  expectOneLineError(run("render --filter gauss -o " + (tempDir() / "x.png").string()), "",
+                     "unknown filter 'gauss'");
 }
 
 TEST(Cli, BenchWritesTheJsonFieldsBenchMdNames) {
@@ -154,6 +158,8 @@ TEST(Cli, TruthAndCompare) {
   const CliRun c = run("compare " + ours + " " + truth + " --edges " + edges);
   EXPECT_EQ(c.status, 0) << c.out;
   EXPECT_NE(c.out.find("edge pixels"), std::string::npos) << c.out;
+  ASSERT_EQ(run("render -o " + ours + " --width 64 --height 48 --aa 16 --filter tent3").status, 0);
+  EXPECT_EQ(run("compare " + ours + " " + truth).status, 0);
   expectOneLineError(run("truth -o " + truth + " --samples 3"), "", "must be a square");
   expectOneLineError(run("compare " + ours + " /no/such.png"), "/no/such.png", "");
 }

@@ -168,6 +168,64 @@ TEST(Render, SupersamplingAveragesSamplesInLinearLight) {
   EXPECT_FALSE(validate(bad).ok());  // 16 000 px wide inside
 }
 
+// A quad edge at x = 10.5 (vertical, through the middle of column 10) with anti-aliasing: column
+// 10 is half covered — half its samples white, half black — and resolves to the sRGB encoding of
+// 0.5 linear (188), as supersampling does; with the tent filter, column 10 is the weighted mean
+// ¼·1 + ½·½ + ¼·0 = ½ of its neighbours too, and columns 9 and 11 blend by a quarter (¾ and ¼).
+TEST(Render, AntiAliasingAndTheTentFilterAverageInLinearLight) {
+  const int w = 40, h = 8;
+  scene::Scene s = scene::benchCameraScene("quad");
+  const double tanHalf = std::tan(30.0 * 3.14159265358979 / 180), aspect = double(w) / h;
+  auto at = [&](double px, double py) {
+    return Vec3{float((2 * px / w - 1) * 2 * tanHalf * aspect), float((1 - 2 * py / h) * 2 * tanHalf),
+                -2.0f};
+  };
+  scene::Mesh m;
+  m.positions = {at(-5, -5), at(10.5, -5), at(10.5, h + 5), at(-5, h + 5)};
+  m.indices = {0, 1, 2, 0, 2, 3};
+  m.material = 0;
+  s.meshes.push_back(m);
+  auto render = [&](int samples, RenderOptions::Filter filter, int threads) {
+    RenderOptions o;
+    o.width = w;
+    o.height = h;
+    o.threads = threads;
+    o.samples = samples;
+    o.filter = filter;
+    Renderer r(o);
+    Image img;
+    EXPECT_TRUE(r.render(s, img).ok());
+    return img;
+  };
+  for (int n : {4, 8, 16, 64}) {
+    const Image img = render(n, RenderOptions::Filter::box, 2);
+    EXPECT_EQ(img.rgb, render(n, RenderOptions::Filter::box, 1).rgb) << n;
+    for (int y = 0; y < h; ++y) {
+      EXPECT_EQ(img.pixel(9, y)[0], 255) << n;
+      EXPECT_NEAR(img.pixel(10, y)[1], 188, 1) << n;  // n/2 samples on each side of x = 10.5
+      EXPECT_EQ(img.pixel(11, y)[2], 0) << n;
+    }
+    const Image tent = render(n, RenderOptions::Filter::tent3, 2);
+    EXPECT_EQ(tent.rgb, render(n, RenderOptions::Filter::tent3, 1).rgb) << n;
+    for (int y = 0; y < h; ++y) {
+      EXPECT_EQ(tent.pixel(5, y)[0], 255) << n;
+      EXPECT_NEAR(tent.pixel(9, y)[0], 240, 1) << n;   // sRGB of 0.875 = ¼ + ½ + ⅛
+      EXPECT_NEAR(tent.pixel(10, y)[0], 188, 1) << n;  // 0.5
+      EXPECT_NEAR(tent.pixel(11, y)[0], 99, 1) << n;   // 0.125
+      EXPECT_EQ(tent.pixel(13, y)[0], 0) << n;
+    }
+  }
+  RenderOptions bad;
+  bad.samples = 2;
+  EXPECT_NE(validate(bad).error().str().find("not supported"), std::string::npos);
+  bad.samples = 16;
+  bad.supersample = 2;
+  EXPECT_FALSE(validate(bad).ok());
+  bad.supersample = 1;
+  bad.debugOverdraw = true;
+  EXPECT_FALSE(validate(bad).ok());
+}
+
 TEST(LayersGenerator, SameSeedSameSceneAndStatistics) {
   scene::LayersParams p;
   p.layers = 3;
