@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstring>
 
 namespace sv::output {
 
@@ -127,11 +128,38 @@ void forEachBlockMean(const uint16_t* color, int tileX, int tileY, int factor, i
 
 void resolveSampleTile(const uint16_t* color, int tileX, int tileY, int samples,
                        const GammaTables& gamma, Image& image) {
-  forEachSampleMean(color, tileX, tileY, samples, image.width, image.height,
-                    [&](int x, int y, const uint16_t* mean) {
-                      uint8_t* out = image.pixel(x, y);
-                      for (int ch = 0; ch < 3; ++ch) out[ch] = gamma.table[size_t(ch)][mean[ch]];
-                    });
+  // forEachSampleMean with the stores written out: through a generic sink, the byte stores (which
+  // may alias anything) made the compiler reload every pointer per pixel — 17 % of a 4-sample frame.
+  using namespace raster;
+  const int x0 = tileX * kTileSize, y0 = tileY * kTileSize;
+  const int w = std::min(kTileSize, image.width - x0), h = std::min(kTileSize, image.height - y0);
+  const uint32_t half = uint32_t(samples) / 2;
+  const int shift = std::countr_zero(unsigned(samples));
+  const uint8_t* const r = gamma.table[0].data();
+  const uint8_t* const g = gamma.table[1].data();
+  const uint8_t* const b = gamma.table[2].data();
+  uint8_t* const rgb = image.rgb.data();
+  const size_t stride = size_t(image.width) * 3;
+  for (int by = 0; by < h; by += kBlockSize)
+    for (int bx = 0; bx < w; bx += kBlockSize) {
+      const uint16_t* block =
+          color + size_t((by >> kBlockLog2) * kBlocksPerTileSide + (bx >> kBlockLog2)) * samples *
+                      kColorPerBlock;
+      uint32_t sum[kColorPerBlock];
+      for (int i = 0; i < kColorPerBlock; ++i) sum[i] = block[i];
+      for (int s = 1; s < samples; ++s)
+        for (int i = 0; i < kColorPerBlock; ++i) sum[i] += block[s * kColorPerBlock + i];
+      uint8_t out[kBlockPixels * 3];
+      for (int p = 0; p < kBlockPixels; ++p) {
+        out[3 * p] = r[(sum[p] + half) >> shift];
+        out[3 * p + 1] = g[(sum[kBlockPixels + p] + half) >> shift];
+        out[3 * p + 2] = b[(sum[2 * kBlockPixels + p] + half) >> shift];
+      }
+      const int rows = std::min(kBlockSize, h - by), cols = std::min(kBlockSize, w - bx);
+      for (int py = 0; py < rows; ++py)
+        std::memcpy(rgb + size_t(y0 + by + py) * stride + size_t(x0 + bx) * 3,
+                    out + py * kBlockSize * 3, size_t(cols) * 3);
+    }
 }
 
 void resolveTileLinear(const uint16_t* color, int tileX, int tileY, int factor, int samples,
