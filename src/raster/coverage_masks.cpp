@@ -1,5 +1,5 @@
 // Based on: SPEC §5 (seed 000: masks from a table indexed by distance and slope); Schilling 1991
-// (A new simple and efficient antialiasing with subpixel masks); Microsoft, D3D11 standard
+// (A new simple and efficient antialiasing with subpixel masks: masks chosen by area); Microsoft, D3D11 standard
 // multisample patterns (D3D11_STANDARD_MULTISAMPLE_PATTERN) for 8 and 16 samples.
 #include "raster/coverage_masks.h"
 
@@ -32,8 +32,35 @@ SamplePattern jittered8x8() {
   return p;
 }
 
-// The side a tie (v = 0) belongs to: antisymmetric in the normal, like setup.cpp's fill rule.
+// The side an edge through the pixel centre (d = 0) gives the centre cell to: antisymmetric in the
+// normal, like setup.cpp's fill rule.
 bool ownsTie(double nx, double ny) { return nx > 0 || (nx == 0 && ny > 0); }
+
+// The area of the pixel (−½, ½)² where nx·x + ny·y + d ≥ 0: the square clipped by the line
+// (Sutherland–Hodgman), then the shoelace formula.
+double halfPlaneArea(double nx, double ny, double d) {
+  const double square[4][2] = {{-0.5, -0.5}, {0.5, -0.5}, {0.5, 0.5}, {-0.5, 0.5}};
+  double poly[8][2];
+  int n = 0;
+  for (int i = 0; i < 4; ++i) {
+    const double* p = square[i];
+    const double* q = square[(i + 1) % 4];
+    const double ep = nx * p[0] + ny * p[1] + d, eq = nx * q[0] + ny * q[1] + d;
+    if (ep >= 0) {
+      poly[n][0] = p[0];
+      poly[n++][1] = p[1];
+    }
+    if ((ep >= 0) != (eq >= 0)) {
+      const double u = ep / (ep - eq);
+      poly[n][0] = p[0] + u * (q[0] - p[0]);
+      poly[n++][1] = p[1] + u * (q[1] - p[1]);
+    }
+  }
+  double area = 0;
+  for (int i = 0; i < n; ++i)
+    area += poly[i][0] * poly[(i + 1) % n][1] - poly[(i + 1) % n][0] * poly[i][1];
+  return std::fabs(area) / 2;
+}
 
 }  // namespace
 
@@ -65,20 +92,27 @@ EdgeMaskTable::EdgeMaskTable(const SamplePattern& pattern)
   for (int q = 0; q < 4; ++q)
     for (int i = 0; i < kSlopeSteps; ++i) {
       uint64_t* row = table_.data() + size_t(rowIndex(q, i)) * kRowEntries;
+      uint64_t* mirror = table_.data() + size_t(rowIndex(q ^ 3, i)) * kRowEntries;
       row[0] = 0;
       row[kRowEntries - 1] = all_;
-      for (int j = 0; j < kDistanceSteps; ++j) {
-        // The cell's centre; all dyadic, so the reversed edge's values are exact negations.
+      // The cells with d > 0; each one's reversed edge, (q ^ 3, i, mirrored cell), gets the
+      // complement — exact complements by construction.
+      for (int j = kDistanceSteps / 2; j < kDistanceSteps; ++j) {
         const double t = (i + 0.5) / kSlopeSteps;
         const double nx = (q & 1) ? -t : t, ny = (q & 2) ? -(1 - t) : (1 - t);
         const double d = (j + 0.5) / kDistanceSteps - 0.5;
+        // The k = round(N·A) samples farthest inside (largest v; ties by sample index).
+        std::vector<std::pair<double, int>> v(static_cast<size_t>(count_));
+        for (int s = 0; s < count_; ++s)
+          v[size_t(s)] = {nx * pattern.offsets[size_t(s)][0] + ny * pattern.offsets[size_t(s)][1] + d,
+                          s};
+        const int k = int(std::lround(halfPlaneArea(nx, ny, d) * count_));
+        std::stable_sort(v.begin(), v.end(),
+                         [](const auto& a, const auto& b) { return a.first > b.first; });
         uint64_t m = 0;
-        for (int s = 0; s < count_; ++s) {
-          const auto& o = pattern.offsets[size_t(s)];
-          const double v = nx * o[0] + ny * o[1] + d;
-          if (v > 0 || (v == 0 && ownsTie(nx, ny))) m |= uint64_t(1) << s;
-        }
+        for (int s = 0; s < k; ++s) m |= uint64_t(1) << v[size_t(s)].second;
         row[1 + j] = m;
+        mirror[1 + (kDistanceSteps - 1 - j)] = ~m & all_;
       }
     }
   uint64_t* constant = table_.data() + size_t(kConstantRow) * kRowEntries;
@@ -104,6 +138,10 @@ uint64_t EdgeMaskTable::mask(double a, double b, double c) const {
 
 CoverageTables::CoverageTables(const SamplePattern& p)
     : samples(p.count), words(p.count > 32 ? 2 : 1), pattern(&p), table(p) {
+  for (int s = 0; s < p.count; ++s) {
+    offsetX[s] = int32_t(std::lround(p.offsets[size_t(s)][0] * 256));  // exact: 1/256 grid
+    offsetY[s] = int32_t(std::lround(p.offsets[size_t(s)][1] * 256));
+  }
   for (int w = 0; w < words; ++w) {
     word[w].resize(size_t(EdgeMaskTable::kRows) * EdgeMaskTable::kRowEntries);
     for (int r = 0; r < EdgeMaskTable::kRows; ++r)

@@ -123,17 +123,23 @@ HWY_INLINE void blockBases(const TriangleSetup& t, const PlaneLanes& lanes, int 
               d8, base + p);
 }
 
-// Perspective-correct colour channel ch = (colour/w)·w, clamped to [0, 1], as 16-bit linear light
-// in int32 lanes. Float → 16-bit by the magic-number trick: for 0 ≤ v < 2^23, the float v + 2^23
-// holds round-to-nearest-even(v) in its low mantissa bits (no range fix-ups, unlike ConvertTo).
+// Perspective-correct colour (colour/w)·w, clamped to [0, 1], as 16-bit linear light in int32
+// lanes. Float → 16-bit by the magic-number trick: for 0 ≤ v < 2^23, the float v + 2^23 holds
+// round-to-nearest-even(v) in its low mantissa bits (no range fix-ups, unlike ConvertTo).
 template <class DF, class V>
-HWY_INLINE auto colorLanes(DF df, const PlaneLanes& lanes, const float* base, int ch, size_t i,
-                           V w) {
+HWY_INLINE auto colorToLanes(DF df, V cw, V w) {
   const hn::RebindToSigned<DF> di;
-  const auto cw = hn::Add(hn::Set(df, base[kRed + ch]), hn::LoadU(df, lanes.offset[kRed + ch] + i));
   const auto c = hn::Min(hn::Max(hn::Mul(cw, w), hn::Zero(df)), hn::Set(df, 1.0f));
   return hn::And(hn::BitCast(di, hn::Add(hn::Mul(c, hn::Set(df, 65535.0f)), hn::Set(df, 8388608.0f))),
                  hn::Set(di, 0xFFFF));
+}
+
+// Channel ch at the pixel centres of lanes i… .
+template <class DF, class V>
+HWY_INLINE auto colorLanes(DF df, const PlaneLanes& lanes, const float* base, int ch, size_t i,
+                           V w) {
+  const auto cw = hn::Add(hn::Set(df, base[kRed + ch]), hn::LoadU(df, lanes.offset[kRed + ch] + i));
+  return colorToLanes(df, cw, w);
 }
 
 // Depth test ("less") and Gouraud colour for the pixels of one 4×4 block set in `mask`.
@@ -172,12 +178,17 @@ HWY_INLINE void shadeBlock(const TriangleSetup& t, const PlaneLanes& lanes, uint
 
 // The same with N samples per pixel (SPEC §5): masks[w][p] holds pixel p's samples 32·w … 32·w + 31
 // (masks == nullptr: every sample of every pixel). Depth is tested per sample at its position,
-// z_s = z(centre) + sampleDepth[s]; colour is shaded once per pixel, at its centre, and written to
-// the samples that pass. `depth` and `color` point at the block's first sample plane.
+// z_s = z(centre) + sampleDepth[s]; colour is shaded once per pixel and written to the samples that
+// pass — at the centre of a fully covered pixel, and at the centroid of the covered samples of a
+// partly covered one, which lies inside the triangle (the centre may not: extrapolated colour at
+// silhouettes doubled the edge error of 16 samples on small random triangles, docs/quality.md).
+// The centroid is (Σ offsets in 1/256 px, an exact integer) / count / 256, and the planes are
+// evaluated there as (base + offset) + (dx·cx + dy·cy).
 HWY_INLINE void shadeBlockSamples(const TriangleSetup& t, const PlaneLanes& lanes,
-                                  const float* sampleDepth, int samples,
+                                  const CoverageTables& cov, const float* sampleDepth,
                                   const uint32_t (*masks)[kBlockPixels], int gx, int gy,
                                   float* depth, uint16_t* color) {
+  const int samples = cov.samples;
   const hn::CappedTag<float, kBlockPixels> df;
   const hn::RebindToSigned<decltype(df)> di;
   const hn::RebindToUnsigned<decltype(df)> du32;
@@ -185,7 +196,6 @@ HWY_INLINE void shadeBlockSamples(const TriangleSetup& t, const PlaneLanes& lane
   const size_t n = hn::Lanes(df);
   alignas(32) float base[8];
   blockBases(t, lanes, gx, gy, base);
-  // Outside the triangle (a pixel it only partly covers) 1/w is extrapolated and may reach 0.
   const auto one = hn::Set(df, 1.0f), tiny = hn::Set(df, 1e-30f);
   for (size_t i = 0; i < size_t(kBlockPixels); i += n) {
     auto m0 = hn::Set(du32, ~0u), m1 = m0;
@@ -195,11 +205,32 @@ HWY_INLINE void shadeBlockSamples(const TriangleSetup& t, const PlaneLanes& lane
       if (hn::AllTrue(du32, hn::Eq(hn::Or(m0, m1), hn::Zero(du32)))) continue;
     }
     const auto zPix = hn::Add(hn::Set(df, base[kDepth]), hn::LoadU(df, lanes.offset[kDepth] + i));
-    const auto w = hn::Div(
-        one, hn::Max(hn::Add(hn::Set(df, base[kInvW]), hn::LoadU(df, lanes.offset[kInvW] + i)),
-                     tiny));
+    // The shading position, relative to the pixel centre.
+    auto cx = hn::Zero(df), cy = cx;
+    if (masks) {
+      auto sx = hn::Zero(di), sy = sx, count = sx;
+      for (int s = 0; s < samples; ++s) {
+        const auto covered =
+            hn::RebindMask(di, hn::TestBit(s < 32 ? m0 : m1, hn::Set(du32, 1u << (s & 31))));
+        sx = hn::Add(sx, hn::IfThenElseZero(covered, hn::Set(di, cov.offsetX[s])));
+        sy = hn::Add(sy, hn::IfThenElseZero(covered, hn::Set(di, cov.offsetY[s])));
+        count = hn::Sub(count, hn::VecFromMask(di, covered));
+      }
+      const auto partial = hn::RebindMask(df, hn::Lt(count, hn::Set(di, samples)));
+      const auto countF = hn::ConvertTo(df, hn::Max(count, hn::Set(di, 1)));
+      const auto scale = hn::Set(df, 1.0f / 256);
+      cx = hn::IfThenElseZero(partial, hn::Mul(hn::Div(hn::ConvertTo(df, sx), countF), scale));
+      cy = hn::IfThenElseZero(partial, hn::Mul(hn::Div(hn::ConvertTo(df, sy), countF), scale));
+    }
+    auto at = [&](int plane) {
+      return hn::Add(hn::Add(hn::Set(df, base[plane]), hn::LoadU(df, lanes.offset[plane] + i)),
+                     hn::Add(hn::Mul(hn::Set(df, lanes.dx[plane]), cx),
+                             hn::Mul(hn::Set(df, lanes.dy[plane]), cy)));
+    };
+    // Outside the triangle 1/w is extrapolated and may reach 0; the clamp keeps w finite.
+    const auto w = hn::Div(one, hn::Max(at(kInvW), tiny));
     hn::Vec<decltype(di)> c16[kColorChannels];
-    for (int ch = 0; ch < kColorChannels; ++ch) c16[ch] = colorLanes(df, lanes, base, ch, i, w);
+    for (int ch = 0; ch < kColorChannels; ++ch) c16[ch] = colorToLanes(df, at(kRed + ch), w);
     for (int s = 0; s < samples; ++s) {
       const auto covered =
           hn::RebindMask(df, hn::TestBit(s < 32 ? m0 : m1, hn::Set(du32, 1u << (s & 31))));
@@ -429,9 +460,14 @@ class TriangleRaster {
     const hn::Rebind<float, decltype(di)> df;
     const size_t lanes = hn::Lanes(di);
     const CoverageTables& cov = *ctx_.coverage;
-    // int64 edges: |E|/4 (capped) and the sign per pixel in scalar code first (these are the
-    // large triangles' leaves, few); int32 edges go straight from the vector below.
-    alignas(64) int32_t quarter[E][kBlockPixels], positive[E][kBlockPixels];
+    // The distance cell q = ⌊|E|·D / N1⌋ = ⌊(|E| >> kShift) / S⌋ for D = kDistanceSteps cells
+    // (N1 = 256·S; nested floors of positive integers compose), capped at D/2 (|d| ≥ ½).
+    constexpr int kHalf = EdgeMaskTable::kDistanceSteps / 2;
+    constexpr int kShift = 8 - std::countr_zero(unsigned(EdgeMaskTable::kDistanceSteps));
+    static_assert(EdgeMaskTable::kDistanceSteps << kShift == 256, "D divides 256");
+    // int64 edges: the cell and the side per pixel in scalar code first (exact int64 division;
+    // these are the large triangles' leaves, few); int32 edges go straight from the vector below.
+    alignas(64) int32_t cell[E][kBlockPixels], positive[E][kBlockPixels];
     if constexpr (sizeof(T) == 8) {
       for (int k = 0; k < E; ++k) {
         if (!(active & (1u << k))) continue;
@@ -439,8 +475,8 @@ class TriangleRaster {
           const T e = tl[k] + leafOffset_[k][p];
           const T geometric = e + bias_[k];
           positive[k][p] = e >= 0 ? -1 : 0;
-          quarter[k][p] = int32_t(std::min<T>((geometric < 0 ? -geometric : geometric) >> 2,
-                                              T(32) * divisor_[k]));
+          cell[k][p] = int32_t(std::min<T>(
+              ((geometric < 0 ? -geometric : geometric) >> kShift) / divisor_[k], kHalf));
         }
       }
     }
@@ -451,30 +487,46 @@ class TriangleRaster {
     const int32_t* word0 = reinterpret_cast<const int32_t*>(cov.word[0].data());
     const int32_t* word1 = reinterpret_cast<const int32_t*>(cov.word[1].data());
     int covered = 0;
+    // Pixels outside the triangle's box get nothing: near a vertex the AND of area masks can claim
+    // samples beyond the triangle (coverage_masks.h); the box — the pixel squares the triangle
+    // reaches — bounds them, as it bounds the traversal.
+    const int gx = ctx_.originX + lx, gy = ctx_.originY + ly;
+    const bool clipToBox = gx < t_.minX || gx + kBlockSize - 1 > t_.maxX || gy < t_.minY ||
+                           gy + kBlockSize - 1 > t_.maxY;
     for (size_t i = 0; i < size_t(kBlockPixels); i += lanes) {
       auto m0 = hn::Set(di, -1), m1 = m0;
+      if (clipToBox) {
+        const auto x = hn::Add(hn::Set(di, gx), hn::LoadU(di, kLaneX + i));
+        const auto y = hn::Add(hn::Set(di, gy), hn::LoadU(di, kLaneY + i));
+        const auto inBox = hn::And(
+            hn::And(hn::Gt(x, hn::Set(di, t_.minX - 1)), hn::Lt(x, hn::Set(di, t_.maxX + 1))),
+            hn::And(hn::Gt(y, hn::Set(di, t_.minY - 1)), hn::Lt(y, hn::Set(di, t_.maxY + 1))));
+        m0 = m1 = hn::VecFromMask(di, inBox);
+      }
       for (int k = 0; k < E; ++k) {
         if (!(active & (1u << k))) continue;
-        const auto S = hn::Set(di, divisor_[k]);
-        hn::Vec<decltype(di)> a;
+        hn::Vec<decltype(di)> q;
         hn::Mask<decltype(di)> inside;  // e ≥ 0: the side of the edge the cell index counts up
         if constexpr (sizeof(T) == 4) {
+          const auto S = hn::Set(di, divisor_[k]);
           const auto e = hn::Add(hn::Set(di, tl[k]), hn::LoadU(di, leafOffset_[k] + i));
           inside = hn::Gt(e, minusOne);
-          a = hn::Min(hn::ShiftRight<2>(hn::Abs(hn::Add(e, hn::Set(di, bias_[k])))),
-                      hn::Set(di, 32 * divisor_[k]));
+          // a ≤ (D/2)·S < 2^23 (small triangles: S ≤ 2^15): the float estimate of a / S is
+          // within one of ⌊a / S⌋, then corrected exactly.
+          const auto a = hn::Min(hn::ShiftRight<kShift>(hn::Abs(hn::Add(e, hn::Set(di, bias_[k])))),
+                                 hn::Set(di, kHalf * divisor_[k]));
+          q = hn::ConvertTo(di, hn::Mul(hn::ConvertTo(df, a), hn::Set(df, reciprocal_[k])));
+          const auto r = hn::Sub(a, hn::Mul(q, S));
+          q = hn::Add(q, hn::VecFromMask(di, hn::Lt(r, zero)));                        // − 1
+          q = hn::Sub(q, hn::VecFromMask(di, hn::Gt(r, hn::Sub(S, hn::Set(di, 1)))));  // + 1
         } else {
           inside = hn::Lt(hn::LoadU(di, positive[k] + i), zero);
-          a = hn::LoadU(di, quarter[k] + i);
+          q = hn::LoadU(di, cell[k] + i);
         }
-        // q = ⌊a / S⌋: the float estimate is within one of it (a < 2^30), then corrected exactly.
-        auto q = hn::ConvertTo(di, hn::Mul(hn::ConvertTo(df, a), hn::Set(df, reciprocal_[k])));
-        const auto r = hn::Sub(a, hn::Mul(q, S));
-        q = hn::Add(q, hn::VecFromMask(di, hn::Lt(r, zero)));                        // − 1
-        q = hn::Sub(q, hn::VecFromMask(di, hn::Gt(r, hn::Sub(S, hn::Set(di, 1)))));  // + 1
-        // Row entry: 1 + (32 + q) on the inside, 1 + (31 − q) mirrored (EdgeMaskTable::mask).
-        const auto idx = hn::IfThenElse(inside, hn::Add(q, hn::Set(di, rowOffset_[k] + 33)),
-                                        hn::Sub(hn::Set(di, rowOffset_[k] + 32), q));
+        // Row entry: 1 + (D/2 + q) on the inside, 1 + (D/2 − 1 − q) mirrored
+        // (EdgeMaskTable::mask).
+        const auto idx = hn::IfThenElse(inside, hn::Add(q, hn::Set(di, rowOffset_[k] + kHalf + 1)),
+                                        hn::Sub(hn::Set(di, rowOffset_[k] + kHalf), q));
         m0 = hn::And(m0, hn::GatherIndex(di, word0, idx));
         if (cov.words == 2) m1 = hn::And(m1, hn::GatherIndex(di, word1, idx));
       }
@@ -512,7 +564,7 @@ class TriangleRaster {
     ctx_.stats->fragments += uint64_t(pixels);
     const size_t block = size_t(ly >> kBlockLog2) * kBlocksPerTileSide + (lx >> kBlockLog2);
     const size_t planes = block * size_t(ctx_.samples);
-    shadeBlockSamples(t_, planeLanes_, sampleDepth_, ctx_.samples, masks, ctx_.originX + lx,
+    shadeBlockSamples(t_, planeLanes_, *ctx_.coverage, sampleDepth_, masks, ctx_.originX + lx,
                       ctx_.originY + ly, ctx_.depth + planes * kBlockPixels,
                       ctx_.color + planes * kColorPerBlock);
   }

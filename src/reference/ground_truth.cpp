@@ -46,6 +46,22 @@ Result<Image> renderGroundTruth(const scene::Scene& scene, const GroundTruthOpti
   const Result<Mat4> camera = viewProjection(scene, o);
   if (!camera.ok()) return camera.error();
   const int W = o.width, H = o.height, n = g.samplesPerSide, S = n * n;
+  // Stratified samples: one per cell of an n×n grid, jittered inside it by a hash of the pixel,
+  // cell and axis (deterministic). A regular grid would favour the regular patterns it is used to
+  // judge — its own error is correlated with theirs: against a regular 16×16 truth, 4×4 supersampling
+  // looked 1.5× better than 16 n-rooks samples on mixed.json, against this one they are level
+  // (docs/quality.md). One sample per pixel stays at the centre (point sampling).
+  auto jitter = [n](int x, int y, int sx, int sy, int axis) {
+    if (n == 1) return 0.5;
+    uint64_t h = (uint64_t(uint32_t(x)) << 32 | uint32_t(y)) * 0x9E3779B97F4A7C15ull ^
+                 (uint64_t(sx) << 24 | uint64_t(sy) << 8 | uint64_t(axis));
+    h ^= h >> 31;  // splitmix64 finalizer
+    h *= 0xBF58476D1CE4E5B9ull;
+    h ^= h >> 27;
+    h *= 0x94D049BB133111EBull;
+    h ^= h >> 31;
+    return (double(h >> 11) + 0.5) / 9007199254740992.0;  // (0, 1)
+  };
 
   // The same clip-space vertices and lit colours as synthvis's vertex stage.
   std::vector<Tri> tris;
@@ -133,8 +149,8 @@ Result<Image> renderGroundTruth(const scene::Scene& scene, const GroundTruthOpti
         for (int x = t.x0; x <= t.x1; ++x)
           for (int sy = 0; sy < n; ++sy)
             for (int sx = 0; sx < n; ++sx) {
-              const double X = 2 * (x + (sx + 0.5) / n) / W - 1;
-              const double Y = 1 - 2 * (y + (sy + 0.5) / n) / H;
+              const double X = 2 * (x + (sx + jitter(x, y, sx, sy, 0)) / n) / W - 1;
+              const double Y = 1 - 2 * (y + (sy + jitter(x, y, sx, sy, 1)) / n) / H;
               double l[3], sum = 0;
               bool inside = true;
               for (int k = 0; k < 3; ++k) {

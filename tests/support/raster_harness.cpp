@@ -1,6 +1,7 @@
 #include "support/raster_harness.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 namespace sv::test {
@@ -103,8 +104,12 @@ Frame renderReference(const render::DrawPackets& p, const render::FrameSettings&
       sampleDepth[k] = t.depth.dx * float(pattern->offsets[size_t(k)][0]) +
                        t.depth.dy * float(pattern->offsets[size_t(k)][1]);
     // Every pixel of the raster, not just the bounding box: the box is part of what is tested.
+    // With anti-aliasing the box is part of the definition: near a vertex the AND of area masks
+    // (coverage_masks.h) can claim samples beyond the triangle's extent, and the box — every
+    // pixel square the triangle reaches, tested in setup_test — bounds them.
     for (int y = 0; y < s.height; ++y)
       for (int x = 0; x < s.width; ++x) {
+        if (n > 1 && (x < t.minX || x > t.maxX || y < t.minY || y > t.maxY)) continue;
         uint64_t mask = table.allSamples();
         for (int k = 0; k < t.edgeCount && mask; ++k) {
           const geometry::EdgeFunction& e = t.edges[k];
@@ -124,13 +129,30 @@ Frame renderReference(const render::DrawPackets& p, const render::FrameSettings&
           continue;
         }
         const float zCentre = evalPlane(t.depth, x, y, t.minX, t.minY);
-        const float invW = evalPlane(t.invW, x, y, t.minX, t.minY);
+        // Colour at the centre, or with anti-aliasing for a partly covered pixel at the centroid
+        // of its covered samples: (Σ offsets in 1/256 px) / count / 256.
+        float cx = 0, cy = 0;
+        const int covered = std::popcount(mask);
+        if (n > 1 && covered < n) {
+          int sx = 0, sy = 0;
+          for (int k = 0; k < n; ++k)
+            if (mask >> k & 1) {
+              sx += int(std::lround(pattern->offsets[size_t(k)][0] * 256));
+              sy += int(std::lround(pattern->offsets[size_t(k)][1] * 256));
+            }
+          cx = float(sx) / float(covered) * (1.0f / 256);
+          cy = float(sy) / float(covered) * (1.0f / 256);
+        }
+        auto at = [&](const geometry::Plane& plane) {
+          return evalPlane(plane, x, y, t.minX, t.minY) + (plane.dx * cx + plane.dy * cy);
+        };
+        const float invW = n > 1 ? at(t.invW) : evalPlane(t.invW, x, y, t.minX, t.minY);
         const float w = 1.0f / (n > 1 ? std::max(invW, 1e-30f) : invW);
         uint16_t c16[3];
         const geometry::Plane* planes[3] = {&t.red, &t.green, &t.blue};
         for (int ch = 0; ch < 3; ++ch) {
-          const float c =
-              std::min(std::max(evalPlane(*planes[ch], x, y, t.minX, t.minY) * w, 0.0f), 1.0f);
+          const float v = n > 1 ? at(*planes[ch]) : evalPlane(*planes[ch], x, y, t.minX, t.minY);
+          const float c = std::min(std::max(v * w, 0.0f), 1.0f);
           c16[ch] = uint16_t(std::nearbyint(c * 65535.0f));  // ties to even
         }
         for (int k = 0; k < n; ++k) {
