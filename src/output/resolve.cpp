@@ -156,9 +156,13 @@ void resolveSampleTile(const uint16_t* color, int tileX, int tileY, int samples,
         out[3 * p + 2] = b[(sum[2 * kBlockPixels + p] + half) >> shift];
       }
       const int rows = std::min(kBlockSize, h - by), cols = std::min(kBlockSize, w - bx);
-      for (int py = 0; py < rows; ++py)
-        std::memcpy(rgb + size_t(y0 + by + py) * stride + size_t(x0 + bx) * 3,
-                    out + py * kBlockSize * 3, size_t(cols) * 3);
+      uint8_t* dst = rgb + size_t(y0 + by) * stride + size_t(x0 + bx) * 3;
+      for (int py = 0; py < rows; ++py, dst += stride) {
+        if (cols == kBlockSize)  // a constant size: inlined, not a call
+          std::memcpy(dst, out + py * kBlockSize * 3, kBlockSize * 3);
+        else
+          std::memcpy(dst, out + py * kBlockSize * 3, size_t(cols) * 3);
+      }
     }
 }
 

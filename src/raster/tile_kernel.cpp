@@ -182,13 +182,16 @@ HWY_INLINE void shadeBlock(const TriangleSetup& t, const PlaneLanes& lanes, uint
 // pass — at the centre of a fully covered pixel, and at the centroid of the covered samples of a
 // partly covered one, which lies inside the triangle (the centre may not: extrapolated colour at
 // silhouettes doubled the edge error of 16 samples on small random triangles, docs/quality.md).
-// The centroid is (Σ offsets in 1/256 px, an exact integer) / count / 256, and the planes are
-// evaluated there as (base + offset) + (dx·cx + dy·cy).
+// The centroid is (Σ offsets in 1/256 px, an exact integer) · (1 / (count · 256)), and the planes
+// are evaluated there as (base + offset) + (dx·cx + dy·cy).
 HWY_INLINE void shadeBlockSamples(const TriangleSetup& t, const PlaneLanes& lanes,
                                   const CoverageTables& cov, const float* sampleDepth,
                                   const uint32_t (*masks)[kBlockPixels], int gx, int gy,
                                   float* depth, uint16_t* color) {
   const int samples = cov.samples;
+  // The words of a full mask.
+  const uint32_t fullWord0 = samples >= 32 ? ~0u : (1u << samples) - 1;
+  const uint32_t fullWord1 = samples > 32 ? ~0u : 0u;
   const hn::CappedTag<float, kBlockPixels> df;
   const hn::RebindToSigned<decltype(df)> di;
   const hn::RebindToUnsigned<decltype(df)> du32;
@@ -207,7 +210,9 @@ HWY_INLINE void shadeBlockSamples(const TriangleSetup& t, const PlaneLanes& lane
     const auto zPix = hn::Add(hn::Set(df, base[kDepth]), hn::LoadU(df, lanes.offset[kDepth] + i));
     // The shading position, relative to the pixel centre.
     auto cx = hn::Zero(df), cy = cx;
-    if (masks) {
+    const bool full = !masks || (hn::AllTrue(du32, hn::Eq(m0, hn::Set(du32, fullWord0))) &&
+                                 hn::AllTrue(du32, hn::Eq(m1, hn::Set(du32, fullWord1))));
+    if (!full) {
       auto sx = hn::Zero(di), sy = sx, count = sx;
       for (int s = 0; s < samples; ++s) {
         const auto covered =
@@ -217,10 +222,10 @@ HWY_INLINE void shadeBlockSamples(const TriangleSetup& t, const PlaneLanes& lane
         count = hn::Sub(count, hn::VecFromMask(di, covered));
       }
       const auto partial = hn::RebindMask(df, hn::Lt(count, hn::Set(di, samples)));
-      const auto countF = hn::ConvertTo(df, hn::Max(count, hn::Set(di, 1)));
-      const auto scale = hn::Set(df, 1.0f / 256);
-      cx = hn::IfThenElseZero(partial, hn::Mul(hn::Div(hn::ConvertTo(df, sx), countF), scale));
-      cy = hn::IfThenElseZero(partial, hn::Mul(hn::Div(hn::ConvertTo(df, sy), countF), scale));
+      const auto scale = hn::Div(
+          one, hn::Mul(hn::ConvertTo(df, hn::Max(count, hn::Set(di, 1))), hn::Set(df, 256.0f)));
+      cx = hn::IfThenElseZero(partial, hn::Mul(hn::ConvertTo(df, sx), scale));
+      cy = hn::IfThenElseZero(partial, hn::Mul(hn::ConvertTo(df, sy), scale));
     }
     auto at = [&](int plane) {
       return hn::Add(hn::Add(hn::Set(df, base[plane]), hn::LoadU(df, lanes.offset[plane] + i)),
@@ -338,9 +343,12 @@ class TriangleRaster {
       int row = EdgeMaskTable::kConstantRow;
       if (S != 0) {
         const int quadrant = int(a < 0 || (a == 0 && b < 0)) | int(b < 0 || (b == 0 && a < 0)) << 1;
+        // ⌊32·|a| / S⌋ in double: the correctly rounded quotient of integers below 2^53 floors
+        // exactly (as EdgeMaskTable::mask's), and costs a fraction of an int64 division.
+        const double slope = std::floor(double(EdgeMaskTable::kSlopeSteps) * double(std::abs(a)) /
+                                        double(S));
         row = EdgeMaskTable::rowIndex(
-            quadrant, int(std::min<int64_t>(EdgeMaskTable::kSlopeSteps - 1,
-                                            EdgeMaskTable::kSlopeSteps * std::abs(a) / S)));
+            quadrant, std::min(EdgeMaskTable::kSlopeSteps - 1, int(slope)));
       }
       rowOffset_[k] = row * EdgeMaskTable::kRowEntries;
       divisor_[k] = int32_t(std::max<int64_t>(S, 1));  // S < 2^25 (setup.h budget)

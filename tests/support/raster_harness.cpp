@@ -130,7 +130,7 @@ Frame renderReference(const render::DrawPackets& p, const render::FrameSettings&
         }
         const float zCentre = evalPlane(t.depth, x, y, t.minX, t.minY);
         // Colour at the centre, or with anti-aliasing for a partly covered pixel at the centroid
-        // of its covered samples: (Σ offsets in 1/256 px) / count / 256.
+        // of its covered samples: (Σ offsets in 1/256 px) · (1 / (count · 256)).
         float cx = 0, cy = 0;
         const int covered = std::popcount(mask);
         if (n > 1 && covered < n) {
@@ -140,8 +140,9 @@ Frame renderReference(const render::DrawPackets& p, const render::FrameSettings&
               sx += int(std::lround(pattern->offsets[size_t(k)][0] * 256));
               sy += int(std::lround(pattern->offsets[size_t(k)][1] * 256));
             }
-          cx = float(sx) / float(covered) * (1.0f / 256);
-          cy = float(sy) / float(covered) * (1.0f / 256);
+          const float scale = 1.0f / (float(covered) * 256.0f);
+          cx = float(sx) * scale;
+          cy = float(sy) * scale;
         }
         auto at = [&](const geometry::Plane& plane) {
           return evalPlane(plane, x, y, t.minX, t.minY) + (plane.dx * cx + plane.dy * cy);
