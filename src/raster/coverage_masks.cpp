@@ -137,7 +137,7 @@ uint64_t EdgeMaskTable::mask(double a, double b, double c) const {
 }
 
 CoverageTables::CoverageTables(const SamplePattern& p)
-    : samples(p.count), words(p.count > 32 ? 2 : 1), pattern(&p), table(p) {
+    : samples(p.count), words(p.count > 32 ? 2 : 1), pattern(&p), centroid(p.count >= 16), table(p) {
   for (int s = 0; s < p.count; ++s) {
     offsetX[s] = int32_t(std::lround(p.offsets[size_t(s)][0] * 256));  // exact: 1/256 grid
     offsetY[s] = int32_t(std::lround(p.offsets[size_t(s)][1] * 256));

@@ -101,6 +101,11 @@ struct CoverageTables {
   int words = 0;
   const SamplePattern* pattern = nullptr;
   int32_t offsetX[64] = {}, offsetY[64] = {};  // the pattern's offsets in 1/256 pixel
+  // Shade a partly covered pixel at the centroid of its covered samples rather than at its centre
+  // (tile_kernel.cpp): with 16 and 64 samples, where it cuts the edge error of small Gouraud
+  // triangles by 4 %; with 4 and 8 it changes it by under 1 % and costs 6 % of the frame
+  // (docs/quality.md).
+  bool centroid = false;
   EdgeMaskTable table;
   std::vector<uint32_t> word[2];  // kRows × kRowEntries each
 

@@ -133,7 +133,7 @@ Frame renderReference(const render::DrawPackets& p, const render::FrameSettings&
         // of its covered samples: (Σ offsets in 1/256 px) · (1 / (count · 256)).
         float cx = 0, cy = 0;
         const int covered = std::popcount(mask);
-        if (n > 1 && covered < n) {
+        if (n > 1 && covered < n && raster::CoverageTables::forCount(n)->centroid) {
           int sx = 0, sy = 0;
           for (int k = 0; k < n; ++k)
             if (mask >> k & 1) {
