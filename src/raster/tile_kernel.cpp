@@ -476,18 +476,24 @@ class TriangleRaster {
     constexpr int kHalf = EdgeMaskTable::kDistanceSteps / 2;
     constexpr int kShift = 8 - std::countr_zero(unsigned(EdgeMaskTable::kDistanceSteps));
     static_assert(EdgeMaskTable::kDistanceSteps << kShift == 256, "D divides 256");
-    // int64 edges: the cell and the side per pixel in scalar code first (exact int64 division;
-    // these are the large triangles' leaves, few); int32 edges go straight from the vector below.
+    // int64 edges: the cell and the side per pixel in scalar code first (the large triangles'
+    // leaves); int32 edges go straight from the vector below. The same estimate-and-correct
+    // division as there, in double and int64 (a ≤ (D/2)·S < 2^32).
     alignas(64) int32_t cell[E][kBlockPixels], positive[E][kBlockPixels];
     if constexpr (sizeof(T) == 8) {
       for (int k = 0; k < E; ++k) {
         if (!(active & (1u << k))) continue;
+        const T S = divisor_[k];
+        const double reciprocal = 1.0 / double(S);
         for (int p = 0; p < kBlockPixels; ++p) {
           const T e = tl[k] + leafOffset_[k][p];
           const T geometric = e + bias_[k];
           positive[k][p] = e >= 0 ? -1 : 0;
-          cell[k][p] = int32_t(std::min<T>(
-              ((geometric < 0 ? -geometric : geometric) >> kShift) / divisor_[k], kHalf));
+          const T a = std::min<T>((geometric < 0 ? -geometric : geometric) >> kShift, kHalf * S);
+          T q = T(double(a) * reciprocal);
+          const T r = a - q * S;
+          q += (r >= S) - (r < 0);
+          cell[k][p] = int32_t(q);
         }
       }
     }
