@@ -24,15 +24,21 @@ namespace sv::geometry {
 // max(|A|, |B|) ≤ 2^23 and |C| is clamped to 2^46 (beyond which the line cannot cross the raster),
 // which keeps them inside the same budget. Everything fits int64_t with 15 bits to spare.
 inline constexpr int kSubPixelBits = 8;
-inline constexpr int kSmallExtent = 64;  // pixels
+inline constexpr int kSmallExtent = 96;  // pixels
 inline constexpr int kSubPixelScale = 1 << kSubPixelBits;
 inline constexpr int kMaxRasterLog2 = 13;
 inline constexpr int kMaxRasterSize = 1 << kMaxRasterLog2;
 inline constexpr int kGuardBandLog2 = 15;
 inline constexpr int kMaxEdges = 5;  // three sides, the near plane and the far plane
-// Budget of the int32 path: |A|, |B| ≤ 64·2^8 = 2^14; the rasterizer's windows (cells of ≤ 32 px
-// around the box) stay within 97 px of every vertex, < 2^14.6 sub-pixel units; so
-// |e| ≤ 2·2^14·2^14.6 < 2^30.
+// Budget of the int32 path: |A|, |B| ≤ 96·2^8; the rasterizer evaluates edges only at pixel
+// centres of a 64-px tile that meets the box (widened by 1 px for the anti-aliasing aperture), so
+// within 96 + 65 px of every vertex on each axis; |e| ≤ 2·(96·2^8)·(161·2^8) ≈ 2.026·10^9, and the
+// aperture's constants add at most 128·(|A| + |B|) ≈ 6.3·10^6: below 2^31 with 5 % to spare.
+// (64 px before; 96 px moved tris 10k × 1000 px from the int64 to the int32 path, docs/performance.md.)
+static_assert(2.0 * (kSmallExtent * 256.0) * ((kSmallExtent + 65) * 256.0) +
+                      128.0 * 2 * kSmallExtent * 256.0 <
+                  2147483647.0,
+              "small triangles' edge values must fit int32_t");
 static_assert(kGuardBandLog2 + kSubPixelBits + 1 + kSubPixelBits + kMaxRasterLog2 + 1 < 62,
               "edge values must fit int64_t");
 
@@ -86,7 +92,7 @@ struct TriangleSetup {
   int16_t minX, minY, maxX, maxY;  // inclusive pixel bounding box, clipped to the raster
   uint8_t edgeCount;
   // True when the triangle is small (three integer edges, bounding box ≤ kSmallExtent pixels):
-  // then |e| < 2^30 within 97 px of its vertices, and the rasterizer may step in int32.
+  // then edge values fit int32 wherever the rasterizer evaluates them (budget above).
   bool small;
 };
 

@@ -233,6 +233,26 @@ TEST(Quadtree, EveryLegLengthFromOneTo4096PixelsEqualsBruteForce) {
   }
 }
 
+// Triangles at the edge of the int32 budget (geometry/setup.h: extent up to kSmallExtent = 96 px,
+// evaluated anywhere in the tiles their box meets), at every offset to the tile grid, with and
+// without anti-aliasing: the int32 stepping equals the brute-force reference.
+TEST(Quadtree, SmallTrianglesAtTheInt32BudgetEqualBruteForce) {
+  const int w = 320, h = 256;
+  DrawPackets p;
+  const double e = geometry::kSmallExtent - 0.01;
+  for (int off = 0; off < 64; off += 9) {
+    const double x = 40 + off, y = 30 + off * 0.7;
+    addTriangle(p, pixelVertex(x, y, w, h, 0.2f), pixelVertex(x + e, y + 0.3, w, h, 0.5f),
+                pixelVertex(x + 0.2, y + e, w, h, 0.8f));
+    addTriangle(p, pixelVertex(x + e, y + e, w, h, 0.3f), pixelVertex(x, y + e * 0.5, w, h, 0.4f),
+                pixelVertex(x + e * 0.5, y + 0.1, w, h, 0.6f));  // a sliver across the box
+  }
+  EXPECT_TRUE(test::renderQuadtree(p, countSettings(w, h)) == test::renderReference(p, countSettings(w, h)));
+  FrameSettings aa = gouraudSettings(w, h);
+  aa.samples = 16;
+  EXPECT_TRUE(test::renderQuadtree(p, aa) == test::renderReference(p, aa));
+}
+
 TEST(BadVertices, NonFiniteAndHugeCoordinatesAreDroppedOrDrawnDeterministically) {
   const int w = 64, h = 64;
   const float inf = std::numeric_limits<float>::infinity(), nan = std::nanf("");
