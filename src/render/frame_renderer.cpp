@@ -44,7 +44,7 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
   const int samples = coverage ? coverage->samples : 1;
   const geometry::Viewport viewport{settings.width, settings.height, coverage != nullptr};
   const uint32_t triangleCount = static_cast<uint32_t>(packets.indices.size() / 3);
-  const uint32_t batchTriangles = std::clamp<uint32_t>(settings.batchTriangles, 1, 1u << 24);
+  const uint32_t batchTriangles = std::clamp<uint32_t>(settings.batchTriangles, 1, kMaxBatchTriangles);
   // One batch: each tile is cleared, drawn and handed on in a per-thread 64×64 buffer. Several: the
   // tiles persist in a whole-frame buffer from batch to batch.
   const bool wholeFrame = triangleCount > batchTriangles;

@@ -28,6 +28,9 @@ struct DrawPackets {
   std::vector<DrawCall> calls;    // in submission order
 };
 
+// The largest batch a frame uses (FrameSettings::batchTriangles is clamped to it).
+inline constexpr uint32_t kMaxBatchTriangles = 1u << 24;
+
 struct FrameSettings {
   int width = 0, height = 0;
   float clearColor[3] = {0, 0, 0};  // linear

@@ -198,6 +198,25 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
   fs.clearColor[2] = scene.background.z;
   fs.shade = o.debugOverdraw ? raster::ShadeMode::overdraw : raster::ShadeMode::gouraud;
   fs.samples = o.samples;
+  if (o.samples > 1) {
+    // A frame of several batches keeps a whole-frame sample buffer (samples × 10 bytes a pixel:
+    // 330 MB at 1080p with 16 samples). Batches as large as the records that buffer would hold
+    // (144 bytes a triangle) cost no more memory and avoid it for all but huge scenes; beyond
+    // that the buffer is allowed up to 4 GiB.
+    const size_t tiles = size_t((fs.width + raster::kTileSize - 1) >> raster::kTileLog2) *
+                         size_t((fs.height + raster::kTileSize - 1) >> raster::kTileLog2);
+    const size_t bufferBytes = tiles * raster::kTilePixels * size_t(o.samples) *
+                               (sizeof(float) + raster::kColorChannels * sizeof(uint16_t));
+    const size_t batch = std::clamp<size_t>(bufferBytes / sizeof(geometry::TriangleSetup),
+                                            fs.batchTriangles, render::kMaxBatchTriangles);
+    fs.batchTriangles = uint32_t(batch);
+    if (p.indices.size() / 3 > batch && bufferBytes > (size_t(4) << 30))
+      return Error{"", "",
+                   fmt::format("{} triangles in a {}x{} frame with {} samples per pixel need a "
+                               "{:.1f} GB sample buffer (over the 4 GB limit); use fewer samples",
+                               p.indices.size() / 3, o.width, o.height, o.samples,
+                               double(bufferBytes) / 1e9)};
+  }
   // Stage 5, display: each tile is resolved into the image as soon as it is finished (k divides
   // the 64-pixel tile, so a pixel's k×k samples always lie in one tile) — or, for the tent filter,
   // which reads across tile borders, into a linear frame that is filtered once all tiles are in.
