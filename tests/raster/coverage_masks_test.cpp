@@ -5,6 +5,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <random>
 
 #include "raster/coverage_masks.h"
@@ -80,7 +81,9 @@ TEST(EdgeMasks, ChooseTheSamplesFarthestInsideTheEdge) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(-1, 1);
   const double cell = 0.5 / EdgeMaskTable::kSlopeSteps + 0.5 / EdgeMaskTable::kDistanceSteps;
+  std::map<int, double> worst;
   for (int n : kCounts) {
+    worst[n] = 0;
     const SamplePattern& p = *samplePattern(n);
     const EdgeMaskTable table(p);
     for (int k = 0; k < 5000; ++k) {
@@ -96,7 +99,21 @@ TEST(EdgeMasks, ChooseTheSamplesFarthestInsideTheEdge) {
           highestOut = std::max(highestOut, v);
       }
       ASSERT_LE(highestOut, lowestIn + 2 * cell) << n << " samples, edge " << a << " " << b << " " << c;
+      // How far from the edge a sample's bit can disagree with the exact test at its position.
+      for (int s = 0; s < n; ++s) {
+        const double v = (a * p.offsets[size_t(s)][0] + b * p.offsets[size_t(s)][1] + c) / norm;
+        if (bool(m >> s & 1) != (v >= 0)) worst[n] = std::max(worst[n], std::fabs(v));
+      }
     }
+  }
+  // Area masks give up per-sample agreement where the area asks for another count of samples: the
+  // disagreeing samples are the ones nearest the edge, within these L1-normalized distances
+  // (measured over 5 000 edges: 4: 0.117, 8: 0.116, 16: 0.095, 64: 0.048; point-sample masks from
+  // a table of this precision would stay within the cell's 0.020).
+  const std::map<int, double> bound = {{1, 0.03}, {4, 0.13}, {8, 0.13}, {16, 0.105}, {64, 0.055}};
+  for (const auto& [n, d] : worst) {
+    std::printf("%d samples: bits disagree with the exact test up to %.4f from the edge\n", n, d);
+    EXPECT_LE(d, bound.at(n)) << n << " samples";
   }
 }
 
