@@ -528,11 +528,15 @@ class TriangleRaster {
           const auto S = hn::Set(di, divisor_[k]);
           const auto e = hn::Add(hn::Set(di, tl[k]), hn::LoadU(di, leafOffset_[k] + i));
           inside = hn::Gt(e, minusOne);
-          // a ≤ (D/2)·S < 2^23 (small triangles: S ≤ 2^15): the float estimate of a / S is
-          // within one of ⌊a / S⌋, then corrected exactly.
+          // a ≤ (D/2)·S < 2^23 (small triangles: S ≤ 2^15), so a / S ≤ D/2: the float estimate
+          // rounded to an integer by the magic number 2^23 (cheaper than a checked conversion)
+          // is within one of ⌊a / S⌋, then corrected exactly.
           const auto a = hn::Min(hn::ShiftRight<kShift>(hn::Abs(hn::Add(e, hn::Set(di, bias_[k])))),
                                  hn::Set(di, kHalf * divisor_[k]));
-          q = hn::ConvertTo(di, hn::Mul(hn::ConvertTo(df, a), hn::Set(df, reciprocal_[k])));
+          q = hn::Sub(hn::BitCast(di, hn::Add(hn::Mul(hn::ConvertTo(df, a),
+                                                      hn::Set(df, reciprocal_[k])),
+                                              hn::Set(df, 8388608.0f))),
+                      hn::Set(di, 0x4B000000));  // the bits of 2^23
           const auto r = hn::Sub(a, hn::Mul(q, S));
           q = hn::Add(q, hn::VecFromMask(di, hn::Lt(r, zero)));                        // − 1
           q = hn::Sub(q, hn::VecFromMask(di, hn::Gt(r, hn::Sub(S, hn::Set(di, 1)))));  // + 1
