@@ -37,6 +37,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cstring>
 
 #include "raster/framebuffer.h"
 #include "raster/rasterizer.h"
@@ -605,9 +606,13 @@ class TriangleRaster {
 void clearTile(const TileWork& w) {
   const int planes = kTilePixels / kBlockPixels * (w.coverage ? w.coverage->samples : 1);
   std::fill(w.depth, w.depth + size_t(planes) * kBlockPixels, w.clearDepth);
+  // One plane's worth, copied whole (two or three vector stores): 3 fills of 16 values per plane
+  // were 5 % of a 4-sample frame.
+  alignas(64) uint16_t plane[kColorPerBlock];
+  for (int ch = 0; ch < kColorChannels; ++ch)
+    std::fill_n(plane + ch * kBlockPixels, kBlockPixels, w.clearColor[ch]);
   for (int b = 0; b < planes; ++b)
-    for (int ch = 0; ch < kColorChannels; ++ch)
-      std::fill_n(w.color + b * kColorPerBlock + ch * kBlockPixels, kBlockPixels, w.clearColor[ch]);
+    std::memcpy(w.color + size_t(b) * kColorPerBlock, plane, sizeof(plane));
 }
 
 template <ShadeMode kShade, bool kAA>
