@@ -126,52 +126,6 @@ void forEachBlockMean(const uint16_t* color, int tileX, int tileY, int factor, i
 
 }  // namespace
 
-namespace {
-
-// Writes `cols` pixels of one block row: the rounded means of their sample sums (red at sum[p],
-// green at sum[16 + p], blue at sum[32 + p]) through the tables. Restrict-qualified parameters:
-// otherwise every byte store may alias the sums and tables and forces their reload.
-void storeBlockRow(uint8_t* __restrict dst, const uint32_t* __restrict sum, int cols,
-                   uint32_t half, int shift, const uint8_t* __restrict r,
-                   const uint8_t* __restrict g, const uint8_t* __restrict b) {
-  for (int p = 0; p < cols; ++p) {
-    dst[3 * p] = r[(sum[p] + half) >> shift];
-    dst[3 * p + 1] = g[(sum[raster::kBlockPixels + p] + half) >> shift];
-    dst[3 * p + 2] = b[(sum[2 * raster::kBlockPixels + p] + half) >> shift];
-  }
-}
-
-}  // namespace
-
-void resolveSampleTile(const uint16_t* color, int tileX, int tileY, int samples,
-                       const GammaTables& gamma, Image& image) {
-  // The sums of a block's sample planes (vectorized by the compiler), then its rows straight into
-  // the image. (Staged through a 48-byte block and copied row by row, the copies' loads stalled on
-  // store forwarding: a quarter of the resolve.)
-  using namespace raster;
-  const int x0 = tileX * kTileSize, y0 = tileY * kTileSize;
-  const int w = std::min(kTileSize, image.width - x0), h = std::min(kTileSize, image.height - y0);
-  const uint32_t half = uint32_t(samples) / 2;
-  const int shift = std::countr_zero(unsigned(samples));
-  uint8_t* const rgb = image.rgb.data();
-  const size_t stride = size_t(image.width) * 3;
-  for (int by = 0; by < h; by += kBlockSize)
-    for (int bx = 0; bx < w; bx += kBlockSize) {
-      const uint16_t* block =
-          color + size_t((by >> kBlockLog2) * kBlocksPerTileSide + (bx >> kBlockLog2)) * samples *
-                      kColorPerBlock;
-      uint32_t sum[kColorPerBlock];
-      for (int i = 0; i < kColorPerBlock; ++i) sum[i] = block[i];
-      for (int s = 1; s < samples; ++s)
-        for (int i = 0; i < kColorPerBlock; ++i) sum[i] += block[s * kColorPerBlock + i];
-      const int rows = std::min(kBlockSize, h - by), cols = std::min(kBlockSize, w - bx);
-      uint8_t* dst = rgb + size_t(y0 + by) * stride + size_t(x0 + bx) * 3;
-      for (int py = 0; py < rows; ++py, dst += stride)
-        storeBlockRow(dst, sum + py * kBlockSize, cols, half, shift, gamma.table[0].data(),
-                      gamma.table[1].data(), gamma.table[2].data());
-    }
-}
-
 void resolveTileLinear(const uint16_t* color, int tileX, int tileY, int factor, int samples,
                        LinearImage& linear) {
   auto store = [&](int x, int y, const uint16_t* mean) {

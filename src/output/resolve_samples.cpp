@@ -1,0 +1,78 @@
+// The resolve of anti-aliased tiles (N sample planes per 4×4 block, raster/framebuffer.h): each
+// pixel the rounded mean of its samples in linear light, the 1×1 box filter of SPEC §5, then gamma.
+// The plane sums run in SIMD lanes (Highway, dispatched once per tile); the table look-ups and
+// byte stores per pixel stay scalar.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "output/resolve_samples.cpp"
+#include "hwy/foreach_target.h"  // IWYU pragma: keep
+#include "hwy/highway.h"
+
+#include <algorithm>
+#include <bit>
+
+#include "output/resolve.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace sv::output {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+// Writes `cols` pixels of one block row from the means (red at mean[p], green at mean[16 + p],
+// blue at mean[32 + p]). Restrict-qualified: otherwise every byte store may alias the means and
+// tables and forces their reload.
+HWY_INLINE void StoreBlockRow(uint8_t* HWY_RESTRICT dst, const uint16_t* HWY_RESTRICT mean,
+                              int cols, const uint8_t* HWY_RESTRICT r,
+                              const uint8_t* HWY_RESTRICT g, const uint8_t* HWY_RESTRICT b) {
+  for (int p = 0; p < cols; ++p) {
+    dst[3 * p] = r[mean[p]];
+    dst[3 * p + 1] = g[mean[raster::kBlockPixels + p]];
+    dst[3 * p + 2] = b[mean[2 * raster::kBlockPixels + p]];
+  }
+}
+
+void ResolveSampleTile(const uint16_t* color, int tileX, int tileY, int samples,
+                       const GammaTables& gamma, Image& image) {
+  using namespace raster;
+  const hn::CappedTag<int32_t, kBlockPixels> d32;
+  const hn::Rebind<uint16_t, decltype(d32)> d16;
+  const size_t n = hn::Lanes(d32);
+  const int x0 = tileX * kTileSize, y0 = tileY * kTileSize;
+  const int w = std::min(kTileSize, image.width - x0), h = std::min(kTileSize, image.height - y0);
+  const int shift = std::countr_zero(unsigned(samples));  // samples is a power of two
+  const auto half = hn::Set(d32, samples / 2);
+  uint8_t* const rgb = image.rgb.data();
+  const size_t stride = size_t(image.width) * 3;
+  for (int by = 0; by < h; by += kBlockSize)
+    for (int bx = 0; bx < w; bx += kBlockSize) {
+      const uint16_t* block =
+          color + size_t((by >> kBlockLog2) * kBlocksPerTileSide + (bx >> kBlockLog2)) * samples *
+                      kColorPerBlock;
+      alignas(64) uint16_t mean[kColorPerBlock];
+      for (size_t i = 0; i < size_t(kColorPerBlock); i += n) {
+        auto sum = hn::PromoteTo(d32, hn::LoadU(d16, block + i));
+        for (int s = 1; s < samples; ++s)
+          sum = hn::Add(sum, hn::PromoteTo(d32, hn::LoadU(d16, block + s * kColorPerBlock + i)));
+        hn::Store(hn::DemoteTo(d16, hn::ShiftRightSame(hn::Add(sum, half), shift)), d16, mean + i);
+      }
+      const int rows = std::min(kBlockSize, h - by), cols = std::min(kBlockSize, w - bx);
+      uint8_t* dst = rgb + size_t(y0 + by) * stride + size_t(x0 + bx) * 3;
+      for (int py = 0; py < rows; ++py, dst += stride)
+        StoreBlockRow(dst, mean + py * kBlockSize, cols, gamma.table[0].data(),
+                      gamma.table[1].data(), gamma.table[2].data());
+    }
+}
+
+}  // namespace HWY_NAMESPACE
+}  // namespace sv::output
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace sv::output {
+HWY_EXPORT(ResolveSampleTile);
+
+void resolveSampleTile(const uint16_t* color, int tileX, int tileY, int samples,
+                       const GammaTables& gamma, Image& image) {
+  HWY_DYNAMIC_DISPATCH(ResolveSampleTile)(color, tileX, tileY, samples, gamma, image);
+}
+}  // namespace sv::output
+#endif
