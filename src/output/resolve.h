@@ -35,7 +35,7 @@ void resolveTile(const uint16_t* color, int tileX, int tileY, int factor, const 
 
 // A tile of N samples per pixel (anti-aliasing; N = 4, 8, 16 or 64, sample planes as
 // raster/framebuffer.h describes): each image pixel is the rounded mean of its samples in linear
-// light — the 1×1 box filter of SPEC §5.
+// light — the 1×1 box filter of SPEC §5. In SIMD lanes: resolve_samples.cpp.
 void resolveSampleTile(const uint16_t* color, int tileX, int tileY, int samples,
                        const GammaTables& gamma, Image& image);
 
