@@ -18,6 +18,7 @@ using render::DrawPackets;
 using render::FrameSettings;
 using test::addTriangle;
 using test::pixelVertex;
+using test::randomScene;
 
 constexpr int kSampleCounts[] = {4, 8, 16, 64};
 
@@ -30,32 +31,6 @@ FrameSettings aaSettings(int w, int h, int samples) {
   s.clearColor[1] = 0.2f;
   s.clearColor[2] = 0.3f;
   return s;
-}
-
-// Random triangles of every size class (legs 1 … 4096 px); `wild` adds vertices behind the eye and
-// beyond the near and far planes (homogeneous edges, near/far edges, int64 stepping).
-DrawPackets randomScene(int width, int height, int count, unsigned seed, bool wild) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u01(0, 1);
-  DrawPackets p;
-  for (int t = 0; t < count; ++t) {
-    const double size = std::pow(2.0, 12 * u01(rng));
-    const double cx = u01(rng) * width, cy = u01(rng) * height;
-    ClipVertex v[3];
-    for (auto& vert : v) {
-      const float w = wild && u01(rng) < 0.15 ? float(u01(rng) * 2 - 0.5) : float(0.5 + u01(rng) * 3);
-      const float z = wild ? float(u01(rng) * 1.4 - 0.2) : float(u01(rng));
-      vert = pixelVertex(cx + (u01(rng) - 0.5) * size, cy + (u01(rng) - 0.5) * size, width, height,
-                         z, w, float(u01(rng)), float(u01(rng)), float(u01(rng)));
-      if (wild && vert.w <= 0) {
-        vert.x = float(u01(rng) * 4 - 2);
-        vert.y = float(u01(rng) * 4 - 2);
-        vert.z = float(u01(rng) * 2 - 1);
-      }
-    }
-    addTriangle(p, v[0], v[1], v[2], t % 3 == 0 ? geometry::CullMode::back : geometry::CullMode::none);
-  }
-  return p;
 }
 
 // The first differing sample, for a readable failure.

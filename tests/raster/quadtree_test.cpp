@@ -12,6 +12,8 @@
 namespace sv {
 namespace {
 
+using test::randomScene;
+
 using geometry::ClipVertex;
 using render::DrawPackets;
 using render::FrameSettings;
@@ -164,32 +166,6 @@ TEST(NearPlane, CameraInsideClosedSphereHitsEveryPixelOnce) {
   p.calls.push_back({0, uint32_t(p.indices.size() / 3), geometry::CullMode::none});
   const test::Frame f = test::renderQuadtree(p, countSettings(w, h));
   EXPECT_EQ(countPixels(f, 1), w * h);
-}
-
-// Random triangles of every size class, some crossing the eye plane and the near plane.
-DrawPackets randomScene(int width, int height, int count, unsigned seed, bool wild) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u01(0, 1);
-  DrawPackets p;
-  for (int t = 0; t < count; ++t) {
-    const double size = std::pow(2.0, 12 * u01(rng));  // 1 … 4096 px legs
-    const double cx = u01(rng) * width, cy = u01(rng) * height;
-    ClipVertex v[3];
-    for (auto& vert : v) {
-      const float w = wild && u01(rng) < 0.15 ? float(u01(rng) * 2 - 0.5) : float(0.5 + u01(rng) * 3);
-      const float z = wild ? float(u01(rng) * 1.4 - 0.2) : float(u01(rng));
-      vert = pixelVertex(cx + (u01(rng) - 0.5) * size, cy + (u01(rng) - 0.5) * size, width, height,
-                         z, w, float(u01(rng)), float(u01(rng)), float(u01(rng)));
-      if (wild && vert.w <= 0) {
-        // pixelVertex scales by w; for w ≤ 0 give the vertex an arbitrary clip position instead.
-        vert.x = float(u01(rng) * 4 - 2);
-        vert.y = float(u01(rng) * 4 - 2);
-        vert.z = float(u01(rng) * 2 - 1);
-      }
-    }
-    addTriangle(p, v[0], v[1], v[2], t % 3 == 0 ? geometry::CullMode::back : geometry::CullMode::none);
-  }
-  return p;
 }
 
 TEST(Quadtree, EqualsBruteForcePixelForPixelOnRandomScenes) {

@@ -130,10 +130,9 @@ TEST(TrisGenerator, RenderedAreaMatchesTheRequestedArea) {
   EXPECT_NEAR(double(stats.fragments) / p.count, 50, 2.5);
 }
 
-// Supersampling: a quad whose edge crosses column 10 at x = 10.5 covers half of that column's
-// samples at k = 2, 4, 8 (linear 0.5 → sRGB 188), all of column 9 and none of 11.
-TEST(Render, SupersamplingAveragesSamplesInLinearLight) {
-  const int w = 40, h = 8;
+// A white quad (unlit, double-sided) on black whose right edge runs down the middle of column 10
+// (x = 10.5) of a w × h image: column 9 fully covered, column 10 half, column 11 not at all.
+scene::Scene halfCoveredColumnScene(int w, int h) {
   scene::Scene s = scene::benchCameraScene("quad");
   const double tanHalf = std::tan(30.0 * 3.14159265358979 / 180), aspect = double(w) / h;
   auto at = [&](double px, double py) {
@@ -145,6 +144,14 @@ TEST(Render, SupersamplingAveragesSamplesInLinearLight) {
   m.indices = {0, 1, 2, 0, 2, 3};
   m.material = 0;  // unlit white, double-sided
   s.meshes.push_back(m);
+  return s;
+}
+
+// Supersampling: a quad whose edge crosses column 10 at x = 10.5 covers half of that column's
+// samples at k = 2, 4, 8 (linear 0.5 → sRGB 188), all of column 9 and none of 11.
+TEST(Render, SupersamplingAveragesSamplesInLinearLight) {
+  const int w = 40, h = 8;
+  const scene::Scene s = halfCoveredColumnScene(w, h);
   for (int k : {2, 4, 8}) {
     RenderOptions o;
     o.width = w;
@@ -174,17 +181,7 @@ TEST(Render, SupersamplingAveragesSamplesInLinearLight) {
 // ¼·1 + ½·½ + ¼·0 = ½ of its neighbours too, and columns 9 and 11 blend by a quarter (¾ and ¼).
 TEST(Render, AntiAliasingAndTheTentFilterAverageInLinearLight) {
   const int w = 40, h = 8;
-  scene::Scene s = scene::benchCameraScene("quad");
-  const double tanHalf = std::tan(30.0 * 3.14159265358979 / 180), aspect = double(w) / h;
-  auto at = [&](double px, double py) {
-    return Vec3{float((2 * px / w - 1) * 2 * tanHalf * aspect), float((1 - 2 * py / h) * 2 * tanHalf),
-                -2.0f};
-  };
-  scene::Mesh m;
-  m.positions = {at(-5, -5), at(10.5, -5), at(10.5, h + 5), at(-5, h + 5)};
-  m.indices = {0, 1, 2, 0, 2, 3};
-  m.material = 0;
-  s.meshes.push_back(m);
+  const scene::Scene s = halfCoveredColumnScene(w, h);
   auto render = [&](int samples, RenderOptions::Filter filter, int threads) {
     RenderOptions o;
     o.width = w;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <random>
 
 namespace sv::test {
 
@@ -28,6 +29,31 @@ void addTriangle(render::DrawPackets& p, const geometry::ClipVertex& a,
   } else {
     p.calls.push_back({tri, 1, cull});
   }
+}
+
+render::DrawPackets randomScene(int width, int height, int count, unsigned seed, bool wild) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u01(0, 1);
+  render::DrawPackets p;
+  for (int t = 0; t < count; ++t) {
+    const double size = std::pow(2.0, 12 * u01(rng));  // 1 … 4096 px legs
+    const double cx = u01(rng) * width, cy = u01(rng) * height;
+    geometry::ClipVertex v[3];
+    for (auto& vert : v) {
+      const float w = wild && u01(rng) < 0.15 ? float(u01(rng) * 2 - 0.5) : float(0.5 + u01(rng) * 3);
+      const float z = wild ? float(u01(rng) * 1.4 - 0.2) : float(u01(rng));
+      vert = pixelVertex(cx + (u01(rng) - 0.5) * size, cy + (u01(rng) - 0.5) * size, width, height,
+                         z, w, float(u01(rng)), float(u01(rng)), float(u01(rng)));
+      if (wild && vert.w <= 0) {
+        // pixelVertex scales by w; for w ≤ 0 give the vertex an arbitrary clip position instead.
+        vert.x = float(u01(rng) * 4 - 2);
+        vert.y = float(u01(rng) * 4 - 2);
+        vert.z = float(u01(rng) * 2 - 1);
+      }
+    }
+    addTriangle(p, v[0], v[1], v[2], t % 3 == 0 ? geometry::CullMode::back : geometry::CullMode::none);
+  }
+  return p;
 }
 
 Frame renderQuadtree(const render::DrawPackets& p, const render::FrameSettings& s, int threads,

@@ -14,6 +14,11 @@ namespace sv::test {
 geometry::ClipVertex pixelVertex(double x, double y, int width, int height, float z = 0.5f,
                                  float w = 1.0f, float r = 1, float g = 1, float b = 1);
 
+// Random triangles of every size class (legs 1 … 4096 px, random depths and colours, every third
+// back-face culled); `wild` puts some vertices behind the eye and beyond the near and far planes
+// (homogeneous edges, near/far edges, int64 stepping). Seeded: the same scene every time.
+render::DrawPackets randomScene(int width, int height, int count, unsigned seed, bool wild);
+
 // Adds a triangle (no culling) to `p`.
 void addTriangle(render::DrawPackets& p, const geometry::ClipVertex& a,
                  const geometry::ClipVertex& b, const geometry::ClipVertex& c,
