@@ -6,6 +6,8 @@
 //   setup, SIMD lanes              → triangles/s
 //   edge-mask table look-up (AA)   → masks/s
 //   whole frame, BENCH.md tris     → triangles/s
+// The tile and frame benchmarks take the samples per pixel as their last argument (1 = point
+// sampling; 4, 16 = anti-aliasing with sub-pixel masks, issue 4).
 #include <benchmark/benchmark.h>
 
 #include <array>
@@ -24,8 +26,9 @@ geometry::ClipVertex at(double x, double y, int w, int h, float z) {
   return {float(2 * x / w - 1), float(1 - 2 * y / h), 2 * z - 1, 1, 0.5f, 0.6f, 0.7f, 1};
 }
 
-// Triangles of about `area` px² inside a 64×64 tile at the origin of a 64×64 raster.
-std::vector<geometry::TriangleSetup> tileTriangles(double area, int count) {
+// Triangles of about `area` px² inside a 64×64 tile at the origin of a 64×64 raster, set up for
+// anti-aliasing (the pixel aperture) when `aperture`.
+std::vector<geometry::TriangleSetup> tileTriangles(double area, int count, bool aperture) {
   std::mt19937 rng(42);
   std::uniform_real_distribution<double> u(0, 1);
   std::vector<geometry::TriangleSetup> out;
@@ -37,19 +40,20 @@ std::vector<geometry::TriangleSetup> tileTriangles(double area, int count) {
                                 at(x + leg * std::cos(a), y + leg * std::sin(a), 64, 64, 0.5f),
                                 at(x + leg * std::cos(a + 1.571), y + leg * std::sin(a + 1.571), 64,
                                    64, 0.5f),
-                                {64, 64}, geometry::CullMode::none, t) == geometry::SetupOutcome::drawn)
+                                {64, 64, aperture}, geometry::CullMode::none,
+                                t) == geometry::SetupOutcome::drawn)
       out.push_back(t);
   }
   return out;
 }
 
 void rasterTile(benchmark::State& state, double area) {
-  const int count = int(state.range(0));
-  const auto tris = tileTriangles(area, count);
+  const int count = int(state.range(0)), samples = int(state.range(1));
+  const auto tris = tileTriangles(area, count, samples > 1);
   std::vector<uint32_t> list(tris.size());
   for (size_t i = 0; i < list.size(); ++i) list[i] = uint32_t(i);
   raster::FrameBuffer fb;
-  fb.resize(64, 64);
+  fb.resize(64, 64, samples);
   const uint32_t* lists[1] = {list.data()};
   const uint32_t sizes[1] = {uint32_t(list.size())};
   raster::TileWork w;
@@ -60,6 +64,7 @@ void rasterTile(benchmark::State& state, double area) {
   w.lists = lists;
   w.listSizes = sizes;
   w.listCount = 1;
+  w.coverage = samples > 1 ? raster::CoverageTables::forCount(samples) : nullptr;
   raster::RasterStats stats;
   for (auto _ : state) raster::rasterizeTile(w, stats);
   state.counters["triangles/s"] =
@@ -75,9 +80,9 @@ void rasterTile(benchmark::State& state, double area) {
 void BM_TileSmallTriangles(benchmark::State& s) { rasterTile(s, 10); }
 void BM_TileMediumTriangles(benchmark::State& s) { rasterTile(s, 100); }
 void BM_TileLargeTriangles(benchmark::State& s) { rasterTile(s, 1000); }
-BENCHMARK(BM_TileSmallTriangles)->Arg(1000);
-BENCHMARK(BM_TileMediumTriangles)->Arg(200);
-BENCHMARK(BM_TileLargeTriangles)->Arg(20);
+BENCHMARK(BM_TileSmallTriangles)->Args({1000, 1})->Args({1000, 4})->Args({1000, 16});
+BENCHMARK(BM_TileMediumTriangles)->Args({200, 1})->Args({200, 4})->Args({200, 16});
+BENCHMARK(BM_TileLargeTriangles)->Args({20, 1})->Args({20, 4})->Args({20, 16});
 
 // 4096 small triangles of a 1080p raster, w between 1 and 2: the setup benchmarks' input.
 std::vector<geometry::ClipVertex> setupInput() {
@@ -147,13 +152,15 @@ void BM_EdgeMaskLookup(benchmark::State& state) {
 }
 BENCHMARK(BM_EdgeMaskLookup)->Arg(4)->Arg(16)->Arg(64);
 
-// BENCH.md tris through setup, binning and tiles (no vertex stage, no resolve), 1 thread.
+// BENCH.md tris through setup, binning and tiles (no vertex stage, no resolve), 1 thread, with
+// the given samples per pixel.
 void BM_FrameTris(benchmark::State& state) {
   const render::DrawPackets packets = bench::trisPackets(int(state.range(0)), double(state.range(1)));
   render::FrameRenderer fr(1);
   render::FrameSettings fs;
   fs.width = 1920;
   fs.height = 1080;
+  fs.samples = int(state.range(2));
   for (auto _ : state) {
     FrameStats stats;
     fr.render(packets, fs, stats);
@@ -162,7 +169,12 @@ void BM_FrameTris(benchmark::State& state) {
       benchmark::Counter(double(packets.indices.size() / 3) * state.iterations(),
                          benchmark::Counter::kIsRate);
 }
-BENCHMARK(BM_FrameTris)->Args({100000, 10})->Args({10000, 1000})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FrameTris)
+    ->Args({100000, 10, 1})
+    ->Args({10000, 1000, 1})
+    ->Args({100000, 10, 4})
+    ->Args({10000, 1000, 4})
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace sv
