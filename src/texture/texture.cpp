@@ -1,0 +1,223 @@
+#include "texture/texture.h"
+
+#include <png.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <filesystem>
+#include <fmt/format.h>
+
+namespace sv::texture {
+
+int wrapIndex(int i, int size, Wrap wrap) {
+  switch (wrap) {
+    case Wrap::clamp: return std::clamp(i, 0, size - 1);
+    case Wrap::mirror: {
+      const int period = 2 * size;
+      const int m = ((i % period) + period) % period;
+      return m < size ? m : period - 1 - m;
+    }
+    case Wrap::repeat:
+    default: return ((i % size) + size) % size;
+  }
+}
+
+namespace {
+
+Color4 toColor(const Texel& t) {
+  constexpr float kScale = 1.0f / 65535.0f;
+  return {t.r * kScale, t.g * kScale, t.b * kScale, t.a * kScale};
+}
+
+Color4 mix(const Color4& a, float wa, const Color4& b, float wb) {
+  return {a.r * wa + b.r * wb, a.g * wa + b.g * wb, a.b * wa + b.b * wb, a.a * wa + b.a * wb};
+}
+
+Color4 mix3(const Color4& a, float wa, const Color4& b, float wb, const Color4& c, float wc) {
+  return {a.r * wa + b.r * wb + c.r * wc, a.g * wa + b.g * wb + c.g * wc,
+          a.b * wa + b.b * wb + c.b * wc, a.a * wa + b.a * wb + c.a * wc};
+}
+
+// Level k + 1 from level k (the constructor's comment): the 3×3 triangle filter centred on every
+// other texel, weights 1 2 1 / 2 4 2 / 1 2 1 over 16, rounded to nearest.
+Level decimate(const Level& src, Wrap wrapX, Wrap wrapY) {
+  Level dst;
+  dst.width = (src.width + 1) / 2;
+  dst.height = (src.height + 1) / 2;
+  dst.texels.resize(size_t(dst.width) * size_t(dst.height));
+  static constexpr uint32_t kWeight[3] = {1, 2, 1};
+  for (int y = 0; y < dst.height; ++y)
+    for (int x = 0; x < dst.width; ++x) {
+      uint32_t sum[4] = {8, 8, 8, 8};  // + 8: round to nearest on the division by 16
+      for (int dy = -1; dy <= 1; ++dy) {
+        const int sy = wrapIndex(2 * y + dy, src.height, wrapY);
+        for (int dx = -1; dx <= 1; ++dx) {
+          const Texel& t = src.at(wrapIndex(2 * x + dx, src.width, wrapX), sy);
+          const uint32_t w = kWeight[dx + 1] * kWeight[dy + 1];
+          sum[0] += w * t.r;
+          sum[1] += w * t.g;
+          sum[2] += w * t.b;
+          sum[3] += w * t.a;
+        }
+      }
+      dst.texels[size_t(y) * size_t(dst.width) + size_t(x)] = {
+          uint16_t(sum[0] >> 4), uint16_t(sum[1] >> 4), uint16_t(sum[2] >> 4), uint16_t(sum[3] >> 4)};
+    }
+  return dst;
+}
+
+}  // namespace
+
+Texture::Texture(Level base, Wrap wrapX, Wrap wrapY) : wrapX_(wrapX), wrapY_(wrapY) {
+  levels_.push_back(std::move(base));
+  while (levels_.back().width > 1 || levels_.back().height > 1)
+    levels_.push_back(decimate(levels_.back(), wrapX_, wrapY_));
+}
+
+const Texel& Texture::texel(int k, int x, int y) const {
+  const Level& l = levels_[size_t(k)];
+  return l.at(wrapIndex(x, l.width, wrapX_), wrapIndex(y, l.height, wrapY_));
+}
+
+Color4 Texture::nearest(int k, float x, float y) const {
+  return toColor(texel(k, int(std::floor(x + 0.5f)), int(std::floor(y + 0.5f))));
+}
+
+Color4 Texture::bilinear(int k, float x, float y) const {
+  // SPEC §7: R = γ(ΘR3 + (1−Θ)R2) + (1−γ)(ΘR4 + (1−Θ)R1), with R1…R4 the texels at (0,0),
+  // (1,0), (1,1), (0,1) of the cell and γ, Θ the fractional parts.
+  const float fx = std::floor(x), fy = std::floor(y);
+  const int x0 = int(fx), y0 = int(fy);
+  const float g = x - fx, t = y - fy;
+  const Color4 r1 = toColor(texel(k, x0, y0)), r2 = toColor(texel(k, x0 + 1, y0));
+  const Color4 r3 = toColor(texel(k, x0 + 1, y0 + 1)), r4 = toColor(texel(k, x0, y0 + 1));
+  return mix(mix(r3, t, r2, 1 - t), g, mix(r4, t, r1, 1 - t), 1 - g);
+}
+
+Color4 Texture::threePoint(int k, float x, float y) const {
+  // SPEC §7, seed 001: the cell split along its diagonal from R1 to R3;
+  //   Θ ≥ γ: R = γ·R3 + (Θ − γ)·R4 + (1 − Θ)·R1;   Θ < γ: R = Θ·R3 + (γ − Θ)·R2 + (1 − γ)·R1.
+  const float fx = std::floor(x), fy = std::floor(y);
+  const int x0 = int(fx), y0 = int(fy);
+  const float g = x - fx, t = y - fy;
+  const Color4 r1 = toColor(texel(k, x0, y0)), r3 = toColor(texel(k, x0 + 1, y0 + 1));
+  if (t >= g) return mix3(r3, g, toColor(texel(k, x0, y0 + 1)), t - g, r1, 1 - t);
+  return mix3(r3, t, toColor(texel(k, x0 + 1, y0)), g - t, r1, 1 - g);
+}
+
+namespace {
+
+// Level k's coordinates of level-0 position (x0, y0): texel i of level k sits at level 0's 2^k·i.
+template <class Sample>
+Color4 blendLevels(const Texture& tex, float lod, float x0, float y0, Sample sample) {
+  lod = std::clamp(lod, 0.0f, float(tex.levelCount() - 1));
+  const int k = std::min(int(lod), tex.levelCount() - 1);
+  const float scale = std::ldexp(1.0f, -k);
+  const Color4 a = sample(k, x0 * scale, y0 * scale);
+  const float t = lod - float(k);
+  if (t == 0 || k + 1 >= tex.levelCount()) return a;
+  const Color4 b = sample(k + 1, x0 * scale * 0.5f, y0 * scale * 0.5f);
+  return mix(a, 1 - t, b, t);
+}
+
+}  // namespace
+
+Color4 Texture::trilinear(float lod, float x0, float y0) const {
+  return blendLevels(*this, lod, x0, y0, [&](int k, float x, float y) { return bilinear(k, x, y); });
+}
+
+Color4 Texture::trilinearThreePoint(float lod, float x0, float y0) const {
+  return blendLevels(*this, lod, x0, y0,
+                     [&](int k, float x, float y) { return threePoint(k, x, y); });
+}
+
+namespace {
+
+// libpng's simplified API has begun reading `png` (`bytes` long); finish into a linear,
+// premultiplied level.
+Result<Level> finishRead(png_image& png, uint64_t bytes, const std::string& name) {
+  if (png.width == 0 || png.height == 0 || png.width > uint32_t(kMaxTextureSide) ||
+      png.height > uint32_t(kMaxTextureSide) ||
+      int64_t(png.width) * int64_t(png.height) > kMaxTextureTexels) {
+    png_image_free(&png);
+    return Error{name, "",
+                 fmt::format("texture size {}x{} is out of range (sides 1…{}, at most {} texels)",
+                             png.width, png.height, kMaxTextureSide, kMaxTextureTexels)};
+  }
+  // Deflate expands at most about 1032:1, so a file too short for the size its header states is
+  // refused before the image is allocated (a 60-byte file must not cost half a gigabyte).
+  if (uint64_t(PNG_IMAGE_SIZE(png)) > bytes * 1032 + 65536) {
+    png_image_free(&png);
+    return Error{name, "",
+                 fmt::format("{} bytes of PNG cannot hold the {}x{} image its header states", bytes,
+                             png.width, png.height)};
+  }
+  Level level;
+  level.width = int(png.width);
+  level.height = int(png.height);
+  level.texels.resize(size_t(png.width) * png.height);
+  static_assert(sizeof(Texel) == 4 * sizeof(png_uint_16));
+  auto fail = [&] {
+    const std::string message = png.message;
+    png_image_free(&png);
+    return Error{name, "", "cannot decode PNG: " + message};
+  };
+  if (png.format & PNG_FORMAT_FLAG_LINEAR) {
+    // A 16-bit file: libpng's linear RGBA with premultiplied alpha (its samples are linear unless
+    // a gAMA chunk says otherwise, which libpng then undoes).
+    png.format = PNG_FORMAT_LINEAR_RGB_ALPHA;
+    if (!png_image_finish_read(&png, nullptr, level.texels.data(), 0, nullptr)) return fail();
+    return level;
+  }
+  // An 8-bit file: sRGB-encoded RGBA (libpng re-encodes another stated gamma as sRGB), decoded here
+  // by the exact IEC 61966-2-1 curve — libpng's own linear output uses a 2.2 power law — and
+  // premultiplied by alpha.
+  png.format = PNG_FORMAT_RGBA;
+  std::vector<uint8_t> encoded(PNG_IMAGE_SIZE(png));
+  if (!png_image_finish_read(&png, nullptr, encoded.data(), 0, nullptr)) return fail();
+  static const auto decode = [] {
+    std::array<double, 256> t{};
+    for (int i = 0; i < 256; ++i) {
+      const double e = i / 255.0;
+      t[size_t(i)] = e <= 0.04045 ? e / 12.92 : std::pow((e + 0.055) / 1.055, 2.4);
+    }
+    return t;
+  }();
+  for (size_t i = 0; i < level.texels.size(); ++i) {
+    const uint8_t* p = &encoded[4 * i];
+    const double alpha = p[3] / 255.0;
+    auto channel = [&](uint8_t c) { return uint16_t(std::lround(decode[c] * alpha * 65535.0)); };
+    level.texels[i] = {channel(p[0]), channel(p[1]), channel(p[2]),
+                       uint16_t(std::lround(alpha * 65535.0))};
+  }
+  return level;
+}
+
+}  // namespace
+
+Result<Level> readTextureImage(const std::string& path) {
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  if (!png_image_begin_read_from_file(&png, path.c_str())) {
+    const std::string message = png.message;
+    png_image_free(&png);
+    return Error{path, "", "cannot read PNG: " + message};
+  }
+  std::error_code error;
+  const uintmax_t bytes = std::filesystem::file_size(path, error);
+  return finishRead(png, error ? 0 : uint64_t(bytes), path);
+}
+
+Result<Level> decodeTextureImage(const void* data, size_t size, const std::string& name) {
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  if (!png_image_begin_read_from_memory(&png, data, size)) {
+    const std::string message = png.message;
+    png_image_free(&png);
+    return Error{name, "", "cannot read PNG: " + message};
+  }
+  return finishRead(png, size, name);
+}
+
+}  // namespace sv::texture

@@ -1,0 +1,94 @@
+// Texture maps (SPEC §7, seed 001): images in linear light, the MIP pyramid built the seed's way,
+// and the samplers — nearest, the seed's three-point interpolation, bilinear, and the trilinear
+// blends of the last two between pyramid levels. Scalar reference code: the tile kernel's SIMD
+// texturing (issue 5) must give the same values.
+//
+// Based on: SPEC §7 (seed 001: pyramid by a 3×3-texel triangle filter and decimation by 2, the
+// three-point interpolation); pbrt-v4's src/pbrt/util/mipmap.cpp for the structure (not its code).
+//
+// Coordinates. A level is addressed in continuous texel coordinates (x, y): texel (i, j) is centred
+// at (i, j), so level 0's texel centres sit at integer positions and a texture coordinate u ∈ [0, 1]
+// maps to x = u·width − ½. Level k's texel i is the filtered level k − 1 at texel 2i, so it is
+// centred where level 0's texel 2^k·i is: a position x₀ on level 0 is x₀ / 2^k on level k. (This
+// is the seed's "filter, then keep every other texel"; the usual box pyramid centres level k's
+// texels between level k − 1's instead.)
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "synthvis/result.h"
+
+namespace sv::texture {
+
+// What a coordinate outside [0, size) means: repeat the image, clamp to its edge texels, or
+// mirror it (…, 1, 0, 0, 1, …, n − 1, n − 1, n − 2, …).
+enum class Wrap : uint8_t { repeat, clamp, mirror };
+
+// Maps a texel index to [0, size) by `wrap`.
+int wrapIndex(int i, int size, Wrap wrap);
+
+// Four channels, linear light, alpha premultiplied, 0 … 65535.
+struct Texel {
+  uint16_t r = 0, g = 0, b = 0, a = 0;
+  bool operator==(const Texel&) const = default;
+};
+
+// A float texel, as the samplers return it (0 … 1).
+struct Color4 {
+  float r = 0, g = 0, b = 0, a = 0;
+};
+
+struct Level {
+  int width = 0, height = 0;
+  std::vector<Texel> texels;  // row-major, top row first
+  const Texel& at(int x, int y) const { return texels[size_t(y) * size_t(width) + size_t(x)]; }
+};
+
+// The largest texture side accepted, and the most texels in level 0 (so a pyramid stays within
+// 4/3 · 2^26 · 8 bytes ≈ 716 MB).
+inline constexpr int kMaxTextureSide = 16384;
+inline constexpr int64_t kMaxTextureTexels = int64_t(1) << 26;
+
+class Texture {
+ public:
+  // Takes level 0 and builds the pyramid down to 1×1 (SPEC §7): level k + 1 is level k filtered
+  // by the 3×3-texel triangle filter [1 2 1]ᵀ[1 2 1]/16 and decimated by 2 — texel i of level k + 1
+  // is the filter centred on texel 2i of level k, edges continued by the wrap modes. A level of
+  // odd size n gives ⌈n/2⌉ texels (its last texel keeps the image's last texel), so any size
+  // works; each level halves until both sides are 1.
+  Texture(Level base, Wrap wrapX, Wrap wrapY);
+
+  int levelCount() const { return int(levels_.size()); }
+  const Level& level(int k) const { return levels_[size_t(k)]; }
+  Wrap wrapX() const { return wrapX_; }
+  Wrap wrapY() const { return wrapY_; }
+
+  // The texel at integer coordinates, wrapped.
+  const Texel& texel(int k, int x, int y) const;
+
+  // Samplers on level k at continuous texel coordinates of that level (texel centres at integers).
+  Color4 nearest(int k, float x, float y) const;
+  Color4 bilinear(int k, float x, float y) const;
+  // SPEC §7, seed 001: the cell split along its diagonal, three texels per sample.
+  Color4 threePoint(int k, float x, float y) const;
+  // Between levels ⌊lod⌋ and ⌊lod⌋ + 1, at level-0 texel coordinates (x₀, y₀), with bilinear or
+  // three-point interpolation in each level; lod is clamped to [0, levelCount − 1].
+  Color4 trilinear(float lod, float x0, float y0) const;
+  Color4 trilinearThreePoint(float lod, float x0, float y0) const;
+
+ private:
+  std::vector<Level> levels_;
+  Wrap wrapX_, wrapY_;
+};
+
+// Reads a PNG (8 or 16 bits; grey, grey + alpha, RGB or RGBA; palette) into level 0 in linear light
+// with premultiplied alpha. 8-bit samples are sRGB-encoded and decoded by the exact sRGB curve;
+// 16-bit samples are linear (PNG's convention for them), either unless a gAMA chunk says otherwise.
+// Errors name the file: unreadable, malformed, larger than the limits above, or shorter than the
+// size its header states could compress to.
+Result<Level> readTextureImage(const std::string& path);
+Result<Level> decodeTextureImage(const void* data, size_t size, const std::string& name);
+
+}  // namespace sv::texture

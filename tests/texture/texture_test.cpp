@@ -1,0 +1,197 @@
+// Texture maps (SPEC §7): wrap modes, the seed's pyramid against a direct evaluation of its 3×3
+// triangle filter, three-point interpolation against the seed's formulas at the corners, on the
+// diagonal and at the centre, bilinear and trilinear, and PNG decoding to linear light.
+#include <gtest/gtest.h>
+
+#include <png.h>
+
+#include <cmath>
+#include <random>
+
+#include "texture/texture.h"
+
+namespace sv::texture {
+namespace {
+
+Level randomLevel(int w, int h, unsigned seed) {
+  std::mt19937 rng(seed);
+  Level l;
+  l.width = w;
+  l.height = h;
+  l.texels.resize(size_t(w) * size_t(h));
+  for (Texel& t : l.texels)
+    t = {uint16_t(rng() & 0xFFFF), uint16_t(rng() & 0xFFFF), uint16_t(rng() & 0xFFFF),
+         uint16_t(rng() & 0xFFFF)};
+  return l;
+}
+
+TEST(Wrap, RepeatClampAndMirror) {
+  const int expectRepeat[] = {2, 0, 1, 2, 0, 1, 2, 0, 1, 2, 0};
+  const int expectClamp[] = {0, 0, 0, 0, 0, 1, 2, 2, 2, 2, 2};
+  const int expectMirror[] = {2, 2, 1, 0, 0, 1, 2, 2, 1, 0, 0};
+  for (int i = -4; i <= 6; ++i) {
+    EXPECT_EQ(wrapIndex(i, 3, Wrap::repeat), expectRepeat[i + 4]) << i;
+    EXPECT_EQ(wrapIndex(i, 3, Wrap::clamp), expectClamp[i + 4]) << i;
+    EXPECT_EQ(wrapIndex(i, 3, Wrap::mirror), expectMirror[i + 4]) << i;
+  }
+}
+
+// Every texel of every level against the 3×3 triangle filter of the level above, written out
+// independently: weights (2 − |dx|)(2 − |dy|) / 16, centred on texel (2x, 2y), rounded to nearest.
+TEST(Pyramid, LevelsAreTheTriangleFilterOfTheLevelAboveDecimatedByTwo) {
+  for (Wrap wrap : {Wrap::repeat, Wrap::clamp, Wrap::mirror}) {
+    const Texture tex(randomLevel(13, 7, 3), wrap, wrap);
+    ASSERT_EQ(tex.levelCount(), 5);  // 13×7, 7×4, 4×2, 2×1, 1×1
+    const int sizes[5][2] = {{13, 7}, {7, 4}, {4, 2}, {2, 1}, {1, 1}};
+    for (int k = 0; k < 5; ++k) {
+      EXPECT_EQ(tex.level(k).width, sizes[k][0]);
+      EXPECT_EQ(tex.level(k).height, sizes[k][1]);
+    }
+    for (int k = 1; k < tex.levelCount(); ++k)
+      for (int y = 0; y < tex.level(k).height; ++y)
+        for (int x = 0; x < tex.level(k).width; ++x) {
+          double sum[4] = {};
+          for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+              const Texel& t = tex.texel(k - 1, 2 * x + dx, 2 * y + dy);
+              const double w = (2 - std::abs(dx)) * (2 - std::abs(dy)) / 16.0;
+              sum[0] += w * t.r;
+              sum[1] += w * t.g;
+              sum[2] += w * t.b;
+              sum[3] += w * t.a;
+            }
+          const Texel& got = tex.level(k).at(x, y);
+          const uint16_t c[4] = {got.r, got.g, got.b, got.a};
+          for (int ch = 0; ch < 4; ++ch)
+            ASSERT_EQ(c[ch], uint16_t(std::floor(sum[ch] + 0.5))) << "level " << k << " texel " << x
+                                                                   << "," << y << " channel " << ch;
+        }
+  }
+}
+
+TEST(Pyramid, ConstantImageStaysConstantAndOneTexelIsItsOwnPyramid) {
+  Level l;
+  l.width = 10;
+  l.height = 6;
+  l.texels.assign(60, Texel{1000, 2000, 3000, 65535});
+  const Texture tex(l, Wrap::repeat, Wrap::clamp);
+  for (int k = 0; k < tex.levelCount(); ++k)
+    for (const Texel& t : tex.level(k).texels) EXPECT_EQ(t, (Texel{1000, 2000, 3000, 65535}));
+  Level one;
+  one.width = one.height = 1;
+  one.texels = {Texel{7, 8, 9, 10}};
+  EXPECT_EQ(Texture(one, Wrap::repeat, Wrap::repeat).levelCount(), 1);
+}
+
+float channel(const Color4& c) { return c.r; }
+float value(const Texture& t, int x, int y) { return t.texel(0, x, y).r / 65535.0f; }
+
+// SPEC §7, seed 001: Θ ≥ γ: R = γR3 + (Θ − γ)R4 + (1 − Θ)R1; Θ < γ: R = ΘR3 + (γ − Θ)R2 + (1 − γ)R1,
+// with R1…R4 at (0,0), (1,0), (1,1), (0,1).
+TEST(Samplers, ThreePointFollowsTheSeedAtCornersDiagonalAndCentre) {
+  const Texture tex(randomLevel(4, 4, 9), Wrap::repeat, Wrap::repeat);
+  const float r1 = value(tex, 1, 1), r2 = value(tex, 2, 1), r3 = value(tex, 2, 2), r4 = value(tex, 1, 2);
+  const float eps = 1e-6f;
+  // Corners: the texels themselves.
+  EXPECT_NEAR(channel(tex.threePoint(0, 1, 1)), r1, eps);
+  EXPECT_NEAR(channel(tex.threePoint(0, 2, 1)), r2, eps);
+  EXPECT_NEAR(channel(tex.threePoint(0, 2, 2)), r3, eps);
+  EXPECT_NEAR(channel(tex.threePoint(0, 1, 2)), r4, eps);
+  // The diagonal γ = Θ: only R1 and R3 contribute.
+  for (float s : {0.25f, 0.5f, 0.75f})
+    EXPECT_NEAR(channel(tex.threePoint(0, 1 + s, 1 + s)), s * r3 + (1 - s) * r1, eps) << s;
+  // The centre lies on the diagonal: the mean of R1 and R3 — where bilinear takes all four.
+  EXPECT_NEAR(channel(tex.threePoint(0, 1.5f, 1.5f)), 0.5f * (r1 + r3), eps);
+  EXPECT_NEAR(channel(tex.bilinear(0, 1.5f, 1.5f)), 0.25f * (r1 + r2 + r3 + r4), eps);
+  // Either side of the diagonal, the seed's two formulas.
+  EXPECT_NEAR(channel(tex.threePoint(0, 1.25f, 1.75f)), 0.25f * r3 + 0.5f * r4 + 0.25f * r1, eps);
+  EXPECT_NEAR(channel(tex.threePoint(0, 1.75f, 1.25f)), 0.25f * r3 + 0.5f * r2 + 0.25f * r1, eps);
+}
+
+TEST(Samplers, NearestBilinearAndTrilinear) {
+  const Texture tex(randomLevel(8, 8, 11), Wrap::repeat, Wrap::repeat);
+  EXPECT_NEAR(channel(tex.nearest(0, 2.4f, 5.6f)), value(tex, 2, 6), 1e-6f);
+  EXPECT_NEAR(channel(tex.nearest(0, -0.6f, 0.2f)), value(tex, 7, 0), 1e-6f);  // wrapped
+  // Bilinear is exact at texel centres and linear along an edge.
+  EXPECT_NEAR(channel(tex.bilinear(0, 3, 4)), value(tex, 3, 4), 1e-6f);
+  EXPECT_NEAR(channel(tex.bilinear(0, 3.25f, 4)), 0.75f * value(tex, 3, 4) + 0.25f * value(tex, 4, 4),
+              1e-6f);
+  // Trilinear: an integer level of detail is that level's bilinear sample (level-0 coordinates
+  // scaled by 2^-k); halfway between two levels is their mean.
+  EXPECT_NEAR(channel(tex.trilinear(1, 4.0f, 6.0f)), channel(tex.bilinear(1, 2.0f, 3.0f)), 1e-6f);
+  const float a = channel(tex.bilinear(1, 2.5f, 1.5f)), b = channel(tex.bilinear(2, 1.25f, 0.75f));
+  EXPECT_NEAR(channel(tex.trilinear(1.5f, 5.0f, 3.0f)), 0.5f * (a + b), 1e-6f);
+  EXPECT_NEAR(channel(tex.trilinearThreePoint(1.5f, 5.0f, 3.0f)),
+              0.5f * (channel(tex.threePoint(1, 2.5f, 1.5f)) + channel(tex.threePoint(2, 1.25f, 0.75f))),
+              1e-6f);
+  // Beyond the last level the 1×1 level is all there is.
+  EXPECT_NEAR(channel(tex.trilinear(10, 3, 3)), tex.level(3).at(0, 0).r / 65535.0f, 1e-6f);
+}
+
+// A PNG in memory through libpng's simplified writer.
+std::vector<uint8_t> encodePng(int w, int h, uint32_t format, const void* pixels) {
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  png.width = uint32_t(w);
+  png.height = uint32_t(h);
+  png.format = format;
+  png_alloc_size_t size = 0;
+  EXPECT_TRUE(png_image_write_to_memory(&png, nullptr, &size, 0, pixels, 0, nullptr));
+  std::vector<uint8_t> out(size);
+  EXPECT_TRUE(png_image_write_to_memory(&png, out.data(), &size, 0, pixels, 0, nullptr));
+  out.resize(size);
+  return out;
+}
+
+TEST(TextureImage, PngDecodesToLinearLightWithPremultipliedAlpha) {
+  // 8-bit grey, sRGB: 0, 188 (linear 0.5029 by the sRGB curve, 32 956), 255.
+  const uint8_t grey[3] = {0, 188, 255};
+  auto png = encodePng(3, 1, PNG_FORMAT_GRAY, grey);
+  auto l = decodeTextureImage(png.data(), png.size(), "grey.png");
+  ASSERT_TRUE(l.ok()) << l.error().str();
+  EXPECT_EQ(l->texels[0], (Texel{0, 0, 0, 65535}));
+  EXPECT_NEAR(l->texels[1].g, 32956, 1);
+  EXPECT_EQ(l->texels[2], (Texel{65535, 65535, 65535, 65535}));
+  // 8-bit RGBA: white at half alpha comes out premultiplied.
+  const uint8_t rgba[8] = {255, 255, 255, 128, 255, 0, 0, 255};
+  png = encodePng(2, 1, PNG_FORMAT_RGBA, rgba);
+  l = decodeTextureImage(png.data(), png.size(), "rgba.png");
+  ASSERT_TRUE(l.ok()) << l.error().str();
+  EXPECT_EQ(l->texels[0].a, 32896);  // 128/255
+  EXPECT_EQ(l->texels[0].r, 32896);
+  EXPECT_EQ(l->texels[1], (Texel{65535, 0, 0, 65535}));
+  // 16-bit linear RGB round-trips exactly.
+  const uint16_t rgb16[6] = {1, 30000, 65535, 12345, 0, 40000};
+  png = encodePng(2, 1, PNG_FORMAT_LINEAR_RGB, rgb16);
+  l = decodeTextureImage(png.data(), png.size(), "rgb16.png");
+  ASSERT_TRUE(l.ok()) << l.error().str();
+  EXPECT_EQ(l->texels[0], (Texel{1, 30000, 65535, 65535}));
+  EXPECT_EQ(l->texels[1], (Texel{12345, 0, 40000, 65535}));
+}
+
+TEST(TextureImage, ErrorsNameTheFileAndTheProblem) {
+  const uint8_t junk[16] = {0x89, 'P', 'N', 'G', 1, 2, 3};
+  auto l = decodeTextureImage(junk, sizeof(junk), "junk.png");
+  ASSERT_FALSE(l.ok());
+  EXPECT_EQ(l.error().file, "junk.png");
+  EXPECT_FALSE(l.error().message.empty());
+  // Wider than the limit.
+  std::vector<uint8_t> wide(size_t(kMaxTextureSide) + 1, 7);
+  auto png = encodePng(kMaxTextureSide + 1, 1, PNG_FORMAT_GRAY, wide.data());
+  l = decodeTextureImage(png.data(), png.size(), "wide.png");
+  ASSERT_FALSE(l.ok());
+  EXPECT_NE(l.error().message.find("out of range"), std::string::npos) << l.error().message;
+  // A header stating more image than the bytes can hold is refused before allocating it.
+  std::vector<uint8_t> big(size_t(4096) * 4096, 0);
+  png = encodePng(4096, 4096, PNG_FORMAT_GRAY, big.data());
+  png.resize(200);  // a few hundred bytes cannot hold 16 M pixels
+  l = decodeTextureImage(png.data(), png.size(), "short.png");
+  ASSERT_FALSE(l.ok());
+  EXPECT_NE(l.error().message.find("cannot hold"), std::string::npos) << l.error().message;
+  l = readTextureImage("/no/such/texture.png");
+  ASSERT_FALSE(l.ok());
+  EXPECT_EQ(l.error().file, "/no/such/texture.png");
+}
+
+}  // namespace
+}  // namespace sv::texture
