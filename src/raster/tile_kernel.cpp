@@ -25,9 +25,10 @@
 // wholly outside the edge iff E ≤ −N1/2 and wholly inside iff E ≥ N1/2 (every sample is within ½
 // of the centre in the L1 norm), so the window tests gain the constants H − 1 + bias and −H + bias
 // (H = N1/2 = 128·S). A leaf pixel reads each crossing edge's mask from the row (sign quadrant,
-// slope ⌊32·|a|/S⌋) of coverage_masks.h at distance cell q = ⌊|E| / (4·S)⌋ = ⌊64·|E|/N1⌋, mirrored
-// for negative E exactly as EdgeMaskTable::mask does, so reversed edges read complementary masks;
-// q is estimated in float and corrected exactly in integers. The pixel's mask is the AND.
+// slope ⌊32·|a|/S⌋) of coverage_masks.h at distance cell q = ⌊D·|E|/N1⌋ = ⌊(|E| >> 1) / S⌋ for
+// the table's D = 128 cells, mirrored for negative E exactly as EdgeMaskTable::mask does, so
+// reversed edges read complementary masks; q is estimated in float and corrected exactly in
+// integers. The pixel's mask is the AND, cut to the triangle's box (see leafSamples).
 
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "raster/tile_kernel.cpp"
@@ -529,7 +530,7 @@ class TriangleRaster {
           const auto S = hn::Set(di, divisor_[k]);
           const auto e = hn::Add(hn::Set(di, tl[k]), hn::LoadU(di, leafOffset_[k] + i));
           inside = hn::Gt(e, minusOne);
-          // a ≤ (D/2)·S < 2^23 (small triangles: S ≤ 2^15), so a / S ≤ D/2: the float estimate
+          // a ≤ (D/2)·S < 2^23 (small triangles: S < 2^16), so a / S ≤ D/2: the float estimate
           // rounded to an integer by the magic number 2^23 (cheaper than a checked conversion)
           // is within one of ⌊a / S⌋, then corrected exactly.
           const auto a = hn::Min(hn::ShiftRight<kShift>(hn::Abs(hn::Add(e, hn::Set(di, bias_[k])))),
