@@ -6,6 +6,7 @@
 //   setup, SIMD lanes              → triangles/s
 //   edge-mask table look-up (AA)   → masks/s
 //   whole frame, BENCH.md tris     → triangles/s
+//   texture samples, per filter    → samples/s (scalar Texture::sample, SIMD sampleBlock)
 // The tile and frame benchmarks take the samples per pixel as their last argument (1 = point
 // sampling; 4, 16 = anti-aliasing with sub-pixel masks, issue 4).
 #include <benchmark/benchmark.h>
@@ -16,6 +17,7 @@
 #include "raster/coverage_masks.h"
 #include "raster/framebuffer.h"
 #include "raster/rasterizer.h"
+#include "texture/texture.h"
 #include "render/frame_renderer.h"
 #include "bench_scenes.h"
 
@@ -151,6 +153,45 @@ void BM_EdgeMaskLookup(benchmark::State& state) {
       benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_EdgeMaskLookup)->Arg(4)->Arg(16)->Arg(64);
+
+// Texture sampling (issue 5): a 1024×1024 texture, points scattered over it at levels of detail
+// 0…4, by filter (0 nearest, 1 three-point, 2 bilinear, 3 trilinear three-point, 4 trilinear);
+// range(1) = 0 for the scalar Texture::sample, 1 for the SIMD sampleBlock (16 points a call).
+void BM_TextureSample(benchmark::State& state) {
+  const auto filter = texture::Filter(state.range(0));
+  const bool simd = state.range(1) != 0;
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<float> u(0, 1);
+  texture::Level base;
+  base.width = base.height = 1024;
+  base.texels.resize(size_t(1024) * 1024);
+  for (auto& t : base.texels) t = {uint16_t(rng()), uint16_t(rng()), uint16_t(rng()), 65535};
+  const texture::Texture tex(std::move(base), texture::Wrap::repeat, texture::Wrap::repeat);
+  constexpr int kPoints = 4096;
+  std::vector<float> lod(kPoints), x(kPoints), y(kPoints);
+  for (int i = 0; i < kPoints; ++i) {
+    lod[size_t(i)] = u(rng) * 4;
+    x[size_t(i)] = u(rng) * 1024;
+    y[size_t(i)] = u(rng) * 1024;
+  }
+  float sink = 0;
+  for (auto _ : state) {
+    for (int i = 0; i < kPoints; i += 16) {
+      if (simd) {
+        float out[4][16];
+        texture::sampleBlock(tex, filter, &lod[size_t(i)], &x[size_t(i)], &y[size_t(i)], 16, out);
+        sink += out[0][0];
+      } else {
+        for (int j = i; j < i + 16; ++j)
+          sink += tex.sample(filter, lod[size_t(j)], x[size_t(j)], y[size_t(j)]).r;
+      }
+    }
+  }
+  benchmark::DoNotOptimize(sink);
+  state.counters["samples/s"] =
+      benchmark::Counter(double(kPoints) * state.iterations(), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_TextureSample)->ArgsProduct({{0, 1, 2, 3, 4}, {0, 1}});
 
 // BENCH.md tris through setup, binning and tiles (no vertex stage, no resolve), 1 thread, with
 // the given samples per pixel.

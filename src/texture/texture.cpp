@@ -70,23 +70,49 @@ Level decimate(const Level& src, Wrap wrapX, Wrap wrapY) {
 }  // namespace
 
 Texture::Texture(Level base, Wrap wrapX, Wrap wrapY) : wrapX_(wrapX), wrapY_(wrapY) {
-  levels_.push_back(std::move(base));
-  while (levels_.back().width > 1 || levels_.back().height > 1)
-    levels_.push_back(decimate(levels_.back(), wrapX_, wrapY_));
+  std::vector<Level> levels;
+  levels.push_back(std::move(base));
+  while (levels.back().width > 1 || levels.back().height > 1)
+    levels.push_back(decimate(levels.back(), wrapX_, wrapY_));
+  size_t total = 0;
+  for (const Level& l : levels) total += l.texels.size();
+  texels_.reserve(total);
+  for (const Level& l : levels) {
+    info_.push_back({l.width, l.height, int32_t(texels_.size())});  // < 2^27 (kMaxTextureTexels)
+    texels_.insert(texels_.end(), l.texels.begin(), l.texels.end());
+  }
+}
+
+LevelView Texture::level(int k) const {
+  const LevelInfo& l = info_[size_t(k)];
+  return {l.width, l.height,
+          std::span<const Texel>(texels_.data() + l.offset, size_t(l.width) * size_t(l.height))};
 }
 
 const Texel& Texture::texel(int k, int x, int y) const {
-  const Level& l = levels_[size_t(k)];
-  return l.at(wrapIndex(x, l.width, wrapX_), wrapIndex(y, l.height, wrapY_));
+  const LevelInfo& l = info_[size_t(k)];
+  return texels_[size_t(l.offset) + size_t(wrapIndex(y, l.height, wrapY_)) * size_t(l.width) +
+                 size_t(wrapIndex(x, l.width, wrapX_))];
 }
 
+namespace {
+
+// Texel coordinates the samplers accept (texture.h, kMaxTexelCoordinate).
+float saneCoordinate(float x) { return std::fabs(x) <= kMaxTexelCoordinate ? x : 0.0f; }
+
+}  // namespace
+
 Color4 Texture::nearest(int k, float x, float y) const {
+  x = saneCoordinate(x);
+  y = saneCoordinate(y);
   return toColor(texel(k, int(std::floor(x + 0.5f)), int(std::floor(y + 0.5f))));
 }
 
 Color4 Texture::bilinear(int k, float x, float y) const {
   // SPEC §7: R = γ(ΘR3 + (1−Θ)R2) + (1−γ)(ΘR4 + (1−Θ)R1), with R1…R4 the texels at (0,0),
   // (1,0), (1,1), (0,1) of the cell and γ, Θ the fractional parts.
+  x = saneCoordinate(x);
+  y = saneCoordinate(y);
   const float fx = std::floor(x), fy = std::floor(y);
   const int x0 = int(fx), y0 = int(fy);
   const float g = x - fx, t = y - fy;
@@ -98,6 +124,8 @@ Color4 Texture::bilinear(int k, float x, float y) const {
 Color4 Texture::threePoint(int k, float x, float y) const {
   // SPEC §7, seed 001: the cell split along its diagonal from R1 to R3;
   //   Θ ≥ γ: R = γ·R3 + (Θ − γ)·R4 + (1 − Θ)·R1;   Θ < γ: R = Θ·R3 + (γ − Θ)·R2 + (1 − γ)·R1.
+  x = saneCoordinate(x);
+  y = saneCoordinate(y);
   const float fx = std::floor(x), fy = std::floor(y);
   const int x0 = int(fx), y0 = int(fy);
   const float g = x - fx, t = y - fy;
@@ -112,6 +140,9 @@ namespace {
 template <class Sample>
 Color4 blendLevels(const Texture& tex, float lod, float x0, float y0, Sample sample) {
   lod = std::clamp(lod, 0.0f, float(tex.levelCount() - 1));
+  if (!(lod >= 0)) lod = 0;  // NaN
+  x0 = saneCoordinate(x0);
+  y0 = saneCoordinate(y0);
   const int k = std::min(int(lod), tex.levelCount() - 1);
   const float scale = std::ldexp(1.0f, -k);
   const Color4 a = sample(k, x0 * scale, y0 * scale);
@@ -122,6 +153,19 @@ Color4 blendLevels(const Texture& tex, float lod, float x0, float y0, Sample sam
 }
 
 }  // namespace
+
+Color4 Texture::sample(Filter filter, float lod, float x0, float y0) const {
+  if (filter == Filter::trilinear) return trilinear(lod, x0, y0);
+  if (filter == Filter::trilinearThreePoint) return trilinearThreePoint(lod, x0, y0);
+  lod = std::clamp(lod, 0.0f, float(levelCount() - 1));  // NaN stays NaN: level 0 below
+  const int k = lod >= 0 ? std::min(int(lod + 0.5f), levelCount() - 1) : 0;
+  const float scale = std::ldexp(1.0f, -k);
+  x0 = saneCoordinate(x0) * scale;
+  y0 = saneCoordinate(y0) * scale;
+  if (filter == Filter::nearest) return nearest(k, x0, y0);
+  if (filter == Filter::threePoint) return threePoint(k, x0, y0);
+  return bilinear(k, x0, y0);
+}
 
 Color4 Texture::trilinear(float lod, float x0, float y0) const {
   return blendLevels(*this, lod, x0, y0, [&](int k, float x, float y) { return bilinear(k, x, y); });

@@ -15,6 +15,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -46,6 +47,22 @@ struct Level {
   const Texel& at(int x, int y) const { return texels[size_t(y) * size_t(width) + size_t(x)]; }
 };
 
+// A level inside a Texture, which keeps all its levels in one array (for the SIMD samplers).
+struct LevelView {
+  int width = 0, height = 0;
+  std::span<const Texel> texels;  // row-major, top row first
+  const Texel& at(int x, int y) const { return texels[size_t(y) * size_t(width) + size_t(x)]; }
+};
+
+// The sampling methods (issue 5's --texture-filter): at the pyramid level nearest the level of
+// detail — nearest texel, the seed's three-point interpolation, bilinear — or blended between the
+// two levels around it with three-point or bilinear interpolation in each.
+enum class Filter : uint8_t { nearest, threePoint, bilinear, trilinearThreePoint, trilinear };
+
+// Coordinates beyond ±2^24 texels, and NaN, are read as 0 by every sampler (beyond that float
+// cannot address single texels, and the integer texel index must not overflow).
+inline constexpr float kMaxTexelCoordinate = 16777216.0f;
+
 // The largest texture side accepted, and the most texels in level 0 (so a pyramid stays within
 // 4/3 · 2^26 · 8 bytes ≈ 716 MB).
 inline constexpr int kMaxTextureSide = 16384;
@@ -60,8 +77,8 @@ class Texture {
   // works; each level halves until both sides are 1.
   Texture(Level base, Wrap wrapX, Wrap wrapY);
 
-  int levelCount() const { return int(levels_.size()); }
-  const Level& level(int k) const { return levels_[size_t(k)]; }
+  int levelCount() const { return int(info_.size()); }
+  LevelView level(int k) const;
   Wrap wrapX() const { return wrapX_; }
   Wrap wrapY() const { return wrapY_; }
 
@@ -77,11 +94,27 @@ class Texture {
   // three-point interpolation in each level; lod is clamped to [0, levelCount − 1].
   Color4 trilinear(float lod, float x0, float y0) const;
   Color4 trilinearThreePoint(float lod, float x0, float y0) const;
+  // By `filter`, at level-0 texel coordinates and level of detail lod: the single-level filters
+  // use level ⌊lod + ½⌋ (clamped to the pyramid), the trilinear ones blend as above.
+  Color4 sample(Filter filter, float lod, float x0, float y0) const;
+
+  // All levels in one array, level k at offset(k) (what the SIMD samplers gather from).
+  const Texel* texels() const { return texels_.data(); }
+  int32_t offset(int k) const { return info_[size_t(k)].offset; }
 
  private:
-  std::vector<Level> levels_;
+  struct LevelInfo {
+    int32_t width, height, offset;
+  };
+  std::vector<Texel> texels_;
+  std::vector<LevelInfo> info_;
   Wrap wrapX_, wrapY_;
 };
+
+// SIMD sampling of up to 16 points at once (sample_block.cpp, Highway): r, g, b, a of point i to
+// out[0…3][i], bit for bit what Texture::sample returns for each point, on every SIMD target.
+void sampleBlock(const Texture& texture, Filter filter, const float* lod, const float* x0,
+                 const float* y0, int count, float out[4][16]);
 
 // Reads a PNG (8 or 16 bits; grey, grey + alpha, RGB or RGBA; palette) into level 0 in linear light
 // with premultiplied alpha. 8-bit samples are sRGB-encoded and decoded by the exact sRGB curve;
