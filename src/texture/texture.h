@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "synthvis/result.h"
+#include "texture/footprint.h"
 
 namespace sv::texture {
 
@@ -97,6 +98,12 @@ class Texture {
   // By `filter`, at level-0 texel coordinates and level of detail lod: the single-level filters
   // use level ⌊lod + ½⌋ (clamped to the pyramid), the trilinear ones blend as above.
   Color4 sample(Filter filter, float lod, float x0, float y0) const;
+  // Anisotropic filtering — the remedy for the grazing-angle blur the seed names as its open
+  // problem (SPEC §7): n = min(kMaxProbes, ⌈major / minor⌉) trilinear probes spread evenly over
+  // the footprint's major axis (at offsets (i + ½)/n − ½ of its length), each at the level of detail
+  // of max(minor, major / n), averaged. (x0, y0) and the footprint are in level-0 texels.
+  static constexpr int kMaxProbes = 16;
+  Color4 anisotropic(const Footprint& footprint, float x0, float y0) const;
 
   // All levels in one array, level k at offset(k) (what the SIMD samplers gather from).
   const Texel* texels() const { return texels_.data(); }

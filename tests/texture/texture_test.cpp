@@ -10,6 +10,7 @@
 #include <random>
 
 #include "hwy/targets.h"
+#include "texture/footprint.h"
 #include "texture/texture.h"
 
 namespace sv::texture {
@@ -128,6 +129,34 @@ TEST(Samplers, NearestBilinearAndTrilinear) {
               1e-6f);
   // Beyond the last level the 1×1 level is all there is.
   EXPECT_NEAR(channel(tex.trilinear(10, 3, 3)), tex.level(3).at(0, 0).r / 65535.0f, 1e-6f);
+}
+
+// Anisotropic filtering keeps detail across a long, thin footprint that the trilinear filter, sized
+// by the major axis, blurs away: horizontal stripes 4 texels high, a footprint 16 texels long along
+// u and 1 across. Trilinear at log2(16) averages the stripes to grey; the probes stay in the white.
+TEST(Samplers, AnisotropicKeepsDetailAcrossAThinFootprint) {
+  Level l;
+  l.width = l.height = 64;
+  l.texels.resize(64 * 64);
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x)
+      l.texels[size_t(y) * 64 + size_t(x)] = (y / 4) % 2 ? Texel{65535, 65535, 65535, 65535}
+                                                         : Texel{0, 0, 0, 65535};
+  const Texture tex(l, Wrap::repeat, Wrap::repeat);
+  Footprint f;
+  f.major = 16;
+  f.minor = 1;
+  f.axisX = 1;
+  f.axisY = 0;
+  f.lod = 4;
+  const float x = 20, y = 5.5f;  // the middle of the white band at rows 4…7
+  const float aniso = tex.anisotropic(f, x, y).r, tri = tex.trilinear(4, x, y).r;
+  EXPECT_GT(aniso, 0.9f);
+  EXPECT_NEAR(tri, 0.5f, 0.1f);
+  // An isotropic footprint is one trilinear probe at its own level of detail.
+  f.minor = 16;
+  const Color4 one = tex.anisotropic(f, x, y), ref = tex.trilinear(4, x, y);
+  EXPECT_FLOAT_EQ(one.r, ref.r);
 }
 
 // The SIMD block sampler returns Texture::sample's values bit for bit, for every filter and wrap
