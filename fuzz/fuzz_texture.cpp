@@ -28,7 +28,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (t.level(k).width != (t.level(k - 1).width + 1) / 2 ||
         t.level(k).height != (t.level(k - 1).height + 1) / 2)
       std::abort();
-  const tx::Level& last = t.level(t.levelCount() - 1);
+  const tx::LevelView last = t.level(t.levelCount() - 1);
   if (last.width != 1 || last.height != 1) std::abort();
   for (float lod : {0.0f, 0.7f, 3.2f}) {
     const tx::Color4 c = t.trilinearThreePoint(lod, 1.3f, -2.6f);
