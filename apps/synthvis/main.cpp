@@ -37,6 +37,12 @@ int fail(const sv::Error& e) {
   return 1;
 }
 
+// The scene at `path`, or the built-in demo scene when no path is given.
+sv::Result<sv::scene::Scene> loadSceneOrDemo(const std::string& path) {
+  if (path.empty()) return sv::scene::demoScene();
+  return sv::scene::loadScene(path);
+}
+
 // --filter box|tent3.
 sv::Result<sv::RenderOptions::Filter> parseFilter(const std::string& name) {
   if (name == "box") return sv::RenderOptions::Filter::box;
@@ -66,14 +72,9 @@ int runRender(const RenderArgs& a) {
   }
   if (sv::Status s = sv::validate(o); !s) return fail(s.error());
 
-  sv::scene::Scene scene;
-  if (a.scene.empty()) {
-    scene = sv::scene::demoScene();
-  } else {
-    auto loaded = sv::scene::loadScene(a.scene);
-    if (!loaded) return fail(loaded.error());
-    scene = std::move(loaded).value();
-  }
+  auto loaded = loadSceneOrDemo(a.scene);
+  if (!loaded) return fail(loaded.error());
+  const sv::scene::Scene scene = std::move(loaded).value();
   sv::Renderer renderer(o);
   sv::Image image;
   sv::FrameStats stats;
@@ -294,14 +295,9 @@ int runTruth(const TruthArgs& a) {
   g.options = a.options;
   g.options.cullBackFaces = !a.noCull;
   g.samplesPerSide = side;
-  sv::scene::Scene scene;
-  if (a.scene.empty()) {
-    scene = sv::scene::demoScene();
-  } else {
-    auto loaded = sv::scene::loadScene(a.scene);
-    if (!loaded) return fail(loaded.error());
-    scene = std::move(loaded).value();
-  }
+  auto loaded = loadSceneOrDemo(a.scene);
+  if (!loaded) return fail(loaded.error());
+  const sv::scene::Scene scene = std::move(loaded).value();
   fmt::print("{}: {}x{}, {} samples per pixel…\n", a.output, g.options.width, g.options.height,
              a.samples);
   std::fflush(stdout);

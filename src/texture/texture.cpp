@@ -108,14 +108,27 @@ Color4 Texture::nearest(int k, float x, float y) const {
   return toColor(texel(k, int(std::floor(x + 0.5f)), int(std::floor(y + 0.5f))));
 }
 
-Color4 Texture::bilinear(int k, float x, float y) const {
-  // SPEC §7: R = γ(ΘR3 + (1−Θ)R2) + (1−γ)(ΘR4 + (1−Θ)R1), with R1…R4 the texels at (0,0),
-  // (1,0), (1,1), (0,1) of the cell and γ, Θ the fractional parts.
+namespace {
+
+// The texel cell around (x, y): its corner (x0, y0) and the fractional parts γ, Θ.
+struct Cell {
+  int x0, y0;
+  float g, t;
+};
+
+Cell cellAt(float x, float y) {
   x = saneCoordinate(x);
   y = saneCoordinate(y);
   const float fx = std::floor(x), fy = std::floor(y);
-  const int x0 = int(fx), y0 = int(fy);
-  const float g = x - fx, t = y - fy;
+  return {int(fx), int(fy), x - fx, y - fy};
+}
+
+}  // namespace
+
+Color4 Texture::bilinear(int k, float x, float y) const {
+  // SPEC §7: R = γ(ΘR3 + (1−Θ)R2) + (1−γ)(ΘR4 + (1−Θ)R1), with R1…R4 the texels at (0,0),
+  // (1,0), (1,1), (0,1) of the cell and γ, Θ the fractional parts.
+  const auto [x0, y0, g, t] = cellAt(x, y);
   const Color4 r1 = toColor(texel(k, x0, y0)), r2 = toColor(texel(k, x0 + 1, y0));
   const Color4 r3 = toColor(texel(k, x0 + 1, y0 + 1)), r4 = toColor(texel(k, x0, y0 + 1));
   return mix(mix(r3, t, r2, 1 - t), g, mix(r4, t, r1, 1 - t), 1 - g);
@@ -124,11 +137,7 @@ Color4 Texture::bilinear(int k, float x, float y) const {
 Color4 Texture::threePoint(int k, float x, float y) const {
   // SPEC §7, seed 001: the cell split along its diagonal from R1 to R3;
   //   Θ ≥ γ: R = γ·R3 + (Θ − γ)·R4 + (1 − Θ)·R1;   Θ < γ: R = Θ·R3 + (γ − Θ)·R2 + (1 − γ)·R1.
-  x = saneCoordinate(x);
-  y = saneCoordinate(y);
-  const float fx = std::floor(x), fy = std::floor(y);
-  const int x0 = int(fx), y0 = int(fy);
-  const float g = x - fx, t = y - fy;
+  const auto [x0, y0, g, t] = cellAt(x, y);
   const Color4 r1 = toColor(texel(k, x0, y0)), r3 = toColor(texel(k, x0 + 1, y0 + 1));
   if (t >= g) return mix3(r3, g, toColor(texel(k, x0, y0 + 1)), t - g, r1, 1 - t);
   return mix3(r3, t, toColor(texel(k, x0 + 1, y0)), g - t, r1, 1 - g);
