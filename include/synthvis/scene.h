@@ -6,19 +6,68 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "synthvis/math.h"
 #include "synthvis/result.h"
 
+namespace sv::texture {
+class Texture;  // src/texture/texture.h: a decoded image, its MIP pyramid and wrap modes
+}
+
 namespace sv::scene {
+
+// How a texture map is sampled (SPEC §7; docs/quality.md compares them): nearest texel; the seed's
+// three-point interpolation ("tri3"); bilinear; the trilinear blends of those between pyramid levels
+// ("trilinear3", "trilinear"); anisotropic (trilinear probes along the pixel footprint's major
+// axis). `inherit` (materials only): the frame's choice, RenderOptions::textureFilter.
+enum class TextureFilter : uint8_t {
+  inherit,
+  nearest,
+  threePoint,
+  bilinear,
+  trilinearThreePoint,
+  trilinear,
+  anisotropic,
+};
+
+// How a material's alpha (base colour alpha × vertex alpha × texel alpha) is used (glTF's
+// alphaMode): ignored; blended over what lies behind (translucency, SPEC §8); or a cut-out, the
+// pixel drawn opaque where alpha ≥ alphaCutoff and not at all elsewhere.
+enum class AlphaMode : uint8_t { opaque, blend, mask };
 
 struct Material {
   std::string name;
-  Vec4 baseColor{1, 1, 1, 1};  // linear RGBA, multiplies vertex colours
+  Vec4 baseColor{1, 1, 1, 1};  // linear RGBA, multiplies vertex colours (and the texture)
   bool doubleSided = false;    // if false, back faces are culled when culling is on
-  bool unlit = false;          // if true, the light is ignored (colour used as is)
+  bool unlit = false;          // if true, the lights are ignored (colour used as is)
+  // Base-colour texture map, an index into Scene::textures (−1: none). Its colour multiplies the
+  // base colour, at texture coordinates from the mesh's uvs (u right, v down the image, glTF's
+  // convention); a mesh without uvs reads texel (0, 0).
+  int texture = -1;
+  TextureFilter textureFilter = TextureFilter::inherit;
+  // Lighting per pixel (SPEC §8, seed 003's Phong weighting) instead of per vertex (Gouraud):
+  //   C = (Q_amb·C_amb + Q_diff·C_diff + Q_spec·C_spec) / (Q_amb + Q_diff + Q_spec)
+  // with Q_amb = the light's ambient, Q_diff = 1 − Q_amb, Q_spec = `specular`, and `shininess` the
+  // exponent p of (r·v)^p. With specular = 0 it is the Gouraud formula evaluated per pixel.
+  bool phong = false;
+  float specular = 0;
+  float shininess = 32;
+  AlphaMode alphaMode = AlphaMode::opaque;
+  float alphaCutoff = 0.5f;
+
+  // True when pixels need more than the interpolated vertex colour: a texture, per-pixel light,
+  // or an alpha that matters.
+  bool needsPixelShading() const { return texture >= 0 || phong || alphaMode != AlphaMode::opaque; }
+};
+
+// A texture map shared by materials. Loaders decode images to linear light and build the pyramid
+// once (texture.h); several materials, and several scenes, may share one.
+struct TextureMap {
+  std::string name;  // file name or glTF image name, for messages
+  std::shared_ptr<const texture::Texture> texture;
 };
 
 // An indexed triangle list. `positions` is required; every other attribute array is either empty
@@ -61,12 +110,30 @@ struct Light {
   bool enabled = true;
 };
 
+// A light at a point (no fall-off with distance), used by Phong materials per pixel and by Gouraud
+// ones per vertex, in addition to the directional light.
+struct PointLight {
+  Vec3 position{0, 0, 0};  // world space
+  Vec3 color{1, 1, 1};
+};
+
+// Fog / haze (SPEC §8, seed 002): C_s = C_c·2^(−β·r) + C_F·(1 − 2^(−β·r)), r the true distance
+// from the eye to the point (not window depth), in scene units.
+struct Fog {
+  bool enabled = false;
+  Vec3 color{0.6f, 0.65f, 0.7f};  // C_F, linear
+  float beta = 0;                 // per scene unit; the colour halves every 1/β units
+};
+
 struct Scene {
   std::vector<Mesh> meshes;
   std::vector<Material> materials;
   std::vector<Instance> instances;
   std::vector<Camera> cameras;  // the first one is used unless another is chosen
   Light light;
+  std::vector<PointLight> pointLights;
+  Fog fog;
+  std::vector<TextureMap> textures;
   Vec3 background{0.05f, 0.06f, 0.09f};
 
   size_t triangleCount() const;  // over all instances

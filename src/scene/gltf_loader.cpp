@@ -1,7 +1,7 @@
 // glTF 2.0 loader (.gltf and .glb) on top of tinygltf.
 // Based on: Khronos, glTF 2.0 Specification, sections 3.5 (nodes and hierarchy), 3.6 (binary
 // data: buffers, buffer views, accessors), 3.7 (meshes), 3.9 (materials), 3.10 (cameras), 4.4 (GLB
-// file format); the KHR_materials_unlit extension.
+// file format), 3.8 (textures, images, samplers); the KHR_materials_unlit extension.
 //
 // tinygltf parses the JSON and decodes buffers; it does not check that accessors stay inside
 // their buffer views, that indices stay inside their vertex arrays, or that nodes form trees, and
@@ -18,11 +18,13 @@
 #include <new>
 #include <numbers>
 #include <utility>
+#include <tuple>
 
 #include <fmt/format.h>
 #include <tiny_gltf.h>
 
 #include "scene/loader_common.h"
+#include "texture/texture.h"
 
 namespace sv::scene {
 namespace detail {
@@ -97,17 +99,11 @@ bool nestingWithin(const char* text, size_t size, int limit) {
 
 // --- File access for tinygltf: external buffers only, through readFile's checks. ---
 
-// Images are not used by synthvis yet; refusing them keeps their bytes (and the image decoders)
-// out of reach of the input. A missing image is only a warning for tinygltf.
-bool isImagePath(const std::string& path) {
-  std::string ext = lowerExtension(path);
-  for (const char* image : {".png", ".jpg", ".jpeg", ".ktx2", ".webp", ".bmp", ".gif", ".dds"})
-    if (ext == image) return true;
-  return false;
-}
+// Images are read only as textures, through decodeImage below (PNG). A missing image is only a
+// warning for tinygltf; a material that uses it then fails with a message naming it.
 
 bool fsFileExists(const std::string& path, void* followReferences) {
-  if (!*static_cast<bool*>(followReferences) || isImagePath(path)) return false;
+  if (!*static_cast<bool*>(followReferences)) return false;
   std::error_code ec;
   return std::filesystem::is_regular_file(path, ec);
 }
@@ -117,7 +113,7 @@ std::string fsExpandFilePath(const std::string& path, void*) { return path; }
 
 bool fsReadWholeFile(std::vector<unsigned char>* out, std::string* err, const std::string& path,
                      void* followReferences) {
-  if (!*static_cast<bool*>(followReferences) || isImagePath(path)) {
+  if (!*static_cast<bool*>(followReferences)) {
     if (err) *err += fmt::format("cannot open '{}'\n", path);
     return false;
   }
@@ -134,8 +130,28 @@ bool fsWriteWholeFile(std::string*, const std::string&, const std::vector<unsign
   return false;
 }
 
-bool skipImage(tinygltf::Image*, const int, std::string*, std::string*, int, int,
-               const unsigned char*, int, void*) {
+// The decoded images, by glTF image index, filled by decodeImage as tinygltf meets them.
+struct DecodedImages {
+  std::map<int, texture::Level> levels;
+};
+
+// tinygltf's image callback: PNG only (texture.h's decoder and limits), into DecodedImages.
+bool decodeImage(tinygltf::Image* image, const int index, std::string* err, std::string*, int, int,
+                 const unsigned char* bytes, int size, void* user) {
+  const std::string name = fmt::format("images[{}]{}", index,
+                                       image->name.empty() ? "" : " ('" + image->name + "')");
+  const bool png = size >= 8 && std::memcmp(bytes, "\x89PNG\r\n\x1a\n", 8) == 0;
+  if (!png) {
+    if (err) *err += fmt::format("{}: only PNG textures are supported{}\n", name,
+                                 image->mimeType.empty() ? "" : " (this is " + image->mimeType + ")");
+    return false;
+  }
+  Result<texture::Level> level = texture::decodeTextureImage(bytes, size_t(size), name);
+  if (!level) {
+    if (err) *err += level.error().str() + "\n";
+    return false;
+  }
+  static_cast<DecodedImages*>(user)->levels[index] = std::move(level.value());
   return true;
 }
 
@@ -222,8 +238,8 @@ struct AccessorView {
 
 class GltfConverter {
  public:
-  GltfConverter(const tinygltf::Model& model, const LoadOptions& options)
-      : model_(model), options_(options) {}
+  GltfConverter(const tinygltf::Model& model, const LoadOptions& options, DecodedImages& images)
+      : model_(model), options_(options), images_(images) {}
 
   Scene convert();
 
@@ -231,6 +247,7 @@ class GltfConverter {
   AccessorView accessor(int index, const std::string& where, std::initializer_list<int> types,
                         std::initializer_list<int> componentTypes) const;
   void convertMaterials();
+  int textureFor(int gltfTexture, const std::string& where);
   const std::vector<int>& meshesOf(int gltfMesh);
   Mesh convertPrimitive(const tinygltf::Primitive& primitive, const std::string& where) const;
   Mat4 localMatrix(const tinygltf::Node& node, const std::string& where) const;
@@ -239,7 +256,9 @@ class GltfConverter {
 
   const tinygltf::Model& model_;
   const LoadOptions& options_;
+  DecodedImages& images_;
   Scene scene_;
+  std::map<std::tuple<int, int, int>, int> textures_;  // (image, wrapS, wrapT) → Scene::textures
   uint64_t triangles_ = 0;
   std::map<int, std::vector<int>> meshes_;  // glTF mesh → our meshes, one per primitive
 };
@@ -313,8 +332,71 @@ void GltfConverter::convertMaterials() {
     }
     m.doubleSided = gm.doubleSided;
     m.unlit = gm.extensions.count("KHR_materials_unlit") > 0;
+    const std::string where = fmt::format("materials[{}]", i);
+    const tinygltf::TextureInfo& base = gm.pbrMetallicRoughness.baseColorTexture;
+    if (base.index >= 0) {
+      if (base.texCoord != 0)
+        fail(fmt::format("{}: baseColorTexture uses TEXCOORD_{}; only TEXCOORD_0 is supported",
+                         where, base.texCoord));
+      m.texture = textureFor(base.index, where + ".baseColorTexture");
+    }
+    // glTF 2.0 §3.9.4: OPAQUE ignores alpha, MASK cuts at alphaCutoff, BLEND composites.
+    if (gm.alphaMode == "BLEND") m.alphaMode = AlphaMode::blend;
+    else if (gm.alphaMode == "MASK") m.alphaMode = AlphaMode::mask;
+    else if (gm.alphaMode != "OPAQUE" && !gm.alphaMode.empty())
+      fail(fmt::format("{}: unknown alphaMode '{}'", where, gm.alphaMode));
+    if (!std::isfinite(gm.alphaCutoff) || gm.alphaCutoff < 0)
+      fail(fmt::format("{}: alphaCutoff must be a number ≥ 0", where));
+    m.alphaCutoff = float(gm.alphaCutoff);
     scene_.materials.push_back(std::move(m));
   }
+}
+
+texture::Wrap wrapOf(int mode, const std::string& where) {
+  switch (mode) {  // glTF 2.0 §5.26 (sampler.wrapS / wrapT)
+    case 10497: return texture::Wrap::repeat;
+    case 33071: return texture::Wrap::clamp;
+    case 33648: return texture::Wrap::mirror;
+  }
+  fail(fmt::format("{}: unknown wrap mode {}", where, mode));
+}
+
+// The scene texture for glTF texture `gltfTexture`: its image with its sampler's wrap modes, one
+// pyramid per (image, wrap modes). The sampler's filters are not used: the frame's or the
+// material's texture filter decides (RenderOptions::textureFilter).
+int GltfConverter::textureFor(int gltfTexture, const std::string& where) {
+  if (size_t(gltfTexture) >= model_.textures.size())
+    fail(fmt::format("{}: texture {} does not exist ({} textures)", where, gltfTexture,
+                     model_.textures.size()));
+  const tinygltf::Texture& t = model_.textures[size_t(gltfTexture)];
+  const std::string tw = fmt::format("textures[{}]", gltfTexture);
+  if (t.source < 0 || size_t(t.source) >= model_.images.size())
+    fail(fmt::format("{}: image {} does not exist", tw, t.source));
+  int wrapS = 10497, wrapT = 10497;
+  if (t.sampler >= 0) {
+    if (size_t(t.sampler) >= model_.samplers.size())
+      fail(fmt::format("{}: sampler {} does not exist", tw, t.sampler));
+    wrapS = model_.samplers[size_t(t.sampler)].wrapS;
+    wrapT = model_.samplers[size_t(t.sampler)].wrapT;
+  }
+  const auto key = std::make_tuple(t.source, wrapS, wrapT);
+  if (auto it = textures_.find(key); it != textures_.end()) return it->second;
+  auto level = images_.levels.find(t.source);
+  const tinygltf::Image& image = model_.images[size_t(t.source)];
+  if (level == images_.levels.end())
+    fail(fmt::format("images[{}]{}: could not be read{}", t.source,
+                     image.uri.empty() ? "" : " ('" + image.uri + "')",
+                     options_.followReferences ? "" : " (references to other files are disabled)"));
+  TextureMap map;
+  map.name = !image.name.empty() ? image.name : !image.uri.empty() && image.uri.rfind("data:", 0) != 0
+                                                    ? image.uri
+                                                    : fmt::format("images[{}]", t.source);
+  map.texture = std::make_shared<texture::Texture>(level->second, wrapOf(wrapS, tw + ".sampler.wrapS"),
+                                                   wrapOf(wrapT, tw + ".sampler.wrapT"));
+  scene_.textures.push_back(std::move(map));
+  const int index = int(scene_.textures.size()) - 1;
+  textures_.emplace(key, index);
+  return index;
 }
 
 Mesh GltfConverter::convertPrimitive(const tinygltf::Primitive& primitive,
@@ -617,7 +699,8 @@ Result<Scene> loadGltfFromMemory(const std::string& bytes, const std::string& pa
     tinygltf::TinyGLTF loader;
     loader.SetFsCallbacks({&fsFileExists, &fsExpandFilePath, &fsReadWholeFile, &fsWriteWholeFile,
                            &follow});
-    loader.SetImageLoader(&skipImage, nullptr);
+    DecodedImages images;
+    loader.SetImageLoader(&decodeImage, &images);
     tinygltf::Model model;
     std::string err, warn;
     const std::string baseDir = directoryOf(path);
@@ -630,7 +713,7 @@ Result<Scene> loadGltfFromMemory(const std::string& bytes, const std::string& pa
       return Error{path, "", fmt::format("invalid glTF: {}", err.empty() ? "parse failed" : oneLine(err))};
 
     // Step 3: the model, checked as it is converted.
-    Scene scene = GltfConverter(model, options).convert();
+    Scene scene = GltfConverter(model, options, images).convert();
     Status valid = validate(scene, path);
     if (!valid) return valid.error();
     return scene;

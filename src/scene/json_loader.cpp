@@ -26,6 +26,7 @@
 
 #include "scene/loader_common.h"
 #include "scene/primitives.h"
+#include "texture/texture.h"
 
 namespace sv::scene {
 namespace detail {
@@ -360,6 +361,10 @@ class SceneReader {
   Camera readCamera(const Json& v, const std::string& where) const;
   void readLight(const Json& v, const std::string& where);
   void readMaterials(const Json& v, const std::string& where);
+  void readTextures(const Json& v, const std::string& where);
+  void readFog(const Json& v, const std::string& where);
+  void readPointLights(const Json& v, const std::string& where);
+  void readColorTable(const Json& v, const std::string& where);
   void readObject(const Json& v, const std::string& where);
   // The object's "material" and "color" keys as a material index (or −1).
   int readObjectMaterial(const Json& object, const std::string& where);
@@ -375,6 +380,8 @@ class SceneReader {
   Scene scene_;
   uint64_t triangles_ = 0;
   std::map<std::string, int> materialByName_;
+  std::map<std::string, int> textureByName_;
+  std::vector<Vec3> colorTable_;
   // Materials made for objects' "color" overrides, by (base material, colour), to share them.
   std::map<std::pair<int, std::array<float, 4>>, int> colorMaterials_;
   // Where a referenced file's meshes were placed in this scene, by (file, material override), so
@@ -396,7 +403,7 @@ Scene SceneReader::read(const Json& root) {
     fail("synthvis", fmt::format("unsupported format version {} (this reader understands version {})",
                                  version->dump(), kFormatVersion));
   expectKeys(root, "", {"synthvis", "description", "background", "camera", "cameras", "light",
-                        "materials", "objects"});
+                        "pointLights", "fog", "textures", "colorTable", "materials", "objects"});
 
   if (const Json* description = find(root, "description")) string(*description, "description");
   if (const Json* background = find(root, "background")) {
@@ -413,6 +420,10 @@ Scene SceneReader::read(const Json& root) {
       scene_.cameras.push_back(readCamera((*cameras)[i], element("cameras", i)));
   }
   if (const Json* light = find(root, "light")) readLight(*light, "light");
+  if (const Json* x = find(root, "pointLights")) readPointLights(*x, "pointLights");
+  if (const Json* x = find(root, "fog")) readFog(*x, "fog");
+  if (const Json* x = find(root, "textures")) readTextures(*x, "textures");
+  if (const Json* x = find(root, "colorTable")) readColorTable(*x, "colorTable");
   if (const Json* materials = find(root, "materials")) readMaterials(*materials, "materials");
   if (const Json* objects = find(root, "objects")) {
     array(*objects, "objects");
@@ -443,27 +454,150 @@ Camera SceneReader::readCamera(const Json& v, const std::string& where) const {
   return c;
 }
 
+// Light colours may exceed 1 (a brighter light); they may not be negative.
+Vec3 lightColor(const Json& v, const std::string& where) {
+  Vec3 c = vec3(v, where);
+  if (c.x < 0 || c.y < 0 || c.z < 0) fail(where, "components must not be negative");
+  return c;
+}
+
 void SceneReader::readLight(const Json& v, const std::string& where) {
   expectKeys(v, where, {"direction", "color", "ambient", "enabled"});
   Light& light = scene_.light;
   if (const Json* x = find(v, "direction"))
     light.direction = normalize(nonZeroVec3(*x, member(where, "direction")));
-  if (const Json* x = find(v, "color")) {
-    // Light colours may exceed 1 (a brighter light); they may not be negative.
-    std::string w = member(where, "color");
-    light.color = vec3(*x, w);
-    if (light.color.x < 0 || light.color.y < 0 || light.color.z < 0)
-      fail(w, "components must not be negative");
-  }
+  if (const Json* x = find(v, "color")) light.color = lightColor(*x, member(where, "color"));
   if (const Json* x = find(v, "ambient")) light.ambient = inRange(*x, member(where, "ambient"), 0, 1);
   if (const Json* x = find(v, "enabled")) light.enabled = boolean(*x, member(where, "enabled"));
+}
+
+void SceneReader::readPointLights(const Json& v, const std::string& where) {
+  array(v, where);
+  constexpr size_t kMaxPointLights = 64;  // each costs every Phong pixel a term
+  if (v.size() > kMaxPointLights)
+    fail(where, fmt::format("{} point lights is more than the {} supported", v.size(), kMaxPointLights));
+  for (size_t i = 0; i < v.size(); ++i) {
+    std::string w = element(where, i);
+    expectKeys(v[i], w, {"position", "color"});
+    PointLight light;
+    if (const Json* x = find(v[i], "position")) light.position = vec3(*x, member(w, "position"));
+    else fail(w, "missing key 'position'");
+    if (const Json* x = find(v[i], "color")) light.color = lightColor(*x, member(w, "color"));
+    scene_.pointLights.push_back(light);
+  }
+}
+
+void SceneReader::readFog(const Json& v, const std::string& where) {
+  expectKeys(v, where, {"color", "beta", "enabled"});
+  Fog& fog = scene_.fog;
+  fog.enabled = true;
+  if (const Json* x = find(v, "color")) {
+    Vec4 c = color(*x, member(where, "color"), false);
+    fog.color = {c.x, c.y, c.z};
+  }
+  if (const Json* x = find(v, "beta")) fog.beta = inRange(*x, member(where, "beta"), 0, 1e6f);
+  if (const Json* x = find(v, "enabled")) fog.enabled = boolean(*x, member(where, "enabled"));
+}
+
+void SceneReader::readColorTable(const Json& v, const std::string& where) {
+  array(v, where);
+  if (v.size() > 256) fail(where, fmt::format("{} entries is more than 256 (an 8-bit code)", v.size()));
+  for (size_t i = 0; i < v.size(); ++i) {
+    Vec4 c = color(v[i], element(where, i), false);
+    colorTable_.push_back({c.x, c.y, c.z});
+  }
+}
+
+texture::Wrap wrapMode(const Json& v, const std::string& where) {
+  const std::string name = string(v, where);
+  if (name == "repeat") return texture::Wrap::repeat;
+  if (name == "clamp") return texture::Wrap::clamp;
+  if (name == "mirror") return texture::Wrap::mirror;
+  fail(where, fmt::format("unknown wrap mode '{}' (repeat, clamp or mirror)", name));
+}
+
+void SceneReader::readTextures(const Json& v, const std::string& where) {
+  array(v, where);
+  for (size_t i = 0; i < v.size(); ++i) {
+    std::string w = element(where, i);
+    expectKeys(v[i], w, {"name", "file", "generate", "size", "colors", "seed", "wrap"});
+    TextureMap map;
+    if (const Json* x = find(v[i], "name")) map.name = string(*x, member(w, "name"));
+    const Json* file = find(v[i], "file");
+    const Json* generate = find(v[i], "generate");
+    if (!file == !generate) fail(w, "give either 'file' (a PNG) or 'generate' (a pattern)");
+    texture::Wrap wrap[2] = {texture::Wrap::repeat, texture::Wrap::repeat};
+    if (const Json* x = find(v[i], "wrap")) {
+      std::string ww = member(w, "wrap");
+      if (x->is_array()) {
+        if (x->size() != 2) fail(ww, "expected a wrap mode or an array of 2 ([u, v])");
+        for (size_t a = 0; a < 2; ++a) wrap[a] = wrapMode((*x)[a], element(ww, a));
+      } else {
+        wrap[0] = wrap[1] = wrapMode(*x, ww);
+      }
+    }
+    texture::Level level;
+    if (file) {
+      for (const char* key : {"size", "colors", "seed"})
+        if (find(v[i], key)) fail(member(w, key), "only for generated textures");
+      const std::string ref = string(*file, member(w, "file"));
+      if (!context_.options.followReferences)
+        fail(member(w, "file"), fmt::format("cannot open '{}' (references to other files are disabled)", ref));
+      Result<texture::Level> read = texture::readTextureImage(resolvePath(directoryOf(path_), ref));
+      if (!read) fail(member(w, "file"), read.error().str());
+      level = std::move(read.value());
+      if (map.name.empty()) map.name = ref;
+    } else {
+      const std::string gw = member(w, "generate");
+      const std::string pattern = string(*generate, gw);
+      texture::Pattern p;
+      if (pattern == "noise") p = texture::Pattern::noise;
+      else if (pattern == "squares") p = texture::Pattern::squares;
+      else if (pattern == "checker") p = texture::Pattern::checker;
+      else fail(gw, fmt::format("unknown pattern '{}' (noise, squares or checker)", pattern));
+      int size = 256;
+      if (const Json* x = find(v[i], "size"))
+        size = int(integer(*x, member(w, "size"), 1, texture::kMaxGeneratedSide));
+      texture::Color4 c[2] = {{0, 0, 0, 1}, {1, 1, 1, 1}};
+      if (const Json* x = find(v[i], "colors")) {
+        std::string cw = member(w, "colors");
+        if (!x->is_array() || x->size() != 2) fail(cw, "expected an array of 2 colours");
+        for (size_t k = 0; k < 2; ++k) {
+          Vec4 col = color((*x)[k], element(cw, k), false);
+          c[k] = {col.x, col.y, col.z, 1};
+        }
+      }
+      uint32_t seed = 1;
+      if (const Json* x = find(v[i], "seed")) seed = uint32_t(integer(*x, member(w, "seed"), 0, 0xFFFFFFFF));
+      level = texture::generateTexture(p, size, c[0], c[1], seed);
+      if (map.name.empty()) map.name = pattern;
+    }
+    map.texture = std::make_shared<texture::Texture>(std::move(level), wrap[0], wrap[1]);
+    if (find(v[i], "name"))
+      if (!textureByName_.emplace(map.name, int(i)).second)
+        fail(member(w, "name"), fmt::format("duplicate texture name '{}'", map.name));
+    scene_.textures.push_back(std::move(map));
+  }
+}
+
+TextureFilter textureFilterNamed(const std::string& name, const std::string& where) {
+  static const std::pair<const char*, TextureFilter> kNames[] = {
+      {"nearest", TextureFilter::nearest},       {"tri3", TextureFilter::threePoint},
+      {"bilinear", TextureFilter::bilinear},     {"trilinear3", TextureFilter::trilinearThreePoint},
+      {"trilinear", TextureFilter::trilinear},   {"aniso", TextureFilter::anisotropic}};
+  for (const auto& [n, f] : kNames)
+    if (name == n) return f;
+  fail(where, fmt::format("unknown texture filter '{}' (nearest, tri3, bilinear, trilinear3, "
+                          "trilinear or aniso)", name));
 }
 
 void SceneReader::readMaterials(const Json& v, const std::string& where) {
   array(v, where);
   for (size_t i = 0; i < v.size(); ++i) {
     std::string w = element(where, i);
-    expectKeys(v[i], w, {"name", "color", "doubleSided", "unlit"});
+    expectKeys(v[i], w, {"name", "color", "colorCode", "doubleSided", "unlit", "texture",
+                         "textureFilter", "phong", "specular", "shininess", "opacity",
+                         "alphaCutoff"});
     Material m;
     if (const Json* x = find(v[i], "name")) {
       m.name = string(*x, member(w, "name"));
@@ -471,8 +605,42 @@ void SceneReader::readMaterials(const Json& v, const std::string& where) {
         fail(member(w, "name"), fmt::format("duplicate material name '{}'", m.name));
     }
     if (const Json* x = find(v[i], "color")) m.baseColor = color(*x, member(w, "color"), true);
+    if (const Json* x = find(v[i], "colorCode")) {
+      // SPEC §8 (seed 002): an 8-bit code selects an R:G:B ratio from the table; intensity (the
+      // light) multiplies it as it multiplies any base colour.
+      std::string cw = member(w, "colorCode");
+      if (find(v[i], "color")) fail(cw, "give either 'color' or 'colorCode', not both");
+      if (colorTable_.empty()) fail(cw, "the scene has no 'colorTable'");
+      const Vec3 c = colorTable_[size_t(integer(*x, cw, 0, int64_t(colorTable_.size()) - 1))];
+      m.baseColor = {c.x, c.y, c.z, 1};
+    }
     if (const Json* x = find(v[i], "doubleSided")) m.doubleSided = boolean(*x, member(w, "doubleSided"));
     if (const Json* x = find(v[i], "unlit")) m.unlit = boolean(*x, member(w, "unlit"));
+    if (const Json* x = find(v[i], "texture")) {
+      std::string tw = member(w, "texture");
+      if (x->is_string()) {
+        auto it = textureByName_.find(x->get<std::string>());
+        if (it == textureByName_.end()) fail(tw, fmt::format("no texture named '{}'", x->get<std::string>()));
+        m.texture = it->second;
+      } else {
+        if (scene_.textures.empty()) fail(tw, "there are no textures to refer to");
+        m.texture = int(integer(*x, tw, 0, int64_t(scene_.textures.size()) - 1));
+      }
+    }
+    if (const Json* x = find(v[i], "textureFilter"))
+      m.textureFilter = textureFilterNamed(string(*x, member(w, "textureFilter")), member(w, "textureFilter"));
+    if (const Json* x = find(v[i], "phong")) m.phong = boolean(*x, member(w, "phong"));
+    if (const Json* x = find(v[i], "specular")) m.specular = inRange(*x, member(w, "specular"), 0, 1e6f);
+    if (const Json* x = find(v[i], "shininess")) m.shininess = inRange(*x, member(w, "shininess"), 0, 1e6f);
+    if (const Json* x = find(v[i], "opacity")) {
+      m.baseColor.w = inRange(*x, member(w, "opacity"), 0, 1);
+      m.alphaMode = AlphaMode::blend;
+    }
+    if (const Json* x = find(v[i], "alphaCutoff")) {
+      if (find(v[i], "opacity")) fail(member(w, "alphaCutoff"), "give either 'opacity' or 'alphaCutoff'");
+      m.alphaCutoff = inRange(*x, member(w, "alphaCutoff"), 0, 1);
+      m.alphaMode = AlphaMode::mask;
+    }
     scene_.materials.push_back(std::move(m));
   }
 }
@@ -764,7 +932,14 @@ void SceneReader::readMeshFile(const Json& v, const std::string& where,
   if (placed == placedMeshes_.end()) {
     const int meshBase = int(scene_.meshes.size());
     const int materialBase = int(scene_.materials.size());
-    if (!material) scene_.materials.insert(scene_.materials.end(), file.materials.begin(), file.materials.end());
+    const int textureBase = int(scene_.textures.size());
+    if (!material) {
+      scene_.textures.insert(scene_.textures.end(), file.textures.begin(), file.textures.end());
+      for (Material fm : file.materials) {
+        if (fm.texture >= 0) fm.texture += textureBase;
+        scene_.materials.push_back(std::move(fm));
+      }
+    }
     for (Mesh mesh : file.meshes) {
       mesh.material = material ? *material : mesh.material >= 0 ? mesh.material + materialBase : -1;
       scene_.meshes.push_back(std::move(mesh));

@@ -17,6 +17,7 @@
 #include <tiny_obj_loader.h>
 
 #include "scene/loader_common.h"
+#include "texture/texture.h"
 
 namespace sv::scene {
 namespace detail {
@@ -113,8 +114,10 @@ struct ObjProblem {
 [[noreturn]] void fail(std::string message) { throw ObjProblem{std::move(message)}; }
 
 Scene convertObj(const tinyobj::attrib_t& attrib, const std::vector<tinyobj::shape_t>& shapes,
-                 const std::vector<tinyobj::material_t>& materials, const LoadOptions& options) {
+                 const std::vector<tinyobj::material_t>& materials, const LoadOptions& options,
+                 const std::string& baseDir) {
   Scene scene;
+  std::map<std::string, int> textureByFile;
   for (const tinyobj::material_t& mtl : materials) {
     const float channels[] = {mtl.diffuse[0], mtl.diffuse[1], mtl.diffuse[2], mtl.dissolve};
     for (float c : channels)
@@ -125,6 +128,25 @@ Scene convertObj(const tinyobj::attrib_t& attrib, const std::vector<tinyobj::sha
                .doubleSided = false,
                // Illumination model 0 is "colour on, ambient off": a constant colour.
                .unlit = mtl.illum == 0};
+    if (mtl.dissolve < 1) m.alphaMode = AlphaMode::blend;
+    // map_Kd: the diffuse colour map, a PNG relative to the OBJ's directory.
+    if (!mtl.diffuse_texname.empty()) {
+      auto it = textureByFile.find(mtl.diffuse_texname);
+      if (it == textureByFile.end()) {
+        if (!options.followReferences)
+          fail(fmt::format("material '{}': cannot open '{}' (references to other files are "
+                           "disabled)", mtl.name, mtl.diffuse_texname));
+        Result<texture::Level> level =
+            texture::readTextureImage(resolvePath(baseDir, mtl.diffuse_texname));
+        if (!level) fail(fmt::format("material '{}': {}", mtl.name, level.error().str()));
+        scene.textures.push_back(
+            {mtl.diffuse_texname, std::make_shared<texture::Texture>(std::move(level.value()),
+                                                                     texture::Wrap::repeat,
+                                                                     texture::Wrap::repeat)});
+        it = textureByFile.emplace(mtl.diffuse_texname, int(scene.textures.size()) - 1).first;
+      }
+      m.texture = it->second;
+    }
     scene.materials.push_back(std::move(m));
   }
 
@@ -209,7 +231,8 @@ Scene convertObj(const tinyobj::attrib_t& attrib, const std::vector<tinyobj::sha
             }
             if (corner.vt >= 0) {
               const size_t t = size_t(corner.vt);
-              mesh.uvs.push_back({attrib.texcoords[2 * t], attrib.texcoords[2 * t + 1]});
+              // OBJ's v runs up from the image's bottom row; synthvis's (glTF's) runs down.
+              mesh.uvs.push_back({attrib.texcoords[2 * t], 1 - attrib.texcoords[2 * t + 1]});
             }
           }
           mesh.indices.push_back(it->second);
@@ -243,7 +266,7 @@ Result<Scene> parseObj(const std::string& text, const std::string& path,
       std::string message = oneLine(err);
       return Error{path, lineOf(message), fmt::format("invalid OBJ: {}", message.empty() ? "parse failed" : message)};
     }
-    Scene scene = convertObj(attrib, shapes, materials, options);
+    Scene scene = convertObj(attrib, shapes, materials, options, directoryOf(path));
     Status valid = validate(scene, path);
     if (!valid) return valid.error();
     return scene;

@@ -22,6 +22,7 @@ size_t Scene::triangleCount() const {
 namespace {
 
 bool isFinite(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool isFinite(Vec4 v) { return isFinite(Vec3{v.x, v.y, v.z}) && std::isfinite(v.w); }
 
 bool isFinite(const Mat4& m) {
   for (const auto& column : m.m)
@@ -87,6 +88,24 @@ Status validate(const Scene& scene, const std::string& file) {
     if (!isFinite(instance.transform))
       return fail(fmt::format("instances[{}]: transform is not finite", i));
   }
+  for (size_t i = 0; i < scene.materials.size(); ++i) {
+    const Material& m = scene.materials[i];
+    if (m.texture < -1 || (m.texture >= 0 && size_t(m.texture) >= scene.textures.size()))
+      return fail(fmt::format("materials[{}]: texture {} does not exist ({} textures)", i,
+                              m.texture, scene.textures.size()));
+    if (!isFinite(m.baseColor) || !(m.specular >= 0 && m.specular <= 1e6f) ||
+        !(m.shininess >= 0 && m.shininess <= 1e6f) || !std::isfinite(m.alphaCutoff))
+      return fail(fmt::format("materials[{}]: colour, specular, shininess or alphaCutoff is not "
+                              "finite or out of range", i));
+  }
+  for (size_t i = 0; i < scene.textures.size(); ++i)
+    if (!scene.textures[i].texture)
+      return fail(fmt::format("textures[{}] ('{}') holds no image", i, scene.textures[i].name));
+  if (!isFinite(scene.fog.color) || !(scene.fog.beta >= 0 && std::isfinite(scene.fog.beta)))
+    return fail("fog: colour or beta is not finite, or beta is negative");
+  for (size_t i = 0; i < scene.pointLights.size(); ++i)
+    if (!isFinite(scene.pointLights[i].position) || !isFinite(scene.pointLights[i].color))
+      return fail(fmt::format("pointLights[{}]: not finite", i));
   for (size_t i = 0; i < scene.cameras.size(); ++i) {
     const Camera& c = scene.cameras[i];
     if (!isFinite(c.position) || !isFinite(c.target) || !isFinite(c.up) ||
@@ -99,14 +118,19 @@ Status validate(const Scene& scene, const std::string& file) {
 void appendScene(Scene& scene, Scene other, const Mat4& transform) {
   const int materialBase = static_cast<int>(scene.materials.size());
   const int meshBase = static_cast<int>(scene.meshes.size());
-  for (Material& material : other.materials) scene.materials.push_back(std::move(material));
+  const int textureBase = static_cast<int>(scene.textures.size());
+  for (TextureMap& map : other.textures) scene.textures.push_back(std::move(map));
+  for (Material& material : other.materials) {
+    if (material.texture >= 0) material.texture += textureBase;
+    scene.materials.push_back(std::move(material));
+  }
   for (Mesh& mesh : other.meshes) {
     if (mesh.material >= 0) mesh.material += materialBase;
     scene.meshes.push_back(std::move(mesh));
   }
   for (const Instance& instance : other.instances)
     scene.instances.push_back({instance.mesh + meshBase, transform * instance.transform});
-  // Cameras travel with their geometry; the light and background belong to the outer scene
+  // Cameras travel with their geometry; the lights, fog and background belong to the outer scene
   // (docs/scene-format.md, "Referenced files").
   for (Camera camera : other.cameras) {
     camera.position = transform.transformPoint(camera.position);

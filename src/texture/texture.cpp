@@ -288,3 +288,41 @@ Result<Level> decodeTextureImage(const void* data, size_t size, const std::strin
 }
 
 }  // namespace sv::texture
+
+namespace sv::texture {
+
+Level generateTexture(Pattern pattern, int size, const Color4& a, const Color4& b, uint32_t seed) {
+  size = std::clamp(size, 1, kMaxGeneratedSide);
+  Level level;
+  level.width = level.height = size;
+  level.texels.resize(size_t(size) * size_t(size));
+  auto texel = [&a, &b](float t) {
+    auto q = [](float v) { return uint16_t(std::lround(std::clamp(v, 0.0f, 1.0f) * 65535.0f)); };
+    return Texel{q(a.r + (b.r - a.r) * t), q(a.g + (b.g - a.g) * t), q(a.b + (b.b - a.b) * t), 65535};
+  };
+  // A 32-bit mix of (seed, index) (the finalizer of MurmurHash3): the texels do not depend on any
+  // library's random number engine.
+  auto hash = [seed](uint32_t i) {
+    uint32_t h = i * 0x9E3779B1u ^ seed * 0x85EBCA77u;
+    h ^= h >> 16;
+    h *= 0x85EBCA6Bu;
+    h ^= h >> 13;
+    h *= 0xC2B2AE35u;
+    return h ^ (h >> 16);
+  };
+  const int cell = std::max(1, size / 8);
+  const int line = std::max(1, cell / 8);
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      float t = 0;
+      switch (pattern) {
+        case Pattern::noise: t = float(hash(uint32_t(y * size + x)) >> 8) / float(1 << 24); break;
+        case Pattern::squares: t = (x % cell < line || y % cell < line) ? 1.0f : 0.0f; break;
+        case Pattern::checker: t = float((x / cell + y / cell) & 1); break;
+      }
+      level.texels[size_t(y) * size_t(size) + size_t(x)] = texel(t);
+    }
+  return level;
+}
+
+}  // namespace sv::texture

@@ -132,3 +132,17 @@ Result<Level> readTextureImage(const std::string& path);
 Result<Level> decodeTextureImage(const void* data, size_t size, const std::string& name);
 
 }  // namespace sv::texture
+
+namespace sv::texture {
+
+// Procedural images (for scenes, benchmarks and tests; docs/scene-format.md "textures"), `size` ×
+// `size` texels from two linear colours a and b (alpha 1):
+//   noise   — every texel a uniformly random mix of a and b (seed 001's random texture, fig. 6);
+//   squares — an 8 × 8 grid of squares of colour a on lines of colour b (seed 001's figs. 7–9);
+//   checker — 8 × 8 squares alternating a and b.
+// The same (pattern, size, colours, seed) always gives the same texels.
+enum class Pattern : uint8_t { noise, squares, checker };
+inline constexpr int kMaxGeneratedSide = 4096;
+Level generateTexture(Pattern pattern, int size, const Color4& a, const Color4& b, uint32_t seed);
+
+}  // namespace sv::texture
