@@ -3,6 +3,7 @@
 //   synthvis render [SCENE] -o out.png [--width W] [--height H] [--threads T] [--camera I]
 //                   [--no-cull] [--debug-view overdraw] [--gamma G] [--supersample K]
 //                   [--aa 1|4|8|16|64] [--filter box|tent3]
+//                   [--texture-filter nearest|tri3|bilinear|trilinear3|trilinear|aniso]
 //   synthvis bench SCENE|--suite quick|full [--count N] [--area A] [--depth D] [--layers D]
 //                  [--order random|f2b|b2f] [--shade gouraud] [--width W] [--height H]
 //                  [--threads T] [--frames F] [--warmup W] [--seed S] [--aa S] [--gl-aa S]
@@ -55,6 +56,7 @@ struct RenderArgs {
   std::string output = "out.png";
   std::string debugView;
   std::string filter = "box";
+  std::string textureFilter = "trilinear";
   bool noCull = false;
   sv::RenderOptions options;
 };
@@ -65,6 +67,9 @@ int runRender(const RenderArgs& a) {
   auto filter = parseFilter(a.filter);
   if (!filter) return fail(filter.error());
   o.filter = filter.value();
+  auto textureFilter = sv::scene::parseTextureFilter(a.textureFilter);
+  if (!textureFilter) return fail(textureFilter.error());
+  o.textureFilter = textureFilter.value();
   if (!a.debugView.empty()) {
     if (a.debugView != "overdraw")
       return fail({"", "", fmt::format("unknown debug view '{}' (available: overdraw)", a.debugView)});
@@ -357,6 +362,10 @@ int main(int argc, char** argv) {
                      "anti-aliasing: samples per pixel, 1 (none), 4, 8, 16 or 64")
       ->capture_default_str();
   render->add_option("--filter", r.filter, "resolve filter: box or tent3 (3x3 triangle)")
+      ->capture_default_str();
+  render->add_option("--texture-filter", r.textureFilter,
+                     "texture sampling for materials that do not choose: nearest, tri3, bilinear, "
+                     "trilinear3, trilinear or aniso")
       ->capture_default_str();
   render->add_option("--gamma", r.options.gamma,
                      "display gamma G (encoded = linear^(1/G)); default 0 = sRGB")

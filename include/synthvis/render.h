@@ -37,6 +37,8 @@ struct RenderOptions {
   // The resolve filter (SPEC §5): the 1×1 box (each pixel the mean of its own samples), or the
   // 3×3 triangle filter of seed 002 over the box-resolved frame, in linear light.
   enum class Filter { box, tent3 } filter = Filter::box;
+  // How texture maps are sampled (SPEC §7), for materials that do not choose (`inherit`).
+  scene::TextureFilter textureFilter = scene::TextureFilter::trilinear;
 };
 
 // Checks sizes and counts; the error names the option.

@@ -33,6 +33,11 @@ enum class TextureFilter : uint8_t {
   anisotropic,
 };
 
+// By name, as the CLI's --texture-filter and the scene format's "textureFilter" write them:
+// nearest, tri3, bilinear, trilinear3, trilinear, aniso.
+Result<TextureFilter> parseTextureFilter(const std::string& name);
+const char* textureFilterName(TextureFilter filter);
+
 // How a material's alpha (base colour alpha × vertex alpha × texel alpha) is used (glTF's
 // alphaMode): ignored; blended over what lies behind (translucency, SPEC §8); or a cut-out, the
 // pixel drawn opaque where alpha ≥ alphaCutoff and not at all elsewhere.
@@ -48,6 +53,7 @@ struct Material {
   // convention); a mesh without uvs reads texel (0, 0).
   int texture = -1;
   TextureFilter textureFilter = TextureFilter::inherit;
+  Vec2 uvScale{1, 1};  // multiplies the mesh's uvs (repeats the texture uvScale times)
   // Lighting per pixel (SPEC §8, seed 003's Phong weighting) instead of per vertex (Gouraud):
   //   C = (Q_amb·C_amb + Q_diff·C_diff + Q_spec·C_spec) / (Q_amb + Q_diff + Q_spec)
   // with Q_amb = the light's ambient, Q_diff = 1 − Q_amb, Q_spec = `specular`, and `shininess` the

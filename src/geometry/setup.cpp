@@ -150,8 +150,38 @@ struct ScreenVertex {
   return s;
 }
 
-}  // namespace
+// The barycentric functions λ_k = g_k(p)·scale (p in pixels) and the vertices' 1/w factors that
+// parameters are multiplied by. Snapped triangles use the integer edges: adj_k = w_i·w_j·(edge
+// k), det = w0·w1·w2·area2, so λ_k = edge_k(p) / (w_k·area2) — the screen-space form of the same
+// functions, cheaper and consistent with the coverage test. Others use the homogeneous adjugate.
+struct Lambda {
+  double g[3][3];
+  double scale;
+  double invW[3];
+};
 
+Lambda lambdaFunctions(bool allSnapped, const int64_t intEdge[3][3], const ScreenVertex s[3],
+                       const HomVertex adj[3], double det, int64_t area2) {
+  Lambda l;
+  for (int k = 0; k < 3; ++k) {
+    if (allSnapped) {
+      // edge in pixel units: A·256·x + B·256·y + C  (x_f = 256·x)
+      l.g[k][0] = double(intEdge[k][0]) * kSubPixelScale;
+      l.g[k][1] = double(intEdge[k][1]) * kSubPixelScale;
+      l.g[k][2] = double(intEdge[k][2]);
+      l.invW[k] = s[k].invW;
+    } else {
+      l.g[k][0] = adj[k].x;
+      l.g[k][1] = adj[k].y;
+      l.g[k][2] = adj[k].w;
+      l.invW[k] = 1.0;
+    }
+  }
+  l.scale = allSnapped ? 1.0 / double(area2) : 1.0 / det;
+  return l;
+}
+
+}  // namespace
 
 // Snapping happens here, per triangle, rather than once per vertex in a pass of its own: it is a
 // pure function of the vertex, so a shared vertex still snaps identically in all its triangles, and
@@ -254,30 +284,11 @@ SetupOutcome setupTriangle(const ClipVertex& v0, const ClipVertex& v1, const Cli
           {orientation * adj[k].x, orientation * adj[k].y, orientation * adj[k].w});
     }
   }
-  // Step 8: parameter planes, λ_k = g_k(p)·scale. Snapped triangles use the integer edges:
-  // adj_k = w_i·w_j·(edge k), det = w0·w1·w2·area2, so λ_k = edge_k(p) / (w_k·area2) — the
-  // screen-space form of the same functions, cheaper and consistent with the coverage test.
-  double g[3][3];
-  double scale;
-  double invW[3];
-  if (allSnapped) {
-    for (int k = 0; k < 3; ++k) {
-      // edge in pixel units: A·256·x + B·256·y + C  (x_f = 256·x)
-      g[k][0] = double(intEdge[k][0]) * kSubPixelScale;
-      g[k][1] = double(intEdge[k][1]) * kSubPixelScale;
-      g[k][2] = double(intEdge[k][2]);
-      invW[k] = sv[k]->invW;
-    }
-    scale = 1.0 / double(area2);
-  } else {
-    for (int k = 0; k < 3; ++k) {
-      g[k][0] = adj[k].x;
-      g[k][1] = adj[k].y;
-      g[k][2] = adj[k].w;
-      invW[k] = 1.0;
-    }
-    scale = 1.0 / det;
-  }
+  // Step 8: parameter planes, λ_k = g_k(p)·scale (lambdaFunctions).
+  const Lambda lambda = lambdaFunctions(allSnapped, intEdge, s, adj, det, area2);
+  const auto& g = lambda.g;
+  const double scale = lambda.scale;
+  const double* invW = lambda.invW;
   // The near (z ≥ −w) and far (z ≤ w) planes as edges (SPEC §2), only when some vertex is beyond:
   // Σ λ_k (w_k ± z_k) ≥ 0.
   auto planeEdge = [&](double sign) {
@@ -311,6 +322,44 @@ SetupOutcome setupTriangle(const ClipVertex& v0, const ClipVertex& v1, const Cli
   for (int k = 0; k < 3; ++k) f[k] = v[k]->b * invW[k];
   out.blue = makePlane(g, f, scale, px, py);
   return SetupOutcome::drawn;
+}
+
+void attributePlanes(const ClipVertex& v0, const ClipVertex& v1, const ClipVertex& v2,
+                     const Viewport& viewport, const TriangleSetup& setup,
+                     const float* const values[3], int count, Plane* out) {
+  // The same λ as setupTriangle's steps 3, 4 and 8 for this (drawn, so valid) triangle.
+  const ClipVertex* const v[3] = {&v0, &v1, &v2};
+  const ScreenVertex s[3] = {snapVertex(v0, viewport), snapVertex(v1, viewport),
+                             snapVertex(v2, viewport)};
+  const bool allSnapped = s[0].snapped && s[1].snapped && s[2].snapped;
+  int64_t intEdge[3][3] = {};
+  HomVertex adj[3] = {};
+  double det = 0;
+  int64_t area2 = 0;
+  if (allSnapped) {
+    for (int k = 0; k < 3; ++k) {
+      const int i = (k + 1) % 3, j = (k + 2) % 3;
+      intEdge[k][0] = int64_t(s[i].y) - s[j].y;
+      intEdge[k][1] = int64_t(s[j].x) - s[i].x;
+      intEdge[k][2] = int64_t(s[i].x) * s[j].y - int64_t(s[j].x) * s[i].y;
+    }
+    area2 = intEdge[0][0] * s[0].x + intEdge[0][1] * s[0].y + intEdge[0][2];
+  } else {
+    const double halfW = 0.5 * viewport.width, halfH = 0.5 * viewport.height;
+    HomVertex hv[3];
+    for (int k = 0; k < 3; ++k)
+      hv[k] = {(double(v[k]->x) + v[k]->w) * halfW, (double(v[k]->w) - v[k]->y) * halfH,
+               double(v[k]->w)};
+    for (int k = 0; k < 3; ++k) adj[k] = canonicalCross(hv[(k + 1) % 3], hv[(k + 2) % 3]);
+    det = dot(hv[0], adj[0]);
+  }
+  const Lambda lambda = lambdaFunctions(allSnapped, intEdge, s, adj, det, area2);
+  const double px = double(setup.minX) + 0.5, py = double(setup.minY) + 0.5;
+  for (int a = 0; a < count; ++a) {
+    const double f[3] = {values[0][a] * lambda.invW[0], values[1][a] * lambda.invW[1],
+                         values[2][a] * lambda.invW[2]};
+    out[a] = makePlane(lambda.g, f, lambda.scale, px, py);
+  }
 }
 
 }  // namespace sv::geometry

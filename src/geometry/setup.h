@@ -82,7 +82,7 @@ struct Viewport {
 inline int boxInsetLow(const Viewport& v) { return v.pixelAperture ? kSubPixelScale - 1 : kSubPixelScale / 2; }
 inline int boxInsetHigh(const Viewport& v) { return kSubPixelScale - boxInsetLow(v); }
 
-// 144 bytes: the record the tiles read for every triangle, so kept small (cache misses on it are
+// 160 bytes: the record the tiles read for every triangle, so kept small (cache misses on it are
 // a large part of the cost of small triangles).
 struct TriangleSetup {
   EdgeFunction edges[kMaxEdges];
@@ -90,6 +90,9 @@ struct TriangleSetup {
   // is the ratio colour/w ÷ 1/w, SPEC §2's shared denominator). Origin: pixel (minX, minY).
   Plane depth, invW, red, green, blue;
   int16_t minX, minY, maxX, maxY;  // inclusive pixel bounding box, clipped to the raster
+  // The triangle's number in its draw packets (setupTriangles' firstTriangle + its position): finds
+  // its attribute planes for pixel shading (AttributeSetup) after binning has reordered records.
+  uint32_t triangle;
   uint8_t edgeCount;
   // True when the triangle is small (three integer edges, bounding box ≤ kSmallExtent pixels):
   // then edge values fit int32 wherever the rasterizer evaluates them (budget above).
@@ -105,18 +108,26 @@ enum class SetupOutcome : uint8_t {  // numbered from 0, in this order
   culledInvalid,     // NaN or infinite coordinates
 };
 
-// Sets up one triangle for `viewport`. Returns `drawn` and fills `out`, or a culling reason.
+// Sets up one triangle for `viewport`. Returns `drawn` and fills `out` (all but `triangle`), or a
+// culling reason.
 // Front faces are counter-clockwise in normalized device coordinates (the OpenGL default).
 SetupOutcome setupTriangle(const ClipVertex& v0, const ClipVertex& v1, const ClipVertex& v2,
                            const Viewport& viewport, CullMode cull, TriangleSetup& out);
 
 // The same for `count` triangles (indices: 3 per triangle into `vertices`), several at once in
 // SIMD lanes (setup_batch.cpp); records bit-identical to setupTriangle's. The drawn triangles'
-// records go to out[0, returned count) in order; outcomes[o] is incremented per triangle with
-// outcome o.
+// records go to out[0, returned count) in order, `triangle` set to firstTriangle + their position
+// in `indices`; outcomes[o] is incremented per triangle with outcome o.
 inline constexpr int kSetupOutcomes = 5;
 size_t setupTriangles(const ClipVertex* vertices, const uint32_t* indices, size_t count,
                       const Viewport& viewport, CullMode cull, TriangleSetup* out,
-                      uint64_t outcomes[kSetupOutcomes]);
+                      uint64_t outcomes[kSetupOutcomes], uint32_t firstTriangle = 0);
+
+// Pixel shading's extra parameters (SPEC §2): `count` planes of value/w for per-vertex values
+// values[k][0 … count) of vertex k, relative to the same origin (minX, minY) as `setup`'s planes —
+// the functions setupTriangle gives the colour. `setup` is the triangle's drawn record.
+void attributePlanes(const ClipVertex& v0, const ClipVertex& v1, const ClipVertex& v2,
+                     const Viewport& viewport, const TriangleSetup& setup,
+                     const float* const values[3], int count, Plane* out);
 
 }  // namespace sv::geometry

@@ -26,7 +26,7 @@ constexpr int kMaxLanes = 16;
 
 size_t SetupTriangles(const ClipVertex* vertices, const uint32_t* indices, size_t count,
                       const Viewport& viewport, CullMode cull, TriangleSetup* out,
-                      uint64_t* outcomes) {
+                      uint64_t* outcomes, uint32_t firstTriangle) {
   const hn::ScalableTag<double> d;
   const size_t N = hn::Lanes(d);
   size_t drawn = 0;
@@ -169,6 +169,7 @@ size_t SetupTriangles(const ClipVertex* vertices, const uint32_t* indices, size_
           const uint32_t* idx = indices + (t + l) * 3;
           const SetupOutcome so = setupTriangle(vertices[idx[0]], vertices[idx[1]],
                                                 vertices[idx[2]], viewport, cull, out[drawn]);
+          out[drawn].triangle = firstTriangle + uint32_t(t + l);
           ++outcomes[int(so)];
           drawn += so == SetupOutcome::drawn;
           continue;
@@ -193,6 +194,7 @@ size_t SetupTriangles(const ClipVertex* vertices, const uint32_t* indices, size_
         s.maxY = int16_t(o[q++][l]);
         s.edgeCount = 3;
         s.small = o[r - 1][l] != 0;
+        s.triangle = firstTriangle + uint32_t(t + l);
       }
     }
   }
@@ -200,6 +202,7 @@ size_t SetupTriangles(const ClipVertex* vertices, const uint32_t* indices, size_
     const uint32_t* idx = indices + t * 3;
     const SetupOutcome so = setupTriangle(vertices[idx[0]], vertices[idx[1]], vertices[idx[2]],
                                           viewport, cull, out[drawn]);
+    out[drawn].triangle = firstTriangle + uint32_t(t);
     ++outcomes[int(so)];
     drawn += so == SetupOutcome::drawn;
   }
@@ -216,9 +219,9 @@ HWY_EXPORT(SetupTriangles);
 
 size_t setupTriangles(const ClipVertex* vertices, const uint32_t* indices, size_t count,
                       const Viewport& viewport, CullMode cull, TriangleSetup* out,
-                      uint64_t outcomes[kSetupOutcomes]) {
+                      uint64_t outcomes[kSetupOutcomes], uint32_t firstTriangle) {
   return HWY_DYNAMIC_DISPATCH(SetupTriangles)(vertices, indices, count, viewport, cull, out,
-                                              outcomes);
+                                              outcomes, firstTriangle);
 }
 }  // namespace sv::geometry
 #endif

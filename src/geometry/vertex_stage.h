@@ -1,22 +1,34 @@
 // The vertex half of the projective transform (SPEC §1 stage 3): object space → clip space, with
-// per-vertex Gouraud lighting (SPEC §8).
+// per-vertex Gouraud lighting (SPEC §8) and the attributes pixel shading interpolates.
 #pragma once
 
 #include <vector>
 
 #include "geometry/setup.h"
+#include "shade/shading.h"
 #include "synthvis/scene.h"
 
 namespace sv::geometry {
 
-// Writes the clip-space vertices of mesh vertices [begin, end) to out[0 … end − begin).
-// `model` places the mesh in the world,
-// `viewProj` is projection·view. Colour = material colour × vertex colour × light intensity, where
-// intensity = ambient + (1 − ambient)·max(0, n·l)·lightColour when the mesh has normals, the light
-// is enabled and the material is lit; back faces of double-sided materials are lit as seen from
-// the front (the vertex stage cannot know facing), which matches common viewers.
+// What the vertex stage needs of the frame: camera and lights.
+struct VertexContext {
+  Mat4 view;      // world → eye
+  Mat4 viewProj;  // projection·view
+  const scene::Light* light = nullptr;
+  const std::vector<scene::PointLight>* pointLights = nullptr;  // world space
+};
+
+// Writes the clip-space vertices of mesh vertices [begin, end) to out[0 … end − begin), and, when
+// `attributes` is not null, their pixel-shading attributes (shade::Attribute: uv, eye-space normal
+// and position, alpha) to attributes[0 … end − begin).
+// `model` places the mesh in the world. Colour = material colour × vertex colour × light intensity,
+// where intensity = ambient + (1 − ambient)·Σ max(0, n·l)·lightColour over the directional light
+// and the point lights when the mesh has normals, the light is enabled and the material is lit
+// and not Phong (Phong materials are lit per pixel: their colour is left unlit); back faces of
+// double-sided materials are lit as seen from the front (the vertex stage cannot know facing),
+// which matches common viewers.
 void transformVertices(const scene::Mesh& mesh, const scene::Material& material, const Mat4& model,
-                       const Mat4& viewProj, const scene::Light& light, size_t begin, size_t end,
-                       ClipVertex* out);
+                       const VertexContext& context, size_t begin, size_t end, ClipVertex* out,
+                       shade::VertexAttributes* attributes = nullptr);
 
 }  // namespace sv::geometry

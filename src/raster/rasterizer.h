@@ -8,6 +8,7 @@
 
 #include "geometry/setup.h"
 #include "raster/coverage_masks.h"
+#include "shade/shading.h"
 
 namespace sv::raster {
 
@@ -33,6 +34,17 @@ struct RasterStats {
 enum class ShadeMode : uint8_t {
   gouraud,   // depth test "less", perspective-correct Gouraud colour (SPEC §4, §8)
   overdraw,  // no depth test; the red channel counts the triangles covering the pixel
+  // Depth test "less"; triangles with an AttributeSetup material are shaded per pixel by
+  // shade::shadeFragments (texture, Phong, fog) and written opaque, cut out (alpha mask) or blended
+  // over the pixel without writing depth (translucent); the others as `gouraud`.
+  material,
+};
+
+// Pixel shading's record for one triangle (ShadeMode::material): its attribute planes in
+// shade::Attribute order, with the same origin as its TriangleSetup's planes, and its material.
+struct AttributeSetup {
+  geometry::Plane planes[shade::kAttributeCount];
+  const shade::MaterialShading* material = nullptr;  // nullptr: Gouraud colour, as ShadeMode::gouraud
 };
 
 // One tile's work: triangles in submission order, given as lists of indices into `setups`.
@@ -53,6 +65,10 @@ struct TileWork {
   // centre. The triangles must be set up with Viewport::pixelAperture and the buffers hold N sample
   // planes (framebuffer.h). nullptr: point sampling at pixel centres. Gouraud only.
   const CoverageTables* coverage = nullptr;
+  // ShadeMode::material: setup t's record is attributes[t.triangle − attributeBase].
+  const AttributeSetup* attributes = nullptr;
+  uint32_t attributeBase = 0;
+  const shade::Environment* environment = nullptr;
 };
 
 // Draws the tile's triangles as `work.shade` says. Runs the best SIMD

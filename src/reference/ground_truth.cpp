@@ -71,7 +71,9 @@ Result<Image> renderGroundTruth(const scene::Scene& scene, const GroundTruthOpti
     const scene::Material& mat =
         mesh.material >= 0 ? scene.materials[size_t(mesh.material)] : defaultMaterial;
     std::vector<geometry::ClipVertex> v(mesh.positions.size());
-    geometry::transformVertices(mesh, mat, inst.transform, camera.value(), scene.light, 0,
+    // (The eye-space `view` only places pixel-shading attributes, which are not asked for.)
+    geometry::transformVertices(mesh, mat, inst.transform,
+                                {Mat4{}, camera.value(), &scene.light, &scene.pointLights}, 0,
                                 v.size(), v.data());
     const bool cullBack = o.cullBackFaces && !mat.doubleSided;
     for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {

@@ -60,6 +60,8 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
 
   const uint32_t firstBatch = std::min(triangleCount, batchTriangles);
   setups_.resize(std::max<size_t>(setups_.size(), firstBatch));
+  const bool pixelShading = settings.shade == raster::ShadeMode::material;
+  if (pixelShading) attributes_.resize(std::max<size_t>(attributes_.size(), firstBatch));
   scratch_.resize(size_t(pool_.threadCount()));
   for (WorkerScratch& w : scratch_) {
     w.records.resize(kChunkTriangles);
@@ -93,9 +95,27 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
         const DrawCall* call = cursor.find(tri);
         const uint32_t runEnd =
             call ? std::min(end, call->firstTriangle + call->triangleCount) : tri + 1;
+        const uint32_t first = n;
         n += uint32_t(geometry::setupTriangles(
             packets.vertices.data(), &packets.indices[size_t(tri) * 3], runEnd - tri, viewport,
-            call ? call->cull : geometry::CullMode::none, scratch.records.data() + n, outcomes));
+            call ? call->cull : geometry::CullMode::none, scratch.records.data() + n, outcomes,
+            tri));
+        // Pixel shading's planes for the drawn triangles of a call with a material.
+        const shade::MaterialShading* material = call ? call->material : nullptr;
+        if (pixelShading)
+          for (uint32_t r = first; r < n; ++r) {
+            const geometry::TriangleSetup& s = scratch.records[r];
+            raster::AttributeSetup& a = attributes_[s.triangle - batch];
+            a.material = material;
+            if (!material) continue;
+            const uint32_t* idx = &packets.indices[size_t(s.triangle) * 3];
+            const float* values[3] = {packets.attributes[idx[0]].value,
+                                      packets.attributes[idx[1]].value,
+                                      packets.attributes[idx[2]].value};
+            geometry::attributePlanes(packets.vertices[idx[0]], packets.vertices[idx[1]],
+                                      packets.vertices[idx[2]], viewport, s, values,
+                                      shade::kAttributeCount, a.planes);
+          }
         tri = runEnd;
       }
       SetupCounts c;
@@ -144,6 +164,11 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
       w.listCount = lists;
       w.shade = settings.shade;
       w.coverage = coverage;
+      if (pixelShading) {
+        w.attributes = attributes_.data();
+        w.attributeBase = batch;
+        w.environment = settings.environment;
+      }
       raster::rasterizeTile(w, tileStats_[tile]);
       if (lastBatch && settings.finishTile) settings.finishTile(int(tile), w.depth, w.color);
     });

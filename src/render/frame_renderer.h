@@ -14,16 +14,21 @@
 
 namespace sv::render {
 
-// A run of triangles that share a culling mode.
+// A run of triangles that share a culling mode and a material.
 struct DrawCall {
   uint32_t firstTriangle = 0;
   uint32_t triangleCount = 0;
   geometry::CullMode cull = geometry::CullMode::back;
+  // Shaded per pixel (FrameSettings::shade = material) with this material, reading `attributes`;
+  // nullptr: the interpolated vertex colour.
+  const shade::MaterialShading* material = nullptr;
 };
 
 // The plain input of a frame: vertices after the projective transform and triangles indexing them.
 struct DrawPackets {
   std::vector<geometry::ClipVertex> vertices;
+  // Per vertex, for pixel shading: as many as `vertices` when some call has a material, else empty.
+  std::vector<shade::VertexAttributes> attributes;
   std::vector<uint32_t> indices;  // 3 per triangle, each < vertices.size()
   std::vector<DrawCall> calls;    // in submission order
 };
@@ -35,6 +40,7 @@ struct FrameSettings {
   int width = 0, height = 0;
   float clearColor[3] = {0, 0, 0};  // linear
   raster::ShadeMode shade = raster::ShadeMode::gouraud;
+  const shade::Environment* environment = nullptr;  // lights and fog, for ShadeMode::material
   // Samples per pixel: 1 (point sampling at centres) or 4, 8, 16, 64 (anti-aliasing with sub-pixel
   // masks, SPEC §5; Gouraud only). finishTile then receives `samples` sample planes per block.
   int samples = 1;
@@ -67,6 +73,7 @@ class FrameRenderer {
     raster::FrameBuffer tile;  // 64×64: the tile being drawn, in frames of one batch
   };
   std::vector<geometry::TriangleSetup> setups_;  // the batch's, grouped by tile within each chunk
+  std::vector<raster::AttributeSetup> attributes_;  // the batch's, by triangle (ShadeMode::material)
   std::vector<WorkerScratch> scratch_;           // one per pool worker
   std::vector<raster::RasterStats> tileStats_;
 };

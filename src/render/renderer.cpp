@@ -54,7 +54,13 @@ scene::Camera defaultCamera(const scene::Scene& s) {
 
 }  // namespace
 
-Result<Mat4> viewProjection(const scene::Scene& scene, const RenderOptions& o) {
+namespace {
+
+struct CameraMatrices {
+  Mat4 view, projection;
+};
+
+Result<CameraMatrices> cameraMatrices(const scene::Scene& scene, const RenderOptions& o) {
   scene::Camera cam;
   if (!scene.cameras.empty()) {
     if (o.camera >= int(scene.cameras.size()))
@@ -65,9 +71,79 @@ Result<Mat4> viewProjection(const scene::Scene& scene, const RenderOptions& o) {
     cam = defaultCamera(scene);
   }
   const float aspect = float(o.width) / float(o.height);
-  return Mat4::perspective(cam.yfovDegrees * 3.14159265358979f / 180.0f, aspect, cam.znear,
-                           cam.zfar) *
-         Mat4::lookAt(cam.position, cam.target, cam.up);
+  return CameraMatrices{
+      Mat4::lookAt(cam.position, cam.target, cam.up),
+      Mat4::perspective(cam.yfovDegrees * 3.14159265358979f / 180.0f, aspect, cam.znear, cam.zfar)};
+}
+
+texture::Filter samplerOf(scene::TextureFilter f) {
+  switch (f) {
+    case scene::TextureFilter::nearest: return texture::Filter::nearest;
+    case scene::TextureFilter::threePoint: return texture::Filter::threePoint;
+    case scene::TextureFilter::bilinear: return texture::Filter::bilinear;
+    case scene::TextureFilter::trilinearThreePoint: return texture::Filter::trilinearThreePoint;
+    default: return texture::Filter::trilinear;
+  }
+}
+
+// The shading stage's view of the scene: materials (two variants each — with and without normals
+// to light per pixel), and lights and fog in eye space.
+struct ShadingTables {
+  std::vector<shade::MaterialShading> materials;  // [2·(material + 1) + hasNormals]
+  shade::Environment environment;
+  bool any = false;  // some draw needs pixel shading (or fog)
+
+  const shade::MaterialShading* of(int material, bool hasNormals) const {
+    return &materials[size_t(2 * (material + 1) + (hasNormals ? 1 : 0))];
+  }
+};
+
+void buildShading(const scene::Scene& scene, const RenderOptions& o, const Mat4& view,
+                  ShadingTables& out) {
+  out.materials.clear();
+  const scene::Material defaultMaterial;
+  const bool hasLights = scene.light.enabled || !scene.pointLights.empty();
+  for (int m = -1; m < int(scene.materials.size()); ++m) {
+    const scene::Material& mat = m >= 0 ? scene.materials[size_t(m)] : defaultMaterial;
+    for (int normals = 0; normals < 2; ++normals) {
+      shade::MaterialShading s;
+      if (mat.texture >= 0) s.texture = scene.textures[size_t(mat.texture)].texture.get();
+      const scene::TextureFilter f =
+          mat.textureFilter == scene::TextureFilter::inherit ? o.textureFilter : mat.textureFilter;
+      s.filter = samplerOf(f);
+      s.anisotropic = f == scene::TextureFilter::anisotropic;
+      s.phong = mat.phong && hasLights && !mat.unlit && normals;  // as the vertex stage's `lit`
+      s.twoSided = mat.doubleSided;
+      s.specular = mat.specular;
+      s.shininess = mat.shininess;
+      s.alpha = mat.alphaMode == scene::AlphaMode::blend  ? shade::AlphaUse::blend
+                : mat.alphaMode == scene::AlphaMode::mask ? shade::AlphaUse::mask
+                                                          : shade::AlphaUse::opaque;
+      s.alphaCutoff = mat.alphaCutoff;
+      out.materials.push_back(s);
+    }
+  }
+  shade::Environment& env = out.environment;
+  env.lightOn = scene.light.enabled;
+  env.toLight = normalize(view.transformDirection(normalize(-scene.light.direction)));
+  env.lightColor = scene.light.color;
+  env.ambient = scene.light.ambient;
+  env.points.clear();
+  for (const scene::PointLight& p : scene.pointLights)
+    env.points.push_back({view.transformPoint(p.position), p.color});
+  env.fog = scene.fog.enabled && scene.fog.beta > 0;
+  env.fogColor = scene.fog.color;
+  env.fogBeta = scene.fog.beta;
+  out.any = env.fog;
+  for (const scene::Material& mat : scene.materials) out.any |= mat.needsPixelShading();
+}
+
+}  // namespace
+
+Result<Mat4> viewProjection(const scene::Scene& scene, const RenderOptions& o) {
+  const Result<CameraMatrices> m = cameraMatrices(scene, o);
+  if (!m.ok()) return m.error();
+  return m.value().projection * m.value().view;
 }
 
 Status validate(const RenderOptions& o) {
@@ -119,6 +195,7 @@ struct Renderer::Impl {
   RenderOptions options;
   render::FrameRenderer frame;
   output::GammaTables gamma;
+  ShadingTables shading;
   render::DrawPackets packets;
   output::LinearImage linear;  // the box-resolved frame, for the tent filter
 };
@@ -135,13 +212,19 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
   const auto start = Clock::now();
 
   // Stage 2–3: camera, then every instance's vertices to clip space.
-  const Result<Mat4> camera = viewProjection(scene, o);
+  const Result<CameraMatrices> camera = cameraMatrices(scene, o);
   if (!camera.ok()) return camera.error();
-  const Mat4& viewProj = camera.value();
+  geometry::VertexContext vertexContext{camera.value().view,
+                                        camera.value().projection * camera.value().view,
+                                        &scene.light, &scene.pointLights};
+  ShadingTables& shading = impl_->shading;
+  buildShading(scene, o, camera.value().view, shading);
+  const bool pixelShading = shading.any && !o.debugOverdraw;
 
   auto t0 = Clock::now();
   render::DrawPackets& p = impl_->packets;
   p.vertices.clear();
+  p.attributes.clear();
   p.indices.clear();
   p.calls.clear();
   const scene::Material defaultMaterial;
@@ -157,34 +240,43 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
   constexpr size_t kVertexChunk = 1 << 14;
   std::vector<VertexJob> jobs;
   size_t vertexCount = 0;
-  for (const auto& inst : scene.instances) {
-    const scene::Mesh& mesh = scene.meshes[inst.mesh];
-    const scene::Material& mat = materialOf(mesh);
-    // Indices are 32-bit; a frame of more vertices or triangles than that cannot be expressed.
-    if (vertexCount + mesh.positions.size() > (size_t(1) << 31) ||
-        p.indices.size() + mesh.indices.size() > (size_t(1) << 31))
-      return Error{"", "", "scene too large for one frame (over 2^31 vertices or indices)"};
-    for (size_t b = 0; b < mesh.positions.size(); b += kVertexChunk)
-      jobs.push_back({&inst, b, std::min(mesh.positions.size(), b + kVertexChunk), vertexCount + b});
-    render::DrawCall call;
-    call.firstTriangle = static_cast<uint32_t>(p.indices.size() / 3);
-    call.triangleCount = static_cast<uint32_t>(mesh.triangleCount());
-    call.cull = o.cullBackFaces && !mat.doubleSided ? geometry::CullMode::back
-                                                      : geometry::CullMode::none;
-    const uint32_t base = static_cast<uint32_t>(vertexCount);
-    const size_t at = p.indices.size();
-    p.indices.resize(at + mesh.indices.size());
-    std::transform(mesh.indices.begin(), mesh.indices.end(), p.indices.begin() + ptrdiff_t(at),
-                   [base](uint32_t i) { return base + i; });
-    p.calls.push_back(call);
-    vertexCount += mesh.positions.size();
-  }
+  // Opaque materials first, then translucent ones (SPEC §4: blended over what is behind them),
+  // each in submission order.
+  for (const bool translucentPass : {false, true})
+    for (const auto& inst : scene.instances) {
+      const scene::Mesh& mesh = scene.meshes[inst.mesh];
+      const scene::Material& mat = materialOf(mesh);
+      if ((mat.alphaMode == scene::AlphaMode::blend) != translucentPass) continue;
+      // Indices are 32-bit; a frame of more vertices or triangles than that cannot be expressed.
+      if (vertexCount + mesh.positions.size() > (size_t(1) << 31) ||
+          p.indices.size() + mesh.indices.size() > (size_t(1) << 31))
+        return Error{"", "", "scene too large for one frame (over 2^31 vertices or indices)"};
+      for (size_t b = 0; b < mesh.positions.size(); b += kVertexChunk)
+        jobs.push_back(
+            {&inst, b, std::min(mesh.positions.size(), b + kVertexChunk), vertexCount + b});
+      render::DrawCall call;
+      call.firstTriangle = static_cast<uint32_t>(p.indices.size() / 3);
+      call.triangleCount = static_cast<uint32_t>(mesh.triangleCount());
+      call.cull = o.cullBackFaces && !mat.doubleSided ? geometry::CullMode::back
+                                                        : geometry::CullMode::none;
+      if (pixelShading && (mat.needsPixelShading() || shading.environment.fog))
+        call.material = shading.of(mesh.material, !mesh.normals.empty());
+      const uint32_t base = static_cast<uint32_t>(vertexCount);
+      const size_t at = p.indices.size();
+      p.indices.resize(at + mesh.indices.size());
+      std::transform(mesh.indices.begin(), mesh.indices.end(), p.indices.begin() + ptrdiff_t(at),
+                     [base](uint32_t i) { return base + i; });
+      p.calls.push_back(call);
+      vertexCount += mesh.positions.size();
+    }
   p.vertices.resize(vertexCount);
+  if (pixelShading) p.attributes.resize(vertexCount);
   impl_->frame.pool().parallelFor(jobs.size(), [&](size_t j, int) {
     const VertexJob& job = jobs[j];
     const scene::Mesh& mesh = scene.meshes[job.instance->mesh];
-    geometry::transformVertices(mesh, materialOf(mesh), job.instance->transform, viewProj,
-                                scene.light, job.begin, job.end, p.vertices.data() + job.out);
+    geometry::transformVertices(mesh, materialOf(mesh), job.instance->transform, vertexContext,
+                                job.begin, job.end, p.vertices.data() + job.out,
+                                pixelShading ? p.attributes.data() + job.out : nullptr);
   });
   stats.vertexMs = msSince(t0);
 
@@ -196,7 +288,10 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
   fs.clearColor[0] = scene.background.x;
   fs.clearColor[1] = scene.background.y;
   fs.clearColor[2] = scene.background.z;
-  fs.shade = o.debugOverdraw ? raster::ShadeMode::overdraw : raster::ShadeMode::gouraud;
+  fs.shade = o.debugOverdraw  ? raster::ShadeMode::overdraw
+             : pixelShading   ? raster::ShadeMode::material
+                              : raster::ShadeMode::gouraud;
+  fs.environment = &shading.environment;
   fs.samples = o.samples;
   if (o.samples > 1) {
     // A frame of several batches keeps a whole-frame sample buffer (samples × 10 bytes a pixel:

@@ -580,23 +580,12 @@ void SceneReader::readTextures(const Json& v, const std::string& where) {
   }
 }
 
-TextureFilter textureFilterNamed(const std::string& name, const std::string& where) {
-  static const std::pair<const char*, TextureFilter> kNames[] = {
-      {"nearest", TextureFilter::nearest},       {"tri3", TextureFilter::threePoint},
-      {"bilinear", TextureFilter::bilinear},     {"trilinear3", TextureFilter::trilinearThreePoint},
-      {"trilinear", TextureFilter::trilinear},   {"aniso", TextureFilter::anisotropic}};
-  for (const auto& [n, f] : kNames)
-    if (name == n) return f;
-  fail(where, fmt::format("unknown texture filter '{}' (nearest, tri3, bilinear, trilinear3, "
-                          "trilinear or aniso)", name));
-}
-
 void SceneReader::readMaterials(const Json& v, const std::string& where) {
   array(v, where);
   for (size_t i = 0; i < v.size(); ++i) {
     std::string w = element(where, i);
     expectKeys(v[i], w, {"name", "color", "colorCode", "doubleSided", "unlit", "texture",
-                         "textureFilter", "phong", "specular", "shininess", "opacity",
+                         "textureFilter", "textureScale", "phong", "specular", "shininess", "opacity",
                          "alphaCutoff"});
     Material m;
     if (const Json* x = find(v[i], "name")) {
@@ -627,8 +616,16 @@ void SceneReader::readMaterials(const Json& v, const std::string& where) {
         m.texture = int(integer(*x, tw, 0, int64_t(scene_.textures.size()) - 1));
       }
     }
-    if (const Json* x = find(v[i], "textureFilter"))
-      m.textureFilter = textureFilterNamed(string(*x, member(w, "textureFilter")), member(w, "textureFilter"));
+    if (const Json* x = find(v[i], "textureFilter")) {
+      Result<TextureFilter> f = parseTextureFilter(string(*x, member(w, "textureFilter")));
+      if (!f) fail(member(w, "textureFilter"), f.error().message);
+      m.textureFilter = f.value();
+    }
+    if (const Json* x = find(v[i], "textureScale")) {
+      const std::string sw = member(w, "textureScale");
+      const auto k = x->is_number() ? std::array<float, 2>{number(*x, sw), number(*x, sw)} : numbers<2>(*x, sw);
+      m.uvScale = {k[0], k[1]};
+    }
     if (const Json* x = find(v[i], "phong")) m.phong = boolean(*x, member(w, "phong"));
     if (const Json* x = find(v[i], "specular")) m.specular = inRange(*x, member(w, "specular"), 0, 1e6f);
     if (const Json* x = find(v[i], "shininess")) m.shininess = inRange(*x, member(w, "shininess"), 0, 1e6f);

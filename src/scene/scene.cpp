@@ -41,6 +41,26 @@ std::string meshLabel(const Mesh& mesh, size_t i) {
 
 }  // namespace
 
+namespace {
+constexpr std::pair<const char*, TextureFilter> kTextureFilterNames[] = {
+    {"nearest", TextureFilter::nearest},       {"tri3", TextureFilter::threePoint},
+    {"bilinear", TextureFilter::bilinear},     {"trilinear3", TextureFilter::trilinearThreePoint},
+    {"trilinear", TextureFilter::trilinear},   {"aniso", TextureFilter::anisotropic}};
+}  // namespace
+
+Result<TextureFilter> parseTextureFilter(const std::string& name) {
+  for (const auto& [n, f] : kTextureFilterNames)
+    if (name == n) return f;
+  return Error{"", "", fmt::format("unknown texture filter '{}' (nearest, tri3, bilinear, "
+                                   "trilinear3, trilinear or aniso)", name)};
+}
+
+const char* textureFilterName(TextureFilter filter) {
+  for (const auto& [n, f] : kTextureFilterNames)
+    if (filter == f) return n;
+  return "inherit";
+}
+
 Status validate(const Scene& scene, const std::string& file) {
   auto fail = [&](std::string message) { return Status(Error{file, "", std::move(message)}); };
 
@@ -93,7 +113,7 @@ Status validate(const Scene& scene, const std::string& file) {
     if (m.texture < -1 || (m.texture >= 0 && size_t(m.texture) >= scene.textures.size()))
       return fail(fmt::format("materials[{}]: texture {} does not exist ({} textures)", i,
                               m.texture, scene.textures.size()));
-    if (!isFinite(m.baseColor) || !(m.specular >= 0 && m.specular <= 1e6f) ||
+    if (!isFinite(m.baseColor) || !std::isfinite(m.uvScale.x) || !std::isfinite(m.uvScale.y) || !(m.specular >= 0 && m.specular <= 1e6f) ||
         !(m.shininess >= 0 && m.shininess <= 1e6f) || !std::isfinite(m.alphaCutoff))
       return fail(fmt::format("materials[{}]: colour, specular, shininess or alphaCutoff is not "
                               "finite or out of range", i));

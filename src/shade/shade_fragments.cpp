@@ -1,0 +1,203 @@
+// Pixel shading in SIMD lanes, one lane per pixel (Highway, dispatched per call).
+//
+// Symbols (shading.h): q = 1/w; an attribute plane holds a/w, so a = (a/w)·w. Texture coordinates
+// to level-0 texels: x₀ = u·width − ½ (texture.h). The footprint's Jacobian (footprint.h):
+//     ∂u/∂x = (U_x − u·q_x)·w·width   (and alike for y and v),
+// its larger singular value σ₁ from S = a² + b² + c² + d², D = ad − bc:
+//     σ₁² = (S + √(S² − 4D²)) / 2,   level of detail = max(0, ½·log2 σ₁²).
+// Phong (SPEC §8, seed 003): C = (Q_amb·C_surf + Q_diff·C_surf·Σ(n·l)⁺C_light + Q_spec·Σ((r·v)⁺)^p·C_light)
+// / (Q_amb + Q_diff + Q_spec). Fog (seed 002): C·f + C_F·(1 − f), f = 2^(−β·|eye position|).
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "shade/shade_fragments.cpp"
+#include "hwy/foreach_target.h"  // IWYU pragma: keep
+#include "hwy/contrib/math/math-inl.h"
+#include "hwy/highway.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "shade/shading.h"
+#include "texture/footprint.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace sv::shade {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+using DF = hn::CappedTag<float, kMaxFragments>;
+using VF = hn::Vec<DF>;
+
+struct V3 {
+  VF x, y, z;
+};
+
+HWY_INLINE VF dot3(const V3& a, const V3& b) {
+  return hn::MulAdd(a.x, b.x, hn::MulAdd(a.y, b.y, hn::Mul(a.z, b.z)));
+}
+
+HWY_INLINE V3 normalized(DF df, const V3& a) {
+  const VF len2 = dot3(a, a);
+  // A zero vector stays zero (its lighting terms vanish) rather than becoming NaN.
+  const VF inv = hn::IfThenElseZero(hn::Gt(len2, hn::Set(df, 1e-30f)),
+                                    hn::Div(hn::Set(df, 1.0f), hn::Sqrt(len2)));
+  return {hn::Mul(a.x, inv), hn::Mul(a.y, inv), hn::Mul(a.z, inv)};
+}
+
+// Adds one light's diffuse (n·l)⁺·C and specular ((r·v)^p)·C terms; l and v unit, toward the light
+// and the eye.
+HWY_INLINE void addLight(DF df, const MaterialShading& m, const V3& n, const V3& l, const V3& v,
+                         Vec3 color, V3& diffuse, V3& specular) {
+  const VF nl = dot3(n, l);
+  const VF d = hn::Max(nl, hn::Zero(df));
+  diffuse.x = hn::MulAdd(d, hn::Set(df, color.x), diffuse.x);
+  diffuse.y = hn::MulAdd(d, hn::Set(df, color.y), diffuse.y);
+  diffuse.z = hn::MulAdd(d, hn::Set(df, color.z), diffuse.z);
+  if (m.specular <= 0) return;
+  // r = 2(n·l)n − l; only lit sides reflect.
+  const VF two = hn::Add(nl, nl);
+  const V3 r{hn::Sub(hn::Mul(two, n.x), l.x), hn::Sub(hn::Mul(two, n.y), l.y),
+             hn::Sub(hn::Mul(two, n.z), l.z)};
+  const VF rv = hn::IfThenElseZero(hn::Gt(nl, hn::Zero(df)), hn::Max(dot3(r, v), hn::Zero(df)));
+  // (r·v)^p = e^(p·ln(r·v)); 0 stays 0.
+  const VF s = hn::IfThenElseZero(
+      hn::Gt(rv, hn::Zero(df)),
+      hn::Exp(df, hn::Mul(hn::Set(df, m.shininess), hn::Log(df, hn::Max(rv, hn::Set(df, 1e-30f))))));
+  specular.x = hn::MulAdd(s, hn::Set(df, color.x), specular.x);
+  specular.y = hn::MulAdd(s, hn::Set(df, color.y), specular.y);
+  specular.z = hn::MulAdd(s, hn::Set(df, color.z), specular.z);
+}
+
+void ShadeFragments(const MaterialShading& m, const Environment& env, const Fragments& f,
+                    float out[4][kMaxFragments]) {
+  const DF df;
+  const size_t lanes = hn::Lanes(df);
+  const VF one = hn::Set(df, 1.0f), zero = hn::Zero(df);
+  // Texture coordinates and levels of detail for every lane first, then one sampling call.
+  alignas(64) float lod[kMaxFragments], x0[kMaxFragments], y0[kMaxFragments];
+  alignas(64) float texel[4][kMaxFragments];
+  const int count = std::clamp(f.count, 0, kMaxFragments);
+  if (m.texture) {
+    const float width = float(m.texture->level(0).width), height = float(m.texture->level(0).height);
+    for (size_t i = 0; i < size_t(kMaxFragments); i += lanes) {
+      // Outside the triangle (extrapolated AA centroids) q may reach 0: keep w finite.
+      const VF q = hn::Max(hn::Load(df, f.q + i), hn::Set(df, 1e-30f));
+      const VF w = hn::Div(one, q);
+      const VF u = hn::Mul(hn::Load(df, f.attribute[kU] + i), w);
+      const VF v = hn::Mul(hn::Load(df, f.attribute[kV] + i), w);
+      hn::Store(hn::MulSub(u, hn::Set(df, width), hn::Set(df, 0.5f)), df, x0 + i);
+      hn::Store(hn::MulSub(v, hn::Set(df, height), hn::Set(df, 0.5f)), df, y0 + i);
+      const VF ww = hn::Mul(w, hn::Set(df, width)), wh = hn::Mul(w, hn::Set(df, height));
+      const VF a = hn::Mul(hn::NegMulAdd(u, hn::Set(df, f.qdx), hn::Set(df, f.udx)), ww);
+      const VF b = hn::Mul(hn::NegMulAdd(u, hn::Set(df, f.qdy), hn::Set(df, f.udy)), ww);
+      const VF c = hn::Mul(hn::NegMulAdd(v, hn::Set(df, f.qdx), hn::Set(df, f.vdx)), wh);
+      const VF d = hn::Mul(hn::NegMulAdd(v, hn::Set(df, f.qdy), hn::Set(df, f.vdy)), wh);
+      const VF s = hn::MulAdd(a, a, hn::MulAdd(b, b, hn::MulAdd(c, c, hn::Mul(d, d))));
+      const VF det = hn::MulSub(a, d, hn::Mul(b, c));
+      const VF disc = hn::Max(hn::NegMulAdd(hn::Set(df, 4.0f), hn::Mul(det, det), hn::Mul(s, s)), zero);
+      const VF major2 = hn::Mul(hn::Add(s, hn::Sqrt(disc)), hn::Set(df, 0.5f));
+      // ½·log2(σ₁²), at least 0; a degenerate or non-finite footprint reads level 0.
+      VF l = hn::Mul(hn::Log2(df, hn::Max(major2, one)), hn::Set(df, 0.5f));
+      l = hn::IfThenElseZero(hn::Lt(l, hn::Set(df, 64.0f)), l);  // also false for NaN
+      hn::Store(l, df, lod + i);
+    }
+    if (m.anisotropic) {
+      // The elliptical footprint per pixel (footprint.h), probes along its major axis.
+      for (int i = 0; i < count; ++i) {
+        const double q = std::max(double(f.q[i]), 1e-30);
+        const texture::Footprint fp = texture::pixelFootprint(
+            {double(f.attribute[kU][i]), f.udx, f.udy}, {double(f.attribute[kV][i]), f.vdx, f.vdy},
+            {q, f.qdx, f.qdy}, width, m.texture->level(0).height);
+        const texture::Color4 c = m.texture->anisotropic(fp, x0[i], y0[i]);
+        texel[0][i] = c.r;
+        texel[1][i] = c.g;
+        texel[2][i] = c.b;
+        texel[3][i] = c.a;
+      }
+      for (int i = count; i < kMaxFragments; ++i) texel[0][i] = texel[1][i] = texel[2][i] = texel[3][i] = 0;
+    } else {
+      texture::sampleBlock(*m.texture, m.filter, lod, x0, y0, kMaxFragments, texel);
+    }
+  }
+  for (size_t i = 0; i < size_t(kMaxFragments); i += lanes) {
+    const VF q = hn::Max(hn::Load(df, f.q + i), hn::Set(df, 1e-30f));
+    const VF w = hn::Div(one, q);
+    V3 c{hn::Load(df, f.color[0] + i), hn::Load(df, f.color[1] + i), hn::Load(df, f.color[2] + i)};
+    VF alpha = hn::Min(hn::Max(hn::Mul(hn::Load(df, f.attribute[kAlpha] + i), w), zero), one);
+    if (m.texture) {
+      const VF ta = hn::Load(df, texel[3] + i);
+      // Texels are premultiplied; the surface colour is the straight one (0 where alpha is 0).
+      const VF inv = hn::IfThenElseZero(hn::Gt(ta, zero), hn::Div(one, ta));
+      c.x = hn::Mul(c.x, hn::Mul(hn::Load(df, texel[0] + i), inv));
+      c.y = hn::Mul(c.y, hn::Mul(hn::Load(df, texel[1] + i), inv));
+      c.z = hn::Mul(c.z, hn::Mul(hn::Load(df, texel[2] + i), inv));
+      alpha = hn::Mul(alpha, ta);
+    }
+    const V3 eye{hn::Mul(hn::Load(df, f.attribute[kEyeX] + i), w),
+                 hn::Mul(hn::Load(df, f.attribute[kEyeY] + i), w),
+                 hn::Mul(hn::Load(df, f.attribute[kEyeZ] + i), w)};
+    if (m.phong) {
+      // n/w interpolated: its direction is n's, so it needs no division by q.
+      V3 n = normalized(df, {hn::Load(df, f.attribute[kNormalX] + i),
+                             hn::Load(df, f.attribute[kNormalY] + i),
+                             hn::Load(df, f.attribute[kNormalZ] + i)});
+      const V3 view = normalized(df, {hn::Neg(eye.x), hn::Neg(eye.y), hn::Neg(eye.z)});
+      if (m.twoSided) {
+        const auto back = hn::Lt(dot3(n, view), zero);
+        n = {hn::IfThenElse(back, hn::Neg(n.x), n.x), hn::IfThenElse(back, hn::Neg(n.y), n.y),
+             hn::IfThenElse(back, hn::Neg(n.z), n.z)};
+      }
+      V3 diffuse{zero, zero, zero}, specular{zero, zero, zero};
+      if (env.lightOn) {
+        const V3 l{hn::Set(df, env.toLight.x), hn::Set(df, env.toLight.y), hn::Set(df, env.toLight.z)};
+        addLight(df, m, n, l, view, env.lightColor, diffuse, specular);
+      }
+      for (const PointLightEye& p : env.points) {
+        const V3 l = normalized(df, {hn::Sub(hn::Set(df, p.position.x), eye.x),
+                                     hn::Sub(hn::Set(df, p.position.y), eye.y),
+                                     hn::Sub(hn::Set(df, p.position.z), eye.z)});
+        addLight(df, m, n, l, view, p.color, diffuse, specular);
+      }
+      const float qAmb = env.ambient, qDiff = 1 - env.ambient, qSpec = m.specular;
+      const VF norm = hn::Set(df, 1.0f / (qAmb + qDiff + qSpec));
+      auto light = [&](VF surf, VF dif, VF spec) {
+        const VF sum = hn::MulAdd(hn::Set(df, qSpec), spec,
+                                  hn::Mul(surf, hn::MulAdd(hn::Set(df, qDiff), dif, hn::Set(df, qAmb))));
+        return hn::Mul(sum, norm);
+      };
+      c = {light(c.x, diffuse.x, specular.x), light(c.y, diffuse.y, specular.y),
+           light(c.z, diffuse.z, specular.z)};
+    }
+    if (m.alpha == AlphaUse::opaque) alpha = one;
+    if (m.alpha == AlphaUse::mask)
+      alpha = hn::IfThenElseZero(hn::Ge(alpha, hn::Set(df, m.alphaCutoff)), one);
+    if (env.fog) {
+      // SPEC §8: f = 2^(−β·r) = e^(−β·ln2·r), r the true range |eye position|.
+      const VF range = hn::Sqrt(dot3(eye, eye));
+      const VF fog = hn::Exp(df, hn::Mul(hn::Set(df, -env.fogBeta * 0.69314718f), range));
+      const VF haze = hn::Sub(one, fog);
+      c.x = hn::MulAdd(c.x, fog, hn::Mul(hn::Set(df, env.fogColor.x), haze));
+      c.y = hn::MulAdd(c.y, fog, hn::Mul(hn::Set(df, env.fogColor.y), haze));
+      c.z = hn::MulAdd(c.z, fog, hn::Mul(hn::Set(df, env.fogColor.z), haze));
+    }
+    // Premultiplied, clamped to the 0…1 the frame buffer stores.
+    hn::Store(hn::Min(hn::Max(hn::Mul(c.x, alpha), zero), one), df, out[0] + i);
+    hn::Store(hn::Min(hn::Max(hn::Mul(c.y, alpha), zero), one), df, out[1] + i);
+    hn::Store(hn::Min(hn::Max(hn::Mul(c.z, alpha), zero), one), df, out[2] + i);
+    hn::Store(alpha, df, out[3] + i);
+  }
+}
+
+}  // namespace HWY_NAMESPACE
+}  // namespace sv::shade
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace sv::shade {
+HWY_EXPORT(ShadeFragments);
+
+void shadeFragments(const MaterialShading& m, const Environment& env, const Fragments& f,
+                    float out[4][kMaxFragments]) {
+  HWY_DYNAMIC_DISPATCH(ShadeFragments)(m, env, f, out);
+}
+}  // namespace sv::shade
+#endif
