@@ -5,7 +5,8 @@
 //                   [--aa 1|4|8|16|64] [--filter box|tent3]
 //                   [--texture-filter nearest|tri3|bilinear|trilinear3|trilinear|aniso]
 //   synthvis bench SCENE|--suite quick|full [--count N] [--area A] [--depth D] [--layers D]
-//                  [--order random|f2b|b2f] [--shade gouraud] [--width W] [--height H]
+//                  [--order random|f2b|b2f] [--shade gouraud|textured]
+//                  [--texture-filter F] [--width W] [--height H]
 //                  [--threads T] [--frames F] [--warmup W] [--seed S] [--aa S] [--gl-aa S]
 //                  [--filter box|tent3]
 //                  [--renderer synthvis|gl|both] [--gl-readback] [--json FILE] [--html DIR]
@@ -115,6 +116,7 @@ struct BenchArgs {
   std::string suite;
   GeneratorArgs generator;
   std::string shade = "gouraud";
+  std::string textureFilter = "trilinear";
   std::string renderer;  // synthvis, gl or both; default synthvis for a scene, both for a suite
   std::string json;
   std::string html;
@@ -165,8 +167,12 @@ int runBench(BenchArgs a) {
     return fail(f.error());
   else
     a.options.filter = f.value();
-  if (a.shade != "gouraud")
-    return fail({"", "", fmt::format("shading '{}' is not available yet (gouraud)", a.shade)});
+  if (a.shade != "gouraud" && a.shade != "textured")
+    return fail({"", "", fmt::format("unknown shading '{}' (gouraud or textured)", a.shade)});
+  if (auto f = sv::scene::parseTextureFilter(a.textureFilter); !f)
+    return fail(f.error());
+  else
+    a.options.textureFilter = f.value();
   if (sv::Status s = sv::validate(a.options); !s) return fail(s.error());
   if (a.scene.empty() == a.suite.empty())
     return fail({"", "", "give either a scene (a generator name or a file) or --suite quick|full"});
@@ -204,6 +210,7 @@ int runBench(BenchArgs a) {
   settings.warmup = a.warmup;
   settings.referenceMsaa = a.glAa;
   settings.referenceReadback = a.glReadback;
+  settings.textured = a.shade == "textured";
   settings.synthvis = a.renderer != "gl";
   settings.reference = a.renderer != "synthvis";
   ref::BenchRunner runner(settings);
@@ -376,7 +383,12 @@ int main(int argc, char** argv) {
   bench->add_option("scene", b.scene, "generator (tris, layers) or scene file");
   bench->add_option("--suite", b.suite, "a named suite of scenes: quick or full");
   addGeneratorOptions(bench, b.generator);
-  bench->add_option("--shade", b.shade, "gouraud")->capture_default_str();
+  bench->add_option("--shade", b.shade,
+                    "generated scenes: gouraud, or textured (BENCH.md's 1024x1024 texture)")
+      ->capture_default_str();
+  bench->add_option("--texture-filter", b.textureFilter,
+                    "nearest, tri3, bilinear, trilinear3, trilinear or aniso")
+      ->capture_default_str();
   bench->add_option("--width", b.options.width, "image width")->capture_default_str();
   bench->add_option("--height", b.options.height, "image height")->capture_default_str();
   bench->add_option("--threads", b.options.threads, "worker threads")->capture_default_str();

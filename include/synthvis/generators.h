@@ -23,6 +23,9 @@ struct TrisParams {
   uint64_t seed = 1;
   int width = 1920;  // the raster the areas refer to
   int height = 1080;
+  // BENCH.md --shade textured: the material samples a 1024×1024 noise texture (texture 0). The
+  // UVs, 0.5–4 texels per pixel (log-uniform per triangle), are generated either way.
+  bool textured = false;
 };
 
 // What the generator realized (BENCH.md asks for both).
@@ -49,5 +52,8 @@ Scene generateLayers(const LayersParams& params, TrisStats* stats = nullptr);
 // The frame every generated scene shares: one instance of mesh 0 with material 0 (unlit,
 // double-sided, named `name`), the BENCH.md camera, no light, black background. No meshes yet.
 Scene benchCameraScene(const std::string& name);
+// BENCH.md's texture for --shade textured: a 1024 × 1024 noise texture as texture 0, used by every
+// material of `s`.
+void addBenchTexture(Scene& s);
 
 }  // namespace sv::scene

@@ -1,7 +1,11 @@
 #include "reference/gl_renderer.h"
 
+#include "texture/texture.h"
+
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <string>
@@ -27,7 +31,9 @@ constexpr const char* kVertexShader = R"(#version 330 core
 layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;
 layout(location = 2) in vec4 color;
+layout(location = 3) in vec2 uv;
 uniform mat4 mvp;
+uniform vec2 uvScale;
 uniform mat3 normalToWorld;
 uniform vec4 baseColor;
 uniform vec3 toLight;
@@ -35,8 +41,10 @@ uniform vec3 lightColor;
 uniform float ambient;
 uniform bool lit;
 out vec4 vertexColor;
+out vec2 texCoord;
 void main() {
   gl_Position = mvp * vec4(position, 1.0);
+  texCoord = uv * uvScale;
   vec4 c = baseColor * color;
   vec3 intensity = vec3(1.0);
   if (lit) {
@@ -47,10 +55,14 @@ void main() {
 }
 )";
 
+// The texture modulates the vertex colour (synthvis's pixel shading without Phong or fog).
 constexpr const char* kFragmentShader = R"(#version 330 core
 in vec4 vertexColor;
+in vec2 texCoord;
+uniform bool textured;
+uniform sampler2D tex;
 out vec4 fragColor;
-void main() { fragColor = vertexColor; }
+void main() { fragColor = textured ? vertexColor * texture(tex, texCoord) : vertexColor; }
 )";
 
 std::string glError(const char* what) {
@@ -59,9 +71,9 @@ std::string glError(const char* what) {
 }
 
 struct Mesh {
-  GLuint vao = 0, buffers[4] = {};
+  GLuint vao = 0, buffers[5] = {};
   GLsizei indexCount = 0;
-  bool hasNormals = false, hasColors = false;
+  bool hasNormals = false, hasColors = false, hasUvs = false;
 };
 
 struct Draw {
@@ -69,6 +81,8 @@ struct Draw {
   float mvp[16];
   float normalToWorld[9];
   float baseColor[4];
+  float uvScale[2];
+  GLuint texture;  // 0: none
   bool lit, cull;
 };
 
@@ -83,8 +97,9 @@ struct GlRenderer::Impl {
   GLuint fbo = 0, colorRb = 0, depthRb = 0;  // the render target (multisampled if msaa)
   GLuint resolveFbo = 0, resolveRb = 0;      // single-sampled copy for readback (msaa)
   GLint uMvp = -1, uNormal = -1, uBase = -1, uToLight = -1, uLightColor = -1, uAmbient = -1,
-        uLit = -1;
+        uLit = -1, uTextured = -1, uUvScale = -1;
   std::vector<Mesh> meshes;
+  std::vector<GLuint> textures;  // one per scene texture
   std::vector<Draw> draws;
   float background[3] = {0, 0, 0};
   float toLight[3] = {0, 1, 0}, lightColor[3] = {1, 1, 1}, ambient = 1;
@@ -109,9 +124,11 @@ struct GlRenderer::Impl {
   void freeMeshes() {
     for (Mesh& m : meshes) {
       glDeleteVertexArrays(1, &m.vao);
-      glDeleteBuffers(4, m.buffers);
+      glDeleteBuffers(5, m.buffers);
     }
     meshes.clear();
+    glDeleteTextures(GLsizei(textures.size()), textures.data());
+    textures.clear();
   }
 
   Status makeCurrent() {
@@ -213,6 +230,8 @@ Result<std::unique_ptr<GlRenderer>> GlRenderer::create(const RenderOptions& opti
   g.uLightColor = glGetUniformLocation(g.program, "lightColor");
   g.uAmbient = glGetUniformLocation(g.program, "ambient");
   g.uLit = glGetUniformLocation(g.program, "lit");
+  g.uTextured = glGetUniformLocation(g.program, "textured");
+  g.uUvScale = glGetUniformLocation(g.program, "uvScale");
 
   // Render target: sRGB colour and 24-bit depth, multisampled when asked.
   const int w = options.width, h = options.height;
@@ -261,7 +280,7 @@ Status GlRenderer::load(const scene::Scene& scene) {
   for (const scene::Mesh& m : scene.meshes) {
     Mesh out;
     glGenVertexArrays(1, &out.vao);
-    glGenBuffers(4, out.buffers);
+    glGenBuffers(5, out.buffers);
     glBindVertexArray(out.vao);
     auto upload = [](GLenum target, GLuint buffer, const void* data, size_t bytes) {
       glBindBuffer(target, buffer);
@@ -282,12 +301,71 @@ Status GlRenderer::load(const scene::Scene& scene) {
       glVertexAttribPointer(2, 4, GL_FLOAT, GL_FALSE, sizeof(Vec4), nullptr);
       glEnableVertexAttribArray(2);
     }
+    out.hasUvs = !m.uvs.empty();
+    if (out.hasUvs) {
+      upload(GL_ARRAY_BUFFER, out.buffers[4], m.uvs.data(), m.uvs.size() * sizeof(Vec2));
+      glVertexAttribPointer(3, 2, GL_FLOAT, GL_FALSE, sizeof(Vec2), nullptr);
+      glEnableVertexAttribArray(3);
+    }
     upload(GL_ELEMENT_ARRAY_BUFFER, out.buffers[3], m.indices.data(),
            m.indices.size() * sizeof(uint32_t));
     out.indexCount = GLsizei(m.indices.size());
     g.meshes.push_back(out);
   }
   glBindVertexArray(0);
+
+  // Textures: synthvis's own pyramid, level by level, as 8-bit sRGB (GL's usual texture format;
+  // the sampler decodes to linear), with the frame's texture filter as GL's nearest it.
+  GLint minFilter = GL_LINEAR_MIPMAP_LINEAR, magFilter = GL_LINEAR;
+  float anisotropy = 1;
+  switch (g.options.textureFilter) {
+    case scene::TextureFilter::nearest: minFilter = GL_NEAREST_MIPMAP_NEAREST; magFilter = GL_NEAREST; break;
+    case scene::TextureFilter::threePoint:
+    case scene::TextureFilter::bilinear: minFilter = GL_LINEAR_MIPMAP_NEAREST; break;
+    case scene::TextureFilter::anisotropic: anisotropy = 16; break;
+    default: break;
+  }
+  auto wrapOf = [](texture::Wrap w) {
+    return w == texture::Wrap::clamp ? GL_CLAMP_TO_EDGE
+           : w == texture::Wrap::mirror ? GL_MIRRORED_REPEAT : GL_REPEAT;
+  };
+  for (const scene::TextureMap& map : scene.textures) {
+    const texture::Texture& t = *map.texture;
+    GLuint id = 0;
+    glGenTextures(1, &id);
+    g.textures.push_back(id);
+    glBindTexture(GL_TEXTURE_2D, id);
+    std::vector<uint8_t> rgba;
+    for (int k = 0; k < t.levelCount(); ++k) {
+      const texture::LevelView level = t.level(k);
+      rgba.resize(level.texels.size() * 4);
+      for (size_t i = 0; i < level.texels.size(); ++i) {
+        const texture::Texel& x = level.texels[i];
+        // Straight (not premultiplied) colour, sRGB-encoded; alpha linear.
+        const double a = x.a / 65535.0;
+        auto encode = [a](uint16_t c) {
+          const double v = a > 0 ? std::min(1.0, c / 65535.0 / a) : 0.0;
+          const double e = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1 / 2.4) - 0.055;
+          return uint8_t(std::lround(e * 255));
+        };
+        rgba[i * 4 + 0] = encode(x.r);
+        rgba[i * 4 + 1] = encode(x.g);
+        rgba[i * 4 + 2] = encode(x.b);
+        rgba[i * 4 + 3] = uint8_t(std::lround(a * 255));
+      }
+      glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+      glTexImage2D(GL_TEXTURE_2D, k, GL_SRGB8_ALPHA8, level.width, level.height, 0, GL_RGBA,
+                   GL_UNSIGNED_BYTE, rgba.data());
+    }
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, t.levelCount() - 1);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, minFilter);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, magFilter);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, wrapOf(t.wrapX()));
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, wrapOf(t.wrapY()));
+    if (anisotropy > 1) glTexParameterf(GL_TEXTURE_2D, 0x84FE /* GL_TEXTURE_MAX_ANISOTROPY */, anisotropy);
+  }
+  // GL puts the first row uploaded at t = 0 and ours is the image's top row, at v = 0 (glTF's
+  // convention): (s, t) = (u, v).
 
   const scene::Material defaultMaterial;
   for (const scene::Instance& inst : scene.instances) {
@@ -307,6 +385,9 @@ Status GlRenderer::load(const scene::Scene& scene) {
     d.baseColor[2] = mat.baseColor.z;
     d.baseColor[3] = mat.baseColor.w;
     d.lit = scene.light.enabled && !mat.unlit && !mesh.normals.empty();
+    d.texture = mat.texture >= 0 ? g.textures[size_t(mat.texture)] : 0;
+    d.uvScale[0] = mat.uvScale.x;
+    d.uvScale[1] = mat.uvScale.y;
     d.cull = g.options.cullBackFaces && !mat.doubleSided;
     g.draws.push_back(d);
   }
@@ -347,10 +428,14 @@ Status GlRenderer::render() {
     glUniformMatrix3fv(g.uNormal, 1, GL_FALSE, d.normalToWorld);
     glUniform4fv(g.uBase, 1, d.baseColor);
     glUniform1i(g.uLit, d.lit ? 1 : 0);
+    glUniform1i(g.uTextured, d.texture ? 1 : 0);
+    glUniform2fv(g.uUvScale, 1, d.uvScale);
+    if (d.texture) glBindTexture(GL_TEXTURE_2D, d.texture);
     glBindVertexArray(m.vao);
     // Absent attributes read these constants (a disabled array's current value).
     if (!m.hasNormals) glVertexAttrib3f(1, 0, 0, 1);
     if (!m.hasColors) glVertexAttrib4f(2, 1, 1, 1, 1);
+    if (!m.hasUvs) glVertexAttrib2f(3, 0, 0);
     glDrawElements(GL_TRIANGLES, m.indexCount, GL_UNSIGNED_INT, nullptr);
   }
   glBindVertexArray(0);

@@ -141,7 +141,9 @@ Result<CaseResult> BenchRunner::run(const BenchCase& c) {
   const BenchSettings& s = impl_->settings;
   if (s.frames < 1 || s.frames > 100000 || s.warmup < 0 || s.warmup > 100000)
     return Error{"", "", "frames must be 1…100000 and warmup 0…100000"};
-  auto made = makeScene(c, s.options);
+  BenchCase shaded = c;
+  shaded.tris.textured = s.textured;
+  auto made = makeScene(shaded, s.options);
   if (!made.ok()) return made.error();
   const scene::Scene& sc = made.value().scene;
 
@@ -225,7 +227,8 @@ nlohmann::json jsonRows(const CaseResult& r, const BenchSettings& s) {
                 {"threads", s.options.threads},
                 {"frames", s.frames},
                 {"warmup", s.warmup},
-                {"shade", "gouraud"},
+                {"shade", s.textured ? "textured" : "gouraud"},
+                {"texture_filter", scene::textureFilterName(s.options.textureFilter)},
                 {"aa", run.renderer == "synthvis" ? s.options.samples : std::max(1, s.referenceMsaa)},
                 {"filter", s.options.filter == RenderOptions::Filter::tent3 ? "tent3" : "box"},
                 {"readback_timed", run.renderer == "synthvis" || s.referenceReadback},

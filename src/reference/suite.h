@@ -66,6 +66,9 @@ struct BenchSettings {
   // Count the gl reference's read-back (glReadPixels into an 8-bit image in memory) in its frame
   // time: synthvis's frame always ends with the image in memory.
   bool referenceReadback = false;
+  // BENCH.md --shade textured: generated scenes get the bench texture (options.textureFilter
+  // samples it; the reference uses GL's nearest equivalent).
+  bool textured = false;
 };
 
 // Renders, per case, warm-up frames then timed frames, alternating synthvis and the reference

@@ -4,7 +4,7 @@
 // the region; a plane tilted up to 60° from the view direction with a random azimuth; a roughly
 // equilateral triangle (vertices at 120° ± 20° steps, radius U(0.75, 1.25)) scaled so that its
 // projected area meets the target; vertex colours uniform in [64, 255] (sRGB-encoded display
-// values, stored linear).
+// values, stored linear); UVs giving 0.5–4 texels per pixel on a 1024² texture.
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -12,6 +12,7 @@
 
 #include "scene/generator_common.h"
 #include "synthvis/generators.h"
+#include "texture/texture.h"
 
 namespace sv::scene {
 namespace {
@@ -43,6 +44,17 @@ const char* submitOrderName(SubmitOrder order) {
     case SubmitOrder::backToFront: return "b2f";
     default: return "random";
   }
+}
+
+void addBenchTexture(Scene& s) {
+  // BENCH.md's textured scenes: a 1024 × 1024 texture (grey noise, so every texel differs),
+  // repeated, modulating the vertex colours.
+  texture::Level level = texture::generateTexture(texture::Pattern::noise, 1024, {0.2f, 0.2f, 0.2f, 1},
+                                                  {1, 1, 1, 1}, 1);
+  s.textures.push_back({"bench-noise", std::make_shared<texture::Texture>(
+                                           std::move(level), texture::Wrap::repeat,
+                                           texture::Wrap::repeat)});
+  for (Material& m : s.materials) m.texture = 0;
 }
 
 Scene benchCameraScene(const std::string& name) {
@@ -89,8 +101,15 @@ Scene generateTris(const TrisParams& p, TrisStats* stats) {
     regionH = area / regionW;
   }
 
+  // UVs from a generator of their own, so that the geometry and colours are those of earlier
+  // versions for the same seed.
+  std::mt19937_64 uvRng(p.seed ^ 0x5DEECE66Dull);
+  auto uvUniform = [&](double a, double b) {
+    return std::uniform_real_distribution<double>(a, b)(uvRng);
+  };
   struct Tri {
     Dvec v[3];
+    float uv[3][2];
     float c[3][3];
     double distance;
     double area;
@@ -133,6 +152,21 @@ Scene generateTris(const TrisParams& p, TrisStats* stats) {
     }
     t.area = area;
     t.distance = distance;
+    // BENCH.md: ρ = 0.5 … 4 texels per pixel on a 1024-texel texture. A pixel at this distance
+    // spans 2·tan(fov/2)·distance/h world units (ignoring tilt), so uv per world unit is
+    // ρ / (1024 · pixel size); the in-plane coordinates (e1, e2) give u and v.
+    {
+      constexpr double kTextureSide = 1024;
+      const double rho = std::exp2(uvUniform(-1, 2));
+      const double pixelWorld = 2 * tanHalf * distance / h;
+      const double uvPerWorld = rho / (kTextureSide * pixelWorld);
+      const double u0 = uvUniform(0, 1), v0 = uvUniform(0, 1);
+      for (int k = 0; k < 3; ++k) {
+        const Dvec d = local[k] * scale;
+        t.uv[k][0] = float(u0 + dotd(d, e1) * uvPerWorld);
+        t.uv[k][1] = float(v0 + dotd(d, e2) * uvPerWorld);
+      }
+    }
     for (auto& c : t.c) {
       const Vec4 v = detail::randomBenchColor(rng);
       c[0] = v.x, c[1] = v.y, c[2] = v.z;
@@ -150,6 +184,7 @@ Scene generateTris(const TrisParams& p, TrisStats* stats) {
   m.material = 0;
   m.positions.reserve(tris.size() * 3);
   m.colors.reserve(tris.size() * 3);
+  m.uvs.reserve(tris.size() * 3);
   m.indices.reserve(tris.size() * 3);
   double totalArea = 0;
   for (const Tri& t : tris) {
@@ -157,10 +192,12 @@ Scene generateTris(const TrisParams& p, TrisStats* stats) {
       m.indices.push_back(uint32_t(m.positions.size()));
       m.positions.push_back({float(t.v[k].x), float(t.v[k].y), float(t.v[k].z)});
       m.colors.push_back({t.c[k][0], t.c[k][1], t.c[k][2], 1});
+      m.uvs.push_back({t.uv[k][0], t.uv[k][1]});
     }
     totalArea += t.area;
   }
   s.meshes.push_back(std::move(m));
+  if (p.textured) addBenchTexture(s);
   if (stats) {
     stats->meanArea = tris.empty() ? 0 : totalArea / double(tris.size());
     stats->depthComplexity = totalArea / (regionW * regionH);

@@ -34,50 +34,62 @@ struct LevelLanes {
 
 class BlockSampler {
  public:
-  explicit BlockSampler(const Texture& t) : t_(t) {
-    for (int k = 0; k < t.levelCount(); ++k) {
-      widths_[k] = t.level(k).width;
-      heights_[k] = t.level(k).height;
-      offsets_[k] = t.offset(k);
-    }
-    words_ = reinterpret_cast<const int32_t*>(t.texels());
-  }
+  explicit BlockSampler(const Texture& t)
+      : t_(t), table_(t.levelTable()), pow2_(t.powerOfTwo()),
+        texels_(reinterpret_cast<const int64_t*>(t.texels())),
+        words_(reinterpret_cast<const int32_t*>(t.texels())) {}
 
   LevelLanes level(VI k) const {
     const DI di;
-    return {hn::GatherIndex(di, widths_, k), hn::GatherIndex(di, heights_, k),
-            hn::GatherIndex(di, offsets_, k)};
+    return {hn::GatherIndex(di, table_.width, k), hn::GatherIndex(di, table_.height, k),
+            hn::GatherIndex(di, table_.offset, k)};
   }
 
-  // i mod n (texture.cpp's wrapIndex) per lane.
-  static VI wrap(VI i, VI n, Wrap mode) {
+  // i mod n (texture.cpp's wrapIndex) per lane; for power-of-two sizes a mask (the same values).
+  VI wrap(VI i, VI n, Wrap mode) const {
     const DI di;
     const DF df;
-    if (mode == Wrap::clamp) return hn::Min(hn::Max(i, hn::Zero(di)), hn::Sub(n, hn::Set(di, 1)));
+    const VI one = hn::Set(di, 1);
+    if (mode == Wrap::clamp) return hn::Min(hn::Max(i, hn::Zero(di)), hn::Sub(n, one));
     const VI period = mode == Wrap::mirror ? hn::Add(n, n) : n;
-    // The float quotient may be one off (|i| ≤ 2^24 + 1 is not always exact in float); the
-    // integer remainder is then corrected into [0, period).
-    const VI q = hn::ConvertTo(di, hn::Floor(hn::Div(hn::ConvertTo(df, i), hn::ConvertTo(df, period))));
-    VI m = hn::Sub(i, hn::Mul(q, period));
-    m = hn::Add(m, hn::IfThenElseZero(hn::Lt(m, hn::Zero(di)), period));
-    m = hn::Sub(m, hn::IfThenElseZero(hn::Gt(m, hn::Sub(period, hn::Set(di, 1))), period));
+    VI m;
+    if (pow2_) {
+      m = hn::And(i, hn::Sub(period, one));  // two's complement: also right for i < 0
+    } else {
+      // The float quotient may be one off (|i| ≤ 2^24 + 1 is not always exact in float); the
+      // integer remainder is then corrected into [0, period).
+      const VI q =
+          hn::ConvertTo(di, hn::Floor(hn::Div(hn::ConvertTo(df, i), hn::ConvertTo(df, period))));
+      m = hn::Sub(i, hn::Mul(q, period));
+      m = hn::Add(m, hn::IfThenElseZero(hn::Lt(m, hn::Zero(di)), period));
+      m = hn::Sub(m, hn::IfThenElseZero(hn::Gt(m, hn::Sub(period, one)), period));
+    }
     if (mode == Wrap::repeat) return m;
-    return hn::IfThenElse(hn::Lt(m, n), m, hn::Sub(hn::Sub(period, hn::Set(di, 1)), m));
+    return hn::IfThenElse(hn::Lt(m, n), m, hn::Sub(hn::Sub(period, one), m));
   }
 
-  // The texels at integer (x, y) of each lane's level, as floats 0…1 (texture.cpp's toColor).
-  Lanes4 texel(const LevelLanes& l, VI x, VI y) const {
+  // The texels at `index` (into Texture::texels()) as floats 0…1 (texture.cpp's toColor). A
+  // texel's four 16-bit channels are one 64-bit word: gathered as such (half the elements of two
+  // 32-bit gathers), then split into its (r, g) and (b, a) halves.
+  Lanes4 fetch(VI index) const {
     const DI di;
     const DF df;
-    const VI index = hn::Add(l.offset, hn::Add(hn::Mul(wrap(y, l.height, t_.wrapY()), l.width),
-                                               wrap(x, l.width, t_.wrapX())));
+    const hn::RebindToUnsigned<DI> du;
+#if HWY_TARGET == HWY_SCALAR
     const VI word = hn::Add(index, index);
     const VI rg = hn::GatherIndex(di, words_, word);
     const VI ba = hn::GatherIndex(di, words_, hn::Add(word, hn::Set(di, 1)));
+#else
+    const hn::Half<DI> dh;
+    const hn::Rebind<int64_t, decltype(dh)> d64;
+    const auto lo = hn::GatherIndex(d64, texels_, hn::PromoteTo(d64, hn::LowerHalf(dh, index)));
+    const auto hi = hn::GatherIndex(d64, texels_, hn::PromoteTo(d64, hn::UpperHalf(dh, index)));
+    const VI rg = hn::ConcatEven(di, hn::BitCast(di, hi), hn::BitCast(di, lo));
+    const VI ba = hn::ConcatOdd(di, hn::BitCast(di, hi), hn::BitCast(di, lo));
+#endif
     const VI low = hn::Set(di, 0xFFFF);
     const VF scale = hn::Set(df, 1.0f / 65535.0f);
     auto channel = [&](VI v) { return hn::Mul(hn::ConvertTo(df, v), scale); };
-    const hn::RebindToUnsigned<DI> du;
     auto high = [&](VI v) { return hn::BitCast(di, hn::ShiftRight<16>(hn::BitCast(du, v))); };
     return {channel(hn::And(rg, low)), channel(high(rg)), channel(hn::And(ba, low)),
             channel(high(ba))};
@@ -103,34 +115,38 @@ class BlockSampler {
     return hn::IfThenElseZero(hn::Le(hn::Abs(x), hn::Set(df, kMaxTexelCoordinate)), x);
   }
 
-  // One level per lane (k), at that level's coordinates (x, y).
+  // One level per lane (k), at that level's coordinates (x, y). Each coordinate is wrapped once
+  // and each row's start computed once, whatever the number of texels read.
   Lanes4 sampleLevel(Filter filter, VI k, VF x, VF y) const {
     const DF df;
     const DI di;
     const LevelLanes l = level(k);
     x = sane(x);
     y = sane(y);
+    const Wrap wx = t_.wrapX(), wy = t_.wrapY();
+    auto row = [&](VI yi) { return hn::Add(l.offset, hn::Mul(wrap(yi, l.height, wy), l.width)); };
     if (filter == Filter::nearest) {
       const VF half = hn::Set(df, 0.5f);
-      return texel(l, hn::ConvertTo(di, hn::Floor(hn::Add(x, half))),
-                   hn::ConvertTo(di, hn::Floor(hn::Add(y, half))));
+      return fetch(hn::Add(row(hn::ConvertTo(di, hn::Floor(hn::Add(y, half)))),
+                           wrap(hn::ConvertTo(di, hn::Floor(hn::Add(x, half))), l.width, wx)));
     }
     const VF fx = hn::Floor(x), fy = hn::Floor(y);
-    const VI x0 = hn::ConvertTo(di, fx), y0 = hn::ConvertTo(di, fy);
-    const VI x1 = hn::Add(x0, hn::Set(di, 1)), y1 = hn::Add(y0, hn::Set(di, 1));
+    const VI xi = hn::ConvertTo(di, fx), yi = hn::ConvertTo(di, fy);
+    const VI x0 = wrap(xi, l.width, wx), x1 = wrap(hn::Add(xi, hn::Set(di, 1)), l.width, wx);
+    const VI row0 = row(yi), row1 = row(hn::Add(yi, hn::Set(di, 1)));
     const VF g = hn::Sub(x, fx), t = hn::Sub(y, fy), one = hn::Set(df, 1.0f);
-    const Lanes4 r1 = texel(l, x0, y0), r3 = texel(l, x1, y1);
+    const Lanes4 r1 = fetch(hn::Add(row0, x0)), r3 = fetch(hn::Add(row1, x1));
     if (filter == Filter::threePoint || filter == Filter::trilinearThreePoint) {
       // Three texels per lane, as the seed intends: R4 above the diagonal, R2 below it — one
       // gather chooses per lane. The weights are texture.cpp's for the lane's triangle.
       const auto upper = hn::Ge(t, g);
       const auto upperI = hn::RebindMask(di, upper);
-      const Lanes4 r24 = texel(l, hn::IfThenElse(upperI, x0, x1), hn::IfThenElse(upperI, y1, y0));
+      const Lanes4 r24 = fetch(hn::IfThenElse(upperI, hn::Add(row1, x0), hn::Add(row0, x1)));
       return mix3(r3, hn::IfThenElse(upper, g, t), r24,
                   hn::IfThenElse(upper, hn::Sub(t, g), hn::Sub(g, t)), r1,
                   hn::IfThenElse(upper, hn::Sub(one, t), hn::Sub(one, g)));
     }
-    const Lanes4 r2 = texel(l, x1, y0), r4 = texel(l, x0, y1);
+    const Lanes4 r2 = fetch(hn::Add(row0, x1)), r4 = fetch(hn::Add(row1, x0));
     const VF t1 = hn::Sub(one, t);
     return mix(mix(r3, t, r2, t1), g, mix(r4, t, r1, t1), hn::Sub(one, g));
   }
@@ -164,7 +180,9 @@ class BlockSampler {
 
  private:
   const Texture& t_;
-  alignas(64) int32_t widths_[32] = {}, heights_[32] = {}, offsets_[32] = {};
+  const Texture::LevelTable& table_;
+  const bool pow2_;
+  const int64_t* texels_;
   const int32_t* words_;
 };
 

@@ -81,6 +81,13 @@ Texture::Texture(Level base, Wrap wrapX, Wrap wrapY) : wrapX_(wrapX), wrapY_(wra
     info_.push_back({l.width, l.height, int32_t(texels_.size())});  // < 2^27 (kMaxTextureTexels)
     texels_.insert(texels_.end(), l.texels.begin(), l.texels.end());
   }
+  for (size_t k = 0; k < info_.size() && k < size_t(kMaxLevels); ++k) {
+    table_.width[k] = info_[k].width;
+    table_.height[k] = info_[k].height;
+    table_.offset[k] = info_[k].offset;
+  }
+  auto pow2 = [](int n) { return (n & (n - 1)) == 0; };
+  powerOfTwo_ = pow2(info_[0].width) && pow2(info_[0].height);
 }
 
 LevelView Texture::level(int k) const {

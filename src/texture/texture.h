@@ -109,12 +109,24 @@ class Texture {
   const Texel* texels() const { return texels_.data(); }
   int32_t offset(int k) const { return info_[size_t(k)].offset; }
 
+  // The levels' sizes and offsets side by side, for the SIMD samplers' per-lane gathers (a side of
+  // at most 16384 gives at most 15 levels).
+  static constexpr int kMaxLevels = 16;
+  struct LevelTable {
+    alignas(64) int32_t width[kMaxLevels] = {}, height[kMaxLevels] = {}, offset[kMaxLevels] = {};
+  };
+  const LevelTable& levelTable() const { return table_; }
+  // True when level 0's sides are powers of two (then so are every level's, and wrapping is a mask).
+  bool powerOfTwo() const { return powerOfTwo_; }
+
  private:
   struct LevelInfo {
     int32_t width, height, offset;
   };
   std::vector<Texel> texels_;
   std::vector<LevelInfo> info_;
+  LevelTable table_;
+  bool powerOfTwo_ = false;
   Wrap wrapX_, wrapY_;
 };
 
