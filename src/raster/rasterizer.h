@@ -69,6 +69,9 @@ struct TileWork {
   const AttributeSetup* attributes = nullptr;
   uint32_t attributeBase = 0;
   const shade::Environment* environment = nullptr;
+  // ShadeMode::material at one sample: kTilePixels entries of scratch, all ~0u on entry and left
+  // so (which triangle won each pixel: its shading is deferred until the tile's lists are drawn).
+  uint32_t* visible = nullptr;
 };
 
 // Draws the tile's triangles as `work.shade` says. Runs the best SIMD

@@ -66,6 +66,8 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
   for (WorkerScratch& w : scratch_) {
     w.records.resize(kChunkTriangles);
     if (!wholeFrame) w.tile.resize(raster::kTileSize, raster::kTileSize, samples);
+    if (settings.shade == raster::ShadeMode::material && samples == 1)
+      w.visible.assign(raster::kTilePixels, ~0u);
   }
   tileStats_.assign(size_t(tiles), raster::RasterStats{});
   const int maxChunks = std::max(1, int((firstBatch + kChunkTriangles - 1) / kChunkTriangles));
@@ -168,6 +170,7 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
         w.attributes = attributes_.data();
         w.attributeBase = batch;
         w.environment = settings.environment;
+        if (samples == 1) w.visible = scratch_[worker].visible.data();
       }
       raster::rasterizeTile(w, tileStats_[tile]);
       if (lastBatch && settings.finishTile) settings.finishTile(int(tile), w.depth, w.color);

@@ -71,6 +71,7 @@ class FrameRenderer {
     std::vector<geometry::TriangleSetup> records;  // one chunk's, in submission order
     raster::Binner::Scratch bins;
     raster::FrameBuffer tile;  // 64×64: the tile being drawn, in frames of one batch
+    std::vector<uint32_t> visible;  // 64×64 deferred-shading records (TileWork::visible)
   };
   std::vector<geometry::TriangleSetup> setups_;  // the batch's, grouped by tile within each chunk
   std::vector<raster::AttributeSetup> attributes_;  // the batch's, by triangle (ShadeMode::material)

@@ -122,7 +122,10 @@ void ShadeFragments(const MaterialShading& m, const Environment& env, const Frag
     const VF q = hn::Max(hn::Load(df, f.q + i), hn::Set(df, 1e-30f));
     const VF w = hn::Div(one, q);
     V3 c{hn::Load(df, f.color[0] + i), hn::Load(df, f.color[1] + i), hn::Load(df, f.color[2] + i)};
-    VF alpha = hn::Min(hn::Max(hn::Mul(hn::Load(df, f.attribute[kAlpha] + i), w), zero), one);
+    // (Fragments holds only the attributes attributesUsed names.)
+    VF alpha = m.alpha == AlphaUse::opaque
+                   ? one
+                   : hn::Min(hn::Max(hn::Mul(hn::Load(df, f.attribute[kAlpha] + i), w), zero), one);
     if (m.texture) {
       const VF ta = hn::Load(df, texel[3] + i);
       // Texels are premultiplied; the surface colour is the straight one (0 where alpha is 0).
@@ -132,9 +135,11 @@ void ShadeFragments(const MaterialShading& m, const Environment& env, const Frag
       c.z = hn::Mul(c.z, hn::Mul(hn::Load(df, texel[2] + i), inv));
       alpha = hn::Mul(alpha, ta);
     }
-    const V3 eye{hn::Mul(hn::Load(df, f.attribute[kEyeX] + i), w),
-                 hn::Mul(hn::Load(df, f.attribute[kEyeY] + i), w),
-                 hn::Mul(hn::Load(df, f.attribute[kEyeZ] + i), w)};
+    V3 eye{zero, zero, zero};
+    if (m.phong || env.fog)
+      eye = {hn::Mul(hn::Load(df, f.attribute[kEyeX] + i), w),
+             hn::Mul(hn::Load(df, f.attribute[kEyeY] + i), w),
+             hn::Mul(hn::Load(df, f.attribute[kEyeZ] + i), w)};
     if (m.phong) {
       // n/w interpolated: its direction is n's, so it needs no division by q.
       V3 n = normalized(df, {hn::Load(df, f.attribute[kNormalX] + i),

@@ -67,6 +67,17 @@ struct Fragments {
   float qdx = 0, qdy = 0, udx = 0, udy = 0, vdx = 0, vdy = 0;
 };
 
+// The attributes shadeFragments reads for `m` under `env`, a bit per shade::Attribute (the others
+// may be left unset in Fragments).
+inline unsigned attributesUsed(const MaterialShading& m, const Environment& env) {
+  unsigned used = 0;
+  if (m.texture) used |= 1u << kU | 1u << kV;
+  if (m.phong) used |= 1u << kNormalX | 1u << kNormalY | 1u << kNormalZ;
+  if (m.phong || env.fog) used |= 1u << kEyeX | 1u << kEyeY | 1u << kEyeZ;
+  if (m.alpha != AlphaUse::opaque) used |= 1u << kAlpha;
+  return used;
+}
+
 // Shades `f` with material `m` under `env`: out[0…3][i] = premultiplied linear r, g, b, a of
 // fragment i, each 0…1 (alpha 1 for opaque materials; for alpha-masked ones 0 where the pixel is
 // cut away, else 1). Runs the best SIMD target (Highway), bit-identical from run to run.

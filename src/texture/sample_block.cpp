@@ -41,6 +41,11 @@ class BlockSampler {
 
   LevelLanes level(VI k) const {
     const DI di;
+    // Neighbouring pixels mostly share a level: then three broadcasts instead of three gathers.
+    const int32_t k0 = hn::GetLane(k);
+    if (hn::AllTrue(di, hn::Eq(k, hn::Set(di, k0))))
+      return {hn::Set(di, table_.width[k0]), hn::Set(di, table_.height[k0]),
+              hn::Set(di, table_.offset[k0])};
     return {hn::GatherIndex(di, table_.width, k), hn::GatherIndex(di, table_.height, k),
             hn::GatherIndex(di, table_.offset, k)};
   }
@@ -170,11 +175,13 @@ class BlockSampler {
     const Lanes4 a = sampleLevel(filter, k, x, y);
     if (!trilinear) return a;
     const VF t = hn::Sub(lod, hn::ConvertTo(df, k));
+    const auto single =
+        hn::Or(hn::Eq(t, hn::Zero(df)), hn::RebindMask(df, hn::Eq(k, hn::Set(di, last))));
+    // Magnified (lod 0) or exactly on a level everywhere: the second level is not read at all.
+    if (hn::AllTrue(df, single)) return a;
     const VI k1 = hn::Min(hn::Add(k, hn::Set(di, 1)), hn::Set(di, last));
     const VF half = hn::Set(df, 0.5f);
     const Lanes4 b = sampleLevel(filter, k1, hn::Mul(x, half), hn::Mul(y, half));
-    const auto single =
-        hn::Or(hn::Eq(t, hn::Zero(df)), hn::RebindMask(df, hn::Eq(k, hn::Set(di, last))));
     return select(single, a, mix(a, hn::Sub(hn::Set(df, 1.0f), t), b, t));
   }
 
