@@ -1,0 +1,239 @@
+// Textures, fog, lights and the pixel-shading material keys in the scene loaders: glTF materials
+// (baseColorTexture with its sampler's wrap modes, embedded and external PNG images, alphaMode),
+// the JSON format's "textures", "fog", "pointLights", "colorTable" and material keys, OBJ's map_Kd.
+#include <cmath>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "scene/scene_test_util.h"
+#include "synthvis/image.h"
+#include "synthvis/scene.h"
+#include "texture/texture.h"
+
+namespace sv::scene {
+namespace {
+
+using testing::contains;
+using testing::GltfBuilder;
+using testing::oneTriangle;
+using testing::TempDir;
+
+// A 4 × 2 RGB PNG: texel (x, y) has red 60·x, green 200·y, blue 7 (sRGB-encoded bytes).
+std::string pngBytes(const TempDir& dir) {
+  Image img;
+  img.width = 4;
+  img.height = 2;
+  img.rgb.resize(4 * 2 * 3);
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 4; ++x) {
+      img.rgb[size_t(y * 4 + x) * 3 + 0] = uint8_t(60 * x);
+      img.rgb[size_t(y * 4 + x) * 3 + 1] = uint8_t(200 * y);
+      img.rgb[size_t(y * 4 + x) * 3 + 2] = 7;
+    }
+  const std::string path = dir.path("t.png");
+  EXPECT_TRUE(writePng(img, path).ok());
+  return testing::readText(path);
+}
+
+uint16_t srgbTo16(int byte) {
+  const double v = byte / 255.0;
+  return uint16_t(std::lround((v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4)) * 65535));
+}
+
+// One triangle whose material `material` uses texture 0; images and samplers as given.
+GltfBuilder texturedTriangle(nlohmann::json material, nlohmann::json textures,
+                             nlohmann::json images, nlohmann::json samplers) {
+  GltfBuilder b;
+  const int positions = b.addPositions({0, 0, 0, 1, 0, 0, 0, 1, 0});
+  const int uvs = b.addAccessor(std::vector<float>{0, 0, 1, 0, 0, 1}, 5126, "VEC2", 3);
+  const int indices = b.addIndices({0, 1, 2});
+  b.doc["materials"] = nlohmann::json::array({material});
+  b.doc["textures"] = textures;
+  b.doc["images"] = images;
+  if (!samplers.is_null()) b.doc["samplers"] = samplers;
+  const int mesh = b.addMesh({{"attributes", {{"POSITION", positions}, {"TEXCOORD_0", uvs}}},
+                              {"indices", indices},
+                              {"material", 0}});
+  b.addNode({{"mesh", mesh}});
+  return b;
+}
+
+TEST(GltfTextures, BaseColorTextureWithItsSamplerAndAlphaModeMapToTheMaterial) {
+  TempDir dir;
+  const std::string uri = "data:image/png;base64," + testing::base64(pngBytes(dir));
+  GltfBuilder b = texturedTriangle(
+      {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}},
+       {"alphaMode", "MASK"},
+       {"alphaCutoff", 0.3}},
+      nlohmann::json::array({{{"source", 0}, {"sampler", 0}}}),
+      nlohmann::json::array({{{"uri", uri}}}),
+      nlohmann::json::array({{{"wrapS", 33071}, {"wrapT", 33648}}}));
+  Result<Scene> r = loadGltfFromMemory(b.gltf(), "t.gltf");
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  const Scene& s = r.value();
+  ASSERT_EQ(s.textures.size(), 1u);
+  ASSERT_EQ(s.materials.size(), 1u);
+  const Material& m = s.materials[0];
+  EXPECT_EQ(m.texture, 0);
+  EXPECT_EQ(m.alphaMode, AlphaMode::mask);
+  EXPECT_FLOAT_EQ(m.alphaCutoff, 0.3f);
+  const texture::Texture& t = *s.textures[0].texture;
+  EXPECT_EQ(t.wrapX(), texture::Wrap::clamp);
+  EXPECT_EQ(t.wrapY(), texture::Wrap::mirror);
+  ASSERT_EQ(t.level(0).width, 4);
+  ASSERT_EQ(t.level(0).height, 2);
+  // sRGB bytes decoded to linear 16-bit; top row first.
+  EXPECT_EQ(t.level(0).at(2, 1).r, srgbTo16(120));
+  EXPECT_EQ(t.level(0).at(2, 1).g, srgbTo16(200));
+  EXPECT_EQ(t.level(0).at(3, 0).b, srgbTo16(7));
+  EXPECT_EQ(t.level(0).at(3, 0).a, 65535);
+  EXPECT_EQ(s.meshes[0].uvs.size(), 3u);
+}
+
+TEST(GltfTextures, DefaultSamplerRepeatsAndOneImageServesTwoSamplersAsTwoTextures) {
+  TempDir dir;
+  const std::string uri = "data:image/png;base64," + testing::base64(pngBytes(dir));
+  GltfBuilder b = texturedTriangle(
+      {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 1}}}}}},
+      nlohmann::json::array({{{"source", 0}}, {{"source", 0}, {"sampler", 0}}}),
+      nlohmann::json::array({{{"uri", uri}}}),
+      nlohmann::json::array({{{"wrapS", 33071}, {"wrapT", 33071}}}));
+  b.doc["materials"].push_back({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}},
+                                {"alphaMode", "BLEND"}});
+  Result<Scene> r = loadGltfFromMemory(b.gltf(), "t.gltf");
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  ASSERT_EQ(r->textures.size(), 2u);
+  EXPECT_EQ(r->textures[size_t(r->materials[0].texture)].texture->wrapX(), texture::Wrap::clamp);
+  EXPECT_EQ(r->textures[size_t(r->materials[1].texture)].texture->wrapX(), texture::Wrap::repeat);
+  EXPECT_EQ(r->materials[1].alphaMode, AlphaMode::blend);
+}
+
+TEST(GltfTextures, ExternalImageIsReadRelativeToTheFile) {
+  TempDir dir;
+  dir.write("images/t.png", pngBytes(dir));
+  GltfBuilder b = texturedTriangle({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}},
+                                   nlohmann::json::array({{{"source", 0}}}),
+                                   nlohmann::json::array({{{"uri", "images/t.png"}}}), nullptr);
+  const std::string path = dir.write("m.gltf", b.gltf());
+  Result<Scene> r = loadGltf(path);
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  EXPECT_EQ(r->textures.size(), 1u);
+  // With references disabled the image cannot be read, and the material says so.
+  LoadOptions closed;
+  closed.followReferences = false;
+  Result<Scene> c = loadGltfFromMemory(b.gltf(), path, closed);
+  ASSERT_FALSE(c.ok());
+  EXPECT_TRUE(contains(c.error().str(), "images[0] ('images/t.png'): could not be read"));
+}
+
+TEST(GltfTextures, ProblemsAreNamed) {
+  TempDir dir;
+  const std::string png = "data:image/png;base64," + testing::base64(pngBytes(dir));
+  auto error = [](const GltfBuilder& b) {
+    Result<Scene> r = loadGltfFromMemory(b.gltf(), "t.gltf");
+    return r.ok() ? std::string("loaded") : r.error().str();
+  };
+  const auto textures = nlohmann::json::array({{{"source", 0}}});
+  EXPECT_TRUE(contains(
+      error(texturedTriangle({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}},
+                             textures,
+                             nlohmann::json::array({{{"uri", "data:image/jpeg;base64,/9j/4AAQSkZJRg=="}}}),
+                             nullptr)),
+      "only PNG textures are supported"));
+  EXPECT_TRUE(contains(
+      error(texturedTriangle(
+          {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}, {"texCoord", 1}}}}}},
+          textures, nlohmann::json::array({{{"uri", png}}}), nullptr)),
+      "only TEXCOORD_0 is supported"));
+  EXPECT_TRUE(contains(
+      error(texturedTriangle({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 5}}}}}},
+                             textures, nlohmann::json::array({{{"uri", png}}}), nullptr)),
+      "texture 5 does not exist"));
+  EXPECT_TRUE(contains(
+      error(texturedTriangle({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}},
+                             nlohmann::json::array({{{"source", 0}, {"sampler", 0}}}),
+                             nlohmann::json::array({{{"uri", png}}}),
+                             nlohmann::json::array({{{"wrapS", 1234}}}))),
+      "unknown wrap mode 1234"));
+}
+
+Result<Scene> parse(const std::string& body) {
+  return parseJsonScene(R"({"synthvis": 1, )" + body + "}", "t.json");
+}
+
+TEST(JsonTextures, GeneratedTexturesFogLightsAndMaterialKeysAreRead) {
+  Result<Scene> r = parse(R"(
+    "fog": {"color": [0.5, 0.6, 0.7], "beta": 0.25},
+    "pointLights": [{"position": [1, 2, 3], "color": [2, 2, 2]}],
+    "colorTable": [[1, 0, 0], [0.2, 0.4, 0.6]],
+    "textures": [{"name": "n", "generate": "noise", "size": 16, "seed": 3, "wrap": ["clamp", "mirror"]},
+                 {"generate": "squares", "size": 32}],
+    "materials": [{"name": "a", "texture": "n", "textureFilter": "aniso", "textureScale": [4, 2],
+                   "phong": true, "specular": 0.5, "shininess": 10, "opacity": 0.25},
+                  {"colorCode": 1, "texture": 1, "alphaCutoff": 0.4}])");
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  const Scene& s = r.value();
+  EXPECT_TRUE(s.fog.enabled);
+  EXPECT_FLOAT_EQ(s.fog.beta, 0.25f);
+  ASSERT_EQ(s.pointLights.size(), 1u);
+  EXPECT_EQ(s.pointLights[0].color, (Vec3{2, 2, 2}));
+  ASSERT_EQ(s.textures.size(), 2u);
+  EXPECT_EQ(s.textures[0].texture->level(0).width, 16);
+  EXPECT_EQ(s.textures[0].texture->wrapX(), texture::Wrap::clamp);
+  EXPECT_EQ(s.textures[0].texture->wrapY(), texture::Wrap::mirror);
+  const Material& a = s.materials[0];
+  EXPECT_EQ(a.texture, 0);
+  EXPECT_EQ(a.textureFilter, TextureFilter::anisotropic);
+  EXPECT_FLOAT_EQ(a.uvScale.x, 4);
+  EXPECT_TRUE(a.phong);
+  EXPECT_FLOAT_EQ(a.specular, 0.5f);
+  EXPECT_EQ(a.alphaMode, AlphaMode::blend);
+  EXPECT_FLOAT_EQ(a.baseColor.w, 0.25f);
+  const Material& b = s.materials[1];
+  EXPECT_EQ(b.baseColor, (Vec4{0.2f, 0.4f, 0.6f, 1}));  // the table's entry 1
+  EXPECT_EQ(b.texture, 1);
+  EXPECT_EQ(b.alphaMode, AlphaMode::mask);
+  // The same seed gives the same texels.
+  Result<Scene> again = parse(R"("textures": [{"generate": "noise", "size": 16, "seed": 3}])");
+  ASSERT_TRUE(again.ok());
+  EXPECT_EQ(again->textures[0].texture->level(0).at(5, 7), s.textures[0].texture->level(0).at(5, 7));
+}
+
+TEST(JsonTextures, ProblemsAreNamed) {
+  auto error = [](const std::string& body) {
+    Result<Scene> r = parse(body);
+    return r.ok() ? std::string("loaded") : r.error().str();
+  };
+  EXPECT_TRUE(contains(error(R"("textures": [{"generate": "stripes"}])"),
+                       "textures[0].generate: unknown pattern 'stripes'"));
+  EXPECT_TRUE(contains(error(R"("textures": [{"file": "a.png", "generate": "noise"}])"),
+                       "give either 'file'"));
+  EXPECT_TRUE(contains(error(R"("textures": [{"file": "missing.png"}])"), "missing.png"));
+  EXPECT_TRUE(contains(error(R"("textures": [{"generate": "noise", "wrap": "tile"}])"),
+                       "unknown wrap mode 'tile'"));
+  EXPECT_TRUE(contains(error(R"("materials": [{"texture": "nope"}])"), "no texture named 'nope'"));
+  EXPECT_TRUE(contains(error(R"("materials": [{"textureFilter": "cubic"}])"),
+                       "materials[0].textureFilter: unknown texture filter 'cubic'"));
+  EXPECT_TRUE(contains(error(R"("materials": [{"colorCode": 0}])"), "no 'colorTable'"));
+  EXPECT_TRUE(contains(error(R"("fog": {"beta": -1})"), "fog.beta"));
+  EXPECT_TRUE(contains(error(R"("pointLights": [{"color": [1, 1, 1]}])"), "missing key 'position'"));
+}
+
+TEST(ObjTextures, MapKdIsReadAndVRunsDownTheImage) {
+  TempDir dir;
+  dir.write("t.png", pngBytes(dir));
+  dir.write("m.mtl", "newmtl tex\nKd 1 1 1\nmap_Kd t.png\n");
+  const std::string path = dir.write(
+      "m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl tex\nf 1/1 2/2 3/3\n");
+  Result<Scene> r = loadObj(path);
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  ASSERT_EQ(r->textures.size(), 1u);
+  EXPECT_EQ(r->materials[0].texture, 0);
+  ASSERT_EQ(r->meshes[0].uvs.size(), 3u);
+  EXPECT_FLOAT_EQ(r->meshes[0].uvs[0].y, 1.0f);  // OBJ's v = 0 is the image's bottom row
+  EXPECT_FLOAT_EQ(r->meshes[0].uvs[2].y, 0.0f);
+}
+
+}  // namespace
+}  // namespace sv::scene
