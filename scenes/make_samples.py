@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """Writes the small sample assets in scenes/: pyramid.gltf (a vertex-coloured pyramid with its
-buffer embedded as base64) and house.obj + house.mtl. Run once; the outputs are committed.
+buffer embedded as base64), house.obj + house.mtl, and crate.gltf (a textured box: a PNG of
+planks embedded in the glTF, with a repeat sampler). Run once; the outputs are committed.
 
     python3 scenes/make_samples.py
 """
@@ -9,6 +10,7 @@ import json
 import math
 import os
 import struct
+import zlib
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 
@@ -120,6 +122,84 @@ def make_house():
                 "newmtl roof\nKd 0.60 0.12 0.08\nd 1\nillum 1\n")
 
 
+def png_rgb(width, height, pixel):
+    """An 8-bit RGB PNG of pixel(x, y) -> (r, g, b), as bytes (PNG 1.2: IHDR, one IDAT, IEND)."""
+    def chunk(kind, data):
+        return (struct.pack(">I", len(data)) + kind + data +
+                struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF))
+    raw = b"".join(b"\x00" + bytes(c for x in range(width) for c in pixel(x, y))
+                   for y in range(height))
+    return (b"\x89PNG\r\n\x1a\n" +
+            chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)) +
+            chunk(b"IDAT", zlib.compress(raw, 9)) + chunk(b"IEND", b""))
+
+
+def make_crate():
+    # A unit box (centred, on y = 0) with 24 vertices, uvs 0..1 per face, and a 64 x 64 texture
+    # of four planks with dark frame and a cross brace; glTF v runs down the image.
+    def planks(x, y):
+        frame = x < 5 or x > 58 or y < 5 or y > 58
+        brace = abs(x - y) < 4 or abs(x + y - 63) < 4
+        if frame or brace:
+            return (92, 60, 30)
+        seam = (y % 16) in (0, 15)
+        grain = int(12 * math.sin(x * 0.35 + (y // 16) * 1.7)) + ((x * 7 + y * 13) % 5)
+        base = 60 if seam else 150 + grain
+        return (base, int(base * 0.72), int(base * 0.42))
+    image = png_rgb(64, 64, planks)
+    faces = [  # normal, u axis, v axis (v down the image = -up on the face)
+        ((0, 0, 1), (1, 0, 0), (0, -1, 0)), ((0, 0, -1), (-1, 0, 0), (0, -1, 0)),
+        ((1, 0, 0), (0, 0, -1), (0, -1, 0)), ((-1, 0, 0), (0, 0, 1), (0, -1, 0)),
+        ((0, 1, 0), (1, 0, 0), (0, 0, 1)), ((0, -1, 0), (1, 0, 0), (0, 0, -1))]
+    pos, nrm, uv, idx = [], [], [], []
+    for n, u, v in faces:
+        base = len(pos)
+        for cu, cv in ((0, 0), (1, 0), (1, 1), (0, 1)):
+            p = [0.5 * n[i] + (cu - 0.5) * u[i] + (cv - 0.5) * v[i] for i in range(3)]
+            p[1] += 0.5
+            pos.append(p)
+            nrm.append(list(n))
+            uv.append([cu, cv])
+        # Counter-clockwise seen from outside: (u, v) is left-handed on the face (v down).
+        idx += [base, base + 2, base + 1, base, base + 3, base + 2]
+    blob = b"".join(struct.pack("<3f", *p) for p in pos)
+    blob += b"".join(struct.pack("<3f", *n) for n in nrm)
+    blob += b"".join(struct.pack("<2f", *t) for t in uv)
+    blob += b"".join(struct.pack("<H", i) for i in idx)
+    n = len(pos)
+    gltf = {
+        "asset": {"version": "2.0", "generator": "synthvis scenes/make_samples.py"},
+        "scene": 0, "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0, "name": "crate"}],
+        "meshes": [{"name": "crate", "primitives": [{
+            "attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2},
+            "indices": 3, "material": 0}]}],
+        "materials": [{"name": "planks", "pbrMetallicRoughness": {
+            "baseColorTexture": {"index": 0}, "metallicFactor": 0}}],
+        "textures": [{"source": 0, "sampler": 0}],
+        "samplers": [{"wrapS": 10497, "wrapT": 10497}],
+        "images": [{"name": "planks",
+                    "uri": "data:image/png;base64," + base64.b64encode(image).decode()}],
+        "buffers": [{"byteLength": len(blob),
+                     "uri": "data:application/octet-stream;base64," +
+                            base64.b64encode(blob).decode()}],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": 12 * n},
+            {"buffer": 0, "byteOffset": 12 * n, "byteLength": 12 * n},
+            {"buffer": 0, "byteOffset": 24 * n, "byteLength": 8 * n},
+            {"buffer": 0, "byteOffset": 32 * n, "byteLength": 2 * len(idx)}],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": n, "type": "VEC3",
+             "min": [-0.5, 0, -0.5], "max": [0.5, 1, 0.5]},
+            {"bufferView": 1, "componentType": 5126, "count": n, "type": "VEC3"},
+            {"bufferView": 2, "componentType": 5126, "count": n, "type": "VEC2"},
+            {"bufferView": 3, "componentType": 5123, "count": len(idx), "type": "SCALAR"}],
+    }
+    with open(os.path.join(HERE, "crate.gltf"), "w") as f:
+        json.dump(gltf, f, indent=1)
+
+
 if __name__ == "__main__":
     make_pyramid()
     make_house()
+    make_crate()

@@ -3,7 +3,7 @@
 //   synthvis render [SCENE] -o out.png [--width W] [--height H] [--threads T] [--camera I]
 //                   [--no-cull] [--debug-view overdraw] [--gamma G] [--supersample K]
 //                   [--aa 1|4|8|16|64] [--filter box|tent3]
-//                   [--texture-filter nearest|tri3|bilinear|trilinear3|trilinear|aniso]
+//                   [--texture-filter point|nearest|tri3|bilinear|trilinear3|trilinear|aniso]
 //   synthvis bench SCENE|--suite quick|full [--count N] [--area A] [--depth D] [--layers D]
 //                  [--order random|f2b|b2f] [--shade gouraud|textured]
 //                  [--texture-filter F] [--width W] [--height H]
@@ -363,7 +363,7 @@ int main(int argc, char** argv) {
   render->add_flag("--no-cull", r.noCull, "draw back faces of single-sided materials too");
   render->add_option("--debug-view", r.debugView, "false-colour diagnostic image: overdraw");
   render->add_option("--supersample", r.options.supersample,
-                     "render k×k samples per pixel and average them (1, 2, 4, 8)")
+                     "render k×k samples per pixel and average them (1, 2, 4, 8, 16)")
       ->capture_default_str();
   render->add_option("--aa", r.options.samples,
                      "anti-aliasing: samples per pixel, 1 (none), 4, 8, 16 or 64")
@@ -371,8 +371,8 @@ int main(int argc, char** argv) {
   render->add_option("--filter", r.filter, "resolve filter: box or tent3 (3x3 triangle)")
       ->capture_default_str();
   render->add_option("--texture-filter", r.textureFilter,
-                     "texture sampling for materials that do not choose: nearest, tri3, bilinear, "
-                     "trilinear3, trilinear or aniso")
+                     "texture sampling for materials that do not choose: point, nearest, tri3, "
+                     "bilinear, trilinear3, trilinear or aniso")
       ->capture_default_str();
   render->add_option("--gamma", r.options.gamma,
                      "display gamma G (encoded = linear^(1/G)); default 0 = sRGB")
@@ -401,7 +401,7 @@ int main(int argc, char** argv) {
   bench->add_option("--filter", b.filter, "synthvis resolve filter: box or tent3")
       ->capture_default_str();
   bench->add_option("--supersample", b.options.supersample,
-                    "synthvis: k×k samples per pixel, averaged (1, 2, 4, 8)")
+                    "synthvis: k×k samples per pixel, averaged (1, 2, 4, 8, 16)")
       ->capture_default_str();
   bench->add_flag("--gl-readback", b.glReadback,
                   "count the gl reference's read-back of the image in its frame time");

@@ -25,7 +25,7 @@ struct RenderOptions {
   // Output transfer function (SPEC §8): 0 = sRGB (IEC 61966-2-1); otherwise a display gamma G,
   // encoded value = linear^(1/G), G in [0.5, 5].
   double gamma = 0;
-  // Plain supersampling, k = 1, 2, 4 or 8: the frame is rendered at k·width × k·height and each
+  // Plain supersampling, k = 1, 2, 4, 8 or 16: the frame is rendered at k·width × k·height and each
   // pixel is the average of its k×k samples in linear light (the 1×1 box filter). The baseline
   // synthvis's own anti-aliasing (issue 4) is measured against.
   int supersample = 1;

@@ -22,9 +22,12 @@ namespace sv::scene {
 // How a texture map is sampled (SPEC §7; docs/quality.md compares them): nearest texel; the seed's
 // three-point interpolation ("tri3"); bilinear; the trilinear blends of those between pyramid levels
 // ("trilinear3", "trilinear"); anisotropic (trilinear probes along the pixel footprint's major
-// axis). `inherit` (materials only): the frame's choice, RenderOptions::textureFilter.
+// axis); `point`, the nearest texel of the full-resolution image, no pyramid (aliases: the
+// reference that, supersampled, gives docs/quality.md's ground truth). `inherit` (materials
+// only): the frame's choice, RenderOptions::textureFilter.
 enum class TextureFilter : uint8_t {
   inherit,
+  point,
   nearest,
   threePoint,
   bilinear,
@@ -34,7 +37,7 @@ enum class TextureFilter : uint8_t {
 };
 
 // By name, as the CLI's --texture-filter and the scene format's "textureFilter" write them:
-// nearest, tri3, bilinear, trilinear3, trilinear, aniso.
+// point, nearest, tri3, bilinear, trilinear3, trilinear, aniso.
 Result<TextureFilter> parseTextureFilter(const std::string& name);
 const char* textureFilterName(TextureFilter filter);
 

@@ -319,6 +319,7 @@ Status GlRenderer::load(const scene::Scene& scene) {
   GLint minFilter = GL_LINEAR_MIPMAP_LINEAR, magFilter = GL_LINEAR;
   float anisotropy = 1;
   switch (g.options.textureFilter) {
+    case scene::TextureFilter::point: minFilter = GL_NEAREST; magFilter = GL_NEAREST; break;
     case scene::TextureFilter::nearest: minFilter = GL_NEAREST_MIPMAP_NEAREST; magFilter = GL_NEAREST; break;
     case scene::TextureFilter::threePoint:
     case scene::TextureFilter::bilinear: minFilter = GL_LINEAR_MIPMAP_NEAREST; break;

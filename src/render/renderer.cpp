@@ -78,6 +78,7 @@ Result<CameraMatrices> cameraMatrices(const scene::Scene& scene, const RenderOpt
 
 texture::Filter samplerOf(scene::TextureFilter f) {
   switch (f) {
+    case scene::TextureFilter::point:
     case scene::TextureFilter::nearest: return texture::Filter::nearest;
     case scene::TextureFilter::threePoint: return texture::Filter::threePoint;
     case scene::TextureFilter::bilinear: return texture::Filter::bilinear;
@@ -112,6 +113,7 @@ void buildShading(const scene::Scene& scene, const RenderOptions& o, const Mat4&
           mat.textureFilter == scene::TextureFilter::inherit ? o.textureFilter : mat.textureFilter;
       s.filter = samplerOf(f);
       s.anisotropic = f == scene::TextureFilter::anisotropic;
+      s.levelZero = f == scene::TextureFilter::point;
       s.phong = mat.phong && hasLights && !mat.unlit && normals;  // as the vertex stage's `lit`
       s.twoSided = mat.doubleSided;
       s.specular = mat.specular;
@@ -154,8 +156,9 @@ Status validate(const RenderOptions& o) {
     return Error{"", "", fmt::format("thread count {} is out of range (0…{})", o.threads,
                                      kMaxThreads)};
   if (o.camera < 0) return Error{"", "", "camera index must not be negative"};
-  if (o.supersample != 1 && o.supersample != 2 && o.supersample != 4 && o.supersample != 8)
-    return Error{"", "", fmt::format("supersampling {} is not supported (1, 2, 4 or 8)",
+  if (o.supersample != 1 && o.supersample != 2 && o.supersample != 4 && o.supersample != 8 &&
+      o.supersample != 16)
+    return Error{"", "", fmt::format("supersampling {} is not supported (1, 2, 4, 8 or 16)",
                                      o.supersample)};
   if (o.supersample > 1 && (o.width * o.supersample > kMaxRasterSize ||
                             o.height * o.supersample > kMaxRasterSize))

@@ -43,7 +43,8 @@ std::string meshLabel(const Mesh& mesh, size_t i) {
 
 namespace {
 constexpr std::pair<const char*, TextureFilter> kTextureFilterNames[] = {
-    {"nearest", TextureFilter::nearest},       {"tri3", TextureFilter::threePoint},
+    {"point", TextureFilter::point},           {"nearest", TextureFilter::nearest},
+    {"tri3", TextureFilter::threePoint},
     {"bilinear", TextureFilter::bilinear},     {"trilinear3", TextureFilter::trilinearThreePoint},
     {"trilinear", TextureFilter::trilinear},   {"aniso", TextureFilter::anisotropic}};
 }  // namespace
@@ -51,7 +52,7 @@ constexpr std::pair<const char*, TextureFilter> kTextureFilterNames[] = {
 Result<TextureFilter> parseTextureFilter(const std::string& name) {
   for (const auto& [n, f] : kTextureFilterNames)
     if (name == n) return f;
-  return Error{"", "", fmt::format("unknown texture filter '{}' (nearest, tri3, bilinear, "
+  return Error{"", "", fmt::format("unknown texture filter '{}' (point, nearest, tri3, bilinear, "
                                    "trilinear3, trilinear or aniso)", name)};
 }
 

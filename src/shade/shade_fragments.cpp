@@ -98,6 +98,7 @@ void ShadeFragments(const MaterialShading& m, const Environment& env, const Frag
       // ½·log2(σ₁²), at least 0; a degenerate or non-finite footprint reads level 0.
       VF l = hn::Mul(hn::Log2(df, hn::Max(major2, one)), hn::Set(df, 0.5f));
       l = hn::IfThenElseZero(hn::Lt(l, hn::Set(df, 64.0f)), l);  // also false for NaN
+      if (m.levelZero) l = zero;
       hn::Store(l, df, lod + i);
     }
     if (m.anisotropic) {

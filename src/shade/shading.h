@@ -31,6 +31,7 @@ struct MaterialShading {
   const texture::Texture* texture = nullptr;  // base-colour map, or none
   texture::Filter filter = texture::Filter::trilinear;
   bool anisotropic = false;  // probes along the footprint (Texture::anisotropic) instead of filter
+  bool levelZero = false;    // always the full-resolution level (the "point" reference filter)
   // Per-pixel Phong lighting (otherwise the vertex colour already carries the Gouraud light).
   bool phong = false;
   bool twoSided = false;  // light the back face as if it were the front (normal turned to the eye)
