@@ -11,6 +11,7 @@
 #define HWY_TARGET_INCLUDE "shade/shade_fragments.cpp"
 #include "hwy/foreach_target.h"  // IWYU pragma: keep
 #include "hwy/contrib/math/math-inl.h"
+#include "hwy/cache_control.h"
 #include "hwy/highway.h"
 
 #include <algorithm>
@@ -67,40 +68,87 @@ HWY_INLINE void addLight(DF df, const MaterialShading& m, const V3& n, const V3&
   specular.z = hn::MulAdd(s, hn::Set(df, color.z), specular.z);
 }
 
-void ShadeFragments(const MaterialShading& m, const Environment& env, const Fragments& f,
-                    float out[4][kMaxFragments]) {
+// Texture coordinates (level-0 texels) and levels of detail of every lane (shading.h).
+void TextureCoordinates(const MaterialShading& m, const Fragments& f, TexCoords& out,
+                        bool prefetch) {
+  if (!m.texture) return;
   const DF df;
   const size_t lanes = hn::Lanes(df);
   const VF one = hn::Set(df, 1.0f), zero = hn::Zero(df);
-  // Texture coordinates and levels of detail for every lane first, then one sampling call.
-  alignas(64) float lod[kMaxFragments], x0[kMaxFragments], y0[kMaxFragments];
+  const float width = float(m.texture->level(0).width), height = float(m.texture->level(0).height);
+  for (size_t i = 0; i < size_t(kMaxFragments); i += lanes) {
+    // Outside the triangle (extrapolated AA centroids) q may reach 0: keep w finite.
+    const VF q = hn::Max(hn::Load(df, f.q + i), hn::Set(df, 1e-30f));
+    const VF w = hn::Div(one, q);
+    const VF u = hn::Mul(hn::Load(df, f.attribute[kU] + i), w);
+    const VF v = hn::Mul(hn::Load(df, f.attribute[kV] + i), w);
+    hn::Store(hn::MulSub(u, hn::Set(df, width), hn::Set(df, 0.5f)), df, out.x0 + i);
+    hn::Store(hn::MulSub(v, hn::Set(df, height), hn::Set(df, 0.5f)), df, out.y0 + i);
+    const VF ww = hn::Mul(w, hn::Set(df, width)), wh = hn::Mul(w, hn::Set(df, height));
+    const VF a = hn::Mul(hn::NegMulAdd(u, hn::Set(df, f.qdx), hn::Set(df, f.udx)), ww);
+    const VF b = hn::Mul(hn::NegMulAdd(u, hn::Set(df, f.qdy), hn::Set(df, f.udy)), ww);
+    const VF c = hn::Mul(hn::NegMulAdd(v, hn::Set(df, f.qdx), hn::Set(df, f.vdx)), wh);
+    const VF d = hn::Mul(hn::NegMulAdd(v, hn::Set(df, f.qdy), hn::Set(df, f.vdy)), wh);
+    const VF s = hn::MulAdd(a, a, hn::MulAdd(b, b, hn::MulAdd(c, c, hn::Mul(d, d))));
+    const VF det = hn::MulSub(a, d, hn::Mul(b, c));
+    const VF disc = hn::Max(hn::NegMulAdd(hn::Set(df, 4.0f), hn::Mul(det, det), hn::Mul(s, s)), zero);
+    const VF major2 = hn::Mul(hn::Add(s, hn::Sqrt(disc)), hn::Set(df, 0.5f));
+    // ½·log2(σ₁²), at least 0; a degenerate or non-finite footprint reads level 0.
+    VF l = hn::Mul(hn::Log2(df, hn::Max(major2, one)), hn::Set(df, 0.5f));
+    l = hn::IfThenElseZero(hn::Lt(l, hn::Set(df, 64.0f)), l);  // also false for NaN
+    if (m.levelZero) l = zero;
+    hn::Store(l, df, out.lod + i);
+  }
+  if (!prefetch || m.anisotropic || f.count != kMaxFragments) return;
+  // The texels the samplers will read, requested now: each lane's cell (its two rows) on the
+  // block's first level, and the corner lanes' on the second. (Only the two columns' lanes measured
+  // no better: docs/performance.md.)
+  const texture::Texture& t = *m.texture;
+  const texture::Texture::LevelTable& table = t.levelTable();
+  const int last = t.levelCount() - 1;
+  const texture::Texel* texels = t.texels();
+  const bool pow2 = t.powerOfTwo();
+  const bool trilinear = m.filter == texture::Filter::trilinear ||
+                         m.filter == texture::Filter::trilinearThreePoint;
+  auto fetch = [&](int lane, int k, bool below) {
+    const float scale = std::ldexp(1.0f, -k);
+    const float x = out.x0[lane] * scale, y = out.y0[lane] * scale;
+    if (!(std::fabs(x) < texture::kMaxTexelCoordinate && std::fabs(y) < texture::kMaxTexelCoordinate))
+      return;
+    const int w = table.width[k], h = table.height[k];
+    int xi = int(std::floor(x)), yi = int(std::floor(y)) + (below ? 1 : 0);
+    xi = pow2 ? xi & (w - 1) : std::clamp(xi, 0, w - 1);
+    yi = pow2 ? yi & (h - 1) : std::clamp(yi, 0, h - 1);
+    hwy::Prefetch(texels + table.offset[k] + size_t(yi) * size_t(w) + size_t(xi));
+  };
+  const float lod0 = out.lod[0];
+  const int k = std::min(last, lod0 >= 0 && lod0 < 64 ? int(lod0) : 0);
+  for (int lane = 0; lane < kMaxFragments; ++lane) {
+    fetch(lane, k, false);
+    fetch(lane, k, true);
+  }
+  if (trilinear && k < last)
+    for (int lane : {0, 15}) {
+      fetch(lane, k + 1, false);
+      fetch(lane, k + 1, true);
+    }
+}
+
+void ShadeFragments(const MaterialShading& m, const Environment& env, const Fragments& f,
+                    const TexCoords* given, float out[4][kMaxFragments]) {
+  const DF df;
+  const size_t lanes = hn::Lanes(df);
+  const VF one = hn::Set(df, 1.0f), zero = hn::Zero(df);
   alignas(64) float texel[4][kMaxFragments];
   const int count = std::clamp(f.count, 0, kMaxFragments);
   if (m.texture) {
-    const float width = float(m.texture->level(0).width), height = float(m.texture->level(0).height);
-    for (size_t i = 0; i < size_t(kMaxFragments); i += lanes) {
-      // Outside the triangle (extrapolated AA centroids) q may reach 0: keep w finite.
-      const VF q = hn::Max(hn::Load(df, f.q + i), hn::Set(df, 1e-30f));
-      const VF w = hn::Div(one, q);
-      const VF u = hn::Mul(hn::Load(df, f.attribute[kU] + i), w);
-      const VF v = hn::Mul(hn::Load(df, f.attribute[kV] + i), w);
-      hn::Store(hn::MulSub(u, hn::Set(df, width), hn::Set(df, 0.5f)), df, x0 + i);
-      hn::Store(hn::MulSub(v, hn::Set(df, height), hn::Set(df, 0.5f)), df, y0 + i);
-      const VF ww = hn::Mul(w, hn::Set(df, width)), wh = hn::Mul(w, hn::Set(df, height));
-      const VF a = hn::Mul(hn::NegMulAdd(u, hn::Set(df, f.qdx), hn::Set(df, f.udx)), ww);
-      const VF b = hn::Mul(hn::NegMulAdd(u, hn::Set(df, f.qdy), hn::Set(df, f.udy)), ww);
-      const VF c = hn::Mul(hn::NegMulAdd(v, hn::Set(df, f.qdx), hn::Set(df, f.vdx)), wh);
-      const VF d = hn::Mul(hn::NegMulAdd(v, hn::Set(df, f.qdy), hn::Set(df, f.vdy)), wh);
-      const VF s = hn::MulAdd(a, a, hn::MulAdd(b, b, hn::MulAdd(c, c, hn::Mul(d, d))));
-      const VF det = hn::MulSub(a, d, hn::Mul(b, c));
-      const VF disc = hn::Max(hn::NegMulAdd(hn::Set(df, 4.0f), hn::Mul(det, det), hn::Mul(s, s)), zero);
-      const VF major2 = hn::Mul(hn::Add(s, hn::Sqrt(disc)), hn::Set(df, 0.5f));
-      // ½·log2(σ₁²), at least 0; a degenerate or non-finite footprint reads level 0.
-      VF l = hn::Mul(hn::Log2(df, hn::Max(major2, one)), hn::Set(df, 0.5f));
-      l = hn::IfThenElseZero(hn::Lt(l, hn::Set(df, 64.0f)), l);  // also false for NaN
-      if (m.levelZero) l = zero;
-      hn::Store(l, df, lod + i);
-    }
+    TexCoords computed;
+    if (!given) TextureCoordinates(m, f, computed, false);
+    const TexCoords& tc = given ? *given : computed;
+    const float* lod = tc.lod;
+    const float* x0 = tc.x0;
+    const float* y0 = tc.y0;
+    const float width = float(m.texture->level(0).width);
     if (m.anisotropic) {
       // The elliptical footprint per pixel (footprint.h), probes along its major axis.
       for (int i = 0; i < count; ++i) {
@@ -200,10 +248,20 @@ HWY_AFTER_NAMESPACE();
 #if HWY_ONCE
 namespace sv::shade {
 HWY_EXPORT(ShadeFragments);
+HWY_EXPORT(TextureCoordinates);
 
 void shadeFragments(const MaterialShading& m, const Environment& env, const Fragments& f,
                     float out[4][kMaxFragments]) {
-  HWY_DYNAMIC_DISPATCH(ShadeFragments)(m, env, f, out);
+  HWY_DYNAMIC_DISPATCH(ShadeFragments)(m, env, f, nullptr, out);
+}
+
+void textureCoordinates(const MaterialShading& m, const Fragments& f, TexCoords& out) {
+  HWY_DYNAMIC_DISPATCH(TextureCoordinates)(m, f, out, true);
+}
+
+void shadeFragments(const MaterialShading& m, const Environment& env, const Fragments& f,
+                    const TexCoords& coordinates, float out[4][kMaxFragments]) {
+  HWY_DYNAMIC_DISPATCH(ShadeFragments)(m, env, f, &coordinates, out);
 }
 }  // namespace sv::shade
 #endif

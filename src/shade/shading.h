@@ -85,6 +85,18 @@ inline unsigned attributesUsed(const MaterialShading& m, const Environment& env)
 void shadeFragments(const MaterialShading& m, const Environment& env, const Fragments& f,
                     float out[4][kMaxFragments]);
 
+// Shading in two steps, so that texture memory is requested well before it is read: first the
+// texture coordinates (level-0 texels) and levels of detail of every fragment, with a prefetch of
+// the texels they will read; later the shading with them. The result is shadeFragments's.
+struct TexCoords {
+  alignas(64) float lod[kMaxFragments];
+  alignas(64) float x0[kMaxFragments];
+  alignas(64) float y0[kMaxFragments];
+};
+void textureCoordinates(const MaterialShading& m, const Fragments& f, TexCoords& out);
+void shadeFragments(const MaterialShading& m, const Environment& env, const Fragments& f,
+                    const TexCoords& coordinates, float out[4][kMaxFragments]);
+
 // The fog factor 2^(−β·r) at range r (SPEC §8): the weight of the surface colour.
 inline float fogFactor(float beta, float range) { return std::exp2(-beta * range); }
 
