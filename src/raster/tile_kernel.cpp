@@ -519,98 +519,140 @@ HWY_INLINE void visibleBlock(const TriangleSetup& t, const PlaneLanes& lanes, ui
 }
 
 // Shades every pixel that records a triangle, with that triangle's planes and material (or its
-// Gouraud colour), and clears the records. Per 4×4 block, once per distinct triangle in it; the
-// planes' per-lane offsets are kept from one block to the next while the triangle stays the same.
+// Gouraud colour), and clears the records. Pixels are batched by triangle, up to 16 to a batch
+// from anywhere in the tile, so that a batch fills the SIMD lanes even for triangles of a few
+// pixels (a batch per 4×4 block and triangle shaded 3 lanes for every pixel on tris 100k × 10
+// px); open batches sit in a small table by triangle, and a batch leaves it when full or when
+// another triangle needs its slot. Pixel-shaded batches then wait in a queue, so that the texels
+// each will read have been requested (shade::textureCoordinates) a whole queue's work earlier.
+// A pixel's planes are evaluated at it directly, (c0 + dx·X) + dy·Y. docs/performance.md.
 HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
   const hn::CappedTag<float, kBlockPixels> df;
   const hn::RebindToSigned<decltype(df)> di;
-  const hn::RebindToUnsigned<decltype(df)> du;
   const hn::Rebind<uint16_t, decltype(df)> du16;
-  const hn::Rebind<int16_t, decltype(df)> d16;
   const size_t n = hn::Lanes(df);
-  uint32_t current = kNoTriangle;
-  const TriangleSetup* t = nullptr;
-  const AttributeSetup* a = nullptr;
-  PlaneLanes lanes;
-  AttributeLanes attributeLanes{};  // (set before use; initialized for the compiler)
-  // Pixel-shaded blocks wait in a queue of kQueue, so that the texels each will read have been
-  // requested (shade::textureCoordinates) a whole queue's work earlier: the samplers otherwise
-  // wait on memory for every block of a new triangle. Measured on tris 10k × 1000 px textured,
-  // 2 threads: docs/performance.md.
-  constexpr int kQueue = 32;
+  // A pixel is named by its index in the tile's block-major layout (framebuffer.h): block·16 + lane.
+  struct Batch {
+    uint32_t id = kNoTriangle;
+    int count = 0;
+    alignas(64) int32_t pixel[kBlockPixels];
+  };
   struct Queued {
     shade::Fragments fragments;
     shade::TexCoords coordinates;
     const shade::MaterialShading* material;
-    uint16_t* color;
-    uint32_t mask;
+    int count;
+    alignas(64) int32_t pixel[kBlockPixels];
   };
+  constexpr int kSlots = 64, kQueue = 32;
+  Batch slots[kSlots];
   Queued queue[kQueue];
   int queued = 0;
+
+  // Writes lanes [0, count) of 16-bit colour c16 to their pixels.
+  auto store = [&](const int32_t* pixel, int count, const uint16_t (*c16)[kBlockPixels]) {
+    for (int l = 0; l < count; ++l) {
+      const int32_t p = pixel[l];
+      uint16_t* dst = ctx.color + size_t(p >> (2 * kBlockLog2)) * kColorPerBlock +
+                      size_t(p & (kBlockPixels - 1));
+      for (int ch = 0; ch < kColorChannels; ++ch) dst[ch * kBlockPixels] = c16[ch][l];
+    }
+  };
   auto finishQueue = [&] {
     for (int e = 0; e < queued; ++e) {
       const Queued& q = queue[e];
       alignas(64) float rgba[4][kBlockPixels];
       shade::shadeFragments(*q.material, *ctx.environment, q.fragments, q.coordinates, rgba);
-      const auto maskVec = hn::Set(di, static_cast<int32_t>(q.mask));
-      for (size_t i = 0; i < size_t(kBlockPixels); i += n) {
-        const auto pass = hn::RebindMask(df, hn::TestBit(maskVec, hn::LoadU(di, kLaneBit + i)));
-        if (!hn::AllFalse(df, pass)) storeShaded(df, pass, false, rgba, i, q.color);
-      }
+      alignas(64) uint16_t c16[kColorChannels][kBlockPixels];
+      for (int ch = 0; ch < kColorChannels; ++ch)
+        for (size_t i = 0; i < size_t(kBlockPixels); i += n)
+          hn::Store(hn::DemoteTo(du16, unitToLanes(df, hn::Load(df, rgba[ch] + i))), du16,
+                    c16[ch] + i);
+      store(q.pixel, q.count, c16);
     }
     queued = 0;
   };
+  // Shades (Gouraud) or queues (material) batch b and empties it.
+  auto emit = [&](Batch& b) {
+    const TriangleSetup& t = ctx.setups[b.id];
+    const AttributeSetup& a = ctx.attributes[t.triangle - ctx.attributeBase];
+    // Unused lanes repeat the last pixel: valid positions, no extra texels.
+    for (int l = b.count; l < kBlockPixels; ++l) b.pixel[l] = b.pixel[b.count - 1];
+    const unsigned used = a.material ? shade::attributesUsed(*a.material, *ctx.environment) : 0;
+    Queued* q = a.material ? &queue[queued] : nullptr;
+    alignas(64) uint16_t c16[kColorChannels][kBlockPixels];
+    for (size_t i = 0; i < size_t(kBlockPixels); i += n) {
+      const auto p = hn::Load(di, b.pixel + i);
+      const auto block = hn::ShiftRight<2 * kBlockLog2>(p);
+      const auto lane = hn::And(p, hn::Set(di, kBlockPixels - 1));
+      const auto x = hn::Or(hn::ShiftLeft<kBlockLog2>(hn::And(block, hn::Set(di, kBlocksPerTileSide - 1))),
+                            hn::And(lane, hn::Set(di, kBlockSize - 1)));
+      const auto y = hn::Or(hn::ShiftLeft<kBlockLog2>(hn::ShiftRight<4>(block)),
+                            hn::ShiftRight<kBlockLog2>(lane));
+      static_assert(kBlocksPerTileSide == 16, "block row = block >> 4");
+      const auto X = hn::ConvertTo(df, hn::Add(x, hn::Set(di, ctx.originX - t.minX)));
+      const auto Y = hn::ConvertTo(df, hn::Add(y, hn::Set(di, ctx.originY - t.minY)));
+      auto at = [&](const Plane& pl) {
+        return hn::Add(hn::Add(hn::Set(df, pl.c0), hn::Mul(hn::Set(df, pl.dx), X)),
+                       hn::Mul(hn::Set(df, pl.dy), Y));
+      };
+      const auto qv = at(t.invW);
+      const Plane* color[kColorChannels] = {&t.red, &t.green, &t.blue};
+      if (!q) {
+        // shadeBlock's Gouraud colour.
+        const auto w = hn::Div(hn::Set(df, 1.0f), qv);
+        for (int ch = 0; ch < kColorChannels; ++ch)
+          hn::Store(hn::DemoteTo(du16, colorToLanes(df, at(*color[ch]), w)), du16, c16[ch] + i);
+        continue;
+      }
+      shade::Fragments& f = q->fragments;
+      hn::Store(qv, df, f.q + i);
+      const auto w = hn::Div(hn::Set(df, 1.0f), hn::Max(qv, hn::Set(df, 1e-30f)));
+      for (int ch = 0; ch < kColorChannels; ++ch)
+        hn::Store(hn::Min(hn::Max(hn::Mul(at(*color[ch]), w), hn::Zero(df)), hn::Set(df, 1.0f)), df,
+                  f.color[ch] + i);
+      for (int k = 0; k < shade::kAttributeCount; ++k)
+        if (used & (1u << k)) hn::Store(at(a.planes[k]), df, f.attribute[k] + i);
+    }
+    if (q) {
+      shade::Fragments& f = q->fragments;
+      f.count = kBlockPixels;
+      f.qdx = t.invW.dx;
+      f.qdy = t.invW.dy;
+      f.udx = a.planes[shade::kU].dx;
+      f.udy = a.planes[shade::kU].dy;
+      f.vdx = a.planes[shade::kV].dx;
+      f.vdy = a.planes[shade::kV].dy;
+      if (a.material->texture) shade::textureCoordinates(*a.material, f, q->coordinates);
+      q->material = a.material;
+      q->count = b.count;
+      std::copy_n(b.pixel, kBlockPixels, q->pixel);
+      if (++queued == kQueue) finishQueue();
+    } else {
+      store(b.pixel, b.count, c16);
+    }
+    b.id = kNoTriangle;
+    b.count = 0;
+  };
+
   for (int block = 0; block < kTilePixels / kBlockPixels; ++block) {
     uint32_t* visible = ctx.visible + size_t(block) * kBlockPixels;
-    uint32_t pending = 0;
-    for (int p = 0; p < kBlockPixels; ++p) pending |= uint32_t(visible[p] != kNoTriangle) << p;
-    if (!pending) continue;
-    const int gx = ctx.originX + (block % kBlocksPerTileSide) * kBlockSize;
-    const int gy = ctx.originY + (block / kBlocksPerTileSide) * kBlockSize;
-    uint16_t* color = ctx.color + size_t(block) * kColorPerBlock;
-    while (pending) {
-      const uint32_t id = visible[std::countr_zero(pending)];
-      uint32_t mask = 0;
-      for (int p = 0; p < kBlockPixels; ++p) mask |= uint32_t(visible[p] == id) << p;
-      pending &= ~mask;
-      if (id != current) {
-        current = id;
-        t = &ctx.setups[id];
-        a = &ctx.attributes[t->triangle - ctx.attributeBase];
-        computePlaneLanes(*t, lanes);
-        if (a->material) computeAttributeLanes(*a, attributeLanes);
+    for (int l = 0; l < kBlockPixels; ++l) {
+      const uint32_t id = visible[l];
+      if (id == kNoTriangle) continue;
+      visible[l] = kNoTriangle;
+      ++ctx.stats->fragments;
+      Batch& b = slots[(id * 0x9E3779B1u) >> 26];  // 64 slots by a multiplicative hash
+      if (b.id != id) {
+        if (b.count) emit(b);
+        b.id = id;
       }
-      ctx.stats->fragments += uint64_t(std::popcount(mask));
-      alignas(32) float base[8];
-      blockBases(*t, lanes, gx, gy, base);
-      const auto maskVec = hn::Set(di, static_cast<int32_t>(mask));
-      if (a->material) {
-        // Queued: its texels are requested now and read when the queue is full.
-        Queued& q = queue[queued];
-        blockFragments(*t, lanes, attributeLanes, base, gx, gy, nullptr, nullptr,
-                       shade::attributesUsed(*a->material, *ctx.environment), q.fragments);
-        if (a->material->texture) shade::textureCoordinates(*a->material, q.fragments, q.coordinates);
-        q.material = a->material;
-        q.color = color;
-        q.mask = mask;
-        if (++queued == kQueue) finishQueue();
-      } else {
-        // shadeBlock's colour, without its depth test (done already).
-        for (size_t i = 0; i < size_t(kBlockPixels); i += n) {
-          const auto pass = hn::RebindMask(df, hn::TestBit(maskVec, hn::LoadU(di, kLaneBit + i)));
-          if (hn::AllFalse(df, pass)) continue;
-          const auto w = hn::Div(hn::Set(df, 1.0f), hn::Add(hn::Set(df, base[kInvW]),
-                                                           hn::LoadU(df, lanes.offset[kInvW] + i)));
-          const auto pass16 = hn::MaskFromVec(
-              hn::BitCast(du16, hn::DemoteTo(d16, hn::VecFromMask(di, hn::RebindMask(di, pass)))));
-          for (int ch = 0; ch < kColorChannels; ++ch)
-            hn::BlendedStore(hn::DemoteTo(du16, colorLanes(df, lanes, base, ch, i, w)), pass16, du16,
-                             color + ch * kBlockPixels + i);
-        }
-      }
+      b.pixel[b.count++] = block * kBlockPixels + l;
+      if (b.count == kBlockPixels) emit(b);
     }
-    for (size_t i = 0; i < size_t(kBlockPixels); i += n) hn::StoreU(hn::Set(du, kNoTriangle), du, visible + i);
   }
+  for (Batch& b : slots)
+    if (b.count) emit(b);
   finishQueue();
 }
 
