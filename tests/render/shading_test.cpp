@@ -53,12 +53,13 @@ void addQuad(scene::Scene& s, Vec3 o, Vec3 e1, Vec3 e2, int material, Vec4 color
 }
 
 Image render(const scene::Scene& s, int w, int h, int threads = 2,
-             scene::TextureFilter filter = scene::TextureFilter::trilinear) {
+             scene::TextureFilter filter = scene::TextureFilter::trilinear, int samples = 1) {
   RenderOptions o;
   o.width = w;
   o.height = h;
   o.threads = threads;
   o.textureFilter = filter;
+  o.samples = samples;
   Renderer r(o);
   Image img;
   const Status st = r.render(s, img);
@@ -254,12 +255,45 @@ TEST(Shading, TexturedFramesAreIdenticalForAnyThreadCount) {
     addQuad(s, {std::sin(a) * 3, std::cos(a * 1.3f) * 2, -4 - float(i % 7)},
             {1.5f * std::cos(a), 0.4f, 0.3f}, {0.2f, 1.2f, -0.8f * std::sin(a)}, i % 5 == 0 ? 1 : 0);
   }
-  const Image one = render(s, 200, 150, 1);
-  for (int threads : {2, 8})
+  for (int samples : {1, 4, 16})
     for (auto filter : {scene::TextureFilter::trilinear, scene::TextureFilter::anisotropic}) {
-      const Image ref = filter == scene::TextureFilter::trilinear ? one : render(s, 200, 150, 1, filter);
-      EXPECT_EQ(render(s, 200, 150, threads, filter).rgb, ref.rgb) << threads << " threads";
+      const Image one = render(s, 200, 150, 1, filter, samples);
+      for (int threads : {2, 8})
+        EXPECT_EQ(render(s, 200, 150, threads, filter, samples).rgb, one.rgb)
+            << threads << " threads, " << samples << " samples";
     }
+}
+
+TEST(Shading, AntiAliasedTexturingAgreesWithPointSamplingInsideSurfaces) {
+  // Pixel shading with sub-pixel masks (forward, colour once per pixel) against the deferred
+  // shading of one sample: inside a textured, lit, fogged quad the two shade the same centres.
+  scene::Scene s = emptyScene();
+  texture::Level level = texture::generateTexture(texture::Pattern::checker, 64, {0.1f, 0.2f, 0.3f, 1},
+                                                  {0.9f, 0.8f, 0.2f, 1}, 1);
+  s.textures.push_back({"checker", std::make_shared<texture::Texture>(level, texture::Wrap::repeat,
+                                                                      texture::Wrap::repeat)});
+  scene::Material m;
+  m.texture = 0;
+  m.phong = true;
+  s.light.enabled = true;
+  s.fog = {true, {0.5f, 0.5f, 0.6f}, 0.05f};
+  s.materials.push_back(m);
+  // A tilted quad that fills the whole view: no pixel is on an edge.
+  addQuad(s, {-10, -10, -2}, {20, 0, -2}, {0, 20, -6}, 0);
+  const Image one = render(s, 96, 72, 2, scene::TextureFilter::trilinear, 1);
+  // 4 samples shade at pixel centres; 16 at the centroid of the covered samples where a pixel is
+  // only partly covered — along the quad's diagonal, where its two triangles meet (≈ 1.5 % of
+  // the pixels here).
+  for (int samples : {4, 16}) {
+    const Image aa = render(s, 96, 72, 2, scene::TextureFilter::trilinear, samples);
+    int differing = 0;
+    for (size_t i = 0; i < one.rgb.size(); i += 3) {
+      int d = 0;
+      for (int c = 0; c < 3; ++c) d = std::max(d, std::abs(int(one.rgb[i + c]) - int(aa.rgb[i + c])));
+      differing += d > 1;
+    }
+    EXPECT_LE(differing, samples == 4 ? 0 : 96 * 72 / 40) << samples << " samples";
+  }
 }
 
 }  // namespace
