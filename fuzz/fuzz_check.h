@@ -17,6 +17,7 @@ inline LoadOptions fuzzOptions() {
   LoadOptions options;
   options.followReferences = false;
   options.maxTriangles = uint64_t(1) << 18;
+  options.maxTexels = uint64_t(1) << 20;  // generated and embedded textures: 8 MB at most
   return options;
 }
 

@@ -172,8 +172,11 @@ struct LoadOptions {
   // Longest chain of scene files referencing scene files below the one being loaded.
   int maxNesting = 8;
   // False: never open any other file (referenced meshes, .mtl libraries, external glTF buffers
-  // all fail as missing). For untrusted text and fuzzing.
+  // and images all fail as missing). For untrusted text and fuzzing.
   bool followReferences = true;
+  // Most texels (full-resolution images, summed over the textures of one file) a load may decode
+  // or generate: 2^28 texels hold 2 GiB with their pyramids.
+  uint64_t maxTexels = uint64_t(1) << 28;
 };
 
 Result<Scene> loadScene(const std::string& path, const LoadOptions& options);

@@ -133,6 +133,7 @@ bool fsWriteWholeFile(std::string*, const std::string&, const std::vector<unsign
 // The decoded images, by glTF image index, filled by decodeImage as tinygltf meets them.
 struct DecodedImages {
   std::map<int, texture::Level> levels;
+  uint64_t texels = 0, maxTexels = 0;  // LoadOptions::maxTexels
 };
 
 // tinygltf's image callback: PNG only (texture.h's decoder and limits), into DecodedImages.
@@ -151,7 +152,13 @@ bool decodeImage(tinygltf::Image* image, const int index, std::string* err, std:
     if (err) *err += level.error().str() + "\n";
     return false;
   }
-  static_cast<DecodedImages*>(user)->levels[index] = std::move(level.value());
+  DecodedImages& images = *static_cast<DecodedImages*>(user);
+  images.texels += uint64_t(level->width) * uint64_t(level->height);
+  if (images.texels > images.maxTexels) {
+    if (err) *err += fmt::format("{}: the images exceed {} texels\n", name, images.maxTexels);
+    return false;
+  }
+  images.levels[index] = std::move(level.value());
   return true;
 }
 
@@ -700,6 +707,7 @@ Result<Scene> loadGltfFromMemory(const std::string& bytes, const std::string& pa
     loader.SetFsCallbacks({&fsFileExists, &fsExpandFilePath, &fsReadWholeFile, &fsWriteWholeFile,
                            &follow});
     DecodedImages images;
+    images.maxTexels = options.maxTexels;
     loader.SetImageLoader(&decodeImage, &images);
     tinygltf::Model model;
     std::string err, warn;

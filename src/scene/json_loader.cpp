@@ -381,6 +381,7 @@ class SceneReader {
   uint64_t triangles_ = 0;
   std::map<std::string, int> materialByName_;
   std::map<std::string, int> textureByName_;
+  uint64_t texels_ = 0;  // decoded or generated so far (LoadOptions::maxTexels)
   std::vector<Vec3> colorTable_;
   // Materials made for objects' "color" overrides, by (base material, colour), to share them.
   std::map<std::pair<int, std::array<float, 4>>, int> colorMaterials_;
@@ -537,6 +538,12 @@ void SceneReader::readTextures(const Json& v, const std::string& where) {
       }
     }
     texture::Level level;
+    // The texel budget (LoadOptions::maxTexels), before anything is decoded or generated.
+    auto charge = [&](uint64_t texels) {
+      texels_ += texels;
+      if (texels_ > context_.options.maxTexels)
+        fail(w, fmt::format("the scene's textures exceed {} texels", context_.options.maxTexels));
+    };
     if (file) {
       for (const char* key : {"size", "colors", "seed"})
         if (find(v[i], key)) fail(member(w, key), "only for generated textures");
@@ -546,6 +553,7 @@ void SceneReader::readTextures(const Json& v, const std::string& where) {
       Result<texture::Level> read = texture::readTextureImage(resolvePath(directoryOf(path_), ref));
       if (!read) fail(member(w, "file"), read.error().str());
       level = std::move(read.value());
+      charge(uint64_t(level.width) * uint64_t(level.height));
       if (map.name.empty()) map.name = ref;
     } else {
       const std::string gw = member(w, "generate");
@@ -558,6 +566,7 @@ void SceneReader::readTextures(const Json& v, const std::string& where) {
       int size = 256;
       if (const Json* x = find(v[i], "size"))
         size = int(integer(*x, member(w, "size"), 1, texture::kMaxGeneratedSide));
+      charge(uint64_t(size) * uint64_t(size));
       texture::Color4 c[2] = {{0, 0, 0, 1}, {1, 1, 1, 1}};
       if (const Json* x = find(v[i], "colors")) {
         std::string cw = member(w, "colors");

@@ -118,6 +118,7 @@ Scene convertObj(const tinyobj::attrib_t& attrib, const std::vector<tinyobj::sha
                  const std::string& baseDir) {
   Scene scene;
   std::map<std::string, int> textureByFile;
+  uint64_t texels = 0;  // LoadOptions::maxTexels
   for (const tinyobj::material_t& mtl : materials) {
     const float channels[] = {mtl.diffuse[0], mtl.diffuse[1], mtl.diffuse[2], mtl.dissolve};
     for (float c : channels)
@@ -139,6 +140,10 @@ Scene convertObj(const tinyobj::attrib_t& attrib, const std::vector<tinyobj::sha
         Result<texture::Level> level =
             texture::readTextureImage(resolvePath(baseDir, mtl.diffuse_texname));
         if (!level) fail(fmt::format("material '{}': {}", mtl.name, level.error().str()));
+        texels += uint64_t(level->width) * uint64_t(level->height);
+        if (texels > options.maxTexels)
+          fail(fmt::format("material '{}': the textures exceed {} texels", mtl.name,
+                           options.maxTexels));
         scene.textures.push_back(
             {mtl.diffuse_texname, std::make_shared<texture::Texture>(std::move(level.value()),
                                                                      texture::Wrap::repeat,

@@ -218,6 +218,14 @@ TEST(JsonTextures, ProblemsAreNamed) {
   EXPECT_TRUE(contains(error(R"("materials": [{"colorCode": 0}])"), "no 'colorTable'"));
   EXPECT_TRUE(contains(error(R"("fog": {"beta": -1})"), "fog.beta"));
   EXPECT_TRUE(contains(error(R"("pointLights": [{"color": [1, 1, 1]}])"), "missing key 'position'"));
+  // The texel budget: checked before a texture is generated.
+  LoadOptions small;
+  small.maxTexels = 5000;
+  Result<Scene> r = parseJsonScene(
+      R"({"synthvis": 1, "textures": [{"generate": "noise", "size": 64}, {"generate": "noise", "size": 64}]})",
+      "t.json", small);
+  ASSERT_FALSE(r.ok());
+  EXPECT_TRUE(contains(r.error().str(), "textures[1]: the scene's textures exceed 5000 texels"));
 }
 
 TEST(ObjTextures, MapKdIsReadAndVRunsDownTheImage) {
