@@ -376,7 +376,7 @@ HWY_INLINE void storeShaded(DF df, M pass, bool blend, const float (*rgba)[kBloc
     if (blend) {
       const auto old = hn::Mul(hn::ConvertTo(df, hn::PromoteTo(di, hn::LoadU(du, dst))),
                                hn::Set(df, 1.0f / 65535.0f));
-      c = hn::Min(hn::MulAdd(old, keep, c), hn::Set(df, 1.0f));
+      c = hn::Min(hn::Add(hn::Mul(old, keep), c), hn::Set(df, 1.0f));
     }
     hn::BlendedStore(hn::DemoteTo(du, unitToLanes(df, c)), pass16, du, dst);
   }

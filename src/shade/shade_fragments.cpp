@@ -7,10 +7,11 @@
 //     σ₁² = (S + √(S² − 4D²)) / 2,   level of detail = max(0, ½·log2 σ₁²).
 // Phong (SPEC §8, seed 003): C = (Q_amb·C_surf + Q_diff·C_surf·Σ(n·l)⁺C_light + Q_spec·Σ((r·v)⁺)^p·C_light)
 // / (Q_amb + Q_diff + Q_spec). Fog (seed 002): C·f + C_F·(1 − f), f = 2^(−β·|eye position|).
+// Only multiplies, adds, divisions and square roots (all exactly rounded): the same bits on every
+// SIMD target (tests/shade/shade_test.cpp).
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "shade/shade_fragments.cpp"
 #include "hwy/foreach_target.h"  // IWYU pragma: keep
-#include "hwy/contrib/math/math-inl.h"
 #include "hwy/cache_control.h"
 #include "hwy/highway.h"
 
@@ -32,8 +33,41 @@ struct V3 {
   VF x, y, z;
 };
 
+// log2 and exp2 of our own, from multiplies, adds, one division and exponent bits only — no
+// fused multiply-add, which some targets have and others not — so that every SIMD target shades
+// every pixel to the same bits (docs/ARCHITECTURE.md, invariants).
+// log2(x), x > 0 normal: x = 2^e·m, m ∈ [1, 2); log2 m = (2/ln 2)·atanh t, t = (m − 1)/(m + 1)
+// ∈ [0, 1/3), by its series to t⁹ (error < 3·10⁻⁷).
+HWY_INLINE VF log2(DF df, VF x) {
+  const hn::RebindToSigned<DF> di;
+  const auto bits = hn::BitCast(di, x);
+  const VF e = hn::ConvertTo(df, hn::Sub(hn::ShiftRight<23>(bits), hn::Set(di, 127)));
+  const VF m = hn::BitCast(df, hn::Or(hn::And(bits, hn::Set(di, 0x7FFFFF)), hn::Set(di, 0x3F800000)));
+  const VF one = hn::Set(df, 1.0f);
+  const VF t = hn::Div(hn::Sub(m, one), hn::Add(m, one));
+  const VF t2 = hn::Mul(t, t);
+  VF p = hn::Set(df, 1.0f / 9);
+  for (float c : {1.0f / 7, 1.0f / 5, 1.0f / 3, 1.0f}) p = hn::Add(hn::Mul(p, t2), hn::Set(df, c));
+  return hn::Add(e, hn::Mul(hn::Mul(p, t), hn::Set(df, 2.8853900817779268f)));  // 2/ln 2
+}
+
+// exp2(y) for y ≤ 0 (fog, and specular powers of numbers ≤ 1): 2^n·2^f, n = ⌊y⌋, f ∈ [0, 1),
+// 2^f by e^(f·ln 2)'s series to the 8th power (error < 2·10⁻⁷); 0 below 2^−126.
+HWY_INLINE VF exp2(DF df, VF y) {
+  const hn::RebindToSigned<DF> di;
+  y = hn::Max(y, hn::Set(df, -127.0f));
+  const VF n = hn::Floor(y);
+  const VF g = hn::Mul(hn::Sub(y, n), hn::Set(df, 0.69314718055994531f));
+  VF p = hn::Set(df, 1.0f / 40320);
+  for (float c : {1.0f / 5040, 1.0f / 720, 1.0f / 120, 1.0f / 24, 1.0f / 6, 0.5f, 1.0f, 1.0f})
+    p = hn::Add(hn::Mul(p, g), hn::Set(df, c));
+  const auto ni = hn::ConvertTo(di, n);
+  const VF scale = hn::BitCast(df, hn::ShiftLeft<23>(hn::Add(ni, hn::Set(di, 127))));
+  return hn::IfThenElseZero(hn::Gt(n, hn::Set(df, -127.0f)), hn::Mul(p, scale));
+}
+
 HWY_INLINE VF dot3(const V3& a, const V3& b) {
-  return hn::MulAdd(a.x, b.x, hn::MulAdd(a.y, b.y, hn::Mul(a.z, b.z)));
+  return hn::Add(hn::Add(hn::Mul(a.x, b.x), hn::Mul(a.y, b.y)), hn::Mul(a.z, b.z));
 }
 
 HWY_INLINE V3 normalized(DF df, const V3& a) {
@@ -50,9 +84,9 @@ HWY_INLINE void addLight(DF df, const MaterialShading& m, const V3& n, const V3&
                          Vec3 color, V3& diffuse, V3& specular) {
   const VF nl = dot3(n, l);
   const VF d = hn::Max(nl, hn::Zero(df));
-  diffuse.x = hn::MulAdd(d, hn::Set(df, color.x), diffuse.x);
-  diffuse.y = hn::MulAdd(d, hn::Set(df, color.y), diffuse.y);
-  diffuse.z = hn::MulAdd(d, hn::Set(df, color.z), diffuse.z);
+  diffuse.x = hn::Add(diffuse.x, hn::Mul(d, hn::Set(df, color.x)));
+  diffuse.y = hn::Add(diffuse.y, hn::Mul(d, hn::Set(df, color.y)));
+  diffuse.z = hn::Add(diffuse.z, hn::Mul(d, hn::Set(df, color.z)));
   if (m.specular <= 0) return;
   // r = 2(n·l)n − l; only lit sides reflect.
   const VF two = hn::Add(nl, nl);
@@ -62,10 +96,10 @@ HWY_INLINE void addLight(DF df, const MaterialShading& m, const V3& n, const V3&
   // (r·v)^p = e^(p·ln(r·v)); 0 stays 0.
   const VF s = hn::IfThenElseZero(
       hn::Gt(rv, hn::Zero(df)),
-      hn::Exp(df, hn::Mul(hn::Set(df, m.shininess), hn::Log(df, hn::Max(rv, hn::Set(df, 1e-30f))))));
-  specular.x = hn::MulAdd(s, hn::Set(df, color.x), specular.x);
-  specular.y = hn::MulAdd(s, hn::Set(df, color.y), specular.y);
-  specular.z = hn::MulAdd(s, hn::Set(df, color.z), specular.z);
+      exp2(df, hn::Mul(hn::Set(df, m.shininess), log2(df, hn::Max(rv, hn::Set(df, 1e-30f))))));
+  specular.x = hn::Add(specular.x, hn::Mul(s, hn::Set(df, color.x)));
+  specular.y = hn::Add(specular.y, hn::Mul(s, hn::Set(df, color.y)));
+  specular.z = hn::Add(specular.z, hn::Mul(s, hn::Set(df, color.z)));
 }
 
 // Texture coordinates (level-0 texels) and levels of detail of every lane (shading.h).
@@ -82,19 +116,20 @@ void TextureCoordinates(const MaterialShading& m, const Fragments& f, TexCoords&
     const VF w = hn::Div(one, q);
     const VF u = hn::Mul(hn::Load(df, f.attribute[kU] + i), w);
     const VF v = hn::Mul(hn::Load(df, f.attribute[kV] + i), w);
-    hn::Store(hn::MulSub(u, hn::Set(df, width), hn::Set(df, 0.5f)), df, out.x0 + i);
-    hn::Store(hn::MulSub(v, hn::Set(df, height), hn::Set(df, 0.5f)), df, out.y0 + i);
+    hn::Store(hn::Sub(hn::Mul(u, hn::Set(df, width)), hn::Set(df, 0.5f)), df, out.x0 + i);
+    hn::Store(hn::Sub(hn::Mul(v, hn::Set(df, height)), hn::Set(df, 0.5f)), df, out.y0 + i);
     const VF ww = hn::Mul(w, hn::Set(df, width)), wh = hn::Mul(w, hn::Set(df, height));
-    const VF a = hn::Mul(hn::NegMulAdd(u, hn::Set(df, f.qdx), hn::Set(df, f.udx)), ww);
-    const VF b = hn::Mul(hn::NegMulAdd(u, hn::Set(df, f.qdy), hn::Set(df, f.udy)), ww);
-    const VF c = hn::Mul(hn::NegMulAdd(v, hn::Set(df, f.qdx), hn::Set(df, f.vdx)), wh);
-    const VF d = hn::Mul(hn::NegMulAdd(v, hn::Set(df, f.qdy), hn::Set(df, f.vdy)), wh);
-    const VF s = hn::MulAdd(a, a, hn::MulAdd(b, b, hn::MulAdd(c, c, hn::Mul(d, d))));
-    const VF det = hn::MulSub(a, d, hn::Mul(b, c));
-    const VF disc = hn::Max(hn::NegMulAdd(hn::Set(df, 4.0f), hn::Mul(det, det), hn::Mul(s, s)), zero);
+    const VF a = hn::Mul(hn::Sub(hn::Set(df, f.udx), hn::Mul(u, hn::Set(df, f.qdx))), ww);
+    const VF b = hn::Mul(hn::Sub(hn::Set(df, f.udy), hn::Mul(u, hn::Set(df, f.qdy))), ww);
+    const VF c = hn::Mul(hn::Sub(hn::Set(df, f.vdx), hn::Mul(v, hn::Set(df, f.qdx))), wh);
+    const VF d = hn::Mul(hn::Sub(hn::Set(df, f.vdy), hn::Mul(v, hn::Set(df, f.qdy))), wh);
+    const VF s = hn::Add(hn::Add(hn::Mul(a, a), hn::Mul(b, b)), hn::Add(hn::Mul(c, c), hn::Mul(d, d)));
+    const VF det = hn::Sub(hn::Mul(a, d), hn::Mul(b, c));
+    const VF disc =
+        hn::Max(hn::Sub(hn::Mul(s, s), hn::Mul(hn::Set(df, 4.0f), hn::Mul(det, det))), zero);
     const VF major2 = hn::Mul(hn::Add(s, hn::Sqrt(disc)), hn::Set(df, 0.5f));
     // ½·log2(σ₁²), at least 0; a degenerate or non-finite footprint reads level 0.
-    VF l = hn::Mul(hn::Log2(df, hn::Max(major2, one)), hn::Set(df, 0.5f));
+    VF l = hn::Mul(log2(df, hn::Max(major2, one)), hn::Set(df, 0.5f));
     l = hn::IfThenElseZero(hn::Lt(l, hn::Set(df, 64.0f)), l);  // also false for NaN
     if (m.levelZero) l = zero;
     hn::Store(l, df, out.lod + i);
@@ -214,8 +249,8 @@ void ShadeFragments(const MaterialShading& m, const Environment& env, const Frag
       const float qAmb = env.ambient, qDiff = 1 - env.ambient, qSpec = m.specular;
       const VF norm = hn::Set(df, 1.0f / (qAmb + qDiff + qSpec));
       auto light = [&](VF surf, VF dif, VF spec) {
-        const VF sum = hn::MulAdd(hn::Set(df, qSpec), spec,
-                                  hn::Mul(surf, hn::MulAdd(hn::Set(df, qDiff), dif, hn::Set(df, qAmb))));
+        const VF sum = hn::Add(hn::Mul(hn::Set(df, qSpec), spec),
+                               hn::Mul(surf, hn::Add(hn::Mul(hn::Set(df, qDiff), dif), hn::Set(df, qAmb))));
         return hn::Mul(sum, norm);
       };
       c = {light(c.x, diffuse.x, specular.x), light(c.y, diffuse.y, specular.y),
@@ -227,11 +262,11 @@ void ShadeFragments(const MaterialShading& m, const Environment& env, const Frag
     if (env.fog) {
       // SPEC §8: f = 2^(−β·r) = e^(−β·ln2·r), r the true range |eye position|.
       const VF range = hn::Sqrt(dot3(eye, eye));
-      const VF fog = hn::Exp(df, hn::Mul(hn::Set(df, -env.fogBeta * 0.69314718f), range));
+      const VF fog = exp2(df, hn::Mul(hn::Set(df, -env.fogBeta), range));
       const VF haze = hn::Sub(one, fog);
-      c.x = hn::MulAdd(c.x, fog, hn::Mul(hn::Set(df, env.fogColor.x), haze));
-      c.y = hn::MulAdd(c.y, fog, hn::Mul(hn::Set(df, env.fogColor.y), haze));
-      c.z = hn::MulAdd(c.z, fog, hn::Mul(hn::Set(df, env.fogColor.z), haze));
+      c.x = hn::Add(hn::Mul(c.x, fog), hn::Mul(hn::Set(df, env.fogColor.x), haze));
+      c.y = hn::Add(hn::Mul(c.y, fog), hn::Mul(hn::Set(df, env.fogColor.y), haze));
+      c.z = hn::Add(hn::Mul(c.z, fog), hn::Mul(hn::Set(df, env.fogColor.z), haze));
     }
     // Premultiplied, clamped to the 0…1 the frame buffer stores.
     hn::Store(hn::Min(hn::Max(hn::Mul(c.x, alpha), zero), one), df, out[0] + i);
