@@ -186,18 +186,14 @@ void ShadeFragments(const MaterialShading& m, const Environment& env, const Frag
     const float width = float(m.texture->level(0).width);
     if (m.anisotropic) {
       // The elliptical footprint per pixel (footprint.h), probes along its major axis.
+      texture::Footprint fp[kMaxFragments];
       for (int i = 0; i < count; ++i) {
         const double q = std::max(double(f.q[i]), 1e-30);
-        const texture::Footprint fp = texture::pixelFootprint(
+        fp[i] = texture::pixelFootprint(
             {double(f.attribute[kU][i]), f.udx, f.udy}, {double(f.attribute[kV][i]), f.vdx, f.vdy},
             {q, f.qdx, f.qdy}, width, m.texture->level(0).height);
-        const texture::Color4 c = m.texture->anisotropic(fp, x0[i], y0[i]);
-        texel[0][i] = c.r;
-        texel[1][i] = c.g;
-        texel[2][i] = c.b;
-        texel[3][i] = c.a;
       }
-      for (int i = count; i < kMaxFragments; ++i) texel[0][i] = texel[1][i] = texel[2][i] = texel[3][i] = 0;
+      texture::anisotropicBlock(*m.texture, fp, x0, y0, count, texel);
     } else {
       texture::sampleBlock(*m.texture, m.filter, lod, x0, y0, kMaxFragments, texel);
     }

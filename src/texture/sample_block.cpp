@@ -227,5 +227,36 @@ void sampleBlock(const Texture& texture, Filter filter, const float* lod, const 
                  const float* y0, int count, float out[4][16]) {
   HWY_DYNAMIC_DISPATCH(SampleBlock)(texture, filter, lod, x0, y0, std::clamp(count, 0, 16), out);
 }
+
+void anisotropicBlock(const Texture& texture, const Footprint* footprints, const float* x0,
+                      const float* y0, int count, float out[4][16]) {
+  count = std::clamp(count, 0, 16);
+  // The probes in pixel order, 16 to a chunk; a pixel's probes may straddle two chunks, and its
+  // sum adds them in probe order either way (as Texture::anisotropic does).
+  alignas(64) float lod[16] = {}, x[16] = {}, y[16] = {}, probe[4][16];
+  int owner[16], filled = 0;
+  float sum[4][16] = {}, weight[16];
+  auto flush = [&] {
+    HWY_DYNAMIC_DISPATCH(SampleBlock)(texture, Filter::trilinear, lod, x, y, filled, probe);
+    for (int j = 0; j < filled; ++j)
+      for (int ch = 0; ch < 4; ++ch) sum[ch][owner[j]] += probe[ch][j];
+    filled = 0;
+  };
+  for (int i = 0; i < count; ++i) {
+    float pixelLod, px[Texture::kMaxProbes], py[Texture::kMaxProbes];
+    const int n = anisotropicProbes(footprints[i], x0[i], y0[i], pixelLod, px, py);
+    weight[i] = 1.0f / float(n);
+    for (int k = 0; k < n; ++k) {
+      lod[filled] = pixelLod;
+      x[filled] = px[k];
+      y[filled] = py[k];
+      owner[filled++] = i;
+      if (filled == 16) flush();
+    }
+  }
+  if (filled) flush();
+  for (int ch = 0; ch < 4; ++ch)
+    for (int i = 0; i < 16; ++i) out[ch][i] = i < count ? sum[ch][i] * weight[i] : 0.0f;
+}
 }  // namespace sv::texture
 #endif

@@ -192,16 +192,23 @@ Color4 Texture::trilinearThreePoint(float lod, float x0, float y0) const {
                      [&](int k, float x, float y) { return threePoint(k, x, y); });
 }
 
-Color4 Texture::anisotropic(const Footprint& f, float x0, float y0) const {
+int anisotropicProbes(const Footprint& f, float x0, float y0, float& lod, float* x, float* y) {
   const double major = std::max(f.major, 1e-9), minor = std::max(f.minor, 1e-9);
-  const int n = int(std::clamp(std::ceil(major / minor), 1.0, double(kMaxProbes)));
-  const float lod = float(std::max(0.0, std::log2(std::max(minor, major / n))));
-  Color4 sum;
+  const int n = int(std::clamp(std::ceil(major / minor), 1.0, double(Texture::kMaxProbes)));
+  lod = float(std::max(0.0, std::log2(std::max(minor, major / n))));
   for (int i = 0; i < n; ++i) {
     const double s = ((i + 0.5) / n - 0.5) * major;
-    const Color4 c = trilinear(lod, float(x0 + s * f.axisX), float(y0 + s * f.axisY));
-    sum = mix(sum, 1.0f, c, 1.0f);
+    x[i] = float(x0 + s * f.axisX);
+    y[i] = float(y0 + s * f.axisY);
   }
+  return n;
+}
+
+Color4 Texture::anisotropic(const Footprint& f, float x0, float y0) const {
+  float lod, x[kMaxProbes], y[kMaxProbes];
+  const int n = anisotropicProbes(f, x0, y0, lod, x, y);
+  Color4 sum;
+  for (int i = 0; i < n; ++i) sum = mix(sum, 1.0f, trilinear(lod, x[i], y[i]), 1.0f);
   const float w = 1.0f / float(n);
   return {sum.r * w, sum.g * w, sum.b * w, sum.a * w};
 }

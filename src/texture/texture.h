@@ -135,6 +135,17 @@ class Texture {
 void sampleBlock(const Texture& texture, Filter filter, const float* lod, const float* x0,
                  const float* y0, int count, float out[4][16]);
 
+// The probes of Texture::anisotropic for `footprint` at (x0, y0): returns their number n
+// (1…Texture::kMaxProbes) and writes their level of detail and level-0 positions x[0…n), y[0…n).
+int anisotropicProbes(const Footprint& footprint, float x0, float y0, float& lod, float* x,
+                      float* y);
+
+// Anisotropic filtering of up to 16 pixels at once: every pixel's probes packed 16 to a
+// sampleBlock call, so that the trilinear probes run in SIMD lanes. Bit for bit what
+// Texture::anisotropic returns for each pixel.
+void anisotropicBlock(const Texture& texture, const Footprint* footprints, const float* x0,
+                      const float* y0, int count, float out[4][16]);
+
 // Reads a PNG (8 or 16 bits; grey, grey + alpha, RGB or RGBA; palette) into level 0 in linear light
 // with premultiplied alpha. 8-bit samples are sRGB-encoded and decoded by the exact sRGB curve;
 // 16-bit samples are linear (PNG's convention for them), either unless a gAMA chunk says otherwise.
