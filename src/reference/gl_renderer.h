@@ -6,8 +6,12 @@
 // geometry/vertex_stage.cpp (material × vertex colour × (ambient + diffuse·n·l)) in the vertex
 // shader, perspective-correct colour, depth test "less" with depth cleared to 1, back faces culled
 // as RenderOptions and the materials say, an sRGB colour buffer (linear colour in, 8-bit sRGB
-// stored: the conversion synthvis's resolve does). The geometry is uploaded once to static
-// buffers; a frame is clear, one draw per instance, glFinish.
+// stored: the conversion synthvis's resolve does). Textured materials: synthvis's own MIP pyramid
+// uploaded level by level as SRGB8_ALPHA8 (so both renderers sample the same levels), the
+// texture's wrap modes, --texture-filter mapped to the GL min/mag filters (aniso: 16×
+// GL_TEXTURE_MAX_ANISOTROPY), UVs scaled by the material's uvScale, modulating the lit colour.
+// The geometry is uploaded once to static buffers; a frame is clear, one draw per instance,
+// glFinish.
 #pragma once
 
 #include <memory>
