@@ -5,7 +5,7 @@
 //                   [--aa 1|4|8|16|64] [--filter box|tent3]
 //                   [--texture-filter point|nearest|tri3|bilinear|trilinear3|trilinear|aniso]
 //   synthvis bench SCENE|--suite quick|full [--count N] [--area A] [--depth D] [--layers D]
-//                  [--order random|f2b|b2f] [--shade gouraud|textured]
+//                  [--order random|f2b|b2f] [--shade gouraud|textured] [--fog]
 //                  [--texture-filter F] [--width W] [--height H]
 //                  [--threads T] [--frames F] [--warmup W] [--seed S] [--aa S] [--gl-aa S]
 //                  [--filter box|tent3]
@@ -116,6 +116,7 @@ struct BenchArgs {
   std::string suite;
   GeneratorArgs generator;
   std::string shade = "gouraud";
+  bool fog = false;
   std::string textureFilter = "trilinear";
   std::string renderer;  // synthvis, gl or both; default synthvis for a scene, both for a suite
   std::string json;
@@ -211,6 +212,7 @@ int runBench(BenchArgs a) {
   settings.referenceMsaa = a.glAa;
   settings.referenceReadback = a.glReadback;
   settings.textured = a.shade == "textured";
+  settings.fog = a.fog;
   settings.synthvis = a.renderer != "gl";
   settings.reference = a.renderer != "synthvis";
   ref::BenchRunner runner(settings);
@@ -386,6 +388,7 @@ int main(int argc, char** argv) {
   bench->add_option("--shade", b.shade,
                     "generated scenes: gouraud, or textured (BENCH.md's 1024x1024 texture)")
       ->capture_default_str();
+  bench->add_flag("--fog", b.fog, "generated scenes: BENCH.md's fog (haze, beta 0.1 per unit)");
   bench->add_option("--texture-filter", b.textureFilter,
                     "nearest, tri3, bilinear, trilinear3, trilinear or aniso")
       ->capture_default_str();

@@ -26,6 +26,7 @@ struct TrisParams {
   // BENCH.md --shade textured: the material samples a 1024×1024 noise texture (texture 0). The
   // UVs, 0.5–4 texels per pixel (log-uniform per triangle), are generated either way.
   bool textured = false;
+  bool fog = false;  // BENCH.md --fog: addBenchFog
 };
 
 // What the generator realized (BENCH.md asks for both).
@@ -39,13 +40,16 @@ struct TrisStats {
 Scene generateTris(const TrisParams& params, TrisStats* stats = nullptr);
 
 // BENCH.md `layers`: `layers` parallel screen-filling grids of ≈ 200 px triangles at distances
-// 2 … 20, so every pixel is covered `layers` times; same camera and material as `tris`.
+// 2 … 20, so every pixel is covered `layers` times; same camera and material as `tris`. UVs give
+// each layer its own offset and density (0.5–4 texels per pixel, log-uniform) on the bench texture.
 struct LayersParams {
   int layers = 4;
   SubmitOrder order = SubmitOrder::random;
   uint64_t seed = 1;
   int width = 1920;
   int height = 1080;
+  bool textured = false;  // as TrisParams
+  bool fog = false;
 };
 Scene generateLayers(const LayersParams& params, TrisStats* stats = nullptr);
 
@@ -55,5 +59,8 @@ Scene benchCameraScene(const std::string& name);
 // BENCH.md's texture for --shade textured: a 1024 × 1024 noise texture as texture 0, used by every
 // material of `s`.
 void addBenchTexture(Scene& s);
+// BENCH.md's fog for --fog: grey-blue haze with β = 0.1 per unit, so that the generated scenes'
+// nearest surfaces (distance 2) keep 87 % of their colour and the farthest (20) a quarter.
+void addBenchFog(Scene& s);
 
 }  // namespace sv::scene

@@ -11,6 +11,7 @@ namespace sv {
 
 struct Vec2 {
   float x = 0, y = 0;
+  friend bool operator==(Vec2 a, Vec2 b) = default;
 };
 
 struct Vec3 {

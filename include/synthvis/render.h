@@ -47,6 +47,9 @@ Status validate(const RenderOptions& options);
 // The view-projection matrix a frame uses: the scene's camera `options.camera`, or for a scene
 // without cameras one that frames its bounds; the aspect ratio is width / height.
 Result<Mat4> viewProjection(const scene::Scene& scene, const RenderOptions& options);
+// Its view matrix alone: world to eye space (the camera at the origin looking down −z), where
+// lighting and fog ranges are computed.
+Result<Mat4> viewMatrix(const scene::Scene& scene, const RenderOptions& options);
 
 // What one frame did. Window counts are per quadtree level (64 … 4 pixels, then pixel tests).
 struct FrameStats {

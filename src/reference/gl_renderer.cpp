@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,7 @@ layout(location = 1) in vec3 normal;
 layout(location = 2) in vec4 color;
 layout(location = 3) in vec2 uv;
 uniform mat4 mvp;
+uniform mat4 modelView;
 uniform vec2 uvScale;
 uniform mat3 normalToWorld;
 uniform vec4 baseColor;
@@ -42,8 +44,10 @@ uniform float ambient;
 uniform bool lit;
 out vec4 vertexColor;
 out vec2 texCoord;
+out vec3 eyePosition;
 void main() {
   gl_Position = mvp * vec4(position, 1.0);
+  eyePosition = (modelView * vec4(position, 1.0)).xyz;
   texCoord = uv * uvScale;
   vec4 c = baseColor * color;
   vec3 intensity = vec3(1.0);
@@ -55,14 +59,23 @@ void main() {
 }
 )";
 
-// The texture modulates the vertex colour (synthvis's pixel shading without Phong or fog).
+// The texture modulates the vertex colour, then fog (SPEC §8) takes the colour toward the fog
+// colour by the range from the eye: synthvis's pixel shading without Phong.
 constexpr const char* kFragmentShader = R"(#version 330 core
 in vec4 vertexColor;
 in vec2 texCoord;
+in vec3 eyePosition;
 uniform bool textured;
 uniform sampler2D tex;
+uniform bool fog;
+uniform vec3 fogColor;
+uniform float fogBeta;
 out vec4 fragColor;
-void main() { fragColor = textured ? vertexColor * texture(tex, texCoord) : vertexColor; }
+void main() {
+  vec4 c = textured ? vertexColor * texture(tex, texCoord) : vertexColor;
+  if (fog) c.rgb = mix(fogColor, c.rgb, exp2(-fogBeta * length(eyePosition)));
+  fragColor = c;
+}
 )";
 
 std::string glError(const char* what) {
@@ -79,6 +92,7 @@ struct Mesh {
 struct Draw {
   size_t mesh;
   float mvp[16];
+  float modelView[16];
   float normalToWorld[9];
   float baseColor[4];
   float uvScale[2];
@@ -97,13 +111,17 @@ struct GlRenderer::Impl {
   GLuint fbo = 0, colorRb = 0, depthRb = 0;  // the render target (multisampled if msaa)
   GLuint resolveFbo = 0, resolveRb = 0;      // single-sampled copy for readback (msaa)
   GLint uMvp = -1, uNormal = -1, uBase = -1, uToLight = -1, uLightColor = -1, uAmbient = -1,
-        uLit = -1, uTextured = -1, uUvScale = -1;
+        uLit = -1, uTextured = -1, uUvScale = -1, uModelView = -1, uFog = -1, uFogColor = -1,
+        uFogBeta = -1;
   std::vector<Mesh> meshes;
   std::vector<GLuint> textures;  // one per scene texture
   std::vector<Draw> draws;
   float background[3] = {0, 0, 0};
   float toLight[3] = {0, 1, 0}, lightColor[3] = {1, 1, 1}, ambient = 1;
+  bool fog = false;
+  float fogColor[3] = {0, 0, 0}, fogBeta = 0;
   std::string description;
+  bool initialized = false;  // eglInitialize succeeded (counted in displayUsers)
 
   ~Impl() {
     if (display == EGL_NO_DISPLAY) return;
@@ -118,7 +136,21 @@ struct GlRenderer::Impl {
       eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
       eglDestroyContext(display, context);
     }
-    eglTerminate(display);
+    // The surfaceless display is one per process, shared by every renderer: the last one
+    // terminates it (terminating it earlier would destroy the others' contexts).
+    if (initialized) {
+      std::lock_guard<std::mutex> lock(displayMutex());
+      if (--displayUsers() == 0) eglTerminate(display);
+    }
+  }
+
+  static std::mutex& displayMutex() {
+    static std::mutex m;
+    return m;
+  }
+  static int& displayUsers() {
+    static int users = 0;
+    return users;
   }
 
   void freeMeshes() {
@@ -179,11 +211,16 @@ Result<std::unique_ptr<GlRenderer>> GlRenderer::create(const RenderOptions& opti
   g.msaa = msaa;
   g.display = eglGetPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
   EGLint major = 0, minor = 0;
-  if (g.display == EGL_NO_DISPLAY || !eglInitialize(g.display, &major, &minor))
-    return Error{"", "",
-                 fmt::format("gl: no EGL surfaceless display (0x{:x}); is Mesa's "
-                             "libegl-mesa0 installed?",
-                             eglGetError())};
+  {
+    std::lock_guard<std::mutex> lock(Impl::displayMutex());
+    if (g.display == EGL_NO_DISPLAY || !eglInitialize(g.display, &major, &minor))
+      return Error{"", "",
+                   fmt::format("gl: no EGL surfaceless display (0x{:x}); is Mesa's "
+                               "libegl-mesa0 installed?",
+                               eglGetError())};
+    g.initialized = true;
+    ++Impl::displayUsers();
+  }
   if (!eglBindAPI(EGL_OPENGL_API)) return Error{"", "", "gl: EGL cannot bind OpenGL"};
   // Surfaceless: no config is needed (EGL_KHR_no_config_context), rendering goes to our own FBO.
   EGLConfig config = EGL_NO_CONFIG_KHR;
@@ -232,6 +269,10 @@ Result<std::unique_ptr<GlRenderer>> GlRenderer::create(const RenderOptions& opti
   g.uLit = glGetUniformLocation(g.program, "lit");
   g.uTextured = glGetUniformLocation(g.program, "textured");
   g.uUvScale = glGetUniformLocation(g.program, "uvScale");
+  g.uModelView = glGetUniformLocation(g.program, "modelView");
+  g.uFog = glGetUniformLocation(g.program, "fog");
+  g.uFogColor = glGetUniformLocation(g.program, "fogColor");
+  g.uFogBeta = glGetUniformLocation(g.program, "fogBeta");
 
   // Render target: sRGB colour and 24-bit depth, multisampled when asked.
   const int w = options.width, h = options.height;
@@ -275,6 +316,8 @@ Status GlRenderer::load(const scene::Scene& scene) {
   if (Status s = g.makeCurrent(); !s) return s;
   const Result<Mat4> camera = viewProjection(scene, g.options);
   if (!camera.ok()) return camera.error();
+  const Result<Mat4> view = viewMatrix(scene, g.options);
+  if (!view.ok()) return view.error();
   g.freeMeshes();
   g.draws.clear();
   for (const scene::Mesh& m : scene.meshes) {
@@ -376,9 +419,13 @@ Status GlRenderer::load(const scene::Scene& scene) {
     Draw d;
     d.mesh = size_t(inst.mesh);
     const Mat4 mvp = camera.value() * inst.transform;
+    const Mat4 modelView = view.value() * inst.transform;
     const Mat4 n = inst.transform.normalMatrix();
     for (int c = 0; c < 4; ++c)
-      for (int r = 0; r < 4; ++r) d.mvp[c * 4 + r] = mvp.m[c][r];
+      for (int r = 0; r < 4; ++r) {
+        d.mvp[c * 4 + r] = mvp.m[c][r];
+        d.modelView[c * 4 + r] = modelView.m[c][r];
+      }
     for (int c = 0; c < 3; ++c)
       for (int r = 0; r < 3; ++r) d.normalToWorld[c * 3 + r] = n.m[c][r];
     d.baseColor[0] = mat.baseColor.x;
@@ -400,6 +447,11 @@ Status GlRenderer::load(const scene::Scene& scene) {
   g.lightColor[1] = scene.light.color.y;
   g.lightColor[2] = scene.light.color.z;
   g.ambient = scene.light.ambient;
+  g.fog = scene.fog.enabled && scene.fog.beta > 0;
+  g.fogColor[0] = scene.fog.color.x;
+  g.fogColor[1] = scene.fog.color.y;
+  g.fogColor[2] = scene.fog.color.z;
+  g.fogBeta = scene.fog.beta;
   g.background[0] = scene.background.x;
   g.background[1] = scene.background.y;
   g.background[2] = scene.background.z;
@@ -419,6 +471,9 @@ Status GlRenderer::render() {
   glUniform3fv(g.uToLight, 1, g.toLight);
   glUniform3fv(g.uLightColor, 1, g.lightColor);
   glUniform1f(g.uAmbient, g.ambient);
+  glUniform1i(g.uFog, g.fog ? 1 : 0);
+  glUniform3fv(g.uFogColor, 1, g.fogColor);
+  glUniform1f(g.uFogBeta, g.fogBeta);
   for (const Draw& d : g.draws) {
     const Mesh& m = g.meshes[d.mesh];
     if (d.cull)
@@ -426,6 +481,7 @@ Status GlRenderer::render() {
     else
       glDisable(GL_CULL_FACE);
     glUniformMatrix4fv(g.uMvp, 1, GL_FALSE, d.mvp);
+    glUniformMatrix4fv(g.uModelView, 1, GL_FALSE, d.modelView);
     glUniformMatrix3fv(g.uNormal, 1, GL_FALSE, d.normalToWorld);
     glUniform4fv(g.uBase, 1, d.baseColor);
     glUniform1i(g.uLit, d.lit ? 1 : 0);

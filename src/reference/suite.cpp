@@ -142,7 +142,8 @@ Result<CaseResult> BenchRunner::run(const BenchCase& c) {
   if (s.frames < 1 || s.frames > 100000 || s.warmup < 0 || s.warmup > 100000)
     return Error{"", "", "frames must be 1…100000 and warmup 0…100000"};
   BenchCase shaded = c;
-  shaded.tris.textured = s.textured;
+  shaded.tris.textured = shaded.layers.textured = s.textured;
+  shaded.tris.fog = shaded.layers.fog = s.fog;
   auto made = makeScene(shaded, s.options);
   if (!made.ok()) return made.error();
   const scene::Scene& sc = made.value().scene;
@@ -228,6 +229,7 @@ nlohmann::json jsonRows(const CaseResult& r, const BenchSettings& s) {
                 {"frames", s.frames},
                 {"warmup", s.warmup},
                 {"shade", s.textured ? "textured" : "gouraud"},
+                {"fog", s.fog},
                 {"texture_filter", scene::textureFilterName(s.options.textureFilter)},
                 {"aa", run.renderer == "synthvis" ? s.options.samples : std::max(1, s.referenceMsaa)},
                 {"filter", s.options.filter == RenderOptions::Filter::tent3 ? "tent3" : "box"},

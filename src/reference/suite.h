@@ -69,6 +69,8 @@ struct BenchSettings {
   // BENCH.md --shade textured: generated scenes get the bench texture (options.textureFilter
   // samples it; the reference uses GL's nearest equivalent).
   bool textured = false;
+  // BENCH.md --fog: generated scenes get the bench fog (scene::addBenchFog), in both renderers.
+  bool fog = false;
 };
 
 // Renders, per case, warm-up frames then timed frames, alternating synthvis and the reference

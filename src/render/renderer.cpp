@@ -148,6 +148,12 @@ Result<Mat4> viewProjection(const scene::Scene& scene, const RenderOptions& o) {
   return m.value().projection * m.value().view;
 }
 
+Result<Mat4> viewMatrix(const scene::Scene& scene, const RenderOptions& o) {
+  const Result<CameraMatrices> m = cameraMatrices(scene, o);
+  if (!m.ok()) return m.error();
+  return m.value().view;
+}
+
 Status validate(const RenderOptions& o) {
   if (o.width < 1 || o.width > kMaxRasterSize || o.height < 1 || o.height > kMaxRasterSize)
     return Error{"", "", fmt::format("image size {}x{} is out of range (1…{} each)", o.width,

@@ -31,9 +31,16 @@ Scene generateLayers(const LayersParams& p, TrisStats* stats) {
             rows = std::max(1, int(std::lround(h / 20)));
   const double cellW = w / cols, cellH = h / rows;
 
+  // UVs from a generator of their own, so that the geometry and colours are those of earlier
+  // versions for the same seed: per layer an offset and a density in texels per pixel.
+  std::mt19937_64 uvRng(p.seed ^ 0x5DEECE66Dull);
+  auto uvUniform = [&](double a, double b) {
+    return std::uniform_real_distribution<double>(a, b)(uvRng);
+  };
   struct Tri {
     Vec3 v[3];
     Vec4 c[3];
+    Vec2 uv[3];
     int layer;
   };
   std::vector<Tri> tris;
@@ -46,6 +53,8 @@ Scene generateLayers(const LayersParams& p, TrisStats* stats) {
       return Vec3{float((2 * px / w - 1) * z * tanHalf * aspect),
                   float((1 - 2 * py / h) * z * tanHalf), float(-z)};
     };
+    const double uvPerPixel = std::exp2(uvUniform(-1, 2)) / 1024.0;  // BENCH.md's 1024² texture
+    const double u0 = uvUniform(0, 1), v0 = uvUniform(0, 1);
     std::vector<double> gx(size_t(cols + 1) * (rows + 1)), gy(gx.size());
     for (int j = 0; j <= rows; ++j)
       for (int i = 0; i <= cols; ++i) {
@@ -63,6 +72,7 @@ Scene generateLayers(const LayersParams& p, TrisStats* stats) {
           tri.layer = layer;
           for (int k = 0; k < 3; ++k) {
             tri.v[k] = world(gx[t[k]], gy[t[k]]);
+            tri.uv[k] = {float(u0 + gx[t[k]] * uvPerPixel), float(v0 + gy[t[k]] * uvPerPixel)};
             tri.c[k] = detail::randomBenchColor(rng);
           }
           totalArea += 0.5 * std::fabs((gx[t[1]] - gx[t[0]]) * (gy[t[2]] - gy[t[0]]) -
@@ -91,9 +101,12 @@ Scene generateLayers(const LayersParams& p, TrisStats* stats) {
       m.indices.push_back(uint32_t(m.positions.size()));
       m.positions.push_back(t.v[k]);
       m.colors.push_back(t.c[k]);
+      m.uvs.push_back(t.uv[k]);
     }
   Scene s = benchCameraScene("layers");
   s.meshes.push_back(std::move(m));
+  if (p.textured) addBenchTexture(s);
+  if (p.fog) addBenchFog(s);
   if (stats) {
     stats->meanArea = tris.empty() ? 0 : totalArea / double(tris.size());
     stats->depthComplexity = totalArea / (w * h);

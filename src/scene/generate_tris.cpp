@@ -57,6 +57,12 @@ void addBenchTexture(Scene& s) {
   for (Material& m : s.materials) m.texture = 0;
 }
 
+void addBenchFog(Scene& s) {
+  s.fog.enabled = true;
+  s.fog.color = {0.5f, 0.55f, 0.6f};
+  s.fog.beta = 0.1f;
+}
+
 Scene benchCameraScene(const std::string& name) {
   Scene s;
   Material mat;
@@ -198,6 +204,7 @@ Scene generateTris(const TrisParams& p, TrisStats* stats) {
   }
   s.meshes.push_back(std::move(m));
   if (p.textured) addBenchTexture(s);
+  if (p.fog) addBenchFog(s);
   if (stats) {
     stats->meanArea = tris.empty() ? 0 : totalArea / double(tris.size());
     stats->depthComplexity = totalArea / (regionW * regionH);

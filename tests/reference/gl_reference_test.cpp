@@ -40,6 +40,17 @@ TEST(GlReference, DrawsWhatSynthvisDraws) {
     EXPECT_EQ(r->runs[1].renderer, "gl");
     EXPECT_GE(r->psnrDb, 40.0) << c.name;
   }
+  // Textured with fog (BENCH.md's layers as issue 6 benchmarks them): the same texture pyramid,
+  // the same fog by range.
+  {
+    BenchSettings shaded = s;
+    shaded.textured = shaded.fog = true;
+    BenchRunner shadedRunner(shaded);
+    ASSERT_TRUE(shadedRunner.startReference().ok());
+    auto r = shadedRunner.run(layers);
+    ASSERT_TRUE(r.ok()) << r.error().str();
+    EXPECT_GE(r->psnrDb, 40.0);
+  }
   // A lit scene with cameras, culling and the background: the demo scene through a file.
   const std::string demo = (std::filesystem::temp_directory_path() / "sv_suite_demo.glb").string();
   ASSERT_TRUE(scene::saveGltf(scene::demoScene(), demo).ok());

@@ -237,6 +237,40 @@ TEST(LayersGenerator, SameSeedSameSceneAndStatistics) {
   EXPECT_NE(scene::generateLayers(p).meshes[0].positions, s1.meshes[0].positions);
 }
 
+// BENCH.md's layers are textured with fog: the flags add the bench texture and fog and change
+// nothing else; every layer's UVs are a linear map of the screen with 0.5–4 texels per pixel.
+TEST(LayersGenerator, TexturedAndFoggedLayersKeepTheirGeometry) {
+  scene::LayersParams p;
+  p.layers = 4;
+  p.width = 640;
+  p.height = 360;
+  const scene::Scene plain = scene::generateLayers(p);
+  p.textured = p.fog = true;
+  const scene::Scene shaded = scene::generateLayers(p);
+  EXPECT_EQ(plain.meshes[0].positions, shaded.meshes[0].positions);
+  EXPECT_EQ(plain.meshes[0].colors, shaded.meshes[0].colors);
+  EXPECT_EQ(plain.meshes[0].uvs, shaded.meshes[0].uvs);
+  EXPECT_TRUE(plain.textures.empty());
+  EXPECT_FALSE(plain.fog.enabled);
+  ASSERT_EQ(shaded.textures.size(), 1u);
+  EXPECT_EQ(shaded.materials[0].texture, 0);
+  EXPECT_TRUE(shaded.fog.enabled);
+  EXPECT_GT(shaded.fog.beta, 0);
+  EXPECT_TRUE(scene::validate(shaded, "layers").ok());
+  // Texels per pixel from a triangle's UVs and its (parallel-to-screen) pixel positions.
+  const scene::Mesh& m = shaded.meshes[0];
+  ASSERT_EQ(m.uvs.size(), m.positions.size());
+  const double tanHalf = std::tan(30.0 * 3.14159265358979 / 180.0);
+  for (size_t t = 0; t < m.positions.size(); t += 3 * 97) {
+    const Vec3 a = m.positions[t], b = m.positions[t + 1];
+    const double pixelsPerUnit = p.height / (2 * tanHalf * -a.z);
+    const double pixels = std::hypot(b.x - a.x, b.y - a.y) * pixelsPerUnit;
+    const double texels = std::hypot(m.uvs[t + 1].x - m.uvs[t].x, m.uvs[t + 1].y - m.uvs[t].y) * 1024;
+    EXPECT_GE(texels / pixels, 0.5 - 1e-3) << t;
+    EXPECT_LE(texels / pixels, 4 + 1e-3) << t;
+  }
+}
+
 // BENCH.md: "every pixel is covered D times" — counted by the renderer, in every order.
 TEST(LayersGenerator, EveryPixelIsCoveredDTimes) {
   for (auto order : {scene::SubmitOrder::random, scene::SubmitOrder::frontToBack,
