@@ -11,8 +11,8 @@
 //                  [--filter box|tent3]
 //                  [--renderer synthvis|gl|both] [--gl-readback] [--json FILE] [--html DIR]
 //                  [--image FILE]
-//   synthvis gen tris|layers -o scene.glb [--count N] [--area A] [--depth D] [--layers D]
-//                [--order O] [--seed S] [--width W] [--height H]
+//   synthvis gen tris|layers|grazing -o scene.glb [--count N] [--area A] [--depth D] [--layers D]
+//                [--order O] [--seed S] [--width W] [--height H] [--shade gouraud|textured]
 //   synthvis truth [SCENE] -o truth.png [--samples 256] [--width W] [--height H] [--threads T]
 //   synthvis truth … [--edges MASK.png]; synthvis compare IMAGE.png REFERENCE.png [--edges MASK.png]
 //   (shared BENCH.md defines the scenes and the JSON fields)
@@ -133,21 +133,20 @@ struct BenchArgs {
 
 // BENCH.md's generators that need features of later issues.
 const char* missingGenerator(const std::string& name) {
-  if (name == "grazing") return "texture (issue 5)";
   if (name == "freeform" || name == "freeform-one") return "free forms (issue 7)";
-  if (name == "terrain") return "texture and fog";
+  if (name == "terrain") return "height fields";
   if (name == "volume") return "voxel volumes";
   if (name == "lights") return "light points";
   return nullptr;
 }
 
-// The case for generator `kind` (tris or layers) with the given parameters; an error names a
+// The case for generator `kind` (tris, layers or grazing) with the given parameters; an error names a
 // generator that needs a later feature, or an unknown one.
 sv::Result<sv::reference::BenchCase> generatorCase(const std::string& kind, const GeneratorArgs& g) {
   if (const char* needs = missingGenerator(kind))
     return sv::Error{"", "", fmt::format("generator '{}' needs {}, not built yet", kind, needs)};
-  if (kind != "tris" && kind != "layers")
-    return sv::Error{"", "", fmt::format("unknown generator '{}' (tris, layers)", kind)};
+  if (kind != "tris" && kind != "layers" && kind != "grazing")
+    return sv::Error{"", "", fmt::format("unknown generator '{}' (tris, layers, grazing)", kind)};
   auto order = sv::scene::parseSubmitOrder(g.order);
   if (!order) return order.error();
   sv::reference::BenchCase c;
@@ -158,6 +157,7 @@ sv::Result<sv::reference::BenchCase> generatorCase(const std::string& kind, cons
   c.layers.layers = g.layers;
   c.layers.order = order.value();
   c.layers.seed = g.tris.seed;
+  c.grazing.seed = g.tris.seed;
   return c;
 }
 
@@ -194,7 +194,8 @@ int runBench(BenchArgs a) {
     cases = std::move(c).value();
   } else {
     ref::BenchCase c;
-    if (a.scene == "tris" || a.scene == "layers" || missingGenerator(a.scene)) {
+    if (a.scene == "tris" || a.scene == "layers" || a.scene == "grazing" ||
+        missingGenerator(a.scene)) {
       auto g = generatorCase(a.scene, a.generator);
       if (!g) return fail(g.error());
       c = g.value();
@@ -271,23 +272,31 @@ struct GenArgs {
   std::string output;
   GeneratorArgs generator;
   int width = 1920, height = 1080;
+  std::string shade = "gouraud";
 };
 
 // `synthvis gen KIND -o scene.glb`: a BENCH.md scene as glTF, for other renderers.
 int runGen(const GenArgs& a) {
   if (a.width < 1 || a.width > sv::kMaxRasterSize || a.height < 1 || a.height > sv::kMaxRasterSize)
     return fail({"", "", "width and height must be 1…8192"});
+  if (a.shade != "gouraud" && a.shade != "textured")
+    return fail({"", "", fmt::format("unknown shading '{}' (gouraud or textured)", a.shade)});
   auto c = generatorCase(a.kind, a.generator);
   if (!c) return fail(c.error());
+  c.value().tris.textured = c.value().layers.textured = a.shade == "textured";
   sv::RenderOptions o;
   o.width = a.width;
   o.height = a.height;
   auto made = sv::reference::makeScene(c.value(), o);
   if (!made) return fail(made.error());
   if (sv::Status s = sv::scene::saveGltf(made.value().scene, a.output); !s) return fail(s.error());
-  fmt::print("{}: {} {} triangles, mean area {:.1f} px at {}x{}, depth complexity {:.2f}\n",
-             a.output, a.kind, made.value().scene.triangleCount(), made.value().meanArea, a.width,
-             a.height, made.value().depthComplexity);
+  if (made.value().meanArea > 0)
+    fmt::print("{}: {} {} triangles, mean area {:.1f} px at {}x{}, depth complexity {:.2f}\n",
+               a.output, a.kind, made.value().scene.triangleCount(), made.value().meanArea, a.width,
+               a.height, made.value().depthComplexity);
+  else
+    fmt::print("{}: {} {} triangles, {} textures\n", a.output, a.kind,
+               made.value().scene.triangleCount(), made.value().scene.textures.size());
   return 0;
 }
 
@@ -382,7 +391,7 @@ int main(int argc, char** argv) {
 
   BenchArgs b;
   CLI::App* bench = app.add_subcommand("bench", "time whole frames of a benchmark scene (BENCH.md)");
-  bench->add_option("scene", b.scene, "generator (tris, layers) or scene file");
+  bench->add_option("scene", b.scene, "generator (tris, layers, grazing) or scene file");
   bench->add_option("--suite", b.suite, "a named suite of scenes: quick or full");
   addGeneratorOptions(bench, b.generator);
   bench->add_option("--shade", b.shade,
@@ -417,11 +426,14 @@ int main(int argc, char** argv) {
 
   GenArgs g;
   CLI::App* gen = app.add_subcommand("gen", "write a BENCH.md scene as glTF (.glb or .gltf)");
-  gen->add_option("kind", g.kind, "generator: tris or layers")->required();
+  gen->add_option("kind", g.kind, "generator: tris, layers or grazing")->required();
   gen->add_option("-o,--output", g.output, "output file (.glb or .gltf)")->required();
   addGeneratorOptions(gen, g.generator);
   gen->add_option("--width", g.width, "the raster the areas refer to")->capture_default_str();
   gen->add_option("--height", g.height, "the raster the areas refer to")->capture_default_str();
+  gen->add_option("--shade", g.shade,
+                  "tris, layers: gouraud, or textured (BENCH.md's 1024x1024 texture, as a PNG)")
+      ->capture_default_str();
 
   TruthArgs tr;
   CLI::App* truth = app.add_subcommand(

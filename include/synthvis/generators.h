@@ -53,6 +53,15 @@ struct LayersParams {
 };
 Scene generateLayers(const LayersParams& params, TrisStats* stats = nullptr);
 
+// BENCH.md `grazing`: a 1 km ground plane with seed 001's random texture seen from 2 m toward the
+// horizon, and five cubes (thirty faces) with a squares texture, lit, Phong on the cubes — the
+// scene of scenes/grazing.json without its glTF crate. `fog`: haze in the background colour.
+struct GrazingParams {
+  uint64_t seed = 1;  // the textures' noise
+  bool fog = false;
+};
+Scene generateGrazing(const GrazingParams& params);
+
 // The frame every generated scene shares: one instance of mesh 0 with material 0 (unlit,
 // double-sided, named `name`), the BENCH.md camera, no light, black background. No meshes yet.
 Scene benchCameraScene(const std::string& name);

@@ -379,24 +379,10 @@ Status GlRenderer::load(const scene::Scene& scene) {
     glGenTextures(1, &id);
     g.textures.push_back(id);
     glBindTexture(GL_TEXTURE_2D, id);
-    std::vector<uint8_t> rgba;
     for (int k = 0; k < t.levelCount(); ++k) {
       const texture::LevelView level = t.level(k);
-      rgba.resize(level.texels.size() * 4);
-      for (size_t i = 0; i < level.texels.size(); ++i) {
-        const texture::Texel& x = level.texels[i];
-        // Straight (not premultiplied) colour, sRGB-encoded; alpha linear.
-        const double a = x.a / 65535.0;
-        auto encode = [a](uint16_t c) {
-          const double v = a > 0 ? std::min(1.0, c / 65535.0 / a) : 0.0;
-          const double e = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1 / 2.4) - 0.055;
-          return uint8_t(std::lround(e * 255));
-        };
-        rgba[i * 4 + 0] = encode(x.r);
-        rgba[i * 4 + 1] = encode(x.g);
-        rgba[i * 4 + 2] = encode(x.b);
-        rgba[i * 4 + 3] = uint8_t(std::lround(a * 255));
-      }
+      // Straight (not premultiplied) colour, sRGB-encoded; alpha linear.
+      const std::vector<uint8_t> rgba = texture::toSrgb8(level);
       glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
       glTexImage2D(GL_TEXTURE_2D, k, GL_SRGB8_ALPHA8, level.width, level.height, 0, GL_RGBA,
                    GL_UNSIGNED_BYTE, rgba.data());

@@ -101,6 +101,10 @@ Result<CaseScene> makeScene(const BenchCase& c, const RenderOptions& options) {
     out.scene = scene::generateLayers(l, &realized);
     out.params = {
         {"layers", l.layers}, {"order", scene::submitOrderName(l.order)}, {"seed", l.seed}};
+  } else if (c.generator == "grazing") {
+    out.scene = scene::generateGrazing(c.grazing);
+    out.params = {{"seed", c.grazing.seed}};
+    return out;  // no target area or depth complexity to report
   } else if (c.generator.empty()) {
     auto loaded = scene::loadScene(c.file);
     if (!loaded) return loaded.error();
@@ -143,7 +147,7 @@ Result<CaseResult> BenchRunner::run(const BenchCase& c) {
     return Error{"", "", "frames must be 1…100000 and warmup 0…100000"};
   BenchCase shaded = c;
   shaded.tris.textured = shaded.layers.textured = s.textured;
-  shaded.tris.fog = shaded.layers.fog = s.fog;
+  shaded.tris.fog = shaded.layers.fog = shaded.grazing.fog = s.fog;
   auto made = makeScene(shaded, s.options);
   if (!made.ok()) return made.error();
   const scene::Scene& sc = made.value().scene;

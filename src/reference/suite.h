@@ -19,9 +19,10 @@ namespace sv::reference {
 // A scene to time: a generator with its parameters, or a scene file.
 struct BenchCase {
   std::string name;       // e.g. "tris-100k-a10", or the file's path
-  std::string generator;  // "tris", "layers", or empty for a file
+  std::string generator;  // "tris", "layers", "grazing", or empty for a file
   scene::TrisParams tris;
   scene::LayersParams layers;
+  scene::GrazingParams grazing;
   std::string file;
 };
 

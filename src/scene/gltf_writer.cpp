@@ -2,10 +2,14 @@
 // benchmark scenes can be rendered by other tools (`synthvis gen`).
 //
 // What is written is what the loader reads back (docs/scene-format.md, "glTF and OBJ files"):
-// one glTF mesh per Mesh (POSITION with min/max, NORMAL, COLOR_0 as float VEC4, TEXCOORD_0,
-// 32-bit indices), one material per Material (baseColorFactor, doubleSided,
-// KHR_materials_unlit), one node per Instance (its matrix), one node per Camera (camera-to-world
-// matrix, looking down −Z with +Y up; yfov in radians).
+// one glTF mesh per Mesh (POSITION with min/max, NORMAL, COLOR_0 as float VEC4, TEXCOORD_0 —
+// multiplied by its material's uvScale, which glTF cannot state —, 32-bit indices), one material
+// per Material (baseColorFactor, doubleSided, KHR_materials_unlit, alphaMode and alphaCutoff,
+// baseColorTexture), one image per texture (its level 0 as an 8-bit sRGB RGBA PNG in the buffer,
+// glTF's encoding for base colour) with a sampler of its wrap modes, one node per Instance (its
+// matrix), one node per Camera (camera-to-world matrix, looking down −Z with +Y up; yfov in
+// radians). Not written, as glTF core has no place for them: lights, fog, the background, Phong
+// and specular terms, the colour table.
 #include <fmt/format.h>
 #include <tiny_gltf.h>
 
@@ -13,6 +17,7 @@
 #include <cstring>
 
 #include "synthvis/scene.h"
+#include "texture/texture.h"
 
 namespace sv::scene {
 namespace {
@@ -58,6 +63,38 @@ Status saveGltf(const Scene& scene, const std::string& path) {
   model.asset.version = "2.0";
   model.asset.generator = "synthvis";
   model.buffers.resize(1);
+  for (size_t i = 0; i < scene.textures.size(); ++i) {
+    const texture::Texture& t = *scene.textures[i].texture;
+    auto png = texture::encodeTexturePng(t.level(0), path);
+    if (!png.ok()) return png.error();
+    auto& buffer = model.buffers[0].data;
+    tinygltf::BufferView view;
+    view.buffer = 0;
+    view.byteOffset = buffer.size();
+    view.byteLength = png.value().size();
+    buffer.insert(buffer.end(), png.value().begin(), png.value().end());
+    model.bufferViews.push_back(view);
+    tinygltf::Image image;
+    image.name = scene.textures[i].name;
+    image.mimeType = "image/png";
+    image.bufferView = int(model.bufferViews.size()) - 1;
+    model.images.push_back(image);
+    auto wrap = [](texture::Wrap w) {
+      return w == texture::Wrap::clamp    ? TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE
+             : w == texture::Wrap::mirror ? TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT
+                                          : TINYGLTF_TEXTURE_WRAP_REPEAT;
+    };
+    tinygltf::Sampler sampler;
+    sampler.wrapS = wrap(t.wrapX());
+    sampler.wrapT = wrap(t.wrapY());
+    sampler.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
+    sampler.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR;
+    model.samplers.push_back(sampler);
+    tinygltf::Texture texture;
+    texture.source = int(i);
+    texture.sampler = int(i);
+    model.textures.push_back(texture);
+  }
   bool unlitUsed = false;
   for (const Material& m : scene.materials) {
     tinygltf::Material out;
@@ -66,6 +103,12 @@ Status saveGltf(const Scene& scene, const std::string& path) {
                                                 m.baseColor.w};
     out.pbrMetallicRoughness.metallicFactor = 0;
     out.doubleSided = m.doubleSided;
+    if (m.texture >= 0) out.pbrMetallicRoughness.baseColorTexture.index = m.texture;
+    if (m.alphaMode == AlphaMode::blend) out.alphaMode = "BLEND";
+    if (m.alphaMode == AlphaMode::mask) {
+      out.alphaMode = "MASK";
+      out.alphaCutoff = m.alphaCutoff;
+    }
     if (m.unlit) {
       out.extensions["KHR_materials_unlit"] = tinygltf::Value(tinygltf::Value::Object());
       unlitUsed = true;
@@ -99,10 +142,14 @@ Status saveGltf(const Scene& scene, const std::string& path) {
       prim.attributes["COLOR_0"] =
           addAccessor(model, m.colors.data(), m.colors.size(), sizeof(Vec4), TINYGLTF_TYPE_VEC4,
                       TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
-    if (!m.uvs.empty())
+    if (!m.uvs.empty()) {
+      const Vec2 scale = m.material >= 0 ? scene.materials[size_t(m.material)].uvScale : Vec2{1, 1};
+      std::vector<Vec2> uvs(m.uvs);
+      for (Vec2& uv : uvs) uv = {uv.x * scale.x, uv.y * scale.y};
       prim.attributes["TEXCOORD_0"] =
-          addAccessor(model, m.uvs.data(), m.uvs.size(), sizeof(m.uvs[0]), TINYGLTF_TYPE_VEC2,
+          addAccessor(model, uvs.data(), uvs.size(), sizeof(uvs[0]), TINYGLTF_TYPE_VEC2,
                       TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
+    }
     prim.indices = addAccessor(model, m.indices.data(), m.indices.size(), sizeof(uint32_t),
                                TINYGLTF_TYPE_SCALAR, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
                                TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);

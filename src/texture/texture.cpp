@@ -339,4 +339,46 @@ Level generateTexture(Pattern pattern, int size, const Color4& a, const Color4& 
   return level;
 }
 
+std::vector<uint8_t> toSrgb8(const LevelView& level) {
+  std::vector<uint8_t> rgba(level.texels.size() * 4);
+  for (size_t i = 0; i < level.texels.size(); ++i) {
+    const Texel& x = level.texels[i];
+    const double a = x.a / 65535.0;
+    auto encode = [a](uint16_t c) {
+      const double v = a > 0 ? std::min(1.0, c / 65535.0 / a) : 0.0;
+      const double e = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1 / 2.4) - 0.055;
+      return uint8_t(std::lround(e * 255));
+    };
+    rgba[i * 4 + 0] = encode(x.r);
+    rgba[i * 4 + 1] = encode(x.g);
+    rgba[i * 4 + 2] = encode(x.b);
+    rgba[i * 4 + 3] = uint8_t(std::lround(a * 255));
+  }
+  return rgba;
+}
+
+Result<std::vector<uint8_t>> encodeTexturePng(const LevelView& level, const std::string& name) {
+  const std::vector<uint8_t> rgba = toSrgb8(level);
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  png.width = png_uint_32(level.width);
+  png.height = png_uint_32(level.height);
+  png.format = PNG_FORMAT_RGBA;
+  // First the size, then the bytes (libpng's two-call protocol for memory output).
+  png_alloc_size_t bytes = 0;
+  if (!png_image_write_to_memory(&png, nullptr, &bytes, 0, rgba.data(), 0, nullptr)) {
+    const std::string message = png.message;
+    png_image_free(&png);
+    return Error{name, "", "cannot encode PNG: " + message};
+  }
+  std::vector<uint8_t> out(bytes);
+  if (!png_image_write_to_memory(&png, out.data(), &bytes, 0, rgba.data(), 0, nullptr)) {
+    const std::string message = png.message;
+    png_image_free(&png);
+    return Error{name, "", "cannot encode PNG: " + message};
+  }
+  out.resize(bytes);
+  return out;
+}
+
 }  // namespace sv::texture

@@ -154,6 +154,13 @@ void anisotropicBlock(const Texture& texture, const Footprint* footprints, const
 Result<Level> readTextureImage(const std::string& path);
 Result<Level> decodeTextureImage(const void* data, size_t size, const std::string& name);
 
+// A level as 8-bit sRGB-encoded RGBA with straight (not premultiplied) alpha, top row first: what
+// an SRGB8_ALPHA8 GL texture and a glTF base-colour PNG hold (the inverse of the 8-bit decoding
+// above, to within 8-bit rounding).
+std::vector<uint8_t> toSrgb8(const LevelView& level);
+// The same, as an RGBA PNG in memory (for glTF export); errors name `name`.
+Result<std::vector<uint8_t>> encodeTexturePng(const LevelView& level, const std::string& name);
+
 }  // namespace sv::texture
 
 namespace sv::texture {

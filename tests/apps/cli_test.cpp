@@ -143,6 +143,19 @@ TEST(Cli, GenWritesAGlbThatRenders) {
   const CliRun r = run("render " + glb + " -o " + (tempDir() / "gen.png").string() +
                        " --width 320 --height 240");
   EXPECT_EQ(r.status, 0) << r.out;
+  // BENCH.md's grazing scene, textured: its textures travel in the .glb as PNGs.
+  const std::string grazing = (tempDir() / "grazing.glb").string();
+  const CliRun gz = run("gen grazing -o " + grazing);
+  ASSERT_EQ(gz.status, 0) << gz.out;
+  EXPECT_NE(gz.out.find("62 triangles, 2 textures"), std::string::npos) << gz.out;
+  EXPECT_EQ(run("render " + grazing + " -o " + (tempDir() / "grazing.png").string() +
+                " --width 160 --height 90")
+                .status,
+            0);
+  const CliRun b = run("bench grazing --fog --width 160 --height 90 --frames 1 --warmup 0");
+  EXPECT_EQ(b.status, 0) << b.out;
+  EXPECT_NE(b.out.find("grazing"), std::string::npos) << b.out;
+  expectOneLineError(run("gen tris --shade matte -o " + glb), "", "unknown shading");
   expectOneLineError(run("gen freeform -o " + glb), "", "free forms");
   expectOneLineError(run("bench --suite huge"), "", "unknown suite");
 }

@@ -1,10 +1,12 @@
 // saveGltf writes what loadGltf reads back: generated benchmark scenes survive the round trip.
+#include <cmath>
 #include <filesystem>
 
 #include <gtest/gtest.h>
 
 #include "synthvis/generators.h"
 #include "synthvis/scene.h"
+#include "texture/texture.h"
 
 namespace sv::scene {
 namespace {
@@ -53,6 +55,69 @@ TEST(GltfWriter, LitMeshesKeepTheirNormals) {
   ASSERT_TRUE(back.ok()) << back.error().str();
   EXPECT_EQ(back->triangleCount(), s.triangleCount());
   EXPECT_EQ(back->meshes[0].normals, s.meshes[0].normals);
+}
+
+// Textures go out as 8-bit sRGB PNGs with their wrap modes and come back within 8-bit rounding;
+// the material's uvScale is multiplied into the UVs; alpha modes survive.
+TEST(GltfWriter, TexturesWrapModesAndUvScaleRoundTrip) {
+  Scene s = generateGrazing({});
+  ASSERT_EQ(s.textures.size(), 2u);
+  // A third, clamped and mirrored texture with alpha, on a cut-out material.
+  texture::Level level;
+  level.width = 3;
+  level.height = 2;
+  for (int i = 0; i < 6; ++i) {
+    const uint16_t a = uint16_t(i * 13000);
+    level.texels.push_back({uint16_t(a / 2), uint16_t(a / 3), a, a});
+  }
+  s.textures.push_back({"odd", std::make_shared<texture::Texture>(std::move(level),
+                                                                  texture::Wrap::clamp,
+                                                                  texture::Wrap::mirror)});
+  Material cutOut = s.materials[1];
+  cutOut.texture = 2;
+  cutOut.alphaMode = AlphaMode::mask;
+  cutOut.alphaCutoff = 0.3f;
+  cutOut.uvScale = {2, 3};
+  s.materials.push_back(cutOut);
+  s.meshes[1].material = 2;
+  for (const char* name : {"grazing.glb", "grazing.gltf"}) {
+    const std::string path = tempPath(name);
+    ASSERT_TRUE(saveGltf(s, path).ok()) << name;
+    auto back = loadGltf(path);
+    ASSERT_TRUE(back.ok()) << back.error().str();
+    ASSERT_EQ(back->textures.size(), 3u) << name;
+    for (size_t t = 0; t < 3; ++t) {
+      const texture::Texture &a = *s.textures[t].texture, &b = *back->textures[t].texture;
+      EXPECT_EQ(a.wrapX(), b.wrapX()) << t;
+      EXPECT_EQ(a.wrapY(), b.wrapY()) << t;
+      const texture::LevelView la = a.level(0), lb = b.level(0);
+      ASSERT_EQ(la.width, lb.width);
+      ASSERT_EQ(la.height, lb.height);
+      double worst = 0;
+      for (size_t i = 0; i < la.texels.size(); ++i) {
+        // Premultiplied linear; 8-bit sRGB steps are at most 1/78 of linear (near white).
+        worst = std::max({worst, std::fabs(la.texels[i].r - lb.texels[i].r) / 65535.0,
+                          std::fabs(la.texels[i].b - lb.texels[i].b) / 65535.0,
+                          std::fabs(la.texels[i].a - lb.texels[i].a) / 65535.0});
+      }
+      EXPECT_LT(worst, 0.015) << t;
+    }
+    ASSERT_EQ(back->materials.size(), s.materials.size());
+    EXPECT_EQ(back->materials[0].texture, 0);
+    EXPECT_EQ(back->materials[1].texture, 1);
+    EXPECT_EQ(back->materials[2].texture, 2);
+    EXPECT_EQ(back->materials[2].alphaMode, AlphaMode::mask);
+    EXPECT_FLOAT_EQ(back->materials[2].alphaCutoff, 0.3f);
+    // The ground's uvScale of 80 is in its UVs now.
+    for (size_t m = 0; m < s.meshes.size(); ++m) {
+      const Vec2 scale = s.materials[size_t(s.meshes[m].material)].uvScale;
+      ASSERT_EQ(back->meshes[m].uvs.size(), s.meshes[m].uvs.size());
+      for (size_t i = 0; i < s.meshes[m].uvs.size(); ++i) {
+        EXPECT_FLOAT_EQ(back->meshes[m].uvs[i].x, s.meshes[m].uvs[i].x * scale.x);
+        EXPECT_FLOAT_EQ(back->meshes[m].uvs[i].y, s.meshes[m].uvs[i].y * scale.y);
+      }
+    }
+  }
 }
 
 TEST(GltfWriter, RefusesOtherExtensions) {
