@@ -446,15 +446,33 @@ HWY_INLINE void shadeBlockSamplesMaterial(const TriangleSetup& t, const PlaneLan
   alignas(32) float base[8];
   blockBases(t, lanes, gx, gy, base);
   alignas(64) float cx[kBlockPixels] = {}, cy[kBlockPixels] = {};
+  // Step 1, early depth test: the samples that pass, a bit per sample as the masks hold them.
+  // A block none of whose samples pass is not shaded at all (with depth complexity, most).
+  alignas(64) uint32_t pass[2][kBlockPixels];
   bool any = false;
   for (size_t i = 0; i < size_t(kBlockPixels); i += n) {
-    if (!masks) {
-      any = true;
-      continue;
+    auto m0 = hn::Set(du32, fullWord0), m1 = hn::Set(du32, fullWord1);
+    if (masks) {
+      m0 = hn::LoadU(du32, masks[0] + i);
+      m1 = samples > 32 ? hn::LoadU(du32, masks[1] + i) : hn::Zero(du32);
     }
-    const auto m0 = hn::LoadU(du32, masks[0] + i);
-    const auto m1 = samples > 32 ? hn::LoadU(du32, masks[1] + i) : hn::Zero(du32);
-    if (hn::AllTrue(du32, hn::Eq(hn::Or(m0, m1), hn::Zero(du32)))) continue;
+    const auto zPix = hn::Add(hn::Set(df, base[kDepth]), hn::LoadU(df, lanes.offset[kDepth] + i));
+    auto p0 = hn::Zero(du32), p1 = p0;
+    for (int s = 0; s < samples; ++s) {
+      const auto bit = hn::Set(du32, 1u << (s & 31));
+      const auto covered = hn::RebindMask(df, hn::TestBit(s < 32 ? m0 : m1, bit));
+      if (hn::AllFalse(df, covered)) continue;
+      const auto z = hn::Add(zPix, hn::Set(df, sampleDepth[s]));
+      const auto passed = hn::RebindMask(
+          du32, hn::And(covered, hn::Lt(z, hn::LoadU(df, depth + size_t(s) * kBlockPixels + i))));
+      if (s < 32)
+        p0 = hn::Or(p0, hn::IfThenElseZero(passed, bit));
+      else
+        p1 = hn::Or(p1, hn::IfThenElseZero(passed, bit));
+    }
+    hn::StoreU(p0, du32, pass[0] + i);
+    hn::StoreU(p1, du32, pass[1] + i);
+    if (hn::AllTrue(du32, hn::Eq(hn::Or(p0, p1), hn::Zero(du32)))) continue;
     any = true;
     const bool full = hn::AllTrue(du32, hn::Eq(m0, hn::Set(du32, fullWord0))) &&
                       hn::AllTrue(du32, hn::Eq(m1, hn::Set(du32, fullWord1)));
@@ -472,25 +490,21 @@ HWY_INLINE void shadeBlockSamplesMaterial(const TriangleSetup& t, const PlaneLan
   shade::shadeFragments(*a.material, env, f, rgba);
   const bool blend = a.material->alpha == shade::AlphaUse::blend;
   const bool cut = a.material->alpha == shade::AlphaUse::mask;
+  // Step 2: write the shaded colour (and depth) to the samples that passed.
   for (size_t i = 0; i < size_t(kBlockPixels); i += n) {
-    auto m0 = hn::Set(du32, ~0u), m1 = m0;
-    if (masks) {
-      m0 = hn::LoadU(du32, masks[0] + i);
-      m1 = samples > 32 ? hn::LoadU(du32, masks[1] + i) : hn::Zero(du32);
-    }
+    const auto p0 = hn::LoadU(du32, pass[0] + i), p1 = hn::LoadU(du32, pass[1] + i);
+    if (hn::AllTrue(du32, hn::Eq(hn::Or(p0, p1), hn::Zero(du32)))) continue;
     auto shown = hn::FirstN(df, n);  // all lanes
     if (cut) shown = hn::Gt(hn::LoadU(df, rgba[3] + i), hn::Zero(df));
     const auto zPix = hn::Add(hn::Set(df, base[kDepth]), hn::LoadU(df, lanes.offset[kDepth] + i));
     for (int s = 0; s < samples; ++s) {
-      const auto covered = hn::And(
-          shown, hn::RebindMask(df, hn::TestBit(s < 32 ? m0 : m1, hn::Set(du32, 1u << (s & 31)))));
-      if (hn::AllFalse(df, covered)) continue;
-      float* zPlane = depth + size_t(s) * kBlockPixels + i;
-      const auto z = hn::Add(zPix, hn::Set(df, sampleDepth[s]));
-      const auto pass = hn::And(covered, hn::Lt(z, hn::LoadU(df, zPlane)));
-      if (hn::AllFalse(df, pass)) continue;
-      if (!blend) hn::BlendedStore(z, pass, df, zPlane);
-      storeShaded(df, pass, blend, rgba, i, color + size_t(s) * kColorPerBlock);
+      const auto passed = hn::And(
+          shown, hn::RebindMask(df, hn::TestBit(s < 32 ? p0 : p1, hn::Set(du32, 1u << (s & 31)))));
+      if (hn::AllFalse(df, passed)) continue;
+      if (!blend)
+        hn::BlendedStore(hn::Add(zPix, hn::Set(df, sampleDepth[s])), passed, df,
+                         depth + size_t(s) * kBlockPixels + i);
+      storeShaded(df, passed, blend, rgba, i, color + size_t(s) * kColorPerBlock);
     }
   }
 }
