@@ -4,9 +4,10 @@
 //                   [--no-cull] [--debug-view overdraw] [--gamma G] [--supersample K]
 //                   [--aa 1|4|8|16|64] [--filter box|tent3]
 //                   [--texture-filter point|nearest|tri3|bilinear|trilinear3|trilinear|aniso]
+//                   [--hsr zbuffer|priority]
 //   synthvis bench SCENE|--suite quick|full [--count N] [--area A] [--depth D] [--layers D]
 //                  [--order random|f2b|b2f] [--shade gouraud|textured] [--fog]
-//                  [--texture-filter F] [--width W] [--height H]
+//                  [--texture-filter F] [--hsr zbuffer|priority] [--width W] [--height H]
 //                  [--threads T] [--frames F] [--warmup W] [--seed S] [--aa S] [--gl-aa S]
 //                  [--filter box|tent3]
 //                  [--renderer synthvis|gl|both] [--gl-readback] [--json FILE] [--html DIR]
@@ -58,6 +59,7 @@ struct RenderArgs {
   std::string debugView;
   std::string filter = "box";
   std::string textureFilter = "trilinear";
+  std::string hsr = "zbuffer";
   bool noCull = false;
   sv::RenderOptions options;
 };
@@ -71,6 +73,9 @@ int runRender(const RenderArgs& a) {
   auto textureFilter = sv::scene::parseTextureFilter(a.textureFilter);
   if (!textureFilter) return fail(textureFilter.error());
   o.textureFilter = textureFilter.value();
+  auto hsr = sv::parseHsr(a.hsr);
+  if (!hsr) return fail(hsr.error());
+  o.hsr = hsr.value();
   if (!a.debugView.empty()) {
     if (a.debugView != "overdraw")
       return fail({"", "", fmt::format("unknown debug view '{}' (available: overdraw)", a.debugView)});
@@ -118,6 +123,7 @@ struct BenchArgs {
   std::string shade = "gouraud";
   bool fog = false;
   std::string textureFilter = "trilinear";
+  std::string hsr = "zbuffer";
   std::string renderer;  // synthvis, gl or both; default synthvis for a scene, both for a suite
   std::string json;
   std::string html;
@@ -174,6 +180,10 @@ int runBench(BenchArgs a) {
     return fail(f.error());
   else
     a.options.textureFilter = f.value();
+  if (auto h = sv::parseHsr(a.hsr); !h)
+    return fail(h.error());
+  else
+    a.options.hsr = h.value();
   if (sv::Status s = sv::validate(a.options); !s) return fail(s.error());
   if (a.scene.empty() == a.suite.empty())
     return fail({"", "", "give either a scene (a generator name or a file) or --suite quick|full"});
@@ -381,6 +391,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   render->add_option("--filter", r.filter, "resolve filter: box or tent3 (3x3 triangle)")
       ->capture_default_str();
+  render->add_option("--hsr", r.hsr,
+                     "hidden surfaces: zbuffer, or priority (masking; the scene's order is the "
+                     "priority, nearest first)")
+      ->capture_default_str();
   render->add_option("--texture-filter", r.textureFilter,
                      "texture sampling for materials that do not choose: point, nearest, tri3, "
                      "bilinear, trilinear3, trilinear or aniso")
@@ -398,6 +412,8 @@ int main(int argc, char** argv) {
                     "generated scenes: gouraud, or textured (BENCH.md's 1024x1024 texture)")
       ->capture_default_str();
   bench->add_flag("--fog", b.fog, "generated scenes: BENCH.md's fog (haze, beta 0.1 per unit)");
+  bench->add_option("--hsr", b.hsr, "hidden surfaces: zbuffer or priority")
+      ->capture_default_str();
   bench->add_option("--texture-filter", b.textureFilter,
                     "nearest, tri3, bilinear, trilinear3, trilinear or aniso")
       ->capture_default_str();

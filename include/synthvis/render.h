@@ -39,7 +39,16 @@ struct RenderOptions {
   enum class Filter { box, tent3 } filter = Filter::box;
   // How texture maps are sampled (SPEC §7), for materials that do not choose (`inherit`).
   scene::TextureFilter textureFilter = scene::TextureFilter::trilinear;
+  // Hidden-surface removal (SPEC §4): the Z-buffer alone; or multi-level priority masking, which
+  // takes the scene's opaque triangles in submission order as their priority, nearest first
+  // (exact for scenes given in a true front-to-back order without interpenetration, as the seeds'
+  // databases were; docs/hidden-surfaces.md), the depth test kept for translucent triangles.
+  enum class Hsr { zbuffer, priority } hsr = Hsr::zbuffer;
 };
+
+// By name, as the CLI's --hsr writes them: "zbuffer", "priority".
+Result<RenderOptions::Hsr> parseHsr(const std::string& text);
+const char* hsrName(RenderOptions::Hsr hsr);
 
 // Checks sizes and counts; the error names the option.
 Status validate(const RenderOptions& options);
@@ -58,6 +67,7 @@ struct FrameStats {
   uint64_t drawn = 0;
   uint64_t windows[6] = {};
   uint64_t fullWindows = 0, partialBlocks = 0, fragments = 0;
+  uint64_t occludedWindows = 0;  // windows triangles were dropped from as occupied (priority)
   // rasterMs: the tile pass, which includes resolving each finished tile into the image.
   double vertexMs = 0, setupMs = 0, rasterMs = 0, totalMs = 0;
 

@@ -8,6 +8,7 @@
 
 #include "geometry/setup.h"
 #include "raster/coverage_masks.h"
+#include "raster/occupancy.h"
 #include "shade/shading.h"
 
 namespace sv::raster {
@@ -18,6 +19,7 @@ inline constexpr int kStatLevels = 6;
 struct RasterStats {
   uint64_t windows[kStatLevels] = {};  // windows tested per level (each child of a split counts)
   uint64_t fullWindows = 0;            // covered windows filled without further subdivision
+  uint64_t occludedWindows = 0;        // windows a triangle was dropped from as occupied (SPEC §4)
   uint64_t partialBlocks = 0;          // 4×4 leaves tested pixel by pixel
   uint64_t fragments = 0;              // pixels that passed coverage (some sample, with
                                        // anti-aliasing) and reached the depth test
@@ -25,6 +27,7 @@ struct RasterStats {
   void add(const RasterStats& o) {
     for (int i = 0; i < kStatLevels; ++i) windows[i] += o.windows[i];
     fullWindows += o.fullWindows;
+    occludedWindows += o.occludedWindows;
     partialBlocks += o.partialBlocks;
     fragments += o.fragments;
   }
@@ -72,6 +75,12 @@ struct TileWork {
   // ShadeMode::material at one sample: kTilePixels entries of scratch, all ~0u on entry and left
   // so (which triangle won each pixel: its shading is deferred until the tile's lists are drawn).
   uint32_t* visible = nullptr;
+  // Multi-level priority masking (SPEC §4; not with ShadeMode::overdraw): the lists are in priority
+  // order, nearest first, and opaque triangles are dropped from windows nearer ones occupy. The
+  // tile's occupancy, emptied with the tile (`clear`) and kept across calls for later batches.
+  // nullptr: the Z-buffer alone. The depth test stays on either way, so that translucent
+  // triangles (drawn after the opaque ones) are hidden behind nearer opaque ones.
+  Occupancy* occupancy = nullptr;
 };
 
 // Draws the tile's triangles as `work.shade` says. Runs the best SIMD

@@ -41,6 +41,7 @@
 #include <cstring>
 
 #include "raster/framebuffer.h"
+#include "raster/occupancy.h"
 #include "raster/rasterizer.h"
 
 HWY_BEFORE_NAMESPACE();
@@ -86,6 +87,8 @@ struct TileContext {
   const TriangleSetup* setups;
   const AttributeSetup* attributes;
   uint32_t attributeBase;
+  // Priority masking (SPEC §4): the tile's occupied windows, or nullptr (Z-buffer alone).
+  Occupancy* occupancy;
 };
 
 // Parameters are evaluated per 4×4 block as base + offset: base = (c0 + dx·X) + dy·Y at the block's
@@ -680,6 +683,16 @@ class TriangleRaster {
   TriangleRaster(const TriangleSetup& t, const TileContext& ctx,
                  const AttributeSetup* attributes = nullptr, uint32_t id = kNoTriangle)
       : t_(t), ctx_(ctx), attributes_(attributes), id_(id) {
+    // Priority masking: opaque triangles are dropped where nearer ones occupy the tile and mark
+    // what they cover; cut-outs (alpha mask) are dropped but mark nothing (their holes show what
+    // lies behind); translucent ones blend over whatever the depth test lets through.
+    if constexpr (kOp != PixelOp::overdraw) {
+      const shade::AlphaUse alpha = attributes && attributes->material
+                                        ? attributes->material->alpha
+                                        : shade::AlphaUse::opaque;
+      if (alpha != shade::AlphaUse::blend) occ_ = ctx.occupancy;
+      mark_ = occ_ && alpha == shade::AlphaUse::opaque;
+    }
     if constexpr (kOp != PixelOp::overdraw) computePlaneLanes(t, planeLanes_);
     if constexpr (kOp == PixelOp::material) computeAttributeLanes(*attributes, attributeLanes_);
     if constexpr (kAA) setUpSamples();
@@ -780,6 +793,10 @@ class TriangleRaster {
   // Classifies a root window by the coverage function of each edge, then fills, tests or splits.
   void visitRoot(int lx, int ly, int log2n, int n) {
     ++ctx_.stats->windows[statLevel(log2n)];
+    if (occ_ && occ_->fullOrInside(log2n, lx, ly)) {
+      ++ctx_.stats->occludedWindows;
+      return;
+    }
     T tl[kMaxEdges];
     for (int k = 0; k < E; ++k) {
       const auto& e = t_.edges[k];
@@ -834,6 +851,10 @@ class TriangleRaster {
     ctx_.stats->windows[statLevel(hLog2)] += 4;
     for (unsigned live = ~rejected & 0xFu; live; live &= live - 1) {
       const int c = std::countr_zero(live);
+      if (occ_ && occ_->full(hLog2, lx + (c & 1) * int(h), ly + (c >> 1) * int(h))) {
+        ++ctx_.stats->occludedWindows;
+        continue;
+      }
       unsigned childActive = active;
       T ctl[kMaxEdges] = {};
       for (int k = 0; k < E; ++k) {
@@ -866,7 +887,10 @@ class TriangleRaster {
     }
     ++ctx_.stats->partialBlocks;
     ctx_.stats->windows[kStatLevels - 1] += kBlockPixels;
-    if (mask) shade(lx, ly, mask);
+    if (occ_) mask &= ~occ_->pixels(lx, ly);
+    if (!mask) return;
+    shade(lx, ly, mask);
+    if (mark_) occ_->addPixels(lx, ly, mask);
   }
 
   // An anti-aliased leaf: per pixel, the AND of the crossing edges' masks from the table.
@@ -880,7 +904,7 @@ class TriangleRaster {
       if (tl[k] + maxOffset(k, T(kBlockSize - 1)) < 0) return;
       if (tl[k] + minOffset(k, T(kBlockSize - 1)) >= 0) active &= ~(1u << k);
     }
-    if (active == 0) return shadeSamples(lx, ly, nullptr, kBlockPixels);
+    if (active == 0) return fillBlock(lx, ly);
     const hn::CappedTag<int32_t, kBlockPixels> di;
     const hn::Rebind<float, decltype(di)> df;
     const size_t lanes = hn::Lanes(di);
@@ -913,7 +937,8 @@ class TriangleRaster {
     }
     // Row entries are read by vector gathers: scalar loads of SIMD-computed entries measured 7 %
     // slower (AMD Zen 4, 100k triangles of 10 px at 4 samples: 28.1 vs 26.3 ms).
-    alignas(64) uint32_t masks[2][kBlockPixels];
+    alignas(64) uint32_t masks[2][kBlockPixels], occupied[2][kBlockPixels];
+    if (occ_) occ_->samples(lx, ly, occupied);
     const auto zero = hn::Zero(di), minusOne = hn::Set(di, -1);
     const int32_t* word0 = reinterpret_cast<const int32_t*>(cov.word[0].data());
     const int32_t* word1 = reinterpret_cast<const int32_t*>(cov.word[1].data());
@@ -966,14 +991,70 @@ class TriangleRaster {
         if (cov.words == 2) m1 = hn::And(m1, hn::GatherIndex(di, word1, idx));
       }
       if (cov.words == 1) m1 = zero;
+      if (occ_) {  // the samples nearer primitives hold are not this one's
+        m0 = hn::AndNot(hn::LoadU(di, reinterpret_cast<const int32_t*>(occupied[0] + i)), m0);
+        m1 = hn::AndNot(hn::LoadU(di, reinterpret_cast<const int32_t*>(occupied[1] + i)), m1);
+      }
       hn::StoreU(m0, di, reinterpret_cast<int32_t*>(masks[0] + i));
       hn::StoreU(m1, di, reinterpret_cast<int32_t*>(masks[1] + i));
       covered += int(hn::CountTrue(di, hn::Ne(hn::Or(m0, m1), zero)));
     }
-    if (covered) shadeSamples(lx, ly, masks, covered);
+    if (!covered) return;
+    shadeSamples(lx, ly, masks, covered);
+    if (mark_) occ_->addSamples(lx, ly, masks);
   }
 
   void fill(int lx, int ly, int n) {
+    if (occ_) return fillMasked(lx, ly, std::countr_zero(unsigned(n)));
+    plainFill(lx, ly, n);
+  }
+
+  // A covered window under priority masking: occupied parts dropped, empty parts filled directly,
+  // and the window occupied afterwards.
+  void fillMasked(int lx, int ly, int level) {
+    if (occ_->full(level, lx, ly)) {
+      ++ctx_.stats->occludedWindows;
+      return;
+    }
+    if (!occ_->touched(level, lx, ly)) {
+      plainFill(lx, ly, 1 << level);
+      if (mark_) occ_->markFull(level, lx, ly);
+      return;
+    }
+    if (level == kBlockLog2) return fillBlock(lx, ly);
+    const int h = 1 << (level - 1);
+    for (int c = 0; c < 4; ++c) fillMasked(lx + (c & 1) * h, ly + (c >> 1) * h, level - 1);
+  }
+
+  // A 4×4 block wholly inside the triangle: its free pixels (samples) only, under masking.
+  void fillBlock(int lx, int ly) {
+    if (!occ_) return plainFill(lx, ly, kBlockSize);
+    if constexpr (kAA) {
+      alignas(64) uint32_t masks[2][kBlockPixels];
+      occ_->samples(lx, ly, masks);
+      const int samples = ctx_.samples;
+      const uint32_t fullWord0 = samples >= 32 ? ~0u : (1u << samples) - 1;
+      const uint32_t fullWord1 = samples > 32 ? ~0u : 0u;
+      int covered = 0;
+      for (int p = 0; p < kBlockPixels; ++p) {
+        masks[0][p] = fullWord0 & ~masks[0][p];
+        masks[1][p] = fullWord1 & ~masks[1][p];
+        covered += (masks[0][p] | masks[1][p]) != 0;
+      }
+      if (!covered) return;
+      ++ctx_.stats->fullWindows;
+      shadeSamples(lx, ly, masks, covered);
+      if (mark_) occ_->addSamples(lx, ly, masks);
+    } else {
+      const uint32_t mask = 0xFFFFu & ~occ_->pixels(lx, ly);
+      if (!mask) return;
+      ++ctx_.stats->fullWindows;
+      shade(lx, ly, mask);
+      if (mark_) occ_->addPixels(lx, ly, mask);
+    }
+  }
+
+  void plainFill(int lx, int ly, int n) {
     ++ctx_.stats->fullWindows;
     for (int by = ly; by < ly + n; by += kBlockSize)
       for (int bx = lx; bx < lx + n; bx += kBlockSize) {
@@ -1022,6 +1103,8 @@ class TriangleRaster {
   const TileContext& ctx_;
   const AttributeSetup* attributes_;  // PixelOp::material
   const uint32_t id_;                 // PixelOp::visibility
+  Occupancy* occ_ = nullptr;          // priority masking: drop occupied windows
+  bool mark_ = false;                 // … and occupy what this triangle covers
   T sX_[E], sY_[E], pos_[E], neg_[E];
   alignas(64) T leafOffset_[E][kBlockPixels];
   PlaneLanes planeLanes_;
@@ -1063,7 +1146,8 @@ void drawLists(const TileWork& w, RasterStats& stats) {
   const bool deferred = kShade == ShadeMode::material && !kAA;
   const TileContext ctx{w.tileX * kTileSize, w.tileY * kTileSize, w.depth, w.color, &stats,
                         w.coverage, w.coverage ? w.coverage->samples : 1, w.environment,
-                        deferred ? w.visible : nullptr, w.setups, w.attributes, w.attributeBase};
+                        deferred ? w.visible : nullptr, w.setups, w.attributes, w.attributeBase,
+                        kShade == ShadeMode::overdraw ? nullptr : w.occupancy};
   bool pending = false;  // some pixel records a triangle not yet shaded
   // Setup records are read in bin order, scattered over the batch: fetch a few ahead, the loop is
   // otherwise bound by their cache misses. (Before records were grouped by tile this was half the
@@ -1112,6 +1196,7 @@ void drawLists(const TileWork& w, RasterStats& stats) {
 
 void RasterizeTile(const TileWork& w, RasterStats& stats) {
   if (w.clear) clearTile(w);
+  if (w.clear && w.occupancy) w.occupancy->clear(w.coverage ? w.coverage->samples : 1);
   if (w.shade == ShadeMode::overdraw)
     drawLists<ShadeMode::overdraw, false>(w, stats);
   else if (w.shade == ShadeMode::material && w.coverage)

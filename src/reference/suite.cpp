@@ -234,6 +234,7 @@ nlohmann::json jsonRows(const CaseResult& r, const BenchSettings& s) {
                 {"warmup", s.warmup},
                 {"shade", s.textured ? "textured" : "gouraud"},
                 {"fog", s.fog},
+                {"hsr", run.renderer == "synthvis" ? hsrName(s.options.hsr) : "zbuffer"},
                 {"texture_filter", scene::textureFilterName(s.options.textureFilter)},
                 {"aa", run.renderer == "synthvis" ? s.options.samples : std::max(1, s.referenceMsaa)},
                 {"filter", s.options.filter == RenderOptions::Filter::tent3 ? "tent3" : "box"},

@@ -68,7 +68,10 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
     if (!wholeFrame) w.tile.resize(raster::kTileSize, raster::kTileSize, samples);
     if (settings.shade == raster::ShadeMode::material && samples == 1)
       w.visible.assign(raster::kTilePixels, ~0u);
+    if (settings.priorityMasking && !wholeFrame && !w.occupancy)
+      w.occupancy = std::make_unique<raster::Occupancy>();
   }
+  if (settings.priorityMasking && wholeFrame) frameOccupancy_.resize(size_t(tiles));
   tileStats_.assign(size_t(tiles), raster::RasterStats{});
   const int maxChunks = std::max(1, int((firstBatch + kChunkTriangles - 1) / kChunkTriangles));
   std::vector<SetupCounts> counts(static_cast<size_t>(maxChunks));
@@ -172,6 +175,8 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
         w.environment = settings.environment;
         if (samples == 1) w.visible = scratch_[worker].visible.data();
       }
+      if (settings.priorityMasking)
+        w.occupancy = wholeFrame ? &frameOccupancy_[tile] : scratch_[worker].occupancy.get();
       raster::rasterizeTile(w, tileStats_[tile]);
       if (lastBatch && settings.finishTile) settings.finishTile(int(tile), w.depth, w.color);
     });
@@ -182,6 +187,7 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
   for (const auto& s : tileStats_) total.add(s);
   for (int i = 0; i < raster::kStatLevels; ++i) stats.windows[i] += total.windows[i];
   stats.fullWindows += total.fullWindows;
+  stats.occludedWindows += total.occludedWindows;
   stats.partialBlocks += total.partialBlocks;
   stats.fragments += total.fragments;
 }

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "core/thread_pool.h"
@@ -52,6 +53,9 @@ struct FrameSettings {
   // batch draw each tile in a small per-thread buffer that never leaves the core's cache; frames of
   // several keep a whole-frame buffer between batches. Tests lower it to exercise that path.
   uint32_t batchTriangles = 1u << 18;
+  // Multi-level priority masking (raster::TileWork::occupancy): the packets' triangles in priority
+  // order, nearest first.
+  bool priorityMasking = false;
 };
 
 class FrameRenderer {
@@ -72,7 +76,9 @@ class FrameRenderer {
     raster::Binner::Scratch bins;
     raster::FrameBuffer tile;  // 64×64: the tile being drawn, in frames of one batch
     std::vector<uint32_t> visible;  // 64×64 deferred-shading records (TileWork::visible)
+    std::unique_ptr<raster::Occupancy> occupancy;  // the tile's, in frames of one batch
   };
+  std::vector<raster::Occupancy> frameOccupancy_;  // every tile's, in frames of several batches
   std::vector<geometry::TriangleSetup> setups_;  // the batch's, grouped by tile within each chunk
   std::vector<raster::AttributeSetup> attributes_;  // the batch's, by triangle (ShadeMode::material)
   std::vector<WorkerScratch> scratch_;           // one per pool worker

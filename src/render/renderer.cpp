@@ -189,11 +189,21 @@ Status validate(const RenderOptions& o) {
 std::string FrameStats::summary() const {
   return fmt::format(
       "triangles in {} / culled {} (facing {}, outside {}, degenerate {}, invalid {}) / drawn {} | "
-      "windows 64:{} 32:{} 16:{} 8:{} 4:{} px-tests:{} full:{} | {:.2f} ms (vertex {:.2f}, setup "
-      "{:.2f}, tiles {:.2f} incl. resolve)",
+      "windows 64:{} 32:{} 16:{} 8:{} 4:{} px-tests:{} full:{} occluded:{} | {:.2f} ms (vertex "
+      "{:.2f}, setup {:.2f}, tiles {:.2f} incl. resolve)",
       trianglesIn, culled(), culledFacing, culledOutside, culledDegenerate, culledInvalid, drawn,
-      windows[0], windows[1], windows[2], windows[3], windows[4], windows[5], fullWindows, totalMs,
-      vertexMs, setupMs, rasterMs);
+      windows[0], windows[1], windows[2], windows[3], windows[4], windows[5], fullWindows,
+      occludedWindows, totalMs, vertexMs, setupMs, rasterMs);
+}
+
+Result<RenderOptions::Hsr> parseHsr(const std::string& text) {
+  if (text == "zbuffer") return RenderOptions::Hsr::zbuffer;
+  if (text == "priority") return RenderOptions::Hsr::priority;
+  return Error{"", "", fmt::format("unknown hidden-surface method '{}' (zbuffer or priority)", text)};
+}
+
+const char* hsrName(RenderOptions::Hsr hsr) {
+  return hsr == RenderOptions::Hsr::priority ? "priority" : "zbuffer";
 }
 
 struct Renderer::Impl {
@@ -302,6 +312,7 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
                               : raster::ShadeMode::gouraud;
   fs.environment = &shading.environment;
   fs.samples = o.samples;
+  fs.priorityMasking = o.hsr == RenderOptions::Hsr::priority && !o.debugOverdraw;
   if (o.samples > 1) {
     // A frame of several batches keeps a whole-frame sample buffer (samples × 10 bytes a pixel:
     // 330 MB at 1080p with 16 samples). Batches as large as the records that buffer would hold
