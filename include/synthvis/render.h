@@ -67,7 +67,8 @@ struct FrameStats {
   uint64_t drawn = 0;
   uint64_t windows[6] = {};
   uint64_t fullWindows = 0, partialBlocks = 0, fragments = 0;
-  uint64_t occludedWindows = 0;  // windows triangles were dropped from as occupied (priority)
+  uint64_t occludedWindows = 0;    // windows triangles were dropped from as occupied (priority)
+  uint64_t occludedTriangles = 0;  // triangles dropped whole from a tile (their box occupied)
   // rasterMs: the tile pass, which includes resolving each finished tile into the image.
   double vertexMs = 0, setupMs = 0, rasterMs = 0, totalMs = 0;
 

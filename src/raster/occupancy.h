@@ -64,6 +64,12 @@ class Occupancy {
     std::memcpy(out, sampleMask_[blockIndex(lx, ly)], sizeof(uint32_t) * 2 * kBlockPixels);
   }
 
+  // Whether the tile-local pixel rectangle [x0, x1] × [y0, y1] (inside the tile) lies wholly in
+  // full windows: a primitive inside it is hidden before anything about it is set up.
+  bool rectFull(int x0, int y0, int x1, int y1) const {
+    return rectFull(kMaxLevel, 0, 0, x0, y0, x1, y1);
+  }
+
   // Marks a window of size 2^level full: covered by one opaque primitive.
   void markFull(int level, int lx, int ly) {
     touch(level, lx, ly);
@@ -125,6 +131,17 @@ class Occupancy {
   static void set(uint64_t (*bits)[kBlocks / 64], int level, int lx, int ly) {
     const int i = bitIndex(level, lx, ly);
     bits[level - kMinLevel][i >> 6] |= uint64_t(1) << (i & 63);
+  }
+  bool rectFull(int level, int wx, int wy, int x0, int y0, int x1, int y1) const {
+    if (test(full_, level, wx, wy)) return true;
+    if (level == kMinLevel || !test(touched_, level, wx, wy)) return false;
+    const int h = 1 << (level - 1);
+    for (int c = 0; c < 4; ++c) {
+      const int cx = wx + (c & 1) * h, cy = wy + (c >> 1) * h;
+      if (cx > x1 || cy > y1 || cx + h - 1 < x0 || cy + h - 1 < y0) continue;  // disjoint
+      if (!rectFull(level - 1, cx, cy, x0, y0, x1, y1)) return false;
+    }
+    return true;
   }
   // The window and every window containing it hold something occupied.
   void touch(int level, int lx, int ly) {

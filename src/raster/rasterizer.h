@@ -20,6 +20,7 @@ struct RasterStats {
   uint64_t windows[kStatLevels] = {};  // windows tested per level (each child of a split counts)
   uint64_t fullWindows = 0;            // covered windows filled without further subdivision
   uint64_t occludedWindows = 0;        // windows a triangle was dropped from as occupied (SPEC §4)
+  uint64_t occludedTriangles = 0;      // triangles dropped whole in a tile: their box was occupied
   uint64_t partialBlocks = 0;          // 4×4 leaves tested pixel by pixel
   uint64_t fragments = 0;              // pixels that passed coverage (some sample, with
                                        // anti-aliasing) and reached the depth test
@@ -28,6 +29,7 @@ struct RasterStats {
     for (int i = 0; i < kStatLevels; ++i) windows[i] += o.windows[i];
     fullWindows += o.fullWindows;
     occludedWindows += o.occludedWindows;
+    occludedTriangles += o.occludedTriangles;
     partialBlocks += o.partialBlocks;
     fragments += o.fragments;
   }

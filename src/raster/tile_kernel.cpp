@@ -1132,6 +1132,19 @@ void clearTile(const TileWork& w) {
 template <PixelOp kOp, bool kAA>
 HWY_INLINE void drawTriangle(const TriangleSetup& t, const TileContext& ctx,
                              const AttributeSetup* attributes = nullptr, uint32_t id = kNoTriangle) {
+  // Priority masking: a triangle whose box lies in occupied windows is dropped before its
+  // traversal is set up (in a deep stack of layers, most are).
+  if (ctx.occupancy && !(attributes && attributes->material &&
+                         attributes->material->alpha == shade::AlphaUse::blend)) {
+    const int x0 = std::max(t.minX - ctx.originX, 0), y0 = std::max(t.minY - ctx.originY, 0);
+    const int x1 = std::min(t.maxX - ctx.originX, kTileSize - 1);
+    const int y1 = std::min(t.maxY - ctx.originY, kTileSize - 1);
+    if (x0 > x1 || y0 > y1) return;
+    if (ctx.occupancy->rectFull(x0, y0, x1, y1)) {
+      ++ctx.stats->occludedTriangles;
+      return;
+    }
+  }
   if (t.small) return TriangleRaster<3, kOp, int32_t, kAA>(t, ctx, attributes, id).draw();
   switch (t.edgeCount) {
     case 3: return TriangleRaster<3, kOp, int64_t, kAA>(t, ctx, attributes, id).draw();

@@ -188,6 +188,7 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
   for (int i = 0; i < raster::kStatLevels; ++i) stats.windows[i] += total.windows[i];
   stats.fullWindows += total.fullWindows;
   stats.occludedWindows += total.occludedWindows;
+  stats.occludedTriangles += total.occludedTriangles;
   stats.partialBlocks += total.partialBlocks;
   stats.fragments += total.fragments;
 }

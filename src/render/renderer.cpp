@@ -189,11 +189,12 @@ Status validate(const RenderOptions& o) {
 std::string FrameStats::summary() const {
   return fmt::format(
       "triangles in {} / culled {} (facing {}, outside {}, degenerate {}, invalid {}) / drawn {} | "
-      "windows 64:{} 32:{} 16:{} 8:{} 4:{} px-tests:{} full:{} occluded:{} | {:.2f} ms (vertex "
+      "windows 64:{} 32:{} 16:{} 8:{} 4:{} px-tests:{} full:{} occluded:{} (triangles {}) | {:.2f} "
+      "ms (vertex "
       "{:.2f}, setup {:.2f}, tiles {:.2f} incl. resolve)",
       trianglesIn, culled(), culledFacing, culledOutside, culledDegenerate, culledInvalid, drawn,
       windows[0], windows[1], windows[2], windows[3], windows[4], windows[5], fullWindows,
-      occludedWindows, totalMs, vertexMs, setupMs, rasterMs);
+      occludedWindows, occludedTriangles, totalMs, vertexMs, setupMs, rasterMs);
 }
 
 Result<RenderOptions::Hsr> parseHsr(const std::string& text) {
