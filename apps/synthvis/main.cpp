@@ -4,10 +4,10 @@
 //                   [--no-cull] [--debug-view overdraw] [--gamma G] [--supersample K]
 //                   [--aa 1|4|8|16|64] [--filter box|tent3]
 //                   [--texture-filter point|nearest|tri3|bilinear|trilinear3|trilinear|aniso]
-//                   [--hsr zbuffer|priority]
+//                   [--hsr zbuffer|priority|hybrid]
 //   synthvis bench SCENE|--suite quick|full [--count N] [--area A] [--depth D] [--layers D]
 //                  [--order random|f2b|b2f] [--shade gouraud|textured] [--fog]
-//                  [--texture-filter F] [--hsr zbuffer|priority] [--width W] [--height H]
+//                  [--texture-filter F] [--hsr zbuffer|priority|hybrid] [--width W] [--height H]
 //                  [--threads T] [--frames F] [--warmup W] [--seed S] [--aa S] [--gl-aa S]
 //                  [--filter box|tent3]
 //                  [--renderer synthvis|gl|both] [--gl-readback] [--json FILE] [--html DIR]
@@ -392,8 +392,8 @@ int main(int argc, char** argv) {
   render->add_option("--filter", r.filter, "resolve filter: box or tent3 (3x3 triangle)")
       ->capture_default_str();
   render->add_option("--hsr", r.hsr,
-                     "hidden surfaces: zbuffer, or priority (masking; the scene's order is the "
-                     "priority, nearest first)")
+                     "hidden surfaces: zbuffer, priority (masking; the scene's order is the "
+                     "priority, nearest first) or hybrid (masking with depth: any order)")
       ->capture_default_str();
   render->add_option("--texture-filter", r.textureFilter,
                      "texture sampling for materials that do not choose: point, nearest, tri3, "
@@ -412,7 +412,7 @@ int main(int argc, char** argv) {
                     "generated scenes: gouraud, or textured (BENCH.md's 1024x1024 texture)")
       ->capture_default_str();
   bench->add_flag("--fog", b.fog, "generated scenes: BENCH.md's fog (haze, beta 0.1 per unit)");
-  bench->add_option("--hsr", b.hsr, "hidden surfaces: zbuffer or priority")
+  bench->add_option("--hsr", b.hsr, "hidden surfaces: zbuffer, priority or hybrid")
       ->capture_default_str();
   bench->add_option("--texture-filter", b.textureFilter,
                     "nearest, tri3, bilinear, trilinear3, trilinear or aniso")

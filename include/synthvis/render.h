@@ -39,14 +39,16 @@ struct RenderOptions {
   enum class Filter { box, tent3 } filter = Filter::box;
   // How texture maps are sampled (SPEC §7), for materials that do not choose (`inherit`).
   scene::TextureFilter textureFilter = scene::TextureFilter::trilinear;
-  // Hidden-surface removal (SPEC §4): the Z-buffer alone; or multi-level priority masking, which
+  // Hidden-surface removal (SPEC §4): the Z-buffer alone; multi-level priority masking, which
   // takes the scene's opaque triangles in submission order as their priority, nearest first
   // (exact for scenes given in a true front-to-back order without interpenetration, as the seeds'
-  // databases were; docs/hidden-surfaces.md), the depth test kept for translucent triangles.
-  enum class Hsr { zbuffer, priority } hsr = Hsr::zbuffer;
+  // databases were; docs/hidden-surfaces.md), the depth test kept for translucent triangles; or
+  // hybrid — masking combined with depth bounds per window, the Z-buffer's image for any order,
+  // fastest when the order is roughly front to back.
+  enum class Hsr { zbuffer, priority, hybrid } hsr = Hsr::zbuffer;
 };
 
-// By name, as the CLI's --hsr writes them: "zbuffer", "priority".
+// By name, as the CLI's --hsr writes them: "zbuffer", "priority", "hybrid".
 Result<RenderOptions::Hsr> parseHsr(const std::string& text);
 const char* hsrName(RenderOptions::Hsr hsr);
 

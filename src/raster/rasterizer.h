@@ -35,6 +35,10 @@ struct RasterStats {
   }
 };
 
+// Hidden-surface removal besides the Z-buffer (SPEC §4): multi-level priority masking, which
+// trusts the submission order (nearest first), or its combination with depth, which does not.
+enum class Masking : uint8_t { none, priority, hybrid };
+
 // What a covered pixel does.
 enum class ShadeMode : uint8_t {
   gouraud,   // depth test "less", perspective-correct Gouraud colour (SPEC §4, §8)
@@ -77,11 +81,13 @@ struct TileWork {
   // ShadeMode::material at one sample: kTilePixels entries of scratch, all ~0u on entry and left
   // so (which triangle won each pixel: its shading is deferred until the tile's lists are drawn).
   uint32_t* visible = nullptr;
-  // Multi-level priority masking (SPEC §4; not with ShadeMode::overdraw): the lists are in priority
-  // order, nearest first, and opaque triangles are dropped from windows nearer ones occupy. The
-  // tile's occupancy, emptied with the tile (`clear`) and kept across calls for later batches.
-  // nullptr: the Z-buffer alone. The depth test stays on either way, so that translucent
+  // Masking (SPEC §4; not with ShadeMode::overdraw), with the tile's occupancy — emptied with the
+  // tile (`clear`) and kept across calls for later batches. `priority`: the lists are in priority
+  // order, nearest first, and opaque triangles are dropped from windows nearer ones occupy.
+  // `hybrid`: any order; they are dropped from full windows whose depth bound they do not beat,
+  // and the image is the Z-buffer's. The depth test stays on either way, so that translucent
   // triangles (drawn after the opaque ones) are hidden behind nearer opaque ones.
+  Masking masking = Masking::none;
   Occupancy* occupancy = nullptr;
 };
 

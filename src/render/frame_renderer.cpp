@@ -63,15 +63,16 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
   const bool pixelShading = settings.shade == raster::ShadeMode::material;
   if (pixelShading) attributes_.resize(std::max<size_t>(attributes_.size(), firstBatch));
   scratch_.resize(size_t(pool_.threadCount()));
+  const bool masking = settings.masking != raster::Masking::none;
   for (WorkerScratch& w : scratch_) {
     w.records.resize(kChunkTriangles);
     if (!wholeFrame) w.tile.resize(raster::kTileSize, raster::kTileSize, samples);
     if (settings.shade == raster::ShadeMode::material && samples == 1)
       w.visible.assign(raster::kTilePixels, ~0u);
-    if (settings.priorityMasking && !wholeFrame && !w.occupancy)
+    if (masking && !wholeFrame && !w.occupancy)
       w.occupancy = std::make_unique<raster::Occupancy>();
   }
-  if (settings.priorityMasking && wholeFrame) frameOccupancy_.resize(size_t(tiles));
+  if (masking && wholeFrame) frameOccupancy_.resize(size_t(tiles));
   tileStats_.assign(size_t(tiles), raster::RasterStats{});
   const int maxChunks = std::max(1, int((firstBatch + kChunkTriangles - 1) / kChunkTriangles));
   std::vector<SetupCounts> counts(static_cast<size_t>(maxChunks));
@@ -175,7 +176,8 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
         w.environment = settings.environment;
         if (samples == 1) w.visible = scratch_[worker].visible.data();
       }
-      if (settings.priorityMasking)
+      w.masking = settings.masking;
+      if (masking)
         w.occupancy = wholeFrame ? &frameOccupancy_[tile] : scratch_[worker].occupancy.get();
       raster::rasterizeTile(w, tileStats_[tile]);
       if (lastBatch && settings.finishTile) settings.finishTile(int(tile), w.depth, w.color);

@@ -53,9 +53,9 @@ struct FrameSettings {
   // batch draw each tile in a small per-thread buffer that never leaves the core's cache; frames of
   // several keep a whole-frame buffer between batches. Tests lower it to exercise that path.
   uint32_t batchTriangles = 1u << 18;
-  // Multi-level priority masking (raster::TileWork::occupancy): the packets' triangles in priority
-  // order, nearest first.
-  bool priorityMasking = false;
+  // Masking (raster::TileWork::masking): `priority` takes the packets' triangles in priority order,
+  // nearest first.
+  raster::Masking masking = raster::Masking::none;
 };
 
 class FrameRenderer {

@@ -200,11 +200,17 @@ std::string FrameStats::summary() const {
 Result<RenderOptions::Hsr> parseHsr(const std::string& text) {
   if (text == "zbuffer") return RenderOptions::Hsr::zbuffer;
   if (text == "priority") return RenderOptions::Hsr::priority;
-  return Error{"", "", fmt::format("unknown hidden-surface method '{}' (zbuffer or priority)", text)};
+  if (text == "hybrid") return RenderOptions::Hsr::hybrid;
+  return Error{"", "", fmt::format("unknown hidden-surface method '{}' (zbuffer, priority or hybrid)",
+                                   text)};
 }
 
 const char* hsrName(RenderOptions::Hsr hsr) {
-  return hsr == RenderOptions::Hsr::priority ? "priority" : "zbuffer";
+  switch (hsr) {
+    case RenderOptions::Hsr::priority: return "priority";
+    case RenderOptions::Hsr::hybrid: return "hybrid";
+    default: return "zbuffer";
+  }
 }
 
 struct Renderer::Impl {
@@ -313,7 +319,10 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
                               : raster::ShadeMode::gouraud;
   fs.environment = &shading.environment;
   fs.samples = o.samples;
-  fs.priorityMasking = o.hsr == RenderOptions::Hsr::priority && !o.debugOverdraw;
+  fs.masking = o.debugOverdraw                         ? raster::Masking::none
+               : o.hsr == RenderOptions::Hsr::priority ? raster::Masking::priority
+               : o.hsr == RenderOptions::Hsr::hybrid   ? raster::Masking::hybrid
+                                                       : raster::Masking::none;
   if (o.samples > 1) {
     // A frame of several batches keeps a whole-frame sample buffer (samples × 10 bytes a pixel:
     // 330 MB at 1080p with 16 samples). Batches as large as the records that buffer would hold

@@ -111,14 +111,14 @@ DrawPackets frontToBackScene(int w, int h, int count, unsigned seed) {
   return p;
 }
 
-FrameSettings settings(int w, int h, int samples, bool priority) {
+FrameSettings settings(int w, int h, int samples, raster::Masking masking) {
   FrameSettings s;
   s.width = w;
   s.height = h;
   s.samples = samples;
   s.clearColor[0] = 0.1f;
   s.clearColor[2] = 0.3f;
-  s.priorityMasking = priority;
+  s.masking = masking;
   return s;
 }
 
@@ -128,8 +128,8 @@ TEST(PriorityMasking, EqualsTheZBufferOnFrontToBackSceneAtEverySampleCount) {
       const int w = 190, h = 140;
       const DrawPackets p = frontToBackScene(w, h, 900, seed);
       FrameStats zStats, pStats;
-      const test::Frame z = test::renderQuadtree(p, settings(w, h, samples, false), 2, &zStats);
-      const test::Frame m = test::renderQuadtree(p, settings(w, h, samples, true), 2, &pStats);
+      const test::Frame z = test::renderQuadtree(p, settings(w, h, samples, raster::Masking::none), 2, &zStats);
+      const test::Frame m = test::renderQuadtree(p, settings(w, h, samples, raster::Masking::priority), 2, &pStats);
       EXPECT_TRUE(z == m) << samples << " samples, seed " << seed;
       // Masking did its work: windows and whole triangles dropped, fewer fragments shaded.
       EXPECT_GT(pStats.occludedWindows, 0u);
@@ -142,13 +142,13 @@ TEST(PriorityMasking, SameFrameForAnyThreadCountAndBatching) {
   const int w = 200, h = 150;
   const DrawPackets p = frontToBackScene(w, h, 700, 3);
   for (int samples : {1, 16}) {
-    const test::Frame ref = test::renderQuadtree(p, settings(w, h, samples, true), 1);
-    EXPECT_TRUE(test::renderQuadtree(p, settings(w, h, samples, true), 2) == ref);
-    EXPECT_TRUE(test::renderQuadtree(p, settings(w, h, samples, true), 8) == ref);
-    FrameSettings batched = settings(w, h, samples, true);
+    const test::Frame ref = test::renderQuadtree(p, settings(w, h, samples, raster::Masking::priority), 1);
+    EXPECT_TRUE(test::renderQuadtree(p, settings(w, h, samples, raster::Masking::priority), 2) == ref);
+    EXPECT_TRUE(test::renderQuadtree(p, settings(w, h, samples, raster::Masking::priority), 8) == ref);
+    FrameSettings batched = settings(w, h, samples, raster::Masking::priority);
     batched.batchTriangles = 97;  // occupancy kept per tile between batches
     EXPECT_TRUE(test::renderQuadtree(p, batched, 2) == ref) << samples;
-    EXPECT_TRUE(test::renderQuadtree(p, settings(w, h, samples, false), 2) == ref) << samples;
+    EXPECT_TRUE(test::renderQuadtree(p, settings(w, h, samples, raster::Masking::none), 2) == ref) << samples;
   }
 }
 
@@ -164,10 +164,51 @@ TEST(PriorityMasking, TrustsTheOrderItIsGiven) {
   };
   square(0.8f, 1.0f);  // far, first
   square(0.2f, 0.5f);  // near, second
-  const test::Frame z = test::renderQuadtree(p, settings(w, h, 1, false));
-  const test::Frame m = test::renderQuadtree(p, settings(w, h, 1, true));
+  const test::Frame z = test::renderQuadtree(p, settings(w, h, 1, raster::Masking::none));
+  const test::Frame m = test::renderQuadtree(p, settings(w, h, 1, raster::Masking::priority));
   EXPECT_EQ(z.channel(50, 20, 0), 32768);  // the near one (0.5)
   EXPECT_EQ(m.channel(50, 20, 0), 65535);  // the first one
+}
+
+// Hybrid masking keeps the depth test and drops only what depth bounds prove hidden: on scenes in
+// any order — interpenetrating triangles of every size, vertices behind the eye and beyond the
+// far plane — the Z-buffer's frame sample for sample, at every sample count.
+TEST(HybridMasking, EqualsTheZBufferInAnyOrder) {
+  for (int samples : {1, 4, 16, 64})
+    for (unsigned seed : {4u, 5u}) {
+      const int w = 170, h = 120;
+      const DrawPackets p = test::randomScene(w, h, 500, seed, seed == 5);
+      const test::Frame z = test::renderQuadtree(p, settings(w, h, samples, raster::Masking::none), 2);
+      const test::Frame m =
+          test::renderQuadtree(p, settings(w, h, samples, raster::Masking::hybrid), 2);
+      EXPECT_TRUE(z == m) << samples << " samples, seed " << seed;
+    }
+}
+
+// … and on front-to-back input it drops hidden work like priority masking, in every order the
+// same frame; for any thread count and batching.
+TEST(HybridMasking, DropsHiddenWorkInEveryOrderWithTheSameFrame) {
+  const int w = 190, h = 140;
+  DrawPackets f2b = frontToBackScene(w, h, 900, 6), b2f = f2b;
+  // The same triangles back to front.
+  for (size_t t = 0; t < b2f.indices.size() / 3; ++t)
+    for (int k = 0; k < 3; ++k)
+      b2f.indices[t * 3 + size_t(k)] = f2b.indices[(f2b.indices.size() / 3 - 1 - t) * 3 + size_t(k)];
+  for (int samples : {1, 16}) {
+    FrameStats zs, fs, bs;
+    const test::Frame z = test::renderQuadtree(f2b, settings(w, h, samples, raster::Masking::none), 2, &zs);
+    const test::Frame f = test::renderQuadtree(f2b, settings(w, h, samples, raster::Masking::hybrid), 2, &fs);
+    const test::Frame b = test::renderQuadtree(b2f, settings(w, h, samples, raster::Masking::hybrid), 2, &bs);
+    EXPECT_TRUE(f == z) << samples;
+    EXPECT_TRUE(b == test::renderQuadtree(b2f, settings(w, h, samples, raster::Masking::none), 2));
+    EXPECT_GT(fs.occludedTriangles, 0u);
+    EXPECT_LT(fs.fragments, zs.fragments);
+    EXPECT_TRUE(test::renderQuadtree(f2b, settings(w, h, samples, raster::Masking::hybrid), 1) == f);
+    EXPECT_TRUE(test::renderQuadtree(f2b, settings(w, h, samples, raster::Masking::hybrid), 8) == f);
+    FrameSettings batched = settings(w, h, samples, raster::Masking::hybrid);
+    batched.batchTriangles = 97;
+    EXPECT_TRUE(test::renderQuadtree(f2b, batched, 2) == f) << samples;
+  }
 }
 
 }  // namespace
