@@ -316,6 +316,18 @@ HWY_INLINE void computeAttributeLanes(const AttributeSetup& a, AttributeLanes& o
   }
 }
 
+// A full batch's count and the footprint gradients (per pixel, constant over the triangle).
+HWY_INLINE void setGradients(const PlaneLanes& lanes, const AttributeLanes& al,
+                             shade::Fragments& f) {
+  f.count = kBlockPixels;
+  f.qdx = lanes.dx[kInvW];
+  f.qdy = lanes.dy[kInvW];
+  f.udx = al.dx[shade::kU];
+  f.udy = al.dy[shade::kU];
+  f.vdx = al.dx[shade::kV];
+  f.vdy = al.dy[shade::kV];
+}
+
 // The fragments of block (gx, gy) whose base-plane values at the top-left pixel are `base`, at
 // each lane's pixel centre moved by (cx, cy) (nullptr: the centres); of the attributes only those
 // in `used` (bit per shade::Attribute, shade::attributesUsed).
@@ -347,13 +359,7 @@ HWY_INLINE void blockFragments(const TriangleSetup& t, const PlaneLanes& lanes,
       if (used & (1u << p))
         hn::StoreU(at(attrBase[p], al.offset[p], al.dx[p], al.dy[p]), df, f.attribute[p] + i);
   }
-  f.count = kBlockPixels;
-  f.qdx = lanes.dx[kInvW];
-  f.qdy = lanes.dy[kInvW];
-  f.udx = al.dx[shade::kU];
-  f.udy = al.dy[shade::kU];
-  f.vdx = al.dx[shade::kV];
-  f.vdy = al.dy[shade::kV];
+  setGradients(lanes, al, f);
 }
 
 // 0…1 → 16-bit lanes (colorToLanes' rounding, for a value already in range).
@@ -434,14 +440,21 @@ HWY_INLINE void shadeBlockMaterial(const TriangleSetup& t, const PlaneLanes& lan
   }
 }
 
-// One 4×4 block with N samples per pixel: shaded once per pixel (centre, or centroid of the
-// covered samples as shadeBlockSamples), written to each sample that passes its depth test.
-HWY_INLINE void shadeBlockSamplesMaterial(const TriangleSetup& t, const PlaneLanes& lanes,
-                                          const AttributeLanes& al, const AttributeSetup& a,
-                                          const shade::Environment& env, const CoverageTables& cov,
-                                          const float* sampleDepth,
-                                          const uint32_t (*masks)[kBlockPixels], int gx, int gy,
-                                          float* depth, uint16_t* color) {
+// Anti-aliased pixel shading, in three steps so that the pixels of several blocks of one
+// triangle share the SIMD lanes of one shading call (a 200-px triangle touches some 36 blocks
+// whose 16 lanes it would fill a third of): per block, which samples pass the depth test and
+// where each pixel is shaded (centre, or centroid of the covered samples as shadeBlockSamples);
+// then the passing pixels, 16 to a batch (TriangleRaster::flushSamples); then per block the
+// shaded colour written to the samples that passed.
+
+// Step 1 for block (gx, gy): the samples that pass, a bit per sample as the masks hold them
+// (masks nullptr: all covered), and the centroid offsets (cx, cy) of partly covered pixels.
+// False if none pass.
+HWY_INLINE bool samplesPassing(const TriangleSetup& t, const PlaneLanes& lanes,
+                               const CoverageTables& cov, const float* sampleDepth,
+                               const uint32_t (*masks)[kBlockPixels], int gx, int gy,
+                               const float* depth, uint32_t (*pass)[kBlockPixels], float* cx,
+                               float* cy) {
   const int samples = cov.samples;
   const uint32_t fullWord0 = samples >= 32 ? ~0u : (1u << samples) - 1;
   const uint32_t fullWord1 = samples > 32 ? ~0u : 0u;
@@ -450,10 +463,6 @@ HWY_INLINE void shadeBlockSamplesMaterial(const TriangleSetup& t, const PlaneLan
   const size_t n = hn::Lanes(df);
   alignas(32) float base[8];
   blockBases(t, lanes, gx, gy, base);
-  alignas(64) float cx[kBlockPixels] = {}, cy[kBlockPixels] = {};
-  // Step 1, early depth test: the samples that pass, a bit per sample as the masks hold them.
-  // A block none of whose samples pass is not shaded at all (with depth complexity, most).
-  alignas(64) uint32_t pass[2][kBlockPixels];
   bool any = false;
   for (size_t i = 0; i < size_t(kBlockPixels); i += n) {
     auto m0 = hn::Set(du32, fullWord0), m1 = hn::Set(du32, fullWord1);
@@ -477,25 +486,33 @@ HWY_INLINE void shadeBlockSamplesMaterial(const TriangleSetup& t, const PlaneLan
     }
     hn::StoreU(p0, du32, pass[0] + i);
     hn::StoreU(p1, du32, pass[1] + i);
-    if (hn::AllTrue(du32, hn::Eq(hn::Or(p0, p1), hn::Zero(du32)))) continue;
-    any = true;
-    const bool full = hn::AllTrue(du32, hn::Eq(m0, hn::Set(du32, fullWord0))) &&
-                      hn::AllTrue(du32, hn::Eq(m1, hn::Set(du32, fullWord1)));
-    if (cov.centroid && !full) {
-      auto x = hn::Zero(df), y = x;
-      centroidOffsets(df, cov, m0, m1, x, y);
-      hn::StoreU(x, df, cx + i);
-      hn::StoreU(y, df, cy + i);
+    auto x = hn::Zero(df), y = x;
+    if (!hn::AllTrue(du32, hn::Eq(hn::Or(p0, p1), hn::Zero(du32)))) {
+      any = true;
+      const bool full = hn::AllTrue(du32, hn::Eq(m0, hn::Set(du32, fullWord0))) &&
+                        hn::AllTrue(du32, hn::Eq(m1, hn::Set(du32, fullWord1)));
+      if (cov.centroid && !full) centroidOffsets(df, cov, m0, m1, x, y);
     }
+    hn::StoreU(x, df, cx + i);
+    hn::StoreU(y, df, cy + i);
   }
-  if (!any) return;
-  shade::Fragments f;
-  blockFragments(t, lanes, al, base, gx, gy, cx, cy, shade::attributesUsed(*a.material, env), f);
-  alignas(64) float rgba[4][kBlockPixels];
-  shade::shadeFragments(*a.material, env, f, rgba);
-  const bool blend = a.material->alpha == shade::AlphaUse::blend;
-  const bool cut = a.material->alpha == shade::AlphaUse::mask;
-  // Step 2: write the shaded colour (and depth) to the samples that passed.
+  return any;
+}
+
+// Step 3 for block (gx, gy): shaded colour `rgba` (block lanes) to the samples that passed —
+// opaque, cut out where alpha is 0, or blended over the sample without writing depth.
+HWY_INLINE void writeSamples(const TriangleSetup& t, const PlaneLanes& lanes,
+                             const shade::MaterialShading& m, const float* sampleDepth, int samples,
+                             const uint32_t (*pass)[kBlockPixels],
+                             const float (*rgba)[kBlockPixels], int gx, int gy, float* depth,
+                             uint16_t* color) {
+  const hn::CappedTag<float, kBlockPixels> df;
+  const hn::RebindToUnsigned<decltype(df)> du32;
+  const size_t n = hn::Lanes(df);
+  const bool blend = m.alpha == shade::AlphaUse::blend;
+  const bool cut = m.alpha == shade::AlphaUse::mask;
+  alignas(32) float base[8];
+  blockBases(t, lanes, gx, gy, base);
   for (size_t i = 0; i < size_t(kBlockPixels); i += n) {
     const auto p0 = hn::LoadU(du32, pass[0] + i), p1 = hn::LoadU(du32, pass[1] + i);
     if (hn::AllTrue(du32, hn::Eq(hn::Or(p0, p1), hn::Zero(du32)))) continue;
@@ -512,6 +529,43 @@ HWY_INLINE void shadeBlockSamplesMaterial(const TriangleSetup& t, const PlaneLan
       storeShaded(df, passed, blend, rgba, i, color + size_t(s) * kColorPerBlock);
     }
   }
+}
+
+// Step 2's fragments: up to 16 pixels of one triangle from anywhere in the tile — pixel i in the
+// block whose top-left pixel is (bx[i], by[i]) from the planes' origin, at lane lane[i], moved by
+// (cx[i], cy[i]) — with exactly blockFragments' float operations, so that a pixel shades the same
+// in a batch as it would in its block.
+HWY_INLINE void batchFragments(const PlaneLanes& lanes,
+                               const AttributeLanes& al, const float* bx, const float* by,
+                               const int32_t* lane, const float* cx, const float* cy,
+                               unsigned used, shade::Fragments& f) {
+  const hn::CappedTag<float, kBlockPixels> df;
+  const hn::RebindToSigned<decltype(df)> di;
+  const size_t n = hn::Lanes(df);
+  const auto zero = hn::Zero(df), one = hn::Set(df, 1.0f);
+  for (size_t i = 0; i < size_t(kBlockPixels); i += n) {
+    const auto X = hn::LoadU(df, bx + i), Y = hn::LoadU(df, by + i);
+    const auto l = hn::LoadU(di, lane + i);
+    const auto ox = hn::LoadU(df, cx + i), oy = hn::LoadU(df, cy + i);
+    auto at = [&](float c0, float dx, float dy, const float* offset) {
+      const auto base = hn::Add(hn::Add(hn::Set(df, c0), hn::Mul(hn::Set(df, dx), X)),
+                                hn::Mul(hn::Set(df, dy), Y));
+      return hn::Add(hn::Add(base, hn::GatherIndex(df, offset, l)),
+                     hn::Add(hn::Mul(hn::Set(df, dx), ox), hn::Mul(hn::Set(df, dy), oy)));
+    };
+    const auto q = at(lanes.c0[kInvW], lanes.dx[kInvW], lanes.dy[kInvW], lanes.offset[kInvW]);
+    hn::StoreU(q, df, f.q + i);
+    const auto w = hn::Div(one, hn::Max(q, hn::Set(df, 1e-30f)));
+    for (int ch = 0; ch < kColorChannels; ++ch) {
+      const int p = kRed + ch;
+      const auto cw = at(lanes.c0[p], lanes.dx[p], lanes.dy[p], lanes.offset[p]);
+      hn::StoreU(hn::Min(hn::Max(hn::Mul(cw, w), zero), one), df, f.color[ch] + i);
+    }
+    for (int p = 0; p < shade::kAttributeCount; ++p)
+      if (used & (1u << p))
+        hn::StoreU(at(al.c0[p], al.dx[p], al.dy[p], al.offset[p]), df, f.attribute[p] + i);
+  }
+  setGradients(lanes, al, f);
 }
 
 // Visibility (PixelOp::visibility): the depth test alone, recording triangle `id` in the pixels it
@@ -675,10 +729,6 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
   finishQueue();
 }
 
-// One triangle in one tile. T is the type edge values are stepped in: int64_t always works
-// (geometry/setup.h's budget); int32_t is used for small triangles, whose values provably fit, and
-// doubles the lanes per vector.
-// kAA: anti-aliased (ctx.coverage set): pixel-square windows and sub-pixel masks in the leaves.
 // A bound of the triangle's depth over the pixels [gx0, gx1] × [gy0, gy1] (frame coordinates, with
 // their squares when anti-aliased: samples lie within half a pixel of the centres): the smallest
 // (upper = false) or largest value of its depth plane there, widened by more than the rounding of
@@ -697,6 +747,10 @@ HWY_INLINE float depthBound(const TriangleSetup& t, int gx0, int gy0, int gx1, i
   return float(c0 + std::min(dx * x0, dx * x1) + std::min(dy * y0, dy * y1) - margin);
 }
 
+// One triangle in one tile. T is the type edge values are stepped in: int64_t always works
+// (geometry/setup.h's budget); int32_t is used for small triangles, whose values provably fit, and
+// doubles the lanes per vector.
+// kAA: anti-aliased (ctx.coverage set): pixel-square windows and sub-pixel masks in the leaves.
 template <int E, PixelOp kOp, class T, bool kAA = false>
 class TriangleRaster {
  public:
@@ -768,6 +822,7 @@ class TriangleRaster {
     for (int cy = y0 >> log2n; cy <= y1 >> log2n; ++cy)
       for (int cx = x0 >> log2n; cx <= x1 >> log2n; ++cx)
         visitRoot(cx << log2n, cy << log2n, log2n, n);
+    if constexpr (kAA && kOp == PixelOp::material) flushSamples();
   }
 
  private:
@@ -1189,16 +1244,120 @@ class TriangleRaster {
     ctx_.stats->fragments += uint64_t(pixels);
     const size_t block = size_t(ly >> kBlockLog2) * kBlocksPerTileSide + (lx >> kBlockLog2);
     const size_t planes = block * size_t(ctx_.samples);
-    if constexpr (kOp == PixelOp::material)
-      return shadeBlockSamplesMaterial(t_, planeLanes_, attributeLanes_, *attributes_,
-                                       *ctx_.environment, *ctx_.coverage, sampleDepth_, masks,
-                                       ctx_.originX + lx, ctx_.originY + ly,
-                                       ctx_.depth + planes * kBlockPixels,
-                                       ctx_.color + planes * kColorPerBlock);
+    if constexpr (kOp == PixelOp::material) return queueSamples(lx, ly, masks);
     shadeBlockSamples(t_, planeLanes_, *ctx_.coverage, sampleDepth_, masks, ctx_.originX + lx,
                       ctx_.originY + ly, ctx_.depth + planes * kBlockPixels,
                       ctx_.color + planes * kColorPerBlock);
   }
+
+  // Anti-aliased pixel shading (PixelOp::material): step 1 for the block at (lx, ly), its passing
+  // pixels queued for step 2.
+  void queueSamples(int lx, int ly, const uint32_t (*masks)[kBlockPixels]) {
+    const size_t block = size_t(ly >> kBlockLog2) * kBlocksPerTileSide + (lx >> kBlockLog2);
+    const size_t planes = block * size_t(ctx_.samples);
+    PendingBlock& b = pending_[pendingBlocks_];
+    alignas(64) float cx[kBlockPixels], cy[kBlockPixels];
+    const int gx = ctx_.originX + lx, gy = ctx_.originY + ly;
+    if (!samplesPassing(t_, planeLanes_, *ctx_.coverage, sampleDepth_, masks, gx, gy,
+                        ctx_.depth + planes * kBlockPixels, b.pass, cx, cy))
+      return;
+    int passing = 0;
+    for (int l = 0; l < kBlockPixels; ++l) passing += (b.pass[0][l] | b.pass[1][l]) != 0;
+    if (passing == kBlockPixels) {
+      // A block whose every pixel passes fills the lanes by itself: shaded and written at once.
+      const shade::MaterialShading& m = *attributes_->material;
+      alignas(32) float base[8];
+      blockBases(t_, planeLanes_, gx, gy, base);
+      shade::Fragments f;
+      blockFragments(t_, planeLanes_, attributeLanes_, base, gx, gy, cx, cy,
+                     shade::attributesUsed(m, *ctx_.environment), f);
+      alignas(64) float rgba[4][kBlockPixels];
+      shade::shadeFragments(m, *ctx_.environment, f, rgba);
+      writeSamples(t_, planeLanes_, m, sampleDepth_, ctx_.samples, b.pass, rgba, gx, gy,
+                   ctx_.depth + planes * kBlockPixels, ctx_.color + planes * kColorPerBlock);
+      return;
+    }
+    b.lx = lx;
+    b.ly = ly;
+    b.firstPixel = pendingPixels_;
+    const float bx = float(gx - t_.minX), by = float(gy - t_.minY);
+    for (int l = 0; l < kBlockPixels; ++l) {
+      if (!(b.pass[0][l] | b.pass[1][l])) continue;
+      const int p = pendingPixels_++;
+      pixelX_[p] = bx;
+      pixelY_[p] = by;
+      pixelLane_[p] = l;
+      pixelCx_[p] = cx[l];
+      pixelCy_[p] = cy[l];
+    }
+    b.pixelCount = pendingPixels_ - b.firstPixel;
+    if (++pendingBlocks_ == kPendingBlocks) flushSamples();
+  }
+
+  // Steps 2 and 3 for the queued blocks: their pixels shaded 16 at a time, then written.
+  void flushSamples() {
+    if (pendingBlocks_ == 0) return;
+    const shade::MaterialShading& m = *attributes_->material;
+    const unsigned used = shade::attributesUsed(m, *ctx_.environment);
+    // All batches' texture coordinates first, which requests their texels (shadeVisible's queue).
+    constexpr int kBatches = kPendingPixels / kBlockPixels;
+    shade::Fragments f[kBatches];
+    shade::TexCoords coordinates[kBatches];
+    for (int first = 0; first < pendingPixels_; first += kBlockPixels) {
+      const int count = std::min(kBlockPixels, pendingPixels_ - first);
+      // Unused lanes repeat the last pixel: valid positions, no extra texels.
+      for (int l = count; l < kBlockPixels; ++l) {
+        const int last = first + count - 1, p = first + l;
+        pixelX_[p] = pixelX_[last];
+        pixelY_[p] = pixelY_[last];
+        pixelLane_[p] = pixelLane_[last];
+        pixelCx_[p] = pixelCx_[last];
+        pixelCy_[p] = pixelCy_[last];
+      }
+      const int batch = first / kBlockPixels;
+      batchFragments(planeLanes_, attributeLanes_, pixelX_ + first, pixelY_ + first,
+                     pixelLane_ + first, pixelCx_ + first, pixelCy_ + first, used, f[batch]);
+      if (m.texture) shade::textureCoordinates(m, f[batch], coordinates[batch]);
+    }
+    for (int first = 0; first < pendingPixels_; first += kBlockPixels) {
+      const int count = std::min(kBlockPixels, pendingPixels_ - first), batch = first / kBlockPixels;
+      alignas(64) float rgba[4][kBlockPixels];
+      if (m.texture)
+        shade::shadeFragments(m, *ctx_.environment, f[batch], coordinates[batch], rgba);
+      else
+        shade::shadeFragments(m, *ctx_.environment, f[batch], rgba);
+      for (int ch = 0; ch < 4; ++ch) std::copy_n(rgba[ch], count, pixelRgba_[ch] + first);
+    }
+    for (int i = 0; i < pendingBlocks_; ++i) {
+      const PendingBlock& b = pending_[i];
+      alignas(64) float rgba[4][kBlockPixels] = {};
+      for (int k = 0; k < b.pixelCount; ++k) {
+        const int p = b.firstPixel + k;
+        for (int ch = 0; ch < 4; ++ch) rgba[ch][pixelLane_[p]] = pixelRgba_[ch][p];
+      }
+      const size_t block = size_t(b.ly >> kBlockLog2) * kBlocksPerTileSide + (b.lx >> kBlockLog2);
+      const size_t planes = block * size_t(ctx_.samples);
+      writeSamples(t_, planeLanes_, m, sampleDepth_, ctx_.samples, b.pass, rgba,
+                   ctx_.originX + b.lx, ctx_.originY + b.ly, ctx_.depth + planes * kBlockPixels,
+                   ctx_.color + planes * kColorPerBlock);
+    }
+    pendingBlocks_ = pendingPixels_ = 0;
+  }
+
+  struct PendingBlock {
+    int lx, ly, firstPixel, pixelCount;
+    alignas(64) uint32_t pass[2][kBlockPixels];
+  };
+  static constexpr int kPendingBlocks = 16;
+  static constexpr int kPendingPixels = kPendingBlocks * kBlockPixels;
+  // Only the AA material path uses these (left uninitialized otherwise: written before read).
+  PendingBlock pending_[kAA && kOp == PixelOp::material ? kPendingBlocks : 1];
+  int pendingBlocks_ = 0, pendingPixels_ = 0;
+  static constexpr int kPixelSlots = kAA && kOp == PixelOp::material ? kPendingPixels + kBlockPixels : 1;
+  alignas(64) float pixelX_[kPixelSlots], pixelY_[kPixelSlots];
+  alignas(64) int32_t pixelLane_[kPixelSlots];
+  alignas(64) float pixelCx_[kPixelSlots], pixelCy_[kPixelSlots];
+  alignas(64) float pixelRgba_[4][kPixelSlots];
 
   const TriangleSetup& t_;
   const TileContext& ctx_;
