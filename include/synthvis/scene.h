@@ -98,6 +98,9 @@ struct Mesh {
 struct Instance {
   int mesh = 0;  // index into Scene::meshes
   Mat4 transform;
+  // Priority for hidden-surface masking (SPEC §4, RenderOptions::hsr): opaque instances are drawn
+  // in increasing priority, those of equal priority nearest first. 0 unless the scene says.
+  int priority = 0;
 };
 
 struct Camera {

@@ -1,10 +1,12 @@
 // The one place that wires a frame together (STYLE.md habit 1): scene → vertex stage → setup and
 // binning → tiles → resolve.
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <fmt/format.h>
 #include <limits>
+#include <numeric>
 #include <thread>
 
 #include "geometry/vertex_stage.h"
@@ -140,6 +142,60 @@ void buildShading(const scene::Scene& scene, const RenderOptions& o, const Mat4&
   for (const scene::Material& mat : scene.materials) out.any |= mat.needsPixelShading();
 }
 
+// The order instances are drawn in (indices into scene.instances). Opaque ones: in submission
+// order for the Z-buffer; for masking (SPEC §4) by priority, then nearest first — by the smallest
+// view depth of their bounding box's corners, which orders objects separated in depth correctly
+// (docs/hidden-surfaces.md). Translucent ones, always: farthest first by the view depth of their
+// box's centre, so that nearer ones blend over farther ones. Stable: ties keep submission order.
+std::vector<uint32_t> drawOrder(const scene::Scene& scene, const Mat4& view, RenderOptions::Hsr hsr) {
+  std::vector<uint32_t> order(scene.instances.size());
+  std::iota(order.begin(), order.end(), 0u);
+  const bool sortOpaque = hsr != RenderOptions::Hsr::zbuffer;
+  bool anyTranslucent = false;
+  for (const scene::Mesh& m : scene.meshes)
+    anyTranslucent |= m.material >= 0 && scene.materials[size_t(m.material)].alphaMode ==
+                                             scene::AlphaMode::blend;
+  if (!sortOpaque && !anyTranslucent) return order;
+  // Per mesh its box; per instance the view depths of the box's corners.
+  std::vector<std::array<Vec3, 2>> boxes(scene.meshes.size());
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    const auto& pos = scene.meshes[m].positions;
+    Vec3 lo{0, 0, 0}, hi{0, 0, 0};
+    for (size_t i = 0; i < pos.size(); ++i) {
+      lo = i ? Vec3{std::min(lo.x, pos[i].x), std::min(lo.y, pos[i].y), std::min(lo.z, pos[i].z)} : pos[i];
+      hi = i ? Vec3{std::max(hi.x, pos[i].x), std::max(hi.y, pos[i].y), std::max(hi.z, pos[i].z)} : pos[i];
+    }
+    boxes[m] = {lo, hi};
+  }
+  std::vector<float> nearest(order.size()), centre(order.size());
+  for (size_t i = 0; i < order.size(); ++i) {
+    const scene::Instance& inst = scene.instances[i];
+    const auto& [lo, hi] = boxes[size_t(inst.mesh)];
+    const Mat4 toEye = view * inst.transform;
+    float near = std::numeric_limits<float>::infinity();
+    for (int c = 0; c < 8; ++c) {
+      const Vec3 corner{c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z};
+      near = std::min(near, -toEye.transformPoint(corner).z);
+    }
+    nearest[i] = near;
+    centre[i] = -toEye.transformPoint((lo + hi) * 0.5f).z;
+  }
+  auto translucent = [&](uint32_t i) {
+    const int m = scene.meshes[size_t(scene.instances[i].mesh)].material;
+    return m >= 0 && scene.materials[size_t(m)].alphaMode == scene::AlphaMode::blend;
+  };
+  std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+    const bool ta = translucent(a), tb = translucent(b);
+    if (ta != tb) return tb;  // opaque first (the passes pick them out again)
+    if (ta) return centre[a] > centre[b];
+    if (!sortOpaque) return false;
+    if (scene.instances[a].priority != scene.instances[b].priority)
+      return scene.instances[a].priority < scene.instances[b].priority;
+    return nearest[a] < nearest[b];
+  });
+  return order;
+}
+
 }  // namespace
 
 Result<Mat4> viewProjection(const scene::Scene& scene, const RenderOptions& o) {
@@ -266,10 +322,11 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
   constexpr size_t kVertexChunk = 1 << 14;
   std::vector<VertexJob> jobs;
   size_t vertexCount = 0;
-  // Opaque materials first, then translucent ones (SPEC §4: blended over what is behind them),
-  // each in submission order.
+  // Opaque materials first, then translucent ones (SPEC §4: blended over what is behind them).
+  const std::vector<uint32_t> order = drawOrder(scene, camera.value().view, o.hsr);
   for (const bool translucentPass : {false, true})
-    for (const auto& inst : scene.instances) {
+    for (const uint32_t i : order) {
+      const scene::Instance& inst = scene.instances[i];
       const scene::Mesh& mesh = scene.meshes[inst.mesh];
       const scene::Material& mat = materialOf(mesh);
       if ((mat.alphaMode == scene::AlphaMode::blend) != translucentPass) continue;

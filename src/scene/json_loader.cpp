@@ -366,6 +366,7 @@ class SceneReader {
   void readPointLights(const Json& v, const std::string& where);
   void readColorTable(const Json& v, const std::string& where);
   void readObject(const Json& v, const std::string& where);
+  void readObjectGeometry(const Json& v, const std::string& where);
   // The object's "material" and "color" keys as a material index (or −1).
   int readObjectMaterial(const Json& object, const std::string& where);
   void readPrimitive(const Json& object, const std::string& where);
@@ -698,6 +699,17 @@ void SceneReader::addTriangles(uint64_t triangles, const std::string& where) {
 
 void SceneReader::readObject(const Json& v, const std::string& where) {
   if (!v.is_object()) fail(where, fmt::format("expected an object, got {}", typeName(v)));
+  const size_t firstInstance = scene_.instances.size();
+  readObjectGeometry(v, where);
+  // The object's priority (SPEC §4 masking: smaller first, nearer), for every instance it made.
+  if (const Json* x = find(v, "priority")) {
+    const int priority = int(integer(*x, member(where, "priority"), -1000000000, 1000000000));
+    for (size_t i = firstInstance; i < scene_.instances.size(); ++i)
+      scene_.instances[i].priority = priority;
+  }
+}
+
+void SceneReader::readObjectGeometry(const Json& v, const std::string& where) {
   const Json* mesh = find(v, "mesh");
   const Json* primitive = find(v, "primitive");
   if (mesh && primitive) fail(where, "an object has either 'mesh' or 'primitive', not both");
@@ -708,7 +720,7 @@ void SceneReader::readObject(const Json& v, const std::string& where) {
     readPrimitive(v, where);
     return;
   }
-  expectKeys(v, where, {"name", "mesh", "material", "color", "transform"});
+  expectKeys(v, where, {"name", "mesh", "material", "color", "transform", "priority"});
   Mat4 m;
   if (const Json* t = find(v, "transform")) m = readTransform(*t, member(where, "transform"));
   bool overridesMaterial = find(v, "material") || find(v, "color");
@@ -736,35 +748,35 @@ void SceneReader::readPrimitive(const Json& v, const std::string& where) {
   // Step 1: the kind decides which keys are allowed.
   if (kind == "box") {
     p.kind = PrimitiveKind::kBox;
-    expectKeys(v, where, {"name", "primitive", "material", "color", "transform", "size"});
+    expectKeys(v, where, {"name", "primitive", "material", "color", "transform", "priority", "size"});
   } else if (kind == "sphere") {
     p.kind = PrimitiveKind::kSphere;
-    expectKeys(v, where, {"name", "primitive", "material", "color", "transform", "radius",
+    expectKeys(v, where, {"name", "primitive", "material", "color", "transform", "priority", "radius",
                           "segments", "rings"});
   } else if (kind == "plane") {
     p.kind = PrimitiveKind::kPlane;
-    expectKeys(v, where, {"name", "primitive", "material", "color", "transform", "size",
+    expectKeys(v, where, {"name", "primitive", "material", "color", "transform", "priority", "size",
                           "subdivisions"});
   } else if (kind == "checker") {
     p.kind = PrimitiveKind::kChecker;
     p.size = {8, 1, 8};
     p.divisionsX = p.divisionsZ = 8;
-    expectKeys(v, where, {"name", "primitive", "material", "color", "transform", "size",
+    expectKeys(v, where, {"name", "primitive", "material", "color", "transform", "priority", "size",
                           "squares", "colors"});
   } else if (kind == "cylinder") {
     p.kind = PrimitiveKind::kCylinder;
-    expectKeys(v, where, {"name", "primitive", "material", "color", "transform", "radius",
+    expectKeys(v, where, {"name", "primitive", "material", "color", "transform", "priority", "radius",
                           "height", "segments", "caps"});
   } else if (kind == "cone") {
     p.kind = PrimitiveKind::kCone;
-    expectKeys(v, where, {"name", "primitive", "material", "color", "transform", "radius",
+    expectKeys(v, where, {"name", "primitive", "material", "color", "transform", "priority", "radius",
                           "height", "segments", "caps"});
   } else if (kind == "torus") {
     p.kind = PrimitiveKind::kTorus;
     p.radius = 0.375f;
     p.segments = 48;
     p.sides = 24;
-    expectKeys(v, where, {"name", "primitive", "material", "color", "transform", "radius", "tube",
+    expectKeys(v, where, {"name", "primitive", "material", "color", "transform", "priority", "radius", "tube",
                           "segments", "sides"});
   } else {
     fail(kindWhere, fmt::format("unknown primitive '{}' (expected box, sphere, plane, checker, "

@@ -53,13 +53,15 @@ void addQuad(scene::Scene& s, Vec3 o, Vec3 e1, Vec3 e2, int material, Vec4 color
 }
 
 Image render(const scene::Scene& s, int w, int h, int threads = 2,
-             scene::TextureFilter filter = scene::TextureFilter::trilinear, int samples = 1) {
+             scene::TextureFilter filter = scene::TextureFilter::trilinear, int samples = 1,
+             RenderOptions::Hsr hsr = RenderOptions::Hsr::zbuffer) {
   RenderOptions o;
   o.width = w;
   o.height = h;
   o.threads = threads;
   o.textureFilter = filter;
   o.samples = samples;
+  o.hsr = hsr;
   Renderer r(o);
   Image img;
   const Status st = r.render(s, img);
@@ -151,6 +153,52 @@ TEST(Shading, TranslucentSurfacesBlendOverWhatIsBehindInLinearLight) {
   // Outside the glass: the blue quad alone.
   EXPECT_EQ(pixel(img, 1, 1)[2], 255);
   EXPECT_EQ(pixel(img, 1, 1)[0], 0);
+}
+
+// Two translucent quads blend in depth order whatever their submission order: the renderer
+// draws translucent objects farthest first.
+TEST(Shading, TranslucentObjectsBlendFarthestFirstInAnySubmissionOrder) {
+  scene::Scene nearFirst = emptyScene();
+  scene::Material red, green;
+  red.unlit = green.unlit = true;
+  red.baseColor = {1, 0, 0, 0.5f};
+  green.baseColor = {0, 1, 0, 0.5f};
+  red.alphaMode = green.alphaMode = scene::AlphaMode::blend;
+  nearFirst.materials = {red, green};
+  scene::Scene farFirst = nearFirst;
+  addQuad(nearFirst, {-1, -1, -2}, {2, 0, 0}, {0, 2, 0}, 0);  // red, near
+  addQuad(nearFirst, {-2, -2, -4}, {4, 0, 0}, {0, 4, 0}, 1);  // green, far
+  addQuad(farFirst, {-2, -2, -4}, {4, 0, 0}, {0, 4, 0}, 1);
+  addQuad(farFirst, {-1, -1, -2}, {2, 0, 0}, {0, 2, 0}, 0);
+  const Image a = render(nearFirst, 32, 32), b = render(farFirst, 32, 32);
+  EXPECT_EQ(a.rgb, b.rgb);
+  // Red over (green over black): red 0.5, green 0.25 in linear light.
+  EXPECT_GT(pixel(a, 16, 16)[0], pixel(a, 16, 16)[1]);
+}
+
+// Masking draws opaque objects nearest first (their boxes' nearest corners), so a scene given far
+// to near renders as the Z-buffer does; an explicit priority overrides distance, and masking
+// obeys it (the seeds' databases chose priorities; the Z-buffer ignores them).
+TEST(Shading, MaskingOrdersObjectsNearestFirstUnlessPrioritiesSay) {
+  scene::Scene s = emptyScene();
+  scene::Material blue, red;
+  blue.unlit = red.unlit = true;
+  blue.baseColor = {0, 0, 1, 1};
+  red.baseColor = {1, 0, 0, 1};
+  s.materials = {blue, red};
+  addQuad(s, {-5, -5, -6}, {10, 0, 0}, {0, 10, 0}, 0);  // far, blue, first
+  addQuad(s, {-1, -1, -2}, {2, 0, 0}, {0, 2, 0}, 1);    // near, red
+  const Image z = render(s, 48, 32);
+  for (auto hsr : {RenderOptions::Hsr::priority, RenderOptions::Hsr::hybrid})
+    for (int samples : {1, 16})
+      EXPECT_EQ(render(s, 48, 32, 2, scene::TextureFilter::trilinear, samples, hsr).rgb,
+                render(s, 48, 32, 2, scene::TextureFilter::trilinear, samples).rgb);
+  EXPECT_EQ(pixel(z, 24, 16)[0], 255);
+  s.instances[0].priority = -1;  // the far quad declared nearest
+  const Image p = render(s, 48, 32, 2, scene::TextureFilter::trilinear, 1, RenderOptions::Hsr::priority);
+  EXPECT_EQ(pixel(p, 24, 16)[2], 255);  // blue hides red: the order was trusted
+  EXPECT_EQ(render(s, 48, 32, 2, scene::TextureFilter::trilinear, 1, RenderOptions::Hsr::hybrid).rgb,
+            z.rgb);  // hybrid stays exact
 }
 
 TEST(Shading, AlphaCutOutsShowWhatIsBehindWhereAlphaIsBelowTheCutoff) {

@@ -236,6 +236,21 @@ TEST(JsonScene, RejectsAbsurdSegments) {
 }
 
 // Malformed inputs the data files do not cover, one row each, with the reason.
+// "priority" orders objects for hidden-surface masking: every instance an object makes gets it.
+TEST(JsonScene, ObjectPriorityReachesEveryInstanceItMakes) {
+  Result<Scene> r = parse(withObjects(
+      R"({"primitive": "box", "priority": -3}, {"primitive": "sphere"},
+         {"mesh": {"positions": [0,0,0, 1,0,0, 0,1,0], "indices": [0,1,2]}, "priority": 7})"));
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  ASSERT_EQ(r->instances.size(), 3u);
+  EXPECT_EQ(r->instances[0].priority, -3);
+  EXPECT_EQ(r->instances[1].priority, 0);
+  EXPECT_EQ(r->instances[2].priority, 7);
+  EXPECT_NE(errorOf(withObjects(R"({"primitive": "box", "priority": 1.5})"))
+                .find("objects[0].priority: expected an integer"),
+            std::string::npos);
+}
+
 TEST(JsonScene, RejectsEachMalformedClassWithAClearMessage) {
   struct Row {
     const char* text;
