@@ -1,7 +1,7 @@
 // synthvis — command-line front end.
 //
 //   synthvis render [SCENE] -o out.png [--width W] [--height H] [--threads T] [--camera I]
-//                   [--no-cull] [--debug-view overdraw] [--gamma G] [--supersample K]
+//                   [--no-cull] [--debug-view overdraw|levels|occupancy] [--gamma G] [--supersample K]
 //                   [--aa 1|4|8|16|64] [--filter box|tent3]
 //                   [--texture-filter point|nearest|tri3|bilinear|trilinear3|trilinear|aniso]
 //                   [--hsr zbuffer|priority|hybrid]
@@ -77,9 +77,16 @@ int runRender(const RenderArgs& a) {
   if (!hsr) return fail(hsr.error());
   o.hsr = hsr.value();
   if (!a.debugView.empty()) {
-    if (a.debugView != "overdraw")
-      return fail({"", "", fmt::format("unknown debug view '{}' (available: overdraw)", a.debugView)});
-    o.debugOverdraw = true;
+    using DebugView = sv::RenderOptions::DebugView;
+    if (a.debugView == "overdraw")
+      o.debugView = DebugView::overdraw;
+    else if (a.debugView == "levels")
+      o.debugView = DebugView::levels;
+    else if (a.debugView == "occupancy")
+      o.debugView = DebugView::occupancy;
+    else
+      return fail({"", "", fmt::format("unknown debug view '{}' (overdraw, levels or occupancy)",
+                                       a.debugView)});
   }
   if (sv::Status s = sv::validate(o); !s) return fail(s.error());
 
@@ -382,7 +389,9 @@ int main(int argc, char** argv) {
   render->add_option("--camera", r.options.camera, "index of the scene camera to use")
       ->capture_default_str();
   render->add_flag("--no-cull", r.noCull, "draw back faces of single-sided materials too");
-  render->add_option("--debug-view", r.debugView, "false-colour diagnostic image: overdraw");
+  render->add_option("--debug-view", r.debugView,
+                     "false-colour diagnostic image: overdraw, levels or occupancy (with --hsr "
+                     "priority or hybrid)");
   render->add_option("--supersample", r.options.supersample,
                      "render k×k samples per pixel and average them (1, 2, 4, 8, 16)")
       ->capture_default_str();

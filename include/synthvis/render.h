@@ -21,7 +21,11 @@ struct RenderOptions {
   int threads = 0;             // worker threads in all; 0 = one per hardware thread
   bool cullBackFaces = true;   // for materials that are not double-sided
   int camera = 0;              // index into Scene::cameras (a default camera if there is none)
-  bool debugOverdraw = false;  // instead of colours, count the triangles covering each pixel
+  // False-colour diagnostics instead of the image (one sample per pixel): how many triangles
+  // covered each pixel (no depth test); where the visible triangle's subdivision stopped (the
+  // window size it was filled at, or a 4×4 leaf tested pixel by pixel); which windows masking
+  // found occupied (the largest full window holding the pixel; --hsr priority or hybrid).
+  enum class DebugView { none, overdraw, levels, occupancy } debugView = DebugView::none;
   // Output transfer function (SPEC §8): 0 = sRGB (IEC 61966-2-1); otherwise a display gamma G,
   // encoded value = linear^(1/G), G in [0.5, 5].
   double gamma = 0;

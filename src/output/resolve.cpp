@@ -167,11 +167,18 @@ void resolveTile(const uint16_t* color, int tileX, int tileY, int factor, const 
                    });
 }
 
-void resolveOverdrawTile(const uint16_t* color, int tileX, int tileY, Image& image) {
-  static constexpr uint8_t kPalette[6][3] = {{0, 0, 0},     {30, 60, 220}, {0, 200, 220},
-                                             {40, 200, 40}, {240, 220, 0}, {230, 30, 30}};
+void resolveDebugTile(const uint16_t* color, int tileX, int tileY, DebugPalette palette,
+                      Image& image) {
+  static constexpr uint8_t kCount[6][3] = {{0, 0, 0},     {30, 60, 220}, {0, 200, 220},
+                                           {40, 200, 40}, {240, 220, 0}, {230, 30, 30}};
+  static constexpr uint8_t kLevel[7][3] = {{0, 0, 0},    {128, 128, 128}, {30, 60, 220},
+                                           {0, 200, 220}, {40, 200, 40},  {240, 220, 0},
+                                           {230, 30, 30}};
+  const bool count = palette == DebugPalette::count;
   forEachTileRow(color, tileX, tileY, image, [&](uint8_t* out, const uint16_t* src, int n) {
-    for (int i = 0; i < n; ++i) std::copy_n(kPalette[std::min<int>(src[i], 5)], 3, out + 3 * i);
+    for (int i = 0; i < n; ++i)
+      std::copy_n(count ? kCount[std::min<int>(src[i], 5)] : kLevel[std::min<int>(src[i], 6)], 3,
+                  out + 3 * i);
   });
 }
 

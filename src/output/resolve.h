@@ -63,8 +63,13 @@ void resolveTileLinear(const uint16_t* color, int tileX, int tileY, int factor, 
 void tentFilterRows(const LinearImage& linear, const GammaTables& gamma, int rowBegin, int rowEnd,
                     Image& image);
 
-// For the overdraw count (raster::ShadeMode::overdraw): a false-colour image, black for 0, then
-// blue, cyan, green, yellow, red for 1, 2, 3, 4, ≥5 triangles covering the pixel.
-void resolveOverdrawTile(const uint16_t* color, int tileX, int tileY, Image& image);
+// Debug views: the red channel holds a small number per pixel, shown in false colour. `count`
+// (raster::ShadeMode::overdraw): black for 0, then blue, cyan, green, yellow, red for 1, 2, 3,
+// 4, ≥5 triangles covering the pixel. `level` (ShadeMode::levels, and the occupancy view): black
+// for 0 (nothing), then grey for 1 (a pixel: tested in a 4×4 leaf, or occupied alone), and blue,
+// cyan, green, yellow, red for 2…6 (a window of 4, 8, 16, 32, 64 pixels).
+enum class DebugPalette { count, level };
+void resolveDebugTile(const uint16_t* color, int tileX, int tileY, DebugPalette palette,
+                      Image& image);
 
 }  // namespace sv::output

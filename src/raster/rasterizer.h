@@ -43,6 +43,9 @@ enum class Masking : uint8_t { none, priority, hybrid };
 enum class ShadeMode : uint8_t {
   gouraud,   // depth test "less", perspective-correct Gouraud colour (SPEC §4, §8)
   overdraw,  // no depth test; the red channel counts the triangles covering the pixel
+  // Depth test "less"; the red channel records where the winning triangle's subdivision stopped:
+  // 1 for a pixel tested in a 4×4 leaf, else log2 of the window it was filled in (2…6).
+  levels,
   // Depth test "less"; triangles with an AttributeSetup material are shaded per pixel by
   // shade::shadeFragments (texture, Phong, fog) and written opaque, cut out (alpha mask) or blended
   // over the pixel without writing depth (translucent); the others as `gouraud`.
@@ -89,6 +92,9 @@ struct TileWork {
   // triangles (drawn after the opaque ones) are hidden behind nearer opaque ones.
   Masking masking = Masking::none;
   Occupancy* occupancy = nullptr;
+  // After the tile's triangles: its colour replaced by the occupancy view — the red channel 0
+  // where nothing is occupied, 1 for an occupied pixel, else log2 of the largest full window.
+  bool debugOccupancy = false;
 };
 
 // Draws the tile's triangles as `work.shade` says. Runs the best SIMD

@@ -68,7 +68,7 @@ constexpr int32_t kLaneY[kBlockPixels] = {0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 3,
 // write Gouraud colour; depth-test and shade it now (shade::shadeFragments); or depth-test and
 // record which triangle won (visibility), to be shaded once per pixel when the tile's triangles are
 // all drawn (shadeVisible).
-enum class PixelOp : uint8_t { overdraw, gouraud, material, visibility };
+enum class PixelOp : uint8_t { overdraw, gouraud, material, visibility, levels };
 
 // Visibility: "no triangle recorded since the last shading pass".
 constexpr uint32_t kNoTriangle = ~0u;
@@ -591,6 +591,38 @@ HWY_INLINE void visibleBlock(const TriangleSetup& t, const PlaneLanes& lanes, ui
   }
 }
 
+// The levels view (PixelOp::levels): the depth test, and in the pixels that pass, `level` in the
+// red channel (ShadeMode::levels).
+HWY_INLINE void levelBlock(const TriangleSetup& t, const PlaneLanes& lanes, uint32_t mask, int gx,
+                           int gy, int level, float* depth, uint16_t* color) {
+  alignas(32) float base[8];
+  blockBases(t, lanes, gx, gy, base);
+  for (int l = 0; l < kBlockPixels; ++l) {
+    if (!(mask >> l & 1)) continue;
+    const float z = base[kDepth] + lanes.offset[kDepth][l];
+    if (!(z < depth[l])) continue;
+    depth[l] = z;
+    color[l] = uint16_t(level);
+    color[kBlockPixels + l] = color[2 * kBlockPixels + l] = 0;
+  }
+}
+
+// The occupancy view (TileWork::debugOccupancy): each pixel's red channel the log2 size of the
+// largest full window holding it, 1 if only the pixel is occupied, 0 if nothing is.
+void occupancyView(const Occupancy& occ, uint16_t* color) {
+  for (int ly = 0; ly < kTileSize; ++ly)
+    for (int lx = 0; lx < kTileSize; ++lx) {
+      int level = 0;
+      for (int l = Occupancy::kMaxLevel; l >= Occupancy::kMinLevel && !level; --l)
+        if (occ.full(l, lx, ly)) level = l;
+      if (!level) level = occ.pixels(lx, ly) >> ((ly & 3) * 4 + (lx & 3)) & 1;
+      const size_t block = size_t(ly >> kBlockLog2) * kBlocksPerTileSide + (lx >> kBlockLog2);
+      uint16_t* c = color + block * kColorPerBlock + (ly & 3) * kBlockSize + (lx & 3);
+      c[0] = uint16_t(level);
+      c[kBlockPixels] = c[2 * kBlockPixels] = 0;
+    }
+}
+
 // Shades every pixel that records a triangle, with that triangle's planes and material (or its
 // Gouraud colour), and clears the records. Pixels are batched by triangle, up to 16 to a batch
 // from anywhere in the tile, so that a batch fills the SIMD lanes even for triangles of a few
@@ -971,6 +1003,7 @@ class TriangleRaster {
     ctx_.stats->windows[kStatLevels - 1] += kBlockPixels;
     if (occ_ && !ctx_.hybrid) mask &= ~occ_->pixels(lx, ly);
     if (!mask) return;
+    drawLevel_ = 1;
     shade(lx, ly, mask);
     if (mark_) occ_->addPixels(lx, ly, mask, blockDepth(lx, ly));
   }
@@ -1174,6 +1207,7 @@ class TriangleRaster {
       const uint32_t mask = 0xFFFFu & ~occ_->pixels(lx, ly);
       if (!mask) return;
       ++ctx_.stats->fullWindows;
+      drawLevel_ = kBlockLog2;
       shade(lx, ly, mask);
       if (mark_) occ_->addPixels(lx, ly, mask);
     }
@@ -1212,6 +1246,7 @@ class TriangleRaster {
 
   void plainFill(int lx, int ly, int n) {
     ++ctx_.stats->fullWindows;
+    drawLevel_ = std::countr_zero(unsigned(n));
     for (int by = ly; by < ly + n; by += kBlockSize)
       for (int bx = lx; bx < lx + n; bx += kBlockSize) {
         if constexpr (kAA)
@@ -1226,6 +1261,9 @@ class TriangleRaster {
     const size_t block = size_t(ly >> kBlockLog2) * kBlocksPerTileSide + (lx >> kBlockLog2);
     if constexpr (kOp == PixelOp::overdraw) {
       countBlock(mask, ctx_.color + block * kColorPerBlock);
+    } else if constexpr (kOp == PixelOp::levels) {
+      levelBlock(t_, planeLanes_, mask, ctx_.originX + lx, ctx_.originY + ly, drawLevel_,
+                 ctx_.depth + block * kBlockPixels, ctx_.color + block * kColorPerBlock);
     } else if constexpr (kOp == PixelOp::visibility) {
       visibleBlock(t_, planeLanes_, mask, ctx_.originX + lx, ctx_.originY + ly, id_,
                    ctx_.depth + block * kBlockPixels, ctx_.visible + block * kBlockPixels);
@@ -1366,6 +1404,7 @@ class TriangleRaster {
   Occupancy* occ_ = nullptr;          // masking: drop occupied windows
   bool mark_ = false;                 // … and occupy what this triangle covers
   int boxX0_ = 0, boxY0_ = 0, boxX1_ = 0, boxY1_ = 0;  // the box inside the tile (draw)
+  int drawLevel_ = 1;  // PixelOp::levels: what shade() records
   float boxZmin_ = 0;  // hybrid: the triangle's smallest depth in that box
   T sX_[E], sY_[E], pos_[E], neg_[E];
   alignas(64) T leafOffset_[E][kBlockPixels];
@@ -1470,7 +1509,10 @@ void drawLists(const TileWork& w, RasterStats& stats) {
         else
           drawTriangle<PixelOp::gouraud, kAA>(t, ctx);
       } else {
-        drawTriangle<kShade == ShadeMode::overdraw ? PixelOp::overdraw : PixelOp::gouraud, kAA>(t, ctx);
+        constexpr PixelOp op = kShade == ShadeMode::overdraw ? PixelOp::overdraw
+                               : kShade == ShadeMode::levels ? PixelOp::levels
+                                                             : PixelOp::gouraud;
+        drawTriangle<op, kAA>(t, ctx);
       }
     }
   }
@@ -1482,6 +1524,8 @@ void RasterizeTile(const TileWork& w, RasterStats& stats) {
   if (w.clear && w.occupancy) w.occupancy->clear(w.coverage ? w.coverage->samples : 1);
   if (w.shade == ShadeMode::overdraw)
     drawLists<ShadeMode::overdraw, false>(w, stats);
+  else if (w.shade == ShadeMode::levels)
+    drawLists<ShadeMode::levels, false>(w, stats);
   else if (w.shade == ShadeMode::material && w.coverage)
     drawLists<ShadeMode::material, true>(w, stats);
   else if (w.shade == ShadeMode::material)
@@ -1490,6 +1534,7 @@ void RasterizeTile(const TileWork& w, RasterStats& stats) {
     drawLists<ShadeMode::gouraud, true>(w, stats);
   else
     drawLists<ShadeMode::gouraud, false>(w, stats);
+  if (w.debugOccupancy && w.occupancy) occupancyView(*w.occupancy, w.color);
 }
 
 }  // namespace HWY_NAMESPACE

@@ -56,7 +56,8 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
   for (int ch = 0; ch < 3; ++ch)
     clear16[ch] = static_cast<uint16_t>(
         std::lround(std::clamp(settings.clearColor[ch], 0.0f, 1.0f) * 65535.0f));
-  if (settings.shade == raster::ShadeMode::overdraw) std::fill_n(clear16, 3, uint16_t(0));
+  if (settings.shade == raster::ShadeMode::overdraw || settings.shade == raster::ShadeMode::levels)
+    std::fill_n(clear16, 3, uint16_t(0));
 
   const uint32_t firstBatch = std::min(triangleCount, batchTriangles);
   setups_.resize(std::max<size_t>(setups_.size(), firstBatch));
@@ -177,6 +178,7 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
         if (samples == 1) w.visible = scratch_[worker].visible.data();
       }
       w.masking = settings.masking;
+      w.debugOccupancy = settings.debugOccupancy && lastBatch;
       if (masking)
         w.occupancy = wholeFrame ? &frameOccupancy_[tile] : scratch_[worker].occupancy.get();
       raster::rasterizeTile(w, tileStats_[tile]);

@@ -56,6 +56,8 @@ struct FrameSettings {
   // Masking (raster::TileWork::masking): `priority` takes the packets' triangles in priority order,
   // nearest first.
   raster::Masking masking = raster::Masking::none;
+  // The occupancy debug view (raster::TileWork::debugOccupancy).
+  bool debugOccupancy = false;
 };
 
 class FrameRenderer {

@@ -226,17 +226,20 @@ Status validate(const RenderOptions& o) {
                             o.height * o.supersample > kMaxRasterSize))
     return Error{"", "", fmt::format("supersampling {}x{} by {} exceeds the {}-pixel raster",
                                      o.width, o.height, o.supersample, kMaxRasterSize)};
-  if (o.supersample > 1 && o.debugOverdraw)
-    return Error{"", "", "the overdraw view counts triangles per pixel; it cannot be supersampled"};
+  const bool debug = o.debugView != RenderOptions::DebugView::none;
+  if (o.supersample > 1 && debug)
+    return Error{"", "", "a debug view shows one value per pixel; it cannot be supersampled"};
   if (o.samples != 1 && o.samples != 4 && o.samples != 8 && o.samples != 16 && o.samples != 64)
     return Error{"", "", fmt::format("{} samples per pixel is not supported (1, 4, 8, 16 or 64)",
                                      o.samples)};
   if (o.samples > 1 && o.supersample > 1)
     return Error{"", "", "anti-aliasing and supersampling are alternatives; choose one"};
-  if (o.samples > 1 && o.debugOverdraw)
-    return Error{"", "", "the overdraw view counts triangles per pixel; it cannot be anti-aliased"};
-  if (o.filter != RenderOptions::Filter::box && o.debugOverdraw)
-    return Error{"", "", "the overdraw view cannot be filtered"};
+  if (o.samples > 1 && debug)
+    return Error{"", "", "a debug view shows one value per pixel; it cannot be anti-aliased"};
+  if (o.filter != RenderOptions::Filter::box && debug)
+    return Error{"", "", "a debug view cannot be filtered"};
+  if (o.debugView == RenderOptions::DebugView::occupancy && o.hsr == RenderOptions::Hsr::zbuffer)
+    return Error{"", "", "the occupancy view shows masking: use --hsr priority or hybrid"};
   if (o.gamma != 0 && !(o.gamma >= 0.5 && o.gamma <= 5))
     return Error{"", "", fmt::format("gamma {} is out of range (0.5…5, or 0 for sRGB)", o.gamma)};
   return {};
@@ -301,7 +304,7 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
                                         &scene.light, &scene.pointLights};
   ShadingTables& shading = impl_->shading;
   buildShading(scene, o, camera.value().view, shading);
-  const bool pixelShading = shading.any && !o.debugOverdraw;
+  const bool pixelShading = shading.any && o.debugView == RenderOptions::DebugView::none;
 
   auto t0 = Clock::now();
   render::DrawPackets& p = impl_->packets;
@@ -371,12 +374,15 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
   fs.clearColor[0] = scene.background.x;
   fs.clearColor[1] = scene.background.y;
   fs.clearColor[2] = scene.background.z;
-  fs.shade = o.debugOverdraw  ? raster::ShadeMode::overdraw
+  using DebugView = RenderOptions::DebugView;
+  fs.shade = o.debugView == DebugView::overdraw ? raster::ShadeMode::overdraw
+             : o.debugView == DebugView::levels ? raster::ShadeMode::levels
              : pixelShading   ? raster::ShadeMode::material
                               : raster::ShadeMode::gouraud;
   fs.environment = &shading.environment;
   fs.samples = o.samples;
-  fs.masking = o.debugOverdraw                         ? raster::Masking::none
+  fs.debugOccupancy = o.debugView == DebugView::occupancy;
+  fs.masking = o.debugView == DebugView::overdraw      ? raster::Masking::none
                : o.hsr == RenderOptions::Hsr::priority ? raster::Masking::priority
                : o.hsr == RenderOptions::Hsr::hybrid   ? raster::Masking::hybrid
                                                        : raster::Masking::none;
@@ -406,9 +412,12 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
   const bool tent = o.filter == RenderOptions::Filter::tent3;
   output::LinearImage& linear = impl_->linear;
   if (tent) linear.resize(o.width, o.height);
-  if (o.debugOverdraw)
+  if (o.debugView != DebugView::none)
     fs.finishTile = [&](int tile, const float*, const uint16_t* color) {
-      output::resolveOverdrawTile(color, tile % tilesX, tile / tilesX, image);
+      output::resolveDebugTile(color, tile % tilesX, tile / tilesX,
+                               o.debugView == DebugView::overdraw ? output::DebugPalette::count
+                                                                  : output::DebugPalette::level,
+                               image);
     };
   else if (tent)
     fs.finishTile = [&](int tile, const float*, const uint16_t* color) {

@@ -2,6 +2,7 @@
 // option validation, and the benchmark generator's stated statistics.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 
 #include <cstdlib>
@@ -122,7 +123,7 @@ TEST(TrisGenerator, RenderedAreaMatchesTheRequestedArea) {
   o.width = 640;
   o.height = 480;
   o.threads = 2;
-  o.debugOverdraw = true;  // counts covered pixels
+  o.debugView = RenderOptions::DebugView::overdraw;  // counts covered pixels
   Renderer r(o);
   Image img;
   FrameStats stats;
@@ -219,8 +220,40 @@ TEST(Render, AntiAliasingAndTheTentFilterAverageInLinearLight) {
   bad.supersample = 2;
   EXPECT_FALSE(validate(bad).ok());
   bad.supersample = 1;
-  bad.debugOverdraw = true;
+  bad.debugView = RenderOptions::DebugView::overdraw;
   EXPECT_FALSE(validate(bad).ok());
+}
+
+// The masking diagnostics (issue 6): where subdivision stopped, and which windows were occupied.
+// BENCH.md's grazing scene: the sky is black in the levels view (nothing drawn), the ground plane
+// is filled in whole windows, pixels along edges are leaf-tested (grey). Two of BENCH.md's layers
+// front to back: the occupancy view shows every tile full (red) once both are in.
+TEST(DebugViews, LevelsAndOccupancyShowTheSubdivisionAndTheMasks) {
+  RenderOptions o;
+  o.width = 256;
+  o.height = 128;
+  o.threads = 2;
+  o.hsr = RenderOptions::Hsr::priority;
+  o.debugView = RenderOptions::DebugView::levels;
+  Image levels, occupancy;
+  ASSERT_TRUE(Renderer(o).render(scene::generateGrazing({}), levels).ok());
+  std::set<std::array<uint8_t, 3>> colours;
+  for (size_t i = 0; i < levels.rgb.size(); i += 3)
+    colours.insert({levels.rgb[i], levels.rgb[i + 1], levels.rgb[i + 2]});
+  EXPECT_EQ(colours.count({0, 0, 0}), 1u) << "the sky";
+  EXPECT_EQ(colours.count({128, 128, 128}), 1u) << "leaf-tested pixels along edges";
+  EXPECT_GE(colours.size(), 3u) << "and pixels filled in whole windows";
+  scene::LayersParams p;
+  p.layers = 2;
+  p.order = scene::SubmitOrder::frontToBack;
+  p.width = o.width;
+  p.height = o.height;
+  o.debugView = RenderOptions::DebugView::occupancy;
+  ASSERT_TRUE(Renderer(o).render(scene::generateLayers(p), occupancy).ok());
+  for (size_t i = 0; i < occupancy.rgb.size(); i += 3)
+    ASSERT_EQ(occupancy.rgb[i], 230) << "pixel " << i / 3 << " not in a full 64-px tile";
+  o.hsr = RenderOptions::Hsr::zbuffer;
+  EXPECT_FALSE(validate(o).ok()) << "occupancy needs masking";
 }
 
 TEST(LayersGenerator, SameSeedSameSceneAndStatistics) {
@@ -340,7 +373,7 @@ TEST(LayersGenerator, EveryPixelIsCoveredDTimes) {
     o.width = p.width;
     o.height = p.height;
     o.threads = 2;
-    o.debugOverdraw = true;
+    o.debugView = RenderOptions::DebugView::overdraw;
     Renderer r(o);
     Image img;
     FrameStats stats;
