@@ -1116,7 +1116,23 @@ class TriangleRaster {
     }
     if (!covered) return;
     shadeSamples(lx, ly, masks, covered);
-    if (mark_) markSamples(lx, ly, masks);
+    if (mark_) markOrDefer(lx, ly, masks);
+  }
+
+  // Hybrid masking reads a block's depth when it becomes full: a block whose samples are still
+  // queued for shading (queueSamples) is marked once they are written (flushSamples).
+  void markOrDefer(int lx, int ly, const uint32_t (*masks)[kBlockPixels]) {
+    if constexpr (kAA && kOp == PixelOp::material) {
+      if (ctx_.hybrid && pendingBlocks_ > 0 && pending_[pendingBlocks_ - 1].lx == lx &&
+          pending_[pendingBlocks_ - 1].ly == ly) {
+        PendingBlock& b = pending_[pendingBlocks_ - 1];
+        std::copy_n(masks[0], kBlockPixels, b.marks[0]);
+        std::copy_n(masks[1], kBlockPixels, b.marks[1]);
+        b.markAfter = true;
+        return;
+      }
+    }
+    markSamples(lx, ly, masks);
   }
 
   // Occupies the samples `masks` holds in the block at (lx, ly) (Occupancy::addSamples in SIMD
@@ -1183,8 +1199,15 @@ class TriangleRaster {
       plainFill(lx, ly, kBlockSize);
       if (!mark_) return;
       if (wasFull) return occ_->lowerZmax(kBlockLog2, lx, ly, windowZmax(kBlockLog2, lx, ly));
-      occ_->sampleWords(lx, ly);  // touched
-      occ_->setPixels(lx, ly, 0xFFFF, blockZmax(lx, ly));
+      if constexpr (kAA) {
+        alignas(64) uint32_t all[2][kBlockPixels];
+        std::fill_n(all[0], kBlockPixels, occ_->fullWords()[0]);
+        std::fill_n(all[1], kBlockPixels, occ_->fullWords()[1]);
+        markOrDefer(lx, ly, all);
+      } else {
+        occ_->sampleWords(lx, ly);  // touched
+        occ_->setPixels(lx, ly, 0xFFFF, blockZmax(lx, ly));
+      }
       return;
     }
     if constexpr (kAA) {
@@ -1317,6 +1340,7 @@ class TriangleRaster {
     }
     b.lx = lx;
     b.ly = ly;
+    b.markAfter = false;
     b.firstPixel = pendingPixels_;
     const float bx = float(gx - t_.minX), by = float(gy - t_.minY);
     for (int l = 0; l < kBlockPixels; ++l) {
@@ -1378,13 +1402,16 @@ class TriangleRaster {
       writeSamples(t_, planeLanes_, m, sampleDepth_, ctx_.samples, b.pass, rgba,
                    ctx_.originX + b.lx, ctx_.originY + b.ly, ctx_.depth + planes * kBlockPixels,
                    ctx_.color + planes * kColorPerBlock);
+      if (b.markAfter) markSamples(b.lx, b.ly, b.marks);
     }
     pendingBlocks_ = pendingPixels_ = 0;
   }
 
   struct PendingBlock {
     int lx, ly, firstPixel, pixelCount;
+    bool markAfter;  // hybrid: occupy `marks` once written (markOrDefer)
     alignas(64) uint32_t pass[2][kBlockPixels];
+    alignas(64) uint32_t marks[2][kBlockPixels];
   };
   static constexpr int kPendingBlocks = 16;
   static constexpr int kPendingPixels = kPendingBlocks * kBlockPixels;
