@@ -141,23 +141,16 @@ class Occupancy {
   // sample planes.
   void addSamples(int lx, int ly, const uint32_t (*mask)[kBlockPixels],
                   const float* depth = nullptr) {
-    const int b = blockIndex(lx, ly);
-    if (!touched(kMinLevel, lx, ly)) {
-      pixels_[b] = 0;
-      std::memset(sampleMask_[b], 0, sizeof(sampleMask_[b]));
-      touch(kMinLevel, lx, ly);
-    }
-    if (pixels_[b] == 0xFFFF) return;
+    if (full(kMinLevel, lx, ly)) return;
+    uint32_t(*words)[kBlockPixels] = sampleWords(lx, ly);
     uint32_t fullPixels = 0;
     for (int p = 0; p < kBlockPixels; ++p) {
-      const uint32_t w0 = sampleMask_[b][0][p] |= mask[0][p];
-      const uint32_t w1 = sampleMask_[b][1][p] |= mask[1][p];
+      const uint32_t w0 = words[0][p] |= mask[0][p];
+      const uint32_t w1 = words[1][p] |= mask[1][p];
       fullPixels |= uint32_t(w0 == fullWord_[0] && w1 == fullWord_[1]) << p;
     }
-    pixels_[b] = uint16_t(fullPixels);
-    if (fullPixels == 0xFFFF)
-      markFull(kMinLevel, lx, ly,
-               depth ? maxOf(depth, kBlockPixels * sampleCount_) : kNoBound);
+    setPixels(lx, ly, fullPixels,
+              fullPixels == 0xFFFF && depth ? maxOf(depth, kBlockPixels * sampleCount_) : kNoBound);
   }
 
   // The pieces of addSamples for a SIMD caller (the tile kernel): the block's occupied-sample
@@ -178,8 +171,6 @@ class Occupancy {
     if (pixels == 0xFFFF) markFull(kMinLevel, lx, ly, zmax);
   }
   const uint32_t* fullWords() const { return fullWord_; }
-
-  int sampleCount() const { return sampleCount_; }
 
  private:
   // Window (lx, ly) of size 2^level: bit (ly >> level)·(64 >> level) + (lx >> level).

@@ -76,6 +76,35 @@ TEST(Occupancy, APixelIsOccupiedWhenAllItsSamplesAre) {
   EXPECT_EQ(o.pixels(8, 4), 0u);
 }
 
+// Hybrid masking's depth bounds: exact from the depth buffer when a block becomes full, the
+// largest of the children's for a parent, lowered (never raised) when drawn over again; a
+// rectangle is hidden for a triangle whose smallest depth there is not below its windows' bounds.
+TEST(Occupancy, DepthBoundsComeFromTheDepthBufferAndPropagate) {
+  Occupancy o;
+  o.clear(1);
+  EXPECT_EQ(o.zmaxOver(2, 0, 0), Occupancy::kNoBound);
+  float depth[16];
+  for (int i = 0; i < 16; ++i) depth[i] = 0.1f + 0.01f * float(i);
+  o.addPixels(0, 0, 0x00FF, depth);
+  EXPECT_EQ(o.zmaxOver(2, 0, 0), Occupancy::kNoBound);  // not full yet
+  o.addPixels(0, 0, 0xFF00, depth);
+  EXPECT_FLOAT_EQ(o.zmaxOver(2, 0, 0), 0.25f);
+  // The other three blocks of the 8×8 window, by whole-window fills with their own bounds.
+  o.markFull(2, 4, 0, 0.5f);
+  o.markFull(2, 0, 4, 0.3f);
+  EXPECT_EQ(o.zmaxOver(3, 0, 0), Occupancy::kNoBound);
+  o.markFull(2, 4, 4, 0.2f);
+  EXPECT_FLOAT_EQ(o.zmaxOver(3, 0, 0), 0.5f);
+  o.lowerZmax(2, 4, 0, 0.7f);  // not lower: kept
+  EXPECT_FLOAT_EQ(o.zmaxOver(2, 4, 0), 0.5f);
+  o.lowerZmax(2, 4, 0, 0.4f);
+  EXPECT_FLOAT_EQ(o.zmaxOver(3, 0, 0), 0.4f);
+  EXPECT_TRUE(o.rectHidden(1, 1, 6, 6, 0.4f));
+  EXPECT_FALSE(o.rectHidden(1, 1, 6, 6, 0.39f));
+  EXPECT_TRUE(o.rectHidden(0, 0, 3, 3, 0.3f));  // the first block alone: bound 0.25
+  EXPECT_FALSE(o.rectHidden(0, 0, 8, 3, 0.9f));  // reaches an empty block
+}
+
 // Random triangles of every size at distinct constant depths, sorted nearest first: a valid
 // priority order without interpenetration.
 DrawPackets frontToBackScene(int w, int h, int count, unsigned seed) {
