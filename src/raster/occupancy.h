@@ -70,13 +70,9 @@ class Occupancy {
     return touched(kMinLevel, lx, ly) ? pixels_[blockIndex(lx, ly)] : 0u;
   }
   // Its occupied samples per pixel (anti-aliasing), in the words of the coverage masks
-  // (raster/coverage_masks.h): samples[w][pixel]. All zero for an untouched block.
-  void samples(int lx, int ly, uint32_t out[2][kBlockPixels]) const {
-    if (!touched(kMinLevel, lx, ly)) {
-      std::memset(out, 0, sizeof(uint32_t) * 2 * kBlockPixels);
-      return;
-    }
-    std::memcpy(out, sampleMask_[blockIndex(lx, ly)], sizeof(uint32_t) * 2 * kBlockPixels);
+  // (raster/coverage_masks.h): samples[w][pixel]; nullptr for an untouched block (none).
+  const uint32_t (*samples(int lx, int ly) const)[kBlockPixels] {
+    return touched(kMinLevel, lx, ly) ? sampleMask_[blockIndex(lx, ly)] : nullptr;
   }
 
   // Whether the tile-local pixel rectangle [x0, x1] × [y0, y1] (inside the tile) lies wholly in
@@ -232,25 +228,28 @@ class Occupancy {
     }
   }
   // The flat per-block copies: the blocks of a full window (level, lx, ly) lie in a full window,
-  // bounded by at most z.
+  // bounded by at most z (+∞: masking alone, no bounds to keep).
   void coverBlocks(int level, int lx, int ly, float z) {
     const int side = 1 << (level - kMinLevel);
     const int bx = (lx >> level << level) >> kMinLevel, by = (ly >> level << level) >> kMinLevel;
-    for (int y = by; y < by + side; ++y)
-      for (int x = bx; x < bx + side; ++x) {
-        const int b = y * (kTileSize >> kMinLevel) + x;
-        blockInFull_[b >> 6] |= uint64_t(1) << (b & 63);
-        blockBound_[b] = std::min(blockBound_[b], z);
-      }
+    const bool bounded = z < kNoBound;
+    for (int y = by; y < by + side; ++y) {
+      // A row of up to 16 blocks lies in one 64-bit word (16 blocks a row, 4 rows a word).
+      const int b = y * (kTileSize >> kMinLevel) + bx;
+      blockInFull_[b >> 6] |= ((side == 16 ? 0xFFFFull : (uint64_t(1) << side) - 1)) << (b & 63);
+      if (bounded)
+        for (int x = 0; x < side; ++x) blockBound_[b + x] = std::min(blockBound_[b + x], z);
+    }
   }
   static float maxOf(const float* v, int n) {
     float m = v[0];
     for (int i = 1; i < n; ++i) m = std::max(m, v[i]);
     return m;
   }
-  // The window and every window containing it hold something occupied.
+  // The window and every window containing it hold something occupied (a touched window's
+  // ancestors are all touched already).
   void touch(int level, int lx, int ly) {
-    for (int l = level; l <= kMaxLevel; ++l) set(touched_, l, lx, ly);
+    for (int l = level; l <= kMaxLevel && !test(touched_, l, lx, ly); ++l) set(touched_, l, lx, ly);
   }
 
   static constexpr int kLevelCount = kMaxLevel - kMinLevel + 1;
