@@ -328,8 +328,8 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
   // Opaque materials first, then translucent ones (SPEC §4: blended over what is behind them).
   const std::vector<uint32_t> order = drawOrder(scene, camera.value().view, o.hsr);
   for (const bool translucentPass : {false, true})
-    for (const uint32_t i : order) {
-      const scene::Instance& inst = scene.instances[i];
+    for (const uint32_t instance : order) {
+      const scene::Instance& inst = scene.instances[instance];
       const scene::Mesh& mesh = scene.meshes[inst.mesh];
       const scene::Material& mat = materialOf(mesh);
       if ((mat.alphaMode == scene::AlphaMode::blend) != translucentPass) continue;
