@@ -30,6 +30,16 @@ inline constexpr int kTilePixels = kTileSize * kTileSize;
 inline constexpr int kColorChannels = 3;
 inline constexpr int kColorPerBlock = kBlockPixels * kColorChannels;
 
+// The index of the 4×4 block holding tile-local pixel (lx, ly), in a tile's block-major layout.
+constexpr size_t tileBlock(int lx, int ly) {
+  return size_t(ly >> kBlockLog2) * kBlocksPerTileSide + size_t(lx >> kBlockLog2);
+}
+
+// Word w (0 or 1) of a pixel's sample mask (raster/coverage_masks.h) with all `samples` set.
+constexpr uint32_t fullSampleWord(int samples, int w) {
+  return w == 0 ? (samples >= 32 ? ~0u : (1u << samples) - 1) : (samples > 32 ? ~0u : 0u);
+}
+
 class FrameBuffer {
  public:
   // Allocates for a width × height raster (1 … 8192 each; checked by the caller) of `samples`
@@ -68,15 +78,15 @@ class FrameBuffer {
 
 inline size_t FrameBuffer::depthOffset(int x, int y, int samples, int s) {
   int lx = x & (kTileSize - 1), ly = y & (kTileSize - 1);
-  int block = (ly >> kBlockLog2) * kBlocksPerTileSide + (lx >> kBlockLog2);
-  return (size_t(block) * samples + size_t(s)) * kBlockPixels + (ly & (kBlockSize - 1)) * kBlockSize +
+  const size_t block = tileBlock(lx, ly);
+  return (block * samples + size_t(s)) * kBlockPixels + (ly & (kBlockSize - 1)) * kBlockSize +
          (lx & (kBlockSize - 1));
 }
 
 inline size_t FrameBuffer::colorOffset(int x, int y, int channel, int samples, int s) {
   int lx = x & (kTileSize - 1), ly = y & (kTileSize - 1);
-  int block = (ly >> kBlockLog2) * kBlocksPerTileSide + (lx >> kBlockLog2);
-  return (size_t(block) * samples + size_t(s)) * kColorPerBlock + channel * kBlockPixels +
+  const size_t block = tileBlock(lx, ly);
+  return (block * samples + size_t(s)) * kColorPerBlock + channel * kBlockPixels +
          (ly & (kBlockSize - 1)) * kBlockSize + (lx & (kBlockSize - 1));
 }
 

@@ -45,8 +45,8 @@ class Occupancy {
     std::memset(blockInFull_, 0, sizeof(blockInFull_));
     std::fill_n(blockBound_, kBlocks, kNoBound);
     sampleCount_ = samples;
-    fullWord_[0] = samples >= 32 ? ~0u : (1u << samples) - 1;
-    fullWord_[1] = samples > 32 ? ~0u : 0u;
+    fullWord_[0] = fullSampleWord(samples, 0);
+    fullWord_[1] = fullSampleWord(samples, 1);
   }
 
   // Whether the window of size 2^level at tile-local pixel (lx, ly) is full — by its own bit only

@@ -234,8 +234,7 @@ HWY_INLINE void shadeBlockSamples(const TriangleSetup& t, const PlaneLanes& lane
                                   float* depth, uint16_t* color) {
   const int samples = cov.samples;
   // The words of a full mask.
-  const uint32_t fullWord0 = samples >= 32 ? ~0u : (1u << samples) - 1;
-  const uint32_t fullWord1 = samples > 32 ? ~0u : 0u;
+  const uint32_t fullWord0 = fullSampleWord(samples, 0), fullWord1 = fullSampleWord(samples, 1);
   const hn::CappedTag<float, kBlockPixels> df;
   const hn::RebindToSigned<decltype(df)> di;
   const hn::RebindToUnsigned<decltype(df)> du32;
@@ -456,8 +455,7 @@ HWY_INLINE bool samplesPassing(const TriangleSetup& t, const PlaneLanes& lanes,
                                const float* depth, uint32_t (*pass)[kBlockPixels], float* cx,
                                float* cy) {
   const int samples = cov.samples;
-  const uint32_t fullWord0 = samples >= 32 ? ~0u : (1u << samples) - 1;
-  const uint32_t fullWord1 = samples > 32 ? ~0u : 0u;
+  const uint32_t fullWord0 = fullSampleWord(samples, 0), fullWord1 = fullSampleWord(samples, 1);
   const hn::CappedTag<float, kBlockPixels> df;
   const hn::RebindToUnsigned<decltype(df)> du32;
   const size_t n = hn::Lanes(df);
@@ -616,7 +614,7 @@ void occupancyView(const Occupancy& occ, uint16_t* color) {
       for (int l = Occupancy::kMaxLevel; l >= Occupancy::kMinLevel && !level; --l)
         if (occ.full(l, lx, ly)) level = l;
       if (!level) level = occ.pixels(lx, ly) >> ((ly & 3) * 4 + (lx & 3)) & 1;
-      const size_t block = size_t(ly >> kBlockLog2) * kBlocksPerTileSide + (lx >> kBlockLog2);
+      const size_t block = tileBlock(lx, ly);
       uint16_t* c = color + block * kColorPerBlock + (ly & 3) * kBlockSize + (lx & 3);
       c[0] = uint16_t(level);
       c[kBlockPixels] = c[2 * kBlockPixels] = 0;
@@ -798,8 +796,8 @@ class TriangleRaster {
                                         : shade::AlphaUse::opaque;
       if (alpha != shade::AlphaUse::blend) occ_ = ctx.occupancy;
       mark_ = occ_ && alpha == shade::AlphaUse::opaque;
+      computePlaneLanes(t, planeLanes_);
     }
-    if constexpr (kOp != PixelOp::overdraw) computePlaneLanes(t, planeLanes_);
     if constexpr (kOp == PixelOp::material) computeAttributeLanes(*attributes, attributeLanes_);
     if constexpr (kAA) setUpSamples();
     for (int k = 0; k < E; ++k) {
@@ -1213,9 +1211,8 @@ class TriangleRaster {
     if constexpr (kAA) {
       alignas(64) uint32_t masks[2][kBlockPixels] = {};
       if (const auto* held = occ_->samples(lx, ly)) std::memcpy(masks, held, sizeof(masks));
-      const int samples = ctx_.samples;
-      const uint32_t fullWord0 = samples >= 32 ? ~0u : (1u << samples) - 1;
-      const uint32_t fullWord1 = samples > 32 ? ~0u : 0u;
+      const uint32_t fullWord0 = fullSampleWord(ctx_.samples, 0);
+      const uint32_t fullWord1 = fullSampleWord(ctx_.samples, 1);
       int covered = 0;
       for (int p = 0; p < kBlockPixels; ++p) {
         masks[0][p] = fullWord0 & ~masks[0][p];
@@ -1263,7 +1260,7 @@ class TriangleRaster {
   // full (hybrid); nullptr for priority masking.
   const float* blockDepth(int lx, int ly) const {
     if (!ctx_.hybrid) return nullptr;
-    const size_t block = size_t(ly >> kBlockLog2) * kBlocksPerTileSide + (lx >> kBlockLog2);
+    const size_t block = tileBlock(lx, ly);
     return ctx_.depth + block * size_t(ctx_.samples) * kBlockPixels;
   }
 
@@ -1281,7 +1278,7 @@ class TriangleRaster {
 
   void shade(int lx, int ly, uint32_t mask) {
     ctx_.stats->fragments += std::popcount(mask);
-    const size_t block = size_t(ly >> kBlockLog2) * kBlocksPerTileSide + (lx >> kBlockLog2);
+    const size_t block = tileBlock(lx, ly);
     if constexpr (kOp == PixelOp::overdraw) {
       countBlock(mask, ctx_.color + block * kColorPerBlock);
     } else if constexpr (kOp == PixelOp::levels) {
@@ -1303,7 +1300,7 @@ class TriangleRaster {
 
   void shadeSamples(int lx, int ly, const uint32_t (*masks)[kBlockPixels], int pixels) {
     ctx_.stats->fragments += uint64_t(pixels);
-    const size_t block = size_t(ly >> kBlockLog2) * kBlocksPerTileSide + (lx >> kBlockLog2);
+    const size_t block = tileBlock(lx, ly);
     const size_t planes = block * size_t(ctx_.samples);
     if constexpr (kOp == PixelOp::material) return queueSamples(lx, ly, masks);
     shadeBlockSamples(t_, planeLanes_, *ctx_.coverage, sampleDepth_, masks, ctx_.originX + lx,
@@ -1314,7 +1311,7 @@ class TriangleRaster {
   // Anti-aliased pixel shading (PixelOp::material): step 1 for the block at (lx, ly), its passing
   // pixels queued for step 2.
   void queueSamples(int lx, int ly, const uint32_t (*masks)[kBlockPixels]) {
-    const size_t block = size_t(ly >> kBlockLog2) * kBlocksPerTileSide + (lx >> kBlockLog2);
+    const size_t block = tileBlock(lx, ly);
     const size_t planes = block * size_t(ctx_.samples);
     PendingBlock& b = pending_[pendingBlocks_];
     alignas(64) float cx[kBlockPixels], cy[kBlockPixels];
@@ -1397,7 +1394,7 @@ class TriangleRaster {
         const int p = b.firstPixel + k;
         for (int ch = 0; ch < 4; ++ch) rgba[ch][pixelLane_[p]] = pixelRgba_[ch][p];
       }
-      const size_t block = size_t(b.ly >> kBlockLog2) * kBlocksPerTileSide + (b.lx >> kBlockLog2);
+      const size_t block = tileBlock(b.lx, b.ly);
       const size_t planes = block * size_t(ctx_.samples);
       writeSamples(t_, planeLanes_, m, sampleDepth_, ctx_.samples, b.pass, rgba,
                    ctx_.originX + b.lx, ctx_.originY + b.ly, ctx_.depth + planes * kBlockPixels,
