@@ -5,6 +5,7 @@
 // Colours are linear-light RGB(A) in [0, 1].
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -92,6 +93,9 @@ struct Mesh {
   int material = -1;  // index into Scene::materials, or −1 for the default white material
 
   size_t triangleCount() const { return indices.size() / 3; }
+  // The smallest and largest coordinates of its positions, in its own space ({0, 0, 0} twice for
+  // a mesh without positions).
+  std::array<Vec3, 2> bounds() const;
 };
 
 // A mesh placed in the world.

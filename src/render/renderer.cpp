@@ -158,15 +158,7 @@ std::vector<uint32_t> drawOrder(const scene::Scene& scene, const Mat4& view, Ren
   if (!sortOpaque && !anyTranslucent) return order;
   // Per mesh its box; per instance the view depths of the box's corners.
   std::vector<std::array<Vec3, 2>> boxes(scene.meshes.size());
-  for (size_t m = 0; m < scene.meshes.size(); ++m) {
-    const auto& pos = scene.meshes[m].positions;
-    Vec3 lo{0, 0, 0}, hi{0, 0, 0};
-    for (size_t i = 0; i < pos.size(); ++i) {
-      lo = i ? Vec3{std::min(lo.x, pos[i].x), std::min(lo.y, pos[i].y), std::min(lo.z, pos[i].z)} : pos[i];
-      hi = i ? Vec3{std::max(hi.x, pos[i].x), std::max(hi.y, pos[i].y), std::max(hi.z, pos[i].z)} : pos[i];
-    }
-    boxes[m] = {lo, hi};
-  }
+  for (size_t m = 0; m < scene.meshes.size(); ++m) boxes[m] = scene.meshes[m].bounds();
   std::vector<float> nearest(order.size()), centre(order.size());
   for (size_t i = 0; i < order.size(); ++i) {
     const scene::Instance& inst = scene.instances[i];

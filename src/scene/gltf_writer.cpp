@@ -125,12 +125,7 @@ Status saveGltf(const Scene& scene, const std::string& path) {
         addAccessor(model, m.positions.data(), m.positions.size(), sizeof(Vec3), TINYGLTF_TYPE_VEC3,
                     TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
     // The specification requires bounds on POSITION.
-    Vec3 lo{0, 0, 0}, hi{0, 0, 0};
-    for (size_t i = 0; i < m.positions.size(); ++i) {
-      const Vec3 p = m.positions[i];
-      lo = i ? Vec3{std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)} : p;
-      hi = i ? Vec3{std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)} : p;
-    }
+    const auto [lo, hi] = m.bounds();
     model.accessors[size_t(pos)].minValues = {lo.x, lo.y, lo.z};
     model.accessors[size_t(pos)].maxValues = {hi.x, hi.y, hi.z};
     prim.attributes["POSITION"] = pos;

@@ -11,6 +11,16 @@
 
 namespace sv::scene {
 
+std::array<Vec3, 2> Mesh::bounds() const {
+  if (positions.empty()) return {Vec3{0, 0, 0}, Vec3{0, 0, 0}};
+  Vec3 lo = positions[0], hi = positions[0];
+  for (const Vec3& p : positions) {
+    lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+    hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+  }
+  return {lo, hi};
+}
+
 size_t Scene::triangleCount() const {
   size_t n = 0;
   for (const Instance& instance : instances)
