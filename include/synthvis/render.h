@@ -70,15 +70,21 @@ Result<Mat4> viewMatrix(const scene::Scene& scene, const RenderOptions& options)
 struct FrameStats {
   uint64_t trianglesIn = 0;
   uint64_t culledFacing = 0, culledOutside = 0, culledDegenerate = 0, culledInvalid = 0;
+  // With masking, in frames of several batches: triangles of objects whose bound lay in windows
+  // earlier batches occupied, dropped before setup (object-space culling, SPEC §4).
+  uint64_t culledOccluded = 0;
   uint64_t drawn = 0;
   uint64_t windows[6] = {};
   uint64_t fullWindows = 0, partialBlocks = 0, fragments = 0;
   uint64_t occludedWindows = 0;    // windows triangles were dropped from as occupied (priority)
   uint64_t occludedTriangles = 0;  // triangles dropped whole from a tile (their box occupied)
+  uint64_t occludedObjects = 0;    // objects dropped whole from a tile (their bound occupied)
   // rasterMs: the tile pass, which includes resolving each finished tile into the image.
   double vertexMs = 0, setupMs = 0, rasterMs = 0, totalMs = 0;
 
-  uint64_t culled() const { return culledFacing + culledOutside + culledDegenerate + culledInvalid; }
+  uint64_t culled() const {
+    return culledFacing + culledOutside + culledDegenerate + culledInvalid + culledOccluded;
+  }
   // One line: triangles in / culled / drawn, windows per level, milliseconds.
   std::string summary() const;
 };

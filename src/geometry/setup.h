@@ -82,6 +82,14 @@ struct Viewport {
 inline int boxInsetLow(const Viewport& v) { return v.pixelAperture ? kSubPixelScale - 1 : kSubPixelScale / 2; }
 inline int boxInsetHigh(const Viewport& v) { return kSubPixelScale - boxInsetLow(v); }
 
+// Object-space culling (SPEC §4, seed 004): the screen box and nearest depth of a whole object,
+// which every sample of every triangle of it lies within. The tiles test it against their occupied
+// windows before touching the object's triangles (raster::TileWork::objects).
+struct ObjectBound {
+  int minX = 0, minY = 0, maxX = -1, maxY = -1;  // inclusive pixels, clipped to the raster
+  float zmin = 0;  // window depth (0 … 1) no sample of the object is nearer than
+};
+
 // 160 bytes: the record the tiles read for every triangle, so kept small (cache misses on it are
 // a large part of the cost of small triangles).
 struct TriangleSetup {

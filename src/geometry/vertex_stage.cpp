@@ -2,6 +2,7 @@
 #include "geometry/vertex_stage.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace sv::geometry {
 
@@ -61,6 +62,41 @@ void transformVertices(const scene::Mesh& mesh, const scene::Material& material,
       a.value[shade::kAlpha] = alpha;
     }
   }
+}
+
+bool boundObject(const Mat4& mvp, Vec3 lo, Vec3 hi, const Viewport& viewport, ObjectBound& out) {
+  double x0 = HUGE_VAL, y0 = HUGE_VAL, x1 = -HUGE_VAL, y1 = -HUGE_VAL, z0 = HUGE_VAL;
+  for (int c = 0; c < 8; ++c) {
+    const double p[3] = {c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z};
+    double clip[4];
+    for (int r = 0; r < 4; ++r)
+      clip[r] = double(mvp.m[0][r]) * p[0] + double(mvp.m[1][r]) * p[1] +
+                double(mvp.m[2][r]) * p[2] + double(mvp.m[3][r]);
+    // In front of the near plane (z ≥ −w, w > 0) the box's image is the hull of its corners'.
+    if (!(clip[3] > 0) || !(clip[2] >= -clip[3]) || !std::isfinite(clip[0]) ||
+        !std::isfinite(clip[1]))
+      return false;
+    const double invW = 1.0 / clip[3];
+    // As setup.cpp maps clip space to pixels and window depth.
+    const double px = (clip[0] + clip[3]) * (0.5 * viewport.width) * invW;
+    const double py = (clip[3] - clip[1]) * (0.5 * viewport.height) * invW;
+    x0 = std::min(x0, px), x1 = std::max(x1, px);
+    y0 = std::min(y0, py), y1 = std::max(y1, py);
+    z0 = std::min(z0, 0.5 * (clip[2] + clip[3]) * invW);
+  }
+  // Pixel p's square is [p, p + 1): two pixels of slack cover the float vertex transform's
+  // rounding and the sample aperture of anti-aliasing.
+  auto pixel = [](double v, int size) {
+    return int(std::clamp(std::floor(v), -4.0, double(size) + 4));
+  };
+  out.minX = std::max(pixel(x0, viewport.width) - 2, 0);
+  out.minY = std::max(pixel(y0, viewport.height) - 2, 0);
+  out.maxX = std::min(pixel(x1, viewport.width) + 2, viewport.width - 1);
+  out.maxY = std::min(pixel(y1, viewport.height) + 2, viewport.height - 1);
+  // Depth planes are evaluated in float per sample; 2^-10 covers their rounding by a wide margin
+  // for any triangle whose depth gradient is below ~10^4 per pixel (docs/hidden-surfaces.md).
+  out.zmin = float(z0 - 0x1p-10);
+  return true;
 }
 
 }  // namespace sv::geometry

@@ -31,4 +31,11 @@ void transformVertices(const scene::Mesh& mesh, const scene::Material& material,
                        const VertexContext& context, size_t begin, size_t end, ClipVertex* out,
                        shade::VertexAttributes* attributes = nullptr);
 
+// The bound of an object whose vertices lie in the box [lo, hi] placed by `mvp` (object → clip):
+// the projected corners' pixel box, widened by two pixels for vertex rounding and sample
+// apertures, and their nearest window depth less a margin for the depth planes' float rounding.
+// False when no bound exists: the box reaches behind the near plane (its projection is then
+// unbounded, SPEC §2), or it is not finite.
+bool boundObject(const Mat4& mvp, Vec3 lo, Vec3 hi, const Viewport& viewport, ObjectBound& out);
+
 }  // namespace sv::geometry

@@ -13,7 +13,8 @@ void Binner::reset(int chunks, int tilesX, int tilesY) {
 }
 
 void Binner::binChunk(int chunk, const geometry::TriangleSetup* records, uint32_t n,
-                      geometry::TriangleSetup* storage, uint32_t storageBase, Scratch& scratch) {
+                      geometry::TriangleSetup* storage, uint32_t storageBase, Scratch& scratch,
+                      const uint32_t* objects) {
   // Counting sort by the tile of the top-left corner; stable, so each group keeps submission order.
   scratch.key.resize(n);
   scratch.position.resize(n);
@@ -52,6 +53,13 @@ void Binner::binChunk(int chunk, const geometry::TriangleSetup* records, uint32_
   for (uint32_t i = 0; i < n; ++i) {
     const uint32_t index = storageBase + scratch.position[i];
     forEachTile(records[i], [&](int tile) { out.entries[scratch.cursor[tile]++] = index; });
+  }
+  out.objects.clear();
+  if (objects) {
+    out.objects.resize(out.entries.size());
+    scratch.cursor.assign(out.offsets.begin(), out.offsets.end() - 1);
+    for (uint32_t i = 0; i < n; ++i)
+      forEachTile(records[i], [&](int tile) { out.objects[scratch.cursor[tile]++] = objects[i]; });
   }
 }
 

@@ -33,18 +33,24 @@ class Binner {
   // Stores the `n` records of chunk `chunk` (in submission order in `records`) into
   // storage[0, n), grouped by tile, and appends storageBase + their position to the list of every
   // tile each one's bounding box overlaps, in submission order. Chunks may be binned concurrently.
+  // With `objects` (per record, in the order of `records`), each list entry's object goes to the
+  // list's parallel `objects` array.
   void binChunk(int chunk, const geometry::TriangleSetup* records, uint32_t n,
-                geometry::TriangleSetup* storage, uint32_t storageBase, Scratch& scratch);
+                geometry::TriangleSetup* storage, uint32_t storageBase, Scratch& scratch,
+                const uint32_t* objects = nullptr);
 
   struct List {
     const uint32_t* data;
     uint32_t size;
+    const uint32_t* objects;  // per entry, when binned with objects; else nullptr
   };
   int chunkCount() const { return chunks_; }
   List list(int chunk, int tile) const {
     const ChunkLists& c = chunkLists_[size_t(chunk)];
-    if (c.offsets.empty()) return {nullptr, 0};
-    return {c.entries.data() + c.offsets[size_t(tile)], c.offsets[size_t(tile) + 1] - c.offsets[size_t(tile)]};
+    if (c.offsets.empty()) return {nullptr, 0, nullptr};
+    const uint32_t begin = c.offsets[size_t(tile)];
+    return {c.entries.data() + begin, c.offsets[size_t(tile) + 1] - begin,
+            c.objects.empty() ? nullptr : c.objects.data() + begin};
   }
 
  private:
@@ -52,7 +58,7 @@ class Binner {
   // Filled by a counting pass and a placing pass: two flat arrays per chunk instead of a vector per
   // tile and chunk (the same speed on tris 100k×10, far fewer allocations at 8192² rasters).
   struct ChunkLists {
-    std::vector<uint32_t> offsets, entries;
+    std::vector<uint32_t> offsets, entries, objects;
   };
   int chunks_ = 0, tilesX_ = 0, tiles_ = 0;
   std::vector<ChunkLists> chunkLists_;

@@ -4,6 +4,7 @@
 // children tested together in SIMD lanes), §4 (Z-buffer).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 
 #include "geometry/setup.h"
@@ -21,6 +22,7 @@ struct RasterStats {
   uint64_t fullWindows = 0;            // covered windows filled without further subdivision
   uint64_t occludedWindows = 0;        // windows a triangle was dropped from as occupied (SPEC §4)
   uint64_t occludedTriangles = 0;      // triangles dropped whole in a tile: their box was occupied
+  uint64_t occludedObjects = 0;        // objects dropped whole in a tile: their bound was occupied
   uint64_t partialBlocks = 0;          // 4×4 leaves tested pixel by pixel
   uint64_t fragments = 0;              // pixels that passed coverage (some sample, with
                                        // anti-aliasing) and reached the depth test
@@ -30,6 +32,7 @@ struct RasterStats {
     fullWindows += o.fullWindows;
     occludedWindows += o.occludedWindows;
     occludedTriangles += o.occludedTriangles;
+    occludedObjects += o.occludedObjects;
     partialBlocks += o.partialBlocks;
     fragments += o.fragments;
   }
@@ -38,6 +41,21 @@ struct RasterStats {
 // Hidden-surface removal besides the Z-buffer (SPEC §4): multi-level priority masking, which
 // trusts the submission order (nearest first), or its combination with depth, which does not.
 enum class Masking : uint8_t { none, priority, hybrid };
+
+// Object-space culling (SPEC §4, seed 004): whether an object bounded by `bound` can show nothing
+// in tile (tileX, tileY) — its bound misses the tile, or lies there in windows the occupancy holds
+// occupied (priority) or full and nearer than all of it (hybrid).
+inline bool objectHidden(const Occupancy& occupancy, const geometry::ObjectBound& bound, int tileX,
+                         int tileY, Masking masking) {
+  const int x0 = std::max(bound.minX - tileX * kTileSize, 0);
+  const int y0 = std::max(bound.minY - tileY * kTileSize, 0);
+  const int x1 = std::min(bound.maxX - tileX * kTileSize, kTileSize - 1);
+  const int y1 = std::min(bound.maxY - tileY * kTileSize, kTileSize - 1);
+  if (x0 > x1 || y0 > y1) return true;
+  return masking == Masking::hybrid ? occupancy.rectHidden(x0, y0, x1, y1, bound.zmin)
+                                    : occupancy.rectFull(x0, y0, x1, y1);
+}
+inline constexpr uint32_t kNoObject = ~0u;
 
 // What a covered pixel does.
 enum class ShadeMode : uint8_t {
@@ -92,6 +110,11 @@ struct TileWork {
   // triangles (drawn after the opaque ones) are hidden behind nearer opaque ones.
   Masking masking = Masking::none;
   Occupancy* occupancy = nullptr;
+  // Object-space culling with masking: per list, each entry's object — an index into `objects`,
+  // or kNoObject (unbounded, or translucent) — or nullptr for none. An object's run of entries is
+  // skipped where objectHidden says so, before any of its records is read.
+  const uint32_t* const* listObjects = nullptr;
+  const geometry::ObjectBound* objects = nullptr;
   // After the tile's triangles: its colour replaced by the occupancy view — the red channel 0
   // where nothing is occupied, 1 for an occupied pixel, else log2 of the largest full window.
   bool debugOccupancy = false;

@@ -21,7 +21,7 @@ double msSince(Clock::time_point t0) {
 }
 
 struct SetupCounts {
-  uint64_t facing = 0, outside = 0, degenerate = 0, invalid = 0, drawn = 0;
+  uint64_t facing = 0, outside = 0, degenerate = 0, invalid = 0, occluded = 0, drawn = 0;
 };
 
 // For triangle number `tri` (global), the draw call it belongs to, found by a forward scan.
@@ -34,6 +34,18 @@ struct CallCursor {
     return index < calls.size() && tri >= calls[index].firstTriangle ? &calls[index] : nullptr;
   }
 };
+
+// Object-space culling before setup (SPEC §4, seed 004): whether the object bounded by `bound`
+// lies in occupied windows of every tile it reaches — the occupancy earlier batches left.
+bool hiddenInFrame(const geometry::ObjectBound& bound, const std::vector<raster::Occupancy>& tiles,
+                   int tilesX, raster::Masking masking) {
+  if (bound.minX > bound.maxX || bound.minY > bound.maxY) return false;  // off screen: setup culls
+  for (int ty = bound.minY >> raster::kTileLog2; ty <= bound.maxY >> raster::kTileLog2; ++ty)
+    for (int tx = bound.minX >> raster::kTileLog2; tx <= bound.maxX >> raster::kTileLog2; ++tx)
+      if (!raster::objectHidden(tiles[size_t(ty * tilesX + tx)], bound, tx, ty, masking))
+        return false;
+  return true;
+}
 
 }  // namespace
 
@@ -72,13 +84,26 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
       w.visible.assign(raster::kTilePixels, ~0u);
     if (masking && !wholeFrame && !w.occupancy)
       w.occupancy = std::make_unique<raster::Occupancy>();
+    if (masking) w.objects.resize(kChunkTriangles);
   }
   if (masking && wholeFrame) frameOccupancy_.resize(size_t(tiles));
+  // Object-space culling: every draw call's bound; its records carry the call's index, or
+  // kNoObject when it has no bound or is translucent (blended after all opaque ones, so occupied
+  // windows do not hide it).
+  objects_.clear();
+  if (masking)
+    for (const DrawCall& call : packets.calls) objects_.push_back(call.bound);
+  auto objectOf = [&](const DrawCall* call) {
+    const bool blend = call && call->material && call->material->alpha == shade::AlphaUse::blend;
+    return call && call->bounded && !blend ? uint32_t(call - packets.calls.data())
+                                           : raster::kNoObject;
+  };
   tileStats_.assign(size_t(tiles), raster::RasterStats{});
   const int maxChunks = std::max(1, int((firstBatch + kChunkTriangles - 1) / kChunkTriangles));
   std::vector<SetupCounts> counts(static_cast<size_t>(maxChunks));
   std::vector<const uint32_t*> listPtrs(size_t(maxChunks) * pool_.threadCount());
   std::vector<uint32_t> listSizes(listPtrs.size());
+  std::vector<const uint32_t*> listObjects(listPtrs.size());
   stats.trianglesIn += triangleCount;
 
   // Always run at least one (empty) batch, so the tiles get cleared.
@@ -97,16 +122,25 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
       // Runs of triangles that share a draw call (a culling mode), set up several at a time.
       uint64_t outcomes[geometry::kSetupOutcomes] = {};
       uint32_t n = 0;
+      uint64_t occluded = 0;
       CallCursor cursor{packets.calls};
       for (uint32_t tri = begin; tri < end;) {
         const DrawCall* call = cursor.find(tri);
         const uint32_t runEnd =
             call ? std::min(end, call->firstTriangle + call->triangleCount) : tri + 1;
+        const uint32_t object = masking ? objectOf(call) : raster::kNoObject;
+        if (object != raster::kNoObject && wholeFrame && batch > 0 &&
+            hiddenInFrame(objects_[object], frameOccupancy_, tilesX, settings.masking)) {
+          occluded += runEnd - tri;
+          tri = runEnd;
+          continue;
+        }
         const uint32_t first = n;
         n += uint32_t(geometry::setupTriangles(
             packets.vertices.data(), &packets.indices[size_t(tri) * 3], runEnd - tri, viewport,
             call ? call->cull : geometry::CullMode::none, scratch.records.data() + n, outcomes,
             tri));
+        if (masking) std::fill(scratch.objects.begin() + first, scratch.objects.begin() + n, object);
         // Pixel shading's planes for the drawn triangles of a call with a material.
         const shade::MaterialShading* material = call ? call->material : nullptr;
         if (pixelShading)
@@ -131,9 +165,10 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
       c.outside = outcomes[int(geometry::SetupOutcome::culledOutside)];
       c.degenerate = outcomes[int(geometry::SetupOutcome::culledDegenerate)];
       c.invalid = outcomes[int(geometry::SetupOutcome::culledInvalid)];
+      c.occluded = occluded;
       const uint32_t storageBase = begin - batch;
       binner_.binChunk(int(chunk), scratch.records.data(), n, setups_.data() + storageBase,
-                       storageBase, scratch.bins);
+                       storageBase, scratch.bins, masking ? scratch.objects.data() : nullptr);
       counts[chunk] = c;
     });
     for (int i = 0; i < chunks; ++i) {
@@ -142,6 +177,7 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
       stats.culledOutside += counts[i].outside;
       stats.culledDegenerate += counts[i].degenerate;
       stats.culledInvalid += counts[i].invalid;
+      stats.culledOccluded += counts[i].occluded;
     }
     stats.setupMs += msSince(t0);
 
@@ -151,10 +187,12 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
     pool_.parallelFor(size_t(tiles), [&](size_t tile, int worker) {
       const uint32_t** listPtr = listPtrs.data() + size_t(worker) * maxChunks;
       uint32_t* listSize = listSizes.data() + size_t(worker) * maxChunks;
+      const uint32_t** listObject = listObjects.data() + size_t(worker) * maxChunks;
       for (int c = 0; c < lists; ++c) {
         const raster::Binner::List l = binner_.list(c, int(tile));
         listPtr[c] = l.data;
         listSize[c] = l.size;
+        listObject[c] = l.objects;
       }
       raster::TileWork w;
       w.tileX = int(tile) % tilesX;
@@ -179,8 +217,11 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
       }
       w.masking = settings.masking;
       w.debugOccupancy = settings.debugOccupancy && lastBatch;
-      if (masking)
+      if (masking) {
         w.occupancy = wholeFrame ? &frameOccupancy_[tile] : scratch_[worker].occupancy.get();
+        w.listObjects = listObject;
+        w.objects = objects_.data();
+      }
       raster::rasterizeTile(w, tileStats_[tile]);
       if (lastBatch && settings.finishTile) settings.finishTile(int(tile), w.depth, w.color);
     });
@@ -193,6 +234,7 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
   stats.fullWindows += total.fullWindows;
   stats.occludedWindows += total.occludedWindows;
   stats.occludedTriangles += total.occludedTriangles;
+  stats.occludedObjects += total.occludedObjects;
   stats.partialBlocks += total.partialBlocks;
   stats.fragments += total.fragments;
 }

@@ -23,6 +23,10 @@ struct DrawCall {
   // Shaded per pixel (FrameSettings::shade = material) with this material, reading `attributes`;
   // nullptr: the interpolated vertex colour.
   const shade::MaterialShading* material = nullptr;
+  // With masking: the object the run draws, bounded on screen (object-space culling, SPEC §4) —
+  // its triangles are dropped wherever the bound lies in occupied windows. Unbounded: no test.
+  bool bounded = false;
+  geometry::ObjectBound bound{};
 };
 
 // The plain input of a frame: vertices after the projective transform and triangles indexing them.
@@ -79,7 +83,9 @@ class FrameRenderer {
     raster::FrameBuffer tile;  // 64×64: the tile being drawn, in frames of one batch
     std::vector<uint32_t> visible;  // 64×64 deferred-shading records (TileWork::visible)
     std::unique_ptr<raster::Occupancy> occupancy;  // the tile's, in frames of one batch
+    std::vector<uint32_t> objects;  // with masking: the chunk's records' objects (TileWork)
   };
+  std::vector<geometry::ObjectBound> objects_;   // with masking: every draw call's bound
   std::vector<raster::Occupancy> frameOccupancy_;  // every tile's, in frames of several batches
   std::vector<geometry::TriangleSetup> setups_;  // the batch's, grouped by tile within each chunk
   std::vector<raster::AttributeSetup> attributes_;  // the batch's, by triangle (ShadeMode::material)

@@ -147,18 +147,14 @@ void buildShading(const scene::Scene& scene, const RenderOptions& o, const Mat4&
 // view depth of their bounding box's corners, which orders objects separated in depth correctly
 // (docs/hidden-surfaces.md). Translucent ones, always: farthest first by the view depth of their
 // box's centre, so that nearer ones blend over farther ones. Stable: ties keep submission order.
-std::vector<uint32_t> drawOrder(const scene::Scene& scene, const Mat4& view, RenderOptions::Hsr hsr) {
+// `boxes`: every mesh's bounds (Mesh::bounds), or empty when neither sort applies.
+std::vector<uint32_t> drawOrder(const scene::Scene& scene, const Mat4& view, RenderOptions::Hsr hsr,
+                                const std::vector<std::array<Vec3, 2>>& boxes) {
   std::vector<uint32_t> order(scene.instances.size());
   std::iota(order.begin(), order.end(), 0u);
+  if (boxes.empty()) return order;
   const bool sortOpaque = hsr != RenderOptions::Hsr::zbuffer;
-  bool anyTranslucent = false;
-  for (const scene::Mesh& m : scene.meshes)
-    anyTranslucent |= m.material >= 0 && scene.materials[size_t(m.material)].alphaMode ==
-                                             scene::AlphaMode::blend;
-  if (!sortOpaque && !anyTranslucent) return order;
-  // Per mesh its box; per instance the view depths of the box's corners.
-  std::vector<std::array<Vec3, 2>> boxes(scene.meshes.size());
-  for (size_t m = 0; m < scene.meshes.size(); ++m) boxes[m] = scene.meshes[m].bounds();
+  // Per instance the view depths of its mesh's box's corners.
   std::vector<float> nearest(order.size()), centre(order.size());
   for (size_t i = 0; i < order.size(); ++i) {
     const scene::Instance& inst = scene.instances[i];
@@ -239,13 +235,13 @@ Status validate(const RenderOptions& o) {
 
 std::string FrameStats::summary() const {
   return fmt::format(
-      "triangles in {} / culled {} (facing {}, outside {}, degenerate {}, invalid {}) / drawn {} | "
-      "windows 64:{} 32:{} 16:{} 8:{} 4:{} px-tests:{} full:{} occluded:{} (triangles {}) | {:.2f} "
-      "ms (vertex "
-      "{:.2f}, setup {:.2f}, tiles {:.2f} incl. resolve)",
-      trianglesIn, culled(), culledFacing, culledOutside, culledDegenerate, culledInvalid, drawn,
+      "triangles in {} / culled {} (facing {}, outside {}, degenerate {}, invalid {}{}) / drawn {} "
+      "| windows 64:{} 32:{} 16:{} 8:{} 4:{} px-tests:{} full:{} occluded:{} (triangles {}, "
+      "objects {}) | {:.2f} ms (vertex {:.2f}, setup {:.2f}, tiles {:.2f} incl. resolve)",
+      trianglesIn, culled(), culledFacing, culledOutside, culledDegenerate, culledInvalid,
+      culledOccluded ? fmt::format(", occluded {}", culledOccluded) : std::string(), drawn,
       windows[0], windows[1], windows[2], windows[3], windows[4], windows[5], fullWindows,
-      occludedWindows, occludedTriangles, totalMs, vertexMs, setupMs, rasterMs);
+      occludedWindows, occludedTriangles, occludedObjects, totalMs, vertexMs, setupMs, rasterMs);
 }
 
 Result<RenderOptions::Hsr> parseHsr(const std::string& text) {
@@ -297,6 +293,7 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
   ShadingTables& shading = impl_->shading;
   buildShading(scene, o, camera.value().view, shading);
   const bool pixelShading = shading.any && o.debugView == RenderOptions::DebugView::none;
+  using DebugView = RenderOptions::DebugView;
 
   auto t0 = Clock::now();
   render::DrawPackets& p = impl_->packets;
@@ -317,8 +314,17 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
   constexpr size_t kVertexChunk = 1 << 14;
   std::vector<VertexJob> jobs;
   size_t vertexCount = 0;
+  // Every mesh's bounds, for the draw order and the objects' screen bounds, when they are needed.
+  const bool masking = o.hsr != RenderOptions::Hsr::zbuffer && o.debugView != DebugView::overdraw;
+  bool anyTranslucent = false;
+  for (const scene::Material& m : scene.materials)
+    anyTranslucent |= m.alphaMode == scene::AlphaMode::blend;
+  std::vector<std::array<Vec3, 2>> boxes;
+  if (o.hsr != RenderOptions::Hsr::zbuffer || anyTranslucent)
+    for (const scene::Mesh& m : scene.meshes) boxes.push_back(m.bounds());
+  const geometry::Viewport boundViewport{o.width * o.supersample, o.height * o.supersample};
   // Opaque materials first, then translucent ones (SPEC §4: blended over what is behind them).
-  const std::vector<uint32_t> order = drawOrder(scene, camera.value().view, o.hsr);
+  const std::vector<uint32_t> order = drawOrder(scene, camera.value().view, o.hsr, boxes);
   for (const bool translucentPass : {false, true})
     for (const uint32_t instance : order) {
       const scene::Instance& inst = scene.instances[instance];
@@ -339,6 +345,10 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
                                                         : geometry::CullMode::none;
       if (pixelShading && (mat.needsPixelShading() || shading.environment.fog))
         call.material = shading.of(mesh.material, !mesh.normals.empty());
+      if (masking)
+        call.bounded = geometry::boundObject(vertexContext.viewProj * inst.transform,
+                                             boxes[size_t(inst.mesh)][0],
+                                             boxes[size_t(inst.mesh)][1], boundViewport, call.bound);
       const uint32_t base = static_cast<uint32_t>(vertexCount);
       const size_t at = p.indices.size();
       p.indices.resize(at + mesh.indices.size());
@@ -366,7 +376,6 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
   fs.clearColor[0] = scene.background.x;
   fs.clearColor[1] = scene.background.y;
   fs.clearColor[2] = scene.background.z;
-  using DebugView = RenderOptions::DebugView;
   fs.shade = o.debugView == DebugView::overdraw ? raster::ShadeMode::overdraw
              : o.debugView == DebugView::levels ? raster::ShadeMode::levels
              : pixelShading   ? raster::ShadeMode::material

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <random>
 
+#include "geometry/vertex_stage.h"
 #include "raster/occupancy.h"
 #include "support/raster_harness.h"
 
@@ -237,6 +238,70 @@ TEST(HybridMasking, DropsHiddenWorkInEveryOrderWithTheSameFrame) {
     batched.batchTriangles = 97;
     EXPECT_TRUE(test::renderQuadtree(f2b, batched, 2) == f) << samples;
   }
+}
+
+// Objects of eight triangles each around a centre, nearest first (each triangle at its own depth,
+// objects separated in depth), with their bounds
+// (as the renderer gives each instance, geometry::boundObject): a large near object hides many.
+DrawPackets objectScene(int w, int h, int objects, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  DrawPackets p;
+  for (int o = 0; o < objects; ++o) {
+    const double size = o < 3 ? 0.6 * w : std::exp2(3 + u(rng) * 4);  // three near walls
+    const double cx = u(rng) * w, cy = u(rng) * h;
+    const float z = float(0.05 + 0.9 * (o + 0.5) / objects);
+    render::DrawCall call;
+    call.firstTriangle = uint32_t(p.indices.size() / 3);
+    Vec3 lo{1e9f, 1e9f, 1e9f}, hi = -lo;
+    for (int t = 0; t < 8; ++t) {
+      geometry::ClipVertex v[3];
+      for (auto& vert : v) {
+        vert = test::pixelVertex(cx + (u(rng) - 0.5) * size, cy + (u(rng) - 0.5) * size, w, h,
+                                 z + float(t * 0.05 / objects), 1, float(u(rng)),
+                                 float(u(rng)), float(u(rng)));
+        lo = {std::min(lo.x, vert.x), std::min(lo.y, vert.y), std::min(lo.z, vert.z)};
+        hi = {std::max(hi.x, vert.x), std::max(hi.y, vert.y), std::max(hi.z, vert.z)};
+      }
+      p.vertices.insert(p.vertices.end(), {v[0], v[1], v[2]});
+      for (uint32_t k = 0; k < 3; ++k) p.indices.push_back(uint32_t(p.vertices.size()) - 3 + k);
+    }
+    call.triangleCount = 8;
+    call.cull = geometry::CullMode::none;
+    call.bounded = geometry::boundObject(Mat4{}, lo, hi, {w, h}, call.bound);
+    p.calls.push_back(call);
+  }
+  return p;
+}
+
+// Object-space culling (SPEC §4, seed 004): objects whose bounds lie in occupied windows are
+// dropped whole — in the tiles before their records are read, and, in frames of several batches,
+// before setup — and the frame stays the Z-buffer's, for every thread count and batching.
+TEST(ObjectCulling, DropsHiddenObjectsWholeWithTheZBufferFrame) {
+  const int w = 230, h = 170;
+  const DrawPackets p = objectScene(w, h, 400, 7);
+  for (const raster::Masking masking : {raster::Masking::priority, raster::Masking::hybrid})
+    for (int samples : {1, 16}) {
+      const test::Frame z = test::renderQuadtree(p, settings(w, h, samples, raster::Masking::none), 2);
+      FrameStats stats, batchedStats;
+      EXPECT_TRUE(test::renderQuadtree(p, settings(w, h, samples, masking), 2, &stats) == z)
+          << samples;
+      EXPECT_GT(stats.occludedObjects, 0u);
+      EXPECT_EQ(stats.culledOccluded, 0u);  // one batch: all set up before any tile
+      EXPECT_TRUE(test::renderQuadtree(p, settings(w, h, samples, masking), 1) == z);
+      EXPECT_TRUE(test::renderQuadtree(p, settings(w, h, samples, masking), 8) == z);
+      FrameSettings batched = settings(w, h, samples, masking);
+      batched.batchTriangles = 200;
+      EXPECT_TRUE(test::renderQuadtree(p, batched, 2, &batchedStats) == z) << samples;
+      EXPECT_GT(batchedStats.culledOccluded, 0u);
+      EXPECT_LT(batchedStats.drawn, stats.drawn);
+      // Without bounds nothing is dropped whole, and the frame is the same.
+      DrawPackets unbounded = p;
+      for (render::DrawCall& c : unbounded.calls) c.bounded = false;
+      FrameStats plain;
+      EXPECT_TRUE(test::renderQuadtree(unbounded, batched, 2, &plain) == z);
+      EXPECT_EQ(plain.occludedObjects + plain.culledOccluded, 0u);
+    }
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <set>
 
+#include "scene/primitives.h"
 #include "synthvis/generators.h"
 #include "synthvis/render.h"
 
@@ -356,6 +357,57 @@ TEST(LayersGenerator, PriorityMaskingDrawsTheZBufferImageOfOrderedLayers) {
     } else {
       EXPECT_LT(differing, z.rgb.size() / 2000) << "channels differing";  // measured: 3 of 122 880
       EXPECT_LE(worst, 8) << "a sample of 16";  // measured: 1
+    }
+  }
+}
+
+// Object-space culling (SPEC §4, seed 004) through the renderer: each instance's box, projected,
+// is tested against the tiles' occupied windows before its triangles are. Cubes hidden behind a
+// wall are dropped whole; those beside it, one reaching behind the eye (no bound) and a
+// translucent one (never culled) are drawn; the image is the Z-buffer's at 1 and 16 samples.
+TEST(ObjectCulling, HiddenInstancesAreDroppedWholeWithTheZBufferImage) {
+  scene::Scene s;
+  scene::Camera cam;
+  cam.position = {0, 0, 0};
+  cam.target = {0, 0, -1};
+  cam.znear = 0.1f;
+  cam.zfar = 100;
+  s.cameras.push_back(cam);
+  scene::Material wall, cube, glass;
+  wall.baseColor = {0.8f, 0.7f, 0.6f, 1};
+  cube.baseColor = {0.2f, 0.5f, 0.9f, 1};
+  glass.baseColor = {0.9f, 0.2f, 0.1f, 0.5f};
+  glass.alphaMode = scene::AlphaMode::blend;
+  s.materials = {wall, cube, glass};
+  scene::Mesh wallMesh = scene::detail::makeBox({3, 2, 0.1f});
+  wallMesh.material = 0;
+  scene::Mesh cubeMesh = scene::detail::makeBox({0.3f, 0.3f, 0.3f});
+  cubeMesh.material = 1;
+  scene::Mesh glassMesh = cubeMesh;
+  glassMesh.material = 2;
+  s.meshes = {wallMesh, cubeMesh, glassMesh};
+  s.instances.push_back({0, Mat4::translation({0, 0, -3})});
+  for (int i = 0; i < 60; ++i)
+    s.instances.push_back(
+        {1, Mat4::translation({float(i % 10) * 0.8f - 3.6f, float(i / 10) * 0.6f - 1.5f,
+                               -5.0f - float(i % 7)})});
+  s.instances.push_back({1, Mat4::translation({0.3f, -0.2f, -0.1f})});  // cut by the near plane
+  s.instances.push_back({2, Mat4::translation({0.2f, 0.1f, -6})});      // translucent, hidden
+  for (int samples : {1, 16}) {
+    RenderOptions o;
+    o.width = 200;
+    o.height = 120;
+    o.threads = 2;
+    o.samples = samples;
+    Image z;
+    ASSERT_TRUE(Renderer(o).render(s, z).ok());
+    for (auto hsr : {RenderOptions::Hsr::priority, RenderOptions::Hsr::hybrid}) {
+      o.hsr = hsr;
+      Image m;
+      FrameStats stats;
+      ASSERT_TRUE(Renderer(o).render(s, m, &stats).ok());
+      EXPECT_EQ(m.rgb, z.rgb) << samples << " samples, " << hsrName(hsr);
+      EXPECT_GT(stats.occludedObjects, 20u) << hsrName(hsr);
     }
   }
 }
