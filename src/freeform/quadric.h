@@ -1,0 +1,102 @@
+// Quadrics, the base primitives of free-form surfaces, with interval bounds and projective maps.
+//
+// Based on: SPEC §11 (seed 003: quadrics F = Ax² + By² + Cz² + Dxy + Exz + Fyz + Gx + Hy + Iz + K),
+// §12 (a quadric stays a quadric under a projective map, S' = M^{-T} S M^{-1}; a projective map of
+// space is fixed by five point pairs, no four coplanar). Interval arithmetic as in libfive's
+// recursive subdivision (Keeter 2020, "Massively Parallel Rendering of Complex Closed-Form Implicit
+// Surfaces").
+//
+// Sign convention (SPEC §11 leaves it to the implementation): the surface is F = 0 and the
+// inside is F ≥ 0 — a sphere of radius r about c is r² − |p − c|².
+#pragma once
+
+#include <array>
+#include <optional>
+
+namespace sv::freeform {
+
+struct Vec3d {
+  double x = 0, y = 0, z = 0;
+  friend Vec3d operator+(Vec3d a, Vec3d b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+  friend Vec3d operator-(Vec3d a, Vec3d b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+  friend Vec3d operator*(Vec3d a, double s) { return {a.x * s, a.y * s, a.z * s}; }
+  friend Vec3d operator*(double s, Vec3d a) { return a * s; }
+};
+inline double dot(Vec3d a, Vec3d b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+Vec3d normalize(Vec3d v);  // v unchanged when it has zero length
+
+struct Vec4d {
+  double v[4] = {0, 0, 0, 0};
+  double& operator[](int i) { return v[i]; }
+  double operator[](int i) const { return v[i]; }
+};
+
+// A 4×4 matrix in double, row-major: m[r][c]. Acts on column vectors.
+struct Mat4d {
+  std::array<std::array<double, 4>, 4> m{{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}}};
+  friend Mat4d operator*(const Mat4d& a, const Mat4d& b);
+  Vec4d operator*(const Vec4d& v) const;
+  Mat4d transposed() const;
+  // The inverse by Gauss–Jordan elimination with partial pivoting; nothing when singular (a pivot
+  // below 1e-300 relative to the row scale).
+  std::optional<Mat4d> inverse() const;
+  // The point p (w = 1) mapped and divided by its w.
+  Vec3d transformPoint(Vec3d p) const;
+};
+
+// The projective map of space taking src[i] to dst[i] for i = 0…4 (SPEC §12: (C)(M^i) = r_i·(P^i),
+// r_5 = 1). Nothing when four of either five are coplanar (no unique map exists).
+// Method: the map B·A⁻¹ where A takes the four unit points e_1…e_4 to the homogeneous src[0…3]
+// scaled so that e_1 + … + e_4 goes to src[4], and B likewise for dst.
+std::optional<Mat4d> projectiveFromFivePoints(const std::array<Vec3d, 5>& src,
+                                              const std::array<Vec3d, 5>& dst);
+
+// A closed interval [lo, hi] with conservative arithmetic (no directed rounding: bounds are widened
+// by a relative ulp-scale margin where the surface test reads them, raycast.cpp).
+struct Interval {
+  double lo = 0, hi = 0;
+  static Interval point(double v) { return {v, v}; }
+  bool containsZero() const { return lo <= 0 && hi >= 0; }
+  friend Interval operator+(Interval a, Interval b) { return {a.lo + b.lo, a.hi + b.hi}; }
+  friend Interval operator+(Interval a, double b) { return {a.lo + b, a.hi + b}; }
+  friend Interval operator*(Interval a, double s) {
+    return s >= 0 ? Interval{a.lo * s, a.hi * s} : Interval{a.hi * s, a.lo * s};
+  }
+  friend Interval operator*(Interval a, Interval b);
+};
+Interval square(Interval a);  // exact: [0, …] when a contains 0
+Interval cube(Interval a);    // monotonic
+Interval positivePart(Interval a);  // max(0, a)
+
+// F(x, y, z) = Ax² + By² + Cz² + Dxy + Exz + Fyz + Gx + Hy + Iz + K: coefficients in this order.
+struct Quadric {
+  std::array<double, 10> c{};
+
+  // Convenience forms, all inside ≥ 0. Axes need not be unit length (they are normalized).
+  static Quadric sphere(Vec3d centre, double radius);
+  static Quadric ellipsoid(Vec3d centre, Vec3d radii);  // axis-aligned semi-axes
+  // The infinite cylinder of `radius` about the line through `point` along `axis`.
+  static Quadric cylinder(Vec3d point, Vec3d axis, double radius);
+  // The infinite double cone with apex `apex`, axis `axis`, half-angle `halfAngle` (radians).
+  static Quadric cone(Vec3d apex, Vec3d axis, double halfAngle);
+  // The paraboloid of revolution opening along `axis` from `vertex`: inside where the height along
+  // the axis exceeds k·(distance from the axis)².
+  static Quadric paraboloid(Vec3d vertex, Vec3d axis, double k);
+  // The half-space n·p ≤ d (inside), bounded by the plane n·p = d.
+  static Quadric halfSpace(Vec3d normal, double d);
+
+  double evaluate(Vec3d p) const;
+  Vec3d gradient(Vec3d p) const;
+  // A range that contains F over the box x × y × z (interval arithmetic, the square terms exact).
+  Interval bound(Interval x, Interval y, Interval z) const;
+
+  // The symmetric matrix S with F(p) = (p, 1)ᵀ S (p, 1).
+  Mat4d matrix() const;
+  static Quadric fromMatrix(const Mat4d& s);  // reads the symmetric part
+  // The quadric of the image of this one's points under the map `inverse`⁻¹: S' = M^{-T} S M^{-1}
+  // with M^{-1} = `inverse` given. Then F'(q) = (u(q))²·F(p) for q the image of p, where u(q) is the
+  // w of M^{-1}·(q, 1) — the same sign, so the same surface and inside.
+  Quadric transformedByInverse(const Mat4d& inverse) const;
+};
+
+}  // namespace sv::freeform

@@ -1,0 +1,203 @@
+// Quadrics and perturbed quadrics (SPEC §11–§12): the convenience forms against their definitions,
+// the projective transform of a quadric against point evaluation, the five-point projective map,
+// interval bounds containing sampled values (property tests), gradients against differences, and
+// the perturbation's continuity where Q crosses 0.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "freeform/freeform.h"
+
+namespace sv::freeform {
+namespace {
+
+Vec3d randomPoint(std::mt19937& rng, double r) {
+  std::uniform_real_distribution<double> u(-r, r);
+  return {u(rng), u(rng), u(rng)};
+}
+
+// A sculpture-like form: a sphere with two bumps, one of them bumped again.
+FreeForm bumpySphere() {
+  FreeForm f;
+  f.base = Quadric::sphere({0, 0, 0}, 1);
+  FreeForm bump;
+  bump.base = Quadric::sphere({0.9, 0, 0}, 0.5);
+  FreeForm inner;
+  inner.base = Quadric::ellipsoid({1.1, 0.2, 0}, {0.3, 0.2, 0.25});
+  bump.perturbations.push_back(inner);
+  FreeForm dent;
+  dent.base = Quadric::cylinder({0, 0.8, 0}, {0, 0, 1}, 0.3);
+  dent.base.c[9] -= 0.02;  // shallower
+  f.perturbations = {bump, dent};
+  return f;
+}
+
+TEST(Quadric, FormsAreZeroOnTheirSurfacesAndPositiveInside) {
+  const double s2 = std::sqrt(2.0);
+  struct Case {
+    const char* name;
+    Quadric q;
+    Vec3d on, in, out;
+  };
+  const Case cases[] = {
+      {"sphere", Quadric::sphere({1, 2, 3}, 2), {3, 2, 3}, {1, 2, 3}, {1, 4.5, 3}},
+      {"ellipsoid", Quadric::ellipsoid({0, 0, 0}, {1, 2, 3}), {0, 0, 3}, {0.5, 0, 0}, {0, 2.1, 0}},
+      {"cylinder", Quadric::cylinder({0, 0, 0}, {0, 0, 5}, 1), {1 / s2, 1 / s2, 7}, {0.2, 0, -9}, {1, 1, 0}},
+      {"cone", Quadric::cone({0, 0, 0}, {0, 1, 0}, M_PI / 4), {1, 1, 0}, {0, 2, 0.5}, {2, 1, 0}},
+      {"paraboloid", Quadric::paraboloid({0, -1, 0}, {0, 1, 0}, 2), {1, 1, 0}, {0, 0, 0}, {2, 0, 0}},
+      {"half-space", Quadric::halfSpace({0, 0, 2}, 2), {5, -3, 1}, {0, 0, 0}, {0, 0, 1.5}},
+  };
+  for (const Case& c : cases) {
+    EXPECT_NEAR(c.q.evaluate(c.on), 0, 1e-12) << c.name;
+    EXPECT_GT(c.q.evaluate(c.in), 0) << c.name;
+    EXPECT_LT(c.q.evaluate(c.out), 0) << c.name;
+    EXPECT_TRUE(Quadric::fromMatrix(c.q.matrix()).c == c.q.c) << c.name;
+  }
+  // The half-space's value is the signed distance to its plane.
+  EXPECT_NEAR(Quadric::halfSpace({0, 0, 2}, 2).evaluate({0, 0, -3}), 4, 1e-12);
+}
+
+TEST(Quadric, GradientsMatchCentralDifferences) {
+  std::mt19937 rng(1);
+  const FreeForm f = bumpySphere();
+  for (int i = 0; i < 200; ++i) {
+    const Vec3d p = randomPoint(rng, 1.5);
+    const Vec3d g = f.gradient(p);
+    const double h = 1e-6;
+    const double dx = (f.evaluate(p + Vec3d{h, 0, 0}) - f.evaluate(p - Vec3d{h, 0, 0})) / (2 * h);
+    const double dy = (f.evaluate(p + Vec3d{0, h, 0}) - f.evaluate(p - Vec3d{0, h, 0})) / (2 * h);
+    const double dz = (f.evaluate(p + Vec3d{0, 0, h}) - f.evaluate(p - Vec3d{0, 0, h})) / (2 * h);
+    EXPECT_NEAR(g.x, dx, 1e-5 * (1 + std::fabs(dx)));
+    EXPECT_NEAR(g.y, dy, 1e-5 * (1 + std::fabs(dy)));
+    EXPECT_NEAR(g.z, dz, 1e-5 * (1 + std::fabs(dz)));
+  }
+}
+
+// R = Q³ where Q ≥ 0 (SPEC §11): across Q = 0 the value, gradient and second derivative of the
+// perturbed form are continuous — no crack, no crease.
+TEST(Quadric, PerturbationIsContinuousWhereQCrossesZero) {
+  FreeForm f;
+  f.base = Quadric::halfSpace({0, 1, 0}, 0);  // the ground y ≤ 0
+  FreeForm bump;
+  bump.base = Quadric::sphere({0, 0, 0}, 1);
+  f.perturbations.push_back(bump);
+  // Along x through the bump's rim at x = 1 (y = 0.3): Q = 1 − x² − 0.09 crosses 0 at x ≈ 0.954.
+  const double x0 = std::sqrt(1 - 0.09);
+  for (double eps : {1e-3, 1e-5}) {
+    const Vec3d a{x0 - eps, 0.3, 0}, b{x0 + eps, 0.3, 0};
+    EXPECT_NEAR(f.evaluate(a), f.evaluate(b), 10 * eps * eps * eps + 1e-15) << eps;
+    EXPECT_NEAR(f.gradient(a).x, f.gradient(b).x, 100 * eps * eps) << eps;
+  }
+}
+
+TEST(Quadric, ProjectiveTransformAgreesWithPointEvaluation) {
+  std::mt19937 rng(2);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int trial = 0; trial < 50; ++trial) {
+    Mat4d m;
+    for (auto& row : m.m)
+      for (double& v : row) v = u(rng);
+    for (int i = 0; i < 4; ++i) m.m[i][i] += 2.5;  // well conditioned
+    const std::optional<Mat4d> inv = m.inverse();
+    ASSERT_TRUE(inv);
+    Quadric q;
+    for (double& c : q.c) c = u(rng);
+    const Quadric t = q.transformedByInverse(*inv);
+    for (int k = 0; k < 20; ++k) {
+      const Vec3d p = randomPoint(rng, 1);
+      const Vec4d image = m * Vec4d{{p.x, p.y, p.z, 1}};
+      if (std::fabs(image[3]) < 0.1) continue;
+      const Vec3d qp{image[0] / image[3], image[1] / image[3], image[2] / image[3]};
+      const double uw = 1 / image[3];  // the w of M⁻¹·(q, 1)
+      EXPECT_NEAR(t.evaluate(qp), uw * uw * q.evaluate(p), 1e-9 * (1 + std::fabs(uw * uw)));
+    }
+  }
+}
+
+TEST(Projective, FivePointPairsFixTheMapWhichReproducesThemAndInvertsExactly) {
+  std::mt19937 rng(3);
+  for (int trial = 0; trial < 100; ++trial) {
+    std::array<Vec3d, 5> src, dst;
+    for (auto& p : src) p = randomPoint(rng, 2);
+    for (auto& p : dst) p = randomPoint(rng, 2);
+    const std::optional<Mat4d> m = projectiveFromFivePoints(src, dst);
+    ASSERT_TRUE(m) << trial;
+    const std::optional<Mat4d> inv = m->inverse();
+    ASSERT_TRUE(inv);
+    for (int i = 0; i < 5; ++i) {
+      const Vec3d a = m->transformPoint(src[size_t(i)]), b = inv->transformPoint(dst[size_t(i)]);
+      for (double d : {a.x - dst[size_t(i)].x, a.y - dst[size_t(i)].y, a.z - dst[size_t(i)].z,
+                       b.x - src[size_t(i)].x, b.y - src[size_t(i)].y, b.z - src[size_t(i)].z})
+        EXPECT_NEAR(d, 0, 1e-7) << trial << " point " << i;
+    }
+    // M·M⁻¹ is the identity.
+    const Mat4d id = *m * *inv;
+    for (int r = 0; r < 4; ++r)
+      for (int c = 0; c < 4; ++c) EXPECT_NEAR(id.m[r][c], r == c ? 1 : 0, 1e-9);
+  }
+  // The view frustum onto the cube: the map a perspective projection makes, recovered from five
+  // of the frustum's corners.
+  std::array<Vec3d, 5> frustum = {Vec3d{-1, -1, -1}, {1, -1, -1}, {-1, 1, -1}, {-10, -10, -10}, {10, 10, -10}};
+  std::array<Vec3d, 5> cube = {Vec3d{-1, -1, -1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}, {1, 1, 1}};
+  const std::optional<Mat4d> p = projectiveFromFivePoints(frustum, cube);
+  ASSERT_TRUE(p);
+  const Vec3d far = p->transformPoint({10, -10, -10});  // the sixth corner follows
+  EXPECT_NEAR(far.x, 1, 1e-9);
+  EXPECT_NEAR(far.y, -1, 1e-9);
+  EXPECT_NEAR(far.z, 1, 1e-9);
+  // Four coplanar points fix no map.
+  std::array<Vec3d, 5> flat = {Vec3d{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {0, 0, 1}};
+  EXPECT_FALSE(projectiveFromFivePoints(flat, cube));
+  EXPECT_FALSE(projectiveFromFivePoints(cube, flat));
+}
+
+// Property test: the bound of every box contains the function at points sampled inside it — for
+// quadrics, perturbed forms, and their projected versions.
+TEST(Interval, BoundsContainSampledValues) {
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> u(0, 1);
+  const FreeForm f = bumpySphere();
+  // A perspective map: the frustum of a camera at z = 4 looking down −z onto the cube.
+  std::array<Vec3d, 5> frustum = {Vec3d{-1, -1, 3}, {1, -1, 3}, {-1, 1, 3}, {-5, -5, -1}, {5, 5, -1}};
+  std::array<Vec3d, 5> cube = {Vec3d{-1, -1, -1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}, {1, 1, 1}};
+  const std::optional<ProjectedFreeForm> g = ProjectedFreeForm::make(f, *projectiveFromFivePoints(frustum, cube));
+  ASSERT_TRUE(g);
+  for (int trial = 0; trial < 2000; ++trial) {
+    const double size = std::exp2(-u(rng) * 10);
+    const Vec3d lo = randomPoint(rng, 1.2);
+    const Interval x{lo.x, lo.x + size * u(rng)}, y{lo.y, lo.y + size * u(rng)},
+        z{lo.z, lo.z + size * u(rng)};
+    const Interval bf = f.bound(x, y, z), bg = g->bound(x, y, z);
+    for (int k = 0; k < 8; ++k) {
+      const Vec3d p{x.lo + (x.hi - x.lo) * u(rng), y.lo + (y.hi - y.lo) * u(rng),
+                    z.lo + (z.hi - z.lo) * u(rng)};
+      const double vf = f.evaluate(p), vg = g->evaluate(p);
+      EXPECT_LE(bf.lo, vf);
+      EXPECT_GE(bf.hi, vf);
+      EXPECT_LE(bg.lo, vg);
+      EXPECT_GE(bg.hi, vg);
+    }
+  }
+}
+
+// The projected form has the object's surface and inside: H = u²·F' at corresponding points.
+TEST(Projected, HasTheSameSignAsTheObjectFormAtCorrespondingPoints) {
+  const FreeForm f = bumpySphere();
+  std::array<Vec3d, 5> frustum = {Vec3d{-1, -1, 3}, {1, -1, 3}, {-1, 1, 3}, {-5, -5, -1}, {5, 5, -1}};
+  std::array<Vec3d, 5> cube = {Vec3d{-1, -1, -1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}, {1, 1, 1}};
+  const Mat4d m = *projectiveFromFivePoints(frustum, cube);
+  const std::optional<ProjectedFreeForm> g = ProjectedFreeForm::make(f, m);
+  ASSERT_TRUE(g);
+  std::mt19937 rng(5);
+  for (int i = 0; i < 500; ++i) {
+    const Vec3d q = randomPoint(rng, 1);
+    const Vec3d p = g->toObject(q);
+    const Vec4d h = g->inverse() * Vec4d{{q.x, q.y, q.z, 1}};
+    const double u2 = h[3] * h[3];
+    EXPECT_NEAR(g->evaluate(q), u2 * f.evaluate(p), 1e-9 * (1 + std::fabs(u2 * f.evaluate(p))));
+  }
+}
+
+}  // namespace
+}  // namespace sv::freeform
