@@ -50,6 +50,11 @@ struct RenderOptions {
   // hybrid — masking combined with depth bounds per window, the Z-buffer's image for any order,
   // fastest when the order is roughly front to back.
   enum class Hsr { zbuffer, priority, hybrid } hsr = Hsr::zbuffer;
+  // How free forms (Scene::freeForms) are drawn: multi-level ray casting (SPEC §12), or — the
+  // baseline it is measured against — every pixel marched front to back in `marchSteps` equal
+  // steps of depth (in the cube the view volume is mapped onto), its first sign change bisected.
+  enum class FreeFormMethod { raycast, march } freeFormMethod = FreeFormMethod::raycast;
+  int marchSteps = 1024;
 };
 
 // By name, as the CLI's --hsr writes them: "zbuffer", "priority", "hybrid".
@@ -79,6 +84,10 @@ struct FrameStats {
   uint64_t occludedWindows = 0;    // windows triangles were dropped from as occupied (priority)
   uint64_t occludedTriangles = 0;  // triangles dropped whole from a tile (their box occupied)
   uint64_t occludedObjects = 0;    // objects dropped whole from a tile (their bound occupied)
+  // Free forms (SPEC §12): objects, screen cells bounded, cells skipped by masking, interval
+  // bounds evaluated, pixel (sample) rays solved, and those that took a surface.
+  uint64_t freeForms = 0, freeFormCells = 0, freeFormMaskedCells = 0, freeFormBounds = 0,
+           freeFormRays = 0, freeFormHits = 0;
   // rasterMs: the tile pass, which includes resolving each finished tile into the image.
   double vertexMs = 0, setupMs = 0, rasterMs = 0, totalMs = 0;
 

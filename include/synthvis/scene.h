@@ -107,6 +107,29 @@ struct Instance {
   int priority = 0;
 };
 
+// A free-form surface (SPEC §11; docs/scene-format.md "Free forms"): the quadric
+// F = Ax² + By² + Cz² + Dxy + Exz + Fyz + Gx + Hy + Iz + K (coefficients in this order; inside
+// F ≥ 0) plus, for each perturbation, weight·max(0, Q)³ with Q itself a free form.
+inline constexpr int kMaxFreeFormQuadrics = 256;  // per free-form object, perturbations included
+inline constexpr int kMaxFreeFormDepth = 16;      // nesting of perturbations
+inline constexpr size_t kMaxFreeFormObjects = 65536;
+
+struct FreeFormNode {
+  std::array<double, 10> quadric{};
+  double weight = 1;  // where this node perturbs its parent: R = weight·Q³
+  std::vector<FreeFormNode> perturbations;
+  int quadricCount() const;  // this node's and all its perturbations', recursively
+};
+
+// A free form placed in the world: rendered directly by multi-level ray casting (SPEC §12), never
+// tessellated, in the same depth and frame buffer as the polygons.
+struct FreeFormObject {
+  std::string name;
+  FreeFormNode form;
+  Mat4 transform;     // object → world; affine (last row 0, 0, 0, 1) and invertible
+  int material = -1;  // index into Scene::materials, or −1 for the default material
+};
+
 struct Camera {
   std::string name;
   Vec3 position{0, 0, 5};
@@ -145,6 +168,7 @@ struct Scene {
   std::vector<Mesh> meshes;
   std::vector<Material> materials;
   std::vector<Instance> instances;
+  std::vector<FreeFormObject> freeForms;
   std::vector<Camera> cameras;  // the first one is used unless another is chosen
   Light light;
   std::vector<PointLight> pointLights;

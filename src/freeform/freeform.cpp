@@ -11,7 +11,7 @@ double FreeForm::evaluate(Vec3d p) const {
   double f = base.evaluate(p);
   for (const FreeForm& q : perturbations) {
     const double v = q.evaluate(p);
-    if (v > 0) f += v * v * v;
+    if (v > 0) f += q.weight * v * v * v;
   }
   return f;
 }
@@ -20,14 +20,15 @@ Vec3d FreeForm::gradient(Vec3d p) const {
   Vec3d g = base.gradient(p);
   for (const FreeForm& q : perturbations) {
     const double v = q.evaluate(p);
-    if (v > 0) g = g + q.gradient(p) * (3 * v * v);
+    if (v > 0) g = g + q.gradient(p) * (3 * q.weight * v * v);
   }
   return g;
 }
 
 Interval FreeForm::bound(Interval x, Interval y, Interval z) const {
   Interval f = base.bound(x, y, z);
-  for (const FreeForm& q : perturbations) f = f + cube(positivePart(q.bound(x, y, z)));
+  for (const FreeForm& q : perturbations)
+    f = f + cube(positivePart(q.bound(x, y, z))) * q.weight;
   return f;
 }
 
@@ -40,7 +41,7 @@ int FreeForm::quadricCount() const {
 void ProjectedFreeForm::flatten(const FreeForm& form, const Mat4d& inverse,
                                 std::vector<Node>& out) {
   const size_t at = out.size();
-  out.push_back({form.base.transformedByInverse(inverse), 0});
+  out.push_back({form.base.transformedByInverse(inverse), form.weight, 0});
   for (const FreeForm& q : form.perturbations) flatten(q, inverse, out);
   out[at].end = uint32_t(out.size());
 }
@@ -59,7 +60,7 @@ double ProjectedFreeForm::evaluateNode(uint32_t i, Vec3d q, double invU4) const 
   double h = nodes_[i].q.evaluate(q);
   for (uint32_t c = i + 1; c < nodes_[i].end; c = nodes_[c].end) {
     const double v = evaluateNode(c, q, invU4);
-    if (v > 0) h += v * v * v * invU4;
+    if (v > 0) h += nodes_[c].weight * v * v * v * invU4;
   }
   return h;
 }
@@ -75,7 +76,7 @@ Interval ProjectedFreeForm::boundNode(uint32_t i, Interval x, Interval y, Interv
                                       Interval invU4) const {
   Interval h = nodes_[i].q.bound(x, y, z);
   for (uint32_t c = i + 1; c < nodes_[i].end; c = nodes_[c].end)
-    h = h + cube(positivePart(boundNode(c, x, y, z, invU4))) * invU4;  // both factors ≥ 0
+    h = h + cube(positivePart(boundNode(c, x, y, z, invU4))) * invU4 * nodes_[c].weight;
   return h;
 }
 

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace sv::freeform {
 
@@ -236,10 +237,40 @@ Vec3d Quadric::gradient(Vec3d p) const {
           2 * c[2] * z + c[4] * x + c[5] * y + c[8]};
 }
 
+namespace {
+
+// The range of a·t² + b·t + c over t ∈ T, b ∈ B, c ∈ C, exactly when b and c are independent of
+// t and each other: for fixed t it is linear in b, so b's extremes suffice, and for fixed b the
+// quadratic's extremes lie at T's ends or at its vertex −b/2a.
+Interval quadraticRange(double a, Interval b, Interval c, Interval t) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  auto at = [&](double bb, double tt) {
+    const double v = (a * tt + bb) * tt;
+    lo = std::min(lo, v);
+    hi = std::max(hi, v);
+  };
+  for (const double bb : {b.lo, b.hi}) {
+    at(bb, t.lo);
+    at(bb, t.hi);
+    if (a != 0) {
+      const double vertex = -bb / (2 * a);
+      if (vertex > t.lo && vertex < t.hi) at(bb, vertex);
+    }
+  }
+  return {lo + c.lo, hi + c.hi};
+}
+
+}  // namespace
+
 Interval Quadric::bound(Interval x, Interval y, Interval z) const {
-  // Each square exact; products of distinct variables by their corners.
-  return square(x) * c[0] + square(y) * c[1] + square(z) * c[2] + (x * y) * c[3] +
-         (x * z) * c[4] + (y * z) * c[5] + x * c[6] + y * c[7] + z * c[8] + c[9];
+  // Nested by variable — F = C·z² + (E·x + F·y + I)·z + [A·x² + (D·y + G)·x + (B·y² + H·y + K)] —
+  // each level's quadratic bounded exactly in its own variable (quadraticRange): far tighter than
+  // term-by-term interval arithmetic, which loses the cancellation between a variable's square and
+  // linear terms (in the cube those are large and nearly cancel). Exact where x and y are points
+  // (a pixel's ray).
+  const Interval inY = quadraticRange(c[1], Interval::point(c[7]), Interval::point(c[9]), y);
+  const Interval inX = quadraticRange(c[0], y * c[3] + c[6], inY, x);
+  return quadraticRange(c[2], x * c[4] + y * c[5] + c[8], inX, z);
 }
 
 Mat4d Quadric::matrix() const {

@@ -10,9 +10,9 @@
 namespace sv::freeform {
 namespace {
 
-// Cube coordinates of pixel centres (raycast.h).
-double cubeX(int px, int width) { return 2.0 * (px + 0.5) / width - 1; }
-double cubeY(int py, int height) { return 1 - 2.0 * (py + 0.5) / height; }
+// Cube coordinates of pixel centres (raycast.h), moved by a sample offset d (pixels).
+double cubeX(int px, int width, double d) { return 2.0 * (px + 0.5 + d) / width - 1; }
+double cubeY(int py, int height, double d) { return 1 - 2.0 * (py + 0.5 + d) / height; }
 double windowDepth(double z) { return 0.5 * (z + 1); }
 
 bool inside(double h) { return h >= 0; }
@@ -87,8 +87,8 @@ class Caster {
       ++stats_.maskedCells;
       return;
     }
-    const Interval x{cubeX(gx0, w_.width), cubeX(gx1, w_.width)};
-    const Interval y{cubeY(gy1, w_.height), cubeY(gy0, w_.height)};
+    const Interval x{cubeX(gx0, w_.width, w_.offsetX), cubeX(gx1, w_.width, w_.offsetX)};
+    const Interval y{cubeY(gy1, w_.height, w_.offsetY), cubeY(gy0, w_.height, w_.offsetY)};
     if (level == 0) return pixel(lx, ly, x.lo, y.lo, zlo, zhi);
     // Step 2: the binary tree in depth, three levels deep: the first and the last of eight slabs
     // whose bound may hold the surface narrow the children's depth range.
@@ -168,7 +168,8 @@ void marchWindow(const ProjectedFreeForm& form, uint32_t id, const CastWindow& w
     for (int lx = 0; lx < window.size && window.x0 + lx < window.width; ++lx) {
       ++stats.pixels;
       const size_t at = size_t(ly) * size_t(window.stride) + size_t(lx);
-      const double x = cubeX(window.x0 + lx, window.width), y = cubeY(window.y0 + ly, window.height);
+      const double x = cubeX(window.x0 + lx, window.width, window.offsetX);
+      const double y = cubeY(window.y0 + ly, window.height, window.offsetY);
       const double zEnd = std::min(1.0, 2.0 * double(window.depth[at]) - 1);
       double a = -1;
       bool insideA = inside(form.evaluate({x, y, a}));

@@ -30,6 +30,9 @@ struct CastWindow {
   uint32_t* object = nullptr;
   double* cubeZ = nullptr;
   int stride = 0;
+  // The rays leave every pixel at this offset from its centre, in pixels: a sample of the
+  // anti-aliasing pattern (SPEC §5), or 0 for point sampling.
+  double offsetX = 0, offsetY = 0;
 };
 
 struct CastStats {

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <functional>
 
 #include "geometry/setup.h"
 #include "raster/coverage_masks.h"
@@ -115,6 +116,13 @@ struct TileWork {
   // skipped where objectHidden says so, before any of its records is read.
   const uint32_t* const* listObjects = nullptr;
   const geometry::ObjectBound* objects = nullptr;
+  // Called once per tile when its opaque triangles are all drawn (and shaded) — before its first
+  // translucent one, or after its last triangle in the frame's last batch — with the tile's
+  // buffers as they stand: free forms are drawn there (freeform/tile_pass.h). `opaqueDone` is set
+  // when it has been called (kept across batches by the caller).
+  const std::function<void()>* afterOpaque = nullptr;
+  uint8_t* opaqueDone = nullptr;
+  bool lastBatch = true;
   // After the tile's triangles: its colour replaced by the occupancy view — the red channel 0
   // where nothing is occupied, 1 for an occupied pixel, else log2 of the largest full window.
   bool debugOccupancy = false;

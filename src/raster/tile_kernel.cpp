@@ -1505,6 +1505,13 @@ HWY_INLINE void drawTriangle(const TriangleSetup& t, const TileContext& ctx,
   }
 }
 
+// The tile's opaque surfaces are all in: TileWork::afterOpaque, once.
+void afterOpaque(const TileWork& w) {
+  if (!w.afterOpaque || !w.opaqueDone || *w.opaqueDone) return;
+  *w.opaqueDone = true;
+  (*w.afterOpaque)();
+}
+
 template <ShadeMode kShade, bool kAA>
 void drawLists(const TileWork& w, RasterStats& stats) {
   // Pixel shading at one sample is deferred: opaque triangles only record the winner per pixel.
@@ -1565,10 +1572,12 @@ void drawLists(const TileWork& w, RasterStats& stats) {
           pending = true;
           continue;
         }
-        // Blending reads the colour behind: the deferred pixels must have theirs first.
-        if (pending && alpha == shade::AlphaUse::blend) {
-          shadeVisible(ctx);
+        // Blending reads the colour behind: the deferred pixels must have theirs first, and the
+        // opaque free forms must be in.
+        if (alpha == shade::AlphaUse::blend) {
+          if (pending) shadeVisible(ctx);
           pending = false;
+          afterOpaque(w);
         }
         if (a.material)
           drawTriangle<PixelOp::material, kAA>(t, ctx, &a);
@@ -1583,6 +1592,7 @@ void drawLists(const TileWork& w, RasterStats& stats) {
     }
   }
   if (pending) shadeVisible(ctx);
+  if (w.lastBatch) afterOpaque(w);
 }
 
 void RasterizeTile(const TileWork& w, RasterStats& stats) {

@@ -99,6 +99,7 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
                                            : raster::kNoObject;
   };
   tileStats_.assign(size_t(tiles), raster::RasterStats{});
+  opaqueDone_.assign(size_t(tiles), 0);
   const int maxChunks = std::max(1, int((firstBatch + kChunkTriangles - 1) / kChunkTriangles));
   std::vector<SetupCounts> counts(static_cast<size_t>(maxChunks));
   std::vector<const uint32_t*> listPtrs(size_t(maxChunks) * pool_.threadCount());
@@ -221,6 +222,15 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
         w.occupancy = wholeFrame ? &frameOccupancy_[tile] : scratch_[worker].occupancy.get();
         w.listObjects = listObject;
         w.objects = objects_.data();
+      }
+      w.lastBatch = lastBatch;
+      std::function<void()> afterOpaque;
+      if (settings.afterOpaque) {
+        afterOpaque = [&, tile, worker] {
+          settings.afterOpaque(int(tile), worker, w.depth, w.color);
+        };
+        w.afterOpaque = &afterOpaque;
+        w.opaqueDone = &opaqueDone_[tile];
       }
       raster::rasterizeTile(w, tileStats_[tile]);
       if (lastBatch && settings.finishTile) settings.finishTile(int(tile), w.depth, w.color);

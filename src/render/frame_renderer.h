@@ -62,6 +62,10 @@ struct FrameSettings {
   raster::Masking masking = raster::Masking::none;
   // The occupancy debug view (raster::TileWork::debugOccupancy).
   bool debugOccupancy = false;
+  // Called once per tile, on the thread drawing it, when its opaque triangles are drawn and before
+  // its translucent ones (raster::TileWork::afterOpaque), with the tile's depth and colour and the
+  // worker's number (0 … threads − 1): the free forms' pass. Empty: none.
+  std::function<void(int tile, int worker, float* depth, uint16_t* color)> afterOpaque;
 };
 
 class FrameRenderer {
@@ -91,6 +95,7 @@ class FrameRenderer {
   std::vector<raster::AttributeSetup> attributes_;  // the batch's, by triangle (ShadeMode::material)
   std::vector<WorkerScratch> scratch_;           // one per pool worker
   std::vector<raster::RasterStats> tileStats_;
+  std::vector<uint8_t> opaqueDone_;  // per tile: FrameSettings::afterOpaque has run
 };
 
 }  // namespace sv::render

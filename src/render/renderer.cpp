@@ -9,6 +9,7 @@
 #include <numeric>
 #include <thread>
 
+#include "freeform/tile_pass.h"
 #include "geometry/vertex_stage.h"
 #include "output/resolve.h"
 #include "render/frame_renderer.h"
@@ -184,6 +185,50 @@ std::vector<uint32_t> drawOrder(const scene::Scene& scene, const Mat4& view, Ren
   return order;
 }
 
+freeform::Mat4d toDouble(const Mat4& m) {  // column-major float → row-major double
+  freeform::Mat4d d;
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) d.m[r][c] = m.m[c][r];
+  return d;
+}
+
+freeform::FreeForm toFreeForm(const scene::FreeFormNode& n) {
+  freeform::FreeForm f;
+  f.base.c = n.quadric;
+  f.weight = n.weight;
+  for (const scene::FreeFormNode& p : n.perturbations) f.perturbations.push_back(toFreeForm(p));
+  return f;
+}
+
+// The frame's free forms for the tile pass: each carried into the cube by projection · view ·
+// model (SPEC §12), lit per pixel with its material's colour and specular term (Phong whenever the
+// scene has lights and the material is lit: the normal is exact at every pixel), both sides lit.
+// Free forms take no texture yet and are always opaque.
+std::vector<freeform::ShadedForm> shadedForms(const scene::Scene& scene, const Mat4& view,
+                                              const Mat4& projection, const ShadingTables& shading) {
+  std::vector<freeform::ShadedForm> out;
+  const scene::Material defaultMaterial;
+  const bool lights = shading.environment.lightOn || !shading.environment.points.empty();
+  for (const scene::FreeFormObject& object : scene.freeForms) {
+    const scene::Material& mat =
+        object.material >= 0 ? scene.materials[size_t(object.material)] : defaultMaterial;
+    const freeform::Mat4d toEye = toDouble(view * object.transform);
+    const std::optional<freeform::Mat4d> eyeInverse = toEye.inverse();
+    const freeform::FreeForm form = toFreeForm(object.form);
+    std::optional<freeform::ProjectedFreeForm> projected =
+        freeform::ProjectedFreeForm::make(form, toDouble(projection) * toEye);
+    if (!eyeInverse || !projected) continue;  // a singular placement shows nothing
+    freeform::ShadedForm s{form, std::move(*projected), toEye, eyeInverse->transposed(), {}, {}};
+    s.material.phong = lights && !mat.unlit;
+    s.material.twoSided = true;
+    s.material.specular = mat.specular;
+    s.material.shininess = mat.shininess;
+    for (int ch = 0; ch < 3; ++ch) s.color[ch] = (&mat.baseColor.x)[ch];
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
 }  // namespace
 
 Result<Mat4> viewProjection(const scene::Scene& scene, const RenderOptions& o) {
@@ -241,7 +286,12 @@ std::string FrameStats::summary() const {
       trianglesIn, culled(), culledFacing, culledOutside, culledDegenerate, culledInvalid,
       culledOccluded ? fmt::format(", occluded {}", culledOccluded) : std::string(), drawn,
       windows[0], windows[1], windows[2], windows[3], windows[4], windows[5], fullWindows,
-      occludedWindows, occludedTriangles, occludedObjects, totalMs, vertexMs, setupMs, rasterMs);
+      occludedWindows, occludedTriangles, occludedObjects, totalMs, vertexMs, setupMs, rasterMs) +
+         (freeForms ? fmt::format(" | free forms {}: cells {} (masked {}), bounds {}, rays {}, "
+                                  "hits {}",
+                                  freeForms, freeFormCells, freeFormMaskedCells, freeFormBounds,
+                                  freeFormRays, freeFormHits)
+                    : std::string());
 }
 
 Result<RenderOptions::Hsr> parseHsr(const std::string& text) {
@@ -271,6 +321,9 @@ struct Renderer::Impl {
   ShadingTables shading;
   render::DrawPackets packets;
   output::LinearImage linear;  // the box-resolved frame, for the tent filter
+  freeform::FreeFormFrame freeForms;
+  std::vector<freeform::FreeFormFrame::Scratch> freeFormScratch;  // per worker
+  std::vector<freeform::CastStats> freeFormStats;                 // per worker
 };
 
 Renderer::Renderer(const RenderOptions& options) : impl_(std::make_unique<Impl>(options)) {}
@@ -433,8 +486,38 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
     fs.finishTile = [&](int tile, const float*, const uint16_t* color) {
       output::resolveTile(color, tile % tilesX, tile / tilesX, k, impl_->gamma, image);
     };
+  // The free forms, cast into each tile between its opaque and translucent polygons (not in the
+  // debug views, which show the polygon pipeline).
+  if (!scene.freeForms.empty() && o.debugView == DebugView::none) {
+    const raster::CoverageTables* cov =
+        o.samples > 1 ? raster::CoverageTables::forCount(o.samples) : nullptr;
+    impl_->freeForms.prepare(
+        shadedForms(scene, camera.value().view, camera.value().projection, shading), fs.width,
+        fs.height, o.samples, cov ? cov->offsetX : nullptr, cov ? cov->offsetY : nullptr,
+        &shading.environment, freeform::CastSettings{},
+        o.freeFormMethod == RenderOptions::FreeFormMethod::march ? o.marchSteps : 0);
+    const int threads = impl_->frame.pool().threadCount();
+    impl_->freeFormScratch.resize(size_t(threads));
+    impl_->freeFormStats.assign(size_t(threads), freeform::CastStats{});
+    const int tilesAcross = tilesX;
+    fs.afterOpaque = [&, tilesAcross](int tile, int worker, float* depth, uint16_t* color) {
+      impl_->freeForms.drawTile(tile % tilesAcross, tile / tilesAcross, depth, color,
+                                impl_->freeFormScratch[size_t(worker)],
+                                impl_->freeFormStats[size_t(worker)]);
+    };
+  }
   output::prepareImage(o.width, o.height, image);
   impl_->frame.render(p, fs, stats);
+  if (fs.afterOpaque) {
+    freeform::CastStats cast;
+    for (const freeform::CastStats& s : impl_->freeFormStats) cast.add(s);
+    stats.freeForms += impl_->freeForms.size();
+    stats.freeFormCells += cast.cells;
+    stats.freeFormMaskedCells += cast.maskedCells;
+    stats.freeFormBounds += cast.depthTests;
+    stats.freeFormRays += cast.pixels;
+    stats.freeFormHits += cast.hits;
+  }
   if (tent) {
     t0 = Clock::now();
     constexpr int kBand = 16;  // rows per task

@@ -21,6 +21,12 @@ std::array<Vec3, 2> Mesh::bounds() const {
   return {lo, hi};
 }
 
+int FreeFormNode::quadricCount() const {
+  int n = 1;
+  for (const FreeFormNode& p : perturbations) n += p.quadricCount();
+  return n;
+}
+
 size_t Scene::triangleCount() const {
   size_t n = 0;
   for (const Instance& instance : instances)
@@ -119,6 +125,35 @@ Status validate(const Scene& scene, const std::string& file) {
     if (!isFinite(instance.transform))
       return fail(fmt::format("instances[{}]: transform is not finite", i));
   }
+  for (size_t i = 0; i < scene.freeForms.size(); ++i) {
+    const FreeFormObject& f = scene.freeForms[i];
+    const std::string label = f.name.empty() ? fmt::format("freeForms[{}]", i)
+                                             : fmt::format("free form '{}'", f.name);
+    if (f.material < -1 || (f.material >= 0 && size_t(f.material) >= scene.materials.size()))
+      return fail(fmt::format("{}: material {} does not exist ({} materials)", label, f.material,
+                              scene.materials.size()));
+    if (!isFinite(f.transform))
+      return fail(fmt::format("{}: transform is not finite", label));
+    const auto& m = f.transform.m;
+    if (m[0][3] != 0 || m[1][3] != 0 || m[2][3] != 0 || m[3][3] != 1)
+      return fail(fmt::format("{}: transform is not affine (last row must be 0, 0, 0, 1)", label));
+    const float det = m[0][0] * (m[1][1] * m[2][2] - m[2][1] * m[1][2]) -
+                      m[1][0] * (m[0][1] * m[2][2] - m[2][1] * m[0][2]) +
+                      m[2][0] * (m[0][1] * m[1][2] - m[1][1] * m[0][2]);
+    if (!(std::fabs(det) > 1e-20f)) return fail(fmt::format("{}: transform is singular", label));
+    if (f.form.quadricCount() > kMaxFreeFormQuadrics)
+      return fail(fmt::format("{}: {} quadrics (at most {})", label, f.form.quadricCount(),
+                              kMaxFreeFormQuadrics));
+    std::vector<const FreeFormNode*> stack{&f.form};
+    while (!stack.empty()) {
+      const FreeFormNode* n = stack.back();
+      stack.pop_back();
+      for (double c : n->quadric)
+        if (!(std::fabs(c) <= 1e30)) return fail(fmt::format("{}: a quadric coefficient is not finite (or over 1e30)", label));
+      if (!(std::fabs(n->weight) <= 1e30)) return fail(fmt::format("{}: a weight is not finite", label));
+      for (const FreeFormNode& p : n->perturbations) stack.push_back(&p);
+    }
+  }
   for (size_t i = 0; i < scene.materials.size(); ++i) {
     const Material& m = scene.materials[i];
     if (m.texture < -1 || (m.texture >= 0 && size_t(m.texture) >= scene.textures.size()))
@@ -160,7 +195,13 @@ void appendScene(Scene& scene, Scene other, const Mat4& transform) {
     scene.meshes.push_back(std::move(mesh));
   }
   for (const Instance& instance : other.instances)
-    scene.instances.push_back({instance.mesh + meshBase, transform * instance.transform});
+    scene.instances.push_back(
+        {instance.mesh + meshBase, transform * instance.transform, instance.priority});
+  for (FreeFormObject& f : other.freeForms) {
+    if (f.material >= 0) f.material += materialBase;
+    f.transform = transform * f.transform;
+    scene.freeForms.push_back(std::move(f));
+  }
   // Cameras travel with their geometry; the lights, fog and background belong to the outer scene
   // (docs/scene-format.md, "Referenced files").
   for (Camera camera : other.cameras) {

@@ -28,7 +28,7 @@ FreeForm bumpySphere() {
   bump.perturbations.push_back(inner);
   FreeForm dent;
   dent.base = Quadric::cylinder({0, 0.8, 0}, {0, 0, 1}, 0.3);
-  dent.base.c[9] -= 0.02;  // shallower
+  dent.weight = -4;
   f.perturbations = {bump, dent};
   return f;
 }

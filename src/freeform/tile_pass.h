@@ -1,0 +1,67 @@
+// Free forms in the frame: ray cast per 64×64 tile into the tile's own depth and colour buffers
+// (raster/framebuffer.h), after the tile's opaque polygons and before its translucent ones, so
+// that free forms and polygons meet at exact, anti-aliased intersection curves (issue 7 item 4).
+//
+// Based on: SPEC §12 (multi-level ray casting; at a leaf the surface point, the normal from the
+// gradient, Phong shading, fog, depth), §5 (the same sample pattern as the polygons: one ray per
+// sample, colour shaded once per pixel and object), §8 (shading, through shade::shadeFragments).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "freeform/raycast.h"
+#include "shade/shading.h"
+
+namespace sv::freeform {
+
+// One free-form object as the pass draws it.
+struct ShadedForm {
+  FreeForm form;                 // object space: the gradient gives the normal
+  ProjectedFreeForm projected;   // in the cube: what is cast
+  Mat4d objectToEye;             // for the eye-space position (fog, point lights, specular)
+  Mat4d normalToEye;             // the inverse transpose of objectToEye's 3×3 part
+  shade::MaterialShading material;
+  float color[3] = {1, 1, 1};  // linear base colour
+};
+
+// The frame's free forms, and which tiles each may show in (so a tile casts only those).
+class FreeFormFrame {
+ public:
+  // Finds, for every form, the tiles of the width × height raster (64-pixel tiles) whose pixel
+  // squares its surface may cross, by the same bounds the caster uses, windows of the screen
+  // subdivided from the whole raster down to tiles.
+  void prepare(std::vector<ShadedForm> forms, int width, int height, int samples,
+               const int32_t* sampleOffsetX, const int32_t* sampleOffsetY,
+               const shade::Environment* environment, const CastSettings& settings,
+               int marchSteps);
+
+  bool empty() const { return forms_.empty(); }
+  size_t size() const { return forms_.size(); }
+
+  // Per-thread buffers: the tile's samples row by row while it is cast.
+  struct Scratch {
+    std::vector<float> depth;
+    std::vector<uint32_t> object;
+    std::vector<double> cubeZ;
+  };
+
+  // Casts the forms listed for tile (tileX, tileY) into its buffers — `samples` depth and colour
+  // planes per 4×4 block (raster/framebuffer.h) — shading each pixel once per form that takes any
+  // of its samples. Adds to `stats`.
+  void drawTile(int tileX, int tileY, float* depth, uint16_t* color, Scratch& scratch,
+                CastStats& stats) const;
+
+ private:
+  void markTiles(uint32_t form, int x0, int y0, int size, double zlo, double zhi);
+
+  std::vector<ShadedForm> forms_;
+  int width_ = 0, height_ = 0, samples_ = 1, tilesX_ = 0, tilesY_ = 0;
+  double offsetX_[64] = {}, offsetY_[64] = {};  // sample offsets from the pixel centre, pixels
+  const shade::Environment* environment_ = nullptr;
+  CastSettings settings_;
+  int marchSteps_ = 0;  // > 0: the fixed-step marcher instead of the caster (the baseline)
+  std::vector<std::vector<uint32_t>> tileForms_;  // per tile, the forms it casts, in order
+};
+
+}  // namespace sv::freeform
