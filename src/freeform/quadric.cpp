@@ -175,14 +175,15 @@ Quadric Quadric::ellipsoid(Vec3d centre, Vec3d radii) {
 }
 
 Quadric Quadric::cylinder(Vec3d point, Vec3d axis, double radius) {
-  // r² − |p − a|² + ((p − a)·u)²: r² less the squared distance from the axis.
+  // 1 − (|p − a|² − ((p − a)·u)²)/r²: the squared distance from the axis, over r².
   const Vec3d u = normalize(axis);
+  const double w = 1 / (radius * radius);
   Mat4d s = zeroMatrix();
-  s.m[3][3] = radius * radius;
-  addMinusDistanceSquared(s, point, 1);
+  s.m[3][3] = 1;
+  addMinusDistanceSquared(s, point, w);
   double v[4];
   axisForm(point, u, v);
-  addSquare(s, v, 1);
+  addSquare(s, v, w);
   return fromMatrix(s);
 }
 

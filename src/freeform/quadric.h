@@ -7,7 +7,8 @@
 // Surfaces").
 //
 // Sign convention (SPEC §11 leaves it to the implementation): the surface is F = 0 and the
-// inside is F ≥ 0 — a sphere of radius r about c is r² − |p − c|².
+// inside is F ≥ 0 — a sphere of radius r about c is 1 − |p − c|²/r², which is 1 at its centre
+// whatever its size, so a perturbation's weight sets its height the same way for any radius.
 #pragma once
 
 #include <array>
@@ -73,16 +74,19 @@ struct Quadric {
   std::array<double, 10> c{};
 
   // Convenience forms, all inside ≥ 0. Axes need not be unit length (they are normalized).
-  static Quadric sphere(Vec3d centre, double radius);
-  static Quadric ellipsoid(Vec3d centre, Vec3d radii);  // axis-aligned semi-axes
-  // The infinite cylinder of `radius` about the line through `point` along `axis`.
+  static Quadric sphere(Vec3d centre, double radius);  // 1 − |p − c|²/r²
+  static Quadric ellipsoid(Vec3d centre, Vec3d radii);  // 1 − Σ ((p_i − c_i)/r_i)², axis-aligned
+  // The infinite cylinder of `radius` about the line through `point` along `axis`:
+  // 1 − (distance from the axis)²/r².
   static Quadric cylinder(Vec3d point, Vec3d axis, double radius);
-  // The infinite double cone with apex `apex`, axis `axis`, half-angle `halfAngle` (radians).
+  // The infinite double cone with apex `apex`, axis `axis`, half-angle `halfAngle` (radians):
+  // ((p − a)·u)² − cos²θ·|p − a|².
   static Quadric cone(Vec3d apex, Vec3d axis, double halfAngle);
   // The paraboloid of revolution opening along `axis` from `vertex`: inside where the height along
-  // the axis exceeds k·(distance from the axis)².
+  // the axis exceeds k·(distance from the axis)²: h − k·ρ².
   static Quadric paraboloid(Vec3d vertex, Vec3d axis, double k);
-  // The half-space n·p ≤ d (inside), bounded by the plane n·p = d.
+  // The half-space n·p ≤ d (inside), bounded by the plane n·p = d: (d − n·p)/|n|, the signed
+  // distance.
   static Quadric halfSpace(Vec3d normal, double d);
 
   double evaluate(Vec3d p) const;

@@ -78,6 +78,37 @@ TEST(JsonScene, ReadsEveryTopLevelSection) {
   EXPECT_EQ(s.triangleCount(), 12u);
 }
 
+// A free-form object (SPEC §11): the convenience quadrics become their coefficients (inside
+// F ≥ 0), perturbations keep their weights and nesting, and the material and transform apply.
+TEST(JsonScene, ReadsFreeFormObjects) {
+  const Result<Scene> r = parse(R"({"synthvis": 1, "materials": [{"name": "clay"}], "objects": [
+    {"name": "blob", "material": "clay", "transform": {"translate": [1, 2, 3]}, "priority": 4,
+     "freeform": {"quadric": "sphere", "center": [1, 0, 0], "radius": 2,
+       "perturbations": [
+         {"quadric": "ellipsoid", "radii": [1, 2, 4], "weight": -3,
+          "perturbations": [{"quadric": "plane", "normal": [0, 2, 0], "d": 1}]},
+         {"quadric": "general", "coefficients": [1, 2, 3, 4, 5, 6, 7, 8, 9, 10]}]}}]})");
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  ASSERT_EQ(r.value().freeForms.size(), 1u);
+  const FreeFormObject& f = r.value().freeForms[0];
+  EXPECT_EQ(f.name, "blob");
+  EXPECT_EQ(f.material, 0);
+  EXPECT_EQ(f.transform.m[3][1], 2.0f);
+  // 1 − ((x − 1)² + y² + z²)/4
+  const std::array<double, 10> sphere = {-0.25, -0.25, -0.25, 0, 0, 0, 0.5, 0, 0, 0.75};
+  for (size_t i = 0; i < 10; ++i) EXPECT_NEAR(f.form.quadric[i], sphere[i], 1e-12) << i;
+  ASSERT_EQ(f.form.perturbations.size(), 2u);
+  const FreeFormNode& e = f.form.perturbations[0];
+  EXPECT_EQ(e.weight, -3);
+  EXPECT_NEAR(e.quadric[1], -0.25, 1e-12);  // 1 − x² − y²/4 − z²/16
+  EXPECT_NEAR(e.quadric[2], -1.0 / 16, 1e-12);
+  ASSERT_EQ(e.perturbations.size(), 1u);
+  EXPECT_NEAR(e.perturbations[0].quadric[7], -1, 1e-12);  // 1 − y (the normal normalized)
+  EXPECT_NEAR(e.perturbations[0].quadric[9], 0.5, 1e-12);
+  EXPECT_EQ(f.form.perturbations[1].quadric[9], 10);
+  EXPECT_EQ(f.form.quadricCount(), 4);
+}
+
 TEST(JsonScene, DefaultsMatchTheSceneTypes) {
   Result<Scene> r = parse(R"({"synthvis": 1})");
   ASSERT_TRUE(r.ok()) << r.error().str();
@@ -275,8 +306,30 @@ TEST(JsonScene, RejectsEachMalformedClassWithAClearMessage) {
        "objects[0].material: no material named 'rde' (did you mean 'red'?)"},
       {R"({"synthvis": 1, "objects": [{"primitive": "box", "material": 0}]})", "objects[0].material: there are no materials"},
       {R"({"synthvis": 1, "objects": {}})", "objects: expected an array, got an object"},
-      {R"({"synthvis": 1, "objects": [{}]})", "objects[0]: missing key 'mesh' or 'primitive'"},
-      {R"({"synthvis": 1, "objects": [{"mesh": "a.obj", "primitive": "box"}]})", "either 'mesh' or 'primitive'"},
+      {R"({"synthvis": 1, "objects": [{}]})", "objects[0]: missing key 'mesh', 'primitive' or 'freeform'"},
+      {R"({"synthvis": 1, "objects": [{"mesh": "a.obj", "primitive": "box"}]})", "one of 'mesh', 'primitive' or 'freeform', not several"},
+      // Free forms (SPEC §11).
+      {R"({"synthvis": 1, "objects": [{"freeform": {}}]})", "objects[0].freeform: missing key 'quadric'"},
+      {R"({"synthvis": 1, "objects": [{"freeform": {"quadric": "torus"}}]})",
+       "objects[0].freeform.quadric: unknown quadric 'torus'"},
+      {R"({"synthvis": 1, "objects": [{"freeform": {"quadric": "sphere", "radius": -1}}]})",
+       "objects[0].freeform.radius: expected a number greater than 0"},
+      {R"({"synthvis": 1, "objects": [{"freeform": {"quadric": "sphere", "radii": [1, 1, 1]}}]})",
+       "objects[0].freeform: unknown key 'radii'"},
+      {R"({"synthvis": 1, "objects": [{"freeform": {"quadric": "sphere", "weight": 2}}]})",
+       "objects[0].freeform.weight: 'weight' belongs to perturbations"},
+      {R"({"synthvis": 1, "objects": [{"freeform": {"quadric": "cone", "angle": 90}}]})",
+       "objects[0].freeform.angle: 90 is out of range"},
+      {R"({"synthvis": 1, "objects": [{"freeform": {"quadric": "cylinder", "axis": [0, 0, 0]}}]})",
+       "objects[0].freeform.axis: expected a non-zero vector"},
+      {R"({"synthvis": 1, "objects": [{"freeform": {"quadric": "general", "coefficients": [1, 2]}}]})",
+       "objects[0].freeform.coefficients: expected an array of 10 numbers, got 2 elements"},
+      {R"({"synthvis": 1, "objects": [{"freeform": {"quadric": "sphere", "perturbations": [{"quadric": "sphere", "weight": "x"}]}}]})",
+       "objects[0].freeform.perturbations[0].weight: expected a number, got a string"},
+      {R"({"synthvis": 1, "objects": [{"freeform": {"quadric": "sphere"}, "primitive": "box"}]})",
+       "not several"},
+      {R"({"synthvis": 1, "objects": [{"freeform": {"quadric": "sphere"}, "transform": {"matrix": [1,0,0,0, 0,1,0,0, 0,0,0,0, 0,0,0,1]}}]})",
+       "freeForms[0]: transform is singular"},
       {R"({"synthvis": 1, "objects": [{"primitive": "teapot"}]})", "objects[0].primitive: unknown primitive 'teapot'"},
       {R"({"synthvis": 1, "objects": [{"primitive": "box", "radius": 1}]})", "objects[0]: unknown key 'radius'"},
       {R"({"synthvis": 1, "objects": [{"primitive": "sphere", "radius": -1}]})", "objects[0].radius: expected a number greater than 0, got -1"},
