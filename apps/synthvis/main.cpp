@@ -111,6 +111,7 @@ struct GeneratorArgs {
   sv::scene::TrisParams tris;
   int layers = 4;
   std::string order = "random";
+  int objects = 100;
 };
 
 void addGeneratorOptions(CLI::App* app, GeneratorArgs& g) {
@@ -119,6 +120,8 @@ void addGeneratorOptions(CLI::App* app, GeneratorArgs& g) {
   app->add_option("--depth", g.tris.depth, "tris: depth complexity (0 = whole screen)")
       ->capture_default_str();
   app->add_option("--layers", g.layers, "layers: depth complexity D")->capture_default_str();
+  app->add_option("--objects", g.objects, "freeform: number of perturbed quadrics")
+      ->capture_default_str();
   app->add_option("--order", g.order, "tris, layers: random, f2b or b2f")->capture_default_str();
   app->add_option("--seed", g.tris.seed, "generator seed")->capture_default_str();
 }
@@ -146,7 +149,6 @@ struct BenchArgs {
 
 // BENCH.md's generators that need features of later issues.
 const char* missingGenerator(const std::string& name) {
-  if (name == "freeform" || name == "freeform-one") return "free forms (issue 7)";
   if (name == "terrain") return "height fields";
   if (name == "volume") return "voxel volumes";
   if (name == "lights") return "light points";
@@ -158,8 +160,11 @@ const char* missingGenerator(const std::string& name) {
 sv::Result<sv::reference::BenchCase> generatorCase(const std::string& kind, const GeneratorArgs& g) {
   if (const char* needs = missingGenerator(kind))
     return sv::Error{"", "", fmt::format("generator '{}' needs {}, not built yet", kind, needs)};
-  if (kind != "tris" && kind != "layers" && kind != "grazing")
-    return sv::Error{"", "", fmt::format("unknown generator '{}' (tris, layers, grazing)", kind)};
+  if (kind != "tris" && kind != "layers" && kind != "grazing" && kind != "freeform" &&
+      kind != "freeform-one")
+    return sv::Error{"", "", fmt::format("unknown generator '{}' (tris, layers, grazing, freeform, "
+                                         "freeform-one)",
+                                         kind)};
   auto order = sv::scene::parseSubmitOrder(g.order);
   if (!order) return order.error();
   sv::reference::BenchCase c;
@@ -171,6 +176,8 @@ sv::Result<sv::reference::BenchCase> generatorCase(const std::string& kind, cons
   c.layers.order = order.value();
   c.layers.seed = g.tris.seed;
   c.grazing.seed = g.tris.seed;
+  c.freeform.count = g.objects;
+  c.freeform.seed = g.tris.seed;
   return c;
 }
 
@@ -195,8 +202,10 @@ int runBench(BenchArgs a) {
   if (a.scene.empty() == a.suite.empty())
     return fail({"", "", "give either a scene (a generator name or a file) or --suite quick|full"});
   if (a.renderer.empty()) a.renderer = a.suite.empty() ? "synthvis" : "both";
-  if (a.renderer != "synthvis" && a.renderer != "gl" && a.renderer != "both")
-    return fail({"", "", fmt::format("unknown renderer '{}' (synthvis, gl or both)", a.renderer)});
+  if (a.renderer != "synthvis" && a.renderer != "gl" && a.renderer != "both" &&
+      a.renderer != "sphere-trace")
+    return fail({"", "", fmt::format("unknown renderer '{}' (synthvis, gl, both or sphere-trace)",
+                                     a.renderer)});
   if (auto order = sv::scene::parseSubmitOrder(a.generator.order); !order)
     return fail(order.error());
   if (a.glAa == -1) a.glAa = a.aa >= 2 ? std::min(a.aa, 4) : 0;
@@ -212,7 +221,7 @@ int runBench(BenchArgs a) {
   } else {
     ref::BenchCase c;
     if (a.scene == "tris" || a.scene == "layers" || a.scene == "grazing" ||
-        missingGenerator(a.scene)) {
+        a.scene == "freeform" || a.scene == "freeform-one" || missingGenerator(a.scene)) {
       auto g = generatorCase(a.scene, a.generator);
       if (!g) return fail(g.error());
       c = g.value();
@@ -232,7 +241,8 @@ int runBench(BenchArgs a) {
   settings.textured = a.shade == "textured";
   settings.fog = a.fog;
   settings.synthvis = a.renderer != "gl";
-  settings.reference = a.renderer != "synthvis";
+  settings.sphereTrace = a.renderer == "sphere-trace";
+  settings.reference = a.renderer == "gl" || a.renderer == "both";
   ref::BenchRunner runner(settings);
   if (settings.reference) {
     if (sv::Status s = runner.startReference(); !s) {
@@ -414,7 +424,8 @@ int main(int argc, char** argv) {
 
   BenchArgs b;
   CLI::App* bench = app.add_subcommand("bench", "time whole frames of a benchmark scene (BENCH.md)");
-  bench->add_option("scene", b.scene, "generator (tris, layers, grazing) or scene file");
+  bench->add_option("scene", b.scene,
+                    "generator (tris, layers, grazing, freeform, freeform-one) or scene file");
   bench->add_option("--suite", b.suite, "a named suite of scenes: quick or full");
   addGeneratorOptions(bench, b.generator);
   bench->add_option("--shade", b.shade,
@@ -443,8 +454,12 @@ int main(int argc, char** argv) {
   bench->add_flag("--gl-readback", b.glReadback,
                   "count the gl reference's read-back of the image in its frame time");
   bench->add_option("--renderer", b.renderer,
-                    "synthvis, gl (Mesa llvmpipe) or both, alternating frames; default: synthvis "
-                    "for a scene, both for a suite");
+                    "synthvis, gl (Mesa llvmpipe) or both, alternating frames; sphere-trace: "
+                    "synthvis against its free forms marched in fixed steps (--march-steps); "
+                    "default: synthvis for a scene, both for a suite");
+  bench->add_option("--march-steps", b.options.marchSteps,
+                    "sphere-trace: depth steps per ray of the fixed-step marcher")
+      ->capture_default_str();
   bench->add_option("--json", b.json, "write the results as JSON to this file");
   bench->add_option("--html", b.html, "write an HTML page with plots and images to this directory");
   bench->add_option("--image", b.image, "write the last frame of the last scene to this image file");
@@ -488,7 +503,12 @@ int main(int argc, char** argv) {
     return app.exit(e) == 0 ? 0 : 2;
   }
   if (*render) return runRender(r);
-  if (*bench) return runBench(b);
+  if (*bench) {
+    // BENCH.md's freeform-one is 1024 × 1024 unless the size is given.
+    if (b.scene == "freeform-one" && bench->count("--width") == 0 && bench->count("--height") == 0)
+      b.options.width = b.options.height = 1024;
+    return runBench(b);
+  }
   if (*gen) return runGen(g);
   if (*truth) return runTruth(tr);
   if (*compare) return runCompare(compareImage, compareReference, compareEdges);

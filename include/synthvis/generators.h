@@ -62,6 +62,22 @@ struct GrazingParams {
 };
 Scene generateGrazing(const GrazingParams& params);
 
+// BENCH.md `freeform`: `count` perturbed quadrics — spheres, ellipsoids, capped cylinders and
+// capped paraboloids with 1–5 perturbations each (bumps and dents), randomly turned — spread over
+// the view 5 … 25 m away with partial overlaps, eight Phong materials, a directional light, fog.
+// No triangles: every object is a Scene::freeForms entry, ray cast (SPEC §12).
+struct FreeFormParams {
+  int count = 100;
+  uint64_t seed = 1;
+  int width = 1920;  // the aspect the objects are spread over
+  int height = 1080;
+};
+Scene generateFreeForms(const FreeFormParams& params);
+// BENCH.md `freeform-one`: a unit sphere with six R = w·Q³ perturbations on its surface,
+// alternately bumps and dents (spheres and ellipsoids), Phong-lit, seen in perspective (render it
+// at 1024 × 1024).
+Scene generateFreeFormOne();
+
 // The frame every generated scene shares: one instance of mesh 0 with material 0 (unlit,
 // double-sided, named `name`), the BENCH.md camera, no light, black background. No meshes yet.
 Scene benchCameraScene(const std::string& name);

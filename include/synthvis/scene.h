@@ -118,7 +118,10 @@ struct FreeFormNode {
   std::array<double, 10> quadric{};
   double weight = 1;  // where this node perturbs its parent: R = weight·Q³
   std::vector<FreeFormNode> perturbations;
-  int quadricCount() const;  // this node's and all its perturbations', recursively
+  // At the root only: the form is min(F', C_1, …) — cut to the insides of these plain quadrics
+  // (set-theoretic intersection, e.g. a cylinder capped by two planes).
+  std::vector<std::array<double, 10>> clips;
+  int quadricCount() const;  // this node's, its clips' and all its perturbations', recursively
 };
 
 // A free form placed in the world: rendered directly by multi-level ray casting (SPEC §12), never

@@ -2,6 +2,7 @@
 // their form in the projectively transformed view volume.
 #include "freeform/freeform.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -13,10 +14,22 @@ double FreeForm::evaluate(Vec3d p) const {
     const double v = q.evaluate(p);
     if (v > 0) f += q.weight * v * v * v;
   }
+  for (const Quadric& c : clips) f = std::min(f, c.evaluate(p));
   return f;
 }
 
 Vec3d FreeForm::gradient(Vec3d p) const {
+  if (!clips.empty()) {  // the gradient of whichever term is the minimum
+    double f = base.evaluate(p);
+    for (const FreeForm& q : perturbations) {
+      const double v = q.evaluate(p);
+      if (v > 0) f += q.weight * v * v * v;
+    }
+    const Quadric* active = nullptr;
+    for (const Quadric& c : clips)
+      if (const double v = c.evaluate(p); v < f) f = v, active = &c;
+    if (active) return active->gradient(p);
+  }
   Vec3d g = base.gradient(p);
   for (const FreeForm& q : perturbations) {
     const double v = q.evaluate(p);
@@ -29,6 +42,10 @@ Interval FreeForm::bound(Interval x, Interval y, Interval z) const {
   Interval f = base.bound(x, y, z);
   for (const FreeForm& q : perturbations)
     f = f + cube(positivePart(q.bound(x, y, z))) * q.weight;
+  for (const Quadric& c : clips) {
+    const Interval b = c.bound(x, y, z);
+    f = {std::min(f.lo, b.lo), std::min(f.hi, b.hi)};
+  }
   return f;
 }
 
@@ -53,6 +70,7 @@ std::optional<ProjectedFreeForm> ProjectedFreeForm::make(const FreeForm& form,
   ProjectedFreeForm p;
   p.inverse_ = *inverse;
   flatten(form, *inverse, p.nodes_);
+  for (const Quadric& c : form.clips) p.clips_.push_back(c.transformedByInverse(*inverse));
   return p;
 }
 
@@ -69,7 +87,9 @@ double ProjectedFreeForm::evaluate(Vec3d q) const {
   const auto& w = inverse_.m[3];
   const double u = w[0] * q.x + w[1] * q.y + w[2] * q.z + w[3];
   const double u2 = u * u;
-  return evaluateNode(0, q, 1 / (u2 * u2));
+  double h = evaluateNode(0, q, 1 / (u2 * u2));
+  for (const Quadric& c : clips_) h = std::min(h, c.evaluate(q));
+  return h;
 }
 
 Interval ProjectedFreeForm::boundNode(uint32_t i, Interval x, Interval y, Interval z,
@@ -86,9 +106,184 @@ Interval ProjectedFreeForm::bound(Interval x, Interval y, Interval z) const {
   const Interval u = x * w[0] + y * w[1] + z * w[2] + w[3];
   if (!(u.lo > 0)) return {-kInf, kInf};
   const double lo2 = u.lo * u.lo, hi2 = u.hi * u.hi;
-  const Interval h = boundNode(0, x, y, z, {1 / (hi2 * hi2), 1 / (lo2 * lo2)});
+  Interval h = boundNode(0, x, y, z, {1 / (hi2 * hi2), 1 / (lo2 * lo2)});
+  for (const Quadric& c : clips_) {
+    const Interval b = c.bound(x, y, z);
+    h = {std::min(h.lo, b.lo), std::min(h.hi, b.hi)};
+  }
   // The arithmetic rounds to nearest: widen by a few ulps of the magnitudes involved so that a
   // cell the surface passes through is never rejected.
+  const double margin = 1e-12 * (std::fabs(h.lo) + std::fabs(h.hi)) + 1e-300;
+  return {h.lo - margin, h.hi + margin};
+}
+
+void ProjectedFreeForm::boundNodeSlope(uint32_t i, Interval x, Interval y, Interval z,
+                                       Interval invU4, Interval invU5, Interval& value,
+                                       Interval& slope) const {
+  const Quadric& q = nodes_[i].q;
+  value = q.bound(x, y, z);
+  slope = z * (2 * q.c[2]) + x * q.c[4] + y * q.c[5] + q.c[8];
+  const double u1 = inverse_.m[3][2];
+  for (uint32_t c = i + 1; c < nodes_[i].end; c = nodes_[c].end) {
+    Interval v, dv;
+    boundNodeSlope(c, x, y, z, invU4, invU5, v, dv);
+    // As RayFunction::boundNodeSlope: d/dz [w·p³/u⁴] = w·(3p²·p'/u⁴ − 4p³·u'/u⁵).
+    const Interval p = positivePart(v);
+    const Interval dp = p.hi > 0 ? dv : Interval{0, 0};
+    const double w = nodes_[c].weight;
+    value = value + cube(p) * invU4 * w;
+    slope = slope + ((square(p) * dp) * invU4 * 3 + cube(p) * invU5 * (-4 * u1)) * w;
+  }
+}
+
+void ProjectedFreeForm::bound(Interval x, Interval y, Interval z, Interval& value,
+                              Interval& slope) const {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  const auto& w = inverse_.m[3];
+  const Interval u = x * w[0] + y * w[1] + z * w[2] + w[3];
+  if (!(u.lo > 0)) {
+    value = slope = {-kInf, kInf};
+    return;
+  }
+  const double lo2 = u.lo * u.lo, hi2 = u.hi * u.hi;
+  boundNodeSlope(0, x, y, z, {1 / (hi2 * hi2), 1 / (lo2 * lo2)},
+                 {1 / (hi2 * hi2 * u.hi), 1 / (lo2 * lo2 * u.lo)}, value, slope);
+  for (const Quadric& c : clips_) {
+    const Interval b = c.bound(x, y, z);
+    const Interval db = z * (2 * c.c[2]) + x * c.c[4] + y * c.c[5] + c.c[8];
+    if (b.hi < value.lo)
+      slope = db;
+    else if (b.lo <= value.hi)
+      slope = {std::min(slope.lo, db.lo), std::max(slope.hi, db.hi)};
+    value = {std::min(value.lo, b.lo), std::min(value.hi, b.hi)};
+  }
+  const double margin = 1e-12 * (std::fabs(value.lo) + std::fabs(value.hi)) + 1e-300;
+  value = {value.lo - margin, value.hi + margin};
+  const double slopeMargin = 1e-12 * (std::fabs(slope.lo) + std::fabs(slope.hi)) + 1e-300;
+  slope = {slope.lo - slopeMargin, slope.hi + slopeMargin};
+}
+
+namespace {
+// The quadric at fixed (x, y) as a·z² + b·z + c.
+void alongZ(const Quadric& q, double x, double y, double& a, double& b, double& c) {
+  const auto& k = q.c;
+  a = k[2];
+  b = k[4] * x + k[5] * y + k[8];
+  c = (k[0] * x + k[3] * y + k[6]) * x + (k[1] * y + k[7]) * y + k[9];
+}
+// The exact range of a·z² + b·z + c over Z.
+Interval quadraticOver(double a, double b, double c, Interval z) {
+  auto f = [&](double t) { return (a * t + b) * t + c; };
+  double lo = std::min(f(z.lo), f(z.hi)), hi = std::max(f(z.lo), f(z.hi));
+  if (a != 0) {
+    const double v = -b / (2 * a);
+    if (v > z.lo && v < z.hi) {
+      lo = std::min(lo, f(v));
+      hi = std::max(hi, f(v));
+    }
+  }
+  return {lo, hi};
+}
+}  // namespace
+
+void ProjectedFreeForm::ray(double x, double y, RayFunction& out) const {
+  out.nodes_.resize(nodes_.size());
+  for (size_t i = 0; i < nodes_.size(); ++i) {
+    RayFunction::Node& n = out.nodes_[i];
+    alongZ(nodes_[i].q, x, y, n.a, n.b, n.c);
+    n.weight = nodes_[i].weight;
+    n.end = nodes_[i].end;
+  }
+  out.clips_.resize(clips_.size());
+  for (size_t i = 0; i < clips_.size(); ++i) {
+    RayFunction::Node& n = out.clips_[i];
+    alongZ(clips_[i], x, y, n.a, n.b, n.c);
+    n.weight = 1;
+    n.end = 0;
+  }
+  const auto& w = inverse_.m[3];
+  out.u0_ = w[0] * x + w[1] * y + w[3];
+  out.u1_ = w[2];
+}
+
+double RayFunction::evaluateNode(uint32_t i, double z, double invU4) const {
+  const Node& n = nodes_[i];
+  double h = (n.a * z + n.b) * z + n.c;
+  for (uint32_t c = i + 1; c < n.end; c = nodes_[c].end) {
+    const double v = evaluateNode(c, z, invU4);
+    if (v > 0) h += nodes_[c].weight * v * v * v * invU4;
+  }
+  return h;
+}
+
+double RayFunction::evaluate(double z) const {
+  const double u = u0_ + u1_ * z, u2 = u * u;
+  double h = evaluateNode(0, z, 1 / (u2 * u2));
+  for (const Node& c : clips_) h = std::min(h, (c.a * z + c.b) * z + c.c);
+  return h;
+}
+
+Interval RayFunction::boundNode(uint32_t i, Interval z, Interval invU4) const {
+  const Node& n = nodes_[i];
+  Interval h = quadraticOver(n.a, n.b, n.c, z);
+  for (uint32_t c = i + 1; c < n.end; c = nodes_[c].end)
+    h = h + cube(positivePart(boundNode(c, z, invU4))) * invU4 * nodes_[c].weight;
+  return h;
+}
+
+void RayFunction::boundNodeSlope(uint32_t i, Interval z, Interval invU4, Interval invU5,
+                                 Interval& value, Interval& slope) const {
+  const Node& n = nodes_[i];
+  value = quadraticOver(n.a, n.b, n.c, z);
+  slope = z * (2 * n.a) + n.b;
+  for (uint32_t c = i + 1; c < n.end; c = nodes_[c].end) {
+    Interval v, dv;
+    boundNodeSlope(c, z, invU4, invU5, v, dv);
+    // d/dz [w·p³/u⁴] = w·(3p²·p'/u⁴ − 4p³·u'/u⁵), p = max(0, v), u' = u1.
+    const Interval p = positivePart(v);
+    const Interval dp = p.hi > 0 ? dv : Interval{0, 0};
+    const double w = nodes_[c].weight;
+    value = value + cube(p) * invU4 * w;
+    slope = slope + ((square(p) * dp) * invU4 * 3 + cube(p) * invU5 * (-4 * u1_)) * w;
+  }
+}
+
+void RayFunction::bound(double z0, double z1, Interval& value, Interval& slope) const {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  const Interval u = Interval{z0, z1} * u1_ + u0_;
+  if (!(u.lo > 0)) {
+    value = slope = {-kInf, kInf};
+    return;
+  }
+  const double lo2 = u.lo * u.lo, hi2 = u.hi * u.hi;
+  boundNodeSlope(0, {z0, z1}, {1 / (hi2 * hi2), 1 / (lo2 * lo2)},
+                 {1 / (hi2 * hi2 * u.hi), 1 / (lo2 * lo2 * u.lo)}, value, slope);
+  for (const Node& c : clips_) {
+    const Interval b = quadraticOver(c.a, c.b, c.c, {z0, z1});
+    const Interval db = Interval{z0, z1} * (2 * c.a) + c.b;
+    if (b.hi < value.lo) {  // the clip is the minimum throughout
+      slope = db;
+    } else if (b.lo <= value.hi) {  // either may be: both slopes
+      slope = {std::min(slope.lo, db.lo), std::max(slope.hi, db.hi)};
+    }
+    value = {std::min(value.lo, b.lo), std::min(value.hi, b.hi)};
+  }
+  const double margin = 1e-12 * (std::fabs(value.lo) + std::fabs(value.hi)) + 1e-300;
+  value = {value.lo - margin, value.hi + margin};
+  const double slopeMargin = 1e-12 * (std::fabs(slope.lo) + std::fabs(slope.hi)) + 1e-300;
+  slope = {slope.lo - slopeMargin, slope.hi + slopeMargin};
+}
+
+Interval RayFunction::bound(double z0, double z1) const {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  const Interval u = Interval{z0, z1} * u1_ + u0_;
+  if (!(u.lo > 0)) return {-kInf, kInf};
+  const double lo2 = u.lo * u.lo, hi2 = u.hi * u.hi;
+  Interval h = boundNode(0, {z0, z1}, {1 / (hi2 * hi2), 1 / (lo2 * lo2)});
+  for (const Node& c : clips_) {
+    const Interval b = quadraticOver(c.a, c.b, c.c, {z0, z1});
+    h = {std::min(h.lo, b.lo), std::min(h.hi, b.hi)};
+  }
   const double margin = 1e-12 * (std::fabs(h.lo) + std::fabs(h.hi)) + 1e-300;
   return {h.lo - margin, h.hi + margin};
 }

@@ -22,9 +22,14 @@ struct FreeForm {
   Quadric base;
   double weight = 1;  // w of this form where it perturbs another (unused at the root)
   std::vector<FreeForm> perturbations;
+  // Set-theoretic intersection (issue 7's documented extension; at the root only): the form is
+  // min(F', C_1, …, C_k) — its inside cut to the insides of these plain quadrics, e.g. a cylinder
+  // capped by two half-spaces. Empty: F' alone.
+  std::vector<Quadric> clips;
 
   double evaluate(Vec3d p) const;
-  Vec3d gradient(Vec3d p) const;  // analytic: ∇F + Σ 3·w_i·max(0, Q_i)²·∇Q_i
+  // Analytic: ∇F + Σ 3·w_i·max(0, Q_i)²·∇Q_i, or the gradient of the clip that is the minimum.
+  Vec3d gradient(Vec3d p) const;
   // A range containing F' over the box (Q³ bounded through Q's bound).
   Interval bound(Interval x, Interval y, Interval z) const;
   int quadricCount() const;  // base and every perturbation, recursively
@@ -36,6 +41,34 @@ struct FreeForm {
 // not commute with the cube of a perturbation; so the function cast is
 //   H(q) = u(q)²·F'(p(q)) = F_M(q) + Σ_i w_i·max(0, H_i(q))³ / u(q)⁴,
 // recursively — the same surface and inside wherever u > 0 (in front of the eye).
+class ProjectedFreeForm;
+
+// H along one ray of the cube — x and y fixed, z free — where every quadric is a quadratic in z and
+// u is linear: evaluation costs a few operations per quadric, and bounds over a z interval are
+// exact per quadric (quadraticRange). Built by ProjectedFreeForm::ray; reused from ray to ray.
+class RayFunction {
+ public:
+  double evaluate(double z) const;
+  Interval bound(double z0, double z1) const;  // contains H over [z0, z1], widened for rounding
+  // The same bound, and one of dH/dz over [z0, z1]: where the slope excludes 0, H is monotonic
+  // there and has at most one zero.
+  void bound(double z0, double z1, Interval& value, Interval& slope) const;
+
+ private:
+  friend class ProjectedFreeForm;
+  struct Node {
+    double a, b, c, weight;  // the quadric a·z² + b·z + c; its weight as a perturbation
+    uint32_t end;            // as ProjectedFreeForm::Node
+  };
+  double evaluateNode(uint32_t i, double z, double invU4) const;
+  Interval boundNode(uint32_t i, Interval z, Interval invU4) const;
+  void boundNodeSlope(uint32_t i, Interval z, Interval invU4, Interval invU5, Interval& value,
+                      Interval& slope) const;
+  std::vector<Node> nodes_;
+  std::vector<Node> clips_;
+  double u0_ = 1, u1_ = 0;  // u(z) = u0 + u1·z
+};
+
 class ProjectedFreeForm {
  public:
   // Nothing when M is singular.
@@ -45,7 +78,12 @@ class ProjectedFreeForm {
   // A range containing H over the box, widened for the rounding of its double arithmetic;
   // everything (−∞, ∞) where the box reaches u ≤ 0 (behind the eye).
   Interval bound(Interval x, Interval y, Interval z) const;
+  // The same bound, and one of ∂H/∂z over the box: where that excludes 0, every ray (x, y) of the
+  // box meets the surface at most once in it.
+  void bound(Interval x, Interval y, Interval z, Interval& value, Interval& slopeZ) const;
   Vec3d toObject(Vec3d q) const { return inverse_.transformPoint(q); }
+  // H along the ray (x, y) of the cube, into `out` (its storage reused).
+  void ray(double x, double y, RayFunction& out) const;
   const Mat4d& inverse() const { return inverse_; }
 
  private:
@@ -57,9 +95,12 @@ class ProjectedFreeForm {
   };
   double evaluateNode(uint32_t i, Vec3d q, double invU4) const;
   Interval boundNode(uint32_t i, Interval x, Interval y, Interval z, Interval invU4) const;
+  void boundNodeSlope(uint32_t i, Interval x, Interval y, Interval z, Interval invU4,
+                      Interval invU5, Interval& value, Interval& slope) const;
   static void flatten(const FreeForm& form, const Mat4d& inverse, std::vector<Node>& out);
 
   std::vector<Node> nodes_;
+  std::vector<Quadric> clips_;  // transformed like the nodes: min(H, u²·C_k) = u²·min(F', C_k)
   Mat4d inverse_;
 };
 

@@ -142,21 +142,6 @@ std::optional<Mat4d> projectiveFromFivePoints(const std::array<Vec3d, 5>& src,
   return *b * *aInv;
 }
 
-Interval operator*(Interval a, Interval b) {
-  const double p[4] = {a.lo * b.lo, a.lo * b.hi, a.hi * b.lo, a.hi * b.hi};
-  return {std::min({p[0], p[1], p[2], p[3]}), std::max({p[0], p[1], p[2], p[3]})};
-}
-
-Interval square(Interval a) {
-  const double l = a.lo * a.lo, h = a.hi * a.hi;
-  if (a.lo <= 0 && a.hi >= 0) return {0, std::max(l, h)};
-  return {std::min(l, h), std::max(l, h)};
-}
-
-Interval cube(Interval a) { return {a.lo * a.lo * a.lo, a.hi * a.hi * a.hi}; }
-
-Interval positivePart(Interval a) { return {std::max(a.lo, 0.0), std::max(a.hi, 0.0)}; }
-
 Quadric Quadric::sphere(Vec3d centre, double radius) {
   return ellipsoid(centre, {radius, radius, radius});
 }

@@ -11,6 +11,7 @@
 // whatever its size, so a perturbation's weight sets its height the same way for any radius.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <optional>
 
@@ -63,11 +64,19 @@ struct Interval {
   friend Interval operator*(Interval a, double s) {
     return s >= 0 ? Interval{a.lo * s, a.hi * s} : Interval{a.hi * s, a.lo * s};
   }
-  friend Interval operator*(Interval a, Interval b);
+  friend Interval operator*(Interval a, Interval b) {
+    const double p0 = a.lo * b.lo, p1 = a.lo * b.hi, p2 = a.hi * b.lo, p3 = a.hi * b.hi;
+    return {std::min(std::min(p0, p1), std::min(p2, p3)), std::max(std::max(p0, p1), std::max(p2, p3))};
+  }
 };
-Interval square(Interval a);  // exact: [0, …] when a contains 0
-Interval cube(Interval a);    // monotonic
-Interval positivePart(Interval a);  // max(0, a)
+// Exact: [0, …] when a contains 0.
+inline Interval square(Interval a) {
+  const double l = a.lo * a.lo, h = a.hi * a.hi;
+  if (a.lo <= 0 && a.hi >= 0) return {0, std::max(l, h)};
+  return {std::min(l, h), std::max(l, h)};
+}
+inline Interval cube(Interval a) { return {a.lo * a.lo * a.lo, a.hi * a.hi * a.hi}; }  // monotonic
+inline Interval positivePart(Interval a) { return {std::max(a.lo, 0.0), std::max(a.hi, 0.0)}; }
 
 // F(x, y, z) = Ax² + By² + Cz² + Dxy + Exz + Fyz + Gx + Hy + Iz + K: coefficients in this order.
 struct Quadric {

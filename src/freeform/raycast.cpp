@@ -17,18 +17,28 @@ double windowDepth(double z) { return 0.5 * (z + 1); }
 
 bool inside(double h) { return h >= 0; }
 
-// Step 3 of a pixel: a bracket [a, b] of the ray where H changes sign (inside(H(a)) ≠ inside(H(b)))
-// narrowed by bisection until its ends are adjacent doubles (at most 64 halvings of [−1, 1]); the
-// end on the near side of the crossing is returned, so the hit is never behind the surface.
-double refineBracket(const ProjectedFreeForm& f, double x, double y, double a, double b) {
-  const bool insideA = inside(f.evaluate({x, y, a}));
-  for (int i = 0; i < 80; ++i) {
-    const double m = 0.5 * (a + b);
-    if (!(m > a && m < b)) break;
-    if (inside(f.evaluate({x, y, m})) == insideA)
-      a = m;
-    else
-      b = m;
+// Step 3 of a pixel: a bracket [a, b] of the ray where H changes sign (inside(fa) ≠ inside(fb)),
+// narrowed by the Illinois variant of regula falsi (superlinear; the retained end's value halved
+// when the same end moves twice) until its ends are within a few ulps; the end on the near side
+// of the crossing is returned, so the hit is never behind the surface.
+double refineBracket(const RayFunction& f, double a, double b, double fa, double fb) {
+  const bool insideA = inside(fa);
+  int side = 0;
+  for (int i = 0; i < 100; ++i) {
+    if (b - a <= 4e-16 * std::max(1.0, std::fabs(a))) break;
+    double c = fb != fa ? b - fb * (b - a) / (fb - fa) : 0.5 * (a + b);
+    if (!(c > a && c < b)) c = 0.5 * (a + b);
+    if (!(c > a && c < b)) break;
+    const double fc = f.evaluate(c);
+    if (inside(fc) == insideA) {
+      a = c, fa = fc;
+      if (side == -1) fb *= 0.5;
+      side = -1;
+    } else {
+      b = c, fb = fc;
+      if (side == 1) fa *= 0.5;
+      side = 1;
+    }
   }
   return a;
 }
@@ -37,6 +47,9 @@ double refineBracket(const ProjectedFreeForm& f, double x, double y, double a, d
 // change holds an even number of zeros this close together — a ray grazing the surface within
 // ~1e-4 of a pixel at 1080p — and is taken as a miss.
 constexpr double kBracket = 0x1p-16;
+
+// Windows of 2^kRayLevel pixels and less are cast ray by ray.
+constexpr int kRayLevel = 2;
 
 class Caster {
  public:
@@ -89,50 +102,98 @@ class Caster {
     }
     const Interval x{cubeX(gx0, w_.width, w_.offsetX), cubeX(gx1, w_.width, w_.offsetX)};
     const Interval y{cubeY(gy1, w_.height, w_.offsetY), cubeY(gy0, w_.height, w_.offsetY)};
-    if (level == 0) return pixel(lx, ly, x.lo, y.lo, zlo, zhi);
-    // Step 2: the binary tree in depth, three levels deep: the first and the last of eight slabs
-    // whose bound may hold the surface narrow the children's depth range.
+    // Small windows: every pixel's own ray (RayFunction) is cheaper than bounding the window's
+    // 2×2 and 1×1 subwindows in x, y and z (measured: levels 1 and 2 were 2.5 of the ~2.7 window
+    // bounds per pixel on BENCH.md's freeform).
+    if (level <= kRayLevel) {
+      // A window where ∂H/∂z keeps its sign meets each of its rays at most once: the ends of
+      // each ray's span decide, and the crossing is refined directly.
+      Interval value, slope;
+      ++stats_.depthTests;
+      form_.bound(x, y, {zlo, zhi}, value, slope);
+      if (!value.containsZero()) return;
+      if (!slope.containsZero()) {
+        for (int py = 0; py < n && gy0 + py <= gy1; ++py)
+          for (int px = 0; px < n && gx0 + px <= gx1; ++px)
+            simplePixel(lx + px, ly + py, cubeX(gx0 + px, w_.width, w_.offsetX),
+                        cubeY(gy0 + py, w_.height, w_.offsetY), zlo, zhi);
+        return;
+      }
+      for (int py = 0; py < n && gy0 + py <= gy1; ++py)
+        for (int px = 0; px < n && gx0 + px <= gx1; ++px)
+          pixel(lx + px, ly + py, cubeX(gx0 + px, w_.width, w_.offsetX),
+                cubeY(gy0 + py, w_.height, w_.offsetY), zlo, zhi);
+      return;
+    }
+    // Step 2: the binary tree in depth, three levels deep: of eight slabs, those whose bound may
+    // hold the surface. Runs of such slabs are separate depth ranges — a solid's front and back
+    // surfaces, with its inside (H > 0 throughout) between them — taken front to back, so that
+    // once the front one has filled the window, masking drops the back one whole.
     constexpr int kSlabs = 8;
-    int first = -1, last = -1;
+    bool holds[kSlabs];
     for (int s = 0; s < kSlabs; ++s) {
       const double z0 = zlo + (zhi - zlo) * s / kSlabs, z1 = zlo + (zhi - zlo) * (s + 1) / kSlabs;
-      if (!boundOf(x, y, z0, z1).containsZero()) continue;
-      if (first < 0) first = s;
-      last = s;
+      holds[s] = boundOf(x, y, z0, z1).containsZero();
     }
-    if (first < 0) return;
-    const double nlo = zlo + (zhi - zlo) * first / kSlabs;
-    const double nhi = last + 1 == kSlabs ? zhi : zlo + (zhi - zlo) * (last + 1) / kSlabs;
-    // Step 3: the four children.
     const int h = n / 2;
-    for (int c = 0; c < 4; ++c) cell(level - 1, lx + (c & 1) * h, ly + (c >> 1) * h, nlo, nhi);
+    for (int s = 0; s < kSlabs;) {
+      if (!holds[s]) {
+        ++s;
+        continue;
+      }
+      int e = s + 1;
+      while (e < kSlabs && holds[e]) ++e;
+      const double nlo = zlo + (zhi - zlo) * s / kSlabs;
+      const double nhi = e == kSlabs ? zhi : zlo + (zhi - zlo) * e / kSlabs;
+      // Step 3: the four children, in this range.
+      for (int c = 0; c < 4; ++c) cell(level - 1, lx + (c & 1) * h, ly + (c >> 1) * h, nlo, nhi);
+      s = e;
+    }
   }
 
-  // One pixel's ray: the first zero of H in [zlo, zhi] nearer than the depth it holds, by binary
-  // subdivision front to back down to kBracket, then bisection of the first bracket.
+  // One pixel's ray: the first zero of H in [zlo, zhi] nearer than the depth it holds — the binary
+  // tree in depth on the ray's own function (RayFunction: exact per-quadric bounds), front to
+  // back; a span where H is monotonic (its slope bound excludes 0) holds at most one zero, found
+  // by refineBracket when its ends differ in sign; others are halved down to kBracket.
   void pixel(int lx, int ly, double x, double y, double zlo, double zhi) {
     ++stats_.pixels;
     const size_t at = size_t(ly) * size_t(w_.stride) + size_t(lx);
     zhi = std::min(zhi, 2.0 * double(w_.depth[at]) - 1);
     if (!(zlo < zhi)) return;
+    form_.ray(x, y, ray_);
     struct Span {
       double a, b;
     };
     Span stack[80];
     int n = 0;
     stack[n++] = {zlo, zhi};
-    const Interval px = Interval::point(x), py = Interval::point(y);
     while (n > 0) {
       const Span s = stack[--n];
-      if (!boundOf(px, py, s.a, s.b).containsZero()) continue;
-      if (s.b - s.a <= kBracket || n + 2 > 80) {
-        if (inside(form_.evaluate({x, y, s.a})) == inside(form_.evaluate({x, y, s.b}))) continue;
-        return hit(lx, ly, at, refineBracket(form_, x, y, s.a, s.b));
+      Interval value, slope;
+      ++stats_.depthTests;
+      ray_.bound(s.a, s.b, value, slope);
+      if (!value.containsZero()) continue;
+      const bool monotonic = !slope.containsZero();
+      if (monotonic || s.b - s.a <= kBracket || n + 2 > 80) {
+        const double fa = ray_.evaluate(s.a), fb = ray_.evaluate(s.b);
+        if (inside(fa) == inside(fb)) continue;  // monotonic: no zero; else a touch, a miss
+        return hit(lx, ly, at, refineBracket(ray_, s.a, s.b, fa, fb));
       }
       const double m = 0.5 * (s.a + s.b);
       stack[n++] = {m, s.b};  // the far half waits
       stack[n++] = {s.a, m};
     }
+  }
+
+  // A ray with at most one crossing in [zlo, zhi] (the window's slope bound says so).
+  void simplePixel(int lx, int ly, double x, double y, double zlo, double zhi) {
+    ++stats_.pixels;
+    const size_t at = size_t(ly) * size_t(w_.stride) + size_t(lx);
+    zhi = std::min(zhi, 2.0 * double(w_.depth[at]) - 1);
+    if (!(zlo < zhi)) return;
+    form_.ray(x, y, ray_);
+    const double fa = ray_.evaluate(zlo), fb = ray_.evaluate(zhi);
+    if (inside(fa) != inside(fb)) hit(lx, ly, at, refineBracket(ray_, zlo, zhi, fa, fb));
   }
 
   void hit(int lx, int ly, size_t at, double z) {
@@ -153,6 +214,7 @@ class Caster {
   CastStats& stats_;
   int top_ = 0;
   std::vector<std::vector<float>> zmax_;  // [level][y · (size >> level) + x]
+  RayFunction ray_;  // the current pixel's
 };
 
 }  // namespace
@@ -164,6 +226,7 @@ void castWindow(const ProjectedFreeForm& form, uint32_t id, const CastWindow& wi
 
 void marchWindow(const ProjectedFreeForm& form, uint32_t id, const CastWindow& window, int steps,
                  CastStats& stats) {
+  RayFunction ray;
   for (int ly = 0; ly < window.size && window.y0 + ly < window.height; ++ly)
     for (int lx = 0; lx < window.size && window.x0 + lx < window.width; ++lx) {
       ++stats.pixels;
@@ -171,13 +234,13 @@ void marchWindow(const ProjectedFreeForm& form, uint32_t id, const CastWindow& w
       const double x = cubeX(window.x0 + lx, window.width, window.offsetX);
       const double y = cubeY(window.y0 + ly, window.height, window.offsetY);
       const double zEnd = std::min(1.0, 2.0 * double(window.depth[at]) - 1);
-      double a = -1;
-      bool insideA = inside(form.evaluate({x, y, a}));
+      form.ray(x, y, ray);
+      double a = -1, fa = ray.evaluate(a);
       for (int i = 1; i <= steps && a < zEnd; ++i) {
         const double b = std::min(zEnd, -1 + 2.0 * i / steps);
-        const bool insideB = inside(form.evaluate({x, y, b}));
-        if (insideB != insideA) {
-          const double z = refineBracket(form, x, y, a, b);
+        const double fb = ray.evaluate(b);
+        if (inside(fb) != inside(fa)) {
+          const double z = refineBracket(ray, a, b, fa, fb);
           const float d = float(windowDepth(z));
           if (d < window.depth[at]) {
             ++stats.hits;
@@ -187,7 +250,7 @@ void marchWindow(const ProjectedFreeForm& form, uint32_t id, const CastWindow& w
           }
           break;
         }
-        a = b;
+        a = b, fa = fb;
       }
     }
 }

@@ -51,9 +51,24 @@ void FreeFormFrame::prepare(std::vector<ShadedForm> forms, int width, int height
   tilesX_ = (width + kTileSize - 1) / kTileSize;
   tilesY_ = (height + kTileSize - 1) / kTileSize;
   tileForms_.assign(size_t(tilesX_) * size_t(tilesY_), {});
+  tileNearest_.assign(tileForms_.size(), {});
   int size = kTileSize;
   while (size < width || size < height) size *= 2;
   for (uint32_t f = 0; f < forms_.size(); ++f) markTiles(f, 0, 0, size, -1, 1);
+  // Nearest first; ties in the order of the scene (stable), so the frame never depends on more
+  // than the scene.
+  for (size_t t = 0; t < tileForms_.size(); ++t) {
+    std::vector<uint32_t>& list = tileForms_[t];
+    const std::vector<double>& nearest = tileNearest_[t];
+    std::vector<uint32_t> order(list.size());
+    for (uint32_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(),
+                     [&](uint32_t a, uint32_t b) { return nearest[a] < nearest[b]; });
+    std::vector<uint32_t> sorted(list.size());
+    for (size_t i = 0; i < order.size(); ++i) sorted[i] = list[order[i]];
+    list = std::move(sorted);
+  }
+  tileNearest_.clear();
 }
 
 // Step 0 of a frame, per form: the screen quadtree from the whole raster down to tiles, with the
@@ -74,7 +89,9 @@ void FreeFormFrame::markTiles(uint32_t f, int x0, int y0, int size, double zlo, 
   }
   if (first < 0) return;
   if (size == kTileSize) {
-    tileForms_[size_t(y0 / kTileSize) * size_t(tilesX_) + size_t(x0 / kTileSize)].push_back(f);
+    const size_t t = size_t(y0 / kTileSize) * size_t(tilesX_) + size_t(x0 / kTileSize);
+    tileForms_[t].push_back(f);
+    tileNearest_[t].push_back(zlo + (zhi - zlo) * first / kSlabs);
     return;
   }
   const double nlo = zlo + (zhi - zlo) * first / kSlabs;

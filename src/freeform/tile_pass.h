@@ -61,7 +61,10 @@ class FreeFormFrame {
   const shade::Environment* environment_ = nullptr;
   CastSettings settings_;
   int marchSteps_ = 0;  // > 0: the fixed-step marcher instead of the caster (the baseline)
-  std::vector<std::vector<uint32_t>> tileForms_;  // per tile, the forms it casts, in order
+  // Per tile, the forms it casts, nearest first (by the nearest depth their bounds allow in the
+  // tile), so that masking drops what nearer forms hide.
+  std::vector<std::vector<uint32_t>> tileForms_;
+  std::vector<std::vector<double>> tileNearest_;  // while preparing: each listed form's nearest z
 };
 
 }  // namespace sv::freeform

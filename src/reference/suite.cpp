@@ -105,6 +105,18 @@ Result<CaseScene> makeScene(const BenchCase& c, const RenderOptions& options) {
     out.scene = scene::generateGrazing(c.grazing);
     out.params = {{"seed", c.grazing.seed}};
     return out;  // no target area or depth complexity to report
+  } else if (c.generator == "freeform") {
+    scene::FreeFormParams f = c.freeform;
+    if (f.count < 0 || f.count > 100000) return Error{"", "", "freeform: objects must be 0…100000"};
+    f.width = options.width;
+    f.height = options.height;
+    out.scene = scene::generateFreeForms(f);
+    out.params = {{"objects", f.count}, {"seed", f.seed}};
+    return out;
+  } else if (c.generator == "freeform-one") {
+    out.scene = scene::generateFreeFormOne();
+    out.params = {{"objects", 1}, {"perturbations", 6}};
+    return out;
   } else if (c.generator.empty()) {
     auto loaded = scene::loadScene(c.file);
     if (!loaded) return loaded.error();
@@ -161,7 +173,18 @@ Result<CaseResult> BenchRunner::run(const BenchCase& c) {
   std::optional<RendererRun> ours, ref;
   if (s.synthvis) ours = RendererRun{"synthvis", "synthvis", {}, 0, 0, 0, {}, {}};
   Renderer renderer(s.options);
-  if (impl_->gl) {
+  RenderOptions marchOptions = s.options;
+  marchOptions.freeFormMethod = RenderOptions::FreeFormMethod::march;
+  std::optional<Renderer> marcher;
+  if (s.sphereTrace) marcher.emplace(marchOptions);
+  if (s.sphereTrace) {
+    ref = RendererRun{"sphere-trace",
+                      fmt::format("synthvis, free forms marched in {} steps", s.options.marchSteps),
+                      {}, 0, 0, 0, {}, {}};
+  } else if (impl_->gl) {
+    if (!sc.freeForms.empty())
+      return Error{"", "", "the gl reference draws triangles only: compare a scene with free forms "
+                           "with --renderer sphere-trace"};
     if (Status st = impl_->gl->load(sc); !st) return st.error();
     ref = RendererRun{"gl", impl_->glDescription, {}, 0, 0, 0, {}, {}};
   }
@@ -173,7 +196,12 @@ Result<CaseResult> BenchRunner::run(const BenchCase& c) {
       const double ms = msSince(t0);
       if (i >= s.warmup) ours->frameMs.push_back(ms);
     }
-    if (ref) {
+    if (ref && s.sphereTrace) {
+      const auto t0 = Clock::now();
+      if (Status st = marcher->render(sc, ref->image, &ref->stats); !st) return st.error();
+      const double ms = msSince(t0);
+      if (i >= s.warmup) ref->frameMs.push_back(ms);
+    } else if (ref) {
       const auto t0 = Clock::now();
       if (Status st = impl_->gl->render(); !st) return st.error();
       if (s.referenceReadback)
@@ -188,7 +216,8 @@ Result<CaseResult> BenchRunner::run(const BenchCase& c) {
   }
   if (ref) {
     finish(*ref);
-    if (Status st = impl_->gl->readImage(ref->image); !st) return st.error();
+    if (!s.sphereTrace)
+      if (Status st = impl_->gl->readImage(ref->image); !st) return st.error();
     if (!r.runs.empty()) r.psnrDb = psnr(r.runs[0].image, ref->image);
     r.runs.push_back(std::move(*ref));
   }

@@ -19,10 +19,11 @@ namespace sv::reference {
 // A scene to time: a generator with its parameters, or a scene file.
 struct BenchCase {
   std::string name;       // e.g. "tris-100k-a10", or the file's path
-  std::string generator;  // "tris", "layers", "grazing", or empty for a file
+  std::string generator;  // "tris", "layers", "grazing", "freeform", "freeform-one", or empty
   scene::TrisParams tris;
   scene::LayersParams layers;
   scene::GrazingParams grazing;
+  scene::FreeFormParams freeform;
   std::string file;
 };
 
@@ -64,6 +65,10 @@ struct BenchSettings {
   int referenceMsaa = 0;
   bool synthvis = true;   // time synthvis
   bool reference = true;  // time the gl reference (after startReference)
+  // Time, instead of the gl reference, synthvis with free forms marched in fixed steps (options.
+  // marchSteps; RenderOptions::FreeFormMethod::march) — issue 7's sphere-tracing baseline, renderer
+  // name "sphere-trace".
+  bool sphereTrace = false;
   // Count the gl reference's read-back (glReadPixels into an 8-bit image in memory) in its frame
   // time: synthvis's frame always ends with the image in memory.
   bool referenceReadback = false;

@@ -197,6 +197,7 @@ freeform::FreeForm toFreeForm(const scene::FreeFormNode& n) {
   f.base.c = n.quadric;
   f.weight = n.weight;
   for (const scene::FreeFormNode& p : n.perturbations) f.perturbations.push_back(toFreeForm(p));
+  for (const auto& c : n.clips) f.clips.push_back(freeform::Quadric{c});
   return f;
 }
 
@@ -273,6 +274,8 @@ Status validate(const RenderOptions& o) {
     return Error{"", "", "a debug view cannot be filtered"};
   if (o.debugView == RenderOptions::DebugView::occupancy && o.hsr == RenderOptions::Hsr::zbuffer)
     return Error{"", "", "the occupancy view shows masking: use --hsr priority or hybrid"};
+  if (o.marchSteps < 1 || o.marchSteps > 1000000)
+    return Error{"", "", fmt::format("{} march steps is out of range (1…1000000)", o.marchSteps)};
   if (o.gamma != 0 && !(o.gamma >= 0.5 && o.gamma <= 5))
     return Error{"", "", fmt::format("gamma {} is out of range (0.5…5, or 0 for sRGB)", o.gamma)};
   return {};

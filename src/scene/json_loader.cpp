@@ -795,10 +795,10 @@ FreeFormNode SceneReader::readFreeForm(const Json& v, const std::string& where, 
   FreeFormNode node;
   Quadric q;
   if (kind == "sphere") {
-    expectKeys(v, where, {"quadric", "weight", "perturbations", "center", "radius"});
+    expectKeys(v, where, {"quadric", "weight", "perturbations", "clip", "center", "radius"});
     q = Quadric::sphere(vecOr("center", {}, false), positiveOr("radius", 1));
   } else if (kind == "ellipsoid") {
-    expectKeys(v, where, {"quadric", "weight", "perturbations", "center", "radii"});
+    expectKeys(v, where, {"quadric", "weight", "perturbations", "clip", "center", "radii"});
     Vec3d radii{1, 1, 1};
     if (const Json* x = find(v, "radii")) {
       const auto r = sizes<3>(*x, member(where, "radii"));
@@ -806,11 +806,11 @@ FreeFormNode SceneReader::readFreeForm(const Json& v, const std::string& where, 
     }
     q = Quadric::ellipsoid(vecOr("center", {}, false), radii);
   } else if (kind == "cylinder") {
-    expectKeys(v, where, {"quadric", "weight", "perturbations", "point", "axis", "radius"});
+    expectKeys(v, where, {"quadric", "weight", "perturbations", "clip", "point", "axis", "radius"});
     q = Quadric::cylinder(vecOr("point", {}, false), vecOr("axis", {0, 1, 0}, true),
                           positiveOr("radius", 1));
   } else if (kind == "cone") {
-    expectKeys(v, where, {"quadric", "weight", "perturbations", "apex", "axis", "angle"});
+    expectKeys(v, where, {"quadric", "weight", "perturbations", "clip", "apex", "axis", "angle"});
     double angle = 30;
     if (const Json* x = find(v, "angle")) {
       angle = number(*x, member(where, "angle"));
@@ -820,16 +820,16 @@ FreeFormNode SceneReader::readFreeForm(const Json& v, const std::string& where, 
     q = Quadric::cone(vecOr("apex", {}, false), vecOr("axis", {0, 1, 0}, true),
                       angle * std::numbers::pi / 180);
   } else if (kind == "paraboloid") {
-    expectKeys(v, where, {"quadric", "weight", "perturbations", "vertex", "axis", "k"});
+    expectKeys(v, where, {"quadric", "weight", "perturbations", "clip", "vertex", "axis", "k"});
     q = Quadric::paraboloid(vecOr("vertex", {}, false), vecOr("axis", {0, 1, 0}, true),
                             positiveOr("k", 1));
   } else if (kind == "plane") {
-    expectKeys(v, where, {"quadric", "weight", "perturbations", "normal", "d"});
+    expectKeys(v, where, {"quadric", "weight", "perturbations", "clip", "normal", "d"});
     const Json* d = find(v, "d");
     q = Quadric::halfSpace(vecOr("normal", {0, 1, 0}, true),
                            d ? double(number(*d, member(where, "d"))) : 0.0);
   } else if (kind == "general") {
-    expectKeys(v, where, {"quadric", "weight", "perturbations", "coefficients"});
+    expectKeys(v, where, {"quadric", "weight", "perturbations", "clip", "coefficients"});
     const Json* c = find(v, "coefficients");
     if (!c) fail(where, "missing key 'coefficients' (A … K, 10 numbers)");
     const auto a = numbers<10>(*c, member(where, "coefficients"));
@@ -844,6 +844,17 @@ FreeFormNode SceneReader::readFreeForm(const Json& v, const std::string& where, 
   if (const Json* w = find(v, "weight")) {
     if (root) fail(member(where, "weight"), "'weight' belongs to perturbations, not the base quadric");
     node.weight = number(*w, member(where, "weight"));
+  }
+  if (const Json* clips = find(v, "clip")) {
+    const std::string clipWhere = member(where, "clip");
+    if (!root) fail(clipWhere, "'clip' belongs to the base quadric of a free form");
+    const Json& a = array(*clips, clipWhere);
+    for (size_t i = 0; i < a.size(); ++i) {
+      const std::string w = element(clipWhere, i);
+      if (a[i].is_object() && (find(a[i], "perturbations") || find(a[i], "weight") || find(a[i], "clip")))
+        fail(w, "a clip is a plain quadric (no 'weight', 'perturbations' or 'clip')");
+      node.clips.push_back(readFreeForm(a[i], w, depth + 1, quadrics, false).quadric);
+    }
   }
   if (const Json* list = find(v, "perturbations")) {
     const std::string listWhere = member(where, "perturbations");

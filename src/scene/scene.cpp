@@ -22,7 +22,7 @@ std::array<Vec3, 2> Mesh::bounds() const {
 }
 
 int FreeFormNode::quadricCount() const {
-  int n = 1;
+  int n = 1 + int(clips.size());
   for (const FreeFormNode& p : perturbations) n += p.quadricCount();
   return n;
 }
@@ -148,8 +148,14 @@ Status validate(const Scene& scene, const std::string& file) {
     while (!stack.empty()) {
       const FreeFormNode* n = stack.back();
       stack.pop_back();
-      for (double c : n->quadric)
-        if (!(std::fabs(c) <= 1e30)) return fail(fmt::format("{}: a quadric coefficient is not finite (or over 1e30)", label));
+      bool finite = true;
+      for (double c : n->quadric) finite &= std::fabs(c) <= 1e30;
+      for (const auto& clip : n->clips)
+        for (double c : clip) finite &= std::fabs(c) <= 1e30;
+      if (!finite)
+        return fail(fmt::format("{}: a quadric coefficient is not finite (or over 1e30)", label));
+      if (n != &f.form && !n->clips.empty())
+        return fail(fmt::format("{}: clips belong to the root of a free form", label));
       if (!(std::fabs(n->weight) <= 1e30)) return fail(fmt::format("{}: a weight is not finite", label));
       for (const FreeFormNode& p : n->perturbations) stack.push_back(&p);
     }

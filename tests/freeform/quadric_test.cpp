@@ -33,6 +33,23 @@ FreeForm bumpySphere() {
   return f;
 }
 
+// A capped cylinder: the cylinder's inside cut by two half-spaces; the gradient is the active
+// term's.
+TEST(Quadric, ClipsIntersectInsides) {
+  FreeForm f;
+  f.base = Quadric::cylinder({0, 0, 0}, {0, 1, 0}, 1);
+  f.clips = {Quadric::halfSpace({0, 1, 0}, 1), Quadric::halfSpace({0, -1, 0}, 1)};
+  EXPECT_GT(f.evaluate({0, 0, 0}), 0);
+  EXPECT_LT(f.evaluate({0, 1.5, 0}), 0);   // above the cap
+  EXPECT_LT(f.evaluate({1.5, 0, 0}), 0);   // outside the side
+  EXPECT_NEAR(f.evaluate({0, 1, 0}), 0, 1e-12);
+  const Vec3d top = f.gradient({0, 0.99, 0});  // nearest the top cap: −∇ points up
+  EXPECT_NEAR(top.y, -1, 1e-12);
+  const Vec3d side = f.gradient({0.99, 0, 0});
+  EXPECT_LT(side.x, 0);
+  EXPECT_EQ(side.y, 0);
+}
+
 TEST(Quadric, FormsAreZeroOnTheirSurfacesAndPositiveInside) {
   const double s2 = std::sqrt(2.0);
   struct Case {
@@ -157,7 +174,9 @@ TEST(Projective, FivePointPairsFixTheMapWhichReproducesThemAndInvertsExactly) {
 TEST(Interval, BoundsContainSampledValues) {
   std::mt19937 rng(4);
   std::uniform_real_distribution<double> u(0, 1);
-  const FreeForm f = bumpySphere();
+  FreeForm f = bumpySphere();
+  // Cut by two clips as well (set-theoretic intersection): min(F', C_1, C_2).
+  f.clips = {Quadric::halfSpace({0, 1, 0}, 0.7), Quadric::cylinder({0, 0, 0}, {0, 1, 0}, 1.1)};
   // A perspective map: the frustum of a camera at z = 4 looking down −z onto the cube.
   std::array<Vec3d, 5> frustum = {Vec3d{-1, -1, 3}, {1, -1, 3}, {-1, 1, 3}, {-5, -5, -1}, {5, 5, -1}};
   std::array<Vec3d, 5> cube = {Vec3d{-1, -1, -1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}, {1, 1, 1}};

@@ -87,7 +87,8 @@ TEST(JsonScene, ReadsFreeFormObjects) {
        "perturbations": [
          {"quadric": "ellipsoid", "radii": [1, 2, 4], "weight": -3,
           "perturbations": [{"quadric": "plane", "normal": [0, 2, 0], "d": 1}]},
-         {"quadric": "general", "coefficients": [1, 2, 3, 4, 5, 6, 7, 8, 9, 10]}]}}]})");
+         {"quadric": "general", "coefficients": [1, 2, 3, 4, 5, 6, 7, 8, 9, 10]}],
+       "clip": [{"quadric": "plane", "normal": [0, 1, 0], "d": 0.5}]}}]})");
   ASSERT_TRUE(r.ok()) << r.error().str();
   ASSERT_EQ(r.value().freeForms.size(), 1u);
   const FreeFormObject& f = r.value().freeForms[0];
@@ -106,7 +107,9 @@ TEST(JsonScene, ReadsFreeFormObjects) {
   EXPECT_NEAR(e.perturbations[0].quadric[7], -1, 1e-12);  // 1 − y (the normal normalized)
   EXPECT_NEAR(e.perturbations[0].quadric[9], 0.5, 1e-12);
   EXPECT_EQ(f.form.perturbations[1].quadric[9], 10);
-  EXPECT_EQ(f.form.quadricCount(), 4);
+  ASSERT_EQ(f.form.clips.size(), 1u);
+  EXPECT_NEAR(f.form.clips[0][9], 0.5, 1e-12);
+  EXPECT_EQ(f.form.quadricCount(), 5);
 }
 
 TEST(JsonScene, DefaultsMatchTheSceneTypes) {
@@ -326,6 +329,10 @@ TEST(JsonScene, RejectsEachMalformedClassWithAClearMessage) {
        "objects[0].freeform.coefficients: expected an array of 10 numbers, got 2 elements"},
       {R"({"synthvis": 1, "objects": [{"freeform": {"quadric": "sphere", "perturbations": [{"quadric": "sphere", "weight": "x"}]}}]})",
        "objects[0].freeform.perturbations[0].weight: expected a number, got a string"},
+      {R"({"synthvis": 1, "objects": [{"freeform": {"quadric": "sphere", "perturbations": [{"quadric": "sphere", "clip": []}]}}]})",
+       "objects[0].freeform.perturbations[0].clip: 'clip' belongs to the base quadric"},
+      {R"({"synthvis": 1, "objects": [{"freeform": {"quadric": "cylinder", "clip": [{"quadric": "plane", "weight": 2}]}}]})",
+       "objects[0].freeform.clip[0]: a clip is a plain quadric"},
       {R"({"synthvis": 1, "objects": [{"freeform": {"quadric": "sphere"}, "primitive": "box"}]})",
        "not several"},
       {R"({"synthvis": 1, "objects": [{"freeform": {"quadric": "sphere"}, "transform": {"matrix": [1,0,0,0, 0,1,0,0, 0,0,0,0, 0,0,0,1]}}]})",
