@@ -58,6 +58,11 @@ Status saveGltf(const Scene& scene, const std::string& path) {
   const bool binary = path.size() >= 4 && path.compare(path.size() - 4, 4, ".glb") == 0;
   const bool text = path.size() >= 5 && path.compare(path.size() - 5, 5, ".gltf") == 0;
   if (!binary && !text) return Error{path, "", "the file name must end in .glb or .gltf"};
+  if (!scene.freeForms.empty())
+    return Error{path, "",
+                 fmt::format("glTF holds triangles: the scene's {} free forms cannot be written "
+                             "(render or bench them directly)",
+                             scene.freeForms.size())};
 
   tinygltf::Model model;
   model.asset.version = "2.0";
