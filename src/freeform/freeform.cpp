@@ -216,6 +216,34 @@ double RayFunction::evaluateNode(uint32_t i, double z, double invU4) const {
   return h;
 }
 
+// With the slope: d/dz [w·p³·u⁻⁴] = w·(3p²·p'·u⁻⁴ − 4p³·u'·u⁻⁵); du4 = −4u'·u⁻⁵.
+double RayFunction::evaluateNode(uint32_t i, double z, double invU4, double du4,
+                                 double& slope) const {
+  const Node& n = nodes_[i];
+  double h = (n.a * z + n.b) * z + n.c;
+  slope = 2 * n.a * z + n.b;
+  for (uint32_t c = i + 1; c < n.end; c = nodes_[c].end) {
+    double dv;
+    const double v = evaluateNode(c, z, invU4, du4, dv);
+    if (v > 0) {
+      const double w = nodes_[c].weight, v2 = v * v;
+      h += w * v2 * v * invU4;
+      slope += w * (3 * v2 * dv * invU4 + v2 * v * du4);
+    }
+  }
+  return h;
+}
+
+double RayFunction::evaluate(double z, double& slope) const {
+  const double u = u0_ + u1_ * z, u2 = u * u, invU4 = 1 / (u2 * u2);
+  double h = evaluateNode(0, z, invU4, -4 * u1_ * invU4 / u, slope);
+  for (const Node& c : clips_) {
+    const double v = (c.a * z + c.b) * z + c.c;
+    if (v < h) h = v, slope = 2 * c.a * z + c.b;
+  }
+  return h;
+}
+
 double RayFunction::evaluate(double z) const {
   const double u = u0_ + u1_ * z, u2 = u * u;
   double h = evaluateNode(0, z, 1 / (u2 * u2));

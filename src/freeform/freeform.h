@@ -49,6 +49,7 @@ class ProjectedFreeForm;
 class RayFunction {
  public:
   double evaluate(double z) const;
+  double evaluate(double z, double& slope) const;  // and dH/dz there (Newton's method)
   Interval bound(double z0, double z1) const;  // contains H over [z0, z1], widened for rounding
   // The same bound, and one of dH/dz over [z0, z1]: where the slope excludes 0, H is monotonic
   // there and has at most one zero.
@@ -61,6 +62,7 @@ class RayFunction {
     uint32_t end;            // as ProjectedFreeForm::Node
   };
   double evaluateNode(uint32_t i, double z, double invU4) const;
+  double evaluateNode(uint32_t i, double z, double invU4, double du4, double& slope) const;
   Interval boundNode(uint32_t i, Interval z, Interval invU4) const;
   void boundNodeSlope(uint32_t i, Interval z, Interval invU4, Interval invU5, Interval& value,
                       Interval& slope) const;

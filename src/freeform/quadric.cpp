@@ -249,14 +249,29 @@ Interval quadraticRange(double a, Interval b, Interval c, Interval t) {
 }  // namespace
 
 Interval Quadric::bound(Interval x, Interval y, Interval z) const {
-  // Nested by variable — F = C·z² + (E·x + F·y + I)·z + [A·x² + (D·y + G)·x + (B·y² + H·y + K)] —
-  // each level's quadratic bounded exactly in its own variable (quadraticRange): far tighter than
-  // term-by-term interval arithmetic, which loses the cancellation between a variable's square and
-  // linear terms (in the cube those are large and nearly cancel). Exact where x and y are points
-  // (a pixel's ray).
-  const Interval inY = quadraticRange(c[1], Interval::point(c[7]), Interval::point(c[9]), y);
-  const Interval inX = quadraticRange(c[0], y * c[3] + c[6], inY, x);
-  return quadraticRange(c[2], x * c[4] + y * c[5] + c[8], inX, z);
+  // Exact in z, centred in x and y. With (x, y) = (x_c + h_x, y_c + h_y), |h| ≤ r:
+  //   F = F(x_c, y_c, z) + F_x(x_c, y_c, z)·h_x + F_y(x_c, y_c, z)·h_y + A·h_x² + B·h_y² + D·h_x·h_y
+  // exactly. The first term is a quadratic in z alone, bounded exactly (quadraticRange); the
+  // gradient terms are linear in z, so their largest magnitudes over z are at its ends; the
+  // remainder is second order in the window's size. Term-by-term interval arithmetic loses the
+  // cancellation between terms that share x and y — in the cube, where coefficients are large
+  // and nearly cancel, its excess was larger than the values themselves on small windows (seen on
+  // BENCH.md's freeform: 4-pixel windows three object radii away from a surface kept).
+  const double xc = 0.5 * (x.lo + x.hi), yc = 0.5 * (y.lo + y.hi);
+  const double rx = 0.5 * (x.hi - x.lo), ry = 0.5 * (y.hi - y.lo);
+  // F(x_c, y_c, z) = C·z² + (E·x_c + F·y_c + I)·z + [A·x_c² + B·y_c² + D·x_c·y_c + G·x_c + H·y_c + K]
+  const double b = c[4] * xc + c[5] * yc + c[8];
+  const double k = (c[0] * xc + c[3] * yc + c[6]) * xc + (c[1] * yc + c[7]) * yc + c[9];
+  const Interval centre = quadraticRange(c[2], Interval::point(b), Interval::point(k), z);
+  // F_x = 2A·x_c + D·y_c + G + E·z, F_y = 2B·y_c + D·x_c + H + F·z.
+  const double gx0 = 2 * c[0] * xc + c[3] * yc + c[6], gy0 = 2 * c[1] * yc + c[3] * xc + c[7];
+  const double gx = std::max(std::fabs(gx0 + c[4] * z.lo), std::fabs(gx0 + c[4] * z.hi));
+  const double gy = std::max(std::fabs(gy0 + c[5] * z.lo), std::fabs(gy0 + c[5] * z.hi));
+  const double linear = gx * rx + gy * ry;
+  // A·h_x² + B·h_y² + D·h_x·h_y over the box.
+  const Interval quadratic = Interval{0, rx * rx} * c[0] + Interval{0, ry * ry} * c[1] +
+                             Interval{-1, 1} * (std::fabs(c[3]) * rx * ry);
+  return {centre.lo - linear + quadratic.lo, centre.hi + linear + quadratic.hi};
 }
 
 Mat4d Quadric::matrix() const {

@@ -17,28 +17,41 @@ double windowDepth(double z) { return 0.5 * (z + 1); }
 
 bool inside(double h) { return h >= 0; }
 
+// Brackets are refined until narrower than this (cube depth): float window depth resolves about
+// 6e-8, and 1e-10 of cube depth is under 1e-5 of a pixel's footprint at any depth of BENCH.md's
+// scenes (tests/freeform: within 1e-3 of a cell of the analytic hit).
+constexpr double kRootTolerance = 1e-10;
+
 // Step 3 of a pixel: a bracket [a, b] of the ray where H changes sign (inside(fa) ≠ inside(fb)),
-// narrowed by the Illinois variant of regula falsi (superlinear; the retained end's value halved
-// when the same end moves twice) until its ends are within a few ulps; the end on the near side
-// of the crossing is returned, so the hit is never behind the surface.
-double refineBracket(const RayFunction& f, double a, double b, double fa, double fb) {
+// narrowed by Newton's method safeguarded by the bracket (a step that leaves it is replaced by
+// the secant point, then by bisection), starting at `guess` when it lies inside (a neighbour's
+// hit: the surface is coherent) and stopping when the bracket or the step is below
+// kRootTolerance; returns the end of the final bracket on the near side of the crossing, so the
+// hit is never behind the surface.
+double refineBracket(const RayFunction& f, double a, double b, double fa, double fb,
+                     double guess = std::numeric_limits<double>::quiet_NaN()) {
   const bool insideA = inside(fa);
-  int side = 0;
-  for (int i = 0; i < 100; ++i) {
-    if (b - a <= 4e-16 * std::max(1.0, std::fabs(a))) break;
-    double c = fb != fa ? b - fb * (b - a) / (fb - fa) : 0.5 * (a + b);
-    if (!(c > a && c < b)) c = 0.5 * (a + b);
-    if (!(c > a && c < b)) break;
-    const double fc = f.evaluate(c);
-    if (inside(fc) == insideA) {
-      a = c, fa = fc;
-      if (side == -1) fb *= 0.5;
-      side = -1;
-    } else {
-      b = c, fb = fc;
-      if (side == 1) fa *= 0.5;
-      side = 1;
+  double z = guess > a && guess < b ? guess : b - fb * (b - a) / (fb - fa);
+  if (!(z > a && z < b)) z = 0.5 * (a + b);
+  for (int i = 0; i < 60 && b - a > kRootTolerance; ++i) {
+    double slope;
+    const double fz = f.evaluate(z, slope);
+    if (inside(fz) == insideA)
+      a = z, fa = fz;
+    else
+      b = z, fb = fz;
+    const double step = slope != 0 ? fz / slope : 0;
+    double next = z - step;
+    if (std::fabs(step) <= 0.5 * kRootTolerance) {
+      // Converged: the root lies within half a tolerance of z; close the bracket around it.
+      const double lo = std::max(a, next - kRootTolerance), hi = std::min(b, next + kRootTolerance);
+      if (lo < hi && inside(f.evaluate(lo)) == insideA) a = lo;
+      if (lo < hi && inside(f.evaluate(hi)) != insideA) b = hi;
+      break;
     }
+    if (!(next > a && next < b)) next = fb != fa ? b - fb * (b - a) / (fb - fa) : 0.5 * (a + b);
+    if (!(next > a && next < b)) next = 0.5 * (a + b);
+    z = next;
   }
   return a;
 }
@@ -221,11 +234,16 @@ class Caster {
 
 void castWindow(const ProjectedFreeForm& form, uint32_t id, const CastWindow& window,
                 const CastSettings& settings, CastStats& stats) {
-  Caster(form, id, window, settings, stats).run();
+  // Counted locally: the callers' per-thread totals may share a cache line, and counting into
+  // them directly made one line bounce between the cores on every bound (2/3 of a frame).
+  CastStats local;
+  Caster(form, id, window, settings, local).run();
+  stats.add(local);
 }
 
 void marchWindow(const ProjectedFreeForm& form, uint32_t id, const CastWindow& window, int steps,
-                 CastStats& stats) {
+                 CastStats& total) {
+  CastStats stats;  // local, as castWindow's
   RayFunction ray;
   for (int ly = 0; ly < window.size && window.y0 + ly < window.height; ++ly)
     for (int lx = 0; lx < window.size && window.x0 + lx < window.width; ++lx) {
@@ -253,6 +271,7 @@ void marchWindow(const ProjectedFreeForm& form, uint32_t id, const CastWindow& w
         a = b, fa = fb;
       }
     }
+  total.add(stats);
 }
 
 }  // namespace sv::freeform
