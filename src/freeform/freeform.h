@@ -54,6 +54,9 @@ class RayFunction {
   // The same bound, and one of dH/dz over [z0, z1]: where the slope excludes 0, H is monotonic
   // there and has at most one zero.
   void bound(double z0, double z1, Interval& value, Interval& slope) const;
+  // Cube depth ↔ eye depth along this ray: t = 1/u(z), u linear in z (ProjectedFreeForm).
+  double eyeDepth(double z) const { return 1 / (u0_ + u1_ * z); }
+  double cubeDepth(double t) const { return (1 / t - u0_) / u1_; }
 
  private:
   friend class ProjectedFreeForm;

@@ -26,8 +26,8 @@ constexpr double kRootTolerance = 1e-10;
 // narrowed by Newton's method safeguarded by the bracket (a step that leaves it is replaced by
 // the secant point, then by bisection), starting at `guess` when it lies inside (a neighbour's
 // hit: the surface is coherent) and stopping when the bracket or the step is below
-// kRootTolerance; returns the end of the final bracket on the near side of the crossing, so the
-// hit is never behind the surface.
+// kRootTolerance; returns the last Newton point (within the tolerance of the root) or, if the
+// bracket closed first, its end on the near side of the crossing.
 double refineBracket(const RayFunction& f, double a, double b, double fa, double fb,
                      double guess = std::numeric_limits<double>::quiet_NaN()) {
   const bool insideA = inside(fa);
@@ -42,13 +42,7 @@ double refineBracket(const RayFunction& f, double a, double b, double fa, double
       b = z, fb = fz;
     const double step = slope != 0 ? fz / slope : 0;
     double next = z - step;
-    if (std::fabs(step) <= 0.5 * kRootTolerance) {
-      // Converged: the root lies within half a tolerance of z; close the bracket around it.
-      const double lo = std::max(a, next - kRootTolerance), hi = std::min(b, next + kRootTolerance);
-      if (lo < hi && inside(f.evaluate(lo)) == insideA) a = lo;
-      if (lo < hi && inside(f.evaluate(hi)) != insideA) b = hi;
-      break;
-    }
+    if (std::fabs(step) <= kRootTolerance) return std::clamp(next, a, b);  // converged
     if (!(next > a && next < b)) next = fb != fa ? b - fb * (b - a) / (fb - fa) : 0.5 * (a + b);
     if (!(next > a && next < b)) next = 0.5 * (a + b);
     z = next;
@@ -126,10 +120,11 @@ class Caster {
       form_.bound(x, y, {zlo, zhi}, value, slope);
       if (!value.containsZero()) return;
       if (!slope.containsZero()) {
+        double guess = std::numeric_limits<double>::quiet_NaN();
         for (int py = 0; py < n && gy0 + py <= gy1; ++py)
           for (int px = 0; px < n && gx0 + px <= gx1; ++px)
             simplePixel(lx + px, ly + py, cubeX(gx0 + px, w_.width, w_.offsetX),
-                        cubeY(gy0 + py, w_.height, w_.offsetY), zlo, zhi);
+                        cubeY(gy0 + py, w_.height, w_.offsetY), zlo, zhi, guess);
         return;
       }
       for (int py = 0; py < n && gy0 + py <= gy1; ++py)
@@ -198,15 +193,18 @@ class Caster {
     }
   }
 
-  // A ray with at most one crossing in [zlo, zhi] (the window's slope bound says so).
-  void simplePixel(int lx, int ly, double x, double y, double zlo, double zhi) {
+  // A ray with at most one crossing in [zlo, zhi] (the window's slope bound says so). Newton
+  // starts from the previous ray's hit in the window: the surface is coherent.
+  void simplePixel(int lx, int ly, double x, double y, double zlo, double zhi, double& guess) {
     ++stats_.pixels;
     const size_t at = size_t(ly) * size_t(w_.stride) + size_t(lx);
     zhi = std::min(zhi, 2.0 * double(w_.depth[at]) - 1);
     if (!(zlo < zhi)) return;
     form_.ray(x, y, ray_);
     const double fa = ray_.evaluate(zlo), fb = ray_.evaluate(zhi);
-    if (inside(fa) != inside(fb)) hit(lx, ly, at, refineBracket(ray_, zlo, zhi, fa, fb));
+    if (inside(fa) == inside(fb)) return;
+    guess = refineBracket(ray_, zlo, zhi, fa, fb, guess);
+    hit(lx, ly, at, guess);
   }
 
   void hit(int lx, int ly, size_t at, double z) {
@@ -253,9 +251,11 @@ void marchWindow(const ProjectedFreeForm& form, uint32_t id, const CastWindow& w
       const double y = cubeY(window.y0 + ly, window.height, window.offsetY);
       const double zEnd = std::min(1.0, 2.0 * double(window.depth[at]) - 1);
       form.ray(x, y, ray);
+      const double tNear = ray.eyeDepth(-1), tFar = ray.eyeDepth(1);
       double a = -1, fa = ray.evaluate(a);
       for (int i = 1; i <= steps && a < zEnd; ++i) {
-        const double b = std::min(zEnd, -1 + 2.0 * i / steps);
+        const double b =
+            std::min(zEnd, i == steps ? 1.0 : ray.cubeDepth(tNear + (tFar - tNear) * i / steps));
         const double fb = ray.evaluate(b);
         if (inside(fb) != inside(fa)) {
           const double z = refineBracket(ray, a, b, fa, fb);

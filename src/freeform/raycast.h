@@ -61,7 +61,8 @@ void castWindow(const ProjectedFreeForm& form, uint32_t id, const CastWindow& wi
                 const CastSettings& settings, CastStats& stats);
 
 // The baseline (issue 7): every pixel of the window marched front to back in `steps` equal steps
-// of cube depth, the first sign change refined by bisection as castWindow refines its brackets.
+// of eye depth from the near plane to the far one (equal steps of cube depth would crowd near the
+// eye), the first sign change refined as castWindow refines its brackets.
 void marchWindow(const ProjectedFreeForm& form, uint32_t id, const CastWindow& window, int steps,
                  CastStats& stats);
 
