@@ -60,6 +60,7 @@ struct RenderArgs {
   std::string filter = "box";
   std::string textureFilter = "trilinear";
   std::string hsr = "zbuffer";
+  std::string freeform = "raycast";
   bool noCull = false;
   sv::RenderOptions options;
 };
@@ -76,6 +77,10 @@ int runRender(const RenderArgs& a) {
   auto hsr = sv::parseHsr(a.hsr);
   if (!hsr) return fail(hsr.error());
   o.hsr = hsr.value();
+  if (a.freeform != "raycast" && a.freeform != "march")
+    return fail({"", "", fmt::format("unknown free-form method '{}' (raycast or march)", a.freeform)});
+  o.freeFormMethod = a.freeform == "march" ? sv::RenderOptions::FreeFormMethod::march
+                                           : sv::RenderOptions::FreeFormMethod::raycast;
   if (!a.debugView.empty()) {
     using DebugView = sv::RenderOptions::DebugView;
     if (a.debugView == "overdraw")
@@ -417,6 +422,12 @@ int main(int argc, char** argv) {
   render->add_option("--texture-filter", r.textureFilter,
                      "texture sampling for materials that do not choose: point, nearest, tri3, "
                      "bilinear, trilinear3, trilinear or aniso")
+      ->capture_default_str();
+  render->add_option("--freeform", r.freeform,
+                     "free forms: raycast (multi-level ray casting) or march (the fixed-step "
+                     "baseline, --march-steps steps of eye depth per ray)")
+      ->capture_default_str();
+  render->add_option("--march-steps", r.options.marchSteps, "--freeform march: steps per ray")
       ->capture_default_str();
   render->add_option("--gamma", r.options.gamma,
                      "display gamma G (encoded = linear^(1/G)); default 0 = sRGB")

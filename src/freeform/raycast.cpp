@@ -55,6 +55,11 @@ double refineBracket(const RayFunction& f, double a, double b, double fa, double
 // ~1e-4 of a pixel at 1080p — and is taken as a miss.
 constexpr double kBracket = 0x1p-16;
 
+// A ray gives up after this many spans of its binary tree (and takes no hit): only a degenerate
+// function — zero, or within rounding of zero, along a long stretch of the ray — comes near it
+// (tests/render: a quadric that is zero everywhere); a surface crossing costs some 2·16 spans.
+constexpr int kSpanBudget = 128;
+
 // Windows of 2^kRayLevel pixels and less are cast ray by ray.
 constexpr int kRayLevel = 2;
 
@@ -175,7 +180,7 @@ class Caster {
     Span stack[80];
     int n = 0;
     stack[n++] = {zlo, zhi};
-    while (n > 0) {
+    for (int spans = 0; n > 0 && spans < kSpanBudget; ++spans) {
       const Span s = stack[--n];
       Interval value, slope;
       ++stats_.depthTests;

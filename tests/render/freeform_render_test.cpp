@@ -4,6 +4,7 @@
 // count.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 
 #include "freeform/quadric.h"
@@ -151,6 +152,40 @@ TEST(FreeFormRender, SameBytesForAnyThreadCountAndTranslucencyBlendsOverFreeForm
     EXPECT_GT(p[0], 150);
     EXPECT_GT(p[1], 150);
     EXPECT_EQ(p[2], 0);
+  }
+}
+
+// Absurd free forms — huge and tiny coefficients, surfaces through the eye, everything inside, a
+// quadric that is zero everywhere, deep nesting — render in bounded time, at 1 and 16 samples,
+// without NaN reaching the image.
+TEST(FreeFormRender, AbsurdFormsRenderInBoundedTime) {
+  scene::Scene s = sphereOnGround();
+  auto add = [&](std::array<double, 10> q, double weight = 1) {
+    scene::FreeFormObject o;
+    o.form.quadric = q;
+    scene::FreeFormNode p;
+    p.quadric = q;
+    p.weight = weight;
+    o.form.perturbations.push_back(p);
+    s.freeForms.push_back(o);
+  };
+  add({1e30, -1e30, 1e-30, 0, 0, 0, 1e30, 0, 0, -1e30}, 1e30);
+  add({0, 0, 0, 0, 0, 0, 0, 0, 0, 0});                  // zero everywhere: on the surface
+  add({0, 0, 0, 0, 0, 0, 0, 0, 0, 1});                  // inside everywhere: no surface
+  add({-1, -1, -1, 0, 0, 0, 0, 3, 10, -24}, -1e-30);    // a sphere about the eye
+  add({1e-300, 1e-300, 1e-300, 0, 0, 0, 0, 0, 0, -1e-300});
+  scene::FreeFormNode* n = &s.freeForms.back().form;  // nested 12 deep
+  for (int d = 0; d < 12; ++d) {
+    n->perturbations.push_back({{-1, -1, -1, 0, 0, 0, 0, 0, 0, 0.5}, 2, {}, {}});
+    n = &n->perturbations.back();
+  }
+  for (int samples : {1, 16}) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const Image img = render(s, 64, 48, samples);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    EXPECT_EQ(img.rgb.size(), size_t(64 * 48 * 3));
+    EXPECT_LT(seconds, 30) << samples;
   }
 }
 
