@@ -55,6 +55,11 @@ struct RenderOptions {
   // steps of depth (in the cube the view volume is mapped onto), its first sign change bisected.
   enum class FreeFormMethod { raycast, march } freeFormMethod = FreeFormMethod::raycast;
   int marchSteps = 1024;
+  // With anti-aliasing, free forms cast the pixel centres and every sample only where the centres
+  // do not tell (silhouettes, intersections; docs/freeforms.md) — unless this is set: then every
+  // sample is a ray, exact also for features thinner than a pixel, at up to `samples` times the
+  // cost.
+  bool freeFormEverySample = false;
 };
 
 // By name, as the CLI's --hsr writes them: "zbuffer", "priority", "hybrid".

@@ -60,6 +60,47 @@ constexpr double kBracket = 0x1p-16;
 // (tests/render: a quadric that is zero everywhere); a surface crossing costs some 2·16 spans.
 constexpr int kSpanBudget = 128;
 
+// One ray's binary tree in depth on its own function (RayFunction: exact per-quadric bounds), front
+// to back: the first zero of H in [zlo, zhi]. A span where H is monotonic (its slope bound excludes
+// 0) holds at most one zero, refined when its ends differ in sign; others are halved down to
+// kBracket. With a `hint` (a neighbour's hit), the span around it is tried right after the one
+// in front of it. False if there is none (or the span budget ran out).
+bool firstCrossing(const RayFunction& ray, double zlo, double zhi, double hint, double& z,
+                   CastStats& stats) {
+  struct Span {
+    double a, b;
+  };
+  Span stack[80];
+  int n = 0;
+  if (hint > zlo && hint < zhi) {
+    const double d = 1e-4 * (zhi - zlo);
+    const double a = std::max(zlo, hint - d), b = std::min(zhi, hint + d);
+    if (b < zhi) stack[n++] = {b, zhi};
+    stack[n++] = {a, b};
+    if (zlo < a) stack[n++] = {zlo, a};
+  } else {
+    stack[n++] = {zlo, zhi};
+  }
+  for (int spans = 0; n > 0 && spans < kSpanBudget; ++spans) {
+    const Span s = stack[--n];
+    Interval value, slope;
+    ++stats.depthTests;
+    ray.bound(s.a, s.b, value, slope);
+    if (!value.containsZero()) continue;
+    const bool monotonic = !slope.containsZero();
+    if (monotonic || s.b - s.a <= kBracket || n + 2 > 80) {
+      const double fa = ray.evaluate(s.a), fb = ray.evaluate(s.b);
+      if (inside(fa) == inside(fb)) continue;  // monotonic: no zero; else a touch, a miss
+      z = refineBracket(ray, s.a, s.b, fa, fb, hint);
+      return true;
+    }
+    const double m = 0.5 * (s.a + s.b);
+    stack[n++] = {m, s.b};  // the far half waits
+    stack[n++] = {s.a, m};
+  }
+  return false;
+}
+
 // Windows of 2^kRayLevel pixels and less are cast ray by ray.
 constexpr int kRayLevel = 2;
 
@@ -174,28 +215,9 @@ class Caster {
     zhi = std::min(zhi, 2.0 * double(w_.depth[at]) - 1);
     if (!(zlo < zhi)) return;
     form_.ray(x, y, ray_);
-    struct Span {
-      double a, b;
-    };
-    Span stack[80];
-    int n = 0;
-    stack[n++] = {zlo, zhi};
-    for (int spans = 0; n > 0 && spans < kSpanBudget; ++spans) {
-      const Span s = stack[--n];
-      Interval value, slope;
-      ++stats_.depthTests;
-      ray_.bound(s.a, s.b, value, slope);
-      if (!value.containsZero()) continue;
-      const bool monotonic = !slope.containsZero();
-      if (monotonic || s.b - s.a <= kBracket || n + 2 > 80) {
-        const double fa = ray_.evaluate(s.a), fb = ray_.evaluate(s.b);
-        if (inside(fa) == inside(fb)) continue;  // monotonic: no zero; else a touch, a miss
-        return hit(lx, ly, at, refineBracket(ray_, s.a, s.b, fa, fb));
-      }
-      const double m = 0.5 * (s.a + s.b);
-      stack[n++] = {m, s.b};  // the far half waits
-      stack[n++] = {s.a, m};
-    }
+    double z;
+    if (firstCrossing(ray_, zlo, zhi, std::numeric_limits<double>::quiet_NaN(), z, stats_))
+      hit(lx, ly, at, z);
   }
 
   // A ray with at most one crossing in [zlo, zhi] (the window's slope bound says so). Newton
@@ -242,6 +264,23 @@ void castWindow(const ProjectedFreeForm& form, uint32_t id, const CastWindow& wi
   CastStats local;
   Caster(form, id, window, settings, local).run();
   stats.add(local);
+}
+
+void castRay(const ProjectedFreeForm& form, uint32_t id, double x, double y, double from,
+             double hint, float& depth, uint32_t& object, double& cubeZ, RayFunction& ray,
+             CastStats& stats) {
+  ++stats.pixels;
+  const double zlo = std::max(-1.0, from), zhi = std::min(1.0, 2.0 * double(depth) - 1);
+  if (!(zlo < zhi)) return;
+  form.ray(x, y, ray);
+  double z;
+  if (!firstCrossing(ray, zlo, zhi, hint, z, stats)) return;
+  const float d = float(windowDepth(z));
+  if (!(d < depth)) return;
+  ++stats.hits;
+  depth = d;
+  object = id;
+  cubeZ = z;
 }
 
 void marchWindow(const ProjectedFreeForm& form, uint32_t id, const CastWindow& window, int steps,

@@ -52,6 +52,12 @@ struct CastSettings {
   // nearer than the cell are skipped at every level. Off: every cell is refined (the image is the
   // same; tests compare).
   bool masking = true;
+  // With several samples per pixel (FreeFormFrame): cast the pixel centres, and every sample only
+  // in pixels whose 3×3 neighbourhood of centres does not see one and the same form (silhouettes,
+  // forms crossing) or whose polygon samples lie within the form's depth range over the pixel
+  // (intersection curves); elsewhere the centre's hit stands for all samples. Off: every sample
+  // is a ray (exact for features thinner than a pixel, which centres can miss).
+  bool adaptiveSamples = true;
 };
 
 // Casts `form` (number `id`) into the window: every pixel whose ray meets the surface at a window
@@ -59,6 +65,14 @@ struct CastSettings {
 // [−1, 1], found to double precision once bracketed). Returns nothing; adds to `stats`.
 void castWindow(const ProjectedFreeForm& form, uint32_t id, const CastWindow& window,
                 const CastSettings& settings, CastStats& stats);
+
+// One ray of the cube (x, y): the first crossing of `form` beyond cube depth `from` and nearer
+// than `depth` (window depth) takes `depth`, `object` (= id) and `cubeZ`. `from`: where the form's
+// bounds allow it to begin (−1: the near plane). `hint`: a cube depth near which a crossing is
+// likely (a neighbouring ray's), or NaN. `ray` is scratch, reused from call to call.
+void castRay(const ProjectedFreeForm& form, uint32_t id, double x, double y, double from,
+             double hint, float& depth, uint32_t& object, double& cubeZ, RayFunction& ray,
+             CastStats& stats);
 
 // The baseline (issue 7): every pixel of the window marched front to back in `steps` equal steps
 // of eye depth from the near plane to the far one (equal steps of cube depth would crowd near the

@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <tuple>
 
 #include "raster/framebuffer.h"
 
@@ -65,10 +67,14 @@ void FreeFormFrame::prepare(std::vector<ShadedForm> forms, int width, int height
     std::stable_sort(order.begin(), order.end(),
                      [&](uint32_t a, uint32_t b) { return nearest[a] < nearest[b]; });
     std::vector<uint32_t> sorted(list.size());
-    for (size_t i = 0; i < order.size(); ++i) sorted[i] = list[order[i]];
+    std::vector<double> sortedNearest(list.size());
+    for (size_t i = 0; i < order.size(); ++i) {
+      sorted[i] = list[order[i]];
+      sortedNearest[i] = nearest[order[i]];
+    }
     list = std::move(sorted);
+    tileNearest_[t] = std::move(sortedNearest);
   }
-  tileNearest_.clear();
 }
 
 // Step 0 of a frame, per form: the screen quadtree from the whole raster down to tiles, with the
@@ -102,8 +108,10 @@ void FreeFormFrame::markTiles(uint32_t f, int x0, int y0, int size, double zlo, 
 
 void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color,
                              Scratch& scratch, CastStats& stats) const {
-  const std::vector<uint32_t>& listed = tileForms_[size_t(tileY) * size_t(tilesX_) + size_t(tileX)];
+  const size_t tile = size_t(tileY) * size_t(tilesX_) + size_t(tileX);
+  const std::vector<uint32_t>& listed = tileForms_[tile];
   if (listed.empty()) return;
+  const std::vector<double>& nearest = tileNearest_[tile];
   const int s = samples_;
   const size_t plane = size_t(kTileSize) * kTileSize;
   scratch.depth.resize(plane * size_t(s));
@@ -111,30 +119,152 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
   scratch.cubeZ.resize(plane * size_t(s));
   const int ox = tileX * kTileSize, oy = tileY * kTileSize;
 
-  // Step 1: per sample, the tile's depths row by row, and every listed form cast into them.
+  // Step 1: per sample, the tile's depths row by row; every listed form cast into them — into
+  // all samples, or (CastSettings::adaptiveSamples) into the pixel centres, then into the samples
+  // of the pixels where the centres do not tell.
   for (int k = 0; k < s; ++k) {
     float* d = scratch.depth.data() + plane * size_t(k);
     for (int ly = 0; ly < kTileSize; ++ly)
       for (int lx = 0; lx < kTileSize; ++lx)
         d[ly * kTileSize + lx] = depth[depthIndex(lx, ly, s, k)];
+  }
+  // The window of `size` pixels at tile-local (lx, ly) of buffers `d`, `o`, `z` (row-major,
+  // kTileSize wide), its rays at sample offset (dx, dy); every listed form cast into it.
+  auto cast = [&](int lx, int ly, int size, float* d, uint32_t* o, double* z, double dx,
+                  double dy) {
     CastWindow w;
     w.width = width_;
     w.height = height_;
-    w.x0 = ox;
-    w.y0 = oy;
-    w.size = kTileSize;
-    w.depth = d;
-    w.object = scratch.object.data() + plane * size_t(k);
-    w.cubeZ = scratch.cubeZ.data() + plane * size_t(k);
+    w.x0 = ox + lx;
+    w.y0 = oy + ly;
+    w.size = size;
+    const size_t at = size_t(ly) * kTileSize + size_t(lx);
+    w.depth = d + at;
+    w.object = o + at;
+    w.cubeZ = z + at;
     w.stride = kTileSize;
-    w.offsetX = offsetX_[k];
-    w.offsetY = offsetY_[k];
+    w.offsetX = dx;
+    w.offsetY = dy;
     for (uint32_t f : listed) {
       if (marchSteps_ > 0)
         marchWindow(forms_[f].projected, f, w, marchSteps_, stats);
       else
         castWindow(forms_[f].projected, f, w, settings_, stats);
     }
+  };
+  auto planeOf = [&](int k) {
+    const size_t at = plane * size_t(k);
+    return std::make_tuple(scratch.depth.data() + at, scratch.object.data() + at,
+                           scratch.cubeZ.data() + at);
+  };
+  if (s == 1 || !settings_.adaptiveSamples || marchSteps_ > 0) {
+    for (int k = 0; k < s; ++k) {
+      auto [d, o, z] = planeOf(k);
+      cast(0, 0, kTileSize, d, o, z, offsetX_[k], offsetY_[k]);
+    }
+  } else {
+    // Centres, against the farthest of each pixel's samples (a polygon covering part of the
+    // pixel must not hide the form from the whole of it).
+    scratch.centreDepth.resize(plane);
+    scratch.centreObject.assign(plane, kNoHit);
+    scratch.centreZ.resize(plane);
+    for (size_t p = 0; p < plane; ++p) {
+      float far = scratch.depth[p];
+      for (int k = 1; k < s; ++k) far = std::max(far, scratch.depth[plane * size_t(k) + p]);
+      scratch.centreDepth[p] = far;
+    }
+    const std::vector<float> polygonFar = scratch.centreDepth;
+    cast(0, 0, kTileSize, scratch.centreDepth.data(), scratch.centreObject.data(),
+         scratch.centreZ.data(), 0, 0);
+    // The centres with a ring of one pixel around the tile (kRing wide, row-major): inside from
+    // the cast above; the ring's own rays, which see the forms alone (the neighbouring tiles'
+    // polygons are not here; off the raster, nothing).
+    constexpr int kRing = kTileSize + 2;
+    scratch.ringObject.assign(size_t(kRing) * kRing, kNoHit);
+    scratch.ringDepth.assign(size_t(kRing) * kRing, 1.0f);
+    uint32_t* co = scratch.ringObject.data();
+    float* cd = scratch.ringDepth.data();
+    for (int ly = 0; ly < kTileSize; ++ly)
+      for (int lx = 0; lx < kTileSize; ++lx) {
+        co[size_t(ly + 1) * kRing + size_t(lx + 1)] = scratch.centreObject[size_t(ly) * kTileSize + size_t(lx)];
+        cd[size_t(ly + 1) * kRing + size_t(lx + 1)] = scratch.centreDepth[size_t(ly) * kTileSize + size_t(lx)];
+      }
+    {
+      CastStats local;
+      double ignored;
+      for (int ry = 0; ry < kRing; ++ry)
+        for (int rx = 0; rx < kRing; rx += (ry == 0 || ry == kRing - 1) ? 1 : kRing - 1) {
+          const int px = ox + rx - 1, py = oy + ry - 1;
+          if (px < 0 || py < 0 || px >= width_ || py >= height_) continue;
+          const size_t r = size_t(ry) * kRing + size_t(rx);
+          for (size_t i = 0; i < listed.size(); ++i)
+            castRay(forms_[listed[i]].projected, listed[i], 2.0 * (px + 0.5) / width_ - 1,
+                    1 - 2.0 * (py + 0.5) / height_, nearest[i],
+                    std::numeric_limits<double>::quiet_NaN(), cd[r], co[r], ignored, scratch.ray,
+                    local);
+        }
+      stats.add(local);
+    }
+    for (int ly = 0; ly < kTileSize && oy + ly < height_; ++ly)
+      for (int lx = 0; lx < kTileSize && ox + lx < width_; ++lx) {
+        const size_t p = size_t(ly) * kTileSize + size_t(lx);
+        const size_t r = size_t(ly + 1) * kRing + size_t(lx + 1);
+        const uint32_t o = co[r];
+        // Uniform: a pixel whose 3×3 centres all see form o (or all none).
+        bool uniform = true;
+        for (int j = -1; j <= 1 && uniform; ++j)
+          for (int i = -1; i <= 1 && uniform; ++i)
+            uniform = co[size_t(ptrdiff_t(r) + j * kRing + i)] == o;
+        if (uniform && o == kNoHit) continue;
+        if (uniform) {
+          // The form's depth over the pixel: the centre's ± the largest step to a neighbour's.
+          const float zc = cd[r];
+          float dz = 0;
+          for (const int n : {-1, 1, -kRing, kRing})
+            dz = std::max(dz, std::fabs(cd[size_t(ptrdiff_t(r) + n)] - zc));
+          bool decided = true;
+          for (int k = 0; k < s && decided; ++k) {
+            const float dk = scratch.depth[plane * size_t(k) + p];
+            decided = dk > zc + dz || dk < zc - dz;
+          }
+          if (decided) {  // each sample wholly in front of or behind the polygons
+            for (int k = 0; k < s; ++k) {
+              auto [d, obj, z] = planeOf(k);
+              if (!(zc < d[p])) continue;
+              d[p] = zc;
+              obj[p] = o;
+              z[p] = scratch.centreZ[p];
+            }
+            continue;
+          }
+        }
+        // Silhouettes, forms crossing each other or the polygons: every sample its own ray, for
+        // the forms the 3×3 centres saw (nearest first, as listed), each started near the depth
+        // a centre saw it at.
+        uint32_t seen[9];
+        double hint[9], from[9];
+        int count = 0;
+        for (size_t l = 0; l < listed.size(); ++l)
+          for (int j = -1; j <= 1; ++j)
+            for (int i = -1; i <= 1; ++i) {
+              const uint32_t f = listed[l];
+              const size_t q = size_t(ptrdiff_t(r) + j * kRing + i);
+              if (co[q] != f || (count > 0 && seen[count - 1] == f)) continue;
+              seen[count] = f;
+              from[count] = nearest[l];
+              hint[count++] = q == r ? scratch.centreZ[p] : 2.0 * double(cd[q]) - 1;
+            }
+        CastStats local;
+        for (int k = 0; k < s; ++k) {
+          auto [d, obj, z] = planeOf(k);
+          const double x = 2.0 * (ox + lx + 0.5 + offsetX_[k]) / width_ - 1;
+          const double y = 1 - 2.0 * (oy + ly + 0.5 + offsetY_[k]) / height_;
+          for (int c = 0; c < count; ++c)
+            castRay(forms_[seen[c]].projected, seen[c], x, y, from[c], hint[c], d[p], obj[p],
+                    z[p], scratch.ray, local);
+        }
+        stats.add(local);
+      }
   }
 
   // Step 2: shading, once per pixel and form that took some of its samples — at the first such

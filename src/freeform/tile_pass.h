@@ -44,6 +44,12 @@ class FreeFormFrame {
     std::vector<float> depth;
     std::vector<uint32_t> object;
     std::vector<double> cubeZ;
+    std::vector<float> centreDepth;  // CastSettings::adaptiveSamples: the pixel centres' cast
+    std::vector<uint32_t> centreObject;
+    std::vector<double> centreZ;
+    std::vector<uint32_t> ringObject;  // the centres with a one-pixel ring around the tile
+    std::vector<float> ringDepth;
+    RayFunction ray;
   };
 
   // Casts the forms listed for tile (tileX, tileY) into its buffers — `samples` depth and colour
@@ -64,7 +70,8 @@ class FreeFormFrame {
   // Per tile, the forms it casts, nearest first (by the nearest depth their bounds allow in the
   // tile), so that masking drops what nearer forms hide.
   std::vector<std::vector<uint32_t>> tileForms_;
-  std::vector<std::vector<double>> tileNearest_;  // while preparing: each listed form's nearest z
+  // The nearest cube depth each listed form's bounds allow in the tile, in the same order.
+  std::vector<std::vector<double>> tileNearest_;
 };
 
 }  // namespace sv::freeform

@@ -497,7 +497,8 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
     impl_->freeForms.prepare(
         shadedForms(scene, camera.value().view, camera.value().projection, shading), fs.width,
         fs.height, o.samples, cov ? cov->offsetX : nullptr, cov ? cov->offsetY : nullptr,
-        &shading.environment, freeform::CastSettings{},
+        &shading.environment,
+        freeform::CastSettings{.masking = true, .adaptiveSamples = !o.freeFormEverySample},
         o.freeFormMethod == RenderOptions::FreeFormMethod::march ? o.marchSteps : 0);
     const int threads = impl_->frame.pool().threadCount();
     impl_->freeFormScratch.resize(size_t(threads));
