@@ -282,23 +282,50 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
             pending.push_back({lx, ly, k});
             break;
           }
-    for (size_t begin = 0; begin < pending.size(); begin += shade::kMaxFragments) {
-      const int count = int(std::min<size_t>(shade::kMaxFragments, pending.size() - begin));
+    // Textured forms are shaded a pixel at a time: each has its own footprint (Fragments carries
+    // one gradient per call — a triangle's, constant over it).
+    const bool textured = form.material.texture != nullptr;
+    const size_t batch = textured ? 1 : shade::kMaxFragments;
+    for (size_t begin = 0; begin < pending.size(); begin += batch) {
+      const int count = int(std::min<size_t>(batch, pending.size() - begin));
       shade::Fragments frag;
       frag.count = count;
       for (int i = 0; i < count; ++i) {
         const Pending& p = pending[begin + size_t(i)];
         const size_t at = plane * size_t(p.sample) + size_t(p.ly * kTileSize + p.lx);
-        const Vec3d q{2.0 * (ox + p.lx + 0.5 + offsetX_[p.sample]) / width_ - 1,
-                      1 - 2.0 * (oy + p.ly + 0.5 + offsetY_[p.sample]) / height_,
-                      scratch.cubeZ[at]};
+        const double sx = ox + p.lx + 0.5 + offsetX_[p.sample];
+        const double sy = oy + p.ly + 0.5 + offsetY_[p.sample];
+        const Vec3d q{2.0 * sx / width_ - 1, 1 - 2.0 * sy / height_, scratch.cubeZ[at]};
         const Vec3d point = form.projected.toObject(q);
+        const Vec3d gradient = form.form.gradient(point);
         // Inside is F ≥ 0, so the outward normal is −∇F.
-        const Vec3d n = normalize(apply3(form.normalToEye, form.form.gradient(point) * -1.0));
+        const Vec3d n = normalize(apply3(form.normalToEye, gradient * -1.0));
         const Vec3d eye = form.objectToEye.transformPoint(point);
         frag.q[i] = 1;  // attributes are given as themselves (w = 1)
         for (int ch = 0; ch < 3; ++ch) frag.color[ch][i] = form.color[ch];
-        frag.attribute[shade::kU][i] = frag.attribute[shade::kV][i] = 0;
+        frag.attribute[shade::kU][i] = float(point.x * form.uvScale[0]);
+        frag.attribute[shade::kV][i] = float(point.z * form.uvScale[1]);
+        if (textured) {
+          // The footprint (SPEC §7): where the next pixel's rays, right and down, meet the tangent
+          // plane at the hit — the texture coordinates' derivatives per pixel.
+          auto onTangentPlane = [&](double px, double py, double& u, double& v) {
+            const Vec3d a = form.projected.toObject({2 * px / width_ - 1, 1 - 2 * py / height_, q.z});
+            const Vec3d b = form.projected.toObject(
+                {2 * px / width_ - 1, 1 - 2 * py / height_, std::min(1.0, q.z + 1e-3 * (1 - q.z))});
+            const double den = dot(gradient, b - a);
+            const double t = std::fabs(den) > 1e-300 ? dot(gradient, point - a) / den : 0;
+            const Vec3d x = a + (b - a) * std::clamp(t, -1e6, 1e6);
+            u = x.x * form.uvScale[0];
+            v = x.z * form.uvScale[1];
+          };
+          double ux, vx, uy, vy;
+          onTangentPlane(sx + 1, sy, ux, vx);
+          onTangentPlane(sx, sy + 1, uy, vy);
+          frag.udx = float(ux - point.x * form.uvScale[0]);
+          frag.vdx = float(vx - point.z * form.uvScale[1]);
+          frag.udy = float(uy - point.x * form.uvScale[0]);
+          frag.vdy = float(vy - point.z * form.uvScale[1]);
+        }
         frag.attribute[shade::kNormalX][i] = float(n.x);
         frag.attribute[shade::kNormalY][i] = float(n.y);
         frag.attribute[shade::kNormalZ][i] = float(n.z);

@@ -23,6 +23,9 @@ struct ShadedForm {
   Mat4d normalToEye;             // the inverse transpose of objectToEye's 3×3 part
   shade::MaterialShading material;
   float color[3] = {1, 1, 1};  // linear base colour
+  // material.texture: projected along the object's y axis, u = x·uvScale[0], v = z·uvScale[1]
+  // (object space), its level of detail from the pixel's footprint on the tangent plane.
+  float uvScale[2] = {1, 1};
 };
 
 // The frame's free forms, and which tiles each may show in (so a tile casts only those).

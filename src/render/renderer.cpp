@@ -204,7 +204,7 @@ freeform::FreeForm toFreeForm(const scene::FreeFormNode& n) {
 // The frame's free forms for the tile pass: each carried into the cube by projection · view ·
 // model (SPEC §12), lit per pixel with its material's colour and specular term (Phong whenever the
 // scene has lights and the material is lit: the normal is exact at every pixel), both sides lit.
-// Free forms take no texture yet and are always opaque.
+// A texture is projected along the object's y axis (tile_pass.h). Free forms are always opaque.
 std::vector<freeform::ShadedForm> shadedForms(const scene::Scene& scene, const Mat4& view,
                                               const Mat4& projection, const ShadingTables& shading) {
   std::vector<freeform::ShadedForm> out;
@@ -219,11 +219,13 @@ std::vector<freeform::ShadedForm> shadedForms(const scene::Scene& scene, const M
     std::optional<freeform::ProjectedFreeForm> projected =
         freeform::ProjectedFreeForm::make(form, toDouble(projection) * toEye);
     if (!eyeInverse || !projected) continue;  // a singular placement shows nothing
-    freeform::ShadedForm s{form, std::move(*projected), toEye, eyeInverse->transposed(), {}, {}};
+    freeform::ShadedForm s{form, std::move(*projected), toEye, eyeInverse->transposed(), {}, {}, {}};
+    s.material = *shading.of(object.material, true);
     s.material.phong = lights && !mat.unlit;
     s.material.twoSided = true;
-    s.material.specular = mat.specular;
-    s.material.shininess = mat.shininess;
+    s.material.alpha = shade::AlphaUse::opaque;
+    s.uvScale[0] = mat.uvScale.x;
+    s.uvScale[1] = mat.uvScale.y;
     for (int ch = 0; ch < 3; ++ch) s.color[ch] = (&mat.baseColor.x)[ch];
     out.push_back(std::move(s));
   }

@@ -5,10 +5,12 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <memory>
 #include <cmath>
 
 #include "freeform/quadric.h"
 #include "synthvis/render.h"
+#include "texture/texture.h"
 
 namespace sv {
 namespace {
@@ -208,6 +210,50 @@ TEST(FreeFormRender, AbsurdFormsRenderInBoundedTime) {
     EXPECT_EQ(img.rgb.size(), size_t(64 * 48 * 3));
     EXPECT_LT(seconds, 30) << samples;
   }
+}
+
+// A texture projected on a free form (along its y axis, with the level of detail from the
+// footprint on the tangent plane) looks as the same texture on a polygon with the same texture
+// coordinates: a free-form ground and a polygon ground, each clipped to the same square.
+TEST(FreeFormRender, ProjectedTextureMatchesTheSameTextureOnPolygons) {
+  auto ground = [](bool freeForm) {
+    scene::Scene s = sphereOnGround();
+    s.freeForms.clear();
+    s.meshes.clear();
+    s.instances.clear();
+    scene::TextureMap map;
+    map.name = "squares";
+    map.texture = std::make_shared<texture::Texture>(
+        texture::generateTexture(texture::Pattern::squares, 256, {0.75f, 0.18f, 0.10f, 1},
+                                 {0.92f, 0.90f, 0.82f, 1}, 1),
+        texture::Wrap::repeat, texture::Wrap::repeat);
+    s.textures.push_back(map);
+    s.materials[1].texture = 0;
+    s.materials[1].baseColor = {1, 1, 1, 1};
+    s.materials[1].uvScale = {0.25f, 0.25f};
+    if (freeForm) {
+      scene::FreeFormObject f;
+      f.form.quadric = freeform::Quadric::halfSpace({0, 1, 0}, 0).c;
+      for (const freeform::Vec3d n : {freeform::Vec3d{1, 0, 0}, {-1, 0, 0}, {0, 0, 1}, {0, 0, -1}})
+        f.form.clips.push_back(freeform::Quadric::halfSpace(n, 10).c);
+      f.material = 1;
+      s.freeForms.push_back(f);
+    } else {
+      scene::Mesh m;
+      m.positions = {{-10, 0, -10}, {10, 0, -10}, {10, 0, 10}, {-10, 0, 10}};
+      m.uvs = {{-10, -10}, {10, -10}, {10, 10}, {-10, 10}};
+      m.indices = {0, 2, 1, 0, 3, 2};
+      m.material = 1;
+      s.meshes.push_back(m);
+      s.instances.push_back({0, Mat4{}});
+    }
+    return s;
+  };
+  const Image p = render(ground(false), 160, 120, 1), f = render(ground(true), 160, 120, 1);
+  double sum = 0;
+  for (size_t i = 0; i < p.rgb.size(); ++i) sum += std::pow(double(p.rgb[i]) - f.rgb[i], 2);
+  const double psnr = 10 * std::log10(255.0 * 255.0 / std::max(1e-9, sum / double(p.rgb.size())));
+  EXPECT_GT(psnr, 45);  // measured 55.9 dB (float rounding of the footprint and coordinates)
 }
 
 }  // namespace
