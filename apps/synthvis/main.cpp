@@ -208,8 +208,9 @@ int runBench(BenchArgs a) {
     return fail({"", "", "give either a scene (a generator name or a file) or --suite quick|full"});
   if (a.renderer.empty()) a.renderer = a.suite.empty() ? "synthvis" : "both";
   if (a.renderer != "synthvis" && a.renderer != "gl" && a.renderer != "both" &&
-      a.renderer != "sphere-trace")
-    return fail({"", "", fmt::format("unknown renderer '{}' (synthvis, gl, both or sphere-trace)",
+      a.renderer != "sphere-trace" && a.renderer != "tessellated")
+    return fail({"", "", fmt::format("unknown renderer '{}' (synthvis, gl, both, sphere-trace or "
+                                     "tessellated)",
                                      a.renderer)});
   if (auto order = sv::scene::parseSubmitOrder(a.generator.order); !order)
     return fail(order.error());
@@ -247,6 +248,7 @@ int runBench(BenchArgs a) {
   settings.fog = a.fog;
   settings.synthvis = a.renderer != "gl";
   settings.sphereTrace = a.renderer == "sphere-trace";
+  settings.tessellated = a.renderer == "tessellated";
   settings.reference = a.renderer == "gl" || a.renderer == "both";
   ref::BenchRunner runner(settings);
   if (settings.reference) {
@@ -467,6 +469,8 @@ int main(int argc, char** argv) {
   bench->add_option("--renderer", b.renderer,
                     "synthvis, gl (Mesa llvmpipe) or both, alternating frames; sphere-trace: "
                     "synthvis against its free forms marched in fixed steps (--march-steps); "
+                    "tessellated: against its free forms as triangles (the gl reference always "
+                    "draws those); "
                     "default: synthvis for a scene, both for a suite");
   bench->add_option("--march-steps", b.options.marchSteps,
                     "sphere-trace: depth steps per ray of the fixed-step marcher")

@@ -62,6 +62,13 @@ struct RenderOptions {
   bool freeFormEverySample = false;
 };
 
+// The scene with every free form replaced by triangles (issue 7's polygon baseline): marching
+// tetrahedra on an interval octree in object space, cells small enough that a chord strays at most
+// a quarter of a pixel from the surface at the object's nearest distance in this camera and raster
+// (`options`: camera, height) — equal silhouette error with ray casting, within the resolution of
+// the image. Errors name a form that is unbounded or needs over 4 million triangles.
+Result<scene::Scene> tessellatedScene(const scene::Scene& scene, const RenderOptions& options);
+
 // By name, as the CLI's --hsr writes them: "zbuffer", "priority", "hybrid".
 Result<RenderOptions::Hsr> parseHsr(const std::string& text);
 const char* hsrName(RenderOptions::Hsr hsr);

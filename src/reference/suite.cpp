@@ -176,16 +176,26 @@ Result<CaseResult> BenchRunner::run(const BenchCase& c) {
   RenderOptions marchOptions = s.options;
   marchOptions.freeFormMethod = RenderOptions::FreeFormMethod::march;
   std::optional<Renderer> marcher;
-  if (s.sphereTrace) marcher.emplace(marchOptions);
+  if (s.sphereTrace || s.tessellated) marcher.emplace(s.sphereTrace ? marchOptions : s.options);
+  // Free forms as triangles, for the polygon baseline and for the gl reference.
+  std::optional<scene::Scene> tessellated;
+  if (!sc.freeForms.empty() && (s.tessellated || impl_->gl)) {
+    auto t = tessellatedScene(sc, s.options);
+    if (!t.ok()) return t.error();
+    tessellated = std::move(t).value();
+    r.params["tessellated_triangles"] = tessellated->triangleCount();
+  }
+  const scene::Scene& polygons = tessellated ? *tessellated : sc;
   if (s.sphereTrace) {
     ref = RendererRun{"sphere-trace",
                       fmt::format("synthvis, free forms marched in {} steps", s.options.marchSteps),
                       {}, 0, 0, 0, {}, {}};
+  } else if (s.tessellated) {
+    ref = RendererRun{"tessellated",
+                      fmt::format("synthvis, free forms as {} triangles", polygons.triangleCount()),
+                      {}, 0, 0, 0, {}, {}};
   } else if (impl_->gl) {
-    if (!sc.freeForms.empty())
-      return Error{"", "", "the gl reference draws triangles only: compare a scene with free forms "
-                           "with --renderer sphere-trace"};
-    if (Status st = impl_->gl->load(sc); !st) return st.error();
+    if (Status st = impl_->gl->load(polygons); !st) return st.error();
     ref = RendererRun{"gl", impl_->glDescription, {}, 0, 0, 0, {}, {}};
   }
   // A/B, frame by frame.
@@ -196,9 +206,10 @@ Result<CaseResult> BenchRunner::run(const BenchCase& c) {
       const double ms = msSince(t0);
       if (i >= s.warmup) ours->frameMs.push_back(ms);
     }
-    if (ref && s.sphereTrace) {
+    if (ref && (s.sphereTrace || s.tessellated)) {
       const auto t0 = Clock::now();
-      if (Status st = marcher->render(sc, ref->image, &ref->stats); !st) return st.error();
+      if (Status st = marcher->render(s.sphereTrace ? sc : polygons, ref->image, &ref->stats); !st)
+        return st.error();
       const double ms = msSince(t0);
       if (i >= s.warmup) ref->frameMs.push_back(ms);
     } else if (ref) {
@@ -216,7 +227,7 @@ Result<CaseResult> BenchRunner::run(const BenchCase& c) {
   }
   if (ref) {
     finish(*ref);
-    if (!s.sphereTrace)
+    if (!s.sphereTrace && !s.tessellated)
       if (Status st = impl_->gl->readImage(ref->image); !st) return st.error();
     if (!r.runs.empty()) r.psnrDb = psnr(r.runs[0].image, ref->image);
     r.runs.push_back(std::move(*ref));

@@ -69,6 +69,9 @@ struct BenchSettings {
   // marchSteps; RenderOptions::FreeFormMethod::march) — issue 7's sphere-tracing baseline, renderer
   // name "sphere-trace".
   bool sphereTrace = false;
+  // Time, instead, synthvis on the scene with its free forms tessellated (tessellatedScene) — the
+  // polygon baseline, renderer name "tessellated". (The gl reference always draws that scene.)
+  bool tessellated = false;
   // Count the gl reference's read-back (glReadPixels into an 8-bit image in memory) in its frame
   // time: synthvis's frame always ends with the image in memory.
   bool referenceReadback = false;

@@ -9,6 +9,7 @@
 #include <numeric>
 #include <thread>
 
+#include "freeform/tessellate.h"
 #include "freeform/tile_pass.h"
 #include "geometry/vertex_stage.h"
 #include "output/resolve.h"
@@ -297,6 +298,65 @@ std::string FrameStats::summary() const {
                                   freeForms, freeFormCells, freeFormMaskedCells, freeFormBounds,
                                   freeFormRays, freeFormHits)
                     : std::string());
+}
+
+Result<scene::Scene> tessellatedScene(const scene::Scene& scene, const RenderOptions& o) {
+  const Result<CameraMatrices> camera = cameraMatrices(scene, o);
+  if (!camera.ok()) return camera.error();
+  scene::Camera cam = scene.cameras.empty() ? defaultCamera(scene) : scene.cameras[size_t(o.camera)];
+  const double pixelPerDepth =
+      2 * std::tan(cam.yfovDegrees * 3.14159265358979 / 360) / double(o.height * o.supersample);
+  scene::Scene out = scene;
+  out.freeForms.clear();
+  constexpr size_t kMaxTriangles = size_t(1) << 22;
+  for (size_t i = 0; i < scene.freeForms.size(); ++i) {
+    const scene::FreeFormObject& object = scene.freeForms[i];
+    const std::string label = object.name.empty() ? fmt::format("freeForms[{}]", i)
+                                                  : fmt::format("free form '{}'", object.name);
+    const freeform::FreeForm form = toFreeForm(object.form);
+    bool unbounded = false;
+    const std::optional<freeform::Box> box = freeform::surfaceBounds(form, 1e4, 16, unbounded);
+    if (unbounded)
+      return Error{"", "", fmt::format("{} is unbounded or too large to tessellate", label)};
+    if (!box) continue;  // no surface
+    // The nearest eye depth of the box, and its smallest half extent as the curvature radius.
+    const Mat4 toEye = camera.value().view * object.transform;
+    double nearest = std::numeric_limits<double>::infinity();
+    for (int c = 0; c < 8; ++c) {
+      const Vec3 corner{float(c & 1 ? (*box)[1].x : (*box)[0].x), float(c & 2 ? (*box)[1].y : (*box)[0].y),
+                        float(c & 4 ? (*box)[1].z : (*box)[0].z)};
+      nearest = std::min(nearest, double(-toEye.transformPoint(corner).z));
+    }
+    nearest = std::max(nearest, double(cam.znear));
+    const freeform::Vec3d extent = (*box)[1] - (*box)[0];
+    const double radius = 0.5 * std::min({extent.x, extent.y, extent.z});
+    // Object units per pixel at that depth (the transform's largest scale brings it to the world).
+    double scale = 0;
+    for (int c = 0; c < 3; ++c)
+      scale = std::max(scale, double(length(object.transform.transformDirection(
+                                  Vec3{float(c == 0), float(c == 1), float(c == 2)}))));
+    const double pixel = nearest * pixelPerDepth / std::max(scale, 1e-30);
+    // Sagitta c²/(8r) ≤ pixel/4 for chords c ≤ √3·cell (a leaf's diagonal).
+    const double cell = std::sqrt(2 * radius * pixel / 3);
+    freeform::TriangleSoup soup;
+    if (!freeform::tessellate(form, *box, cell, kMaxTriangles, soup))
+      return Error{"", "", fmt::format("{} is unbounded or needs over {} triangles to tessellate",
+                                       label, kMaxTriangles)};
+    scene::Mesh mesh;
+    mesh.name = object.name + " (tessellated)";
+    mesh.material = object.material;
+    for (size_t v = 0; v < soup.positions.size(); ++v) {
+      const freeform::Vec3d& p = soup.positions[v];
+      const freeform::Vec3d& n = soup.normals[v];
+      mesh.positions.push_back({float(p.x), float(p.y), float(p.z)});
+      mesh.normals.push_back({float(n.x), float(n.y), float(n.z)});
+      mesh.uvs.push_back({float(p.x), float(p.z)});  // the free form's projection (tile_pass.h)
+      mesh.indices.push_back(uint32_t(v));
+    }
+    out.meshes.push_back(std::move(mesh));
+    out.instances.push_back({int(out.meshes.size()) - 1, object.transform});
+  }
+  return out;
 }
 
 Result<RenderOptions::Hsr> parseHsr(const std::string& text) {

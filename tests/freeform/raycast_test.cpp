@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "freeform/raycast.h"
+#include "freeform/tessellate.h"
 
 namespace sv::freeform {
 namespace {
@@ -181,6 +182,42 @@ TEST(RayCast, MaskingChangesNothingAndTheMarcherAgrees) {
     }
   }
   EXPECT_LE(differ, 4);
+}
+
+// The polygon baseline: marching tetrahedra on octree leaves puts every vertex on the surface,
+// faces outward, and closes a sphere with chords no farther from it than the cell allows.
+TEST(Tessellate, SphereVerticesLieOnTheSurfaceWithOutwardFaces) {
+  FreeForm f;
+  f.base = Quadric::sphere({0.3, -0.2, 0.1}, 1.5);
+  bool unbounded = true;
+  const std::optional<Box> box = surfaceBounds(f, 100, 12, unbounded);
+  ASSERT_TRUE(box);
+  EXPECT_FALSE(unbounded);
+  FreeForm plane;
+  plane.base = Quadric::halfSpace({0, 1, 0}, 0);
+  EXPECT_FALSE(surfaceBounds(plane, 100, 12, unbounded));
+  EXPECT_TRUE(unbounded);
+  EXPECT_NEAR((*box)[0].x, 0.3 - 1.5, 0.06);
+  EXPECT_NEAR((*box)[1].y, -0.2 + 1.5, 0.06);
+  TriangleSoup soup;
+  ASSERT_TRUE(tessellate(f, *box, 0.1, 1000000, soup));
+  EXPECT_GT(soup.triangles(), 1000u);
+  double area = 0;
+  for (size_t t = 0; t < soup.triangles(); ++t) {
+    const Vec3d a = soup.positions[3 * t], b = soup.positions[3 * t + 1], c = soup.positions[3 * t + 2];
+    for (const Vec3d& p : {a, b, c}) {
+      const Vec3d d = p - Vec3d{0.3, -0.2, 0.1};
+      EXPECT_NEAR(std::sqrt(dot(d, d)), 1.5, 1e-5);
+    }
+    const Vec3d u = b - a, v = c - a;
+    const Vec3d n{u.y * v.z - u.z * v.y, u.z * v.x - u.x * v.z, u.x * v.y - u.y * v.x};
+    const Vec3d out = (a + b + c) * (1.0 / 3) - Vec3d{0.3, -0.2, 0.1};
+    EXPECT_GE(dot(n, out), 0) << "triangle " << t << " faces inward";
+    area += 0.5 * std::sqrt(dot(n, n));
+  }
+  // Chords cut inside the sphere: a little less than 4πr², by under 1 % at this cell size.
+  EXPECT_LT(area, 4 * M_PI * 1.5 * 1.5);
+  EXPECT_GT(area, 0.99 * 4 * M_PI * 1.5 * 1.5);
 }
 
 }  // namespace

@@ -256,5 +256,32 @@ TEST(FreeFormRender, ProjectedTextureMatchesTheSameTextureOnPolygons) {
   EXPECT_GT(psnr, 45);  // measured 55.9 dB (float rounding of the footprint and coordinates)
 }
 
+// The polygon baseline: the same scene with its free forms tessellated at a quarter pixel's
+// chord error renders nearly the image of ray casting them.
+TEST(FreeFormRender, TessellatedSceneRendersNearlyTheSameImage) {
+  scene::Scene s = sphereOnGround();
+  RenderOptions o;
+  o.width = 160;
+  o.height = 120;
+  o.threads = 2;
+  const Result<scene::Scene> t = tessellatedScene(s, o);
+  ASSERT_TRUE(t.ok()) << t.error().str();
+  EXPECT_TRUE(t.value().freeForms.empty());
+  EXPECT_GT(t.value().triangleCount(), 500u);
+  Image a, b;
+  ASSERT_TRUE(Renderer(o).render(s, a).ok());
+  ASSERT_TRUE(Renderer(o).render(t.value(), b).ok());
+  int differing = 0;
+  for (size_t i = 0; i < a.rgb.size(); ++i) differing += std::abs(int(a.rgb[i]) - int(b.rgb[i])) > 8;
+  EXPECT_LT(differing, 40) << "channels differing by more than 8 (silhouette and curve pixels)";
+  // An unbounded form cannot be tessellated.
+  scene::FreeFormObject plane;
+  plane.form.quadric = freeform::Quadric::halfSpace({0, 1, 0}, -1).c;
+  s.freeForms.push_back(plane);
+  const Result<scene::Scene> bad = tessellatedScene(s, o);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().str().find("unbounded"), std::string::npos) << bad.error().str();
+}
+
 }  // namespace
 }  // namespace sv
