@@ -78,7 +78,7 @@ void FreeFormFrame::prepare(std::vector<ShadedForm> forms, int width, int height
 }
 
 // Step 0 of a frame, per form: the screen quadtree from the whole raster down to tiles, with the
-// eight-slab depth tree of the caster, over whole pixel squares (every sample of a pixel lies in
+// eight-slab depth tree (the caster uses sixteen), over whole pixel squares (every sample of a pixel lies in
 // its square).
 void FreeFormFrame::markTiles(uint32_t f, int x0, int y0, int size, double zlo, double zhi) {
   if (x0 >= width_ || y0 >= height_) return;
