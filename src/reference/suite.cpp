@@ -72,6 +72,12 @@ Result<std::vector<BenchCase>> suiteCases(const std::string& suite) {
       for (SubmitOrder o :
            {SubmitOrder::random, SubmitOrder::frontToBack, SubmitOrder::backToFront})
         cases.push_back(layersCase(d, o));
+    // Free forms (issue 7), at the suite's raster; the gl reference draws them tessellated.
+    for (const char* name : {"freeform", "freeform-one"}) {
+      BenchCase c;
+      c.name = c.generator = name;
+      cases.push_back(c);
+    }
   } else {
     return Error{"", "", fmt::format("unknown suite '{}' (quick or full)", suite)};
   }

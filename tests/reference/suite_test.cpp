@@ -35,9 +35,13 @@ TEST(Suites, QuickAndFullNameBenchMdScenes) {
   auto full = suiteCases("full");
   ASSERT_TRUE(full.ok());
   EXPECT_GT(full->size(), quick->size());
-  bool hasLayers16 = false;
-  for (const auto& c : full.value()) hasLayers16 |= c.name == "layers-d16-b2f";
+  bool hasLayers16 = false, hasFreeForm = false;
+  for (const auto& c : full.value()) {
+    hasLayers16 |= c.name == "layers-d16-b2f";
+    hasFreeForm |= c.generator == "freeform";
+  }
   EXPECT_TRUE(hasLayers16);
+  EXPECT_TRUE(hasFreeForm);
   EXPECT_FALSE(suiteCases("huge").ok());
 }
 
@@ -81,4 +85,26 @@ TEST(Html, WritesPageImagesAndPlots) {
 }
 
 }  // namespace
+// Free-form scenes against their two baselines, frame by frame: the fixed-step marcher and the
+// same forms tessellated (issue 7).
+TEST(BenchRunner, FreeFormsRunAgainstTheMarcherAndTheirTessellation) {
+  for (const bool sphereTrace : {true, false}) {
+    BenchSettings s = smallSettings();
+    s.sphereTrace = sphereTrace;
+    s.tessellated = !sphereTrace;
+    s.options.marchSteps = 64;
+    BenchRunner runner(s);
+    BenchCase c;
+    c.name = c.generator = "freeform-one";
+    auto r = runner.run(c);
+    ASSERT_TRUE(r.ok()) << r.error().str();
+    ASSERT_EQ(r->runs.size(), 2u);
+    EXPECT_EQ(r->runs[1].renderer, sphereTrace ? "sphere-trace" : "tessellated");
+    EXPECT_GT(r->psnrDb, 20) << "both drew the same object";
+    if (!sphereTrace) {
+      EXPECT_GT(r->params.value("tessellated_triangles", 0), 1000);
+    }
+  }
+}
+
 }  // namespace sv::reference
