@@ -11,21 +11,8 @@
 namespace sv::freeform {
 namespace {
 
-using raster::kBlockPixels;
-using raster::kBlockSize;
-using raster::kColorPerBlock;
+using raster::FrameBuffer;
 using raster::kTileSize;
-
-// Sample s of tile-local pixel (lx, ly) in the tile's block-major buffers (raster/framebuffer.h).
-size_t depthIndex(int lx, int ly, int samples, int s) {
-  return (raster::tileBlock(lx, ly) * size_t(samples) + size_t(s)) * kBlockPixels +
-         size_t((ly & (kBlockSize - 1)) * kBlockSize + (lx & (kBlockSize - 1)));
-}
-size_t colorIndex(int lx, int ly, int samples, int s, int channel) {
-  return (raster::tileBlock(lx, ly) * size_t(samples) + size_t(s)) * kColorPerBlock +
-         size_t(channel * kBlockPixels + (ly & (kBlockSize - 1)) * kBlockSize +
-                (lx & (kBlockSize - 1)));
-}
 
 Vec3d apply3(const Mat4d& m, Vec3d v) {  // the 3×3 part
   return {m.m[0][0] * v.x + m.m[0][1] * v.y + m.m[0][2] * v.z,
@@ -126,7 +113,7 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
     float* d = scratch.depth.data() + plane * size_t(k);
     for (int ly = 0; ly < kTileSize; ++ly)
       for (int lx = 0; lx < kTileSize; ++lx)
-        d[ly * kTileSize + lx] = depth[depthIndex(lx, ly, s, k)];
+        d[ly * kTileSize + lx] = depth[FrameBuffer::depthOffset(lx, ly, s, k)];
   }
   // The window of `size` pixels at tile-local (lx, ly) of buffers `d`, `o`, `z` (row-major,
   // kTileSize wide), its rays at sample offset (dx, dy); every listed form cast into it.
@@ -173,7 +160,6 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
       for (int k = 1; k < s; ++k) far = std::max(far, scratch.depth[plane * size_t(k) + p]);
       scratch.centreDepth[p] = far;
     }
-    const std::vector<float> polygonFar = scratch.centreDepth;
     cast(0, 0, kTileSize, scratch.centreDepth.data(), scratch.centreObject.data(),
          scratch.centreZ.data(), 0, 0);
     // The centres with a ring of one pixel around the tile (kRing wide, row-major): inside from
@@ -269,12 +255,10 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
 
   // Step 2: shading, once per pixel and form that took some of its samples — at the first such
   // sample's hit (the centre with one sample) — 16 fragments of one form to a call.
-  struct Pending {
-    int lx, ly, sample;
-  };
   for (uint32_t f : listed) {
     const ShadedForm& form = forms_[f];
-    std::vector<Pending> pending;
+    std::vector<Scratch::Pending>& pending = scratch.pending;
+    pending.clear();
     for (int ly = 0; ly < kTileSize && oy + ly < height_; ++ly)
       for (int lx = 0; lx < kTileSize && ox + lx < width_; ++lx)
         for (int k = 0; k < s; ++k)
@@ -291,7 +275,7 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
       shade::Fragments frag;
       frag.count = count;
       for (int i = 0; i < count; ++i) {
-        const Pending& p = pending[begin + size_t(i)];
+        const Scratch::Pending& p = pending[begin + size_t(i)];
         const size_t at = plane * size_t(p.sample) + size_t(p.ly * kTileSize + p.lx);
         const double sx = ox + p.lx + 0.5 + offsetX_[p.sample];
         const double sy = oy + p.ly + 0.5 + offsetY_[p.sample];
@@ -338,15 +322,16 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
       shade::shadeFragments(form.material, *environment_, frag, out);
       // Step 3: depth and colour to every sample of the pixel this form took.
       for (int i = 0; i < count; ++i) {
-        const Pending& p = pending[begin + size_t(i)];
+        const Scratch::Pending& p = pending[begin + size_t(i)];
         uint16_t c16[3];
         for (int ch = 0; ch < 3; ++ch)
           c16[ch] = uint16_t(std::lrint(std::clamp(out[ch][i], 0.0f, 1.0f) * 65535.0f));
         for (int k = p.sample; k < s; ++k) {
           const size_t at = plane * size_t(k) + size_t(p.ly * kTileSize + p.lx);
           if (scratch.object[at] != f) continue;
-          depth[depthIndex(p.lx, p.ly, s, k)] = scratch.depth[at];
-          for (int ch = 0; ch < 3; ++ch) color[colorIndex(p.lx, p.ly, s, k, ch)] = c16[ch];
+          depth[FrameBuffer::depthOffset(p.lx, p.ly, s, k)] = scratch.depth[at];
+          for (int ch = 0; ch < 3; ++ch)
+            color[FrameBuffer::colorOffset(p.lx, p.ly, ch, s, k)] = c16[ch];
         }
       }
     }

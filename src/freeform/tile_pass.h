@@ -53,6 +53,10 @@ class FreeFormFrame {
     std::vector<uint32_t> ringObject;  // the centres with a one-pixel ring around the tile
     std::vector<float> ringDepth;
     RayFunction ray;
+    struct Pending {  // a pixel to shade, and its first sample the form took
+      int lx, ly, sample;
+    };
+    std::vector<Pending> pending;
   };
 
   // Casts the forms listed for tile (tileX, tileY) into its buffers — `samples` depth and colour

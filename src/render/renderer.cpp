@@ -227,7 +227,9 @@ std::vector<freeform::ShadedForm> shadedForms(const scene::Scene& scene, const M
     s.material.alpha = shade::AlphaUse::opaque;
     s.uvScale[0] = mat.uvScale.x;
     s.uvScale[1] = mat.uvScale.y;
-    for (int ch = 0; ch < 3; ++ch) s.color[ch] = (&mat.baseColor.x)[ch];
+    s.color[0] = mat.baseColor.x;
+    s.color[1] = mat.baseColor.y;
+    s.color[2] = mat.baseColor.z;
     out.push_back(std::move(s));
   }
   return out;
