@@ -8,6 +8,50 @@
 
 namespace sv::freeform {
 
+// u⁻⁴ and u⁻⁵ over u > 0: the factors of a perturbation's term in the cube (freeform.h).
+struct InversePowers {
+  Interval u4, u5;
+};
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+InversePowers inversePowers(Interval u) {
+  const double lo2 = u.lo * u.lo, hi2 = u.hi * u.hi;
+  return {{1 / (hi2 * hi2), 1 / (lo2 * lo2)}, {1 / (hi2 * hi2 * u.hi), 1 / (lo2 * lo2 * u.lo)}};
+}
+
+// A perturbation's term w·max(0, v)³·u⁻⁴ added to `value`, and its derivative in z,
+// w·(3p²·p'·u⁻⁴ − 4p³·u'·u⁻⁵) with p = max(0, v), u' = u1, added to `slope`.
+void addPerturbation(Interval v, Interval dv, double w, const InversePowers& inv, double u1,
+                     Interval& value, Interval& slope) {
+  const Interval p = positivePart(v);
+  const Interval dp = p.hi > 0 ? dv : Interval{0, 0};
+  value = value + cube(p) * inv.u4 * w;
+  slope = slope + ((square(p) * dp) * inv.u4 * 3 + cube(p) * inv.u5 * (-4 * u1)) * w;
+}
+
+// min(F', C) for a clip bounded by `clip`: its slope where it is the minimum throughout, both
+// slopes where either may be.
+Interval minimum(Interval a, Interval b) { return {std::min(a.lo, b.lo), std::min(a.hi, b.hi)}; }
+void takeMinimum(Interval clip, Interval clipSlope, Interval& value, Interval& slope) {
+  if (clip.hi < value.lo)
+    slope = clipSlope;
+  else if (clip.lo <= value.hi)
+    slope = {std::min(slope.lo, clipSlope.lo), std::max(slope.hi, clipSlope.hi)};
+  value = minimum(value, clip);
+}
+
+// The arithmetic rounds to nearest: bounds are widened by a few ulps of the magnitudes involved,
+// so that a cell the surface passes through is never rejected.
+Interval widened(Interval h) {
+  const double margin = 1e-12 * (std::fabs(h.lo) + std::fabs(h.hi)) + 1e-300;
+  return {h.lo - margin, h.hi + margin};
+}
+
+}  // namespace
+
 double FreeForm::evaluate(Vec3d p) const {
   double f = base.evaluate(p);
   for (const FreeForm& q : perturbations) {
@@ -101,66 +145,41 @@ Interval ProjectedFreeForm::boundNode(uint32_t i, Interval x, Interval y, Interv
 }
 
 Interval ProjectedFreeForm::bound(Interval x, Interval y, Interval z) const {
-  constexpr double kInf = std::numeric_limits<double>::infinity();
   const auto& w = inverse_.m[3];
   const Interval u = x * w[0] + y * w[1] + z * w[2] + w[3];
   if (!(u.lo > 0)) return {-kInf, kInf};
-  const double lo2 = u.lo * u.lo, hi2 = u.hi * u.hi;
-  Interval h = boundNode(0, x, y, z, {1 / (hi2 * hi2), 1 / (lo2 * lo2)});
-  for (const Quadric& c : clips_) {
-    const Interval b = c.bound(x, y, z);
-    h = {std::min(h.lo, b.lo), std::min(h.hi, b.hi)};
-  }
-  // The arithmetic rounds to nearest: widen by a few ulps of the magnitudes involved so that a
-  // cell the surface passes through is never rejected.
-  const double margin = 1e-12 * (std::fabs(h.lo) + std::fabs(h.hi)) + 1e-300;
-  return {h.lo - margin, h.hi + margin};
+  Interval h = boundNode(0, x, y, z, inversePowers(u).u4);
+  for (const Quadric& c : clips_) h = minimum(h, c.bound(x, y, z));
+  return widened(h);
 }
 
 void ProjectedFreeForm::boundNodeSlope(uint32_t i, Interval x, Interval y, Interval z,
-                                       Interval invU4, Interval invU5, Interval& value,
+                                       const InversePowers& inv, Interval& value,
                                        Interval& slope) const {
   const Quadric& q = nodes_[i].q;
   value = q.bound(x, y, z);
   slope = z * (2 * q.c[2]) + x * q.c[4] + y * q.c[5] + q.c[8];
-  const double u1 = inverse_.m[3][2];
   for (uint32_t c = i + 1; c < nodes_[i].end; c = nodes_[c].end) {
     Interval v, dv;
-    boundNodeSlope(c, x, y, z, invU4, invU5, v, dv);
-    // As RayFunction::boundNodeSlope: d/dz [w·p³/u⁴] = w·(3p²·p'/u⁴ − 4p³·u'/u⁵).
-    const Interval p = positivePart(v);
-    const Interval dp = p.hi > 0 ? dv : Interval{0, 0};
-    const double w = nodes_[c].weight;
-    value = value + cube(p) * invU4 * w;
-    slope = slope + ((square(p) * dp) * invU4 * 3 + cube(p) * invU5 * (-4 * u1)) * w;
+    boundNodeSlope(c, x, y, z, inv, v, dv);
+    addPerturbation(v, dv, nodes_[c].weight, inv, inverse_.m[3][2], value, slope);
   }
 }
 
 void ProjectedFreeForm::bound(Interval x, Interval y, Interval z, Interval& value,
                               Interval& slope) const {
-  constexpr double kInf = std::numeric_limits<double>::infinity();
   const auto& w = inverse_.m[3];
   const Interval u = x * w[0] + y * w[1] + z * w[2] + w[3];
   if (!(u.lo > 0)) {
     value = slope = {-kInf, kInf};
     return;
   }
-  const double lo2 = u.lo * u.lo, hi2 = u.hi * u.hi;
-  boundNodeSlope(0, x, y, z, {1 / (hi2 * hi2), 1 / (lo2 * lo2)},
-                 {1 / (hi2 * hi2 * u.hi), 1 / (lo2 * lo2 * u.lo)}, value, slope);
-  for (const Quadric& c : clips_) {
-    const Interval b = c.bound(x, y, z);
-    const Interval db = z * (2 * c.c[2]) + x * c.c[4] + y * c.c[5] + c.c[8];
-    if (b.hi < value.lo)
-      slope = db;
-    else if (b.lo <= value.hi)
-      slope = {std::min(slope.lo, db.lo), std::max(slope.hi, db.hi)};
-    value = {std::min(value.lo, b.lo), std::min(value.hi, b.hi)};
-  }
-  const double margin = 1e-12 * (std::fabs(value.lo) + std::fabs(value.hi)) + 1e-300;
-  value = {value.lo - margin, value.hi + margin};
-  const double slopeMargin = 1e-12 * (std::fabs(slope.lo) + std::fabs(slope.hi)) + 1e-300;
-  slope = {slope.lo - slopeMargin, slope.hi + slopeMargin};
+  boundNodeSlope(0, x, y, z, inversePowers(u), value, slope);
+  for (const Quadric& c : clips_)
+    takeMinimum(c.bound(x, y, z), z * (2 * c.c[2]) + x * c.c[4] + y * c.c[5] + c.c[8], value,
+                slope);
+  value = widened(value);
+  slope = widened(slope);
 }
 
 namespace {
@@ -170,19 +189,6 @@ void alongZ(const Quadric& q, double x, double y, double& a, double& b, double& 
   a = k[2];
   b = k[4] * x + k[5] * y + k[8];
   c = (k[0] * x + k[3] * y + k[6]) * x + (k[1] * y + k[7]) * y + k[9];
-}
-// The exact range of a·z² + b·z + c over Z.
-Interval quadraticOver(double a, double b, double c, Interval z) {
-  auto f = [&](double t) { return (a * t + b) * t + c; };
-  double lo = std::min(f(z.lo), f(z.hi)), hi = std::max(f(z.lo), f(z.hi));
-  if (a != 0) {
-    const double v = -b / (2 * a);
-    if (v > z.lo && v < z.hi) {
-      lo = std::min(lo, f(v));
-      hi = std::max(hi, f(v));
-    }
-  }
-  return {lo, hi};
 }
 }  // namespace
 
@@ -253,67 +259,45 @@ double RayFunction::evaluate(double z) const {
 
 Interval RayFunction::boundNode(uint32_t i, Interval z, Interval invU4) const {
   const Node& n = nodes_[i];
-  Interval h = quadraticOver(n.a, n.b, n.c, z);
+  Interval h = quadraticRange(n.a, n.b, n.c, z);
   for (uint32_t c = i + 1; c < n.end; c = nodes_[c].end)
     h = h + cube(positivePart(boundNode(c, z, invU4))) * invU4 * nodes_[c].weight;
   return h;
 }
 
-void RayFunction::boundNodeSlope(uint32_t i, Interval z, Interval invU4, Interval invU5,
+void RayFunction::boundNodeSlope(uint32_t i, Interval z, const InversePowers& inv,
                                  Interval& value, Interval& slope) const {
   const Node& n = nodes_[i];
-  value = quadraticOver(n.a, n.b, n.c, z);
+  value = quadraticRange(n.a, n.b, n.c, z);
   slope = z * (2 * n.a) + n.b;
   for (uint32_t c = i + 1; c < n.end; c = nodes_[c].end) {
     Interval v, dv;
-    boundNodeSlope(c, z, invU4, invU5, v, dv);
-    // d/dz [w·p³/u⁴] = w·(3p²·p'/u⁴ − 4p³·u'/u⁵), p = max(0, v), u' = u1.
-    const Interval p = positivePart(v);
-    const Interval dp = p.hi > 0 ? dv : Interval{0, 0};
-    const double w = nodes_[c].weight;
-    value = value + cube(p) * invU4 * w;
-    slope = slope + ((square(p) * dp) * invU4 * 3 + cube(p) * invU5 * (-4 * u1_)) * w;
+    boundNodeSlope(c, z, inv, v, dv);
+    addPerturbation(v, dv, nodes_[c].weight, inv, u1_, value, slope);
   }
 }
 
 void RayFunction::bound(double z0, double z1, Interval& value, Interval& slope) const {
-  constexpr double kInf = std::numeric_limits<double>::infinity();
-  const Interval u = Interval{z0, z1} * u1_ + u0_;
+  const Interval z{z0, z1}, u = z * u1_ + u0_;
   if (!(u.lo > 0)) {
     value = slope = {-kInf, kInf};
     return;
   }
-  const double lo2 = u.lo * u.lo, hi2 = u.hi * u.hi;
-  boundNodeSlope(0, {z0, z1}, {1 / (hi2 * hi2), 1 / (lo2 * lo2)},
-                 {1 / (hi2 * hi2 * u.hi), 1 / (lo2 * lo2 * u.lo)}, value, slope);
-  for (const Node& c : clips_) {
-    const Interval b = quadraticOver(c.a, c.b, c.c, {z0, z1});
-    const Interval db = Interval{z0, z1} * (2 * c.a) + c.b;
-    if (b.hi < value.lo) {  // the clip is the minimum throughout
-      slope = db;
-    } else if (b.lo <= value.hi) {  // either may be: both slopes
-      slope = {std::min(slope.lo, db.lo), std::max(slope.hi, db.hi)};
-    }
-    value = {std::min(value.lo, b.lo), std::min(value.hi, b.hi)};
-  }
-  const double margin = 1e-12 * (std::fabs(value.lo) + std::fabs(value.hi)) + 1e-300;
-  value = {value.lo - margin, value.hi + margin};
-  const double slopeMargin = 1e-12 * (std::fabs(slope.lo) + std::fabs(slope.hi)) + 1e-300;
-  slope = {slope.lo - slopeMargin, slope.hi + slopeMargin};
+  boundNodeSlope(0, z, inversePowers(u), value, slope);
+  for (const Node& c : clips_)
+    takeMinimum(quadraticRange(c.a, c.b, c.c, z),
+                z * (2 * c.a) + c.b, value, slope);
+  value = widened(value);
+  slope = widened(slope);
 }
 
 Interval RayFunction::bound(double z0, double z1) const {
-  constexpr double kInf = std::numeric_limits<double>::infinity();
-  const Interval u = Interval{z0, z1} * u1_ + u0_;
+  const Interval z{z0, z1}, u = z * u1_ + u0_;
   if (!(u.lo > 0)) return {-kInf, kInf};
-  const double lo2 = u.lo * u.lo, hi2 = u.hi * u.hi;
-  Interval h = boundNode(0, {z0, z1}, {1 / (hi2 * hi2), 1 / (lo2 * lo2)});
-  for (const Node& c : clips_) {
-    const Interval b = quadraticOver(c.a, c.b, c.c, {z0, z1});
-    h = {std::min(h.lo, b.lo), std::min(h.hi, b.hi)};
-  }
-  const double margin = 1e-12 * (std::fabs(h.lo) + std::fabs(h.hi)) + 1e-300;
-  return {h.lo - margin, h.hi + margin};
+  Interval h = boundNode(0, z, inversePowers(u).u4);
+  for (const Node& c : clips_)
+    h = minimum(h, quadraticRange(c.a, c.b, c.c, z));
+  return widened(h);
 }
 
 }  // namespace sv::freeform

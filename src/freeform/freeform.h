@@ -42,6 +42,7 @@ struct FreeForm {
 //   H(q) = u(q)²·F'(p(q)) = F_M(q) + Σ_i w_i·max(0, H_i(q))³ / u(q)⁴,
 // recursively — the same surface and inside wherever u > 0 (in front of the eye).
 class ProjectedFreeForm;
+struct InversePowers;  // u⁻⁴ and u⁻⁵ over a cell (freeform.cpp)
 
 // H along one ray of the cube — x and y fixed, z free — where every quadric is a quadratic in z and
 // u is linear: evaluation costs a few operations per quadric, and bounds over a z interval are
@@ -67,7 +68,7 @@ class RayFunction {
   double evaluateNode(uint32_t i, double z, double invU4) const;
   double evaluateNode(uint32_t i, double z, double invU4, double du4, double& slope) const;
   Interval boundNode(uint32_t i, Interval z, Interval invU4) const;
-  void boundNodeSlope(uint32_t i, Interval z, Interval invU4, Interval invU5, Interval& value,
+  void boundNodeSlope(uint32_t i, Interval z, const InversePowers& inv, Interval& value,
                       Interval& slope) const;
   std::vector<Node> nodes_;
   std::vector<Node> clips_;
@@ -100,8 +101,8 @@ class ProjectedFreeForm {
   };
   double evaluateNode(uint32_t i, Vec3d q, double invU4) const;
   Interval boundNode(uint32_t i, Interval x, Interval y, Interval z, Interval invU4) const;
-  void boundNodeSlope(uint32_t i, Interval x, Interval y, Interval z, Interval invU4,
-                      Interval invU5, Interval& value, Interval& slope) const;
+  void boundNodeSlope(uint32_t i, Interval x, Interval y, Interval z,
+                      const InversePowers& inv, Interval& value, Interval& slope) const;
   static void flatten(const FreeForm& form, const Mat4d& inverse, std::vector<Node>& out);
 
   std::vector<Node> nodes_;

@@ -223,31 +223,6 @@ Vec3d Quadric::gradient(Vec3d p) const {
           2 * c[2] * z + c[4] * x + c[5] * y + c[8]};
 }
 
-namespace {
-
-// The range of a·t² + b·t + c over t ∈ T, b ∈ B, c ∈ C, exactly when b and c are independent of
-// t and each other: for fixed t it is linear in b, so b's extremes suffice, and for fixed b the
-// quadratic's extremes lie at T's ends or at its vertex −b/2a.
-Interval quadraticRange(double a, Interval b, Interval c, Interval t) {
-  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  auto at = [&](double bb, double tt) {
-    const double v = (a * tt + bb) * tt;
-    lo = std::min(lo, v);
-    hi = std::max(hi, v);
-  };
-  for (const double bb : {b.lo, b.hi}) {
-    at(bb, t.lo);
-    at(bb, t.hi);
-    if (a != 0) {
-      const double vertex = -bb / (2 * a);
-      if (vertex > t.lo && vertex < t.hi) at(bb, vertex);
-    }
-  }
-  return {lo + c.lo, hi + c.hi};
-}
-
-}  // namespace
-
 Interval Quadric::bound(Interval x, Interval y, Interval z) const {
   // Exact in z, centred in x and y. With (x, y) = (x_c + h_x, y_c + h_y), |h| ≤ r:
   //   F = F(x_c, y_c, z) + F_x(x_c, y_c, z)·h_x + F_y(x_c, y_c, z)·h_y + A·h_x² + B·h_y² + D·h_x·h_y
@@ -262,7 +237,7 @@ Interval Quadric::bound(Interval x, Interval y, Interval z) const {
   // F(x_c, y_c, z) = C·z² + (E·x_c + F·y_c + I)·z + [A·x_c² + B·y_c² + D·x_c·y_c + G·x_c + H·y_c + K]
   const double b = c[4] * xc + c[5] * yc + c[8];
   const double k = (c[0] * xc + c[3] * yc + c[6]) * xc + (c[1] * yc + c[7]) * yc + c[9];
-  const Interval centre = quadraticRange(c[2], Interval::point(b), Interval::point(k), z);
+  const Interval centre = quadraticRange(c[2], b, k, z);
   // F_x = 2A·x_c + D·y_c + G + E·z, F_y = 2B·y_c + D·x_c + H + F·z.
   const double gx0 = 2 * c[0] * xc + c[3] * yc + c[6], gy0 = 2 * c[1] * yc + c[3] * xc + c[7];
   const double gx = std::max(std::fabs(gx0 + c[4] * z.lo), std::fabs(gx0 + c[4] * z.hi));

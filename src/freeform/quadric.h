@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <array>
+#include <limits>
 #include <optional>
 
 namespace sv::freeform {
@@ -77,6 +78,26 @@ inline Interval square(Interval a) {
 }
 inline Interval cube(Interval a) { return {a.lo * a.lo * a.lo, a.hi * a.hi * a.hi}; }  // monotonic
 inline Interval positivePart(Interval a) { return {std::max(a.lo, 0.0), std::max(a.hi, 0.0)}; }
+// The exact range of a·t² + b·t + c over t ∈ T: its ends, and its vertex −b/2a when inside.
+inline Interval quadraticRange(double a, double b, double c, Interval t) {
+  auto f = [&](double v) { return (a * v + b) * v + c; };
+  double lo = std::min(f(t.lo), f(t.hi)), hi = std::max(f(t.lo), f(t.hi));
+  if (a != 0) {
+    const double vertex = -b / (2 * a);
+    if (vertex > t.lo && vertex < t.hi) {
+      lo = std::min(lo, f(vertex));
+      hi = std::max(hi, f(vertex));
+    }
+  }
+  return {lo, hi};
+}
+// The same over b ∈ B and c ∈ C as well — exact when b and c are independent of t and of each
+// other: for fixed t it is linear in b, so b's ends suffice.
+inline Interval quadraticRange(double a, Interval b, Interval c, Interval t) {
+  const Interval r0 = quadraticRange(a, b.lo, 0.0, t), r1 = quadraticRange(a, b.hi, 0.0, t);
+  return {std::min(r0.lo, r1.lo) + c.lo, std::max(r0.hi, r1.hi) + c.hi};
+}
+
 
 // F(x, y, z) = Ax² + By² + Cz² + Dxy + Exz + Fyz + Gx + Hy + Iz + K: coefficients in this order.
 struct Quadric {
