@@ -60,6 +60,19 @@ constexpr double kBracket = 0x1p-16;
 // (tests/render: a quadric that is zero everywhere); a surface crossing costs some 2·16 spans.
 constexpr int kSpanBudget = 128;
 
+// A crossing at cube depth z of form `id`, taken where it is nearer than the pixel's depth:
+// depth, object and cube depth (those given) written. True if taken.
+bool takeHit(double z, uint32_t id, float& depth, uint32_t* object, double* cubeZ,
+             CastStats& stats) {
+  const float d = float(windowDepth(z));
+  if (!(d < depth)) return false;
+  ++stats.hits;
+  depth = d;
+  if (object) *object = id;
+  if (cubeZ) *cubeZ = z;
+  return true;
+}
+
 // One ray's binary tree in depth on its own function (RayFunction: exact per-quadric bounds), front
 // to back: the first zero of H in [zlo, zhi]. A span where H is monotonic (its slope bound excludes
 // 0) holds at most one zero, refined when its ends differ in sign; others are halved down to
@@ -235,13 +248,10 @@ class Caster {
   }
 
   void hit(int lx, int ly, size_t at, double z) {
-    const float d = float(windowDepth(z));
-    if (!(d < w_.depth[at])) return;
-    ++stats_.hits;
-    w_.depth[at] = d;
-    if (w_.object) w_.object[at] = id_;
-    if (w_.cubeZ) w_.cubeZ[at] = z;
-    node(0, lx, ly) = d;
+    if (!takeHit(z, id_, w_.depth[at], w_.object ? w_.object + at : nullptr,
+                 w_.cubeZ ? w_.cubeZ + at : nullptr, stats_))
+      return;
+    node(0, lx, ly) = w_.depth[at];
     for (int l = 1; l <= top_; ++l) updateNode(l, lx >> l, ly >> l);
   }
 
@@ -274,13 +284,7 @@ void castRay(const ProjectedFreeForm& form, uint32_t id, double x, double y, dou
   if (!(zlo < zhi)) return;
   form.ray(x, y, ray);
   double z;
-  if (!firstCrossing(ray, zlo, zhi, hint, z, stats)) return;
-  const float d = float(windowDepth(z));
-  if (!(d < depth)) return;
-  ++stats.hits;
-  depth = d;
-  object = id;
-  cubeZ = z;
+  if (firstCrossing(ray, zlo, zhi, hint, z, stats)) takeHit(z, id, depth, &object, &cubeZ, stats);
 }
 
 void marchWindow(const ProjectedFreeForm& form, uint32_t id, const CastWindow& window, int steps,
@@ -302,14 +306,9 @@ void marchWindow(const ProjectedFreeForm& form, uint32_t id, const CastWindow& w
             std::min(zEnd, i == steps ? 1.0 : ray.cubeDepth(tNear + (tFar - tNear) * i / steps));
         const double fb = ray.evaluate(b);
         if (inside(fb) != inside(fa)) {
-          const double z = refineBracket(ray, a, b, fa, fb);
-          const float d = float(windowDepth(z));
-          if (d < window.depth[at]) {
-            ++stats.hits;
-            window.depth[at] = d;
-            if (window.object) window.object[at] = id;
-            if (window.cubeZ) window.cubeZ[at] = z;
-          }
+          takeHit(refineBracket(ray, a, b, fa, fb), id, window.depth[at],
+                  window.object ? window.object + at : nullptr,
+                  window.cubeZ ? window.cubeZ + at : nullptr, stats);
           break;
         }
         a = b, fa = fb;

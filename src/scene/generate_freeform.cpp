@@ -23,7 +23,7 @@ FreeFormNode perturbation(Vec3d at, double radius, bool ellipsoid, double weight
   return n;
 }
 
-void addLightAndMaterial(Scene& s) {
+void addBenchLight(Scene& s) {
   s.light.enabled = true;
   s.light.direction = {-0.5f, -1.0f, -0.6f};
   s.light.color = {1.0f, 0.97f, 0.92f};
@@ -37,7 +37,7 @@ Scene generateFreeForms(const FreeFormParams& p) {
   auto uniform = [&](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
   Scene s;
   s.background = {0.55f, 0.62f, 0.72f};
-  addLightAndMaterial(s);
+  addBenchLight(s);
   s.fog = {true, {0.55f, 0.62f, 0.72f}, 0.04f};
   Camera cam;
   cam.name = "bench";
@@ -106,7 +106,7 @@ Scene generateFreeForms(const FreeFormParams& p) {
 Scene generateFreeFormOne() {
   Scene s;
   s.background = {0.08f, 0.09f, 0.12f};
-  addLightAndMaterial(s);
+  addBenchLight(s);
   Camera cam;
   cam.name = "bench";
   cam.position = {0, 0.9f, 3.6f};
