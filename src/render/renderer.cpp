@@ -144,6 +144,16 @@ void buildShading(const scene::Scene& scene, const RenderOptions& o, const Mat4&
   for (const scene::Material& mat : scene.materials) out.any |= mat.needsPixelShading();
 }
 
+// The smallest view depth of the corners of the box [lo, hi] placed by `toEye`.
+float nearestEyeDepth(const Mat4& toEye, Vec3 lo, Vec3 hi) {
+  float near = std::numeric_limits<float>::infinity();
+  for (int c = 0; c < 8; ++c) {
+    const Vec3 corner{c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z};
+    near = std::min(near, -toEye.transformPoint(corner).z);
+  }
+  return near;
+}
+
 // The order instances are drawn in (indices into scene.instances). Opaque ones: in submission
 // order for the Z-buffer; for masking (SPEC §4) by priority, then nearest first — by the smallest
 // view depth of their bounding box's corners, which orders objects separated in depth correctly
@@ -162,12 +172,7 @@ std::vector<uint32_t> drawOrder(const scene::Scene& scene, const Mat4& view, Ren
     const scene::Instance& inst = scene.instances[i];
     const auto& [lo, hi] = boxes[size_t(inst.mesh)];
     const Mat4 toEye = view * inst.transform;
-    float near = std::numeric_limits<float>::infinity();
-    for (int c = 0; c < 8; ++c) {
-      const Vec3 corner{c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z};
-      near = std::min(near, -toEye.transformPoint(corner).z);
-    }
-    nearest[i] = near;
+    nearest[i] = nearestEyeDepth(toEye, lo, hi);
     centre[i] = -toEye.transformPoint((lo + hi) * 0.5f).z;
   }
   auto translucent = [&](uint32_t i) {
@@ -323,13 +328,9 @@ Result<scene::Scene> tessellatedScene(const scene::Scene& scene, const RenderOpt
     if (!box) continue;  // no surface
     // The nearest eye depth of the box, and its smallest half extent as the curvature radius.
     const Mat4 toEye = camera.value().view * object.transform;
-    double nearest = std::numeric_limits<double>::infinity();
-    for (int c = 0; c < 8; ++c) {
-      const Vec3 corner{float(c & 1 ? (*box)[1].x : (*box)[0].x), float(c & 2 ? (*box)[1].y : (*box)[0].y),
-                        float(c & 4 ? (*box)[1].z : (*box)[0].z)};
-      nearest = std::min(nearest, double(-toEye.transformPoint(corner).z));
-    }
-    nearest = std::max(nearest, double(cam.znear));
+    const auto single = [](freeform::Vec3d v) { return Vec3{float(v.x), float(v.y), float(v.z)}; };
+    const double nearest = std::max(
+        double(nearestEyeDepth(toEye, single((*box)[0]), single((*box)[1]))), double(cam.znear));
     const freeform::Vec3d extent = (*box)[1] - (*box)[0];
     const double radius = 0.5 * std::min({extent.x, extent.y, extent.z});
     // Object units per pixel at that depth (the transform's largest scale brings it to the world).
