@@ -93,6 +93,10 @@ struct FrameStats {
   uint64_t drawn = 0;
   uint64_t windows[6] = {};
   uint64_t fullWindows = 0, partialBlocks = 0, fragments = 0;
+  uint64_t hiddenFragments = 0;  // fragments of which the depth test passed no sample
+  // Hybrid masking: tile passes (a tile per batch) in which it woke — a tile starts as the plain
+  // Z-buffer and masks once the depth test has hidden enough (docs/hidden-surfaces.md).
+  uint64_t hybridWoken = 0;
   uint64_t occludedWindows = 0;    // windows triangles were dropped from as occupied (priority)
   uint64_t occludedTriangles = 0;  // triangles dropped whole from a tile (their box occupied)
   uint64_t occludedObjects = 0;    // objects dropped whole from a tile (their bound occupied)

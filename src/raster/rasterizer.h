@@ -27,6 +27,8 @@ struct RasterStats {
   uint64_t partialBlocks = 0;          // 4×4 leaves tested pixel by pixel
   uint64_t fragments = 0;              // pixels that passed coverage (some sample, with
                                        // anti-aliasing) and reached the depth test
+  uint64_t hiddenFragments = 0;        // … of which the depth test passed none
+  uint64_t hybridWoken = 0;           // tile passes in which hybrid masking woke (drawLists)
 
   void add(const RasterStats& o) {
     for (int i = 0; i < kStatLevels; ++i) windows[i] += o.windows[i];
@@ -36,6 +38,8 @@ struct RasterStats {
     occludedObjects += o.occludedObjects;
     partialBlocks += o.partialBlocks;
     fragments += o.fragments;
+    hiddenFragments += o.hiddenFragments;
+    hybridWoken += o.hybridWoken;
   }
 };
 

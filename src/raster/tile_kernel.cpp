@@ -167,7 +167,9 @@ HWY_INLINE auto colorLanes(DF df, const PlaneLanes& lanes, const float* base, in
 
 // Depth test ("less") and Gouraud colour for the pixels of one 4×4 block set in `mask`.
 // (gx, gy) is the block's top-left pixel; `depth` and `color` point at the block's storage.
-HWY_INLINE void shadeBlock(const TriangleSetup& t, const PlaneLanes& lanes, uint32_t mask, int gx,
+// Returns how many of the pixels failed the depth test (hidden fragments, as every depth-testing
+// block operation here: hybrid masking wakes on them, drawLists).
+HWY_INLINE int shadeBlock(const TriangleSetup& t, const PlaneLanes& lanes, uint32_t mask, int gx,
                            int gy, float* depth, uint16_t* color) {
   const hn::CappedTag<float, kBlockPixels> df;
   const hn::RebindToSigned<decltype(df)> di;
@@ -177,6 +179,7 @@ HWY_INLINE void shadeBlock(const TriangleSetup& t, const PlaneLanes& lanes, uint
   blockBases(t, lanes, gx, gy, base);
   const auto maskVec = hn::Set(di, static_cast<int32_t>(mask));
   const auto one = hn::Set(df, 1.0f);
+  int hidden = 0;
   for (size_t i = 0; i < size_t(kBlockPixels); i += n) {
     const auto covered = hn::TestBit(maskVec, hn::LoadU(di, kLaneBit + i));
     if (hn::AllFalse(di, covered)) continue;
@@ -184,6 +187,7 @@ HWY_INLINE void shadeBlock(const TriangleSetup& t, const PlaneLanes& lanes, uint
     const auto z = hn::Add(hn::Set(df, base[kDepth]), hn::LoadU(df, lanes.offset[kDepth] + i));
     const auto zOld = hn::LoadU(df, depth + i);
     const auto pass = hn::And(hn::RebindMask(df, covered), hn::Lt(z, zOld));
+    hidden += int(hn::CountTrue(di, covered) - hn::CountTrue(df, pass));
     if (hn::AllFalse(df, pass)) continue;
     hn::StoreU(hn::IfThenElse(pass, z, zOld), df, depth + i);
     // SPEC §2: perspective-correct colour = (colour/w) / (1/w).
@@ -197,6 +201,7 @@ HWY_INLINE void shadeBlock(const TriangleSetup& t, const PlaneLanes& lanes, uint
                  du, dst);
     }
   }
+  return hidden;
 }
 
 // The centroid of each lane's covered samples relative to its pixel centre, in pixels (zero for a
@@ -230,8 +235,9 @@ HWY_INLINE void centroidOffsets(DF df, const CoverageTables& cov, VU m0, VU m1, 
 // The planes are evaluated at the centroid as (base + offset) + (dx·cx + dy·cy).
 // `shading`: the triangle's coverage that places the shading position when `masks` holds less of
 // it (priority masking removes occupied samples, but the Z-buffer shades the same pixel at the
-// centroid of all it covers; the two must agree); nullptr: `masks`.
-HWY_INLINE void shadeBlockSamples(const TriangleSetup& t, const PlaneLanes& lanes,
+// centroid of all it covers; the two must agree); nullptr: `masks`. Returns the covered pixels
+// none of whose samples passed.
+HWY_INLINE int shadeBlockSamples(const TriangleSetup& t, const PlaneLanes& lanes,
                                   const CoverageTables& cov, const float* sampleDepth,
                                   const uint32_t (*masks)[kBlockPixels], int gx, int gy,
                                   float* depth, uint16_t* color,
@@ -248,6 +254,7 @@ HWY_INLINE void shadeBlockSamples(const TriangleSetup& t, const PlaneLanes& lane
   alignas(32) float base[8];
   blockBases(t, lanes, gx, gy, base);
   const auto one = hn::Set(df, 1.0f), tiny = hn::Set(df, 1e-30f);
+  int hidden = 0;
   for (size_t i = 0; i < size_t(kBlockPixels); i += n) {
     auto m0 = hn::Set(du32, ~0u), m1 = m0;
     if (masks) {
@@ -276,6 +283,7 @@ HWY_INLINE void shadeBlockSamples(const TriangleSetup& t, const PlaneLanes& lane
     hn::Vec<decltype(du)> c16[kColorChannels];
     for (int ch = 0; ch < kColorChannels; ++ch)
       c16[ch] = hn::DemoteTo(du, colorToLanes(df, at(kRed + ch), w));
+    auto anyPass = hn::FirstN(df, 0);
     for (int s = 0; s < samples; ++s) {
       const auto covered =
           hn::RebindMask(df, hn::TestBit(s < 32 ? m0 : m1, hn::Set(du32, 1u << (s & 31))));
@@ -285,6 +293,7 @@ HWY_INLINE void shadeBlockSamples(const TriangleSetup& t, const PlaneLanes& lane
       const auto zOld = hn::LoadU(df, zPlane);
       const auto pass = hn::And(covered, hn::Lt(z, zOld));
       if (hn::AllFalse(df, pass)) continue;
+      anyPass = hn::Or(anyPass, pass);
       hn::BlendedStore(z, pass, df, zPlane);
       // The pass mask in 16-bit lanes (−1 stays −1 under the saturating demotion), then masked
       // stores: a third of the instructions of widening, blending and narrowing each channel.
@@ -294,7 +303,10 @@ HWY_INLINE void shadeBlockSamples(const TriangleSetup& t, const PlaneLanes& lane
         hn::BlendedStore(c16[ch], pass16, du,
                          color + size_t(s) * kColorPerBlock + ch * kBlockPixels + i);
     }
+    hidden += int(hn::CountTrue(du32, hn::Ne(hn::Or(m0, m1), hn::Zero(du32))) -
+                  hn::CountTrue(df, anyPass));
   }
+  return hidden;
 }
 
 // ---- Pixel shading (ShadeMode::material): the kernel finds the pixels and samples that pass the
@@ -401,8 +413,8 @@ HWY_INLINE void storeShaded(DF df, M pass, bool blend, const float (*rgba)[kBloc
   }
 }
 
-// One 4×4 block at one sample per pixel.
-HWY_INLINE void shadeBlockMaterial(const TriangleSetup& t, const PlaneLanes& lanes,
+// One 4×4 block at one sample per pixel; returns the pixels hidden by the depth test.
+HWY_INLINE int shadeBlockMaterial(const TriangleSetup& t, const PlaneLanes& lanes,
                                    const AttributeLanes& al, const AttributeSetup& a,
                                    const shade::Environment& env, uint32_t mask, int gx, int gy,
                                    float* depth, uint16_t* color, uint32_t* visible) {
@@ -421,7 +433,8 @@ HWY_INLINE void shadeBlockMaterial(const TriangleSetup& t, const PlaneLanes& lan
     hn::StoreMaskBits(df, hn::And(covered, hn::Lt(z, hn::LoadU(df, depth + i))), bits);
     passBits |= (uint32_t(bits[0]) | uint32_t(bits[1]) << 8) << i;
   }
-  if (!passBits) return;
+  const int hidden = std::popcount(mask) - std::popcount(passBits);
+  if (!passBits) return hidden;
   // Step 2: shade all 16 pixels at once, then write those that pass (and are not cut away).
   shade::Fragments f;
   blockFragments(t, lanes, al, base, gx, gy, nullptr, nullptr, shade::attributesUsed(*a.material, env), f);
@@ -446,6 +459,7 @@ HWY_INLINE void shadeBlockMaterial(const TriangleSetup& t, const PlaneLanes& lan
     }
     storeShaded(df, pass, blend, rgba, i, color);
   }
+  return hidden;
 }
 
 // Anti-aliased pixel shading, in three steps so that the pixels of several blocks of one
@@ -457,12 +471,12 @@ HWY_INLINE void shadeBlockMaterial(const TriangleSetup& t, const PlaneLanes& lan
 
 // Step 1 for block (gx, gy): the samples that pass, a bit per sample as the masks hold them
 // (masks nullptr: all covered), and the centroid offsets (cx, cy) of partly covered pixels.
-// False if none pass.
+// False if none pass. `hidden` counts the covered pixels none of whose samples pass.
 HWY_INLINE bool samplesPassing(const TriangleSetup& t, const PlaneLanes& lanes,
                                const CoverageTables& cov, const float* sampleDepth,
                                const uint32_t (*masks)[kBlockPixels], int gx, int gy,
                                const float* depth, uint32_t (*pass)[kBlockPixels], float* cx,
-                               float* cy, const uint32_t (*shading)[kBlockPixels] = nullptr) {
+                               float* cy, const uint32_t (*shading)[kBlockPixels], int& hidden) {
   const int samples = cov.samples;
   const uint32_t fullWord0 = fullSampleWord(samples, 0), fullWord1 = fullSampleWord(samples, 1);
   const hn::CappedTag<float, kBlockPixels> df;
@@ -493,8 +507,10 @@ HWY_INLINE bool samplesPassing(const TriangleSetup& t, const PlaneLanes& lanes,
     }
     hn::StoreU(p0, du32, pass[0] + i);
     hn::StoreU(p1, du32, pass[1] + i);
+    const auto none = hn::Eq(hn::Or(p0, p1), hn::Zero(du32));
+    hidden += int(hn::CountTrue(du32, hn::AndNot(hn::Eq(hn::Or(m0, m1), hn::Zero(du32)), none)));
     auto x = hn::Zero(df), y = x;
-    if (!hn::AllTrue(du32, hn::Eq(hn::Or(p0, p1), hn::Zero(du32)))) {
+    if (!hn::AllTrue(du32, none)) {
       any = true;
       auto s0 = m0, s1 = m1;  // as shadeBlockSamples
       if (shading) {
@@ -583,7 +599,8 @@ HWY_INLINE void batchFragments(const PlaneLanes& lanes,
 // Visibility (PixelOp::visibility): the depth test alone, recording triangle `id` in the pixels it
 // wins — the SPEC §1 split of visibility from shading that the image generators of the seeds made
 // in hardware: each pixel is shaded once, by its final winner, however many triangles covered it.
-HWY_INLINE void visibleBlock(const TriangleSetup& t, const PlaneLanes& lanes, uint32_t mask, int gx,
+// Returns the pixels hidden by the depth test.
+HWY_INLINE int visibleBlock(const TriangleSetup& t, const PlaneLanes& lanes, uint32_t mask, int gx,
                              int gy, uint32_t id, float* depth, uint32_t* visible) {
   const hn::CappedTag<float, kBlockPixels> df;
   const hn::RebindToSigned<decltype(df)> di;
@@ -593,30 +610,38 @@ HWY_INLINE void visibleBlock(const TriangleSetup& t, const PlaneLanes& lanes, ui
   blockBases(t, lanes, gx, gy, base);
   const auto maskVec = hn::Set(di, static_cast<int32_t>(mask));
   const auto idVec = hn::Set(du, id);
+  int hidden = 0;
   for (size_t i = 0; i < size_t(kBlockPixels); i += n) {
     const auto covered = hn::RebindMask(df, hn::TestBit(maskVec, hn::LoadU(di, kLaneBit + i)));
     if (hn::AllFalse(df, covered)) continue;
     const auto z = hn::Add(hn::Set(df, base[kDepth]), hn::LoadU(df, lanes.offset[kDepth] + i));
     const auto pass = hn::And(covered, hn::Lt(z, hn::LoadU(df, depth + i)));
+    hidden += int(hn::CountTrue(df, covered) - hn::CountTrue(df, pass));
     hn::BlendedStore(z, pass, df, depth + i);
     hn::BlendedStore(idVec, hn::RebindMask(du, pass), du, visible + i);
   }
+  return hidden;
 }
 
 // The levels view (PixelOp::levels): the depth test, and in the pixels that pass, `level` in the
-// red channel (ShadeMode::levels).
-HWY_INLINE void levelBlock(const TriangleSetup& t, const PlaneLanes& lanes, uint32_t mask, int gx,
-                           int gy, int level, float* depth, uint16_t* color) {
+// red channel (ShadeMode::levels). Returns the pixels hidden by the depth test.
+HWY_INLINE int levelBlock(const TriangleSetup& t, const PlaneLanes& lanes, uint32_t mask, int gx,
+                          int gy, int level, float* depth, uint16_t* color) {
   alignas(32) float base[8];
   blockBases(t, lanes, gx, gy, base);
+  int hidden = 0;
   for (int l = 0; l < kBlockPixels; ++l) {
     if (!(mask >> l & 1)) continue;
     const float z = base[kDepth] + lanes.offset[kDepth][l];
-    if (!(z < depth[l])) continue;
+    if (!(z < depth[l])) {
+      ++hidden;
+      continue;
+    }
     depth[l] = z;
     color[l] = uint16_t(level);
     color[kBlockPixels + l] = color[2 * kBlockPixels + l] = 0;
   }
+  return hidden;
 }
 
 // The occupancy view (TileWork::debugOccupancy): each pixel's red channel the log2 size of the
@@ -1300,19 +1325,23 @@ class TriangleRaster {
     if constexpr (kOp == PixelOp::overdraw) {
       countBlock(mask, ctx_.color + block * kColorPerBlock);
     } else if constexpr (kOp == PixelOp::levels) {
-      levelBlock(t_, planeLanes_, mask, ctx_.originX + lx, ctx_.originY + ly, drawLevel_,
-                 ctx_.depth + block * kBlockPixels, ctx_.color + block * kColorPerBlock);
+      ctx_.stats->hiddenFragments +=
+          levelBlock(t_, planeLanes_, mask, ctx_.originX + lx, ctx_.originY + ly, drawLevel_,
+                     ctx_.depth + block * kBlockPixels, ctx_.color + block * kColorPerBlock);
     } else if constexpr (kOp == PixelOp::visibility) {
-      visibleBlock(t_, planeLanes_, mask, ctx_.originX + lx, ctx_.originY + ly, id_,
-                   ctx_.depth + block * kBlockPixels, ctx_.visible + block * kBlockPixels);
+      ctx_.stats->hiddenFragments +=
+          visibleBlock(t_, planeLanes_, mask, ctx_.originX + lx, ctx_.originY + ly, id_,
+                       ctx_.depth + block * kBlockPixels, ctx_.visible + block * kBlockPixels);
     } else if constexpr (kOp == PixelOp::material) {
-      shadeBlockMaterial(t_, planeLanes_, attributeLanes_, *attributes_, *ctx_.environment, mask,
-                         ctx_.originX + lx, ctx_.originY + ly, ctx_.depth + block * kBlockPixels,
-                         ctx_.color + block * kColorPerBlock,
-                         ctx_.visible ? ctx_.visible + block * kBlockPixels : nullptr);
+      ctx_.stats->hiddenFragments += shadeBlockMaterial(
+          t_, planeLanes_, attributeLanes_, *attributes_, *ctx_.environment, mask,
+          ctx_.originX + lx, ctx_.originY + ly, ctx_.depth + block * kBlockPixels,
+          ctx_.color + block * kColorPerBlock,
+          ctx_.visible ? ctx_.visible + block * kBlockPixels : nullptr);
     } else {
-      shadeBlock(t_, planeLanes_, mask, ctx_.originX + lx, ctx_.originY + ly, ctx_.depth + block * kBlockPixels,
-                 ctx_.color + block * kColorPerBlock);
+      ctx_.stats->hiddenFragments +=
+          shadeBlock(t_, planeLanes_, mask, ctx_.originX + lx, ctx_.originY + ly,
+                     ctx_.depth + block * kBlockPixels, ctx_.color + block * kColorPerBlock);
     }
   }
 
@@ -1323,9 +1352,9 @@ class TriangleRaster {
     const size_t block = tileBlock(lx, ly);
     const size_t planes = block * size_t(ctx_.samples);
     if constexpr (kOp == PixelOp::material) return queueSamples(lx, ly, masks, shading);
-    shadeBlockSamples(t_, planeLanes_, *ctx_.coverage, sampleDepth_, masks, ctx_.originX + lx,
-                      ctx_.originY + ly, ctx_.depth + planes * kBlockPixels,
-                      ctx_.color + planes * kColorPerBlock, shading);
+    ctx_.stats->hiddenFragments += shadeBlockSamples(
+        t_, planeLanes_, *ctx_.coverage, sampleDepth_, masks, ctx_.originX + lx, ctx_.originY + ly,
+        ctx_.depth + planes * kBlockPixels, ctx_.color + planes * kColorPerBlock, shading);
   }
 
   // Anti-aliased pixel shading (PixelOp::material): step 1 for the block at (lx, ly), its passing
@@ -1337,9 +1366,12 @@ class TriangleRaster {
     PendingBlock& b = pending_[pendingBlocks_];
     alignas(64) float cx[kBlockPixels], cy[kBlockPixels];
     const int gx = ctx_.originX + lx, gy = ctx_.originY + ly;
-    if (!samplesPassing(t_, planeLanes_, *ctx_.coverage, sampleDepth_, masks, gx, gy,
-                        ctx_.depth + planes * kBlockPixels, b.pass, cx, cy, shading))
-      return;
+    int hidden = 0;
+    const bool any = samplesPassing(t_, planeLanes_, *ctx_.coverage, sampleDepth_, masks, gx, gy,
+                                    ctx_.depth + planes * kBlockPixels, b.pass, cx, cy, shading,
+                                    hidden);
+    ctx_.stats->hiddenFragments += uint64_t(hidden);
+    if (!any) return;
     int passing = 0;
     for (int l = 0; l < kBlockPixels; ++l) passing += (b.pass[0][l] | b.pass[1][l]) != 0;
     if (passing == kBlockPixels) {
@@ -1505,6 +1537,56 @@ HWY_INLINE void drawTriangle(const TriangleSetup& t, const TileContext& ctx,
   }
 }
 
+// Masking woken in a tile (drawLists): the occupancy rebuilt from the depth buffer as it stands.
+// A sample holding a surface (depth below the clear value) is occupied — drawn by the nearest
+// primitive so far, which with priority masking is final; a block all of whose samples are is full,
+// with hybrid masking bounded by their largest depth. That is what marking from the tile's first
+// triangle would have left (with depth, the same bounds markSamples reads), or more.
+HWY_NOINLINE void occupyFromDepth(const TileContext& ctx, float clearDepth) {
+  Occupancy& occ = *ctx.occupancy;
+  occ.clear(ctx.samples);
+  const hn::CappedTag<float, kBlockPixels> df;
+  const hn::RebindToUnsigned<decltype(df)> du;
+  const size_t lanes = hn::Lanes(df);
+  const int samples = ctx.samples;
+  const auto clear = hn::Set(df, clearDepth);
+  const auto full0 = hn::Set(du, occ.fullWords()[0]), full1 = hn::Set(du, occ.fullWords()[1]);
+  const float* depth = ctx.depth;
+  for (int ly = 0; ly < kTileSize; ly += kBlockSize)
+    for (int lx = 0; lx < kTileSize; lx += kBlockSize, depth += size_t(samples) * kBlockPixels) {
+      alignas(64) uint32_t words[2][kBlockPixels];
+      auto zmax = hn::Set(df, -Occupancy::kNoBound);
+      uint32_t pixels = 0, any = 0;
+      for (size_t i = 0; i < size_t(kBlockPixels); i += lanes) {
+        auto w0 = hn::Zero(du), w1 = w0;
+        for (int s = 0; s < samples; ++s) {
+          const auto z = hn::LoadU(df, depth + size_t(s) * kBlockPixels + i);
+          zmax = hn::Max(zmax, z);
+          const auto held = hn::RebindMask(du, hn::Lt(z, clear));
+          const auto bit = hn::Set(du, 1u << (s & 31));
+          if (s < 32)
+            w0 = hn::Or(w0, hn::IfThenElseZero(held, bit));
+          else
+            w1 = hn::Or(w1, hn::IfThenElseZero(held, bit));
+        }
+        hn::StoreU(w0, du, words[0] + i);
+        hn::StoreU(w1, du, words[1] + i);
+        uint8_t bits[8] = {};
+        hn::StoreMaskBits(du, hn::And(hn::Eq(w0, full0), hn::Eq(w1, full1)), bits);
+        pixels |= (uint32_t(bits[0]) | uint32_t(bits[1]) << 8) << i;
+        hn::StoreMaskBits(du, hn::Ne(hn::Or(w0, w1), hn::Zero(du)), bits);
+        any |= (uint32_t(bits[0]) | uint32_t(bits[1]) << 8) << i;
+      }
+      if (pixels == 0xFFFF) {
+        occ.markFull(kBlockLog2, lx, ly,
+                     ctx.hybrid ? hn::GetLane(hn::MaxOfLanes(df, zmax)) : Occupancy::kNoBound);
+      } else if (any) {
+        std::memcpy(occ.sampleWords(lx, ly), words, sizeof(words));
+        occ.setPixels(lx, ly, pixels);
+      }
+    }
+}
+
 // The tile's opaque surfaces are all in: TileWork::afterOpaque, once.
 void afterOpaque(const TileWork& w) {
   if (!w.afterOpaque || !w.opaqueDone || *w.opaqueDone) return;
@@ -1522,6 +1604,36 @@ void drawLists(const TileWork& w, RasterStats& stats) {
                         kShade == ShadeMode::overdraw || w.masking == Masking::none ? nullptr
                                                                                     : w.occupancy,
                         w.masking == Masking::hybrid};
+  // Hybrid masking pays only where triangles arrive behind what is drawn; elsewhere (one layer, or
+  // back-to-front input) its marking and checks are pure cost. So a tile starts as the plain
+  // Z-buffer (`plain`, no occupancy) and wakes when the depth test has hidden kWakeWork: pixels
+  // that passed none of their samples, a triangle hidden whole counting at least
+  // kHiddenTriangleWork (its traversal costs that much however few pixels it has, and culling it
+  // whole is what masking does best): the occupancy is rebuilt from the depth buffer and masking
+  // runs from there on. The
+  // image is the Z-buffer's either way; only the work differs (docs/hidden-surfaces.md). The
+  // first batch's pass over a tile starts so; one that ends asleep wakes before the next batch,
+  // whose object culling before setup reads the occupancy. (Not priority masking: its order may
+  // overrule depth — stated priorities — which the Z-buffer would not honour.)
+  TileContext plain = ctx;
+  plain.occupancy = nullptr;
+  constexpr uint64_t kWakeWork = kTilePixels / 2, kHiddenTriangleWork = 64;
+  const TileContext* use =
+      ctx.occupancy && ctx.hybrid && w.clear && !w.debugOccupancy ? &plain : &ctx;
+  uint64_t hiddenWork = 0;
+  auto wake = [&] {
+    occupyFromDepth(ctx, w.clearDepth);
+    use = &ctx;
+    ++stats.hybridWoken;
+  };
+  // After a triangle drawn asleep, with the fragment counts as they were before it.
+  auto wakeIfHidden = [&](uint64_t fragments, uint64_t hidden) {
+    if (use != &plain) return;
+    const uint64_t drawn = stats.fragments - fragments;
+    hidden = stats.hiddenFragments - hidden;
+    hiddenWork += drawn > 0 && hidden == drawn ? std::max(hidden, kHiddenTriangleWork) : hidden;
+    if (hiddenWork >= kWakeWork) wake();
+  };
   bool pending = false;  // some pixel records a triangle not yet shaded
   // Setup records are read in bin order, scattered over the batch: fetch a few ahead, the loop is
   // otherwise bound by their cache misses. (Before records were grouped by tile this was half the
@@ -1536,7 +1648,7 @@ void drawLists(const TileWork& w, RasterStats& stats) {
     const uint32_t size = w.listSizes[l];
     const uint32_t* objects = ctx.occupancy && w.listObjects ? w.listObjects[l] : nullptr;
     for (uint32_t i = 0; i < size; ++i) {
-      if (objects && objects[i] != kNoObject) {
+      if (objects && use->occupancy && objects[i] != kNoObject) {
         const uint32_t object = objects[i];
         if (object != lastObject) {
           lastObject = object;
@@ -1557,6 +1669,7 @@ void drawLists(const TileWork& w, RasterStats& stats) {
         for (size_t line = 0; line < sizeof(TriangleSetup); line += 64) hwy::Prefetch(next + line);
       }
       const TriangleSetup& t = w.setups[list[i]];
+      const uint64_t fragmentsBefore = stats.fragments, hiddenBefore = stats.hiddenFragments;
       if constexpr (kShade == ShadeMode::material) {
         // The attribute record is found through the setup record: fetch the next one's now.
         if (i + 1 < size) {
@@ -1568,8 +1681,9 @@ void drawLists(const TileWork& w, RasterStats& stats) {
         const AttributeSetup& a = w.attributes[t.triangle - w.attributeBase];
         const shade::AlphaUse alpha = a.material ? a.material->alpha : shade::AlphaUse::opaque;
         if (deferred && alpha == shade::AlphaUse::opaque) {
-          drawTriangle<PixelOp::visibility, false>(t, ctx, nullptr, list[i]);
+          drawTriangle<PixelOp::visibility, false>(t, *use, nullptr, list[i]);
           pending = true;
+          wakeIfHidden(fragmentsBefore, hiddenBefore);
           continue;
         }
         // Blending reads the colour behind: the deferred pixels must have theirs first, and the
@@ -1580,18 +1694,20 @@ void drawLists(const TileWork& w, RasterStats& stats) {
           afterOpaque(w);
         }
         if (a.material)
-          drawTriangle<PixelOp::material, kAA>(t, ctx, &a);
+          drawTriangle<PixelOp::material, kAA>(t, *use, &a);
         else
-          drawTriangle<PixelOp::gouraud, kAA>(t, ctx);
+          drawTriangle<PixelOp::gouraud, kAA>(t, *use);
       } else {
         constexpr PixelOp op = kShade == ShadeMode::overdraw ? PixelOp::overdraw
                                : kShade == ShadeMode::levels ? PixelOp::levels
                                                              : PixelOp::gouraud;
-        drawTriangle<op, kAA>(t, ctx);
+        drawTriangle<op, kAA>(t, *use);
       }
+      wakeIfHidden(fragmentsBefore, hiddenBefore);
     }
   }
   if (pending) shadeVisible(ctx);
+  if (use == &plain && !w.lastBatch) wake();
   if (w.lastBatch) afterOpaque(w);
 }
 

@@ -247,6 +247,8 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
   stats.occludedObjects += total.occludedObjects;
   stats.partialBlocks += total.partialBlocks;
   stats.fragments += total.fragments;
+  stats.hiddenFragments += total.hiddenFragments;
+  stats.hybridWoken += total.hybridWoken;
 }
 
 }  // namespace sv::render

@@ -208,14 +208,18 @@ TEST(HybridMasking, EqualsTheZBufferInAnyOrder) {
       const int w = 170, h = 120;
       const DrawPackets p = test::randomScene(w, h, 500, seed, seed == 5);
       const test::Frame z = test::renderQuadtree(p, settings(w, h, samples, raster::Masking::none), 2);
+      FrameStats stats;
       const test::Frame m =
-          test::renderQuadtree(p, settings(w, h, samples, raster::Masking::hybrid), 2);
+          test::renderQuadtree(p, settings(w, h, samples, raster::Masking::hybrid), 2, &stats);
       EXPECT_TRUE(z == m) << samples << " samples, seed " << seed;
+      // Tiles woke part-way, their occupancy rebuilt from the depth buffer (drawLists).
+      EXPECT_GT(stats.hybridWoken, 0u);
     }
 }
 
 // … and on front-to-back input it drops hidden work like priority masking, in every order the
-// same frame; for any thread count and batching.
+// same frame; for any thread count and batching. Where nothing arrives behind what is drawn
+// (back to front) it never wakes.
 TEST(HybridMasking, DropsHiddenWorkInEveryOrderWithTheSameFrame) {
   const int w = 190, h = 140;
   DrawPackets f2b = frontToBackScene(w, h, 900, 6), b2f = f2b;
@@ -232,6 +236,13 @@ TEST(HybridMasking, DropsHiddenWorkInEveryOrderWithTheSameFrame) {
     EXPECT_TRUE(b == test::renderQuadtree(b2f, settings(w, h, samples, raster::Masking::none), 2));
     EXPECT_GT(fs.occludedTriangles, 0u);
     EXPECT_LT(fs.fragments, zs.fragments);
+    EXPECT_GT(fs.hybridWoken, 0u);
+    // Back to front nothing is ever hidden: the tiles stay the plain Z-buffer, with no masking
+    // work to pay for.
+    EXPECT_EQ(bs.hiddenFragments, 0u);
+    EXPECT_EQ(bs.hybridWoken, 0u);
+    EXPECT_EQ(bs.occludedWindows + bs.occludedTriangles, 0u);
+    EXPECT_GT(zs.hiddenFragments, 0u);
     EXPECT_TRUE(test::renderQuadtree(f2b, settings(w, h, samples, raster::Masking::hybrid), 1) == f);
     EXPECT_TRUE(test::renderQuadtree(f2b, settings(w, h, samples, raster::Masking::hybrid), 8) == f);
     FrameSettings batched = settings(w, h, samples, raster::Masking::hybrid);
