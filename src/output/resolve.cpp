@@ -73,8 +73,8 @@ namespace {
 // rounded mean of its samples (linear, 16-bit). Sums run over a block's sample planes, 16 pixels
 // at a time (vectorized by the compiler).
 template <class Sink>
-void forEachSampleMean(const uint16_t* color, int tileX, int tileY, int samples, int width,
-                       int height, Sink sink) {
+void forEachSampleMean(const uint16_t* color, const int32_t* sums, int tileX, int tileY,
+                       int samples, int width, int height, Sink sink) {
   using namespace raster;
   const int x0 = tileX * kTileSize, y0 = tileY * kTileSize;
   const int w = std::min(kTileSize, width - x0), h = std::min(kTileSize, height - y0);
@@ -82,12 +82,15 @@ void forEachSampleMean(const uint16_t* color, int tileX, int tileY, int samples,
   const int shift = std::countr_zero(unsigned(samples));  // samples is a power of two
   for (int by = 0; by < h; by += kBlockSize)
     for (int bx = 0; bx < w; bx += kBlockSize) {
-      const uint16_t* block =
-          color + size_t((by >> kBlockLog2) * kBlocksPerTileSide + (bx >> kBlockLog2)) * samples *
-                      kColorPerBlock;
+      const size_t b = size_t((by >> kBlockLog2) * kBlocksPerTileSide + (bx >> kBlockLog2));
       uint32_t sum[kColorPerBlock] = {};
-      for (int s = 0; s < samples; ++s)
-        for (int i = 0; i < kColorPerBlock; ++i) sum[i] += block[s * kColorPerBlock + i];
+      if (sums) {
+        std::copy_n(sums + b * kColorPerBlock, kColorPerBlock, sum);
+      } else {
+        const uint16_t* block = color + b * samples * kColorPerBlock;
+        for (int s = 0; s < samples; ++s)
+          for (int i = 0; i < kColorPerBlock; ++i) sum[i] += block[s * kColorPerBlock + i];
+      }
       for (int py = 0; py < std::min(kBlockSize, h - by); ++py)
         for (int px = 0; px < std::min(kBlockSize, w - bx); ++px) {
           const int p = py * kBlockSize + px;
@@ -125,15 +128,15 @@ void forEachBlockMean(const uint16_t* color, int tileX, int tileY, int factor, i
 
 }  // namespace
 
-void resolveTileLinear(const uint16_t* color, int tileX, int tileY, int factor, int samples,
-                       LinearImage& linear) {
+void resolveTileLinear(const uint16_t* color, const int32_t* sums, int tileX, int tileY,
+                       int factor, int samples, LinearImage& linear) {
   auto store = [&](int x, int y, const uint16_t* mean) {
     std::copy_n(mean, 3, linear.rgb.data() + (size_t(y) * size_t(linear.width) + size_t(x)) * 3);
   };
   if (factor > 1)
     forEachBlockMean(color, tileX, tileY, factor, linear.width, linear.height, store);
   else
-    forEachSampleMean(color, tileX, tileY, samples, linear.width, linear.height, store);
+    forEachSampleMean(color, sums, tileX, tileY, samples, linear.width, linear.height, store);
 }
 
 void tentFilterRows(const LinearImage& linear, const GammaTables& gamma, int rowBegin, int rowEnd,

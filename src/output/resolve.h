@@ -35,9 +35,10 @@ void resolveTile(const uint16_t* color, int tileX, int tileY, int factor, const 
 
 // A tile of N samples per pixel (anti-aliasing; N = 4, 8, 16 or 64, sample planes as
 // raster/framebuffer.h describes): each image pixel is the rounded mean of its samples in linear
-// light — the 1×1 box filter of SPEC §5. In SIMD lanes: resolve_samples.cpp.
-void resolveSampleTile(const uint16_t* color, int tileX, int tileY, int samples,
-                       const GammaTables& gamma, Image& image);
+// light — the 1×1 box filter of SPEC §5. In SIMD lanes: resolve_samples.cpp. With `sums` (the
+// tile's colour sums, raster/framebuffer.h) the means come from them and `color` is not read.
+void resolveSampleTile(const uint16_t* color, const int32_t* sums, int tileX, int tileY,
+                       int samples, const GammaTables& gamma, Image& image);
 
 // Linear colour of a whole frame, 3 × uint16 per pixel, row-major: the box-resolved frame buffer
 // that the 3×3 tent filter reads across tile borders.
@@ -53,9 +54,9 @@ struct LinearImage {
 
 // Box-resolves one tile into `linear` (sized for the image) instead of the display image, for any
 // of the layouts above: `factor` × `factor` pixels per image pixel (supersampling) or `samples`
-// samples per pixel (one of the two is 1).
-void resolveTileLinear(const uint16_t* color, int tileX, int tileY, int factor, int samples,
-                       LinearImage& linear);
+// samples per pixel (one of the two is 1); `sums` as resolveSampleTile.
+void resolveTileLinear(const uint16_t* color, const int32_t* sums, int tileX, int tileY,
+                       int factor, int samples, LinearImage& linear);
 
 // The 3×3 triangle (tent) filter of seed 002 (SPEC §5) over the box-resolved frame, weights
 // [1 2 1]ᵀ[1 2 1] / 16 in linear light, edges clamped; then gamma. Writes rows [rowBegin, rowEnd)

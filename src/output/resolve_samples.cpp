@@ -30,8 +30,8 @@ HWY_INLINE void StoreBlockRow(uint8_t* HWY_RESTRICT dst, const uint16_t* HWY_RES
   }
 }
 
-void ResolveSampleTile(const uint16_t* color, int tileX, int tileY, int samples,
-                       const GammaTables& gamma, Image& image) {
+void ResolveSampleTile(const uint16_t* color, const int32_t* sums, int tileX, int tileY,
+                       int samples, const GammaTables& gamma, Image& image) {
   using namespace raster;
   const hn::CappedTag<int32_t, kBlockPixels> d32;
   const hn::Rebind<uint16_t, decltype(d32)> d16;
@@ -48,8 +48,16 @@ void ResolveSampleTile(const uint16_t* color, int tileX, int tileY, int samples,
   const int blocksX = (w + kBlockSize - 1) / kBlockSize;
   for (int by = 0; by < h; by += kBlockSize) {
     for (int b = 0; b < blocksX; ++b) {
-      const uint16_t* block =
-          color + size_t((by >> kBlockLog2) * kBlocksPerTileSide + b) * samples * kColorPerBlock;
+      const size_t index = size_t((by >> kBlockLog2) * kBlocksPerTileSide + b);
+      if (sums) {  // the sums of the planes, kept as they were drawn
+        const int32_t* sum = sums + index * kColorPerBlock;
+        for (size_t i = 0; i < size_t(kColorPerBlock); i += n)
+          hn::Store(hn::DemoteTo(d16, hn::ShiftRightSame(hn::Add(hn::LoadU(d32, sum + i), half),
+                                                         shift)),
+                    d16, mean[b] + i);
+        continue;
+      }
+      const uint16_t* block = color + index * samples * kColorPerBlock;
       for (size_t i = 0; i < size_t(kColorPerBlock); i += n) {
         auto sum = hn::PromoteTo(d32, hn::LoadU(d16, block + i));
         for (int s = 1; s < samples; ++s)
@@ -76,9 +84,9 @@ HWY_AFTER_NAMESPACE();
 namespace sv::output {
 HWY_EXPORT(ResolveSampleTile);
 
-void resolveSampleTile(const uint16_t* color, int tileX, int tileY, int samples,
-                       const GammaTables& gamma, Image& image) {
-  HWY_DYNAMIC_DISPATCH(ResolveSampleTile)(color, tileX, tileY, samples, gamma, image);
+void resolveSampleTile(const uint16_t* color, const int32_t* sums, int tileX, int tileY,
+                       int samples, const GammaTables& gamma, Image& image) {
+  HWY_DYNAMIC_DISPATCH(ResolveSampleTile)(color, sums, tileX, tileY, samples, gamma, image);
 }
 }  // namespace sv::output
 #endif

@@ -11,6 +11,10 @@
 // the other: plane s is the 16 pixels' sample s, laid out exactly as a 1-sample block. The kernel
 // then tests depth and writes colour one plane — 16 pixels — per vector, and the resolve sums the
 // planes. Memory per pixel: N × (4 bytes of depth + 6 of colour).
+// Colour sums (TileWork::sums): where every sample is written at most once (priority masking,
+// opaque), a pixel's colour is kept instead as the sum of its N samples' 16-bit values, 3 int32
+// per pixel laid out as one plane (block by block, 16 R, 16 G, 16 B) — what the resolve would
+// have summed, so the image is the same bit for bit.
 #pragma once
 
 #include <cstddef>
@@ -29,6 +33,7 @@ inline constexpr int kBlocksPerTileSide = kTileSize / kBlockSize;
 inline constexpr int kTilePixels = kTileSize * kTileSize;
 inline constexpr int kColorChannels = 3;
 inline constexpr int kColorPerBlock = kBlockPixels * kColorChannels;
+inline constexpr int kSumsPerTile = kTilePixels * kColorChannels;
 
 // The index of the 4×4 block holding tile-local pixel (lx, ly), in a tile's block-major layout.
 constexpr size_t tileBlock(int lx, int ly) {
@@ -43,8 +48,8 @@ constexpr uint32_t fullSampleWord(int samples, int w) {
 class FrameBuffer {
  public:
   // Allocates for a width × height raster (1 … 8192 each; checked by the caller) of `samples`
-  // samples per pixel (1 … 64).
-  void resize(int width, int height, int samples = 1);
+  // samples per pixel (1 … 64); with `sums`, colour sums besides (kSumsPerTile per tile).
+  void resize(int width, int height, int samples = 1, bool sums = false);
 
   int width() const { return width_; }
   int height() const { return height_; }
@@ -63,6 +68,8 @@ class FrameBuffer {
   const uint16_t* tileColor(int tile) const {
     return color_.get() + size_t(tile) * kTilePixels * kColorChannels * samples_;
   }
+  // The tile's colour sums; nullptr unless allocated (resize with `sums`).
+  int32_t* tileSums(int tile) { return sums_ ? sums_.get() + size_t(tile) * kSumsPerTile : nullptr; }
 
   // Offsets of sample s of pixel (x, y) inside its tile's depth and colour arrays, for a buffer of
   // `samples` samples per pixel.
@@ -74,6 +81,8 @@ class FrameBuffer {
   size_t capacity_ = 0;  // pixels × samples allocated
   hwy::AlignedFreeUniquePtr<float[]> depth_;
   hwy::AlignedFreeUniquePtr<uint16_t[]> color_;
+  size_t sumsCapacity_ = 0;  // tiles
+  hwy::AlignedFreeUniquePtr<int32_t[]> sums_;
 };
 
 inline size_t FrameBuffer::depthOffset(int x, int y, int samples, int s) {

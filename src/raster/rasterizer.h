@@ -87,6 +87,11 @@ struct TileWork {
   int tileX = 0, tileY = 0;  // tile coordinates (pixel origin = 64·tileX, 64·tileY)
   float* depth = nullptr;     // the tile's buffers, laid out as FrameBuffer describes
   uint16_t* color = nullptr;
+  // Colour sums instead of sample planes (FrameBuffer, "colour sums"): anti-aliased priority
+  // masking where every triangle is opaque and nothing reads the tile but the resolve, so each
+  // sample is written once. The kernel adds coverage × colour per pixel, tests sample depth only
+  // against the clear depth, and leaves `depth` and `color` untouched. nullptr: sample planes.
+  int32_t* sums = nullptr;
   bool clear = false;  // clear the tile before drawing
   float clearDepth = 1.0f;
   uint16_t clearColor[3] = {0, 0, 0};

@@ -91,7 +91,25 @@ struct TileContext {
   // `hybrid`, windows are dropped by their depth bounds instead of their occupancy alone.
   Occupancy* occupancy;
   bool hybrid;
+  // Colour sums (TileWork::sums), or nullptr; then `clearPlanes` holds the clear depth for every
+  // sample of a block (what an unwritten sample holds: the depth test's only opponent) and
+  // `clearColor` the clear colour each unwritten sample contributes to a sum.
+  int32_t* sums = nullptr;
+  float* clearPlanes = nullptr;
+  int32_t clearColor[kColorChannels] = {};
 };
+
+// Adds `count` samples of colour `c` (16-bit values in int32 lanes) to a block's colour sums in
+// place of as many samples of the clear colour (TileWork::sums; the sums start at N × clear).
+template <class DI, class VI>
+HWY_INLINE void addToSums(DI di, VI count, const VI* c, const int32_t* clear, int32_t* sums,
+                          size_t i) {
+  for (int ch = 0; ch < kColorChannels; ++ch) {
+    int32_t* dst = sums + ch * kBlockPixels + i;
+    hn::StoreU(hn::Add(hn::LoadU(di, dst), hn::Mul(count, hn::Sub(c[ch], hn::Set(di, clear[ch])))),
+               di, dst);
+  }
+}
 
 // Parameters are evaluated per 4×4 block as base + offset: base = (c0 + dx·X) + dy·Y at the block's
 // top-left pixel (X, Y relative to the plane's origin), offset = dx·lx + dy·ly per lane, computed
@@ -237,11 +255,14 @@ HWY_INLINE void centroidOffsets(DF df, const CoverageTables& cov, VU m0, VU m1, 
 // it (priority masking removes occupied samples, but the Z-buffer shades the same pixel at the
 // centroid of all it covers; the two must agree); nullptr: `masks`. Returns the covered pixels
 // none of whose samples passed.
+// With `sums` (TileWork::sums) the samples are tested against `depth` alone, which then holds the
+// clear depth, and added to the sums instead of written.
 HWY_INLINE int shadeBlockSamples(const TriangleSetup& t, const PlaneLanes& lanes,
                                   const CoverageTables& cov, const float* sampleDepth,
                                   const uint32_t (*masks)[kBlockPixels], int gx, int gy,
                                   float* depth, uint16_t* color,
-                                  const uint32_t (*shading)[kBlockPixels] = nullptr) {
+                                  const uint32_t (*shading)[kBlockPixels], int32_t* sums,
+                                  const int32_t* clearColor) {
   const int samples = cov.samples;
   // The words of a full mask.
   const uint32_t fullWord0 = fullSampleWord(samples, 0), fullWord1 = fullSampleWord(samples, 1);
@@ -280,10 +301,14 @@ HWY_INLINE int shadeBlockSamples(const TriangleSetup& t, const PlaneLanes& lanes
     };
     // Outside the triangle 1/w is extrapolated and may reach 0; the clamp keeps w finite.
     const auto w = hn::Div(one, hn::Max(at(kInvW), tiny));
+    hn::Vec<decltype(di)> c32[kColorChannels];
     hn::Vec<decltype(du)> c16[kColorChannels];
-    for (int ch = 0; ch < kColorChannels; ++ch)
-      c16[ch] = hn::DemoteTo(du, colorToLanes(df, at(kRed + ch), w));
+    for (int ch = 0; ch < kColorChannels; ++ch) {
+      c32[ch] = colorToLanes(df, at(kRed + ch), w);
+      c16[ch] = hn::DemoteTo(du, c32[ch]);
+    }
     auto anyPass = hn::FirstN(df, 0);
+    auto count = hn::Zero(di);  // samples passed, with sums
     for (int s = 0; s < samples; ++s) {
       const auto covered =
           hn::RebindMask(df, hn::TestBit(s < 32 ? m0 : m1, hn::Set(du32, 1u << (s & 31))));
@@ -294,6 +319,10 @@ HWY_INLINE int shadeBlockSamples(const TriangleSetup& t, const PlaneLanes& lanes
       const auto pass = hn::And(covered, hn::Lt(z, zOld));
       if (hn::AllFalse(df, pass)) continue;
       anyPass = hn::Or(anyPass, pass);
+      if (sums) {
+        count = hn::Sub(count, hn::VecFromMask(di, hn::RebindMask(di, pass)));
+        continue;
+      }
       hn::BlendedStore(z, pass, df, zPlane);
       // The pass mask in 16-bit lanes (−1 stays −1 under the saturating demotion), then masked
       // stores: a third of the instructions of widening, blending and narrowing each channel.
@@ -305,6 +334,7 @@ HWY_INLINE int shadeBlockSamples(const TriangleSetup& t, const PlaneLanes& lanes
     }
     hidden += int(hn::CountTrue(du32, hn::Ne(hn::Or(m0, m1), hn::Zero(du32))) -
                   hn::CountTrue(df, anyPass));
+    if (sums) addToSums(di, count, c32, clearColor, sums, i);
   }
   return hidden;
 }
@@ -528,14 +558,26 @@ HWY_INLINE bool samplesPassing(const TriangleSetup& t, const PlaneLanes& lanes,
 }
 
 // Step 3 for block (gx, gy): shaded colour `rgba` (block lanes) to the samples that passed —
-// opaque, cut out where alpha is 0, or blended over the sample without writing depth.
+// opaque, cut out where alpha is 0, or blended over the sample without writing depth. With `sums`
+// (TileWork::sums: opaque only) added to the block's colour sums instead.
 HWY_INLINE void writeSamples(const TriangleSetup& t, const PlaneLanes& lanes,
                              const shade::MaterialShading& m, const float* sampleDepth, int samples,
                              const uint32_t (*pass)[kBlockPixels],
                              const float (*rgba)[kBlockPixels], int gx, int gy, float* depth,
-                             uint16_t* color) {
+                             uint16_t* color, int32_t* sums, const int32_t* clearColor) {
   const hn::CappedTag<float, kBlockPixels> df;
   const hn::RebindToUnsigned<decltype(df)> du32;
+  if (sums) {
+    const hn::RebindToSigned<decltype(df)> di;
+    for (size_t i = 0; i < size_t(kBlockPixels); i += hn::Lanes(df)) {
+      const auto count = hn::BitCast(di, hn::Add(hn::PopulationCount(hn::LoadU(du32, pass[0] + i)),
+                                                 hn::PopulationCount(hn::LoadU(du32, pass[1] + i))));
+      hn::Vec<decltype(di)> c[kColorChannels];
+      for (int ch = 0; ch < kColorChannels; ++ch) c[ch] = unitToLanes(df, hn::LoadU(df, rgba[ch] + i));
+      addToSums(di, count, c, clearColor, sums, i);
+    }
+    return;
+  }
   const size_t n = hn::Lanes(df);
   const bool blend = m.alpha == shade::AlphaUse::blend;
   const bool cut = m.alpha == shade::AlphaUse::mask;
@@ -1354,7 +1396,17 @@ class TriangleRaster {
     if constexpr (kOp == PixelOp::material) return queueSamples(lx, ly, masks, shading);
     ctx_.stats->hiddenFragments += shadeBlockSamples(
         t_, planeLanes_, *ctx_.coverage, sampleDepth_, masks, ctx_.originX + lx, ctx_.originY + ly,
-        ctx_.depth + planes * kBlockPixels, ctx_.color + planes * kColorPerBlock, shading);
+        blockDepthOrClear(planes), ctx_.color + planes * kColorPerBlock, shading, blockSums(block),
+        ctx_.clearColor);
+  }
+
+  // Colour sums (TileWork::sums): block `block`'s, or nullptr; and the depth its samples are
+  // tested against — the tile's planes, or with sums the clear depth (all an unwritten sample holds).
+  int32_t* blockSums(size_t block) const {
+    return ctx_.sums ? ctx_.sums + block * kColorPerBlock : nullptr;
+  }
+  float* blockDepthOrClear(size_t planes) const {
+    return ctx_.sums ? ctx_.clearPlanes : ctx_.depth + planes * kBlockPixels;
   }
 
   // Anti-aliased pixel shading (PixelOp::material): step 1 for the block at (lx, ly), its passing
@@ -1368,8 +1420,7 @@ class TriangleRaster {
     const int gx = ctx_.originX + lx, gy = ctx_.originY + ly;
     int hidden = 0;
     const bool any = samplesPassing(t_, planeLanes_, *ctx_.coverage, sampleDepth_, masks, gx, gy,
-                                    ctx_.depth + planes * kBlockPixels, b.pass, cx, cy, shading,
-                                    hidden);
+                                    blockDepthOrClear(planes), b.pass, cx, cy, shading, hidden);
     ctx_.stats->hiddenFragments += uint64_t(hidden);
     if (!any) return;
     int passing = 0;
@@ -1385,7 +1436,8 @@ class TriangleRaster {
       alignas(64) float rgba[4][kBlockPixels];
       shade::shadeFragments(m, *ctx_.environment, f, rgba);
       writeSamples(t_, planeLanes_, m, sampleDepth_, ctx_.samples, b.pass, rgba, gx, gy,
-                   ctx_.depth + planes * kBlockPixels, ctx_.color + planes * kColorPerBlock);
+                   ctx_.depth + planes * kBlockPixels, ctx_.color + planes * kColorPerBlock,
+                   blockSums(block), ctx_.clearColor);
       return;
     }
     b.lx = lx;
@@ -1451,7 +1503,7 @@ class TriangleRaster {
       const size_t planes = block * size_t(ctx_.samples);
       writeSamples(t_, planeLanes_, m, sampleDepth_, ctx_.samples, b.pass, rgba,
                    ctx_.originX + b.lx, ctx_.originY + b.ly, ctx_.depth + planes * kBlockPixels,
-                   ctx_.color + planes * kColorPerBlock);
+                   ctx_.color + planes * kColorPerBlock, blockSums(block), ctx_.clearColor);
       if (b.markAfter) markSamples(b.lx, b.ly, b.marks);
     }
     pendingBlocks_ = pendingPixels_ = 0;
@@ -1495,7 +1547,15 @@ class TriangleRaster {
 };
 
 void clearTile(const TileWork& w) {
-  const int planes = kTilePixels / kBlockPixels * (w.coverage ? w.coverage->samples : 1);
+  const int samples = w.coverage ? w.coverage->samples : 1;
+  if (w.sums) {  // N samples of the clear colour; the planes are not used
+    for (int b = 0; b < kTilePixels / kBlockPixels; ++b)
+      for (int ch = 0; ch < kColorChannels; ++ch)
+        std::fill_n(w.sums + size_t(b) * kColorPerBlock + ch * kBlockPixels, kBlockPixels,
+                    int32_t(w.clearColor[ch]) * samples);
+    return;
+  }
+  const int planes = kTilePixels / kBlockPixels * samples;
   std::fill(w.depth, w.depth + size_t(planes) * kBlockPixels, w.clearDepth);
   // One plane's worth, copied whole (two or three vector stores): 3 fills of 16 values per plane
   // were 5 % of a 4-sample frame.
@@ -1598,12 +1658,19 @@ template <ShadeMode kShade, bool kAA>
 void drawLists(const TileWork& w, RasterStats& stats) {
   // Pixel shading at one sample is deferred: opaque triangles only record the winner per pixel.
   const bool deferred = kShade == ShadeMode::material && !kAA;
-  const TileContext ctx{w.tileX * kTileSize, w.tileY * kTileSize, w.depth, w.color, &stats,
+  TileContext ctx{w.tileX * kTileSize, w.tileY * kTileSize, w.depth, w.color, &stats,
                         w.coverage, w.coverage ? w.coverage->samples : 1, w.environment,
                         deferred ? w.visible : nullptr, w.setups, w.attributes, w.attributeBase,
                         kShade == ShadeMode::overdraw || w.masking == Masking::none ? nullptr
                                                                                     : w.occupancy,
                         w.masking == Masking::hybrid};
+  alignas(64) float clearPlanes[64 * kBlockPixels];
+  if (w.sums) {
+    std::fill_n(clearPlanes, ctx.samples * kBlockPixels, w.clearDepth);
+    ctx.sums = w.sums;
+    ctx.clearPlanes = clearPlanes;
+    for (int ch = 0; ch < kColorChannels; ++ch) ctx.clearColor[ch] = w.clearColor[ch];
+  }
   // Hybrid masking pays only where triangles arrive behind what is drawn; elsewhere (one layer, or
   // back-to-front input) its marking and checks are pure cost. So a tile starts as the plain
   // Z-buffer (`plain`, no occupancy) and wakes when the depth test has hidden kWakeWork: pixels

@@ -63,7 +63,16 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
   const int tilesX = (settings.width + raster::kTileSize - 1) >> raster::kTileLog2;
   const int tilesY = (settings.height + raster::kTileSize - 1) >> raster::kTileLog2;
   const int tiles = tilesX * tilesY;
-  if (wholeFrame) fb_.resize(settings.width, settings.height, samples);
+  // Colour sums (raster::TileWork::sums): each sample written at most once and read by nothing but
+  // the resolve — priority masking (every written sample occupied), opaque triangles only (a
+  // cut-out occupies nothing, a blended one reads what is behind).
+  bool sums = settings.colorSums && settings.masking == raster::Masking::priority && samples > 1 &&
+              !settings.afterOpaque && !settings.debugOccupancy &&
+              (settings.shade == raster::ShadeMode::material ||
+               settings.shade == raster::ShadeMode::gouraud);
+  for (const DrawCall& call : packets.calls)
+    if (call.material && call.material->alpha != shade::AlphaUse::opaque) sums = false;
+  if (wholeFrame) fb_.resize(settings.width, settings.height, samples, sums);
   uint16_t clear16[3];
   for (int ch = 0; ch < 3; ++ch)
     clear16[ch] = static_cast<uint16_t>(
@@ -79,7 +88,7 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
   const bool masking = settings.masking != raster::Masking::none;
   for (WorkerScratch& w : scratch_) {
     w.records.resize(kChunkTriangles);
-    if (!wholeFrame) w.tile.resize(raster::kTileSize, raster::kTileSize, samples);
+    if (!wholeFrame) w.tile.resize(raster::kTileSize, raster::kTileSize, samples, sums);
     if (settings.shade == raster::ShadeMode::material && samples == 1)
       w.visible.assign(raster::kTilePixels, ~0u);
     if (masking && !wholeFrame && !w.occupancy)
@@ -202,6 +211,7 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
       const int index = wholeFrame ? int(tile) : 0;
       w.depth = buffer.tileDepth(index);
       w.color = buffer.tileColor(index);
+      if (sums) w.sums = buffer.tileSums(index);
       w.clear = batch == 0;
       std::copy_n(clear16, 3, w.clearColor);
       w.setups = setups_.data();
@@ -233,7 +243,7 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
         w.opaqueDone = &opaqueDone_[tile];
       }
       raster::rasterizeTile(w, tileStats_[tile]);
-      if (lastBatch && settings.finishTile) settings.finishTile(int(tile), w.depth, w.color);
+      if (lastBatch && settings.finishTile) settings.finishTile(int(tile), w.depth, w.color, w.sums);
     });
     stats.rasterMs += msSince(t0);
   }

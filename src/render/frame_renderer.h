@@ -50,9 +50,17 @@ struct FrameSettings {
   // masks, SPEC §5; Gouraud only). finishTile then receives `samples` sample planes per block.
   int samples = 1;
   // Called once per tile, on the thread that drew it, right after the tile's last triangle, with
-  // the tile's depth and colour (laid out as raster/framebuffer.h describes, `samples` per pixel). This is the only way
-  // out of the frame: the storage is reused for the next tile as soon as the call returns.
-  std::function<void(int tile, const float* depth, const uint16_t* color)> finishTile;
+  // the tile's depth and colour (laid out as raster/framebuffer.h describes, `samples` per pixel),
+  // or — when colour sums are used (`colorSums`) — its sums instead (then depth and colour hold
+  // nothing; otherwise `sums` is nullptr). This is the only way out of the frame: the storage is
+  // reused for the next tile as soon as the call returns.
+  std::function<void(int tile, const float* depth, const uint16_t* color, const int32_t* sums)>
+      finishTile;
+  // finishTile can take colour sums (it needs no more than each pixel's mean: a box resolve).
+  // They are used when the frame allows — anti-aliased priority masking, every triangle opaque,
+  // no afterOpaque pass, no occupancy view (raster::TileWork::sums) — and save writing, clearing
+  // and summing N sample planes per pixel.
+  bool colorSums = false;
   // Triangles per batch (every batch sets up its triangles, then walks the tiles). Frames of one
   // batch draw each tile in a small per-thread buffer that never leaves the core's cache; frames of
   // several keep a whole-frame buffer between batches. Tests lower it to exercise that path.

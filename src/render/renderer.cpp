@@ -537,24 +537,26 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
   const bool tent = o.filter == RenderOptions::Filter::tent3;
   output::LinearImage& linear = impl_->linear;
   if (tent) linear.resize(o.width, o.height);
+  // Both sample resolves need only each pixel's sum (the debug views read the planes).
+  fs.colorSums = o.debugView == DebugView::none && k == 1;
   if (o.debugView != DebugView::none)
-    fs.finishTile = [&](int tile, const float*, const uint16_t* color) {
+    fs.finishTile = [&](int tile, const float*, const uint16_t* color, const int32_t*) {
       output::resolveDebugTile(color, tile % tilesX, tile / tilesX,
                                o.debugView == DebugView::overdraw ? output::DebugPalette::count
                                                                   : output::DebugPalette::level,
                                image);
     };
   else if (tent)
-    fs.finishTile = [&](int tile, const float*, const uint16_t* color) {
-      output::resolveTileLinear(color, tile % tilesX, tile / tilesX, k, o.samples, linear);
+    fs.finishTile = [&](int tile, const float*, const uint16_t* color, const int32_t* sums) {
+      output::resolveTileLinear(color, sums, tile % tilesX, tile / tilesX, k, o.samples, linear);
     };
   else if (o.samples > 1)
-    fs.finishTile = [&](int tile, const float*, const uint16_t* color) {
-      output::resolveSampleTile(color, tile % tilesX, tile / tilesX, o.samples, impl_->gamma,
-                                image);
+    fs.finishTile = [&](int tile, const float*, const uint16_t* color, const int32_t* sums) {
+      output::resolveSampleTile(color, sums, tile % tilesX, tile / tilesX, o.samples,
+                                impl_->gamma, image);
     };
   else
-    fs.finishTile = [&](int tile, const float*, const uint16_t* color) {
+    fs.finishTile = [&](int tile, const float*, const uint16_t* color, const int32_t*) {
       output::resolveTile(color, tile % tilesX, tile / tilesX, k, impl_->gamma, image);
     };
   // The free forms, cast into each tile between its opaque and translucent polygons (not in the

@@ -181,6 +181,36 @@ TEST(PriorityMasking, SameFrameForAnyThreadCountAndBatching) {
   }
 }
 
+// Colour sums (raster/framebuffer.h): under anti-aliased priority masking every sample is written
+// once, so the tiles keep per pixel the sum of its samples instead of N planes — the same image bit
+// for bit, at every sample count, thread count and batching; and not used where a sample may be
+// written twice (the Z-buffer, hybrid masking).
+TEST(PriorityMasking, ColourSumsResolveToTheSamePixels) {
+  const int w = 190, h = 140;
+  const DrawPackets p = frontToBackScene(w, h, 900, 7);
+  for (int samples : {4, 16, 64}) {
+    FrameSettings planes = settings(w, h, samples, raster::Masking::priority), sums = planes;
+    sums.colorSums = true;
+    bool used = false;
+    const std::vector<uint16_t> ref = test::renderResolved(p, planes, 2, &used);
+    EXPECT_FALSE(used);
+    EXPECT_TRUE(test::renderResolved(p, sums, 2, &used) == ref) << samples;
+    EXPECT_TRUE(used);
+    EXPECT_TRUE(test::renderResolved(p, sums, 1) == ref) << samples;
+    EXPECT_TRUE(test::renderResolved(p, sums, 8) == ref) << samples;
+    sums.batchTriangles = 97;  // the whole-frame buffer's sums, kept between batches
+    EXPECT_TRUE(test::renderResolved(p, sums, 2, &used) == ref) << samples;
+    EXPECT_TRUE(used);
+    // The Z-buffer's pixels are the same (a valid order); it and hybrid masking keep planes.
+    for (const raster::Masking m : {raster::Masking::none, raster::Masking::hybrid}) {
+      FrameSettings other = settings(w, h, samples, m);
+      other.colorSums = true;
+      EXPECT_TRUE(test::renderResolved(p, other, 2, &used) == ref) << samples;
+      EXPECT_FALSE(used);
+    }
+  }
+}
+
 // Without a valid order masking is not the Z-buffer: a far triangle given first hides a near one
 // (the documented price of priority masking; hybrid masking keeps the depth test for this).
 TEST(PriorityMasking, TrustsTheOrderItIsGiven) {

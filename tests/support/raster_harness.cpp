@@ -1,6 +1,7 @@
 #include "support/raster_harness.h"
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <random>
@@ -66,7 +67,7 @@ Frame renderQuadtree(const render::DrawPackets& p, const render::FrameSettings& 
   render::FrameSettings settings = s;
   const int tilesX = (s.width + raster::kTileSize - 1) >> raster::kTileLog2;
   // Tiles are copied out as they are finished (concurrently: each writes its own pixels).
-  settings.finishTile = [&](int tile, const float* depth, const uint16_t* color) {
+  settings.finishTile = [&](int tile, const float* depth, const uint16_t* color, const int32_t*) {
     const int x0 = (tile % tilesX) * raster::kTileSize, y0 = (tile / tilesX) * raster::kTileSize;
     for (int y = y0; y < std::min(s.height, y0 + raster::kTileSize); ++y)
       for (int x = x0; x < std::min(s.width, x0 + raster::kTileSize); ++x) {
@@ -81,6 +82,37 @@ Frame renderQuadtree(const render::DrawPackets& p, const render::FrameSettings& 
   FrameStats local;
   r.render(p, settings, stats ? *stats : local);
   return f;
+}
+
+std::vector<uint16_t> renderResolved(const render::DrawPackets& p, const render::FrameSettings& s,
+                                     int threads, bool* usedSums) {
+  render::FrameRenderer r(threads);
+  const uint32_t n = uint32_t(s.samples);
+  std::vector<uint16_t> rgb(size_t(s.width) * s.height * 3);
+  std::atomic<int> sumTiles{0}, planeTiles{0};
+  render::FrameSettings settings = s;
+  const int tilesX = (s.width + raster::kTileSize - 1) >> raster::kTileLog2;
+  settings.finishTile = [&](int tile, const float*, const uint16_t* color, const int32_t* sums) {
+    ++(sums ? sumTiles : planeTiles);
+    const int x0 = (tile % tilesX) * raster::kTileSize, y0 = (tile / tilesX) * raster::kTileSize;
+    for (int y = y0; y < std::min(s.height, y0 + raster::kTileSize); ++y)
+      for (int x = x0; x < std::min(s.width, x0 + raster::kTileSize); ++x)
+        for (int ch = 0; ch < 3; ++ch) {
+          uint32_t sum = 0;
+          if (sums) {
+            // A sum sits where sample 0 of a one-sample plane would (raster/framebuffer.h).
+            sum = uint32_t(sums[raster::FrameBuffer::colorOffset(x, y, ch)]);
+          } else {
+            for (uint32_t k = 0; k < n; ++k)
+              sum += color[raster::FrameBuffer::colorOffset(x, y, ch, int(n), int(k))];
+          }
+          rgb[(size_t(y) * s.width + x) * 3 + ch] = uint16_t((sum + n / 2) / n);
+        }
+  };
+  FrameStats stats;
+  r.render(p, settings, stats);
+  if (usedSums) *usedSums = sumTiles > 0 && planeTiles == 0;  // every tile, or none
+  return rgb;
 }
 
 namespace {

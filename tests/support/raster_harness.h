@@ -41,6 +41,12 @@ struct Frame {
 Frame renderQuadtree(const render::DrawPackets& p, const render::FrameSettings& s, int threads = 1,
                      FrameStats* stats = nullptr);
 
+// Renders and box-resolves: each pixel's 3 channels, the rounded mean of its samples (row-major),
+// from the tiles' sample planes or — when the frame renderer hands them over (s.colorSums) — their
+// colour sums; `usedSums` (optional) says whether every tile came as sums.
+std::vector<uint16_t> renderResolved(const render::DrawPackets& p, const render::FrameSettings& s,
+                                     int threads = 1, bool* usedSums = nullptr);
+
 // The brute-force reference (RASTER-NOTES "hierarchy = flat"): for every pixel and every triangle
 // in submission order, test the pixel centre against each edge function directly, then the same
 // depth test and colour expressions as the kernel, in scalar code. With s.samples > 1 the pixel's
