@@ -501,12 +501,16 @@ HWY_INLINE int shadeBlockMaterial(const TriangleSetup& t, const PlaneLanes& lane
 
 // Step 1 for block (gx, gy): the samples that pass, a bit per sample as the masks hold them
 // (masks nullptr: all covered), and the centroid offsets (cx, cy) of partly covered pixels.
-// False if none pass. `hidden` counts the covered pixels none of whose samples pass.
+// False if none pass. `hidden` counts the covered pixels none of whose samples pass. `uniform`
+// (optional): every sample of `depth` holds uniform[0] (colour sums: the clear depth), and
+// uniform[1] is the largest of sampleDepth — a lane whose largest sample depth is below the
+// former passes every covered sample without testing each (float addition is monotonic).
 HWY_INLINE bool samplesPassing(const TriangleSetup& t, const PlaneLanes& lanes,
                                const CoverageTables& cov, const float* sampleDepth,
                                const uint32_t (*masks)[kBlockPixels], int gx, int gy,
                                const float* depth, uint32_t (*pass)[kBlockPixels], float* cx,
-                               float* cy, const uint32_t (*shading)[kBlockPixels], int& hidden) {
+                               float* cy, const uint32_t (*shading)[kBlockPixels], int& hidden,
+                               const float* uniform = nullptr) {
   const int samples = cov.samples;
   const uint32_t fullWord0 = fullSampleWord(samples, 0), fullWord1 = fullSampleWord(samples, 1);
   const hn::CappedTag<float, kBlockPixels> df;
@@ -523,7 +527,14 @@ HWY_INLINE bool samplesPassing(const TriangleSetup& t, const PlaneLanes& lanes,
     }
     const auto zPix = hn::Add(hn::Set(df, base[kDepth]), hn::LoadU(df, lanes.offset[kDepth] + i));
     auto p0 = hn::Zero(du32), p1 = p0;
-    for (int s = 0; s < samples; ++s) {
+    const bool allPass =
+        uniform &&
+        hn::AllTrue(df, hn::Lt(hn::Add(zPix, hn::Set(df, uniform[1])), hn::Set(df, uniform[0])));
+    if (allPass) {
+      p0 = m0;
+      p1 = m1;
+    }
+    for (int s = 0; !allPass && s < samples; ++s) {
       const auto bit = hn::Set(du32, 1u << (s & 31));
       const auto covered = hn::RebindMask(df, hn::TestBit(s < 32 ? m0 : m1, bit));
       if (hn::AllFalse(df, covered)) continue;
@@ -978,9 +989,12 @@ class TriangleRaster {
       reciprocal_[k] = 1.0f / float(divisor_[k]);
     }
     const auto& offsets = cov.pattern->offsets;
-    for (int s = 0; s < cov.samples; ++s)
+    sampleDepthMax_ = -std::numeric_limits<float>::infinity();
+    for (int s = 0; s < cov.samples; ++s) {
       sampleDepth_[s] = t_.depth.dx * float(offsets[size_t(s)][0]) +
                         t_.depth.dy * float(offsets[size_t(s)][1]);
+      sampleDepthMax_ = std::max(sampleDepthMax_, sampleDepth_[s]);
+    }
   }
 
   // Classifies a root window by the coverage function of each edge, then fills, tests or splits.
@@ -1419,8 +1433,10 @@ class TriangleRaster {
     alignas(64) float cx[kBlockPixels], cy[kBlockPixels];
     const int gx = ctx_.originX + lx, gy = ctx_.originY + ly;
     int hidden = 0;
+    const float uniform[2] = {ctx_.clearPlanes ? ctx_.clearPlanes[0] : 0.0f, sampleDepthMax_};
     const bool any = samplesPassing(t_, planeLanes_, *ctx_.coverage, sampleDepth_, masks, gx, gy,
-                                    blockDepthOrClear(planes), b.pass, cx, cy, shading, hidden);
+                                    blockDepthOrClear(planes), b.pass, cx, cy, shading, hidden,
+                                    ctx_.sums ? uniform : nullptr);
     ctx_.stats->hiddenFragments += uint64_t(hidden);
     if (!any) return;
     int passing = 0;
@@ -1544,6 +1560,7 @@ class TriangleRaster {
   int32_t rowOffset_[E], divisor_[E];
   float reciprocal_[E];
   float sampleDepth_[64];
+  float sampleDepthMax_ = 0;  // the largest of them
 };
 
 void clearTile(const TileWork& w) {
