@@ -326,7 +326,7 @@ SetupOutcome setupTriangle(const ClipVertex& v0, const ClipVertex& v1, const Cli
 
 void attributePlanes(const ClipVertex& v0, const ClipVertex& v1, const ClipVertex& v2,
                      const Viewport& viewport, const TriangleSetup& setup,
-                     const float* const values[3], int count, Plane* out) {
+                     const float* const values[3], int count, Plane* out, unsigned used) {
   // The same λ as setupTriangle's steps 3, 4 and 8 for this (drawn, so valid) triangle.
   const ClipVertex* const v[3] = {&v0, &v1, &v2};
   const ScreenVertex s[3] = {snapVertex(v0, viewport), snapVertex(v1, viewport),
@@ -356,6 +356,10 @@ void attributePlanes(const ClipVertex& v0, const ClipVertex& v1, const ClipVerte
   const Lambda lambda = lambdaFunctions(allSnapped, intEdge, s, adj, det, area2);
   const double px = double(setup.minX) + 0.5, py = double(setup.minY) + 0.5;
   for (int a = 0; a < count; ++a) {
+    if (!(used >> a & 1)) {
+      out[a] = Plane{};
+      continue;
+    }
     const double f[3] = {values[0][a] * lambda.invW[0], values[1][a] * lambda.invW[1],
                          values[2][a] * lambda.invW[2]};
     out[a] = makePlane(lambda.g, f, lambda.scale, px, py);

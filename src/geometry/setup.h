@@ -133,9 +133,10 @@ size_t setupTriangles(const ClipVertex* vertices, const uint32_t* indices, size_
 
 // Pixel shading's extra parameters (SPEC §2): `count` planes of value/w for per-vertex values
 // values[k][0 … count) of vertex k, relative to the same origin (minX, minY) as `setup`'s planes —
-// the functions setupTriangle gives the colour. `setup` is the triangle's drawn record.
+// the functions setupTriangle gives the colour. `setup` is the triangle's drawn record. Only the
+// planes whose bit is set in `used` are computed; the others are set to zero (nothing reads them).
 void attributePlanes(const ClipVertex& v0, const ClipVertex& v1, const ClipVertex& v2,
                      const Viewport& viewport, const TriangleSetup& setup,
-                     const float* const values[3], int count, Plane* out);
+                     const float* const values[3], int count, Plane* out, unsigned used = ~0u);
 
 }  // namespace sv::geometry

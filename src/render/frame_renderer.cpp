@@ -153,6 +153,8 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
         if (masking) std::fill(scratch.objects.begin() + first, scratch.objects.begin() + n, object);
         // Pixel shading's planes for the drawn triangles of a call with a material.
         const shade::MaterialShading* material = call ? call->material : nullptr;
+        const unsigned used =
+            material ? shade::attributesUsed(*material, *settings.environment) : 0u;
         if (pixelShading)
           for (uint32_t r = first; r < n; ++r) {
             const geometry::TriangleSetup& s = scratch.records[r];
@@ -165,7 +167,7 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
                                       packets.attributes[idx[2]].value};
             geometry::attributePlanes(packets.vertices[idx[0]], packets.vertices[idx[1]],
                                       packets.vertices[idx[2]], viewport, s, values,
-                                      shade::kAttributeCount, a.planes);
+                                      shade::kAttributeCount, a.planes, used);
           }
         tri = runEnd;
       }
