@@ -421,8 +421,8 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
 
   auto t0 = Clock::now();
   render::DrawPackets& p = impl_->packets;
-  p.vertices.clear();
-  p.attributes.clear();
+  // Vertices and attributes are resized below and every one is written by the vertex stage:
+  // not cleared first, so that a frame of the same size does not zero megabytes for nothing.
   p.indices.clear();
   p.calls.clear();
   const scene::Material defaultMaterial;
@@ -482,7 +482,7 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
       vertexCount += mesh.positions.size();
     }
   p.vertices.resize(vertexCount);
-  if (pixelShading) p.attributes.resize(vertexCount);
+  p.attributes.resize(pixelShading ? vertexCount : 0);
   impl_->frame.pool().parallelFor(jobs.size(), [&](size_t j, int) {
     const VertexJob& job = jobs[j];
     const scene::Mesh& mesh = scene.meshes[job.instance->mesh];
