@@ -4,6 +4,7 @@ prints the table of frame times against depth complexity D per --hsr mode and or
 targets' ratios, and draws an SVG plot (time vs D, one line per mode and order)."""
 import argparse
 import json
+import statistics
 import sys
 
 ap = argparse.ArgumentParser()
@@ -22,13 +23,17 @@ if a.json:
     with open(a.json, "w") as f:
         json.dump(rows, f, indent=1)
 
-times = {}  # (hsr, order, D) -> median ms
+runs = {}  # (hsr, order, D) -> every run's median ms
 for r in rows:
-    times[(r["hsr"], r["order"], int(r["layers"]))] = r["median_ms"]
+    runs.setdefault((r["hsr"], r["order"], int(r["layers"])), []).append(r["median_ms"])
+times = {k: statistics.median(v) for k, v in runs.items()}  # the median over runs
 ds = sorted({k[2] for k in times})
 modes = ["zbuffer", "priority", "hybrid"]
 orders = ["random", "f2b", "b2f"]
 
+rounds = max(len(v) for v in runs.values())
+if rounds > 1:
+    print(f"(each cell the median of {rounds} runs)")
 print("| D | " + " | ".join(f"{m} {o}" for m in modes for o in orders) + " |")
 print("|---" * (1 + len(modes) * len(orders)) + "|")
 for d in ds:
