@@ -123,6 +123,25 @@ struct PlaneLanes {
   alignas(32) float c0[8], dx[8], dy[8];
 };
 
+// The lanes of `m` (at most 16: one 4×4 block's worth from lane i on) as bits, shifted to bit i.
+template <class D, class M>
+HWY_INLINE uint32_t laneBits(D d, M m, size_t i) {
+  uint8_t bits[8] = {};
+  hn::StoreMaskBits(d, m, bits);
+  return (uint32_t(bits[0]) | uint32_t(bits[1]) << 8) << i;
+}
+
+// Sets sample s's bit, in the coverage masks' two words (w0: samples 0–31, w1: 32–63), in the
+// lanes of `m`.
+template <class DU, class M, class VU>
+HWY_INLINE void orSampleBit(DU du, M m, int s, VU& w0, VU& w1) {
+  const auto bit = hn::IfThenElseZero(m, hn::Set(du, 1u << (s & 31)));
+  if (s < 32)
+    w0 = hn::Or(w0, bit);
+  else
+    w1 = hn::Or(w1, bit);
+}
+
 HWY_INLINE const Plane& planeOf(const TriangleSetup& t, int p) {
   const Plane* planes[kPlaneCount] = {&t.depth, &t.invW, &t.red, &t.green, &t.blue};
   return *planes[p];
@@ -459,9 +478,7 @@ HWY_INLINE int shadeBlockMaterial(const TriangleSetup& t, const PlaneLanes& lane
   for (size_t i = 0; i < size_t(kBlockPixels); i += n) {
     const auto covered = hn::RebindMask(df, hn::TestBit(maskVec, hn::LoadU(di, kLaneBit + i)));
     const auto z = hn::Add(hn::Set(df, base[kDepth]), hn::LoadU(df, lanes.offset[kDepth] + i));
-    uint8_t bits[8] = {};
-    hn::StoreMaskBits(df, hn::And(covered, hn::Lt(z, hn::LoadU(df, depth + i))), bits);
-    passBits |= (uint32_t(bits[0]) | uint32_t(bits[1]) << 8) << i;
+    passBits |= laneBits(df, hn::And(covered, hn::Lt(z, hn::LoadU(df, depth + i))), i);
   }
   const int hidden = std::popcount(mask) - std::popcount(passBits);
   if (!passBits) return hidden;
@@ -539,12 +556,8 @@ HWY_INLINE bool samplesPassing(const TriangleSetup& t, const PlaneLanes& lanes,
       const auto covered = hn::RebindMask(df, hn::TestBit(s < 32 ? m0 : m1, bit));
       if (hn::AllFalse(df, covered)) continue;
       const auto z = hn::Add(zPix, hn::Set(df, sampleDepth[s]));
-      const auto passed = hn::RebindMask(
-          du32, hn::And(covered, hn::Lt(z, hn::LoadU(df, depth + size_t(s) * kBlockPixels + i))));
-      if (s < 32)
-        p0 = hn::Or(p0, hn::IfThenElseZero(passed, bit));
-      else
-        p1 = hn::Or(p1, hn::IfThenElseZero(passed, bit));
+      const auto zOld = hn::LoadU(df, depth + size_t(s) * kBlockPixels + i);
+      orSampleBit(du32, hn::RebindMask(du32, hn::And(covered, hn::Lt(z, zOld))), s, p0, p1);
     }
     hn::StoreU(p0, du32, pass[0] + i);
     hn::StoreU(p1, du32, pass[1] + i);
@@ -1088,9 +1101,7 @@ class TriangleRaster {
         const auto e = hn::Add(hn::Set(d, tl[k]), hn::LoadU(d, leafOffset_[k] + i));
         inside = hn::And(inside, hn::Gt(e, minusOne));
       }
-      uint8_t bits[8] = {};
-      hn::StoreMaskBits(d, inside, bits);
-      mask |= (uint32_t(bits[0]) | uint32_t(bits[1]) << 8) << i;
+      mask |= laneBits(d, inside, i);
     }
     ++ctx_.stats->partialBlocks;
     ctx_.stats->windows[kStatLevels - 1] += kBlockPixels;
@@ -1244,9 +1255,7 @@ class TriangleRaster {
       const auto w1 = hn::Or(hn::LoadU(du, words[1] + i), hn::LoadU(du, masks[1] + i));
       hn::StoreU(w0, du, words[0] + i);
       hn::StoreU(w1, du, words[1] + i);
-      uint8_t bits[8] = {};
-      hn::StoreMaskBits(du, hn::And(hn::Eq(w0, full0), hn::Eq(w1, full1)), bits);
-      pixels |= (uint32_t(bits[0]) | uint32_t(bits[1]) << 8) << i;
+      pixels |= laneBits(du, hn::And(hn::Eq(w0, full0), hn::Eq(w1, full1)), i);
     }
     occ_->setPixels(lx, ly, pixels, pixels == 0xFFFF ? blockZmax(lx, ly) : Occupancy::kNoBound);
   }
@@ -1639,20 +1648,12 @@ HWY_NOINLINE void occupyFromDepth(const TileContext& ctx, float clearDepth) {
         for (int s = 0; s < samples; ++s) {
           const auto z = hn::LoadU(df, depth + size_t(s) * kBlockPixels + i);
           zmax = hn::Max(zmax, z);
-          const auto held = hn::RebindMask(du, hn::Lt(z, clear));
-          const auto bit = hn::Set(du, 1u << (s & 31));
-          if (s < 32)
-            w0 = hn::Or(w0, hn::IfThenElseZero(held, bit));
-          else
-            w1 = hn::Or(w1, hn::IfThenElseZero(held, bit));
+          orSampleBit(du, hn::RebindMask(du, hn::Lt(z, clear)), s, w0, w1);
         }
         hn::StoreU(w0, du, words[0] + i);
         hn::StoreU(w1, du, words[1] + i);
-        uint8_t bits[8] = {};
-        hn::StoreMaskBits(du, hn::And(hn::Eq(w0, full0), hn::Eq(w1, full1)), bits);
-        pixels |= (uint32_t(bits[0]) | uint32_t(bits[1]) << 8) << i;
-        hn::StoreMaskBits(du, hn::Ne(hn::Or(w0, w1), hn::Zero(du)), bits);
-        any |= (uint32_t(bits[0]) | uint32_t(bits[1]) << 8) << i;
+        pixels |= laneBits(du, hn::And(hn::Eq(w0, full0), hn::Eq(w1, full1)), i);
+        any |= laneBits(du, hn::Ne(hn::Or(w0, w1), hn::Zero(du)), i);
       }
       if (pixels == 0xFFFF) {
         occ.markFull(kBlockLog2, lx, ly,

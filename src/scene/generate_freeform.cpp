@@ -4,6 +4,7 @@
 #include <random>
 
 #include "freeform/quadric.h"
+#include "scene/generator_common.h"
 #include "synthvis/generators.h"
 
 namespace sv::scene {
@@ -39,14 +40,7 @@ Scene generateFreeForms(const FreeFormParams& p) {
   s.background = {0.55f, 0.62f, 0.72f};
   addBenchLight(s);
   s.fog = {true, {0.55f, 0.62f, 0.72f}, 0.04f};
-  Camera cam;
-  cam.name = "bench";
-  cam.position = {0, 0, 0};
-  cam.target = {0, 0, -1};
-  cam.yfovDegrees = 60;
-  cam.znear = 0.5f;
-  cam.zfar = 100;
-  s.cameras.push_back(cam);
+  s.cameras.push_back(detail::benchCamera({0, 0, 0}, {0, 0, -1}, 60, 0.5f, 100));
   // Eight Phong materials of random colours.
   for (int m = 0; m < 8; ++m) {
     Material mat;
@@ -107,14 +101,7 @@ Scene generateFreeFormOne() {
   Scene s;
   s.background = {0.08f, 0.09f, 0.12f};
   addBenchLight(s);
-  Camera cam;
-  cam.name = "bench";
-  cam.position = {0, 0.9f, 3.6f};
-  cam.target = {0, 0, 0};
-  cam.yfovDegrees = 45;
-  cam.znear = 0.5f;
-  cam.zfar = 20;
-  s.cameras.push_back(cam);
+  s.cameras.push_back(detail::benchCamera({0, 0.9f, 3.6f}, {0, 0, 0}, 45, 0.5f, 20));
   Material clay;
   clay.name = "clay";
   clay.baseColor = {0.75f, 0.45f, 0.3f, 1};

@@ -71,14 +71,7 @@ Scene benchCameraScene(const std::string& name) {
   mat.doubleSided = true;
   s.materials.push_back(mat);
   s.instances.push_back({0, Mat4{}});
-  Camera cam;
-  cam.name = "bench";
-  cam.position = {0, 0, 0};
-  cam.target = {0, 0, -1};
-  cam.yfovDegrees = 60;
-  cam.znear = 0.1f;
-  cam.zfar = 100;
-  s.cameras.push_back(cam);
+  s.cameras.push_back(detail::benchCamera({0, 0, 0}, {0, 0, -1}, 60, 0.1f, 100));
   s.light.enabled = false;
   s.background = {0, 0, 0};
   return s;

@@ -5,6 +5,7 @@
 #include <random>
 
 #include "synthvis/math.h"
+#include "synthvis/scene.h"
 
 namespace sv::scene::detail {
 
@@ -18,6 +19,19 @@ Vec4 randomBenchColor(Rng& rng) {
   };
   const float r = channel(), g = channel(), b = channel();
   return {r, g, b, 1};
+}
+
+// The camera a generated scene is seen through: named "bench", looking from `position` at
+// `target`, vertical field of view `yfovDegrees`, depth range [znear, zfar].
+inline Camera benchCamera(Vec3 position, Vec3 target, float yfovDegrees, float znear, float zfar) {
+  Camera cam;
+  cam.name = "bench";
+  cam.position = position;
+  cam.target = target;
+  cam.yfovDegrees = yfovDegrees;
+  cam.znear = znear;
+  cam.zfar = zfar;
+  return cam;
 }
 
 }  // namespace sv::scene::detail
