@@ -99,7 +99,7 @@ struct TriangleSetup {
   Plane depth, invW, red, green, blue;
   int16_t minX, minY, maxX, maxY;  // inclusive pixel bounding box, clipped to the raster
   // The triangle's number in its draw packets (setupTriangles' firstTriangle + its position): finds
-  // its attribute planes for pixel shading (AttributeSetup) after binning has reordered records.
+  // its vertices again (pixel shading's attribute planes, set up from them after this record).
   uint32_t triangle;
   uint8_t edgeCount;
   // True when the triangle is small (three integer edges, bounding box ≤ kSmallExtent pixels):

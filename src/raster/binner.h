@@ -22,7 +22,8 @@ namespace sv::raster {
 
 class Binner {
  public:
-  // Per-worker temporary arrays for binChunk (kept between calls to avoid reallocation).
+  // Per-worker temporary arrays for binChunk (kept between calls to avoid reallocation). After a
+  // call, order[p] is the position in `records` of the record stored at storage[p].
   struct Scratch {
     std::vector<uint32_t> key, position, order, count, cursor;
   };

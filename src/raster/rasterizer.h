@@ -105,9 +105,8 @@ struct TileWork {
   // centre. The triangles must be set up with Viewport::pixelAperture and the buffers hold N sample
   // planes (framebuffer.h). nullptr: point sampling at pixel centres. Gouraud only.
   const CoverageTables* coverage = nullptr;
-  // ShadeMode::material: setup t's record is attributes[t.triangle − attributeBase].
+  // ShadeMode::material: setups[i]'s pixel-shading record is attributes[i].
   const AttributeSetup* attributes = nullptr;
-  uint32_t attributeBase = 0;
   const shade::Environment* environment = nullptr;
   // ShadeMode::material at one sample: kTilePixels entries of scratch, all ~0u on entry and left
   // so (which triangle won each pixel: its shading is deferred until the tile's lists are drawn).

@@ -86,7 +86,6 @@ struct TileContext {
   uint32_t* visible;
   const TriangleSetup* setups;
   const AttributeSetup* attributes;
-  uint32_t attributeBase;
   // Priority masking (SPEC §4): the tile's occupied windows, or nullptr (Z-buffer alone); with
   // `hybrid`, windows are dropped by their depth bounds instead of their occupancy alone.
   Occupancy* occupancy;
@@ -783,7 +782,7 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
   // Shades (Gouraud) or queues (material) batch b and empties it.
   auto emit = [&](Batch& b) {
     const TriangleSetup& t = ctx.setups[b.id];
-    const AttributeSetup& a = ctx.attributes[t.triangle - ctx.attributeBase];
+    const AttributeSetup& a = ctx.attributes[b.id];
     // Unused lanes repeat the last pixel: valid positions, no extra texels.
     for (int l = b.count; l < kBlockPixels; ++l) b.pixel[l] = b.pixel[b.count - 1];
     const unsigned used = a.material ? shade::attributesUsed(*a.material, *ctx.environment) : 0;
@@ -1678,7 +1677,7 @@ void drawLists(const TileWork& w, RasterStats& stats) {
   const bool deferred = kShade == ShadeMode::material && !kAA;
   TileContext ctx{w.tileX * kTileSize, w.tileY * kTileSize, w.depth, w.color, &stats,
                         w.coverage, w.coverage ? w.coverage->samples : 1, w.environment,
-                        deferred ? w.visible : nullptr, w.setups, w.attributes, w.attributeBase,
+                        deferred ? w.visible : nullptr, w.setups, w.attributes,
                         kShade == ShadeMode::overdraw || w.masking == Masking::none ? nullptr
                                                                                     : w.occupancy,
                         w.masking == Masking::hybrid};
@@ -1750,20 +1749,20 @@ void drawLists(const TileWork& w, RasterStats& stats) {
         }
       }
       if (i + kPrefetchDistance < size) {
-        const char* next = reinterpret_cast<const char*>(w.setups + list[i + kPrefetchDistance]);
+        const uint32_t ahead = list[i + kPrefetchDistance];
+        const char* next = reinterpret_cast<const char*>(w.setups + ahead);
         for (size_t line = 0; line < sizeof(TriangleSetup); line += 64) hwy::Prefetch(next + line);
+        // Pixel shading's record sits at the same index (TileWork::attributes).
+        if (kShade == ShadeMode::material) {
+          next = reinterpret_cast<const char*>(w.attributes + ahead);
+          for (size_t line = 0; line < sizeof(AttributeSetup); line += 64) hwy::Prefetch(next + line);
+        }
       }
       const TriangleSetup& t = w.setups[list[i]];
       const uint64_t fragmentsBefore = stats.fragments, hiddenBefore = stats.hiddenFragments;
       if constexpr (kShade == ShadeMode::material) {
-        // The attribute record is found through the setup record: fetch the next one's now.
-        if (i + 1 < size) {
-          const char* next = reinterpret_cast<const char*>(
-              w.attributes + (w.setups[list[i + 1]].triangle - w.attributeBase));
-          for (size_t line = 0; line < sizeof(AttributeSetup); line += 64) hwy::Prefetch(next + line);
-        }
         // Per triangle: shaded per pixel when it has a material, else plain Gouraud.
-        const AttributeSetup& a = w.attributes[t.triangle - w.attributeBase];
+        const AttributeSetup& a = w.attributes[list[i]];
         const shade::AlphaUse alpha = a.material ? a.material->alpha : shade::AlphaUse::opaque;
         if (deferred && alpha == shade::AlphaUse::opaque) {
           drawTriangle<PixelOp::visibility, false>(t, *use, nullptr, list[i]);

@@ -94,6 +94,7 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
     if (masking && !wholeFrame && !w.occupancy)
       w.occupancy = std::make_unique<raster::Occupancy>();
     if (masking) w.objects.resize(kChunkTriangles);
+    if (pixelShading) w.attributes.resize(kChunkTriangles);
   }
   if (masking && wholeFrame) frameOccupancy_.resize(size_t(tiles));
   // Object-space culling: every draw call's bound; its records carry the call's index, or
@@ -151,14 +152,15 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
             call ? call->cull : geometry::CullMode::none, scratch.records.data() + n, outcomes,
             tri));
         if (masking) std::fill(scratch.objects.begin() + first, scratch.objects.begin() + n, object);
-        // Pixel shading's planes for the drawn triangles of a call with a material.
+        // Pixel shading's planes for the drawn triangles of a call with a material (computed
+        // here, where the vertices are read in order; stored after binning).
         const shade::MaterialShading* material = call ? call->material : nullptr;
         const unsigned used =
             material ? shade::attributesUsed(*material, *settings.environment) : 0u;
         if (pixelShading)
           for (uint32_t r = first; r < n; ++r) {
             const geometry::TriangleSetup& s = scratch.records[r];
-            raster::AttributeSetup& a = attributes_[s.triangle - batch];
+            raster::AttributeSetup& a = scratch.attributes[r];
             a.material = material;
             if (!material) continue;
             const uint32_t* idx = &packets.indices[size_t(s.triangle) * 3];
@@ -181,6 +183,11 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
       const uint32_t storageBase = begin - batch;
       binner_.binChunk(int(chunk), scratch.records.data(), n, setups_.data() + storageBase,
                        storageBase, scratch.bins, masking ? scratch.objects.data() : nullptr);
+      // Pixel shading's planes, stored as the setup records are (grouped by tile): a tile finds
+      // each triangle's from its list entry and reads them in runs, as it reads the records.
+      if (pixelShading)
+        for (uint32_t p = 0; p < n; ++p)
+          attributes_[storageBase + p] = scratch.attributes[scratch.bins.order[p]];
       counts[chunk] = c;
     });
     for (int i = 0; i < chunks; ++i) {
@@ -224,7 +231,6 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
       w.coverage = coverage;
       if (pixelShading) {
         w.attributes = attributes_.data();
-        w.attributeBase = batch;
         w.environment = settings.environment;
         if (samples == 1) w.visible = scratch_[worker].visible.data();
       }

@@ -96,11 +96,12 @@ class FrameRenderer {
     std::vector<uint32_t> visible;  // 64×64 deferred-shading records (TileWork::visible)
     std::unique_ptr<raster::Occupancy> occupancy;  // the tile's, in frames of one batch
     std::vector<uint32_t> objects;  // with masking: the chunk's records' objects (TileWork)
+    std::vector<raster::AttributeSetup> attributes;  // pixel shading: the records', in their order
   };
   std::vector<geometry::ObjectBound> objects_;   // with masking: every draw call's bound
   std::vector<raster::Occupancy> frameOccupancy_;  // every tile's, in frames of several batches
   std::vector<geometry::TriangleSetup> setups_;  // the batch's, grouped by tile within each chunk
-  std::vector<raster::AttributeSetup> attributes_;  // the batch's, by triangle (ShadeMode::material)
+  std::vector<raster::AttributeSetup> attributes_;  // ShadeMode::material: setups_[i]'s is attributes_[i]
   std::vector<WorkerScratch> scratch_;           // one per pool worker
   std::vector<raster::RasterStats> tileStats_;
   std::vector<uint8_t> opaqueDone_;  // per tile: FrameSettings::afterOpaque has run
