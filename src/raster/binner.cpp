@@ -14,7 +14,7 @@ void Binner::reset(int chunks, int tilesX, int tilesY) {
 
 void Binner::binChunk(int chunk, const geometry::TriangleSetup* records, uint32_t n,
                       geometry::TriangleSetup* storage, uint32_t storageBase, Scratch& scratch,
-                      const uint32_t* objects) {
+                      const uint32_t* objects, bool boxes) {
   // Counting sort by the tile of the top-left corner; stable, so each group keeps submission order.
   scratch.key.resize(n);
   scratch.position.resize(n);
@@ -53,6 +53,16 @@ void Binner::binChunk(int chunk, const geometry::TriangleSetup* records, uint32_
   for (uint32_t i = 0; i < n; ++i) {
     const uint32_t index = storageBase + scratch.position[i];
     forEachTile(records[i], [&](int tile) { out.entries[scratch.cursor[tile]++] = index; });
+  }
+  out.boxes.clear();
+  if (boxes) {
+    out.boxes.resize(out.entries.size());
+    scratch.cursor.assign(out.offsets.begin(), out.offsets.end() - 1);
+    for (uint32_t i = 0; i < n; ++i) {
+      const geometry::TriangleSetup& t = records[i];
+      const Box box{t.minX, t.minY, t.maxX, t.maxY};
+      forEachTile(t, [&](int tile) { out.boxes[scratch.cursor[tile]++] = box; });
+    }
   }
   out.objects.clear();
   if (objects) {

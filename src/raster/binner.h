@@ -35,23 +35,30 @@ class Binner {
   // storage[0, n), grouped by tile, and appends storageBase + their position to the list of every
   // tile each one's bounding box overlaps, in submission order. Chunks may be binned concurrently.
   // With `objects` (per record, in the order of `records`), each list entry's object goes to the
-  // list's parallel `objects` array.
+  // list's parallel `objects` array; with `boxes`, its record's bounding box to `boxes`.
   void binChunk(int chunk, const geometry::TriangleSetup* records, uint32_t n,
                 geometry::TriangleSetup* storage, uint32_t storageBase, Scratch& scratch,
-                const uint32_t* objects = nullptr);
+                const uint32_t* objects = nullptr, bool boxes = false);
 
+  // A record's bounding box (TriangleSetup::minX …), beside its list entry: priority masking tests
+  // it against the tile's occupancy without reading the record (TileWork::listBoxes).
+  struct Box {
+    int16_t minX, minY, maxX, maxY;
+  };
   struct List {
     const uint32_t* data;
     uint32_t size;
     const uint32_t* objects;  // per entry, when binned with objects; else nullptr
+    const Box* boxes;         // per entry, when binned with boxes; else nullptr
   };
   int chunkCount() const { return chunks_; }
   List list(int chunk, int tile) const {
     const ChunkLists& c = chunkLists_[size_t(chunk)];
-    if (c.offsets.empty()) return {nullptr, 0, nullptr};
+    if (c.offsets.empty()) return {nullptr, 0, nullptr, nullptr};
     const uint32_t begin = c.offsets[size_t(tile)];
     return {c.entries.data() + begin, c.offsets[size_t(tile) + 1] - begin,
-            c.objects.empty() ? nullptr : c.objects.data() + begin};
+            c.objects.empty() ? nullptr : c.objects.data() + begin,
+            c.boxes.empty() ? nullptr : c.boxes.data() + begin};
   }
 
  private:
@@ -60,6 +67,7 @@ class Binner {
   // tile and chunk (the same speed on tris 100k×10, far fewer allocations at 8192² rasters).
   struct ChunkLists {
     std::vector<uint32_t> offsets, entries, objects;
+    std::vector<Box> boxes;
   };
   int chunks_ = 0, tilesX_ = 0, tiles_ = 0;
   std::vector<ChunkLists> chunkLists_;

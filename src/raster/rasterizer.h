@@ -9,6 +9,7 @@
 #include <functional>
 
 #include "geometry/setup.h"
+#include "raster/binner.h"
 #include "raster/coverage_masks.h"
 #include "raster/occupancy.h"
 #include "shade/shading.h"
@@ -124,6 +125,10 @@ struct TileWork {
   // skipped where objectHidden says so, before any of its records is read.
   const uint32_t* const* listObjects = nullptr;
   const geometry::ObjectBound* objects = nullptr;
+  // Priority masking where no triangle is translucent: per list, each entry's bounding box
+  // (Binner::Box), or nullptr. A triangle whose box lies in occupied windows is dropped before
+  // its records — setup and pixel shading's — are read (in a deep stack of layers, most are).
+  const Binner::Box* const* listBoxes = nullptr;
   // Called once per tile when its opaque triangles are all drawn (and shaded) — before its first
   // translucent one, or after its last triangle in the frame's last batch — with the tile's
   // buffers as they stand: free forms are drawn there (freeform/tile_pass.h). `opaqueDone` is set

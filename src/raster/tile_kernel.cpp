@@ -1591,29 +1591,38 @@ void clearTile(const TileWork& w) {
     std::memcpy(w.color + size_t(b) * kColorPerBlock, plane, sizeof(plane));
 }
 
+// Priority masking: whether the triangle with box (minX, minY)–(maxX, maxY) lies in occupied
+// windows of the tile, so that it is dropped before its traversal is set up (in a deep stack of
+// layers, most are); counted as occluded. Hybrid masking (`t`): in full windows whose depth bounds
+// its nearest depth does not beat. Also true, uncounted, for a box outside the tile.
+template <bool kAA>
+HWY_INLINE bool boxHidden(const TileContext& ctx, int minX, int minY, int maxX, int maxY,
+                          const TriangleSetup* t = nullptr) {
+  const int x0 = std::max(minX - ctx.originX, 0), y0 = std::max(minY - ctx.originY, 0);
+  const int x1 = std::min(maxX - ctx.originX, kTileSize - 1);
+  const int y1 = std::min(maxY - ctx.originY, kTileSize - 1);
+  if (x0 > x1 || y0 > y1) return true;  // (the traversal would draw nothing)
+  const bool hidden =
+      ctx.hybrid ? ctx.occupancy->rectHidden(
+                       x0, y0, x1, y1,
+                       depthBound(*t, ctx.originX + x0, ctx.originY + y0, ctx.originX + x1,
+                                  ctx.originY + y1, kAA, false))
+                 : ctx.occupancy->rectFull(x0, y0, x1, y1);
+  ctx.stats->occludedTriangles += hidden;
+  return hidden;
+}
+
 // One triangle, specialized on its edge count and integer width (STYLE.md habit 6).
+// `boxTested`: boxHidden has passed it already (TileWork::listBoxes).
 template <PixelOp kOp, bool kAA>
 HWY_INLINE void drawTriangle(const TriangleSetup& t, const TileContext& ctx,
-                             const AttributeSetup* attributes = nullptr, uint32_t id = kNoTriangle) {
-  // Priority masking: a triangle whose box lies in occupied windows is dropped before its
-  // traversal is set up (in a deep stack of layers, most are).
-  if (ctx.occupancy && !(attributes && attributes->material &&
-                         attributes->material->alpha == shade::AlphaUse::blend)) {
-    const int x0 = std::max(t.minX - ctx.originX, 0), y0 = std::max(t.minY - ctx.originY, 0);
-    const int x1 = std::min(t.maxX - ctx.originX, kTileSize - 1);
-    const int y1 = std::min(t.maxY - ctx.originY, kTileSize - 1);
-    if (x0 > x1 || y0 > y1) return;
-    const bool hidden =
-        ctx.hybrid ? ctx.occupancy->rectHidden(
-                         x0, y0, x1, y1,
-                         depthBound(t, ctx.originX + x0, ctx.originY + y0, ctx.originX + x1,
-                                    ctx.originY + y1, kAA, false))
-                   : ctx.occupancy->rectFull(x0, y0, x1, y1);
-    if (hidden) {
-      ++ctx.stats->occludedTriangles;
-      return;
-    }
-  }
+                             const AttributeSetup* attributes = nullptr, uint32_t id = kNoTriangle,
+                             bool boxTested = false) {
+  if (ctx.occupancy && !boxTested &&
+      !(attributes && attributes->material &&
+        attributes->material->alpha == shade::AlphaUse::blend) &&
+      boxHidden<kAA>(ctx, t.minX, t.minY, t.maxX, t.maxY, &t))
+    return;
   if (t.small) return TriangleRaster<3, kOp, int32_t, kAA>(t, ctx, attributes, id).draw();
   switch (t.edgeCount) {
     case 3: return TriangleRaster<3, kOp, int64_t, kAA>(t, ctx, attributes, id).draw();
@@ -1731,6 +1740,8 @@ void drawLists(const TileWork& w, RasterStats& stats) {
     const uint32_t* list = w.lists[l];
     const uint32_t size = w.listSizes[l];
     const uint32_t* objects = ctx.occupancy && w.listObjects ? w.listObjects[l] : nullptr;
+    const Binner::Box* boxes =
+        ctx.occupancy && !ctx.hybrid && w.listBoxes ? w.listBoxes[l] : nullptr;
     for (uint32_t i = 0; i < size; ++i) {
       if (objects && use->occupancy && objects[i] != kNoObject) {
         const uint32_t object = objects[i];
@@ -1748,6 +1759,8 @@ void drawLists(const TileWork& w, RasterStats& stats) {
           continue;
         }
       }
+      if (boxes && boxHidden<kAA>(ctx, boxes[i].minX, boxes[i].minY, boxes[i].maxX, boxes[i].maxY))
+        continue;
       if (i + kPrefetchDistance < size) {
         const uint32_t ahead = list[i + kPrefetchDistance];
         const char* next = reinterpret_cast<const char*>(w.setups + ahead);
@@ -1765,7 +1778,7 @@ void drawLists(const TileWork& w, RasterStats& stats) {
         const AttributeSetup& a = w.attributes[list[i]];
         const shade::AlphaUse alpha = a.material ? a.material->alpha : shade::AlphaUse::opaque;
         if (deferred && alpha == shade::AlphaUse::opaque) {
-          drawTriangle<PixelOp::visibility, false>(t, *use, nullptr, list[i]);
+          drawTriangle<PixelOp::visibility, false>(t, *use, nullptr, list[i], boxes != nullptr);
           pending = true;
           wakeIfHidden(fragmentsBefore, hiddenBefore);
           continue;
@@ -1778,14 +1791,14 @@ void drawLists(const TileWork& w, RasterStats& stats) {
           afterOpaque(w);
         }
         if (a.material)
-          drawTriangle<PixelOp::material, kAA>(t, *use, &a);
+          drawTriangle<PixelOp::material, kAA>(t, *use, &a, kNoTriangle, boxes != nullptr);
         else
-          drawTriangle<PixelOp::gouraud, kAA>(t, *use);
+          drawTriangle<PixelOp::gouraud, kAA>(t, *use, nullptr, kNoTriangle, boxes != nullptr);
       } else {
         constexpr PixelOp op = kShade == ShadeMode::overdraw ? PixelOp::overdraw
                                : kShade == ShadeMode::levels ? PixelOp::levels
                                                              : PixelOp::gouraud;
-        drawTriangle<op, kAA>(t, *use);
+        drawTriangle<op, kAA>(t, *use, nullptr, kNoTriangle, boxes != nullptr);
       }
       wakeIfHidden(fragmentsBefore, hiddenBefore);
     }

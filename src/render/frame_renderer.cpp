@@ -70,8 +70,13 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
               !settings.afterOpaque && !settings.debugOccupancy &&
               (settings.shade == raster::ShadeMode::material ||
                settings.shade == raster::ShadeMode::gouraud);
-  for (const DrawCall& call : packets.calls)
+  // Priority masking tests each list entry's box before reading its records (TileWork::listBoxes),
+  // unless some triangle is translucent (never dropped by occupancy).
+  bool boxes = settings.masking == raster::Masking::priority;
+  for (const DrawCall& call : packets.calls) {
     if (call.material && call.material->alpha != shade::AlphaUse::opaque) sums = false;
+    if (call.material && call.material->alpha == shade::AlphaUse::blend) boxes = false;
+  }
   if (wholeFrame) fb_.resize(settings.width, settings.height, samples, sums);
   uint16_t clear16[3];
   for (int ch = 0; ch < 3; ++ch)
@@ -115,6 +120,7 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
   std::vector<const uint32_t*> listPtrs(size_t(maxChunks) * pool_.threadCount());
   std::vector<uint32_t> listSizes(listPtrs.size());
   std::vector<const uint32_t*> listObjects(listPtrs.size());
+  std::vector<const raster::Binner::Box*> listBoxes(listPtrs.size());
   stats.trianglesIn += triangleCount;
 
   // Always run at least one (empty) batch, so the tiles get cleared.
@@ -182,7 +188,8 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
       c.occluded = occluded;
       const uint32_t storageBase = begin - batch;
       binner_.binChunk(int(chunk), scratch.records.data(), n, setups_.data() + storageBase,
-                       storageBase, scratch.bins, masking ? scratch.objects.data() : nullptr);
+                       storageBase, scratch.bins, masking ? scratch.objects.data() : nullptr,
+                       boxes);
       // Pixel shading's planes, stored as the setup records are (grouped by tile): a tile finds
       // each triangle's from its list entry and reads them in runs, as it reads the records.
       if (pixelShading)
@@ -207,11 +214,13 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
       const uint32_t** listPtr = listPtrs.data() + size_t(worker) * maxChunks;
       uint32_t* listSize = listSizes.data() + size_t(worker) * maxChunks;
       const uint32_t** listObject = listObjects.data() + size_t(worker) * maxChunks;
+      const raster::Binner::Box** listBox = listBoxes.data() + size_t(worker) * maxChunks;
       for (int c = 0; c < lists; ++c) {
         const raster::Binner::List l = binner_.list(c, int(tile));
         listPtr[c] = l.data;
         listSize[c] = l.size;
         listObject[c] = l.objects;
+        listBox[c] = l.boxes;
       }
       raster::TileWork w;
       w.tileX = int(tile) % tilesX;
@@ -239,6 +248,7 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
       if (masking) {
         w.occupancy = wholeFrame ? &frameOccupancy_[tile] : scratch_[worker].occupancy.get();
         w.listObjects = listObject;
+        if (boxes) w.listBoxes = listBox;
         w.objects = objects_.data();
       }
       w.lastBatch = lastBatch;
