@@ -122,14 +122,30 @@ enum class SetupOutcome : uint8_t {  // numbered from 0, in this order
 SetupOutcome setupTriangle(const ClipVertex& v0, const ClipVertex& v1, const ClipVertex& v2,
                            const Viewport& viewport, CullMode cull, TriangleSetup& out);
 
+// Pixel shading's extra planes (attributePlanes'), asked of setupTriangles for the triangles it
+// draws. Vertex v's values are values[v·valueStride, v·valueStride + count) (strides in floats);
+// drawn record r's planes go to out + r·outStride (a stride in bytes, so that they may sit in a
+// larger record), the planes not in `used` set to zero.
+struct AttributeRequest {
+  const float* values = nullptr;
+  size_t valueStride = 0;
+  int count = 0;  // ≤ kMaxAttributePlanes
+  unsigned used = 0;
+  Plane* out = nullptr;
+  size_t outStride = 0;
+};
+inline constexpr int kMaxAttributePlanes = 16;
+
 // The same for `count` triangles (indices: 3 per triangle into `vertices`), several at once in
 // SIMD lanes (setup_batch.cpp); records bit-identical to setupTriangle's. The drawn triangles'
 // records go to out[0, returned count) in order, `triangle` set to firstTriangle + their position
-// in `indices`; outcomes[o] is incremented per triangle with outcome o.
+// in `indices`; outcomes[o] is incremented per triangle with outcome o. With `attributes`, each
+// drawn triangle's attribute planes too, bit-identical to attributePlanes'.
 inline constexpr int kSetupOutcomes = 5;
 size_t setupTriangles(const ClipVertex* vertices, const uint32_t* indices, size_t count,
                       const Viewport& viewport, CullMode cull, TriangleSetup* out,
-                      uint64_t outcomes[kSetupOutcomes], uint32_t firstTriangle = 0);
+                      uint64_t outcomes[kSetupOutcomes], uint32_t firstTriangle = 0,
+                      const AttributeRequest* attributes = nullptr);
 
 // Pixel shading's extra parameters (SPEC §2): `count` planes of value/w for per-vertex values
 // values[k][0 … count) of vertex k, relative to the same origin (minX, minY) as `setup`'s planes —

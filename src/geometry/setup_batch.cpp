@@ -26,14 +26,31 @@ constexpr int kMaxLanes = 16;
 
 size_t SetupTriangles(const ClipVertex* vertices, const uint32_t* indices, size_t count,
                       const Viewport& viewport, CullMode cull, TriangleSetup* out,
-                      uint64_t* outcomes, uint32_t firstTriangle) {
+                      uint64_t* outcomes, uint32_t firstTriangle,
+                      const AttributeRequest* attributes) {
   const hn::ScalableTag<double> d;
   const size_t N = hn::Lanes(d);
   size_t drawn = 0;
   size_t t = 0;
+  auto planesOf = [&](size_t record) {
+    return reinterpret_cast<Plane*>(reinterpret_cast<char*>(attributes->out) +
+                                    record * attributes->outStride);
+  };
+  // Triangle `tri` (its position in `indices`), drawn as record `record` by setupTriangle: its
+  // attribute planes by attributePlanes, as the lanes compute them.
+  auto scalarAttributes = [&](size_t tri, size_t record) {
+    if (!attributes) return;
+    const uint32_t* idx = indices + tri * 3;
+    const float* values[3];
+    for (int k = 0; k < 3; ++k) values[k] = attributes->values + idx[k] * attributes->valueStride;
+    attributePlanes(vertices[idx[0]], vertices[idx[1]], vertices[idx[2]], viewport, out[record],
+                    values, attributes->count, planesOf(record), attributes->used);
+  };
   if (N >= 2 && N <= size_t(kMaxLanes)) {
     alignas(64) double in[3][7][kMaxLanes];  // vertex k, component x y z w r g b, lane
     alignas(64) double o[64][kMaxLanes];     // results, per lane
+    alignas(64) double ao[kMaxAttributePlanes][3][kMaxLanes];  // attribute planes, per lane
+    const bool laneAttributes = attributes && attributes->count <= kMaxAttributePlanes;
     const auto zero = hn::Zero(d), one = hn::Set(d, 1.0), half = hn::Set(d, 0.5);
     const auto sub = hn::Set(d, double(kSubPixelScale)),
                halfPixel = hn::Set(d, double(kSubPixelScale / 2));
@@ -126,7 +143,8 @@ size_t SetupTriangles(const ClipVertex* vertices, const uint32_t* indices, size_
       }
       const auto scale = hn::Div(one, area2);
       const auto px0 = hn::Add(bx0, half), py0 = hn::Add(by0, half);
-      auto plane = [&](const hn::Vec<decltype(d)> f[3]) {
+      // The plane of f (per vertex: value/w) into rows[0, 3): c0, dx, dy.
+      auto planeTo = [&](const hn::Vec<decltype(d)> f[3], double (*rows)[kMaxLanes]) {
         const auto a = hn::Mul(hn::Add(hn::Add(hn::Mul(f[0], g[0][0]), hn::Mul(f[1], g[1][0])),
                                        hn::Mul(f[2], g[2][0])),
                                scale);
@@ -136,9 +154,13 @@ size_t SetupTriangles(const ClipVertex* vertices, const uint32_t* indices, size_
         const auto c = hn::Mul(hn::Add(hn::Add(hn::Mul(f[0], g[0][2]), hn::Mul(f[1], g[1][2])),
                                        hn::Mul(f[2], g[2][2])),
                                scale);
-        hn::Store(hn::Add(hn::Add(hn::Mul(a, px0), hn::Mul(b, py0)), c), d, o[r++]);
-        hn::Store(a, d, o[r++]);
-        hn::Store(b, d, o[r++]);
+        hn::Store(hn::Add(hn::Add(hn::Mul(a, px0), hn::Mul(b, py0)), c), d, rows[0]);
+        hn::Store(a, d, rows[1]);
+        hn::Store(b, d, rows[2]);
+      };
+      auto plane = [&](const hn::Vec<decltype(d)> f[3]) {
+        planeTo(f, o + r);
+        r += 3;
       };
       hn::Vec<decltype(d)> f[3];
       for (int k = 0; k < 3; ++k) f[k] = hn::Mul(hn::Mul(half, hn::Add(z[k], w[k])), invW[k]);
@@ -147,6 +169,18 @@ size_t SetupTriangles(const ClipVertex* vertices, const uint32_t* indices, size_
       for (int ch = 0; ch < 3; ++ch) {
         for (int k = 0; k < 3; ++k) f[k] = hn::Mul(hn::Load(d, in[k][4 + ch]), invW[k]);
         plane(f);
+      }
+      // Pixel shading's planes: attributePlanes' λ is this one (the common case is all snapped).
+      for (int a = 0; laneAttributes && a < attributes->count; ++a) {
+        if (!(attributes->used >> a & 1)) continue;
+        alignas(64) double value[3][kMaxLanes];
+        for (size_t l = 0; l < N; ++l)
+          for (int k = 0; k < 3; ++k)
+            value[k][l] = double(attributes->values[indices[(t + l) * 3 + size_t(k)] *
+                                                        attributes->valueStride +
+                                                    size_t(a)]);
+        for (int k = 0; k < 3; ++k) f[k] = hn::Mul(hn::Load(d, value[k]), invW[k]);
+        planeTo(f, ao[a]);
       }
       hn::Store(bx0, d, o[r++]);
       hn::Store(by0, d, o[r++]);
@@ -171,7 +205,7 @@ size_t SetupTriangles(const ClipVertex* vertices, const uint32_t* indices, size_
                                                 vertices[idx[2]], viewport, cull, out[drawn]);
           out[drawn].triangle = firstTriangle + uint32_t(t + l);
           ++outcomes[int(so)];
-          drawn += so == SetupOutcome::drawn;
+          if (so == SetupOutcome::drawn) scalarAttributes(t + l, drawn++);
           continue;
         }
         ++outcomes[outcome];
@@ -195,6 +229,14 @@ size_t SetupTriangles(const ClipVertex* vertices, const uint32_t* indices, size_
         s.edgeCount = 3;
         s.small = o[r - 1][l] != 0;
         s.triangle = firstTriangle + uint32_t(t + l);
+        if (attributes && !laneAttributes) scalarAttributes(t + l, drawn - 1);
+        if (laneAttributes) {
+          Plane* planes = planesOf(drawn - 1);
+          for (int a = 0; a < attributes->count; ++a)
+            planes[a] = attributes->used >> a & 1
+                            ? Plane{float(ao[a][0][l]), float(ao[a][1][l]), float(ao[a][2][l])}
+                            : Plane{};
+        }
       }
     }
   }
@@ -204,7 +246,7 @@ size_t SetupTriangles(const ClipVertex* vertices, const uint32_t* indices, size_
                                           viewport, cull, out[drawn]);
     out[drawn].triangle = firstTriangle + uint32_t(t);
     ++outcomes[int(so)];
-    drawn += so == SetupOutcome::drawn;
+    if (so == SetupOutcome::drawn) scalarAttributes(t, drawn++);
   }
   return drawn;
 }
@@ -219,9 +261,10 @@ HWY_EXPORT(SetupTriangles);
 
 size_t setupTriangles(const ClipVertex* vertices, const uint32_t* indices, size_t count,
                       const Viewport& viewport, CullMode cull, TriangleSetup* out,
-                      uint64_t outcomes[kSetupOutcomes], uint32_t firstTriangle) {
+                      uint64_t outcomes[kSetupOutcomes], uint32_t firstTriangle,
+                      const AttributeRequest* attributes) {
   return HWY_DYNAMIC_DISPATCH(SetupTriangles)(vertices, indices, count, viewport, cull, out,
-                                              outcomes, firstTriangle);
+                                              outcomes, firstTriangle, attributes);
 }
 }  // namespace sv::geometry
 #endif

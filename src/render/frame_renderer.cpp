@@ -153,30 +153,25 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
           continue;
         }
         const uint32_t first = n;
+        // Pixel shading's planes for the drawn triangles of a call with a material, set up with
+        // them (stored after binning, as the records are).
+        const shade::MaterialShading* material = call ? call->material : nullptr;
+        geometry::AttributeRequest request;
+        if (pixelShading && material) {
+          request.values = packets.attributes.data()->value;
+          request.valueStride = sizeof(shade::VertexAttributes) / sizeof(float);
+          request.count = shade::kAttributeCount;
+          request.used = shade::attributesUsed(*material, *settings.environment);
+          request.out = scratch.attributes[n].planes;
+          request.outStride = sizeof(raster::AttributeSetup);
+        }
         n += uint32_t(geometry::setupTriangles(
             packets.vertices.data(), &packets.indices[size_t(tri) * 3], runEnd - tri, viewport,
             call ? call->cull : geometry::CullMode::none, scratch.records.data() + n, outcomes,
-            tri));
+            tri, request.out ? &request : nullptr));
         if (masking) std::fill(scratch.objects.begin() + first, scratch.objects.begin() + n, object);
-        // Pixel shading's planes for the drawn triangles of a call with a material (computed
-        // here, where the vertices are read in order; stored after binning).
-        const shade::MaterialShading* material = call ? call->material : nullptr;
-        const unsigned used =
-            material ? shade::attributesUsed(*material, *settings.environment) : 0u;
         if (pixelShading)
-          for (uint32_t r = first; r < n; ++r) {
-            const geometry::TriangleSetup& s = scratch.records[r];
-            raster::AttributeSetup& a = scratch.attributes[r];
-            a.material = material;
-            if (!material) continue;
-            const uint32_t* idx = &packets.indices[size_t(s.triangle) * 3];
-            const float* values[3] = {packets.attributes[idx[0]].value,
-                                      packets.attributes[idx[1]].value,
-                                      packets.attributes[idx[2]].value};
-            geometry::attributePlanes(packets.vertices[idx[0]], packets.vertices[idx[1]],
-                                      packets.vertices[idx[2]], viewport, s, values,
-                                      shade::kAttributeCount, a.planes, used);
-          }
+          for (uint32_t r = first; r < n; ++r) scratch.attributes[r].material = material;
         tri = runEnd;
       }
       SetupCounts c;

@@ -220,9 +220,6 @@ TEST(Setup, EdgesAreExactOnTheLargestRaster) {
   EXPECT_GT(tested, 50000);
 }
 
-// setupTriangles (SIMD lanes) must give setupTriangle's records bit for bit, on every SIMD target,
-// in every regime: small and large, culled either way, degenerate, behind and across the eye,
-// beyond the far plane, outside the guard band, NaN and infinite.
 // SPEC §3.2 with the pixel aperture: the box holds exactly the pixels whose square [p, p + 1)
 // the vertices' extent reaches, so no pixel with a covered sample is left out of binning.
 TEST(Setup, ApertureBoxSpansEveryPixelSquareTheTriangleReaches) {
@@ -261,6 +258,10 @@ TEST(Setup, ApertureBoxSpansEveryPixelSquareTheTriangleReaches) {
   }
 }
 
+// setupTriangles (SIMD lanes) must give setupTriangle's records bit for bit, on every SIMD target,
+// in every regime: small and large, culled either way, degenerate, behind and across the eye,
+// beyond the far plane, outside the guard band, NaN and infinite —
+// and the attribute planes attributePlanes gives.
 TEST(Setup, BatchedSetupEqualsOneByOneOnEveryTarget) {
   const int w = 1000, h = 700;
   std::mt19937 rng(17);
@@ -286,6 +287,11 @@ TEST(Setup, BatchedSetupEqualsOneByOneOnEveryTarget) {
   std::vector<uint32_t> indices(v.size());
   for (size_t i = 0; i < indices.size(); ++i) indices[i] = uint32_t(i);
   const size_t count = v.size() / 3;
+  // Pixel shading's planes asked of the batch: five values per vertex, the fourth unused.
+  constexpr int kValues = 5;
+  constexpr unsigned kUsed = 0b10111;
+  std::vector<float> values(v.size() * kValues);
+  for (float& x : values) x = u(rng) * 4 - 2;
   int targets = 0;
   for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
     hwy::SetSupportedTargetsForTest(target);
@@ -294,15 +300,25 @@ TEST(Setup, BatchedSetupEqualsOneByOneOnEveryTarget) {
       const geometry::CullMode cull = mode == 3 ? geometry::CullMode::back : geometry::CullMode(mode);
       const geometry::Viewport vp{w, h, mode == 3};
       std::vector<TriangleSetup> one, batch(count);
+      std::vector<geometry::Plane> onePlanes, batchPlanes(count * kValues, {7, 7, 7});
       uint64_t oneOutcomes[geometry::kSetupOutcomes] = {}, batchOutcomes[geometry::kSetupOutcomes] = {};
       for (size_t t = 0; t < count; ++t) {
         TriangleSetup s;
         const auto o = geometry::setupTriangle(v[3 * t], v[3 * t + 1], v[3 * t + 2], vp, cull, s);
         ++oneOutcomes[int(o)];
-        if (o == geometry::SetupOutcome::drawn) one.push_back(s);
+        if (o != geometry::SetupOutcome::drawn) continue;
+        one.push_back(s);
+        const float* vals[3] = {&values[(3 * t) * kValues], &values[(3 * t + 1) * kValues],
+                                &values[(3 * t + 2) * kValues]};
+        geometry::Plane planes[kValues];
+        geometry::attributePlanes(v[3 * t], v[3 * t + 1], v[3 * t + 2], vp, s, vals, kValues,
+                                  planes, kUsed);
+        onePlanes.insert(onePlanes.end(), planes, planes + kValues);
       }
+      geometry::AttributeRequest request{values.data(), kValues, kValues, kUsed,
+                                         batchPlanes.data(), sizeof(geometry::Plane) * kValues};
       const size_t n = geometry::setupTriangles(v.data(), indices.data(), count, vp, cull,
-                                                batch.data(), batchOutcomes);
+                                                batch.data(), batchOutcomes, 0, &request);
       ASSERT_EQ(n, one.size()) << hwy::TargetName(target);
       for (int o = 0; o < geometry::kSetupOutcomes; ++o)
         EXPECT_EQ(batchOutcomes[o], oneOutcomes[o]) << "outcome " << o;
@@ -318,6 +334,10 @@ TEST(Setup, BatchedSetupEqualsOneByOneOnEveryTarget) {
         const geometry::Plane* pb[] = {&b.depth, &b.invW, &b.red, &b.green, &b.blue};
         for (int p = 0; p < 5; ++p)
           ASSERT_EQ(0, std::memcmp(pa[p], pb[p], sizeof(geometry::Plane))) << i << " plane " << p;
+        for (int p = 0; p < kValues; ++p)
+          ASSERT_EQ(0, std::memcmp(&onePlanes[i * kValues + p], &batchPlanes[i * kValues + p],
+                                   sizeof(geometry::Plane)))
+              << i << " attribute plane " << p;
         ASSERT_EQ(a.minX, b.minX);
         ASSERT_EQ(a.minY, b.minY);
         ASSERT_EQ(a.maxX, b.maxX);
