@@ -1703,7 +1703,10 @@ void drawLists(const TileWork& w, RasterStats& stats) {
   // that passed none of their samples, a triangle hidden whole counting at least
   // kHiddenTriangleWork (its traversal costs that much however few pixels it has, and culling it
   // whole is what masking does best): the occupancy is rebuilt from the depth buffer and masking
-  // runs from there on. The
+  // runs from there on — if at least a quarter of the tile's triangles are still to come: the
+  // rebuild reads the whole depth buffer, which a few remaining triangles do not repay (random
+  // order at D = 2 reaches kWakeWork near the end of a tile's list: waking there made the frame
+  // 2 % slower than the Z-buffer's). The
   // image is the Z-buffer's either way; only the work differs (docs/hidden-surfaces.md). The
   // first batch's pass over a tile starts so; one that ends asleep wakes before the next batch,
   // whose object culling before setup reads the occupancy. (Not priority masking: its order may
@@ -1714,6 +1717,8 @@ void drawLists(const TileWork& w, RasterStats& stats) {
   const TileContext* use =
       ctx.occupancy && ctx.hybrid && w.clear && !w.debugOccupancy ? &plain : &ctx;
   uint64_t hiddenWork = 0;
+  uint64_t entries = 0, entriesDone = 0;  // the tile's list entries, and those drawn so far
+  for (int l = 0; l < w.listCount; ++l) entries += w.listSizes[l];
   auto wake = [&] {
     occupyFromDepth(ctx, w.clearDepth);
     use = &ctx;
@@ -1725,7 +1730,7 @@ void drawLists(const TileWork& w, RasterStats& stats) {
     const uint64_t drawn = stats.fragments - fragments;
     hidden = stats.hiddenFragments - hidden;
     hiddenWork += drawn > 0 && hidden == drawn ? std::max(hidden, kHiddenTriangleWork) : hidden;
-    if (hiddenWork >= kWakeWork) wake();
+    if (hiddenWork >= kWakeWork && 4 * (entries - entriesDone) >= entries) wake();
   };
   bool pending = false;  // some pixel records a triangle not yet shaded
   // Setup records are read in bin order, scattered over the batch: fetch a few ahead, the loop is
@@ -1742,7 +1747,7 @@ void drawLists(const TileWork& w, RasterStats& stats) {
     const uint32_t* objects = ctx.occupancy && w.listObjects ? w.listObjects[l] : nullptr;
     const Binner::Box* boxes =
         ctx.occupancy && !ctx.hybrid && w.listBoxes ? w.listBoxes[l] : nullptr;
-    for (uint32_t i = 0; i < size; ++i) {
+    for (uint32_t i = 0; i < size; ++i, ++entriesDone) {
       if (objects && use->occupancy && objects[i] != kNoObject) {
         const uint32_t object = objects[i];
         if (object != lastObject) {
@@ -1755,6 +1760,7 @@ void drawLists(const TileWork& w, RasterStats& stats) {
           uint32_t end = i + 1;
           while (end < size && objects[end] == object) ++end;
           stats.occludedTriangles += end - i;
+          entriesDone += end - 1 - i;
           i = end - 1;
           continue;
         }

@@ -281,6 +281,53 @@ TEST(HybridMasking, DropsHiddenWorkInEveryOrderWithTheSameFrame) {
   }
 }
 
+// A tile wakes only while a quarter of its triangles are still to come: rebuilding its occupancy
+// from the whole depth buffer does not pay for the last few. One 64×64 tile: a near layer of
+// `near` triangles, then `far` triangles wholly behind it (each hidden whole, 128 px, counts as
+// 128 hidden pixels: 16 reach the wake work of 2048).
+TEST(HybridMasking, WakesOnlyWithEnoughOfTheTileToCome) {
+  auto scene = [](int near, int far) {
+    DrawPackets p;
+    auto strip = [&](int count, float z) {  // `count` triangles over the tile, in vertical strips
+      const double width = 128.0 / count;  // of a strip: two triangles
+      for (int i = 0; i < count; ++i) {
+        const double x0 = (i / 2) * width, x1 = x0 + width;
+        geometry::ClipVertex v[4] = {test::pixelVertex(x0, 0, 64, 64, z, 1, 1, 0, 0),
+                                     test::pixelVertex(x1, 0, 64, 64, z, 1, 0, 1, 0),
+                                     test::pixelVertex(x0, 64, 64, 64, z, 1, 0, 0, 1),
+                                     test::pixelVertex(x1, 64, 64, 64, z, 1, 1, 1, 0)};
+        if (i % 2 == 0)
+          test::addTriangle(p, v[0], v[2], v[1]);
+        else
+          test::addTriangle(p, v[1], v[2], v[3]);
+      }
+    };
+    strip(near, 0.2f);
+    strip(far, 0.8f);
+    return p;
+  };
+  for (int samples : {1, 16}) {
+    // 32 far triangles of 128 px after 32 near ones: the 16th far one reaches the wake work with
+    // half the tile's triangles still to come.
+    FrameStats early;
+    const DrawPackets a = scene(32, 32);
+    const test::Frame wakes =
+        test::renderQuadtree(a, settings(64, 64, samples, raster::Masking::hybrid), 1, &early);
+    EXPECT_EQ(early.hybridWoken, 1u) << samples;
+    EXPECT_GT(early.occludedTriangles + early.occludedWindows, 0u) << samples;
+    EXPECT_TRUE(wakes == test::renderQuadtree(a, settings(64, 64, samples, raster::Masking::none), 1));
+    // The same 32 far triangles after 128 near ones (of 32 px): the wake work is reached with 16
+    // of 160 triangles to come — the tile stays the Z-buffer.
+    FrameStats late;
+    const DrawPackets b = scene(128, 32);
+    const test::Frame sleeps =
+        test::renderQuadtree(b, settings(64, 64, samples, raster::Masking::hybrid), 1, &late);
+    EXPECT_EQ(late.hybridWoken, 0u) << samples;
+    EXPECT_GT(late.hiddenFragments, 2048u) << samples;
+    EXPECT_TRUE(sleeps == test::renderQuadtree(b, settings(64, 64, samples, raster::Masking::none), 1));
+  }
+}
+
 // Objects of eight triangles each around a centre, nearest first (each triangle at its own depth,
 // objects separated in depth), with their bounds
 // (as the renderer gives each instance, geometry::boundObject): a large near object hides many.
