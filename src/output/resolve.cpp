@@ -6,24 +6,24 @@
 
 namespace sv::output {
 
-GammaTables GammaTables::srgb() {
-  GammaTables g;
+GammaTable GammaTable::srgb() {
+  GammaTable g;
   for (int i = 0; i < 65536; ++i) {
     const double l = i / 65535.0;
     // IEC 61966-2-1: linear segment near black, then a 1/2.4 power.
     const double e = l <= 0.0031308 ? 12.92 * l : 1.055 * std::pow(l, 1.0 / 2.4) - 0.055;
     const auto v = static_cast<uint8_t>(std::lround(std::clamp(e, 0.0, 1.0) * 255.0));
-    g.table[0][i] = g.table[1][i] = g.table[2][i] = v;
+    g.table[i] = v;
   }
   return g;
 }
 
-GammaTables GammaTables::power(double gamma) {
-  GammaTables g;
+GammaTable GammaTable::power(double gamma) {
+  GammaTable g;
   for (int i = 0; i < 65536; ++i) {
     const double e = std::pow(i / 65535.0, 1.0 / gamma);
     const auto v = static_cast<uint8_t>(std::lround(std::clamp(e, 0.0, 1.0) * 255.0));
-    g.table[0][i] = g.table[1][i] = g.table[2][i] = v;
+    g.table[i] = v;
   }
   return g;
 }
@@ -55,14 +55,14 @@ void prepareImage(int width, int height, Image& image) {
   image.rgb.resize(size_t(image.width) * image.height * 3);
 }
 
-void resolveTile(const uint16_t* color, int tileX, int tileY, const GammaTables& gamma,
+void resolveTile(const uint16_t* color, int tileX, int tileY, const GammaTable& gamma,
                  Image& image) {
   constexpr int g = raster::kBlockPixels, b = 2 * raster::kBlockPixels;
   forEachTileRow(color, tileX, tileY, image, [&](uint8_t* out, const uint16_t* src, int n) {
     for (int i = 0; i < n; ++i) {
-      out[3 * i] = gamma.table[0][src[i]];
-      out[3 * i + 1] = gamma.table[1][src[g + i]];
-      out[3 * i + 2] = gamma.table[2][src[b + i]];
+      out[3 * i] = gamma.table[src[i]];
+      out[3 * i + 1] = gamma.table[src[g + i]];
+      out[3 * i + 2] = gamma.table[src[b + i]];
     }
   });
 }
@@ -139,7 +139,7 @@ void resolveTileLinear(const uint16_t* color, const int32_t* sums, int tileX, in
     forEachSampleMean(color, sums, tileX, tileY, samples, linear.width, linear.height, store);
 }
 
-void tentFilterRows(const LinearImage& linear, const GammaTables& gamma, int rowBegin, int rowEnd,
+void tentFilterRows(const LinearImage& linear, const GammaTable& gamma, int rowBegin, int rowEnd,
                     Image& image) {
   const int w = linear.width, h = linear.height;
   auto at = [&](int x, int y, int ch) -> uint32_t {
@@ -155,18 +155,18 @@ void tentFilterRows(const LinearImage& linear, const GammaTables& gamma, int row
         const uint32_t sum = at(x - 1, y - 1, ch) + 2 * at(x, y - 1, ch) + at(x + 1, y - 1, ch) +
                              2 * at(x - 1, y, ch) + 4 * at(x, y, ch) + 2 * at(x + 1, y, ch) +
                              at(x - 1, y + 1, ch) + 2 * at(x, y + 1, ch) + at(x + 1, y + 1, ch);
-        out[ch] = gamma.table[size_t(ch)][(sum + 8) >> 4];
+        out[ch] = gamma.table[(sum + 8) >> 4];
       }
     }
 }
 
-void resolveTile(const uint16_t* color, int tileX, int tileY, int factor, const GammaTables& gamma,
+void resolveTile(const uint16_t* color, int tileX, int tileY, int factor, const GammaTable& gamma,
                  Image& image) {
   if (factor == 1) return resolveTile(color, tileX, tileY, gamma, image);
   forEachBlockMean(color, tileX, tileY, factor, image.width, image.height,
                    [&](int x, int y, const uint16_t* mean) {
                      uint8_t* out = image.pixel(x, y);
-                     for (int ch = 0; ch < 3; ++ch) out[ch] = gamma.table[size_t(ch)][mean[ch]];
+                     for (int ch = 0; ch < 3; ++ch) out[ch] = gamma.table[mean[ch]];
                    });
 }
 

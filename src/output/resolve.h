@@ -12,12 +12,14 @@ namespace sv::output {
 
 // Gamma correction by three look-up tables, one per channel (SPEC §8, seed 002), indexed by the
 // frame buffer's 16-bit linear value.
-struct GammaTables {
-  std::array<std::array<uint8_t, 65536>, 3> table;
+// Linear 16-bit → encoded 8-bit: one table for all three channels, which share the transfer
+// function (64 KB for the resolve's look-ups to keep in cache, not three identical copies).
+struct GammaTable {
+  std::array<uint8_t, 65536> table;
 
-  static GammaTables srgb();  // the sRGB transfer function (IEC 61966-2-1)
+  static GammaTable srgb();  // the sRGB transfer function (IEC 61966-2-1)
   // A display gamma: encoded = linear^(1/gamma), rounded to 8 bits.
-  static GammaTables power(double gamma);
+  static GammaTable power(double gamma);
 };
 
 // Sizes `image` for a width × height raster; call once per frame before resolving its tiles.
@@ -26,11 +28,11 @@ void prepareImage(int width, int height, Image& image);
 // Applies the tables to one 64×64 tile's colour (laid out as raster/framebuffer.h describes) and
 // writes the part of it inside `image` (sized by prepareImage) at tile (tileX, tileY). Tiles write
 // disjoint pixels, so different tiles may be resolved on different threads.
-void resolveTile(const uint16_t* color, int tileX, int tileY, const GammaTables& gamma,
+void resolveTile(const uint16_t* color, int tileX, int tileY, const GammaTable& gamma,
                  Image& image);
 // The same for a raster `factor` times larger than the image (factor 2, 4 or 8 divides the tile):
 // each image pixel is the rounded mean of its factor × factor samples in linear light.
-void resolveTile(const uint16_t* color, int tileX, int tileY, int factor, const GammaTables& gamma,
+void resolveTile(const uint16_t* color, int tileX, int tileY, int factor, const GammaTable& gamma,
                  Image& image);
 
 // A tile of N samples per pixel (anti-aliasing; N = 4, 8, 16 or 64, sample planes as
@@ -38,7 +40,7 @@ void resolveTile(const uint16_t* color, int tileX, int tileY, int factor, const 
 // light — the 1×1 box filter of SPEC §5. In SIMD lanes: resolve_samples.cpp. With `sums` (the
 // tile's colour sums, raster/framebuffer.h) the means come from them and `color` is not read.
 void resolveSampleTile(const uint16_t* color, const int32_t* sums, int tileX, int tileY,
-                       int samples, const GammaTables& gamma, Image& image);
+                       int samples, const GammaTable& gamma, Image& image);
 
 // Linear colour of a whole frame, 3 × uint16 per pixel, row-major: the box-resolved frame buffer
 // that the 3×3 tent filter reads across tile borders.
@@ -61,7 +63,7 @@ void resolveTileLinear(const uint16_t* color, const int32_t* sums, int tileX, in
 // The 3×3 triangle (tent) filter of seed 002 (SPEC §5) over the box-resolved frame, weights
 // [1 2 1]ᵀ[1 2 1] / 16 in linear light, edges clamped; then gamma. Writes rows [rowBegin, rowEnd)
 // of `image` (sized by prepareImage), so that bands of rows can go to different threads.
-void tentFilterRows(const LinearImage& linear, const GammaTables& gamma, int rowBegin, int rowEnd,
+void tentFilterRows(const LinearImage& linear, const GammaTable& gamma, int rowBegin, int rowEnd,
                     Image& image);
 
 // Debug views: the red channel holds a small number per pixel, shown in false colour. `count`

@@ -21,17 +21,16 @@ namespace hn = hwy::HWY_NAMESPACE;
 // blue at mean[32 + p]). Restrict-qualified: otherwise every byte store may alias the means and
 // tables and forces their reload.
 HWY_INLINE void StoreBlockRow(uint8_t* HWY_RESTRICT dst, const uint16_t* HWY_RESTRICT mean,
-                              int cols, const uint8_t* HWY_RESTRICT r,
-                              const uint8_t* HWY_RESTRICT g, const uint8_t* HWY_RESTRICT b) {
+                              int cols, const uint8_t* HWY_RESTRICT table) {
   for (int p = 0; p < cols; ++p) {
-    dst[3 * p] = r[mean[p]];
-    dst[3 * p + 1] = g[mean[raster::kBlockPixels + p]];
-    dst[3 * p + 2] = b[mean[2 * raster::kBlockPixels + p]];
+    dst[3 * p] = table[mean[p]];
+    dst[3 * p + 1] = table[mean[raster::kBlockPixels + p]];
+    dst[3 * p + 2] = table[mean[2 * raster::kBlockPixels + p]];
   }
 }
 
 void ResolveSampleTile(const uint16_t* color, const int32_t* sums, int tileX, int tileY,
-                       int samples, const GammaTables& gamma, Image& image) {
+                       int samples, const GammaTable& gamma, Image& image) {
   using namespace raster;
   const hn::CappedTag<int32_t, kBlockPixels> d32;
   const hn::Rebind<uint16_t, decltype(d32)> d16;
@@ -71,7 +70,7 @@ void ResolveSampleTile(const uint16_t* color, const int32_t* sums, int tileX, in
       uint8_t* dst = rgb + size_t(y0 + by + py) * stride + size_t(x0) * 3;
       for (int b = 0; b < blocksX; ++b, dst += 3 * kBlockSize)
         StoreBlockRow(dst, mean[b] + py * kBlockSize, std::min(kBlockSize, w - b * kBlockSize),
-                      gamma.table[0].data(), gamma.table[1].data(), gamma.table[2].data());
+                      gamma.table.data());
     }
   }
 }
@@ -85,7 +84,7 @@ namespace sv::output {
 HWY_EXPORT(ResolveSampleTile);
 
 void resolveSampleTile(const uint16_t* color, const int32_t* sums, int tileX, int tileY,
-                       int samples, const GammaTables& gamma, Image& image) {
+                       int samples, const GammaTable& gamma, Image& image) {
   HWY_DYNAMIC_DISPATCH(ResolveSampleTile)(color, sums, tileX, tileY, samples, gamma, image);
 }
 }  // namespace sv::output

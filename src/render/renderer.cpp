@@ -385,10 +385,10 @@ struct Renderer::Impl {
   explicit Impl(const RenderOptions& o)
       : options(o),
         frame(resolveThreads(o.threads)),
-        gamma(o.gamma == 0 ? output::GammaTables::srgb() : output::GammaTables::power(o.gamma)) {}
+        gamma(o.gamma == 0 ? output::GammaTable::srgb() : output::GammaTable::power(o.gamma)) {}
   RenderOptions options;
   render::FrameRenderer frame;
-  output::GammaTables gamma;
+  output::GammaTable gamma;
   ShadingTables shading;
   render::DrawPackets packets;
   output::LinearImage linear;  // the box-resolved frame, for the tent filter

@@ -61,24 +61,24 @@ TEST(ImageIo, ErrorsNameTheFile) {
   EXPECT_FALSE(writeImage(gradient(2, 2), tempPath("sv_img.bmp")).ok());
 }
 
-TEST(Gamma, DisplayGammaTables) {
-  const auto g = output::GammaTables::power(2.2);
-  EXPECT_EQ(g.table[0][0], 0);
-  EXPECT_EQ(g.table[1][65535], 255);
-  EXPECT_EQ(g.table[2][32768], 186);  // 0.5^(1/2.2) = 0.7297 → 186.1
-  const auto linear = output::GammaTables::power(1.0);
-  EXPECT_EQ(linear.table[0][32768], 128);  // 0.50001 → 127.5 → 128
-  for (int i = 1; i < 65536; ++i) ASSERT_GE(g.table[0][i], g.table[0][i - 1]);
+TEST(Gamma, DisplayGammaTable) {
+  const auto g = output::GammaTable::power(2.2);
+  EXPECT_EQ(g.table[0], 0);
+  EXPECT_EQ(g.table[65535], 255);
+  EXPECT_EQ(g.table[32768], 186);  // 0.5^(1/2.2) = 0.7297 → 186.1
+  const auto linear = output::GammaTable::power(1.0);
+  EXPECT_EQ(linear.table[32768], 128);  // 0.50001 → 127.5 → 128
+  for (int i = 1; i < 65536; ++i) ASSERT_GE(g.table[i], g.table[i - 1]);
 }
 
 TEST(Gamma, SrgbTablesMatchTheStandardAtKnownPoints) {
-  const auto g = output::GammaTables::srgb();
-  EXPECT_EQ(g.table[0][0], 0);
-  EXPECT_EQ(g.table[1][65535], 255);
-  EXPECT_EQ(g.table[2][32768], 188);  // linear 0.5 → sRGB 0.7354 → 187.5 → 188
-  EXPECT_EQ(g.table[0][int(0.2140 * 65535)], 127);  // linear 0.2140 → sRGB 0.49996 → 127.49
-  EXPECT_EQ(g.table[0][int(0.2159 * 65535)], 128);  // sRGB 128/255 is linear 0.21586
-  for (int i = 1; i < 65536; ++i) ASSERT_GE(g.table[0][i], g.table[0][i - 1]);  // monotonic
+  const auto g = output::GammaTable::srgb();
+  EXPECT_EQ(g.table[0], 0);
+  EXPECT_EQ(g.table[65535], 255);
+  EXPECT_EQ(g.table[32768], 188);  // linear 0.5 → sRGB 0.7354 → 187.5 → 188
+  EXPECT_EQ(g.table[int(0.2140 * 65535)], 127);  // linear 0.2140 → sRGB 0.49996 → 127.49
+  EXPECT_EQ(g.table[int(0.2159 * 65535)], 128);  // sRGB 128/255 is linear 0.21586
+  for (int i = 1; i < 65536; ++i) ASSERT_GE(g.table[i], g.table[i - 1]);  // monotonic
 }
 
 }  // namespace
