@@ -182,8 +182,11 @@ struct Scene {
   size_t triangleCount() const;  // over all instances
 };
 
-// Checks the invariants stated on Mesh and Instance; the error names `file`.
-Status validate(const Scene& scene, const std::string& file);
+// Checks the invariants stated on Mesh and Instance; the error names `file`. `vertexData = false`
+// leaves out the two checks that read every vertex and index (positions finite, indices in range):
+// the renderer makes them as its vertex stage reads the data anyway, and asks for the full check
+// only to name the offender.
+Status validate(const Scene& scene, const std::string& file, bool vertexData = true);
 
 // Appends `other`'s meshes and materials to `scene`, placing each of `other`'s instances under
 // `transform`. Cameras and light of `other` are appended/ignored as documented in scene-format.md.

@@ -27,7 +27,9 @@ struct VertexContext {
 // and not Phong (Phong materials are lit per pixel: their colour is left unlit); back faces of
 // double-sided materials are lit as seen from the front (the vertex stage cannot know facing),
 // which matches common viewers.
-void transformVertices(const scene::Mesh& mesh, const scene::Material& material, const Mat4& model,
+// Returns whether every position read was finite (scene::validate's check, made here where the
+// positions are read anyway: the renderer skips it in validate).
+bool transformVertices(const scene::Mesh& mesh, const scene::Material& material, const Mat4& model,
                        const VertexContext& context, size_t begin, size_t end, ClipVertex* out,
                        shade::VertexAttributes* attributes = nullptr);
 

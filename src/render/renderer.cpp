@@ -403,7 +403,13 @@ const RenderOptions& Renderer::options() const { return impl_->options; }
 
 Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* statsOut) {
   if (Status s = validate(impl_->options); !s) return s;
-  if (Status s = scene::validate(scene, ""); !s) return s;
+  // Every vertex and index is checked as the vertex stage reads it (below), not in a pass of its
+  // own; the full check runs only to name an offender.
+  if (Status s = scene::validate(scene, "", false); !s) return s;
+  auto invalidVertexData = [&]() -> Status {
+    if (Status s = scene::validate(scene, ""); !s) return s;
+    return Error{"", "", "invalid vertex data"};  // (validate finds what the stage found)
+  };
   const RenderOptions& o = impl_->options;
   FrameStats stats;
   const auto start = Clock::now();
@@ -476,20 +482,27 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
       const uint32_t base = static_cast<uint32_t>(vertexCount);
       const size_t at = p.indices.size();
       p.indices.resize(at + mesh.indices.size());
-      std::transform(mesh.indices.begin(), mesh.indices.end(), p.indices.begin() + ptrdiff_t(at),
-                     [base](uint32_t i) { return base + i; });
+      uint32_t maxIndex = 0;
+      for (size_t i = 0; i < mesh.indices.size(); ++i) {
+        maxIndex = std::max(maxIndex, mesh.indices[i]);
+        p.indices[at + i] = base + mesh.indices[i];
+      }
+      if (!mesh.indices.empty() && maxIndex >= mesh.positions.size()) return invalidVertexData();
       p.calls.push_back(call);
       vertexCount += mesh.positions.size();
     }
   p.vertices.resize(vertexCount);
   p.attributes.resize(pixelShading ? vertexCount : 0);
+  std::vector<uint8_t> finite(jobs.size());
   impl_->frame.pool().parallelFor(jobs.size(), [&](size_t j, int) {
     const VertexJob& job = jobs[j];
     const scene::Mesh& mesh = scene.meshes[job.instance->mesh];
-    geometry::transformVertices(mesh, materialOf(mesh), job.instance->transform, vertexContext,
-                                job.begin, job.end, p.vertices.data() + job.out,
-                                pixelShading ? p.attributes.data() + job.out : nullptr);
+    finite[j] = geometry::transformVertices(mesh, materialOf(mesh), job.instance->transform,
+                                            vertexContext, job.begin, job.end,
+                                            p.vertices.data() + job.out,
+                                            pixelShading ? p.attributes.data() + job.out : nullptr);
   });
+  if (std::find(finite.begin(), finite.end(), 0) != finite.end()) return invalidVertexData();
   stats.vertexMs = msSince(t0);
 
   // Stage 3–4: setup, binning, tiles (on the k-times larger raster when supersampling).

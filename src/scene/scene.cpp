@@ -78,7 +78,7 @@ const char* textureFilterName(TextureFilter filter) {
   return "inherit";
 }
 
-Status validate(const Scene& scene, const std::string& file) {
+Status validate(const Scene& scene, const std::string& file, bool vertexData) {
   auto fail = [&](std::string message) { return Status(Error{file, "", std::move(message)}); };
 
   for (size_t i = 0; i < scene.meshes.size(); ++i) {
@@ -93,9 +93,13 @@ Status validate(const Scene& scene, const std::string& file) {
           "{}: attribute arrays must be empty or match the {} positions (normals {}, colors {}, "
           "uvs {})",
           meshLabel(mesh, i), n, mesh.normals.size(), mesh.colors.size(), mesh.uvs.size()));
-    // The renderer validates every frame: two branch-free reductions (they vectorize) in the
-    // common case, the offender searched for only when one fails. (perf: the early-exit loops were
-    // 2.5 % of a tris 100k × 10 px frame, on one thread while the others wait.)
+    if (mesh.material < -1 || (mesh.material >= 0 && size_t(mesh.material) >= scene.materials.size()))
+      return fail(fmt::format("{}: material {} does not exist ({} materials)", meshLabel(mesh, i),
+                              mesh.material, scene.materials.size()));
+    if (!vertexData) continue;
+    // Two branch-free reductions (they vectorize) in the common case, the offender searched for
+    // only when one fails. (perf: the early-exit loops were 2.5 % of a tris 100k × 10 px frame
+    // when the renderer ran them every frame, on one thread while the others waited.)
     uint32_t maxIndex = 0;
     for (uint32_t index : mesh.indices) maxIndex = std::max(maxIndex, index);
     if (!mesh.indices.empty() && maxIndex >= n) {
@@ -113,9 +117,6 @@ Status validate(const Scene& scene, const std::string& file) {
         if (!isFinite(mesh.positions[k]))
           return fail(fmt::format("{}: positions[{}] is not finite", meshLabel(mesh, i), k));
     }
-    if (mesh.material < -1 || (mesh.material >= 0 && size_t(mesh.material) >= scene.materials.size()))
-      return fail(fmt::format("{}: material {} does not exist ({} materials)", meshLabel(mesh, i),
-                              mesh.material, scene.materials.size()));
   }
   for (size_t i = 0; i < scene.instances.size(); ++i) {
     const Instance& instance = scene.instances[i];

@@ -97,6 +97,55 @@ TEST(Render, OptionsOutOfRangeAreRejectedWithTheReason) {
   EXPECT_FALSE(r.render(scene::demoScene(), img).ok());
 }
 
+// The renderer checks vertices and indices as its vertex stage reads them (not in a pass of
+// validate's): a bad one is still refused with the loaders' message, naming mesh and element,
+// however many vertex chunks the mesh spans, for any thread count.
+TEST(Render, BadVertexDataIsRefusedWithTheOffenderNamed) {
+  scene::Scene base = scene::demoScene();
+  ASSERT_FALSE(base.meshes.empty());
+  // A mesh large enough for several vertex chunks (2^14 vertices each).
+  scene::Mesh big;
+  big.name = "big";
+  for (int i = 0; i < 40000; ++i) {
+    big.positions.push_back({float(i % 200) * 0.01f, float(i / 200) * 0.01f, 0});
+    if (i >= 2) big.indices.insert(big.indices.end(), {uint32_t(i - 2), uint32_t(i - 1), uint32_t(i)});
+  }
+  base.meshes.push_back(big);
+  scene::Instance instance;
+  instance.mesh = int(base.meshes.size() - 1);
+  base.instances.push_back(instance);
+  const size_t m = base.meshes.size() - 1;
+  for (int threads : {1, 2, 8}) {
+    RenderOptions o;
+    o.width = 64;
+    o.height = 48;
+    o.threads = threads;
+    Renderer r(o);
+    Image img;
+    ASSERT_TRUE(r.render(base, img).ok());
+    scene::Scene nan = base;
+    nan.meshes[m].positions[35000].y = std::nanf("");
+    const Status a = r.render(nan, img);
+    ASSERT_FALSE(a.ok());
+    EXPECT_NE(a.error().str().find("'big': positions[35000] is not finite"), std::string::npos)
+        << a.error().str();
+    scene::Scene far = base;
+    far.meshes[m].positions[17].x = INFINITY;
+    const Status b = r.render(far, img);
+    ASSERT_FALSE(b.ok());
+    EXPECT_NE(b.error().str().find("positions[17] is not finite"), std::string::npos)
+        << b.error().str();
+    scene::Scene range = base;
+    range.meshes[m].indices[3001] = 40000;
+    const Status c = r.render(range, img);
+    ASSERT_FALSE(c.ok());
+    EXPECT_NE(c.error().str().find("indices[3001] = 40000 is out of range (40000 vertices)"),
+              std::string::npos)
+        << c.error().str();
+    ASSERT_TRUE(r.render(base, img).ok());  // and the renderer is fine afterwards
+  }
+}
+
 TEST(TrisGenerator, SameSeedSameSceneAndStatisticsWithinFivePercent) {
   scene::TrisParams p;
   p.count = 20000;
