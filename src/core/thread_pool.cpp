@@ -1,6 +1,17 @@
 #include "core/thread_pool.h"
 
 namespace sv::core {
+namespace {
+
+constexpr int kSpin = 1 << 11;
+
+void pause() {
+#if defined(__x86_64__) || defined(__i386__)
+  __builtin_ia32_pause();
+#endif
+}
+
+}  // namespace
 
 ThreadPool::ThreadPool(int threads) {
   for (int i = 1; i < threads; ++i) workers_.emplace_back([this, i] { workerLoop(i); });
@@ -32,29 +43,31 @@ void ThreadPool::parallelFor(size_t count, const std::function<void(size_t, int)
     job_ = &fn;
     count_ = count;
     next_.store(0, std::memory_order_relaxed);
-    busy_ = static_cast<int>(workers_.size());
-    ++generation_;
+    busy_.store(static_cast<int>(workers_.size()), std::memory_order_relaxed);
+    generation_.fetch_add(1, std::memory_order_release);
   }
   wake_.notify_all();
   runItems(0);
+  for (int i = 0; i < kSpin && busy_.load(std::memory_order_acquire) != 0; ++i) pause();
   std::unique_lock lock(mutex_);
-  done_.wait(lock, [this] { return busy_ == 0; });
+  done_.wait(lock, [this] { return busy_.load(std::memory_order_acquire) == 0; });
   job_ = nullptr;
 }
 
 void ThreadPool::workerLoop(int worker) {
   unsigned seen = 0;
   for (;;) {
+    for (int i = 0; i < kSpin && generation_.load(std::memory_order_acquire) == seen; ++i) pause();
     {
       std::unique_lock lock(mutex_);
-      wake_.wait(lock, [&] { return stop_ || generation_ != seen; });
+      wake_.wait(lock, [&] { return stop_ || generation_.load(std::memory_order_relaxed) != seen; });
       if (stop_) return;
-      seen = generation_;
+      seen = generation_.load(std::memory_order_relaxed);
     }
     runItems(worker);
     {
       std::lock_guard lock(mutex_);
-      if (--busy_ == 0) done_.notify_one();
+      if (busy_.fetch_sub(1, std::memory_order_acq_rel) == 1) done_.notify_one();
     }
   }
 }
