@@ -98,8 +98,9 @@ struct TriangleSetup {
   // is the ratio colour/w ÷ 1/w, SPEC §2's shared denominator). Origin: pixel (minX, minY).
   Plane depth, invW, red, green, blue;
   int16_t minX, minY, maxX, maxY;  // inclusive pixel bounding box, clipped to the raster
-  // The triangle's number in its draw packets (setupTriangles' firstTriangle + its position): finds
-  // its vertices again (pixel shading's attribute planes, set up from them after this record).
+  // The triangle's number in its draw packets (setupTriangles' firstTriangle + its position): which
+  // triangle a record is, once binning has reordered the records (for tests and debugging; the
+  // pipeline finds a record's attribute planes by its storage index, TileWork::attributes).
   uint32_t triangle;
   uint8_t edgeCount;
   // True when the triangle is small (three integer edges, bounding box ≤ kSmallExtent pixels):

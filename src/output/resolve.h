@@ -10,10 +10,9 @@
 
 namespace sv::output {
 
-// Gamma correction by three look-up tables, one per channel (SPEC §8, seed 002), indexed by the
-// frame buffer's 16-bit linear value.
-// Linear 16-bit → encoded 8-bit: one table for all three channels, which share the transfer
-// function (64 KB for the resolve's look-ups to keep in cache, not three identical copies).
+// Gamma correction by a look-up table (SPEC §8, seed 002), indexed by the frame buffer's 16-bit
+// linear value: one table for all three channels, which share the transfer function (64 KB for the
+// resolve's look-ups to keep in cache, not three identical copies).
 struct GammaTable {
   std::array<uint8_t, 65536> table;
 
@@ -25,7 +24,7 @@ struct GammaTable {
 // Sizes `image` for a width × height raster; call once per frame before resolving its tiles.
 void prepareImage(int width, int height, Image& image);
 
-// Applies the tables to one 64×64 tile's colour (laid out as raster/framebuffer.h describes) and
+// Applies the table to one 64×64 tile's colour (laid out as raster/framebuffer.h describes) and
 // writes the part of it inside `image` (sized by prepareImage) at tile (tileX, tileY). Tiles write
 // disjoint pixels, so different tiles may be resolved on different threads.
 void resolveTile(const uint16_t* color, int tileX, int tileY, const GammaTable& gamma,

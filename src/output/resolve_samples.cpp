@@ -19,7 +19,7 @@ namespace hn = hwy::HWY_NAMESPACE;
 
 // Writes `cols` pixels of one block row from the means (red at mean[p], green at mean[16 + p],
 // blue at mean[32 + p]). Restrict-qualified: otherwise every byte store may alias the means and
-// tables and forces their reload.
+// the table and forces their reload.
 HWY_INLINE void StoreBlockRow(uint8_t* HWY_RESTRICT dst, const uint16_t* HWY_RESTRICT mean,
                               int cols, const uint8_t* HWY_RESTRICT table) {
   for (int p = 0; p < cols; ++p) {

@@ -403,8 +403,9 @@ const RenderOptions& Renderer::options() const { return impl_->options; }
 
 Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* statsOut) {
   if (Status s = validate(impl_->options); !s) return s;
-  // Every vertex and index is checked as the vertex stage reads it (below), not in a pass of its
-  // own; the full check runs only to name an offender.
+  // Every vertex and index the frame draws is checked as the vertex stage reads it (below), not in
+  // a pass of its own; the full check runs only to name an offender. (A mesh no instance draws is
+  // left to the loaders' validation.)
   if (Status s = scene::validate(scene, "", false); !s) return s;
   auto invalidVertexData = [&]() -> Status {
     if (Status s = scene::validate(scene, ""); !s) return s;
@@ -451,7 +452,16 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
     anyTranslucent |= m.alphaMode == scene::AlphaMode::blend;
   std::vector<std::array<Vec3, 2>> boxes;
   if (o.hsr != RenderOptions::Hsr::zbuffer || anyTranslucent)
-    for (const scene::Mesh& m : scene.meshes) boxes.push_back(m.bounds());
+    for (const scene::Mesh& m : scene.meshes) {
+      boxes.push_back(m.bounds());
+      // An infinite position (not yet checked: the vertex stage checks them) would give the draw
+      // order NaN depths to sort by.
+      for (const Vec3& corner : boxes.back())
+        if (!(std::fabs(corner.x) <= std::numeric_limits<float>::max() &&
+              std::fabs(corner.y) <= std::numeric_limits<float>::max() &&
+              std::fabs(corner.z) <= std::numeric_limits<float>::max()))
+          return invalidVertexData();
+    }
   const geometry::Viewport boundViewport{o.width * o.supersample, o.height * o.supersample};
   // Opaque materials first, then translucent ones (SPEC §4: blended over what is behind them).
   const std::vector<uint32_t> order = drawOrder(scene, camera.value().view, o.hsr, boxes);

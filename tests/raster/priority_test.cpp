@@ -316,8 +316,8 @@ TEST(HybridMasking, WakesOnlyWithEnoughOfTheTileToCome) {
     EXPECT_EQ(early.hybridWoken, 1u) << samples;
     EXPECT_GT(early.occludedTriangles + early.occludedWindows, 0u) << samples;
     EXPECT_TRUE(wakes == test::renderQuadtree(a, settings(64, 64, samples, raster::Masking::none), 1));
-    // The same 32 far triangles after 128 near ones (of 32 px): the wake work is reached with 16
-    // of 160 triangles to come — the tile stays the Z-buffer.
+    // The same 32 far triangles after 128 near ones (of 32 px): the wake work is reached with 17
+    // of 160 triangles to come (the one just drawn counted) — the tile stays the Z-buffer.
     FrameStats late;
     const DrawPackets b = scene(128, 32);
     const test::Frame sleeps =

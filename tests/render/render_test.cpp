@@ -99,7 +99,8 @@ TEST(Render, OptionsOutOfRangeAreRejectedWithTheReason) {
 
 // The renderer checks vertices and indices as its vertex stage reads them (not in a pass of
 // validate's): a bad one is still refused with the loaders' message, naming mesh and element,
-// however many vertex chunks the mesh spans, for any thread count.
+// however many vertex chunks the mesh spans, for any thread count — also where the draw order
+// reads the meshes' bounds first (priority masking).
 TEST(Render, BadVertexDataIsRefusedWithTheOffenderNamed) {
   scene::Scene base = scene::demoScene();
   ASSERT_FALSE(base.meshes.empty());
@@ -120,6 +121,7 @@ TEST(Render, BadVertexDataIsRefusedWithTheOffenderNamed) {
     o.width = 64;
     o.height = 48;
     o.threads = threads;
+    if (threads == 8) o.hsr = RenderOptions::Hsr::priority;
     Renderer r(o);
     Image img;
     ASSERT_TRUE(r.render(base, img).ok());
