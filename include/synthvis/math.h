@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cmath>
+#include <limits>
 
 namespace sv {
 
@@ -35,6 +36,12 @@ inline Vec3 cross(Vec3 a, Vec3 b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
 inline float length(Vec3 a) { return std::sqrt(dot(a, a)); }
+// Every component finite (false for NaN and ±∞). Branch-free, so that a reduction over many
+// positions vectorizes (scene::validate, the vertex stage).
+inline bool isFinite(Vec3 a) {
+  constexpr float kMax = std::numeric_limits<float>::max();
+  return (std::fabs(a.x) <= kMax) & (std::fabs(a.y) <= kMax) & (std::fabs(a.z) <= kMax);
+}
 // Returns `a` scaled to unit length, or `a` unchanged when it has zero length.
 inline Vec3 normalize(Vec3 a) {
   float l = length(a);

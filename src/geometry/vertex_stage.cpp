@@ -3,14 +3,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 namespace sv::geometry {
 
 bool transformVertices(const scene::Mesh& mesh, const scene::Material& material, const Mat4& model,
                        const VertexContext& context, size_t begin, size_t end, ClipVertex* out,
                        shade::VertexAttributes* attributes) {
-  constexpr float kMaxFloat = std::numeric_limits<float>::max();
   bool finite = true;
   const Mat4 mvp = context.viewProj * model;
   const Mat4 modelView = context.view * model;
@@ -24,8 +22,7 @@ bool transformVertices(const scene::Mesh& mesh, const scene::Material& material,
   const Vec4 base = material.baseColor;
   for (size_t i = begin; i < end; ++i) {
     const Vec3 p = mesh.positions[i];
-    finite &= std::fabs(p.x) <= kMaxFloat && std::fabs(p.y) <= kMaxFloat &&
-              std::fabs(p.z) <= kMaxFloat;  // false for NaN and ±∞
+    finite &= isFinite(p);
     const Vec4 c = mvp * Vec4{p.x, p.y, p.z, 1};
     Vec4 color = base;
     if (!mesh.colors.empty()) {

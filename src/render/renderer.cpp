@@ -457,10 +457,7 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
       // An infinite position (not yet checked: the vertex stage checks them) would give the draw
       // order NaN depths to sort by.
       for (const Vec3& corner : boxes.back())
-        if (!(std::fabs(corner.x) <= std::numeric_limits<float>::max() &&
-              std::fabs(corner.y) <= std::numeric_limits<float>::max() &&
-              std::fabs(corner.z) <= std::numeric_limits<float>::max()))
-          return invalidVertexData();
+        if (!isFinite(corner)) return invalidVertexData();
     }
   const geometry::Viewport boundViewport{o.width * o.supersample, o.height * o.supersample};
   // Opaque materials first, then translucent ones (SPEC §4: blended over what is behind them).

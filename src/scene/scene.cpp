@@ -37,7 +37,6 @@ size_t Scene::triangleCount() const {
 
 namespace {
 
-bool isFinite(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 bool isFinite(Vec4 v) { return isFinite(Vec3{v.x, v.y, v.z}) && std::isfinite(v.w); }
 
 bool isFinite(const Mat4& m) {
@@ -46,8 +45,6 @@ bool isFinite(const Mat4& m) {
       if (!std::isfinite(x)) return false;
   return true;
 }
-
-constexpr float kMaxFloat = std::numeric_limits<float>::max();
 
 // "meshes[3] 'wheel'" — the name helps when a file has hundreds of meshes.
 std::string meshLabel(const Mesh& mesh, size_t i) {
@@ -109,9 +106,7 @@ Status validate(const Scene& scene, const std::string& file, bool vertexData) {
                               meshLabel(mesh, i), k, mesh.indices[k], n));
     }
     bool finite = true;
-    for (const Vec3& p : mesh.positions)
-      finite &= std::fabs(p.x) <= kMaxFloat && std::fabs(p.y) <= kMaxFloat &&
-                std::fabs(p.z) <= kMaxFloat;  // false for NaN and ±∞
+    for (const Vec3& p : mesh.positions) finite &= isFinite(p);
     if (!finite) {
       for (size_t k = 0; k < n; ++k)
         if (!isFinite(mesh.positions[k]))
