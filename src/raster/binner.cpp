@@ -49,27 +49,20 @@ void Binner::binChunk(int chunk, const geometry::TriangleSetup* records, uint32_
   for (uint32_t i = 0; i < n; ++i) forEachTile(records[i], [&](int tile) { ++out.offsets[tile + 1]; });
   for (int k = 0; k < tiles_; ++k) out.offsets[k + 1] += out.offsets[k];
   out.entries.resize(out.offsets[size_t(tiles_)]);
+  // The optional parallel arrays are placed in the same pass, at the entries' positions.
+  out.objects.resize(objects ? out.entries.size() : 0);
+  out.boxes.resize(boxes ? out.entries.size() : 0);
   scratch.cursor.assign(out.offsets.begin(), out.offsets.end() - 1);
   for (uint32_t i = 0; i < n; ++i) {
+    const geometry::TriangleSetup& t = records[i];
     const uint32_t index = storageBase + scratch.position[i];
-    forEachTile(records[i], [&](int tile) { out.entries[scratch.cursor[tile]++] = index; });
-  }
-  out.boxes.clear();
-  if (boxes) {
-    out.boxes.resize(out.entries.size());
-    scratch.cursor.assign(out.offsets.begin(), out.offsets.end() - 1);
-    for (uint32_t i = 0; i < n; ++i) {
-      const geometry::TriangleSetup& t = records[i];
-      const Box box{t.minX, t.minY, t.maxX, t.maxY};
-      forEachTile(t, [&](int tile) { out.boxes[scratch.cursor[tile]++] = box; });
-    }
-  }
-  out.objects.clear();
-  if (objects) {
-    out.objects.resize(out.entries.size());
-    scratch.cursor.assign(out.offsets.begin(), out.offsets.end() - 1);
-    for (uint32_t i = 0; i < n; ++i)
-      forEachTile(records[i], [&](int tile) { out.objects[scratch.cursor[tile]++] = objects[i]; });
+    const Box box{t.minX, t.minY, t.maxX, t.maxY};
+    forEachTile(t, [&](int tile) {
+      const uint32_t at = scratch.cursor[tile]++;
+      out.entries[at] = index;
+      if (objects) out.objects[at] = objects[i];
+      if (boxes) out.boxes[at] = box;
+    });
   }
 }
 
