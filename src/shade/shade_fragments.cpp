@@ -12,7 +12,6 @@
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "shade/shade_fragments.cpp"
 #include "hwy/foreach_target.h"  // IWYU pragma: keep
-#include "hwy/cache_control.h"
 #include "hwy/highway.h"
 
 #include <algorithm>
@@ -134,39 +133,10 @@ void TextureCoordinates(const MaterialShading& m, const Fragments& f, TexCoords&
     if (m.levelZero) l = zero;
     hn::Store(l, df, out.lod + i);
   }
-  if (!prefetch || m.anisotropic || f.count != kMaxFragments) return;
-  // The texels the samplers will read, requested now: each lane's cell (its two rows) on the
-  // block's first level, and the corner lanes' on the second. (Only the two columns' lanes measured
-  // no better: docs/performance.md.)
-  const texture::Texture& t = *m.texture;
-  const texture::Texture::LevelTable& table = t.levelTable();
-  const int last = t.levelCount() - 1;
-  const texture::Texel* texels = t.texels();
-  const bool pow2 = t.powerOfTwo();
-  const bool trilinear = m.filter == texture::Filter::trilinear ||
-                         m.filter == texture::Filter::trilinearThreePoint;
-  auto fetch = [&](int lane, int k, bool below) {
-    const float scale = std::ldexp(1.0f, -k);
-    const float x = out.x0[lane] * scale, y = out.y0[lane] * scale;
-    if (!(std::fabs(x) < texture::kMaxTexelCoordinate && std::fabs(y) < texture::kMaxTexelCoordinate))
-      return;
-    const int w = table.width[k], h = table.height[k];
-    int xi = int(std::floor(x)), yi = int(std::floor(y)) + (below ? 1 : 0);
-    xi = pow2 ? xi & (w - 1) : std::clamp(xi, 0, w - 1);
-    yi = pow2 ? yi & (h - 1) : std::clamp(yi, 0, h - 1);
-    hwy::Prefetch(texels + table.offset[k] + size_t(yi) * size_t(w) + size_t(xi));
-  };
-  const float lod0 = out.lod[0];
-  const int k = std::min(last, lod0 >= 0 && lod0 < 64 ? int(lod0) : 0);
-  for (int lane = 0; lane < kMaxFragments; ++lane) {
-    fetch(lane, k, false);
-    fetch(lane, k, true);
-  }
-  if (trilinear && k < last)
-    for (int lane : {0, 15}) {
-      fetch(lane, k + 1, false);
-      fetch(lane, k + 1, true);
-    }
+  // The texels the samplers will read, requested now (the caller shades a queue's work later).
+  if (prefetch && !m.anisotropic)
+    texture::prefetchBlock(*m.texture, m.filter, out.lod, out.x0, out.y0,
+                           std::clamp(f.count, 0, kMaxFragments));
 }
 
 void ShadeFragments(const MaterialShading& m, const Environment& env, const Fragments& f,

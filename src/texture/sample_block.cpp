@@ -1,8 +1,10 @@
 // Texture sampling for up to 16 points at once, in SIMD lanes (Highway, dispatched per call): the
 // same float operations in the same order as Texture's scalar samplers (texture.cpp), so that every
-// target returns their values bit for bit (tests/texture/texture_test.cpp checks each filter on every
-// compiled target). Each lane has its own level of detail, so level sizes and offsets are gathered
-// per lane; texels (4 × 16 bits) are gathered as two 32-bit words.
+// target returns their values bit for bit (tests/texture/texture_test.cpp checks each filter on
+// every compiled target). Each lane has its own level of detail, so level sizes and offsets are
+// gathered per lane. Texels are 32-bit words (texture.h, PackedTexel); a bilinear cell's two texels
+// in a row are one 64-bit word — rows carry a copy of their wrapped neighbour at column `width` —
+// and are gathered as such, half the gathers of fetching each texel.
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "texture/sample_block.cpp"
 #include "hwy/foreach_target.h"  // IWYU pragma: keep
@@ -35,8 +37,10 @@ struct LevelLanes {
 class BlockSampler {
  public:
   explicit BlockSampler(const Texture& t)
-      : t_(t), table_(t.levelTable()), pow2_(t.powerOfTwo()),
-        texels_(reinterpret_cast<const int64_t*>(t.texels())),
+      : t_(t),
+        table_(t.levelTable()),
+        pow2_(t.powerOfTwo()),
+        pairs_(reinterpret_cast<const int64_t*>(t.texels())),
         words_(reinterpret_cast<const int32_t*>(t.texels())) {}
 
   LevelLanes level(VI k) const {
@@ -73,31 +77,43 @@ class BlockSampler {
     return hn::IfThenElse(hn::Lt(m, n), m, hn::Sub(hn::Sub(period, one), m));
   }
 
-  // The texels at `index` (into Texture::texels()) as floats 0…1 (texture.cpp's toColor). A
-  // texel's four 16-bit channels are one 64-bit word: gathered as such (half the elements of two
-  // 32-bit gathers), then split into its (r, g) and (b, a) halves.
-  Lanes4 fetch(VI index) const {
+  // Packed texels as floats 0…1: texture.cpp's unpackTexel, the same two steps per channel.
+  static Lanes4 unpack(VI t) {
     const DI di;
     const DF df;
     const hn::RebindToUnsigned<DI> du;
+    const VI byte = hn::Set(di, 0xFF);
+    const VF colourScale = hn::Set(df, 1.0f / 65025.0f);
+    auto colour = [&](VI c) {
+      c = hn::And(c, byte);
+      return hn::Mul(hn::ConvertTo(df, hn::Mul(c, c)), colourScale);
+    };
+    const VI alpha = hn::BitCast(di, hn::ShiftRight<24>(hn::BitCast(du, t)));
+    return {colour(t), colour(hn::ShiftRight<8>(t)), colour(hn::ShiftRight<16>(t)),
+            hn::Mul(hn::ConvertTo(df, alpha), hn::Set(df, 1.0f / 255.0f))};
+  }
+
+  // The texel at `index` (into Texture::texels()) of every lane.
+  VI fetch(VI index) const { return hn::GatherIndex(DI(), words_, index); }
+
+  // The texels at `index` and index + 1 of every lane: one 64-bit gather per two texels.
+  void fetchPair(VI index, VI& left, VI& right) const {
+    const DI di;
 #if HWY_TARGET == HWY_SCALAR
-    const VI word = hn::Add(index, index);
-    const VI rg = hn::GatherIndex(di, words_, word);
-    const VI ba = hn::GatherIndex(di, words_, hn::Add(word, hn::Set(di, 1)));
+    left = fetch(index);
+    right = fetch(hn::Add(index, hn::Set(di, 1)));
 #else
     const hn::Half<DI> dh;
     const hn::Rebind<int64_t, decltype(dh)> d64;
-    const auto lo = hn::GatherIndex(d64, texels_, hn::PromoteTo(d64, hn::LowerHalf(dh, index)));
-    const auto hi = hn::GatherIndex(d64, texels_, hn::PromoteTo(d64, hn::UpperHalf(dh, index)));
-    const VI rg = hn::ConcatEven(di, hn::BitCast(di, hi), hn::BitCast(di, lo));
-    const VI ba = hn::ConcatOdd(di, hn::BitCast(di, hi), hn::BitCast(di, lo));
+    // Byte offsets: a pair starts at any texel, so 4-byte aligned.
+    auto offsets = [&](auto half) { return hn::ShiftLeft<2>(hn::PromoteTo(d64, half)); };
+    const auto lo =
+        hn::BitCast(di, hn::GatherOffset(d64, pairs_, offsets(hn::LowerHalf(dh, index))));
+    const auto hi =
+        hn::BitCast(di, hn::GatherOffset(d64, pairs_, offsets(hn::UpperHalf(dh, index))));
+    left = hn::ConcatEven(di, hi, lo);  // little-endian: the lower word is the texel at index
+    right = hn::ConcatOdd(di, hi, lo);
 #endif
-    const VI low = hn::Set(di, 0xFFFF);
-    const VF scale = hn::Set(df, 1.0f / 65535.0f);
-    auto channel = [&](VI v) { return hn::Mul(hn::ConvertTo(df, v), scale); };
-    auto high = [&](VI v) { return hn::BitCast(di, hn::ShiftRight<16>(hn::BitCast(du, v))); };
-    return {channel(hn::And(rg, low)), channel(high(rg)), channel(hn::And(ba, low)),
-            channel(high(ba))};
   }
 
   static Lanes4 mix(const Lanes4& a, VF wa, const Lanes4& b, VF wb) {
@@ -129,31 +145,49 @@ class BlockSampler {
     x = sane(x);
     y = sane(y);
     const Wrap wx = t_.wrapX(), wy = t_.wrapY();
-    auto row = [&](VI yi) { return hn::Add(l.offset, hn::Mul(wrap(yi, l.height, wy), l.width)); };
+    const VI one = hn::Set(di, 1);
+    const VI stride = hn::Add(l.width, one);  // rows of width + 1 (texture.h, LevelView)
+    auto row = [&](VI yi) { return hn::Add(l.offset, hn::Mul(wrap(yi, l.height, wy), stride)); };
     if (filter == Filter::nearest) {
       const VF half = hn::Set(df, 0.5f);
-      return fetch(hn::Add(row(hn::ConvertTo(di, hn::Floor(hn::Add(y, half)))),
-                           wrap(hn::ConvertTo(di, hn::Floor(hn::Add(x, half))), l.width, wx)));
+      return unpack(
+          fetch(hn::Add(row(hn::ConvertTo(di, hn::Floor(hn::Add(y, half)))),
+                        wrap(hn::ConvertTo(di, hn::Floor(hn::Add(x, half))), l.width, wx))));
     }
     const VF fx = hn::Floor(x), fy = hn::Floor(y);
     const VI xi = hn::ConvertTo(di, fx), yi = hn::ConvertTo(di, fy);
-    const VI x0 = wrap(xi, l.width, wx), x1 = wrap(hn::Add(xi, hn::Set(di, 1)), l.width, wx);
-    const VI row0 = row(yi), row1 = row(hn::Add(yi, hn::Set(di, 1)));
-    const VF g = hn::Sub(x, fx), t = hn::Sub(y, fy), one = hn::Set(df, 1.0f);
-    const Lanes4 r1 = fetch(hn::Add(row0, x0)), r3 = fetch(hn::Add(row1, x1));
+    const VI x0 = wrap(xi, l.width, wx), x1 = wrap(hn::Add(xi, one), l.width, wx);
+    const VI row0 = row(yi), row1 = row(hn::Add(yi, one));
+    // The cell's texels: t1 (x0, y0), t2 (x1, y0), t3 (x1, y1), t4 (x0, y1) — R1…R4 of SPEC §7.
+    // Column x0 + 1 holds x1 unless the wrap turned back (mirror, or clamp left of the image):
+    // column `width` holds the texel that wraps there (the border copy).
+    VI t1, t2, t3, t4;
+    const VI next = hn::Add(x0, one);
+    const VI border = wx == Wrap::repeat ? hn::Zero(di) : hn::Sub(l.width, one);
+    const auto paired = hn::Eq(x1, hn::IfThenElse(hn::Eq(next, l.width), border, next));
+    if (hn::AllTrue(di, paired)) {
+      fetchPair(hn::Add(row0, x0), t1, t2);
+      fetchPair(hn::Add(row1, x0), t4, t3);
+    } else {
+      t1 = fetch(hn::Add(row0, x0));
+      t2 = fetch(hn::Add(row0, x1));
+      t3 = fetch(hn::Add(row1, x1));
+      t4 = fetch(hn::Add(row1, x0));
+    }
+    const VF g = hn::Sub(x, fx), t = hn::Sub(y, fy), onef = hn::Set(df, 1.0f);
+    const Lanes4 r1 = unpack(t1), r3 = unpack(t3);
     if (filter == Filter::threePoint || filter == Filter::trilinearThreePoint) {
-      // Three texels per lane, as the seed intends: R4 above the diagonal, R2 below it — one
-      // gather chooses per lane. The weights are texture.cpp's for the lane's triangle.
+      // Three texels per lane, as the seed intends: R4 above the diagonal, R2 below it. The
+      // weights are texture.cpp's for the lane's triangle.
       const auto upper = hn::Ge(t, g);
-      const auto upperI = hn::RebindMask(di, upper);
-      const Lanes4 r24 = fetch(hn::IfThenElse(upperI, hn::Add(row1, x0), hn::Add(row0, x1)));
+      const Lanes4 r24 = unpack(hn::IfThenElse(hn::RebindMask(di, upper), t4, t2));
       return mix3(r3, hn::IfThenElse(upper, g, t), r24,
                   hn::IfThenElse(upper, hn::Sub(t, g), hn::Sub(g, t)), r1,
-                  hn::IfThenElse(upper, hn::Sub(one, t), hn::Sub(one, g)));
+                  hn::IfThenElse(upper, hn::Sub(onef, t), hn::Sub(onef, g)));
     }
-    const Lanes4 r2 = fetch(hn::Add(row0, x1)), r4 = fetch(hn::Add(row1, x0));
-    const VF t1 = hn::Sub(one, t);
-    return mix(mix(r3, t, r2, t1), g, mix(r4, t, r1, t1), hn::Sub(one, g));
+    const Lanes4 r2 = unpack(t2), r4 = unpack(t4);
+    const VF t1f = hn::Sub(onef, t);
+    return mix(mix(r3, t, r2, t1f), g, mix(r4, t, r1, t1f), hn::Sub(onef, g));
   }
 
   Lanes4 sample(Filter filter, VF lod, VF x0, VF y0) const {
@@ -189,7 +223,7 @@ class BlockSampler {
   const Texture& t_;
   const Texture::LevelTable& table_;
   const bool pow2_;
-  const int64_t* texels_;
+  const int64_t* pairs_;
   const int32_t* words_;
 };
 

@@ -23,12 +23,28 @@ int wrapIndex(int i, int size, Wrap wrap) {
   }
 }
 
-namespace {
-
-Color4 toColor(const Texel& t) {
-  constexpr float kScale = 1.0f / 65535.0f;
-  return {t.r * kScale, t.g * kScale, t.b * kScale, t.a * kScale};
+PackedTexel packTexel(const Texel& t) {
+  const uint32_t a = uint32_t(std::lround(t.a * (255.0 / 65535.0)));
+  const float alpha = float(a) * (1.0f / 255.0f);
+  auto colour = [alpha](uint16_t v) {
+    uint32_t c = uint32_t(std::lround(std::sqrt(v / 65535.0) * 255.0));
+    // Premultiplied: the colour read back never exceeds the alpha read back.
+    while (c > 0 && float(c * c) * (1.0f / 65025.0f) > alpha) --c;
+    return c;
+  };
+  return colour(t.r) | colour(t.g) << 8 | colour(t.b) << 16 | a << 24;
 }
+
+Color4 unpackTexel(PackedTexel p) {
+  // (code · code) is exact in float; the SIMD samplers do the same two steps (sample_block.cpp).
+  auto colour = [p](int shift) {
+    const uint32_t c = p >> shift & 0xFF;
+    return float(c * c) * (1.0f / 65025.0f);
+  };
+  return {colour(0), colour(8), colour(16), float(p >> 24) * (1.0f / 255.0f)};
+}
+
+namespace {
 
 Color4 mix(const Color4& a, float wa, const Color4& b, float wb) {
   return {a.r * wa + b.r * wb, a.g * wa + b.g * wb, a.b * wa + b.b * wb, a.a * wa + b.a * wb};
@@ -39,9 +55,11 @@ Color4 mix3(const Color4& a, float wa, const Color4& b, float wb, const Color4& 
           a.b * wa + b.b * wb + c.b * wc, a.a * wa + b.a * wb + c.a * wc};
 }
 
+}  // namespace
+
 // Level k + 1 from level k (the constructor's comment): the 3×3 triangle filter centred on every
 // other texel, weights 1 2 1 / 2 4 2 / 1 2 1 over 16, rounded to nearest.
-Level decimate(const Level& src, Wrap wrapX, Wrap wrapY) {
+Level nextLevel(const Level& src, Wrap wrapX, Wrap wrapY) {
   Level dst;
   dst.width = (src.width + 1) / 2;
   dst.height = (src.height + 1) / 2;
@@ -67,19 +85,26 @@ Level decimate(const Level& src, Wrap wrapX, Wrap wrapY) {
   return dst;
 }
 
-}  // namespace
-
 Texture::Texture(Level base, Wrap wrapX, Wrap wrapY) : wrapX_(wrapX), wrapY_(wrapY) {
-  std::vector<Level> levels;
-  levels.push_back(std::move(base));
-  while (levels.back().width > 1 || levels.back().height > 1)
-    levels.push_back(decimate(levels.back(), wrapX_, wrapY_));
+  auto last = [](int w, int h) { return w <= 1 && h <= 1; };
   size_t total = 0;
-  for (const Level& l : levels) total += l.texels.size();
+  for (int w = base.width, h = base.height;; w = (w + 1) / 2, h = (h + 1) / 2) {
+    total += (size_t(w) + 1) * size_t(h);
+    if (last(w, h)) break;
+  }
   texels_.reserve(total);
-  for (const Level& l : levels) {
-    info_.push_back({l.width, l.height, int32_t(texels_.size())});  // < 2^27 (kMaxTextureTexels)
-    texels_.insert(texels_.end(), l.texels.begin(), l.texels.end());
+  // One 16-bit level at a time: packed into the array, then filtered into the next.
+  Level level = std::move(base);
+  for (;;) {
+    info_.push_back(
+        {level.width, level.height, int32_t(texels_.size())});  // < 2^27 (kMaxTextureTexels)
+    const int border = level.width > 0 ? wrapIndex(level.width, level.width, wrapX_) : 0;
+    for (int y = 0; y < level.height; ++y) {
+      for (int x = 0; x < level.width; ++x) texels_.push_back(packTexel(level.at(x, y)));
+      texels_.push_back(level.width > 0 ? packTexel(level.at(border, y)) : 0);
+    }
+    if (last(level.width, level.height)) break;
+    level = nextLevel(level, wrapX_, wrapY_);
   }
   for (size_t k = 0; k < info_.size() && k < size_t(kMaxLevels); ++k) {
     table_.width[k] = info_[k].width;
@@ -93,12 +118,13 @@ Texture::Texture(Level base, Wrap wrapX, Wrap wrapY) : wrapX_(wrapX), wrapY_(wra
 LevelView Texture::level(int k) const {
   const LevelInfo& l = info_[size_t(k)];
   return {l.width, l.height,
-          std::span<const Texel>(texels_.data() + l.offset, size_t(l.width) * size_t(l.height))};
+          std::span<const PackedTexel>(texels_.data() + l.offset,
+                                       (size_t(l.width) + 1) * size_t(l.height))};
 }
 
-const Texel& Texture::texel(int k, int x, int y) const {
+PackedTexel Texture::packed(int k, int x, int y) const {
   const LevelInfo& l = info_[size_t(k)];
-  return texels_[size_t(l.offset) + size_t(wrapIndex(y, l.height, wrapY_)) * size_t(l.width) +
+  return texels_[size_t(l.offset) + size_t(wrapIndex(y, l.height, wrapY_)) * (size_t(l.width) + 1) +
                  size_t(wrapIndex(x, l.width, wrapX_))];
 }
 
@@ -112,7 +138,7 @@ float saneCoordinate(float x) { return std::fabs(x) <= kMaxTexelCoordinate ? x :
 Color4 Texture::nearest(int k, float x, float y) const {
   x = saneCoordinate(x);
   y = saneCoordinate(y);
-  return toColor(texel(k, int(std::floor(x + 0.5f)), int(std::floor(y + 0.5f))));
+  return texel(k, int(std::floor(x + 0.5f)), int(std::floor(y + 0.5f)));
 }
 
 namespace {
@@ -136,8 +162,8 @@ Color4 Texture::bilinear(int k, float x, float y) const {
   // SPEC §7: R = γ(ΘR3 + (1−Θ)R2) + (1−γ)(ΘR4 + (1−Θ)R1), with R1…R4 the texels at (0,0),
   // (1,0), (1,1), (0,1) of the cell and γ, Θ the fractional parts.
   const auto [x0, y0, g, t] = cellAt(x, y);
-  const Color4 r1 = toColor(texel(k, x0, y0)), r2 = toColor(texel(k, x0 + 1, y0));
-  const Color4 r3 = toColor(texel(k, x0 + 1, y0 + 1)), r4 = toColor(texel(k, x0, y0 + 1));
+  const Color4 r1 = texel(k, x0, y0), r2 = texel(k, x0 + 1, y0);
+  const Color4 r3 = texel(k, x0 + 1, y0 + 1), r4 = texel(k, x0, y0 + 1);
   return mix(mix(r3, t, r2, 1 - t), g, mix(r4, t, r1, 1 - t), 1 - g);
 }
 
@@ -145,9 +171,9 @@ Color4 Texture::threePoint(int k, float x, float y) const {
   // SPEC §7, seed 001: the cell split along its diagonal from R1 to R3;
   //   Θ ≥ γ: R = γ·R3 + (Θ − γ)·R4 + (1 − Θ)·R1;   Θ < γ: R = Θ·R3 + (γ − Θ)·R2 + (1 − γ)·R1.
   const auto [x0, y0, g, t] = cellAt(x, y);
-  const Color4 r1 = toColor(texel(k, x0, y0)), r3 = toColor(texel(k, x0 + 1, y0 + 1));
-  if (t >= g) return mix3(r3, g, toColor(texel(k, x0, y0 + 1)), t - g, r1, 1 - t);
-  return mix3(r3, t, toColor(texel(k, x0 + 1, y0)), g - t, r1, 1 - g);
+  const Color4 r1 = texel(k, x0, y0), r3 = texel(k, x0 + 1, y0 + 1);
+  if (t >= g) return mix3(r3, g, texel(k, x0, y0 + 1), t - g, r1, 1 - t);
+  return mix3(r3, t, texel(k, x0 + 1, y0), g - t, r1, 1 - g);
 }
 
 namespace {
@@ -190,6 +216,66 @@ Color4 Texture::trilinear(float lod, float x0, float y0) const {
 Color4 Texture::trilinearThreePoint(float lod, float x0, float y0) const {
   return blendLevels(*this, lod, x0, y0,
                      [&](int k, float x, float y) { return threePoint(k, x, y); });
+}
+
+namespace {
+
+// A prefetch the compiler keeps: GCC counts __builtin_prefetch as no side effect and deletes a
+// loop that does nothing else (with -fno-math-errno even one calling floor); the empty asm
+// statement that takes the address is a use it must keep.
+inline void prefetch(const void* p) {
+  __builtin_prefetch(p, 0, 3);
+  asm volatile("" : : "r"(p));
+}
+
+}  // namespace
+
+void prefetchBlock(const Texture& t, Filter filter, const float* lod, const float* x0,
+                   const float* y0, int count) {
+  if (count <= 0) return;
+  float xMin = kMaxTexelCoordinate, xMax = -kMaxTexelCoordinate;
+  float yMin = kMaxTexelCoordinate, yMax = -kMaxTexelCoordinate;
+  for (int i = 0; i < count; ++i) {
+    // Only sane coordinates (Texture::sample reads the others as 0, which is one more texel).
+    if (!(std::fabs(x0[i]) <= kMaxTexelCoordinate && std::fabs(y0[i]) <= kMaxTexelCoordinate))
+      continue;
+    xMin = std::min(xMin, x0[i]);
+    xMax = std::max(xMax, x0[i]);
+    yMin = std::min(yMin, y0[i]);
+    yMax = std::max(yMax, y0[i]);
+  }
+  if (xMin > xMax) return;
+  const int last = t.levelCount() - 1;
+  const bool trilinear = filter == Filter::trilinear || filter == Filter::trilinearThreePoint;
+  const float l = std::clamp(lod[0] >= 0 ? lod[0] : 0.0f, 0.0f, float(last));  // NaN → 0
+  const int k = trilinear ? int(l) : std::min(int(l + 0.5f), last);
+  const Texture::LevelTable& table = t.levelTable();
+  const bool pow2 = t.powerOfTwo();
+  auto wrap = [pow2](int i, int n, Wrap mode) {
+    return pow2 && mode == Wrap::repeat ? i & (n - 1) : wrapIndex(i, n, mode);
+  };
+  auto level = [&](int j) {
+    const float scale = std::ldexp(1.0f, -j);
+    const int w = table.width[j], h = table.height[j];
+    const size_t stride = size_t(w) + 1;
+    const PackedTexel* base = t.texels() + table.offset[j];
+    // The cells' corners run from ⌊min⌋ to ⌊max⌋ + 1; a line holds 16 texels.
+    const int x0i = int(std::floor(xMin * scale)),
+              x1i = std::min(int(std::floor(xMax * scale)) + 1, x0i + 31);
+    const int y0i = int(std::floor(yMin * scale)),
+              y1i = std::min(int(std::floor(yMax * scale)) + 1, y0i + 31);
+    const int xa = wrap(x0i, w, t.wrapX()), xb = wrap(x1i, w, t.wrapX());
+    for (int y = y0i; y <= y1i; ++y) {
+      const PackedTexel* row = base + size_t(wrap(y, h, t.wrapY())) * stride;
+      prefetch(row + xa);
+      for (int x = x0i + 16; x < x1i; x += 16) prefetch(row + wrap(x, w, t.wrapX()));
+      // The row's last texel, unless it shares the first one's line.
+      if ((reinterpret_cast<uintptr_t>(row + xa) ^ reinterpret_cast<uintptr_t>(row + xb)) >= 64)
+        prefetch(row + xb);
+    }
+  };
+  level(k);
+  if (trilinear && k < last && l != float(k)) level(k + 1);
 }
 
 int anisotropicProbes(const Footprint& f, float x0, float y0, float& lod, float* x, float* y) {
@@ -340,20 +426,22 @@ Level generateTexture(Pattern pattern, int size, const Color4& a, const Color4& 
 }
 
 std::vector<uint8_t> toSrgb8(const LevelView& level) {
-  std::vector<uint8_t> rgba(level.texels.size() * 4);
-  for (size_t i = 0; i < level.texels.size(); ++i) {
-    const Texel& x = level.texels[i];
-    const double a = x.a / 65535.0;
-    auto encode = [a](uint16_t c) {
-      const double v = a > 0 ? std::min(1.0, c / 65535.0 / a) : 0.0;
-      const double e = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1 / 2.4) - 0.055;
-      return uint8_t(std::lround(e * 255));
-    };
-    rgba[i * 4 + 0] = encode(x.r);
-    rgba[i * 4 + 1] = encode(x.g);
-    rgba[i * 4 + 2] = encode(x.b);
-    rgba[i * 4 + 3] = uint8_t(std::lround(a * 255));
-  }
+  std::vector<uint8_t> rgba(size_t(level.width) * size_t(level.height) * 4);
+  uint8_t* out = rgba.data();
+  for (int y = 0; y < level.height; ++y)
+    for (int x = 0; x < level.width; ++x, out += 4) {
+      const Color4 c = level.at(x, y);
+      const double a = c.a;
+      auto encode = [a](float premultiplied) {
+        const double v = a > 0 ? std::min(1.0, premultiplied / a) : 0.0;
+        const double e = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1 / 2.4) - 0.055;
+        return uint8_t(std::lround(e * 255));
+      };
+      out[0] = encode(c.r);
+      out[1] = encode(c.g);
+      out[2] = encode(c.b);
+      out[3] = uint8_t(std::lround(a * 255));
+    }
   return rgba;
 }
 

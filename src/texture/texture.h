@@ -48,11 +48,30 @@ struct Level {
   const Texel& at(int x, int y) const { return texels[size_t(y) * size_t(width) + size_t(x)]; }
 };
 
-// A level inside a Texture, which keeps all its levels in one array (for the SIMD samplers).
+// How a Texture stores a texel: 8 bits a channel in one 32-bit word, r in the low byte, then g, b,
+// a. The colour channels hold the square root of their linear, premultiplied value — a gamma of 2,
+// near sRGB's 2.2, so that 8 bits keep the dark tones the precision of an sRGB8 texture — and alpha
+// holds alpha:  r = code_r² / 255², … ,  a = code_a / 255.  Half the bytes of a Texel: twice the
+// texels per cache line, and a texel with its right-hand neighbour is one 64-bit word, which the
+// SIMD samplers gather as a pair (docs/performance.md, "Texel storage").
+using PackedTexel = uint32_t;
+// The nearest code of each channel (colour rounded in the square-root domain, never above alpha).
+PackedTexel packTexel(const Texel& t);
+// Its value, as the samplers read it: colour (code · code) · (1/255²), alpha code · (1/255), in
+// float.
+Color4 unpackTexel(PackedTexel p);
+
+// A level inside a Texture, which keeps all its levels in one array (for the SIMD samplers). Each
+// row is width + 1 texels: after its last texel comes a copy of the texel that wraps to column
+// `width` (the first for repeat, the last for clamp and mirror), so that a texel's right-hand
+// neighbour along x is always the next word.
 struct LevelView {
   int width = 0, height = 0;
-  std::span<const Texel> texels;  // row-major, top row first
-  const Texel& at(int x, int y) const { return texels[size_t(y) * size_t(width) + size_t(x)]; }
+  std::span<const PackedTexel> texels;  // height rows of width + 1, top row first
+  PackedTexel packed(int x, int y) const {
+    return texels[size_t(y) * (size_t(width) + 1) + size_t(x)];
+  }
+  Color4 at(int x, int y) const { return unpackTexel(packed(x, y)); }
 };
 
 // The sampling methods (issue 5's --texture-filter): at the pyramid level nearest the level of
@@ -65,7 +84,7 @@ enum class Filter : uint8_t { nearest, threePoint, bilinear, trilinearThreePoint
 inline constexpr float kMaxTexelCoordinate = 16777216.0f;
 
 // The largest texture side accepted, and the most texels in level 0 (so a pyramid stays within
-// 4/3 · 2^26 · 8 bytes ≈ 716 MB).
+// 4/3 · 2^26 · 4 bytes ≈ 358 MB, and building it needs two 16-bit levels besides: 805 MB at most).
 inline constexpr int kMaxTextureSide = 16384;
 inline constexpr int64_t kMaxTextureTexels = int64_t(1) << 26;
 
@@ -75,7 +94,9 @@ class Texture {
   // by the 3×3-texel triangle filter [1 2 1]ᵀ[1 2 1]/16 and decimated by 2 — texel i of level k + 1
   // is the filter centred on texel 2i of level k, edges continued by the wrap modes. A level of
   // odd size n gives ⌈n/2⌉ texels (its last texel keeps the image's last texel), so any size
-  // works; each level halves until both sides are 1.
+  // works; each level halves until both sides are 1. The levels are filtered from one another in
+  // 16 bits (nextLevel) and each is then stored packed (packTexel), so rounding does not accumulate
+  // down the pyramid.
   Texture(Level base, Wrap wrapX, Wrap wrapY);
 
   int levelCount() const { return int(info_.size()); }
@@ -83,8 +104,9 @@ class Texture {
   Wrap wrapX() const { return wrapX_; }
   Wrap wrapY() const { return wrapY_; }
 
-  // The texel at integer coordinates, wrapped.
-  const Texel& texel(int k, int x, int y) const;
+  // The texel at integer coordinates, wrapped, as stored and as read.
+  PackedTexel packed(int k, int x, int y) const;
+  Color4 texel(int k, int x, int y) const { return unpackTexel(packed(k, x, y)); }
 
   // Samplers on level k at continuous texel coordinates of that level (texel centres at integers).
   Color4 nearest(int k, float x, float y) const;
@@ -105,8 +127,9 @@ class Texture {
   static constexpr int kMaxProbes = 16;
   Color4 anisotropic(const Footprint& footprint, float x0, float y0) const;
 
-  // All levels in one array, level k at offset(k) (what the SIMD samplers gather from).
-  const Texel* texels() const { return texels_.data(); }
+  // All levels in one array, level k at offset(k), rows of width(k) + 1 (LevelView): what the
+  // SIMD samplers gather from.
+  const PackedTexel* texels() const { return texels_.data(); }
   int32_t offset(int k) const { return info_[size_t(k)].offset; }
 
   // The levels' sizes and offsets side by side, for the SIMD samplers' per-lane gathers (a side of
@@ -123,17 +146,28 @@ class Texture {
   struct LevelInfo {
     int32_t width, height, offset;
   };
-  std::vector<Texel> texels_;
+  std::vector<PackedTexel> texels_;
   std::vector<LevelInfo> info_;
   LevelTable table_;
   bool powerOfTwo_ = false;
   Wrap wrapX_, wrapY_;
 };
 
+// The pyramid's next level in 16 bits (Texture's constructor): `level` filtered by the 3×3 triangle
+// filter centred on every other texel, edges continued by the wrap modes, rounded to nearest.
+Level nextLevel(const Level& level, Wrap wrapX, Wrap wrapY);
+
 // SIMD sampling of up to 16 points at once (sample_block.cpp, Highway): r, g, b, a of point i to
 // out[0…3][i], bit for bit what Texture::sample returns for each point, on every SIMD target.
 void sampleBlock(const Texture& texture, Filter filter, const float* lod, const float* x0,
                  const float* y0, int count, float out[4][16]);
+
+// Requests the cache lines that sampleBlock(texture, filter, lod, x0, y0, count) will read, so that
+// they arrive while other work runs: on the level of the first point's level of detail (and the
+// next, for the trilinear filters), the texels under the points' bounding box (at most 32 × 32
+// texels of it). For points close together — a block of pixels — that is a few lines per row.
+void prefetchBlock(const Texture& texture, Filter filter, const float* lod, const float* x0,
+                   const float* y0, int count);
 
 // The probes of Texture::anisotropic for `footprint` at (x0, y0): returns their number n
 // (1…Texture::kMaxProbes) and writes their level of detail and level-0 positions x[0…n), y[0…n).

@@ -94,12 +94,13 @@ TEST(GltfWriter, TexturesWrapModesAndUvScaleRoundTrip) {
       ASSERT_EQ(la.width, lb.width);
       ASSERT_EQ(la.height, lb.height);
       double worst = 0;
-      for (size_t i = 0; i < la.texels.size(); ++i) {
-        // Premultiplied linear; 8-bit sRGB steps are at most 1/78 of linear (near white).
-        worst = std::max({worst, std::fabs(la.texels[i].r - lb.texels[i].r) / 65535.0,
-                          std::fabs(la.texels[i].b - lb.texels[i].b) / 65535.0,
-                          std::fabs(la.texels[i].a - lb.texels[i].a) / 65535.0});
-      }
+      for (int y = 0; y < la.height; ++y)
+        for (int x = 0; x < la.width; ++x) {
+          // Premultiplied linear; 8-bit sRGB steps are at most 1/78 of linear (near white).
+          const texture::Color4 ca = la.at(x, y), cb = lb.at(x, y);
+          worst = std::max({worst, double(std::fabs(ca.r - cb.r)), double(std::fabs(ca.b - cb.b)),
+                            double(std::fabs(ca.a - cb.a))});
+        }
       EXPECT_LT(worst, 0.015) << t;
     }
     ASSERT_EQ(back->materials.size(), s.materials.size());

@@ -83,11 +83,13 @@ TEST(GltfTextures, BaseColorTextureWithItsSamplerAndAlphaModeMapToTheMaterial) {
   EXPECT_EQ(t.wrapY(), texture::Wrap::mirror);
   ASSERT_EQ(t.level(0).width, 4);
   ASSERT_EQ(t.level(0).height, 2);
-  // sRGB bytes decoded to linear 16-bit; top row first.
-  EXPECT_EQ(t.level(0).at(2, 1).r, srgbTo16(120));
-  EXPECT_EQ(t.level(0).at(2, 1).g, srgbTo16(200));
-  EXPECT_EQ(t.level(0).at(3, 0).b, srgbTo16(7));
-  EXPECT_EQ(t.level(0).at(3, 0).a, 65535);
+  // sRGB bytes decoded to linear 16-bit, then stored packed (texture.h); top row first.
+  auto stored = [](uint16_t red, uint16_t green, uint16_t blue, uint16_t alpha) {
+    return texture::packTexel({red, green, blue, alpha});
+  };
+  EXPECT_EQ(t.level(0).packed(2, 1) & 0xFFFF,
+            stored(srgbTo16(120), srgbTo16(200), 0, 65535) & 0xFFFF);
+  EXPECT_EQ(t.level(0).packed(3, 0) & 0xFFFF0000, stored(0, 0, srgbTo16(7), 65535) & 0xFFFF0000);
   EXPECT_EQ(s.meshes[0].uvs.size(), 3u);
 }
 
@@ -197,7 +199,8 @@ TEST(JsonTextures, GeneratedTexturesFogLightsAndMaterialKeysAreRead) {
   // The same seed gives the same texels.
   Result<Scene> again = parse(R"("textures": [{"generate": "noise", "size": 16, "seed": 3}])");
   ASSERT_TRUE(again.ok());
-  EXPECT_EQ(again->textures[0].texture->level(0).at(5, 7), s.textures[0].texture->level(0).at(5, 7));
+  EXPECT_EQ(again->textures[0].texture->level(0).packed(5, 7),
+            s.textures[0].texture->level(0).packed(5, 7));
 }
 
 TEST(JsonTextures, ProblemsAreNamed) {

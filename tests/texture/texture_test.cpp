@@ -41,34 +41,52 @@ TEST(Wrap, RepeatClampAndMirror) {
 
 // Every texel of every level against the 3×3 triangle filter of the level above, written out
 // independently: weights (2 − |dx|)(2 − |dy|) / 16, centred on texel (2x, 2y), rounded to nearest.
+// The pyramid is filtered in 16 bits (nextLevel) and each level stored packed: the Texture's levels
+// are exactly the packed 16-bit levels, each row followed by its wrapped neighbour (texture.h).
 TEST(Pyramid, LevelsAreTheTriangleFilterOfTheLevelAboveDecimatedByTwo) {
   for (Wrap wrap : {Wrap::repeat, Wrap::clamp, Wrap::mirror}) {
-    const Texture tex(randomLevel(13, 7, 3), wrap, wrap);
-    ASSERT_EQ(tex.levelCount(), 5);  // 13×7, 7×4, 4×2, 2×1, 1×1
+    std::vector<Level> chain{randomLevel(13, 7, 3)};
+    while (chain.back().width > 1 || chain.back().height > 1)
+      chain.push_back(nextLevel(chain.back(), wrap, wrap));
+    ASSERT_EQ(chain.size(), 5u);  // 13×7, 7×4, 4×2, 2×1, 1×1
     const int sizes[5][2] = {{13, 7}, {7, 4}, {4, 2}, {2, 1}, {1, 1}};
-    for (int k = 0; k < 5; ++k) {
-      EXPECT_EQ(tex.level(k).width, sizes[k][0]);
-      EXPECT_EQ(tex.level(k).height, sizes[k][1]);
-    }
-    for (int k = 1; k < tex.levelCount(); ++k)
-      for (int y = 0; y < tex.level(k).height; ++y)
-        for (int x = 0; x < tex.level(k).width; ++x) {
+    for (size_t k = 1; k < chain.size(); ++k) {
+      const Level &above = chain[k - 1], &level = chain[k];
+      ASSERT_EQ(level.width, sizes[k][0]);
+      ASSERT_EQ(level.height, sizes[k][1]);
+      for (int y = 0; y < level.height; ++y)
+        for (int x = 0; x < level.width; ++x) {
           double sum[4] = {};
           for (int dy = -1; dy <= 1; ++dy)
             for (int dx = -1; dx <= 1; ++dx) {
-              const Texel& t = tex.texel(k - 1, 2 * x + dx, 2 * y + dy);
+              const Texel& t = above.at(wrapIndex(2 * x + dx, above.width, wrap),
+                                        wrapIndex(2 * y + dy, above.height, wrap));
               const double w = (2 - std::abs(dx)) * (2 - std::abs(dy)) / 16.0;
               sum[0] += w * t.r;
               sum[1] += w * t.g;
               sum[2] += w * t.b;
               sum[3] += w * t.a;
             }
-          const Texel& got = tex.level(k).at(x, y);
+          const Texel& got = level.at(x, y);
           const uint16_t c[4] = {got.r, got.g, got.b, got.a};
           for (int ch = 0; ch < 4; ++ch)
             ASSERT_EQ(c[ch], uint16_t(std::floor(sum[ch] + 0.5))) << "level " << k << " texel " << x
                                                                    << "," << y << " channel " << ch;
         }
+    }
+    const Texture tex(chain[0], wrap, wrap);
+    ASSERT_EQ(tex.levelCount(), 5);
+    for (int k = 0; k < tex.levelCount(); ++k) {
+      const LevelView view = tex.level(k);
+      const Level& level = chain[size_t(k)];
+      ASSERT_EQ(view.width, level.width);
+      ASSERT_EQ(view.height, level.height);
+      ASSERT_EQ(view.texels.size(), size_t(level.width + 1) * size_t(level.height));
+      for (int y = 0; y < level.height; ++y)
+        for (int x = 0; x <= level.width; ++x)
+          ASSERT_EQ(view.packed(x, y), packTexel(level.at(wrapIndex(x, level.width, wrap), y)))
+              << "level " << k << " texel " << x << "," << y;
+    }
   }
 }
 
@@ -79,15 +97,44 @@ TEST(Pyramid, ConstantImageStaysConstantAndOneTexelIsItsOwnPyramid) {
   l.texels.assign(60, Texel{1000, 2000, 3000, 65535});
   const Texture tex(l, Wrap::repeat, Wrap::clamp);
   for (int k = 0; k < tex.levelCount(); ++k)
-    for (const Texel& t : tex.level(k).texels) EXPECT_EQ(t, (Texel{1000, 2000, 3000, 65535}));
+    for (PackedTexel t : tex.level(k).texels)
+      EXPECT_EQ(t, packTexel(Texel{1000, 2000, 3000, 65535}));
   Level one;
   one.width = one.height = 1;
   one.texels = {Texel{7, 8, 9, 10}};
   EXPECT_EQ(Texture(one, Wrap::repeat, Wrap::repeat).levelCount(), 1);
 }
 
+// The stored format (texture.h): colour within half a code of the square-root curve, alpha within
+// half a code, black, white and opaque exact, and premultiplied colour never above alpha.
+TEST(PackedTexels, RoundTripWithinHalfACodeAndPremultipliedColourStaysBelowAlpha) {
+  std::mt19937 rng(5);
+  for (int i = 0; i < 200000; ++i) {
+    const uint16_t a = i < 1000 ? 65535 : uint16_t(rng() & 0xFFFF);
+    const uint16_t c = uint16_t(uint32_t(rng() & 0xFFFF) * a / 65535);  // premultiplied: c ≤ a
+    const Color4 back = unpackTexel(packTexel({c, c, c, a}));
+    const double alpha = a / 65535.0;
+    EXPECT_LE(std::fabs(back.a - alpha), 0.5 / 255 + 1e-7) << a;
+    EXPECT_LE(back.r, back.a) << c << " " << a;
+    // Half a code in the square-root domain, unless that code reads above alpha: then the
+    // largest code that does not.
+    const int code = int(std::lround(std::sqrt(back.r) * 255));
+    if (std::fabs(std::sqrt(back.r) - std::sqrt(c / 65535.0)) > 0.5 / 255 + 1e-6) {
+      EXPECT_GT(float((code + 1) * (code + 1)) * (1.0f / 65025.0f), back.a) << c << " " << a;
+    }
+    ASSERT_EQ(back.r, back.g);
+    ASSERT_EQ(back.r, back.b);
+  }
+  EXPECT_EQ(packTexel({0, 0, 0, 0}), 0u);
+  EXPECT_EQ(packTexel({65535, 65535, 65535, 65535}), 0xFFFFFFFFu);
+  const Color4 white = unpackTexel(0xFFFFFFFFu);
+  EXPECT_EQ(white.r, 1.0f);
+  EXPECT_EQ(white.a, 1.0f);
+  EXPECT_EQ(unpackTexel(packTexel({0, 0, 0, 65535})).r, 0.0f);
+}
+
 float channel(const Color4& c) { return c.r; }
-float value(const Texture& t, int x, int y) { return t.texel(0, x, y).r / 65535.0f; }
+float value(const Texture& t, int x, int y) { return t.texel(0, x, y).r; }
 
 // SPEC §7, seed 001: Θ ≥ γ: R = γR3 + (Θ − γ)R4 + (1 − Θ)R1; Θ < γ: R = ΘR3 + (γ − Θ)R2 + (1 − γ)R1,
 // with R1…R4 at (0,0), (1,0), (1,1), (0,1).
@@ -128,7 +175,7 @@ TEST(Samplers, NearestBilinearAndTrilinear) {
               0.5f * (channel(tex.threePoint(1, 2.5f, 1.5f)) + channel(tex.threePoint(2, 1.25f, 0.75f))),
               1e-6f);
   // Beyond the last level the 1×1 level is all there is.
-  EXPECT_NEAR(channel(tex.trilinear(10, 3, 3)), tex.level(3).at(0, 0).r / 65535.0f, 1e-6f);
+  EXPECT_NEAR(channel(tex.trilinear(10, 3, 3)), tex.level(3).at(0, 0).r, 1e-6f);
 }
 
 // Anisotropic filtering keeps detail across a long, thin footprint that the trilinear filter, sized
@@ -161,7 +208,8 @@ TEST(Samplers, AnisotropicKeepsDetailAcrossAThinFootprint) {
 
 // The SIMD block sampler returns Texture::sample's values bit for bit, for every filter and wrap
 // mode, on every compiled SIMD target — including levels of detail below 0, past the last level,
-// NaN, and coordinates far outside the texture, huge or NaN.
+// NaN, coordinates far outside the texture, huge or NaN, and clusters of points anywhere (which
+// take the paired reads where they can).
 TEST(Samplers, SimdBlockEqualsScalarOnEveryTarget) {
   std::mt19937 rng(21);
   std::uniform_real_distribution<float> u(0, 1);
@@ -181,6 +229,17 @@ TEST(Samplers, SimdBlockEqualsScalarOnEveryTarget) {
             lod[i] = u(rng) * 8 - 1;
             x[i] = u(rng) * 200 - 80;
             y[i] = u(rng) * 120 - 50;
+          }
+          if (round % 3 == 1) {
+            // A cluster of points, as a block of pixels gives: inside the image the sampler reads
+            // each row's two texels as one pair, and at the right edge the row's border copy.
+            const float cx = u(rng) * float(w + 6) - 3, cy = u(rng) * float(h + 6) - 3;
+            const float level = u(rng) * 3;
+            for (int i = 0; i < 16; ++i) {
+              lod[i] = level;
+              x[i] = cx + u(rng) * 3;
+              y[i] = cy + u(rng) * 3;
+            }
           }
           if (round == 0) {
             lod[0] = std::nanf("");
