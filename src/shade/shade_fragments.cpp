@@ -19,6 +19,7 @@
 
 #include "shade/shading.h"
 #include "texture/footprint.h"
+#include "texture/sample_block-inl.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace sv::shade {
@@ -146,27 +147,20 @@ void ShadeFragments(const MaterialShading& m, const Environment& env, const Frag
   const VF one = hn::Set(df, 1.0f), zero = hn::Zero(df);
   alignas(64) float texel[4][kMaxFragments];
   const int count = std::clamp(f.count, 0, kMaxFragments);
-  if (m.texture) {
-    TexCoords computed;
-    if (!given) TextureCoordinates(m, f, computed, false);
-    const TexCoords& tc = given ? *given : computed;
-    const float* lod = tc.lod;
-    const float* x0 = tc.x0;
-    const float* y0 = tc.y0;
+  TexCoords computed;
+  if (m.texture && !given) TextureCoordinates(m, f, computed, false);
+  const TexCoords& tc = given ? *given : computed;
+  if (m.texture && m.anisotropic) {
+    // The elliptical footprint per pixel (footprint.h), probes along its major axis.
     const float width = float(m.texture->level(0).width);
-    if (m.anisotropic) {
-      // The elliptical footprint per pixel (footprint.h), probes along its major axis.
-      texture::Footprint fp[kMaxFragments];
-      for (int i = 0; i < count; ++i) {
-        const double q = std::max(double(f.q[i]), 1e-30);
-        fp[i] = texture::pixelFootprint(
-            {double(f.attribute[kU][i]), f.udx, f.udy}, {double(f.attribute[kV][i]), f.vdx, f.vdy},
-            {q, f.qdx, f.qdy}, width, m.texture->level(0).height);
-      }
-      texture::anisotropicBlock(*m.texture, fp, x0, y0, count, texel);
-    } else {
-      texture::sampleBlock(*m.texture, m.filter, lod, x0, y0, kMaxFragments, texel);
+    texture::Footprint fp[kMaxFragments];
+    for (int i = 0; i < count; ++i) {
+      const double q = std::max(double(f.q[i]), 1e-30);
+      fp[i] = texture::pixelFootprint(
+          {double(f.attribute[kU][i]), f.udx, f.udy}, {double(f.attribute[kV][i]), f.vdx, f.vdy},
+          {q, f.qdx, f.qdy}, width, m.texture->level(0).height);
     }
+    texture::anisotropicBlock(*m.texture, fp, tc.x0, tc.y0, count, texel);
   }
   for (size_t i = 0; i < size_t(kMaxFragments); i += lanes) {
     const VF q = hn::Max(hn::Load(df, f.q + i), hn::Set(df, 1e-30f));
@@ -177,13 +171,22 @@ void ShadeFragments(const MaterialShading& m, const Environment& env, const Frag
                    ? one
                    : hn::Min(hn::Max(hn::Mul(hn::Load(df, f.attribute[kAlpha] + i), w), zero), one);
     if (m.texture) {
-      const VF ta = hn::Load(df, texel[3] + i);
+      // The block sampler runs here, in this target's lanes (sample_block-inl.h).
+      const texture::HWY_NAMESPACE::Lanes4 t =
+          m.anisotropic
+              ? texture::HWY_NAMESPACE::Lanes4{hn::Load(df, texel[0] + i),
+                                               hn::Load(df, texel[1] + i),
+                                               hn::Load(df, texel[2] + i),
+                                               hn::Load(df, texel[3] + i)}
+              : texture::HWY_NAMESPACE::BlockSampler(*m.texture)
+                    .sample(m.filter, hn::Load(df, tc.lod + i), hn::Load(df, tc.x0 + i),
+                            hn::Load(df, tc.y0 + i));
       // Texels are premultiplied; the surface colour is the straight one (0 where alpha is 0).
-      const VF inv = hn::IfThenElseZero(hn::Gt(ta, zero), hn::Div(one, ta));
-      c.x = hn::Mul(c.x, hn::Mul(hn::Load(df, texel[0] + i), inv));
-      c.y = hn::Mul(c.y, hn::Mul(hn::Load(df, texel[1] + i), inv));
-      c.z = hn::Mul(c.z, hn::Mul(hn::Load(df, texel[2] + i), inv));
-      alpha = hn::Mul(alpha, ta);
+      const VF inv = hn::IfThenElseZero(hn::Gt(t.a, zero), hn::Div(one, t.a));
+      c.x = hn::Mul(c.x, hn::Mul(t.r, inv));
+      c.y = hn::Mul(c.y, hn::Mul(t.g, inv));
+      c.z = hn::Mul(c.z, hn::Mul(t.b, inv));
+      alpha = hn::Mul(alpha, t.a);
     }
     V3 eye{zero, zero, zero};
     if (m.phong || env.fog)
