@@ -110,14 +110,29 @@ void TextureCoordinates(const MaterialShading& m, const Fragments& f, TexCoords&
   const size_t lanes = hn::Lanes(df);
   const VF one = hn::Set(df, 1.0f), zero = hn::Zero(df);
   const float width = float(m.texture->level(0).width), height = float(m.texture->level(0).height);
+  // The block's bounding box in level-0 texels, for the prefetch; insane coordinates left out.
+  const VF big = hn::Set(df, texture::kMaxTexelCoordinate);
+  VF xMin = big, yMin = big, xMax = hn::Neg(big), yMax = hn::Neg(big);
   for (size_t i = 0; i < size_t(kMaxFragments); i += lanes) {
     // Outside the triangle (extrapolated AA centroids) q may reach 0: keep w finite.
     const VF q = hn::Max(hn::Load(df, f.q + i), hn::Set(df, 1e-30f));
     const VF w = hn::Div(one, q);
     const VF u = hn::Mul(hn::Load(df, f.attribute[kU] + i), w);
     const VF v = hn::Mul(hn::Load(df, f.attribute[kV] + i), w);
-    hn::Store(hn::Sub(hn::Mul(u, hn::Set(df, width)), hn::Set(df, 0.5f)), df, out.x0 + i);
-    hn::Store(hn::Sub(hn::Mul(v, hn::Set(df, height)), hn::Set(df, 0.5f)), df, out.y0 + i);
+    const VF x0 = hn::Sub(hn::Mul(u, hn::Set(df, width)), hn::Set(df, 0.5f));
+    const VF y0 = hn::Sub(hn::Mul(v, hn::Set(df, height)), hn::Set(df, 0.5f));
+    hn::Store(x0, df, out.x0 + i);
+    hn::Store(y0, df, out.y0 + i);
+    if (prefetch) {
+      // Only the fragments there are, with sane (not NaN) coordinates.
+      const size_t live = size_t(std::clamp(f.count, 0, kMaxFragments));
+      const auto sane = hn::And(hn::FirstN(df, live > i ? live - i : 0),
+                                hn::And(hn::Le(hn::Abs(x0), big), hn::Le(hn::Abs(y0), big)));
+      xMin = hn::Min(xMin, hn::IfThenElse(sane, x0, big));
+      yMin = hn::Min(yMin, hn::IfThenElse(sane, y0, big));
+      xMax = hn::Max(xMax, hn::IfThenElse(sane, x0, hn::Neg(big)));
+      yMax = hn::Max(yMax, hn::IfThenElse(sane, y0, hn::Neg(big)));
+    }
     const VF ww = hn::Mul(w, hn::Set(df, width)), wh = hn::Mul(w, hn::Set(df, height));
     const VF a = hn::Mul(hn::Sub(hn::Set(df, f.udx), hn::Mul(u, hn::Set(df, f.qdx))), ww);
     const VF b = hn::Mul(hn::Sub(hn::Set(df, f.udy), hn::Mul(u, hn::Set(df, f.qdy))), ww);
@@ -136,8 +151,9 @@ void TextureCoordinates(const MaterialShading& m, const Fragments& f, TexCoords&
   }
   // The texels the samplers will read, requested now (the caller shades a queue's work later).
   if (prefetch && !m.anisotropic)
-    texture::prefetchBlock(*m.texture, m.filter, out.lod, out.x0, out.y0,
-                           std::clamp(f.count, 0, kMaxFragments));
+    texture::prefetchBox(*m.texture, m.filter, out.lod[0], hn::GetLane(hn::MinOfLanes(df, xMin)),
+                         hn::GetLane(hn::MaxOfLanes(df, xMax)), hn::GetLane(hn::MinOfLanes(df, yMin)),
+                         hn::GetLane(hn::MaxOfLanes(df, yMax)));
 }
 
 void ShadeFragments(const MaterialShading& m, const Environment& env, const Fragments& f,

@@ -230,24 +230,16 @@ inline void prefetch(const void* p) {
 
 }  // namespace
 
-void prefetchBlock(const Texture& t, Filter filter, const float* lod, const float* x0,
-                   const float* y0, int count) {
-  if (count <= 0) return;
-  float xMin = kMaxTexelCoordinate, xMax = -kMaxTexelCoordinate;
-  float yMin = kMaxTexelCoordinate, yMax = -kMaxTexelCoordinate;
-  for (int i = 0; i < count; ++i) {
-    // Only sane coordinates (Texture::sample reads the others as 0, which is one more texel).
-    if (!(std::fabs(x0[i]) <= kMaxTexelCoordinate && std::fabs(y0[i]) <= kMaxTexelCoordinate))
-      continue;
-    xMin = std::min(xMin, x0[i]);
-    xMax = std::max(xMax, x0[i]);
-    yMin = std::min(yMin, y0[i]);
-    yMax = std::max(yMax, y0[i]);
-  }
-  if (xMin > xMax) return;
+void prefetchBox(const Texture& t, Filter filter, float lod, float xMin, float xMax, float yMin,
+                 float yMax) {
+  // Also false for NaN.
+  if (!(xMin <= xMax && yMin <= yMax && std::fabs(xMin) <= kMaxTexelCoordinate &&
+        std::fabs(xMax) <= kMaxTexelCoordinate && std::fabs(yMin) <= kMaxTexelCoordinate &&
+        std::fabs(yMax) <= kMaxTexelCoordinate))
+    return;
   const int last = t.levelCount() - 1;
   const bool trilinear = filter == Filter::trilinear || filter == Filter::trilinearThreePoint;
-  const float l = std::clamp(lod[0] >= 0 ? lod[0] : 0.0f, 0.0f, float(last));  // NaN → 0
+  const float l = std::clamp(lod >= 0 ? lod : 0.0f, 0.0f, float(last));  // NaN → 0
   const int k = trilinear ? int(l) : std::min(int(l + 0.5f), last);
   const Texture::LevelTable& table = t.levelTable();
   const bool pow2 = t.powerOfTwo();

@@ -162,12 +162,13 @@ Level nextLevel(const Level& level, Wrap wrapX, Wrap wrapY);
 void sampleBlock(const Texture& texture, Filter filter, const float* lod, const float* x0,
                  const float* y0, int count, float out[4][16]);
 
-// Requests the cache lines that sampleBlock(texture, filter, lod, x0, y0, count) will read, so that
-// they arrive while other work runs: on the level of the first point's level of detail (and the
-// next, for the trilinear filters), the texels under the points' bounding box (at most 32 × 32
-// texels of it). For points close together — a block of pixels — that is a few lines per row.
-void prefetchBlock(const Texture& texture, Filter filter, const float* lod, const float* x0,
-                   const float* y0, int count);
+// Requests the cache lines that sampling points inside the box [xMin, xMax] × [yMin, yMax] (level-0
+// texels) at level of detail `lod` with `filter` will read, so that they arrive while other work
+// runs: on the level the sampler picks for `lod` (and the next, for the trilinear filters), the
+// texels under the box (at most 32 × 32 of them). For points close together — a block of pixels —
+// that is a few lines per row. Coordinates past kMaxTexelCoordinate request nothing.
+void prefetchBox(const Texture& texture, Filter filter, float lod, float xMin, float xMax,
+                 float yMin, float yMax);
 
 // The probes of Texture::anisotropic for `footprint` at (x0, y0): returns their number n
 // (1…Texture::kMaxProbes) and writes their level of detail and level-0 positions x[0…n), y[0…n).
