@@ -178,18 +178,22 @@ class Caster {
       ++stats_.depthTests;
       form_.bound(x, y, {zlo, zhi}, value, slope);
       if (!value.containsZero()) return;
+      // The rays read their own pixels' depths, never the masking pyramid: a hit writes its
+      // pixel's node, and the window's ancestors are brought up to date once, after its rays.
+      bool hits = false;
       if (!slope.containsZero()) {
         double guess = std::numeric_limits<double>::quiet_NaN();
         for (int py = 0; py < n && gy0 + py <= gy1; ++py)
           for (int px = 0; px < n && gx0 + px <= gx1; ++px)
-            simplePixel(lx + px, ly + py, cubeX(gx0 + px, w_.width, w_.offsetX),
-                        cubeY(gy0 + py, w_.height, w_.offsetY), zlo, zhi, guess);
-        return;
+            hits |= simplePixel(lx + px, ly + py, cubeX(gx0 + px, w_.width, w_.offsetX),
+                                cubeY(gy0 + py, w_.height, w_.offsetY), zlo, zhi, guess);
+      } else {
+        for (int py = 0; py < n && gy0 + py <= gy1; ++py)
+          for (int px = 0; px < n && gx0 + px <= gx1; ++px)
+            hits |= pixel(lx + px, ly + py, cubeX(gx0 + px, w_.width, w_.offsetX),
+                          cubeY(gy0 + py, w_.height, w_.offsetY), zlo, zhi);
       }
-      for (int py = 0; py < n && gy0 + py <= gy1; ++py)
-        for (int px = 0; px < n && gx0 + px <= gx1; ++px)
-          pixel(lx + px, ly + py, cubeX(gx0 + px, w_.width, w_.offsetX),
-                cubeY(gy0 + py, w_.height, w_.offsetY), zlo, zhi);
+      if (hits) refreshAbove(level, lx, ly);
       return;
     }
     // Step 2: the binary tree in depth, four levels deep: of sixteen slabs, those whose bound may
@@ -222,37 +226,49 @@ class Caster {
   // tree in depth on the ray's own function (RayFunction: exact per-quadric bounds), front to
   // back; a span where H is monotonic (its slope bound excludes 0) holds at most one zero, found
   // by refineBracket when its ends differ in sign; others are halved down to kBracket.
-  void pixel(int lx, int ly, double x, double y, double zlo, double zhi) {
+  // True if the pixel took a hit.
+  bool pixel(int lx, int ly, double x, double y, double zlo, double zhi) {
     ++stats_.pixels;
     const size_t at = size_t(ly) * size_t(w_.stride) + size_t(lx);
     zhi = std::min(zhi, 2.0 * double(w_.depth[at]) - 1);
-    if (!(zlo < zhi)) return;
+    if (!(zlo < zhi)) return false;
     form_.ray(x, y, ray_);
     double z;
-    if (firstCrossing(ray_, zlo, zhi, std::numeric_limits<double>::quiet_NaN(), z, stats_))
-      hit(lx, ly, at, z);
+    return firstCrossing(ray_, zlo, zhi, std::numeric_limits<double>::quiet_NaN(), z, stats_) &&
+           hit(lx, ly, at, z);
   }
 
   // A ray with at most one crossing in [zlo, zhi] (the window's slope bound says so). Newton
   // starts from the previous ray's hit in the window: the surface is coherent.
-  void simplePixel(int lx, int ly, double x, double y, double zlo, double zhi, double& guess) {
+  bool simplePixel(int lx, int ly, double x, double y, double zlo, double zhi, double& guess) {
     ++stats_.pixels;
     const size_t at = size_t(ly) * size_t(w_.stride) + size_t(lx);
     zhi = std::min(zhi, 2.0 * double(w_.depth[at]) - 1);
-    if (!(zlo < zhi)) return;
+    if (!(zlo < zhi)) return false;
     form_.ray(x, y, ray_);
     const double fa = ray_.evaluate(zlo), fb = ray_.evaluate(zhi);
-    if (inside(fa) == inside(fb)) return;
+    if (inside(fa) == inside(fb)) return false;
     guess = refineBracket(ray_, zlo, zhi, fa, fb, guess);
-    hit(lx, ly, at, guess);
+    return hit(lx, ly, at, guess);
   }
 
-  void hit(int lx, int ly, size_t at, double z) {
+  // Takes the hit where it is nearer; the pixel's node follows (its ancestors: refreshAbove).
+  bool hit(int lx, int ly, size_t at, double z) {
     if (!takeHit(z, id_, w_.depth[at], w_.object ? w_.object + at : nullptr,
                  w_.cubeZ ? w_.cubeZ + at : nullptr, stats_))
-      return;
+      return false;
     node(0, lx, ly) = w_.depth[at];
-    for (int l = 1; l <= top_; ++l) updateNode(l, lx >> l, ly >> l);
+    return true;
+  }
+
+  // Recomputes the nodes above the window of 2^level pixels at (lx, ly): every node of it at the
+  // levels up to its own, then its single ancestor at each level above.
+  void refreshAbove(int level, int lx, int ly) {
+    for (int l = 1; l <= top_; ++l) {
+      const int span = l <= level ? 1 << (level - l) : 1;
+      for (int y = 0; y < span; ++y)
+        for (int x = 0; x < span; ++x) updateNode(l, (lx >> l) + x, (ly >> l) + y);
+    }
   }
 
   const ProjectedFreeForm& form_;
