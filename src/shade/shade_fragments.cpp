@@ -110,7 +110,10 @@ void TextureCoordinates(const MaterialShading& m, const Fragments& f, TexCoords&
   const size_t lanes = hn::Lanes(df);
   const VF one = hn::Set(df, 1.0f), zero = hn::Zero(df);
   const float width = float(m.texture->level(0).width), height = float(m.texture->level(0).height);
-  // The block's bounding box in level-0 texels, for the prefetch; insane coordinates left out.
+  // The block's bounding box in level-0 texels, for the prefetch (the anisotropic sampler's probes
+  // lie elsewhere: none); only the fragments there are, insane coordinates left out.
+  const bool box = prefetch && !m.anisotropic;
+  const size_t live = size_t(std::clamp(f.count, 0, kMaxFragments));
   const VF big = hn::Set(df, texture::kMaxTexelCoordinate);
   VF xMin = big, yMin = big, xMax = hn::Neg(big), yMax = hn::Neg(big);
   for (size_t i = 0; i < size_t(kMaxFragments); i += lanes) {
@@ -123,9 +126,7 @@ void TextureCoordinates(const MaterialShading& m, const Fragments& f, TexCoords&
     const VF y0 = hn::Sub(hn::Mul(v, hn::Set(df, height)), hn::Set(df, 0.5f));
     hn::Store(x0, df, out.x0 + i);
     hn::Store(y0, df, out.y0 + i);
-    if (prefetch) {
-      // Only the fragments there are, with sane (not NaN) coordinates.
-      const size_t live = size_t(std::clamp(f.count, 0, kMaxFragments));
+    if (box) {
       const auto sane = hn::And(hn::FirstN(df, live > i ? live - i : 0),
                                 hn::And(hn::Le(hn::Abs(x0), big), hn::Le(hn::Abs(y0), big)));
       xMin = hn::Min(xMin, hn::IfThenElse(sane, x0, big));
@@ -150,7 +151,7 @@ void TextureCoordinates(const MaterialShading& m, const Fragments& f, TexCoords&
     hn::Store(l, df, out.lod + i);
   }
   // The texels the samplers will read, requested now (the caller shades a queue's work later).
-  if (prefetch && !m.anisotropic)
+  if (box)
     texture::prefetchBox(*m.texture, m.filter, out.lod[0], hn::GetLane(hn::MinOfLanes(df, xMin)),
                          hn::GetLane(hn::MaxOfLanes(df, xMax)), hn::GetLane(hn::MinOfLanes(df, yMin)),
                          hn::GetLane(hn::MaxOfLanes(df, yMax)));

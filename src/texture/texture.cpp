@@ -36,7 +36,7 @@ PackedTexel packTexel(const Texel& t) {
 }
 
 Color4 unpackTexel(PackedTexel p) {
-  // (code · code) is exact in float; the SIMD samplers do the same two steps (sample_block.cpp).
+  // (code · code) is exact in float; the SIMD samplers do the same two steps (sample_block-inl.h).
   auto colour = [p](int shift) {
     const uint32_t c = p >> shift & 0xFF;
     return float(c * c) * (1.0f / 65025.0f);
