@@ -88,17 +88,23 @@ class ProjectedFreeForm {
   // box meets the surface at most once in it.
   void bound(Interval x, Interval y, Interval z, Interval& value, Interval& slopeZ) const;
   Vec3d toObject(Vec3d q) const { return inverse_.transformPoint(q); }
+  // Which of `count` (1…16) equal slabs of [zlo, zhi] the surface may cross over the box x × y:
+  // holds[s] ⇔ bound(x, y, slab s) contains 0, slab s being [zlo + (zhi − zlo)·s/count,
+  // zlo + (zhi − zlo)·(s + 1)/count]. The same bounds, every slab at once (SIMD, slab_bounds.cpp:
+  // the same operations in the same order, so the same answers on every target).
+  void slabsHolding(Interval x, Interval y, double zlo, double zhi, int count, bool* holds) const;
   // H along the ray (x, y) of the cube, into `out` (its storage reused).
   void ray(double x, double y, RayFunction& out) const;
   const Mat4d& inverse() const { return inverse_; }
 
- private:
   // The quadrics in preorder: a node's perturbations follow it, its subtree ends at `end`.
   struct Node {
     Quadric q;
     double weight;
     uint32_t end;
   };
+
+ private:
   double evaluateNode(uint32_t i, Vec3d q, double invU4) const;
   Interval boundNode(uint32_t i, Interval x, Interval y, Interval z, Interval invU4) const;
   void boundNodeSlope(uint32_t i, Interval x, Interval y, Interval z,

@@ -149,11 +149,6 @@ class Caster {
                              std::max(node(l - 1, 2 * x, 2 * y + 1), node(l - 1, 2 * x + 1, 2 * y + 1)));
   }
 
-  Interval boundOf(Interval x, Interval y, double z0, double z1) {
-    ++stats_.depthTests;
-    return form_.bound(x, y, {z0, z1});
-  }
-
   // The window of 2^level pixels at (lx, ly) (window-local), its cells in depth [zlo, zhi].
   void cell(int level, int lx, int ly, double zlo, double zhi) {
     const int n = 1 << level;
@@ -202,10 +197,8 @@ class Caster {
     // once the front one has filled the window, masking drops the back one whole.
     constexpr int kSlabs = 16;
     bool holds[kSlabs];
-    for (int s = 0; s < kSlabs; ++s) {
-      const double z0 = zlo + (zhi - zlo) * s / kSlabs, z1 = zlo + (zhi - zlo) * (s + 1) / kSlabs;
-      holds[s] = boundOf(x, y, z0, z1).containsZero();
-    }
+    stats_.depthTests += kSlabs;
+    form_.slabsHolding(x, y, zlo, zhi, kSlabs, holds);
     const int h = n / 2;
     for (int s = 0; s < kSlabs;) {
       if (!holds[s]) {

@@ -73,10 +73,11 @@ void FreeFormFrame::markTiles(uint32_t f, int x0, int y0, int size, double zlo, 
   const Interval x{2.0 * x0 / width_ - 1, 2.0 * x1 / width_ - 1};
   const Interval y{1 - 2.0 * y1 / height_, 1 - 2.0 * y0 / height_};
   constexpr int kSlabs = 8;
+  bool holds[kSlabs];
+  forms_[f].projected.slabsHolding(x, y, zlo, zhi, kSlabs, holds);
   int first = -1, last = -1;
   for (int s = 0; s < kSlabs; ++s) {
-    const double z0 = zlo + (zhi - zlo) * s / kSlabs, z1 = zlo + (zhi - zlo) * (s + 1) / kSlabs;
-    if (!forms_[f].projected.bound(x, y, {z0, z1}).containsZero()) continue;
+    if (!holds[s]) continue;
     if (first < 0) first = s;
     last = s;
   }

@@ -1,8 +1,9 @@
 // Quadrics and perturbed quadrics (SPEC §11–§12): the convenience forms against their definitions,
 // the projective transform of a quadric against point evaluation, the five-point projective map,
 // interval bounds containing sampled values (property tests), gradients against differences, and
-// the perturbation's continuity where Q crosses 0.
+// the perturbation's continuity where Q crosses 0; the SIMD slab bounds against the scalar bound.
 #include <gtest/gtest.h>
+#include <hwy/targets.h>
 
 #include <cmath>
 #include <random>
@@ -198,6 +199,50 @@ TEST(Interval, BoundsContainSampledValues) {
       EXPECT_GE(bg.hi, vg);
     }
   }
+}
+
+// The SIMD slab bounds (slab_bounds.cpp) answer as the scalar bound does, slab by slab, on every
+// compiled target — for boxes of every size, a form with a dent, a nested bump and clips, and
+// boxes reaching behind the eye (u ≤ 0), where the bound is everything.
+TEST(Projected, SlabBoundsEqualTheScalarBoundOnEveryTarget) {
+  FreeForm f = bumpySphere();
+  f.clips = {Quadric::halfSpace({0, 1, 0}, 0.7)};
+  std::array<Vec3d, 5> frustum = {
+      Vec3d{-1, -1, 3}, {1, -1, 3}, {-1, 1, 3}, {-5, -5, -1}, {5, 5, -1}};
+  std::array<Vec3d, 5> cube = {Vec3d{-1, -1, -1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}, {1, 1, 1}};
+  const std::optional<ProjectedFreeForm> g =
+      ProjectedFreeForm::make(f, *projectiveFromFivePoints(frustum, cube));
+  ASSERT_TRUE(g);
+  int targets = 0;
+  for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
+    hwy::SetSupportedTargetsForTest(target);
+    ++targets;
+    std::mt19937 rng(6);
+    std::uniform_real_distribution<double> u(0, 1);
+    int held = 0, rejected = 0;
+    for (int trial = 0; trial < 3000; ++trial) {
+      const double size = std::exp2(-u(rng) * 8);
+      const Vec3d lo = randomPoint(rng, 1.1);
+      const Interval x{lo.x, lo.x + size * u(rng)}, y{lo.y, lo.y + size * u(rng)};
+      // Depth ranges reach behind the eye (cube z < −1.75 here is u ≤ 0) in some trials.
+      const double zlo = trial % 10 == 0 ? -3 + u(rng) : lo.z, zhi = zlo + 2 * size * u(rng) + 1e-9;
+      const int count = 1 + trial % 16;
+      bool holds[16];
+      g->slabsHolding(x, y, zlo, zhi, count, holds);
+      for (int s = 0; s < count; ++s) {
+        const Interval z{zlo + (zhi - zlo) * s / count, zlo + (zhi - zlo) * (s + 1) / count};
+        const bool expected = g->bound(x, y, z).containsZero();
+        EXPECT_EQ(holds[s], expected)
+            << hwy::TargetName(target) << " trial " << trial << " slab " << s;
+        (expected ? held : rejected) += 1;
+      }
+    }
+    // Both answers occur often: the comparison is not vacuous.
+    EXPECT_GT(held, 300);
+    EXPECT_GT(rejected, 1000);
+  }
+  hwy::SetSupportedTargetsForTest(0);
+  EXPECT_GE(targets, 1);
 }
 
 // The projected form has the object's surface and inside: H = u²·F' at corresponding points.
