@@ -42,7 +42,13 @@ struct FreeForm {
 //   H(q) = u(q)²·F'(p(q)) = F_M(q) + Σ_i w_i·max(0, H_i(q))³ / u(q)⁴,
 // recursively — the same surface and inside wherever u > 0 (in front of the eye).
 class ProjectedFreeForm;
-struct InversePowers;  // u⁻⁴ and u⁻⁵ over a cell (freeform.cpp)
+struct InversePowers;
+
+// Roots along a ray are refined until their bracket or Newton step is narrower than this (cube
+// depth): float window depth resolves about 6e-8, and 1e-10 of cube depth is under 1e-5 of a
+// pixel's footprint at any depth of BENCH.md's scenes (tests/freeform: within 1e-3 of a cell of
+// the analytic hit).
+inline constexpr double kRootTolerance = 1e-10;  // u⁻⁴ and u⁻⁵ over a cell (freeform.cpp)
 
 // H along one ray of the cube — x and y fixed, z free — where every quadric is a quadratic in z and
 // u is linear: evaluation costs a few operations per quadric, and bounds over a z interval are
@@ -93,6 +99,14 @@ class ProjectedFreeForm {
   // zlo + (zhi − zlo)·(s + 1)/count]. The same bounds, every slab at once (SIMD, slab_bounds.cpp:
   // the same operations in the same order, so the same answers on every target).
   void slabsHolding(Interval x, Interval y, double zlo, double zhi, int count, bool* holds) const;
+  // Rays (x[i], y[i]), i < count ≤ 16, on each of which H has at most one zero in [zlo, zhi[i]]
+  // (a window's bound of ∂H/∂z excludes 0): z[i] is the zero, refined as refineBracket
+  // (raycast.cpp) refines it — safeguarded Newton from `guess` (or the secant point where the
+  // guess lies outside), to kRootTolerance — or NaN where H has one sign at both ends (or
+  // zhi[i] ≤ zlo). Every ray a SIMD lane (window_rays.cpp), each lane on its own, so every target
+  // gives the same z.
+  void monotonicCrossings(const double* x, const double* y, double zlo, const double* zhi,
+                          int count, double guess, double* z) const;
   // H along the ray (x, y) of the cube, into `out` (its storage reused).
   void ray(double x, double y, RayFunction& out) const;
   const Mat4d& inverse() const { return inverse_; }

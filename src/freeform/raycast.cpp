@@ -17,11 +17,6 @@ double windowDepth(double z) { return 0.5 * (z + 1); }
 
 bool inside(double h) { return h >= 0; }
 
-// Brackets are refined until narrower than this (cube depth): float window depth resolves about
-// 6e-8, and 1e-10 of cube depth is under 1e-5 of a pixel's footprint at any depth of BENCH.md's
-// scenes (tests/freeform: within 1e-3 of a cell of the analytic hit).
-constexpr double kRootTolerance = 1e-10;
-
 // Step 3 of a pixel: a bracket [a, b] of the ray where H changes sign (inside(fa) ≠ inside(fb)),
 // narrowed by Newton's method safeguarded by the bracket (a step that leaves it is replaced by
 // the secant point, then by bisection), starting at `guess` when it lies inside (a neighbour's
@@ -177,11 +172,7 @@ class Caster {
       // pixel's node, and the window's ancestors are brought up to date once, after its rays.
       bool hits = false;
       if (!slope.containsZero()) {
-        double guess = std::numeric_limits<double>::quiet_NaN();
-        for (int py = 0; py < n && gy0 + py <= gy1; ++py)
-          for (int px = 0; px < n && gx0 + px <= gx1; ++px)
-            hits |= simplePixel(lx + px, ly + py, cubeX(gx0 + px, w_.width, w_.offsetX),
-                                cubeY(gy0 + py, w_.height, w_.offsetY), zlo, zhi, guess);
+        hits = monotonicWindow(lx, ly, n, gx0, gy0, gx1, gy1, zlo, zhi);
       } else {
         for (int py = 0; py < n && gy0 + py <= gy1; ++py)
           for (int px = 0; px < n && gx0 + px <= gx1; ++px)
@@ -231,18 +222,32 @@ class Caster {
            hit(lx, ly, at, z);
   }
 
-  // A ray with at most one crossing in [zlo, zhi] (the window's slope bound says so). Newton
-  // starts from the previous ray's hit in the window: the surface is coherent.
-  bool simplePixel(int lx, int ly, double x, double y, double zlo, double zhi, double& guess) {
-    ++stats_.pixels;
-    const size_t at = size_t(ly) * size_t(w_.stride) + size_t(lx);
-    zhi = std::min(zhi, 2.0 * double(w_.depth[at]) - 1);
-    if (!(zlo < zhi)) return false;
-    form_.ray(x, y, ray_);
-    const double fa = ray_.evaluate(zlo), fb = ray_.evaluate(zhi);
-    if (inside(fa) == inside(fb)) return false;
-    guess = refineBracket(ray_, zlo, zhi, fa, fb, guess);
-    return hit(lx, ly, at, guess);
+  // The rays of a window of n × n pixels (n ≤ 4) at (lx, ly), raster pixels [gx0, gx1] ×
+  // [gy0, gy1], with at most one crossing each in [zlo, zhi] (the window's slope bound says so):
+  // solved together (ProjectedFreeForm::monotonicCrossings), Newton starting from the last hit
+  // of this form in the tile — the surface is coherent. True if any pixel took a hit.
+  bool monotonicWindow(int lx, int ly, int n, int gx0, int gy0, int gx1, int gy1, double zlo,
+                       double zhi) {
+    double x[16] = {}, y[16] = {}, end[16] = {}, z[16];
+    size_t at[16];
+    int count = 0;
+    for (int py = 0; py < n && gy0 + py <= gy1; ++py)
+      for (int px = 0; px < n && gx0 + px <= gx1; ++px, ++count) {
+        at[count] = size_t(ly + py) * size_t(w_.stride) + size_t(lx + px);
+        x[count] = cubeX(gx0 + px, w_.width, w_.offsetX);
+        y[count] = cubeY(gy0 + py, w_.height, w_.offsetY);
+        end[count] = std::min(zhi, 2.0 * double(w_.depth[at[count]]) - 1);
+      }
+    stats_.pixels += uint64_t(count);
+    form_.monotonicCrossings(x, y, zlo, end, count, guess_, z);
+    bool hits = false;
+    for (int i = 0, py = 0; py < n && gy0 + py <= gy1; ++py)
+      for (int px = 0; px < n && gx0 + px <= gx1; ++px, ++i)
+        if (!std::isnan(z[i]) && hit(lx + px, ly + py, at[i], z[i])) {
+          hits = true;
+          guess_ = z[i];
+        }
+    return hits;
   }
 
   // Takes the hit where it is nearer; the pixel's node follows (its ancestors: refreshAbove).
@@ -272,6 +277,7 @@ class Caster {
   int top_ = 0;
   std::vector<std::vector<float>> zmax_;  // [level][y · (size >> level) + x]
   RayFunction ray_;  // the current pixel's
+  double guess_ = std::numeric_limits<double>::quiet_NaN();  // the last hit (monotonicWindow)
 };
 
 }  // namespace

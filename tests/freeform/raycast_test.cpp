@@ -1,12 +1,17 @@
 // Multi-level ray casting (SPEC §12): hits against analytic ray–quadric intersections for every
 // quadric kind — silhouettes (grazing rays) and a sphere cut by the near plane included — masking
-// on and off giving identical buffers, and the fixed-step marcher agreeing with the caster.
+// on and off giving identical buffers, the fixed-step marcher agreeing with the caster, and the
+// SIMD solver of monotonic windows against analytic roots on every target.
+#include "freeform/raycast.h"
+
 #include <gtest/gtest.h>
+#include <hwy/targets.h>
 
 #include <cmath>
+#include <cstring>
+#include <random>
 #include <vector>
 
-#include "freeform/raycast.h"
 #include "freeform/tessellate.h"
 
 namespace sv::freeform {
@@ -142,6 +147,77 @@ TEST(RayCast, HitsMatchAnalyticRayQuadricIntersectionsForEveryKind) {
     EXPECT_LE(mismatched, 2) << s.name;
     EXPECT_LE(worst, 1e-3) << s.name << ": error in cells";
   }
+}
+
+// ProjectedFreeForm::monotonicCrossings: rays into a sphere, each over the span from the near
+// plane to the middle of its chord (one zero: the entry), give the analytic entry; rays that miss,
+// over the whole depth, give NaN; so do empty spans. Any count of rays, any guess, and the same
+// bits on every compiled target.
+TEST(RayCast, MonotonicCrossingsAreTheEntriesOnEveryTarget) {
+  const int w = 64, h = 64;
+  const Quadric sphere = Quadric::sphere({0.2, -0.1, 0}, 1.2);
+  FreeForm f;
+  f.base = sphere;
+  const Mat4d toCube = cameraToCube(w, h);
+  const auto g = ProjectedFreeForm::make(f, toCube);
+  ASSERT_TRUE(g);
+  std::mt19937 rng(8);
+  std::uniform_int_distribution<int> pixel(0, w - 1);
+  std::vector<double> first;  // every result of the first target, in order
+  int targets = 0;
+  for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
+    hwy::SetSupportedTargetsForTest(target);
+    rng.seed(8);
+    std::vector<double> results;
+    int entries = 0, misses = 0;
+    for (int round = 0; round < 200; ++round) {
+      const int count = 1 + round % 16;
+      double x[16], y[16], zhi[16], z[16], expected[16];
+      for (int i = 0; i < count; ++i) {
+        const int px = pixel(rng), py = pixel(rng);
+        x[i] = 2.0 * (px + 0.5) / w - 1;
+        y[i] = 1 - 2.0 * (py + 0.5) / h;
+        const Vec3d o = g->toObject({x[i], y[i], -1}), d = g->toObject({x[i], y[i], 1}) - o;
+        const double c = sphere.evaluate(o), fp = sphere.evaluate(o + d),
+                     fm = sphere.evaluate(o - d);
+        const double a = 0.5 * (fp + fm) - c, b = 0.5 * (fp - fm), disc = b * b - 4 * a * c;
+        if (disc > 0) {  // F = a·s² + b·s + c, a < 0: entry and exit
+          const double s0 = (-b + std::sqrt(disc)) / (2 * a), s1 = (-b - std::sqrt(disc)) / (2 * a);
+          expected[i] = toCube.transformPoint(o + d * std::min(s0, s1)).z;
+          zhi[i] = toCube.transformPoint(o + d * (0.5 * (s0 + s1))).z;
+          if (i % 5 == 4) zhi[i] = -1, expected[i] = NAN;  // an empty span
+        } else {
+          zhi[i] = 1;
+          expected[i] = NAN;
+        }
+      }
+      const double guess = round % 3 == 0 ? NAN : round % 3 == 1 ? expected[0] : 0.9;
+      g->monotonicCrossings(x, y, -1, zhi, count, guess, z);
+      for (int i = 0; i < count; ++i) {
+        results.push_back(z[i]);
+        if (std::isnan(expected[i])) {
+          EXPECT_TRUE(std::isnan(z[i]))
+              << hwy::TargetName(target) << " round " << round << " ray " << i;
+          ++misses;
+        } else {
+          EXPECT_NEAR(z[i], expected[i], 1e-9)
+              << hwy::TargetName(target) << " round " << round << " ray " << i;
+          ++entries;
+        }
+      }
+    }
+    EXPECT_GT(entries, 300);
+    EXPECT_GT(misses, 200);
+    if (targets++ == 0) {
+      first = results;
+    } else {
+      ASSERT_EQ(results.size(), first.size());
+      EXPECT_EQ(0, std::memcmp(results.data(), first.data(), first.size() * sizeof(double)))
+          << hwy::TargetName(target) << " differs from the first target";
+    }
+  }
+  hwy::SetSupportedTargetsForTest(0);
+  EXPECT_GE(targets, 1);
 }
 
 // A sculpture: masking skips hidden cells but never changes a pixel; the fixed-step marcher finds
