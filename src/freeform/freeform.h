@@ -117,6 +117,8 @@ class ProjectedFreeForm {
     double weight;
     uint32_t end;
   };
+  const std::vector<Node>& nodes() const { return nodes_; }
+  const std::vector<Quadric>& clips() const { return clips_; }
 
  private:
   double evaluateNode(uint32_t i, Vec3d q, double invU4) const;

@@ -14,12 +14,6 @@ namespace {
 using raster::FrameBuffer;
 using raster::kTileSize;
 
-Vec3d apply3(const Mat4d& m, Vec3d v) {  // the 3×3 part
-  return {m.m[0][0] * v.x + m.m[0][1] * v.y + m.m[0][2] * v.z,
-          m.m[1][0] * v.x + m.m[1][1] * v.y + m.m[1][2] * v.z,
-          m.m[2][0] * v.x + m.m[2][1] * v.y + m.m[2][2] * v.z};
-}
-
 }  // namespace
 
 void FreeFormFrame::prepare(std::vector<ShadedForm> forms, int width, int height, int samples,
@@ -27,6 +21,9 @@ void FreeFormFrame::prepare(std::vector<ShadedForm> forms, int width, int height
                             const shade::Environment* environment, const CastSettings& settings,
                             int marchSteps) {
   forms_ = std::move(forms);
+  surfaces_.clear();
+  for (const ShadedForm& f : forms_)
+    surfaces_.emplace_back(f.form, f.projected.inverse(), f.objectToEye, f.normalToEye);
   width_ = width;
   height_ = height;
   samples_ = samples;
@@ -255,7 +252,8 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
   }
 
   // Step 2: shading, once per pixel and form that took some of its samples — at the first such
-  // sample's hit (the centre with one sample) — 16 fragments of one form to a call.
+  // sample's hit (the centre with one sample) — 16 fragments of one form to a call; their surface
+  // points and normals 16 at a time (SurfacePoints).
   for (uint32_t f : listed) {
     const ShadedForm& form = forms_[f];
     std::vector<Scratch::Pending>& pending = scratch.pending;
@@ -270,33 +268,50 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
     // Textured forms are shaded a pixel at a time: each has its own footprint (Fragments carries
     // one gradient per call — a triangle's, constant over it).
     const bool textured = form.material.texture != nullptr;
-    const size_t batch = textured ? 1 : shade::kMaxFragments;
-    for (size_t begin = 0; begin < pending.size(); begin += batch) {
-      const int count = int(std::min<size_t>(batch, pending.size() - begin));
-      shade::Fragments frag;
-      frag.count = count;
+    for (size_t begin = 0; begin < pending.size(); begin += shade::kMaxFragments) {
+      const int count = int(std::min<size_t>(shade::kMaxFragments, pending.size() - begin));
+      // Per fragment: its sample's raster position and cube point.
+      double sx[shade::kMaxFragments], sy[shade::kMaxFragments];
+      double qx[shade::kMaxFragments], qy[shade::kMaxFragments], qz[shade::kMaxFragments];
       for (int i = 0; i < count; ++i) {
         const Scratch::Pending& p = pending[begin + size_t(i)];
-        const size_t at = plane * size_t(p.sample) + size_t(p.ly * kTileSize + p.lx);
-        const double sx = ox + p.lx + 0.5 + offsetX_[p.sample];
-        const double sy = oy + p.ly + 0.5 + offsetY_[p.sample];
-        const Vec3d q{2.0 * sx / width_ - 1, 1 - 2.0 * sy / height_, scratch.cubeZ[at]};
-        const Vec3d point = form.projected.toObject(q);
-        const Vec3d gradient = form.form.gradient(point);
-        // Inside is F ≥ 0, so the outward normal is −∇F.
-        const Vec3d n = normalize(apply3(form.normalToEye, gradient * -1.0));
-        const Vec3d eye = form.objectToEye.transformPoint(point);
-        frag.q[i] = 1;  // attributes are given as themselves (w = 1)
-        for (int ch = 0; ch < 3; ++ch) frag.color[ch][i] = form.color[ch];
-        frag.attribute[shade::kU][i] = float(point.x * form.uvScale[0]);
-        frag.attribute[shade::kV][i] = float(point.z * form.uvScale[1]);
+        sx[i] = ox + p.lx + 0.5 + offsetX_[p.sample];
+        sy[i] = oy + p.ly + 0.5 + offsetY_[p.sample];
+        qx[i] = 2.0 * sx[i] / width_ - 1;
+        qy[i] = 1 - 2.0 * sy[i] / height_;
+        qz[i] = scratch.cubeZ[plane * size_t(p.sample) + size_t(p.ly * kTileSize + p.lx)];
+      }
+      SurfaceLanes& hit = scratch.surface;
+      surfaces_[f].at(qx, qy, qz, count, hit);
+      const int per = textured ? 1 : count;
+      for (int first = 0; first < count; first += per) {
+        shade::Fragments frag;
+        frag.count = per;
+        for (int j = 0; j < per; ++j) {
+          const int i = first + j;
+          frag.q[j] = 1;  // attributes are given as themselves (w = 1)
+          for (int ch = 0; ch < 3; ++ch) frag.color[ch][j] = form.color[ch];
+          frag.attribute[shade::kU][j] = float(hit.point[0][i] * form.uvScale[0]);
+          frag.attribute[shade::kV][j] = float(hit.point[2][i] * form.uvScale[1]);
+          frag.attribute[shade::kNormalX][j] = float(hit.normal[0][i]);
+          frag.attribute[shade::kNormalY][j] = float(hit.normal[1][i]);
+          frag.attribute[shade::kNormalZ][j] = float(hit.normal[2][i]);
+          frag.attribute[shade::kEyeX][j] = float(hit.eye[0][i]);
+          frag.attribute[shade::kEyeY][j] = float(hit.eye[1][i]);
+          frag.attribute[shade::kEyeZ][j] = float(hit.eye[2][i]);
+          frag.attribute[shade::kAlpha][j] = 1;
+        }
         if (textured) {
-          // The footprint (SPEC §7): where the next pixel's rays, right and down, meet the tangent
-          // plane at the hit — the texture coordinates' derivatives per pixel.
+          // The footprint (SPEC §7): where the next pixel's rays, right and down, meet the
+          // tangent plane at the hit — the texture coordinates' derivatives per pixel.
+          const Vec3d point{hit.point[0][first], hit.point[1][first], hit.point[2][first]};
+          const Vec3d gradient{hit.gradient[0][first], hit.gradient[1][first],
+                               hit.gradient[2][first]};
+          const double z = qz[first];
           auto onTangentPlane = [&](double px, double py, double& u, double& v) {
-            const Vec3d a = form.projected.toObject({2 * px / width_ - 1, 1 - 2 * py / height_, q.z});
+            const Vec3d a = form.projected.toObject({2 * px / width_ - 1, 1 - 2 * py / height_, z});
             const Vec3d b = form.projected.toObject(
-                {2 * px / width_ - 1, 1 - 2 * py / height_, std::min(1.0, q.z + 1e-3 * (1 - q.z))});
+                {2 * px / width_ - 1, 1 - 2 * py / height_, std::min(1.0, z + 1e-3 * (1 - z))});
             const double den = dot(gradient, b - a);
             const double t = std::fabs(den) > 1e-300 ? dot(gradient, point - a) / den : 0;
             const Vec3d x = a + (b - a) * std::clamp(t, -1e6, 1e6);
@@ -304,35 +319,28 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
             v = x.z * form.uvScale[1];
           };
           double ux, vx, uy, vy;
-          onTangentPlane(sx + 1, sy, ux, vx);
-          onTangentPlane(sx, sy + 1, uy, vy);
+          onTangentPlane(sx[first] + 1, sy[first], ux, vx);
+          onTangentPlane(sx[first], sy[first] + 1, uy, vy);
           frag.udx = float(ux - point.x * form.uvScale[0]);
           frag.vdx = float(vx - point.z * form.uvScale[1]);
           frag.udy = float(uy - point.x * form.uvScale[0]);
           frag.vdy = float(vy - point.z * form.uvScale[1]);
         }
-        frag.attribute[shade::kNormalX][i] = float(n.x);
-        frag.attribute[shade::kNormalY][i] = float(n.y);
-        frag.attribute[shade::kNormalZ][i] = float(n.z);
-        frag.attribute[shade::kEyeX][i] = float(eye.x);
-        frag.attribute[shade::kEyeY][i] = float(eye.y);
-        frag.attribute[shade::kEyeZ][i] = float(eye.z);
-        frag.attribute[shade::kAlpha][i] = 1;
-      }
-      float out[4][shade::kMaxFragments];
-      shade::shadeFragments(form.material, *environment_, frag, out);
-      // Step 3: depth and colour to every sample of the pixel this form took.
-      for (int i = 0; i < count; ++i) {
-        const Scratch::Pending& p = pending[begin + size_t(i)];
-        uint16_t c16[3];
-        for (int ch = 0; ch < 3; ++ch)
-          c16[ch] = uint16_t(std::lrint(std::clamp(out[ch][i], 0.0f, 1.0f) * 65535.0f));
-        for (int k = p.sample; k < s; ++k) {
-          const size_t at = plane * size_t(k) + size_t(p.ly * kTileSize + p.lx);
-          if (scratch.object[at] != f) continue;
-          depth[FrameBuffer::depthOffset(p.lx, p.ly, s, k)] = scratch.depth[at];
+        float out[4][shade::kMaxFragments];
+        shade::shadeFragments(form.material, *environment_, frag, out);
+        // Step 3: depth and colour to every sample of the pixel this form took.
+        for (int j = 0; j < per; ++j) {
+          const Scratch::Pending& p = pending[begin + size_t(first + j)];
+          uint16_t c16[3];
           for (int ch = 0; ch < 3; ++ch)
-            color[FrameBuffer::colorOffset(p.lx, p.ly, ch, s, k)] = c16[ch];
+            c16[ch] = uint16_t(std::lrint(std::clamp(out[ch][j], 0.0f, 1.0f) * 65535.0f));
+          for (int k = p.sample; k < s; ++k) {
+            const size_t at = plane * size_t(k) + size_t(p.ly * kTileSize + p.lx);
+            if (scratch.object[at] != f) continue;
+            depth[FrameBuffer::depthOffset(p.lx, p.ly, s, k)] = scratch.depth[at];
+            for (int ch = 0; ch < 3; ++ch)
+              color[FrameBuffer::colorOffset(p.lx, p.ly, ch, s, k)] = c16[ch];
+          }
         }
       }
     }

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "freeform/raycast.h"
+#include "freeform/surface_points.h"
 #include "shade/shading.h"
 
 namespace sv::freeform {
@@ -57,6 +58,7 @@ class FreeFormFrame {
       int lx, ly, sample;
     };
     std::vector<Pending> pending;
+    SurfaceLanes surface;
   };
 
   // Casts the forms listed for tile (tileX, tileY) into its buffers — `samples` depth and colour
@@ -69,6 +71,7 @@ class FreeFormFrame {
   void markTiles(uint32_t form, int x0, int y0, int size, double zlo, double zhi);
 
   std::vector<ShadedForm> forms_;
+  std::vector<SurfacePoints> surfaces_;  // per form: its hits' points and normals
   int width_ = 0, height_ = 0, samples_ = 1, tilesX_ = 0, tilesY_ = 0;
   double offsetX_[64] = {}, offsetY_[64] = {};  // sample offsets from the pixel centre, pixels
   const shade::Environment* environment_ = nullptr;

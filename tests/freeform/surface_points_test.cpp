@@ -1,0 +1,83 @@
+// SurfacePoints (SPEC §12, the leaf's point and normal): the SIMD lanes give what the scalar
+// transformPoint, FreeForm::gradient and normalize give, bit for bit, on every compiled target —
+// for a form with a dent, a nested bump and clips (whose gradient is the active term's).
+#include "freeform/surface_points.h"
+
+#include <gtest/gtest.h>
+#include <hwy/targets.h>
+
+#include <cmath>
+#include <random>
+
+namespace sv::freeform {
+namespace {
+
+TEST(SurfacePoints, LanesEqualTheScalarFormulasOnEveryTarget) {
+  FreeForm f;
+  f.base = Quadric::sphere({0, 0, 0}, 1);
+  FreeForm bump, inner, dent;
+  bump.base = Quadric::sphere({0.9, 0, 0}, 0.5);
+  inner.base = Quadric::ellipsoid({1.1, 0.2, 0}, {0.3, 0.2, 0.25});
+  bump.perturbations.push_back(inner);
+  dent.base = Quadric::cylinder({0, 0.8, 0}, {0, 0, 1}, 0.3);
+  dent.weight = -4;
+  f.perturbations = {bump, dent};
+  f.clips = {Quadric::halfSpace({0, 1, 0}, 0.5)};
+  // Cube → object: a perspective frustum's inverse; object → eye: a rotation and a shift.
+  std::array<Vec3d, 5> frustum = {
+      Vec3d{-1, -1, 3}, {1, -1, 3}, {-1, 1, 3}, {-5, -5, -1}, {5, 5, -1}};
+  std::array<Vec3d, 5> cube = {Vec3d{-1, -1, -1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}, {1, 1, 1}};
+  const Mat4d toCube = *projectiveFromFivePoints(frustum, cube);
+  const Mat4d cubeToObject = *toCube.inverse();
+  Mat4d toEye;
+  toEye.m = {{{0.8, 0, 0.6, 0.5}, {0, 1, 0, -0.2}, {-0.6, 0, 0.8, -4}, {0, 0, 0, 1}}};
+  const Mat4d normalToEye = toEye.inverse()->transposed();
+  const SurfacePoints surface(f, cubeToObject, toEye, normalToEye);
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(-1.3, 1.3);
+  int targets = 0, clipped = 0, bumped = 0;
+  for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
+    hwy::SetSupportedTargetsForTest(target);
+    ++targets;
+    for (int round = 0; round < 300; ++round) {
+      const int count = 1 + round % 16;
+      double x[16], y[16], z[16];
+      for (int i = 0; i < count; ++i) {  // the cube points of object points about the form
+        const Vec3d q = toCube.transformPoint({u(rng), u(rng), u(rng)});
+        x[i] = q.x, y[i] = q.y, z[i] = q.z;
+      }
+      SurfaceLanes out;
+      surface.at(x, y, z, count, out);
+      for (int i = 0; i < count; ++i) {
+        const Vec3d p = cubeToObject.transformPoint({x[i], y[i], z[i]});
+        const Vec3d g = f.gradient(p);
+        const Vec3d m = g * -1.0;
+        const Vec3d n = normalize(
+            {normalToEye.m[0][0] * m.x + normalToEye.m[0][1] * m.y + normalToEye.m[0][2] * m.z,
+             normalToEye.m[1][0] * m.x + normalToEye.m[1][1] * m.y + normalToEye.m[1][2] * m.z,
+             normalToEye.m[2][0] * m.x + normalToEye.m[2][1] * m.y + normalToEye.m[2][2] * m.z});
+        const Vec3d e = toEye.transformPoint(p);
+        const Vec3d want[4] = {p, g, n, e};
+        const double(*got[4])[16] = {out.point, out.gradient, out.normal, out.eye};
+        for (int k = 0; k < 4; ++k) {
+          EXPECT_EQ(got[k][0][i], want[k].x)
+              << hwy::TargetName(target) << " " << k << " lane " << i;
+          EXPECT_EQ(got[k][1][i], want[k].y)
+              << hwy::TargetName(target) << " " << k << " lane " << i;
+          EXPECT_EQ(got[k][2][i], want[k].z)
+              << hwy::TargetName(target) << " " << k << " lane " << i;
+        }
+        clipped += f.clips[0].evaluate(p) < f.base.evaluate(p) ? 1 : 0;
+        bumped += bump.evaluate(p) > 0 ? 1 : 0;
+      }
+    }
+  }
+  hwy::SetSupportedTargetsForTest(0);
+  EXPECT_GE(targets, 1);
+  // The clip's gradient and the perturbations' terms were both exercised.
+  EXPECT_GT(clipped, 50 * targets);
+  EXPECT_GT(bumped, 20 * targets);
+}
+
+}  // namespace
+}  // namespace sv::freeform
