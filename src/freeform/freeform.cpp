@@ -257,14 +257,6 @@ double RayFunction::evaluate(double z) const {
   return h;
 }
 
-Interval RayFunction::boundNode(uint32_t i, Interval z, Interval invU4) const {
-  const Node& n = nodes_[i];
-  Interval h = quadraticRange(n.a, n.b, n.c, z);
-  for (uint32_t c = i + 1; c < n.end; c = nodes_[c].end)
-    h = h + cube(positivePart(boundNode(c, z, invU4))) * invU4 * nodes_[c].weight;
-  return h;
-}
-
 void RayFunction::boundNodeSlope(uint32_t i, Interval z, const InversePowers& inv,
                                  Interval& value, Interval& slope) const {
   const Node& n = nodes_[i];
@@ -289,15 +281,6 @@ void RayFunction::bound(double z0, double z1, Interval& value, Interval& slope) 
                 z * (2 * c.a) + c.b, value, slope);
   value = widened(value);
   slope = widened(slope);
-}
-
-Interval RayFunction::bound(double z0, double z1) const {
-  const Interval z{z0, z1}, u = z * u1_ + u0_;
-  if (!(u.lo > 0)) return {-kInf, kInf};
-  Interval h = boundNode(0, z, inversePowers(u).u4);
-  for (const Node& c : clips_)
-    h = minimum(h, quadraticRange(c.a, c.b, c.c, z));
-  return widened(h);
 }
 
 }  // namespace sv::freeform

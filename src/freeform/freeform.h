@@ -57,9 +57,8 @@ class RayFunction {
  public:
   double evaluate(double z) const;
   double evaluate(double z, double& slope) const;  // and dH/dz there (Newton's method)
-  Interval bound(double z0, double z1) const;  // contains H over [z0, z1], widened for rounding
-  // The same bound, and one of dH/dz over [z0, z1]: where the slope excludes 0, H is monotonic
-  // there and has at most one zero.
+  // A range containing H over [z0, z1], and one of dH/dz there, widened for rounding: where the
+  // slope excludes 0, H is monotonic there and has at most one zero.
   void bound(double z0, double z1, Interval& value, Interval& slope) const;
   // Cube depth ↔ eye depth along this ray: t = 1/u(z), u linear in z (ProjectedFreeForm).
   double eyeDepth(double z) const { return 1 / (u0_ + u1_ * z); }
@@ -73,7 +72,6 @@ class RayFunction {
   };
   double evaluateNode(uint32_t i, double z, double invU4) const;
   double evaluateNode(uint32_t i, double z, double invU4, double du4, double& slope) const;
-  Interval boundNode(uint32_t i, Interval z, Interval invU4) const;
   void boundNodeSlope(uint32_t i, Interval z, const InversePowers& inv, Interval& value,
                       Interval& slope) const;
   std::vector<Node> nodes_;

@@ -254,17 +254,30 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
   // Step 2: shading, once per pixel and form that took some of its samples — at the first such
   // sample's hit (the centre with one sample) — 16 fragments of one form to a call; their surface
   // points and normals 16 at a time (SurfacePoints).
-  for (uint32_t f : listed) {
+  // The pixels to shade, per listed form (by its place in the list), in one pass over the tile.
+  scratch.pending.resize(std::max(scratch.pending.size(), listed.size()));
+  scratch.place.resize(forms_.size());
+  scratch.lastPixel.assign(listed.size(), -1);
+  for (size_t i = 0; i < listed.size(); ++i) {
+    scratch.pending[i].clear();
+    scratch.place[listed[i]] = uint32_t(i);
+  }
+  for (int ly = 0; ly < kTileSize && oy + ly < height_; ++ly)
+    for (int lx = 0; lx < kTileSize && ox + lx < width_; ++lx) {
+      const int p = ly * kTileSize + lx;
+      for (int k = 0; k < s; ++k) {
+        const uint32_t o = scratch.object[plane * size_t(k) + size_t(p)];
+        if (o == kNoHit) continue;
+        const uint32_t i = scratch.place[o];
+        if (scratch.lastPixel[i] == p) continue;  // shaded at an earlier sample of the pixel
+        scratch.lastPixel[i] = p;
+        scratch.pending[i].push_back({lx, ly, k});
+      }
+    }
+  for (size_t place = 0; place < listed.size(); ++place) {
+    const uint32_t f = listed[place];
     const ShadedForm& form = forms_[f];
-    std::vector<Scratch::Pending>& pending = scratch.pending;
-    pending.clear();
-    for (int ly = 0; ly < kTileSize && oy + ly < height_; ++ly)
-      for (int lx = 0; lx < kTileSize && ox + lx < width_; ++lx)
-        for (int k = 0; k < s; ++k)
-          if (scratch.object[plane * size_t(k) + size_t(ly * kTileSize + lx)] == f) {
-            pending.push_back({lx, ly, k});
-            break;
-          }
+    const std::vector<Scratch::Pending>& pending = scratch.pending[place];
     // Textured forms are shaded a pixel at a time: each has its own footprint (Fragments carries
     // one gradient per call — a triangle's, constant over it).
     const bool textured = form.material.texture != nullptr;

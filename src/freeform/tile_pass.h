@@ -57,7 +57,9 @@ class FreeFormFrame {
     struct Pending {  // a pixel to shade, and its first sample the form took
       int lx, ly, sample;
     };
-    std::vector<Pending> pending;
+    std::vector<std::vector<Pending>> pending;  // per listed form
+    std::vector<uint32_t> place;                // per form: its place in the tile's list
+    std::vector<int> lastPixel;                 // per listed form: the last pixel pending
     SurfaceLanes surface;
   };
 
