@@ -105,6 +105,14 @@ class ProjectedFreeForm {
   // gives the same z.
   void monotonicCrossings(const double* x, const double* y, double zlo, const double* zhi,
                           int count, double guess, double* z) const;
+  // The same for rays whose H may turn in [zlo, zhi[i]] (a window's slope bound holds 0): each
+  // ray's span is cut at `pieces` equal steps of [zlo, max zhi] and taken front to back; the
+  // ray's own bound (RayFunction::bound) over a piece rejects it, or says H is monotonic there
+  // — a crossing, if the ends differ in sign, is z[i] — or neither: from[i] is where that
+  // piece begins, for the ray's own subdivision (firstCrossing in raycast.cpp) to go on, and
+  // z[i] NaN. z[i] and from[i] both NaN: no crossing. Returns the number of ray bounds made.
+  int piecewiseCrossings(const double* x, const double* y, double zlo, const double* zhi, int count,
+                         int pieces, double guess, double* z, double* from) const;
   // H along the ray (x, y) of the cube, into `out` (its storage reused).
   void ray(double x, double y, RayFunction& out) const;
   const Mat4d& inverse() const { return inverse_; }

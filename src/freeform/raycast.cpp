@@ -111,6 +111,10 @@ bool firstCrossing(const RayFunction& ray, double zlo, double zhi, double hint, 
 
 // Windows of 2^kRayLevel pixels and less are cast ray by ray.
 constexpr int kRayLevel = 2;
+// Rays whose H may turn (Caster::rayWindow) take their spans in this many pieces (measured on
+// BENCH.md's freeform / freeform-one against 8: 2 pieces ×1.13 / ×1.10 slower, 4 ×1.01 / ×1.03,
+// 16 ×1.10 / ×1.03).
+constexpr int kPieces = 8;
 
 class Caster {
  public:
@@ -170,16 +174,8 @@ class Caster {
       if (!value.containsZero()) return;
       // The rays read their own pixels' depths, never the masking pyramid: a hit writes its
       // pixel's node, and the window's ancestors are brought up to date once, after its rays.
-      bool hits = false;
-      if (!slope.containsZero()) {
-        hits = monotonicWindow(lx, ly, n, gx0, gy0, gx1, gy1, zlo, zhi);
-      } else {
-        for (int py = 0; py < n && gy0 + py <= gy1; ++py)
-          for (int px = 0; px < n && gx0 + px <= gx1; ++px)
-            hits |= pixel(lx + px, ly + py, cubeX(gx0 + px, w_.width, w_.offsetX),
-                          cubeY(gy0 + py, w_.height, w_.offsetY), zlo, zhi);
-      }
-      if (hits) refreshAbove(level, lx, ly);
+      if (rayWindow(lx, ly, n, gx0, gy0, gx1, gy1, zlo, zhi, !slope.containsZero()))
+        refreshAbove(level, lx, ly);
       return;
     }
     // Step 2: the binary tree in depth, four levels deep: of sixteen slabs, those whose bound may
@@ -206,29 +202,16 @@ class Caster {
     }
   }
 
-  // One pixel's ray: the first zero of H in [zlo, zhi] nearer than the depth it holds — the binary
-  // tree in depth on the ray's own function (RayFunction: exact per-quadric bounds), front to
-  // back; a span where H is monotonic (its slope bound excludes 0) holds at most one zero, found
-  // by refineBracket when its ends differ in sign; others are halved down to kBracket.
-  // True if the pixel took a hit.
-  bool pixel(int lx, int ly, double x, double y, double zlo, double zhi) {
-    ++stats_.pixels;
-    const size_t at = size_t(ly) * size_t(w_.stride) + size_t(lx);
-    zhi = std::min(zhi, 2.0 * double(w_.depth[at]) - 1);
-    if (!(zlo < zhi)) return false;
-    form_.ray(x, y, ray_);
-    double z;
-    return firstCrossing(ray_, zlo, zhi, std::numeric_limits<double>::quiet_NaN(), z, stats_) &&
-           hit(lx, ly, at, z);
-  }
-
   // The rays of a window of n × n pixels (n ≤ 4) at (lx, ly), raster pixels [gx0, gx1] ×
-  // [gy0, gy1], with at most one crossing each in [zlo, zhi] (the window's slope bound says so):
-  // solved together (ProjectedFreeForm::monotonicCrossings), Newton starting from the last hit
-  // of this form in the tile — the surface is coherent. True if any pixel took a hit.
-  bool monotonicWindow(int lx, int ly, int n, int gx0, int gy0, int gx1, int gy1, double zlo,
-                       double zhi) {
-    double x[16] = {}, y[16] = {}, end[16] = {}, z[16];
+  // [gy0, gy1], over [zlo, zhi], solved together, Newton starting from the last hit of this form
+  // in the tile (the surface is coherent). `monotonic`: the window's slope bound says each ray
+  // crosses at most once (ProjectedFreeForm::monotonicCrossings). Otherwise — silhouettes, mostly
+  // — the rays' spans are taken in pieces, each ray bounding its own (piecewiseCrossings), and
+  // a ray whose H may turn within a piece goes on alone from there (firstCrossing). True if any
+  // pixel took a hit.
+  bool rayWindow(int lx, int ly, int n, int gx0, int gy0, int gx1, int gy1, double zlo, double zhi,
+                 bool monotonic) {
+    double x[16] = {}, y[16] = {}, end[16] = {}, z[16], from[16];
     size_t at[16];
     int count = 0;
     for (int py = 0; py < n && gy0 + py <= gy1; ++py)
@@ -239,7 +222,19 @@ class Caster {
         end[count] = std::min(zhi, 2.0 * double(w_.depth[at[count]]) - 1);
       }
     stats_.pixels += uint64_t(count);
-    form_.monotonicCrossings(x, y, zlo, end, count, guess_, z);
+    if (monotonic) {
+      form_.monotonicCrossings(x, y, zlo, end, count, guess_, z);
+    } else {
+      stats_.depthTests +=
+          uint64_t(form_.piecewiseCrossings(x, y, zlo, end, count, kPieces, guess_, z, from));
+      for (int i = 0; i < count; ++i)
+        if (!std::isnan(from[i])) {
+          form_.ray(x[i], y[i], ray_);
+          if (!firstCrossing(ray_, from[i], end[i], std::numeric_limits<double>::quiet_NaN(), z[i],
+                             stats_))
+            z[i] = std::numeric_limits<double>::quiet_NaN();
+        }
+    }
     bool hits = false;
     for (int i = 0, py = 0; py < n && gy0 + py <= gy1; ++py)
       for (int px = 0; px < n && gx0 + px <= gx1; ++px, ++i)

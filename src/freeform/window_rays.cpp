@@ -28,6 +28,10 @@ using MD = hn::Mask<DD>;
 
 // The lanes' rays: per quadric (the nodes, then the clips) its b and c along z (alongZ in
 // freeform.cpp; a is the quadric's own C), and u = u0 + u1·z.
+struct Lanes {  // an Interval per lane
+  VD lo, hi;
+};
+
 struct Rays {
   const ProjectedFreeForm::Node* nodes;
   const Quadric* clips;
@@ -85,87 +89,252 @@ HWY_INLINE VD Secant(VD a, VD b, VD fa, VD fb) {
 }
 HWY_INLINE MD Within(VD z, VD a, VD b) { return hn::And(hn::Gt(z, a), hn::Lt(z, b)); }
 
-void MonotonicCrossings(const ProjectedFreeForm::Node* nodes, const Quadric* clips,
-                        size_t clipCount, const double* w, const double* x, const double* y,
-                        double zlo, const double* zhi, int count, double guess, double* out) {
-  const DD d;
-  const size_t n = hn::Lanes(d);
-  const size_t quadrics = nodes[0].end + clipCount;
-  // Per thread, grown as needed; aligned to the vectors (padded by one line and rounded up).
+// quadraticRange (quadric.h) of a·z² + b·z + c over the lanes' [zA, zB], b and c per lane.
+HWY_INLINE Lanes QuadraticRange(DD d, double a, VD b, VD c, VD zA, VD zB) {
+  const VD va = hn::Set(d, a);
+  const auto f = [&](VD v) { return hn::Add(hn::Mul(hn::Add(hn::Mul(va, v), b), v), c); };
+  const VD fA = f(zA), fB = f(zB);
+  VD lo = hn::Min(fA, fB), hi = hn::Max(fA, fB);
+  if (a != 0) {
+    const VD vertex = hn::Div(hn::Neg(b), hn::Set(d, 2 * a));
+    const MD within = hn::And(hn::Lt(zA, vertex), hn::Lt(vertex, zB));
+    const VD fv = f(vertex);
+    lo = hn::IfThenElse(within, hn::Min(lo, fv), lo);
+    hi = hn::IfThenElse(within, hn::Max(hi, fv), hi);
+  }
+  return {lo, hi};
+}
+
+// Interval arithmetic per lane (quadric.h's operators).
+HWY_INLINE Lanes Scale(DD d, const Lanes& a, double s) {
+  const VD v = hn::Set(d, s);
+  return s >= 0 ? Lanes{hn::Mul(a.lo, v), hn::Mul(a.hi, v)}
+                : Lanes{hn::Mul(a.hi, v), hn::Mul(a.lo, v)};
+}
+HWY_INLINE Lanes Sum(const Lanes& a, const Lanes& b) {
+  return {hn::Add(a.lo, b.lo), hn::Add(a.hi, b.hi)};
+}
+HWY_INLINE Lanes Product(const Lanes& a, const Lanes& b) {
+  const VD p0 = hn::Mul(a.lo, b.lo), p1 = hn::Mul(a.lo, b.hi);
+  const VD p2 = hn::Mul(a.hi, b.lo), p3 = hn::Mul(a.hi, b.hi);
+  return {hn::Min(hn::Min(p0, p1), hn::Min(p2, p3)), hn::Max(hn::Max(p0, p1), hn::Max(p2, p3))};
+}
+HWY_INLINE MD ContainsZero(DD d, const Lanes& a) {
+  return hn::And(hn::Le(a.lo, hn::Zero(d)), hn::Ge(a.hi, hn::Zero(d)));
+}
+HWY_INLINE Lanes Widened(DD d, const Lanes& h) {  // freeform.cpp's widened
+  const VD margin = hn::Add(hn::Mul(hn::Set(d, 1e-12), hn::Add(hn::Abs(h.lo), hn::Abs(h.hi))),
+                            hn::Set(d, 1e-300));
+  return {hn::Sub(h.lo, margin), hn::Add(h.hi, margin)};
+}
+
+// RayFunction::boundNodeSlope for the lanes' [zA, zB], with freeform.cpp's addPerturbation.
+void NodeBoundSlope(DD d, const Rays& r, uint32_t i, const Lanes& z, const Lanes& u4,
+                    const Lanes& u5, Lanes& value, Lanes& slope) {
+  const double a = r.nodes[i].q.c[2];
+  const VD b = r.b(i, d);
+  value = QuadraticRange(d, a, b, r.c(i, d), z.lo, z.hi);
+  const Lanes s = Scale(d, z, 2 * a);
+  slope = {hn::Add(s.lo, b), hn::Add(s.hi, b)};
+  const VD zero = hn::Zero(d);
+  for (uint32_t c = i + 1; c < r.nodes[i].end; c = r.nodes[c].end) {
+    Lanes v, dv;
+    NodeBoundSlope(d, r, c, z, u4, u5, v, dv);
+    const double w = r.nodes[c].weight;
+    // w·max(0, v)³·u⁻⁴, and its slope w·(3p²·p'·u⁻⁴ − 4p³·u'·u⁻⁵).
+    const Lanes p{hn::Max(v.lo, zero), hn::Max(v.hi, zero)};
+    const MD active = hn::Gt(p.hi, zero);
+    const Lanes dp{hn::IfThenElseZero(active, dv.lo), hn::IfThenElseZero(active, dv.hi)};
+    const Lanes cube{hn::Mul(hn::Mul(p.lo, p.lo), p.lo), hn::Mul(hn::Mul(p.hi, p.hi), p.hi)};
+    const Lanes square{hn::Mul(p.lo, p.lo), hn::Mul(p.hi, p.hi)};  // exact: p ≥ 0
+    value = Sum(value, Scale(d, Product(cube, u4), w));
+    slope = Sum(slope, Scale(d,
+                             Sum(Scale(d, Product(Product(square, dp), u4), 3),
+                                 Scale(d, Product(cube, u5), -4 * r.u1)),
+                             w));
+  }
+}
+
+// RayFunction::bound(value, slope) over the lanes' [zA, zB]; false lanes: u ≤ 0 somewhere (behind
+// the eye), where the bound is everything.
+MD BoundLanes(DD d, const Rays& r, const Lanes& z, Lanes& value, Lanes& slope) {
+  const Lanes zu = Scale(d, z, r.u1);
+  const Lanes u{hn::Add(zu.lo, r.u0), hn::Add(zu.hi, r.u0)};
+  const VD one = hn::Set(d, 1.0), lo2 = hn::Mul(u.lo, u.lo), hi2 = hn::Mul(u.hi, u.hi);
+  const Lanes u4{hn::Div(one, hn::Mul(hi2, hi2)), hn::Div(one, hn::Mul(lo2, lo2))};
+  const Lanes u5{hn::Div(one, hn::Mul(hn::Mul(hi2, hi2), u.hi)),
+                 hn::Div(one, hn::Mul(hn::Mul(lo2, lo2), u.lo))};
+  NodeBoundSlope(d, r, 0, z, u4, u5, value, slope);
+  const size_t nodeCount = r.nodes[0].end;
+  for (size_t k = 0; k < r.clipCount; ++k) {  // freeform.cpp's takeMinimum
+    const double a = r.clips[k].c[2];
+    const VD b = r.b(nodeCount + k, d);
+    const Lanes clip = QuadraticRange(d, a, b, r.c(nodeCount + k, d), z.lo, z.hi);
+    const Lanes s = Scale(d, z, 2 * a);
+    const Lanes clipSlope{hn::Add(s.lo, b), hn::Add(s.hi, b)};
+    const MD below = hn::Lt(clip.hi, value.lo);
+    const MD overlap = hn::AndNot(below, hn::Le(clip.lo, value.hi));
+    slope = {hn::IfThenElse(below, clipSlope.lo,
+                            hn::IfThenElse(overlap, hn::Min(slope.lo, clipSlope.lo), slope.lo)),
+             hn::IfThenElse(below, clipSlope.hi,
+                            hn::IfThenElse(overlap, hn::Max(slope.hi, clipSlope.hi), slope.hi))};
+    value = {hn::Min(value.lo, clip.lo), hn::Min(value.hi, clip.hi)};
+  }
+  value = Widened(d, value);
+  slope = Widened(d, slope);
+  return hn::Gt(u.lo, hn::Zero(d));
+}
+
+// Per-thread storage for the lanes' coefficients, aligned to the vectors.
+double* CoefficientStorage(size_t doubles) {
   thread_local std::vector<double> storage;
-  storage.resize(2 * quadrics * n + 8);
-  double* const coefficients = reinterpret_cast<double*>(
-      (reinterpret_cast<uintptr_t>(storage.data()) + 63) & ~uintptr_t(63));
+  storage.resize(doubles + 8);  // padded by one line and rounded up
+  return reinterpret_cast<double*>((reinterpret_cast<uintptr_t>(storage.data()) + 63) &
+                                   ~uintptr_t(63));
+}
+
+// ProjectedFreeForm::ray for the lanes' rays (vx, vy): each quadric along z, into `coefficients`.
+Rays SetUpRays(DD d, const ProjectedFreeForm::Node* nodes, const Quadric* clips, size_t clipCount,
+               const double* w, VD vx, VD vy, double* coefficients) {
+  const size_t n = hn::Lanes(d), quadrics = nodes[0].end + clipCount;
+  for (size_t q = 0; q < quadrics; ++q) {
+    const auto& k = q < nodes[0].end ? nodes[q].q.c : clips[q - nodes[0].end].c;
+    const VD b = hn::Add(hn::Add(hn::Mul(hn::Set(d, k[4]), vx), hn::Mul(hn::Set(d, k[5]), vy)),
+                         hn::Set(d, k[8]));
+    const VD cx = hn::Add(hn::Add(hn::Mul(hn::Set(d, k[0]), vx), hn::Mul(hn::Set(d, k[3]), vy)),
+                          hn::Set(d, k[6]));
+    const VD cy = hn::Add(hn::Mul(hn::Set(d, k[1]), vy), hn::Set(d, k[7]));
+    const VD c = hn::Add(hn::Add(hn::Mul(cx, vx), hn::Mul(cy, vy)), hn::Set(d, k[9]));
+    hn::Store(b, d, coefficients + (2 * q) * n);
+    hn::Store(c, d, coefficients + (2 * q + 1) * n);
+  }
+  return {nodes,
+          clips,
+          clipCount,
+          coefficients,
+          n,
+          hn::Add(hn::Add(hn::Mul(hn::Set(d, w[0]), vx), hn::Mul(hn::Set(d, w[1]), vy)),
+                  hn::Set(d, w[3])),
+          w[2]};
+}
+
+// refineBracket (raycast.cpp) in the lanes where `crossing` holds — brackets [a, b] with
+// inside(fa) ≠ inside(fb) — from `guess` where it lies inside; NaN in the other lanes.
+VD Refine(DD d, const Rays& rays, VD a, VD b, VD fa, VD fb, MD crossing, VD guess) {
   const VD half = hn::Set(d, 0.5), zero = hn::Zero(d), tolerance = hn::Set(d, kRootTolerance);
-  const VD nan = hn::Set(d, std::numeric_limits<double>::quiet_NaN());
-  alignas(64) double lx[16], ly[16], lz[16], result[16];
+  const MD insideA = hn::Ge(fa, zero);
+  MD live = crossing;
+  VD z = hn::IfThenElse(Within(guess, a, b), guess, Secant(a, b, fa, fb));
+  z = hn::IfThenElse(Within(z, a, b), z, hn::Mul(half, hn::Add(a, b)));
+  VD found = hn::Set(d, std::numeric_limits<double>::quiet_NaN()), slope;
+  MD converged = hn::Lt(zero, zero);  // none yet
+  for (int i = 0; i < 60; ++i) {
+    // Lanes whose bracket has closed stop here and take its near end.
+    live = hn::AndNot(converged, hn::And(live, hn::Gt(hn::Sub(b, a), tolerance)));
+    if (hn::AllFalse(d, live)) break;
+    const VD fz = Evaluate(d, rays, z, slope);
+    const MD same = hn::Not(hn::Xor(hn::Ge(fz, zero), insideA));
+    a = hn::IfThenElse(hn::And(live, same), z, a);
+    fa = hn::IfThenElse(hn::And(live, same), fz, fa);
+    b = hn::IfThenElse(hn::AndNot(same, live), z, b);
+    fb = hn::IfThenElse(hn::AndNot(same, live), fz, fb);
+    const VD step = hn::IfThenElseZero(hn::Ne(slope, zero), hn::Div(fz, slope));
+    VD next = hn::Sub(z, step);
+    const MD done = hn::And(live, hn::Le(hn::Abs(step), tolerance));
+    found = hn::IfThenElse(done, hn::Min(hn::Max(next, a), b), found);
+    converged = hn::Or(converged, done);
+    next = hn::IfThenElse(
+        Within(next, a, b), next,
+        hn::IfThenElse(hn::Ne(fb, fa), Secant(a, b, fa, fb), hn::Mul(half, hn::Add(a, b))));
+    next = hn::IfThenElse(Within(next, a, b), next, hn::Mul(half, hn::Add(a, b)));
+    z = hn::IfThenElse(live, next, z);
+  }
+  // Lanes with a crossing that did not converge by a Newton step: the bracket's near end.
+  return hn::IfThenElse(hn::AndNot(converged, crossing), a, found);
+}
+
+// The lanes' own rays, x[i], y[i] and span ends zhi[i] for i < count, `n` at a time: lanes past
+// `count` are rays with an empty span (zhi = zlo), inactive throughout.
+template <class Body>
+void ForEachVector(DD d, const double* x, const double* y, double zlo, const double* zhi, int count,
+                   const Body& body) {
+  const size_t n = hn::Lanes(d);
+  alignas(64) double lx[16], ly[16], lz[16];
   for (size_t s0 = 0; s0 < size_t(count); s0 += n) {
     const size_t m = std::min(n, size_t(count) - s0);
-    // Lanes past `count` are rays with an empty span (zhi = zlo): inactive throughout.
     for (size_t i = 0; i < n; ++i) {
       lx[i] = i < m ? x[s0 + i] : 0;
       ly[i] = i < m ? y[s0 + i] : 0;
       lz[i] = i < m ? zhi[s0 + i] : zlo;
     }
-    const VD vx = hn::Load(d, lx), vy = hn::Load(d, ly);
-    // ProjectedFreeForm::ray: each quadric along z.
-    for (size_t q = 0; q < quadrics; ++q) {
-      const auto& k = q < nodes[0].end ? nodes[q].q.c : clips[q - nodes[0].end].c;
-      const VD b = hn::Add(hn::Add(hn::Mul(hn::Set(d, k[4]), vx), hn::Mul(hn::Set(d, k[5]), vy)),
-                           hn::Set(d, k[8]));
-      const VD cx = hn::Add(hn::Add(hn::Mul(hn::Set(d, k[0]), vx), hn::Mul(hn::Set(d, k[3]), vy)),
-                            hn::Set(d, k[6]));
-      const VD cy = hn::Add(hn::Mul(hn::Set(d, k[1]), vy), hn::Set(d, k[7]));
-      const VD c = hn::Add(hn::Add(hn::Mul(cx, vx), hn::Mul(cy, vy)), hn::Set(d, k[9]));
-      hn::Store(b, d, coefficients + (2 * q) * n);
-      hn::Store(c, d, coefficients + (2 * q + 1) * n);
-    }
-    const Rays rays{nodes,
-                    clips,
-                    clipCount,
-                    coefficients,
-                    n,
-                    hn::Add(hn::Add(hn::Mul(hn::Set(d, w[0]), vx), hn::Mul(hn::Set(d, w[1]), vy)),
-                            hn::Set(d, w[3])),
-                    w[2]};
-    VD a = hn::Set(d, zlo), b = hn::Load(d, lz);
-    VD slope;
-    VD fa = Evaluate(d, rays, a, slope), fb = Evaluate(d, rays, b, slope);
-    const MD insideA = hn::Ge(fa, zero);
-    // A crossing: the span is not empty and H has opposite signs at its ends.
-    const MD crossing = hn::And(hn::Lt(a, b), hn::Xor(insideA, hn::Ge(fb, zero)));
-    MD live = crossing;
-    VD z = hn::Set(d, guess);
-    z = hn::IfThenElse(Within(z, a, b), z, Secant(a, b, fa, fb));
-    z = hn::IfThenElse(Within(z, a, b), z, hn::Mul(half, hn::Add(a, b)));
-    VD found = nan;
-    MD converged = hn::Lt(zero, zero);  // none yet
-    for (int i = 0; i < 60; ++i) {
-      // Lanes whose bracket has closed stop here and take its near end.
-      live = hn::AndNot(converged, hn::And(live, hn::Gt(hn::Sub(b, a), tolerance)));
-      if (hn::AllFalse(d, live)) break;
-      const VD fz = Evaluate(d, rays, z, slope);
-      const MD same = hn::Not(hn::Xor(hn::Ge(fz, zero), insideA));
-      a = hn::IfThenElse(hn::And(live, same), z, a);
-      fa = hn::IfThenElse(hn::And(live, same), fz, fa);
-      b = hn::IfThenElse(hn::AndNot(same, live), z, b);
-      fb = hn::IfThenElse(hn::AndNot(same, live), fz, fb);
-      const VD step = hn::IfThenElseZero(hn::Ne(slope, zero), hn::Div(fz, slope));
-      VD next = hn::Sub(z, step);
-      const MD done = hn::And(live, hn::Le(hn::Abs(step), tolerance));
-      found = hn::IfThenElse(done, hn::Min(hn::Max(next, a), b), found);
-      converged = hn::Or(converged, done);
-      next = hn::IfThenElse(
-          Within(next, a, b), next,
-          hn::IfThenElse(hn::Ne(fb, fa), Secant(a, b, fa, fb), hn::Mul(half, hn::Add(a, b))));
-      next = hn::IfThenElse(Within(next, a, b), next, hn::Mul(half, hn::Add(a, b)));
-      z = hn::IfThenElse(live, next, z);
-    }
-    // Lanes with a crossing that did not converge by a Newton step: the bracket's near end.
-    found = hn::IfThenElse(hn::AndNot(converged, crossing), a, found);
-    hn::Store(found, d, result);
-    std::copy_n(result, m, out + s0);
+    body(s0, m, hn::Load(d, lx), hn::Load(d, ly), hn::Load(d, lz));
   }
+}
+
+void MonotonicCrossings(const ProjectedFreeForm::Node* nodes, const Quadric* clips,
+                        size_t clipCount, const double* w, const double* x, const double* y,
+                        double zlo, const double* zhi, int count, double guess, double* out) {
+  const DD d;
+  double* coefficients = CoefficientStorage(2 * (nodes[0].end + clipCount) * hn::Lanes(d));
+  ForEachVector(d, x, y, zlo, zhi, count, [&](size_t s0, size_t m, VD vx, VD vy, VD vz) {
+    const Rays rays = SetUpRays(d, nodes, clips, clipCount, w, vx, vy, coefficients);
+    const VD a = hn::Set(d, zlo), b = vz, zero = hn::Zero(d);
+    VD slope;
+    const VD fa = Evaluate(d, rays, a, slope), fb = Evaluate(d, rays, b, slope);
+    // A crossing: the span is not empty and H has opposite signs at its ends.
+    const MD crossing = hn::And(hn::Lt(a, b), hn::Xor(hn::Ge(fa, zero), hn::Ge(fb, zero)));
+    alignas(64) double result[16];
+    hn::Store(Refine(d, rays, a, b, fa, fb, crossing, hn::Set(d, guess)), d, result);
+    std::copy_n(result, m, out + s0);
+  });
+}
+
+int PiecewiseCrossings(const ProjectedFreeForm::Node* nodes, const Quadric* clips, size_t clipCount,
+                       const double* w, const double* x, const double* y, double zlo,
+                       const double* zhi, int count, int pieces, double guess, double* out,
+                       double* from) {
+  const DD d;
+  double* coefficients = CoefficientStorage(2 * (nodes[0].end + clipCount) * hn::Lanes(d));
+  // The pieces divide [zlo, the farthest span end] of all the rays, whatever the lane count.
+  double zMax = zlo;
+  for (int i = 0; i < count; ++i) zMax = std::max(zMax, zhi[i]);
+  int bounds = 0;
+  ForEachVector(d, x, y, zlo, zhi, count, [&](size_t s0, size_t m, VD vx, VD vy, VD vz) {
+    const Rays rays = SetUpRays(d, nodes, clips, clipCount, w, vx, vy, coefficients);
+    const VD zero = hn::Zero(d), nan = hn::Set(d, std::numeric_limits<double>::quiet_NaN());
+    VD found = nan, next = nan;
+    MD pending = hn::Lt(hn::Set(d, zlo), vz);
+    for (int k = 0; k < pieces && !hn::AllFalse(d, pending); ++k) {
+      const double zA = zlo + (zMax - zlo) * k / pieces;
+      const double zB = k + 1 == pieces ? zMax : zlo + (zMax - zlo) * (k + 1) / pieces;
+      const VD a = hn::Set(d, zA), b = hn::Min(hn::Set(d, zB), vz);
+      pending = hn::And(pending, hn::Lt(a, b));  // spans that end before the piece: no crossing
+      bounds += int(hn::CountTrue(d, pending));
+      Lanes value, slope;
+      const MD valid = BoundLanes(d, rays, {a, b}, value, slope);
+      const MD holds = hn::And(pending, hn::Or(hn::Not(valid), ContainsZero(d, value)));
+      const MD monotonic = hn::AndNot(ContainsZero(d, slope), hn::And(holds, valid));
+      // H may turn in the piece: the ray's own subdivision goes on from here (the caller's).
+      const MD turns = hn::AndNot(monotonic, holds);
+      next = hn::IfThenElse(turns, a, next);
+      pending = hn::AndNot(turns, pending);
+      if (hn::AllFalse(d, monotonic)) continue;
+      // Monotonic: the ends decide.
+      VD s;
+      const VD fa = Evaluate(d, rays, a, s), fb = Evaluate(d, rays, b, s);
+      const MD crossing = hn::And(monotonic, hn::Xor(hn::Ge(fa, zero), hn::Ge(fb, zero)));
+      if (hn::AllFalse(d, crossing)) continue;
+      found = hn::IfThenElse(crossing, Refine(d, rays, a, b, fa, fb, crossing, hn::Set(d, guess)),
+                             found);
+      pending = hn::AndNot(crossing, pending);
+    }
+    alignas(64) double result[16], resume[16];
+    hn::Store(found, d, result);
+    hn::Store(next, d, resume);
+    std::copy_n(result, m, out + s0);
+    std::copy_n(resume, m, from + s0);
+  });
+  return bounds;
 }
 
 }  // namespace HWY_NAMESPACE
@@ -176,6 +345,7 @@ HWY_AFTER_NAMESPACE();
 namespace sv::freeform {
 
 HWY_EXPORT(MonotonicCrossings);
+HWY_EXPORT(PiecewiseCrossings);
 
 void ProjectedFreeForm::monotonicCrossings(const double* x, const double* y, double zlo,
                                            const double* zhi, int count, double guess,
@@ -183,6 +353,14 @@ void ProjectedFreeForm::monotonicCrossings(const double* x, const double* y, dou
   HWY_DYNAMIC_DISPATCH(MonotonicCrossings)
   (nodes_.data(), clips_.data(), clips_.size(), inverse_.m[3].data(), x, y, zlo, zhi,
    std::clamp(count, 0, 16), guess, z);
+}
+
+int ProjectedFreeForm::piecewiseCrossings(const double* x, const double* y, double zlo,
+                                          const double* zhi, int count, int pieces, double guess,
+                                          double* z, double* from) const {
+  return HWY_DYNAMIC_DISPATCH(PiecewiseCrossings)(
+      nodes_.data(), clips_.data(), clips_.size(), inverse_.m[3].data(), x, y, zlo, zhi,
+      std::clamp(count, 0, 16), std::max(pieces, 1), guess, z, from);
 }
 
 }  // namespace sv::freeform

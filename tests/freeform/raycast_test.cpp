@@ -149,6 +149,18 @@ TEST(RayCast, HitsMatchAnalyticRayQuadricIntersectionsForEveryKind) {
   }
 }
 
+// The results of each SIMD target, bit for bit those of the first one tried.
+void expectSameAsFirstTarget(const std::vector<double>& results, std::vector<double>& first,
+                             int64_t target, int& targets) {
+  if (targets++ == 0) {
+    first = results;
+    return;
+  }
+  ASSERT_EQ(results.size(), first.size());
+  EXPECT_EQ(0, std::memcmp(results.data(), first.data(), first.size() * sizeof(double)))
+      << hwy::TargetName(target) << " differs from the first target";
+}
+
 // ProjectedFreeForm::monotonicCrossings: rays into a sphere, each over the span from the near
 // plane to the middle of its chord (one zero: the entry), give the analytic entry; rays that miss,
 // over the whole depth, give NaN; so do empty spans. Any count of rays, any guess, and the same
@@ -208,13 +220,89 @@ TEST(RayCast, MonotonicCrossingsAreTheEntriesOnEveryTarget) {
     }
     EXPECT_GT(entries, 300);
     EXPECT_GT(misses, 200);
-    if (targets++ == 0) {
-      first = results;
-    } else {
-      ASSERT_EQ(results.size(), first.size());
-      EXPECT_EQ(0, std::memcmp(results.data(), first.data(), first.size() * sizeof(double)))
-          << hwy::TargetName(target) << " differs from the first target";
+    expectSameAsFirstTarget(results, first, target, targets);
+  }
+  hwy::SetSupportedTargetsForTest(0);
+  EXPECT_GE(targets, 1);
+}
+
+// ProjectedFreeForm::piecewiseCrossings: rays into a sphere over the whole depth (entry and exit,
+// so H turns along them) give the analytic entry — found in a monotonic piece, or by the ray's own
+// subdivision (castRay) from where the lane handed it over; rays that miss give nothing. The
+// same bits on every compiled target, and both ways of finding a hit taken.
+TEST(RayCast, PiecewiseCrossingsAreTheEntriesOnEveryTarget) {
+  const int w = 64, h = 64;
+  FreeForm f;
+  f.base = Quadric::sphere({0.2, -0.1, 0}, 1.2);
+  FreeForm bump;  // a bump, so that the ray's bound has a perturbation's terms
+  bump.base = Quadric::sphere({0.2, -0.1, 1.2}, 0.4);
+  f.perturbations.push_back(bump);
+  const Mat4d toCube = cameraToCube(w, h);
+  const auto g = ProjectedFreeForm::make(f, toCube);
+  ASSERT_TRUE(g);
+  std::vector<double> first;
+  int targets = 0;
+  for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
+    hwy::SetSupportedTargetsForTest(target);
+    std::mt19937 rng(10);
+    std::uniform_int_distribution<int> pixel(0, w - 1);
+    std::vector<double> results;
+    int inLanes = 0, handedOver = 0, misses = 0;
+    for (int round = 0; round < 200; ++round) {
+      const int count = 1 + round % 16;
+      double x[16], y[16], zhi[16], z[16], from[16];
+      for (int i = 0; i < count; ++i) {
+        x[i] = 2.0 * (pixel(rng) + 0.5) / w - 1;
+        y[i] = 1 - 2.0 * (pixel(rng) + 0.5) / h;
+        zhi[i] = i % 7 == 6 ? -0.5 : 1;  // some spans end early
+      }
+      g->piecewiseCrossings(x, y, -1, zhi, count, 8, NAN, z, from);
+      for (int i = 0; i < count; ++i) {
+        double hit = z[i];
+        if (!std::isnan(z[i])) {
+          ++inLanes;
+        } else if (!std::isnan(from[i])) {
+          ++handedOver;
+          float depth = float(0.5 * (zhi[i] + 1));
+          uint32_t object = kNoHit;
+          RayFunction ray;
+          CastStats stats;
+          castRay(*g, 1, x[i], y[i], from[i], NAN, depth, object, hit, ray, stats);
+          if (object == kNoHit) hit = NAN;
+        }
+        // The truth: the first sign change of H along the ray, by fine steps and bisection.
+        RayFunction ray;
+        g->ray(x[i], y[i], ray);
+        double want = NAN, a = -1, fa = ray.evaluate(a);
+        for (int k = 1; k <= 4096 && std::isnan(want); ++k) {
+          const double b = std::min(zhi[i], -1 + 2.0 * k / 4096), fb = ray.evaluate(b);
+          if ((fa >= 0) != (fb >= 0)) {
+            double lo = a, hi = b;
+            for (int it = 0; it < 80; ++it) {
+              const double m = 0.5 * (lo + hi);
+              ((ray.evaluate(m) >= 0) == (fa >= 0) ? lo : hi) = m;
+            }
+            want = lo;
+          }
+          if (b >= zhi[i]) break;
+          a = b, fa = fb;
+        }
+        if (std::isnan(want)) {
+          EXPECT_TRUE(std::isnan(hit))
+              << hwy::TargetName(target) << " round " << round << " ray " << i;
+          ++misses;
+        } else {
+          EXPECT_NEAR(hit, want, 1e-9)
+              << hwy::TargetName(target) << " round " << round << " ray " << i;
+        }
+        results.push_back(z[i]);
+        results.push_back(from[i]);
+      }
     }
+    EXPECT_GT(inLanes, 100);
+    EXPECT_GT(handedOver, 20);
+    EXPECT_GT(misses, 200);
+    expectSameAsFirstTarget(results, first, target, targets);
   }
   hwy::SetSupportedTargetsForTest(0);
   EXPECT_GE(targets, 1);
