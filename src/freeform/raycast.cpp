@@ -20,14 +20,15 @@ bool inside(double h) { return h >= 0; }
 // Step 3 of a pixel: a bracket [a, b] of the ray where H changes sign (inside(fa) ≠ inside(fb)),
 // narrowed by Newton's method safeguarded by the bracket (a step that leaves it is replaced by
 // the secant point, then by bisection), starting at `guess` when it lies inside (a neighbour's
-// hit: the surface is coherent) and stopping when the bracket or the step is below
-// kRootTolerance; returns the last Newton point (within the tolerance of the root) or, if the
-// bracket closed first, its end on the near side of the crossing.
+// hit: the surface is coherent) and stopping when the bracket is below kRootTolerance or the
+// Newton point is within it of the root (newtonConverged); returns the last Newton point or, if
+// the bracket closed first, its end on the near side of the crossing.
 double refineBracket(const RayFunction& f, double a, double b, double fa, double fb,
                      double guess = std::numeric_limits<double>::quiet_NaN()) {
   const bool insideA = inside(fa);
   double z = guess > a && guess < b ? guess : b - fb * (b - a) / (fb - fa);
   if (!(z > a && z < b)) z = 0.5 * (a + b);
+  double previous = 0;  // the last Newton step's length (0: none)
   for (int i = 0; i < 60 && b - a > kRootTolerance; ++i) {
     double slope;
     const double fz = f.evaluate(z, slope);
@@ -37,8 +38,12 @@ double refineBracket(const RayFunction& f, double a, double b, double fa, double
       b = z, fb = fz;
     const double step = slope != 0 ? fz / slope : 0;
     double next = z - step;
-    if (std::fabs(step) <= kRootTolerance) return std::clamp(next, a, b);  // converged
-    if (!(next > a && next < b)) next = fb != fa ? b - fb * (b - a) / (fb - fa) : 0.5 * (a + b);
+    if (newtonConverged(std::fabs(step), previous)) return std::clamp(next, a, b);
+    previous = std::fabs(step);
+    if (!(next > a && next < b)) {  // safeguarded: no Newton step taken
+      next = fb != fa ? b - fb * (b - a) / (fb - fa) : 0.5 * (a + b);
+      previous = 0;
+    }
     if (!(next > a && next < b)) next = 0.5 * (a + b);
     z = next;
   }
@@ -211,7 +216,7 @@ class Caster {
   // pixel took a hit.
   bool rayWindow(int lx, int ly, int n, int gx0, int gy0, int gx1, int gy1, double zlo, double zhi,
                  bool monotonic) {
-    double x[16] = {}, y[16] = {}, end[16] = {}, z[16], from[16];
+    double x[16] = {}, y[16] = {}, end[16] = {}, guess[16] = {}, z[16], from[16];
     size_t at[16];
     int count = 0;
     for (int py = 0; py < n && gy0 + py <= gy1; ++py)
@@ -220,13 +225,14 @@ class Caster {
         x[count] = cubeX(gx0 + px, w_.width, w_.offsetX);
         y[count] = cubeY(gy0 + py, w_.height, w_.offsetY);
         end[count] = std::min(zhi, 2.0 * double(w_.depth[at[count]]) - 1);
+        guess[count] = guessAt(lx, ly, px, py);
       }
     stats_.pixels += uint64_t(count);
     if (monotonic) {
-      form_.monotonicCrossings(x, y, zlo, end, count, guess_, z);
+      form_.monotonicCrossings(x, y, zlo, end, count, guess, z);
     } else {
       stats_.depthTests +=
-          uint64_t(form_.piecewiseCrossings(x, y, zlo, end, count, kPieces, guess_, z, from));
+          uint64_t(form_.piecewiseCrossings(x, y, zlo, end, count, kPieces, guess, z, from));
       for (int i = 0; i < count; ++i)
         if (!std::isnan(from[i])) {
           form_.ray(x[i], y[i], ray_);
@@ -243,6 +249,29 @@ class Caster {
           guess_ = z[i];
         }
     return hits;
+  }
+
+  // Where Newton starts for pixel (px, py) of the window at (lx, ly): the surface is coherent, so
+  // from this form's hits in the pixels just left of the window's row or above its column —
+  // the nearer — extrapolated linearly from the next pixel out where that holds one too; else
+  // from the form's last hit in the tile.
+  double guessAt(int lx, int ly, int px, int py) const {
+    const auto hitAt = [&](int qx, int qy, double& z) {
+      if (qx < 0 || qy < 0 || !w_.object || !w_.cubeZ) return false;
+      const size_t k = size_t(qy) * size_t(w_.stride) + size_t(qx);
+      if (w_.object[k] != id_) return false;
+      z = w_.cubeZ[k];
+      return true;
+    };
+    double z1, z2;
+    for (int side = 0; side < 2; ++side) {
+      const bool left = (side == 0) == (px <= py);
+      const int dx = left ? -1 : 0, dy = left ? 0 : -1, steps = left ? px + 1 : py + 1;
+      const int qx = left ? lx - 1 : lx + px, qy = left ? ly + py : ly - 1;
+      if (!hitAt(qx, qy, z1)) continue;
+      return hitAt(qx + dx, qy + dy, z2) ? z1 + (z1 - z2) * steps : z1;
+    }
+    return guess_;
   }
 
   // Takes the hit where it is nearer; the pixel's node follows (its ancestors: refreshAbove).

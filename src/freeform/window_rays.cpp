@@ -228,6 +228,8 @@ VD Refine(DD d, const Rays& rays, VD a, VD b, VD fa, VD fb, MD crossing, VD gues
   z = hn::IfThenElse(Within(z, a, b), z, hn::Mul(half, hn::Add(a, b)));
   VD found = hn::Set(d, std::numeric_limits<double>::quiet_NaN()), slope;
   MD converged = hn::Lt(zero, zero);  // none yet
+  VD previous = zero;                 // the last Newton step's length (0: none)
+  const VD small = hn::Set(d, 0.01 * kRootTolerance);
   for (int i = 0; i < 60; ++i) {
     // Lanes whose bracket has closed stop here and take its near end.
     live = hn::AndNot(converged, hn::And(live, hn::Gt(hn::Sub(b, a), tolerance)));
@@ -240,11 +242,18 @@ VD Refine(DD d, const Rays& rays, VD a, VD b, VD fa, VD fb, MD crossing, VD gues
     fb = hn::IfThenElse(hn::AndNot(same, live), fz, fb);
     const VD step = hn::IfThenElseZero(hn::Ne(slope, zero), hn::Div(fz, slope));
     VD next = hn::Sub(z, step);
-    const MD done = hn::And(live, hn::Le(hn::Abs(step), tolerance));
+    // newtonConverged (freeform.h).
+    const VD s = hn::Abs(step);
+    const MD quadratic =
+        hn::And(hn::Lt(s, previous),
+                hn::Le(hn::Mul(hn::Mul(s, s), s), hn::Mul(hn::Mul(small, previous), previous)));
+    const MD done = hn::And(live, hn::Or(hn::Le(s, tolerance), quadratic));
     found = hn::IfThenElse(done, hn::Min(hn::Max(next, a), b), found);
     converged = hn::Or(converged, done);
+    const MD newton = Within(next, a, b);  // else safeguarded: no Newton step taken
+    previous = hn::IfThenElseZero(newton, s);
     next = hn::IfThenElse(
-        Within(next, a, b), next,
+        newton, next,
         hn::IfThenElse(hn::Ne(fb, fa), Secant(a, b, fa, fb), hn::Mul(half, hn::Add(a, b))));
     next = hn::IfThenElse(Within(next, a, b), next, hn::Mul(half, hn::Add(a, b)));
     z = hn::IfThenElse(live, next, z);
@@ -253,27 +262,30 @@ VD Refine(DD d, const Rays& rays, VD a, VD b, VD fa, VD fb, MD crossing, VD gues
   return hn::IfThenElse(hn::AndNot(converged, crossing), a, found);
 }
 
+// Values v[s0 … s0 + m) into the lanes, `fill` past them.
+HWY_INLINE VD LoadPadded(DD d, const double* v, size_t s0, size_t m, double fill) {
+  alignas(64) double lanes[16];
+  for (size_t i = 0; i < hn::Lanes(d); ++i) lanes[i] = i < m ? v[s0 + i] : fill;
+  return hn::Load(d, lanes);
+}
+
 // The lanes' own rays, x[i], y[i] and span ends zhi[i] for i < count, `n` at a time: lanes past
 // `count` are rays with an empty span (zhi = zlo), inactive throughout.
 template <class Body>
 void ForEachVector(DD d, const double* x, const double* y, double zlo, const double* zhi, int count,
                    const Body& body) {
   const size_t n = hn::Lanes(d);
-  alignas(64) double lx[16], ly[16], lz[16];
   for (size_t s0 = 0; s0 < size_t(count); s0 += n) {
     const size_t m = std::min(n, size_t(count) - s0);
-    for (size_t i = 0; i < n; ++i) {
-      lx[i] = i < m ? x[s0 + i] : 0;
-      ly[i] = i < m ? y[s0 + i] : 0;
-      lz[i] = i < m ? zhi[s0 + i] : zlo;
-    }
-    body(s0, m, hn::Load(d, lx), hn::Load(d, ly), hn::Load(d, lz));
+    body(s0, m, LoadPadded(d, x, s0, m, 0), LoadPadded(d, y, s0, m, 0),
+         LoadPadded(d, zhi, s0, m, zlo));
   }
 }
 
 void MonotonicCrossings(const ProjectedFreeForm::Node* nodes, const Quadric* clips,
                         size_t clipCount, const double* w, const double* x, const double* y,
-                        double zlo, const double* zhi, int count, double guess, double* out) {
+                        double zlo, const double* zhi, int count, const double* guess,
+                        double* out) {
   const DD d;
   double* coefficients = CoefficientStorage(2 * (nodes[0].end + clipCount) * hn::Lanes(d));
   ForEachVector(d, x, y, zlo, zhi, count, [&](size_t s0, size_t m, VD vx, VD vy, VD vz) {
@@ -284,14 +296,14 @@ void MonotonicCrossings(const ProjectedFreeForm::Node* nodes, const Quadric* cli
     // A crossing: the span is not empty and H has opposite signs at its ends.
     const MD crossing = hn::And(hn::Lt(a, b), hn::Xor(hn::Ge(fa, zero), hn::Ge(fb, zero)));
     alignas(64) double result[16];
-    hn::Store(Refine(d, rays, a, b, fa, fb, crossing, hn::Set(d, guess)), d, result);
+    hn::Store(Refine(d, rays, a, b, fa, fb, crossing, LoadPadded(d, guess, s0, m, 0)), d, result);
     std::copy_n(result, m, out + s0);
   });
 }
 
 int PiecewiseCrossings(const ProjectedFreeForm::Node* nodes, const Quadric* clips, size_t clipCount,
                        const double* w, const double* x, const double* y, double zlo,
-                       const double* zhi, int count, int pieces, double guess, double* out,
+                       const double* zhi, int count, int pieces, const double* guess, double* out,
                        double* from) {
   const DD d;
   double* coefficients = CoefficientStorage(2 * (nodes[0].end + clipCount) * hn::Lanes(d));
@@ -324,8 +336,8 @@ int PiecewiseCrossings(const ProjectedFreeForm::Node* nodes, const Quadric* clip
       const VD fa = Evaluate(d, rays, a, s), fb = Evaluate(d, rays, b, s);
       const MD crossing = hn::And(monotonic, hn::Xor(hn::Ge(fa, zero), hn::Ge(fb, zero)));
       if (hn::AllFalse(d, crossing)) continue;
-      found = hn::IfThenElse(crossing, Refine(d, rays, a, b, fa, fb, crossing, hn::Set(d, guess)),
-                             found);
+      found = hn::IfThenElse(
+          crossing, Refine(d, rays, a, b, fa, fb, crossing, LoadPadded(d, guess, s0, m, 0)), found);
       pending = hn::AndNot(crossing, pending);
     }
     alignas(64) double result[16], resume[16];
@@ -348,7 +360,7 @@ HWY_EXPORT(MonotonicCrossings);
 HWY_EXPORT(PiecewiseCrossings);
 
 void ProjectedFreeForm::monotonicCrossings(const double* x, const double* y, double zlo,
-                                           const double* zhi, int count, double guess,
+                                           const double* zhi, int count, const double* guess,
                                            double* z) const {
   HWY_DYNAMIC_DISPATCH(MonotonicCrossings)
   (nodes_.data(), clips_.data(), clips_.size(), inverse_.m[3].data(), x, y, zlo, zhi,
@@ -356,8 +368,8 @@ void ProjectedFreeForm::monotonicCrossings(const double* x, const double* y, dou
 }
 
 int ProjectedFreeForm::piecewiseCrossings(const double* x, const double* y, double zlo,
-                                          const double* zhi, int count, int pieces, double guess,
-                                          double* z, double* from) const {
+                                          const double* zhi, int count, int pieces,
+                                          const double* guess, double* z, double* from) const {
   return HWY_DYNAMIC_DISPATCH(PiecewiseCrossings)(
       nodes_.data(), clips_.data(), clips_.size(), inverse_.m[3].data(), x, y, zlo, zhi,
       std::clamp(count, 0, 16), std::max(pieces, 1), guess, z, from);

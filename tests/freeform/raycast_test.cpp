@@ -203,7 +203,10 @@ TEST(RayCast, MonotonicCrossingsAreTheEntriesOnEveryTarget) {
           expected[i] = NAN;
         }
       }
-      const double guess = round % 3 == 0 ? NAN : round % 3 == 1 ? expected[0] : 0.9;
+      // Guesses: none, a near one (another ray's entry), a wild one — mixed across the lanes.
+      double guess[16];
+      for (int i = 0; i < count; ++i)
+        guess[i] = (round + i) % 3 == 0 ? NAN : (round + i) % 3 == 1 ? expected[0] : 0.9;
       g->monotonicCrossings(x, y, -1, zhi, count, guess, z);
       for (int i = 0; i < count; ++i) {
         results.push_back(z[i]);
@@ -256,7 +259,9 @@ TEST(RayCast, PiecewiseCrossingsAreTheEntriesOnEveryTarget) {
         y[i] = 1 - 2.0 * (pixel(rng) + 0.5) / h;
         zhi[i] = i % 7 == 6 ? -0.5 : 1;  // some spans end early
       }
-      g->piecewiseCrossings(x, y, -1, zhi, count, 8, NAN, z, from);
+      const double none[16] = {NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN,
+                               NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN};
+      g->piecewiseCrossings(x, y, -1, zhi, count, 8, none, z, from);
       for (int i = 0; i < count; ++i) {
         double hit = z[i];
         if (!std::isnan(z[i])) {
