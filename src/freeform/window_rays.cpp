@@ -218,6 +218,14 @@ Rays SetUpRays(DD d, const ProjectedFreeForm::Node* nodes, const Quadric* clips,
           w[2]};
 }
 
+// newtonConverged (freeform.h) for the lanes' step lengths s and the steps before them.
+HWY_INLINE MD NewtonConverged(DD d, VD s, VD previous) {
+  const VD cubed = hn::Mul(hn::Mul(s, s), s);
+  const VD bound = hn::Mul(hn::Mul(hn::Set(d, 0.01 * kRootTolerance), previous), previous);
+  return hn::Or(hn::Le(s, hn::Set(d, kRootTolerance)),
+                hn::And(hn::Lt(s, previous), hn::Le(cubed, bound)));
+}
+
 // refineBracket (raycast.cpp) in the lanes where `crossing` holds — brackets [a, b] with
 // inside(fa) ≠ inside(fb) — from `guess` where it lies inside; NaN in the other lanes.
 VD Refine(DD d, const Rays& rays, VD a, VD b, VD fa, VD fb, MD crossing, VD guess) {
@@ -229,7 +237,6 @@ VD Refine(DD d, const Rays& rays, VD a, VD b, VD fa, VD fb, MD crossing, VD gues
   VD found = hn::Set(d, std::numeric_limits<double>::quiet_NaN()), slope;
   MD converged = hn::Lt(zero, zero);  // none yet
   VD previous = zero;                 // the last Newton step's length (0: none)
-  const VD small = hn::Set(d, 0.01 * kRootTolerance);
   for (int i = 0; i < 60; ++i) {
     // Lanes whose bracket has closed stop here and take its near end.
     live = hn::AndNot(converged, hn::And(live, hn::Gt(hn::Sub(b, a), tolerance)));
@@ -242,12 +249,8 @@ VD Refine(DD d, const Rays& rays, VD a, VD b, VD fa, VD fb, MD crossing, VD gues
     fb = hn::IfThenElse(hn::AndNot(same, live), fz, fb);
     const VD step = hn::IfThenElseZero(hn::Ne(slope, zero), hn::Div(fz, slope));
     VD next = hn::Sub(z, step);
-    // newtonConverged (freeform.h).
     const VD s = hn::Abs(step);
-    const MD quadratic =
-        hn::And(hn::Lt(s, previous),
-                hn::Le(hn::Mul(hn::Mul(s, s), s), hn::Mul(hn::Mul(small, previous), previous)));
-    const MD done = hn::And(live, hn::Or(hn::Le(s, tolerance), quadratic));
+    const MD done = hn::And(live, NewtonConverged(d, s, previous));
     found = hn::IfThenElse(done, hn::Min(hn::Max(next, a), b), found);
     converged = hn::Or(converged, done);
     const MD newton = Within(next, a, b);  // else safeguarded: no Newton step taken
@@ -290,13 +293,33 @@ void MonotonicCrossings(const ProjectedFreeForm::Node* nodes, const Quadric* cli
   double* coefficients = CoefficientStorage(2 * (nodes[0].end + clipCount) * hn::Lanes(d));
   ForEachVector(d, x, y, zlo, zhi, count, [&](size_t s0, size_t m, VD vx, VD vy, VD vz) {
     const Rays rays = SetUpRays(d, nodes, clips, clipCount, w, vx, vy, coefficients);
-    const VD a = hn::Set(d, zlo), b = vz, zero = hn::Zero(d);
-    VD slope;
-    const VD fa = Evaluate(d, rays, a, slope), fb = Evaluate(d, rays, b, slope);
-    // A crossing: the span is not empty and H has opposite signs at its ends.
-    const MD crossing = hn::And(hn::Lt(a, b), hn::Xor(hn::Ge(fa, zero), hn::Ge(fb, zero)));
+    const VD a = hn::Set(d, zlo), b = vz, zero = hn::Zero(d), g = LoadPadded(d, guess, s0, m, 0);
+    const MD span = hn::Lt(a, b);
+    // Step 1: Newton alone from the guesses. H is monotonic over each span, so a zero Newton
+    // converges to inside it is the span's only crossing — no need to bracket it first.
+    MD open = hn::And(span, Within(g, a, b)), settled = hn::Lt(zero, zero);
+    VD z = g, found = hn::Set(d, std::numeric_limits<double>::quiet_NaN()), previous = zero, slope;
+    for (int i = 0; i < 4 && !hn::AllFalse(d, open); ++i) {
+      const VD fz = Evaluate(d, rays, z, slope);
+      const VD step = hn::Div(fz, slope), next = hn::Sub(z, step), s = hn::Abs(step);
+      const MD converged = hn::And(hn::And(open, hn::And(hn::Ge(next, a), hn::Le(next, b))),
+                                   NewtonConverged(d, s, previous));
+      found = hn::IfThenElse(converged, next, found);
+      settled = hn::Or(settled, converged);
+      open = hn::AndNot(converged, hn::And(open, Within(next, a, b)));  // left: step 2 decides
+      previous = s;
+      z = next;
+    }
+    // Step 2: the other rays — no guess inside, Newton leaving the span or slow — bracketed: H
+    // has opposite signs at the span's ends, refined as refineBracket refines.
+    const MD rest = hn::AndNot(settled, span);
+    if (!hn::AllFalse(d, rest)) {
+      const VD fa = Evaluate(d, rays, a, slope), fb = Evaluate(d, rays, b, slope);
+      const MD crossing = hn::And(rest, hn::Xor(hn::Ge(fa, zero), hn::Ge(fb, zero)));
+      found = hn::IfThenElse(settled, found, Refine(d, rays, a, b, fa, fb, crossing, g));
+    }
     alignas(64) double result[16];
-    hn::Store(Refine(d, rays, a, b, fa, fb, crossing, LoadPadded(d, guess, s0, m, 0)), d, result);
+    hn::Store(found, d, result);
     std::copy_n(result, m, out + s0);
   });
 }
