@@ -216,14 +216,24 @@ class Caster {
   // pixel took a hit.
   bool rayWindow(int lx, int ly, int n, int gx0, int gy0, int gx1, int gy1, double zlo, double zhi,
                  bool monotonic) {
-    double x[16] = {}, y[16] = {}, end[16] = {}, guess[16] = {}, z[16], from[16];
-    size_t at[16];
+    double* const x = lanes_.x;
+    double* const y = lanes_.y;
+    double* const end = lanes_.end;
+    double* const guess = lanes_.guess;
+    double* const z = lanes_.z;
+    double* const from = lanes_.from;
+    size_t* const at = lanes_.at;
+    double columns[4], rows[4];
+    for (int p = 0; p < n; ++p) {
+      columns[p] = cubeX(gx0 + p, w_.width, w_.offsetX);
+      rows[p] = cubeY(gy0 + p, w_.height, w_.offsetY);
+    }
     int count = 0;
     for (int py = 0; py < n && gy0 + py <= gy1; ++py)
       for (int px = 0; px < n && gx0 + px <= gx1; ++px, ++count) {
         at[count] = size_t(ly + py) * size_t(w_.stride) + size_t(lx + px);
-        x[count] = cubeX(gx0 + px, w_.width, w_.offsetX);
-        y[count] = cubeY(gy0 + py, w_.height, w_.offsetY);
+        x[count] = columns[px];
+        y[count] = rows[py];
         end[count] = std::min(zhi, 2.0 * double(w_.depth[at[count]]) - 1);
         guess[count] = guessAt(lx, ly, px, py);
       }
@@ -301,6 +311,10 @@ class Caster {
   int top_ = 0;
   std::vector<std::vector<float>> zmax_;  // [level][y · (size >> level) + x]
   RayFunction ray_;  // the current pixel's
+  struct {           // rayWindow's rays (only the first `count` of each are read)
+    double x[16], y[16], end[16], guess[16], z[16], from[16];
+    size_t at[16];
+  } lanes_;
   double guess_ = std::numeric_limits<double>::quiet_NaN();  // the last hit (monotonicWindow)
 };
 
