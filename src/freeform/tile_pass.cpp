@@ -109,9 +109,14 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
   // of the pixels where the centres do not tell.
   for (int k = 0; k < s; ++k) {
     float* d = scratch.depth.data() + plane * size_t(k);
-    for (int ly = 0; ly < kTileSize; ++ly)
-      for (int lx = 0; lx < kTileSize; ++lx)
-        d[ly * kTileSize + lx] = depth[FrameBuffer::depthOffset(lx, ly, s, k)];
+    // Block by block: a block's sample plane is 4 rows of 4 in a row (FrameBuffer's layout).
+    for (int by = 0; by < kTileSize; by += raster::kBlockSize)
+      for (int bx = 0; bx < kTileSize; bx += raster::kBlockSize) {
+        const float* block = depth + FrameBuffer::depthOffset(bx, by, s, k);
+        for (int r = 0; r < raster::kBlockSize; ++r)
+          std::copy_n(block + r * raster::kBlockSize, raster::kBlockSize,
+                      d + (by + r) * kTileSize + bx);
+      }
   }
   // The window of `size` pixels at tile-local (lx, ly) of buffers `d`, `o`, `z` (row-major,
   // kTileSize wide), its rays at sample offset (dx, dy); every listed form cast into it.
@@ -274,6 +279,14 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
         scratch.pending[i].push_back({lx, ly, k});
       }
     }
+  // The cube x of every column and y of every row, per sample (the rays' own, raycast.h).
+  scratch.columnX.resize(size_t(kTileSize) * size_t(s));
+  scratch.rowY.resize(size_t(kTileSize) * size_t(s));
+  for (int k = 0; k < s; ++k)
+    for (int i = 0; i < kTileSize; ++i) {
+      scratch.columnX[size_t(k * kTileSize + i)] = 2.0 * (ox + i + 0.5 + offsetX_[k]) / width_ - 1;
+      scratch.rowY[size_t(k * kTileSize + i)] = 1 - 2.0 * (oy + i + 0.5 + offsetY_[k]) / height_;
+    }
   for (size_t place = 0; place < listed.size(); ++place) {
     const uint32_t f = listed[place];
     const ShadedForm& form = forms_[f];
@@ -290,8 +303,8 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
         const Scratch::Pending& p = pending[begin + size_t(i)];
         sx[i] = ox + p.lx + 0.5 + offsetX_[p.sample];
         sy[i] = oy + p.ly + 0.5 + offsetY_[p.sample];
-        qx[i] = 2.0 * sx[i] / width_ - 1;
-        qy[i] = 1 - 2.0 * sy[i] / height_;
+        qx[i] = scratch.columnX[size_t(p.sample * kTileSize + p.lx)];
+        qy[i] = scratch.rowY[size_t(p.sample * kTileSize + p.ly)];
         qz[i] = scratch.cubeZ[plane * size_t(p.sample) + size_t(p.ly * kTileSize + p.lx)];
       }
       SurfaceLanes& hit = scratch.surface;

@@ -61,6 +61,7 @@ class FreeFormFrame {
     std::vector<uint32_t> place;                // per form: its place in the tile's list
     std::vector<int> lastPixel;                 // per listed form: the last pixel pending
     SurfaceLanes surface;
+    std::vector<double> columnX, rowY;  // per sample: the tile's columns' cube x, rows' cube y
   };
 
   // Casts the forms listed for tile (tileX, tileY) into its buffers — `samples` depth and colour
