@@ -167,14 +167,27 @@ void ProjectedFreeForm::boundNodeSlope(uint32_t i, Interval x, Interval y, Inter
 }
 
 void ProjectedFreeForm::bound(Interval x, Interval y, Interval z, Interval& value,
-                              Interval& slope) const {
+                              Interval& slope, uint64_t* active) const {
   const auto& w = inverse_.m[3];
   const Interval u = x * w[0] + y * w[1] + z * w[2] + w[3];
+  const uint64_t take = active ? *active : kAllActive;
   if (!(u.lo > 0)) {
     value = slope = {-kInf, kInf};
     return;
   }
-  boundNodeSlope(0, x, y, z, inversePowers(u), value, slope);
+  // boundNodeSlope(0, …), noting which perturbations may be positive.
+  const InversePowers inv = inversePowers(u);
+  const Quadric& q = nodes_[0].q;
+  value = q.bound(x, y, z);
+  slope = z * (2 * q.c[2]) + x * q.c[4] + y * q.c[5] + q.c[8];
+  int i = 0;
+  for (uint32_t c = 1; c < nodes_[0].end; c = nodes_[c].end, ++i) {
+    if (i < 64 && (take >> i & 1) == 0) continue;
+    Interval v, dv;
+    boundNodeSlope(c, x, y, z, inv, v, dv);
+    if (active && i < 64 && v.hi <= 0) *active &= ~(uint64_t(1) << i);
+    addPerturbation(v, dv, nodes_[c].weight, inv, inverse_.m[3][2], value, slope);
+  }
   for (const Quadric& c : clips_)
     takeMinimum(c.bound(x, y, z), z * (2 * c.c[2]) + x * c.c[4] + y * c.c[5] + c.c[8], value,
                 slope);

@@ -44,6 +44,9 @@ struct FreeForm {
 class ProjectedFreeForm;
 struct InversePowers;
 
+// Every perturbation of a form taken as possibly active (ProjectedFreeForm::bound's `active`).
+inline constexpr uint64_t kAllActive = ~uint64_t(0);
+
 // Roots along a ray are refined until their bracket or Newton step is narrower than this (cube
 // depth): float window depth resolves about 6e-8, and 1e-10 of cube depth is under 1e-5 of a
 // pixel's footprint at any depth of BENCH.md's scenes (tests/freeform: within 1e-3 of a cell of
@@ -99,22 +102,33 @@ class ProjectedFreeForm {
   // everything (−∞, ∞) where the box reaches u ≤ 0 (behind the eye).
   Interval bound(Interval x, Interval y, Interval z) const;
   // The same bound, and one of ∂H/∂z over the box: where that excludes 0, every ray (x, y) of the
-  // box meets the surface at most once in it.
-  void bound(Interval x, Interval y, Interval z, Interval& value, Interval& slopeZ) const;
+  // box meets the surface at most once in it. `active` (if given): on entry, the root's
+  // perturbations to bound — bit i for the i-th (i < 64; later ones are always bounded) — the
+  // others being known to be 0 over the box (from a larger box); on return, bit i set where the
+  // i-th may be positive somewhere in the box. Where it is clear, that perturbation's term is 0
+  // throughout the box and can be left out of H there (see kAllActive).
+  void bound(Interval x, Interval y, Interval z, Interval& value, Interval& slopeZ,
+             uint64_t* active = nullptr) const;
   Vec3d toObject(Vec3d q) const { return inverse_.transformPoint(q); }
   // Which of `count` (1…16) equal slabs of [zlo, zhi] the surface may cross over the box x × y:
   // holds[s] ⇔ bound(x, y, slab s) contains 0, slab s being [zlo + (zhi − zlo)·s/count,
   // zlo + (zhi − zlo)·(s + 1)/count]. The same bounds, every slab at once (SIMD, slab_bounds.cpp:
   // the same operations in the same order, so the same answers on every target).
-  void slabsHolding(Interval x, Interval y, double zlo, double zhi, int count, bool* holds) const;
+  // `take`: the root's perturbations to bound (the others are known to be 0 over the box, see
+  // bound's `active`); `active` (if given): those of them that may be positive in some slab.
+  void slabsHolding(Interval x, Interval y, double zlo, double zhi, int count, bool* holds,
+                    uint64_t take = kAllActive, uint64_t* active = nullptr) const;
   // Rays (x[i], y[i]), i < count ≤ 16, on each of which H has at most one zero in [zlo, zhi[i]]
   // (a window's bound of ∂H/∂z excludes 0): z[i] is the zero, refined as refineBracket
   // (raycast.cpp) refines it — safeguarded Newton from guess[i] (or the secant point where the
   // guess lies outside, or is NaN), to kRootTolerance — or NaN where H has one sign at both ends
   // (or zhi[i] ≤ zlo). Every ray a SIMD lane (window_rays.cpp), each lane on its own, so every
   // target gives the same z.
+  // `active`: the root's perturbations that may be positive over the rays (bound's `active`);
+  // the others are left out of H.
   void monotonicCrossings(const double* x, const double* y, double zlo, const double* zhi,
-                          int count, const double* guess, double* z) const;
+                          int count, const double* guess, double* z,
+                          uint64_t active = kAllActive) const;
   // The same for rays whose H may turn in [zlo, zhi[i]] (a window's slope bound holds 0): each
   // ray's span is cut at `pieces` equal steps of [zlo, max zhi] and taken front to back; the
   // ray's own bound (RayFunction::bound) over a piece rejects it, or says H is monotonic there
@@ -122,7 +136,8 @@ class ProjectedFreeForm {
   // piece begins, for the ray's own subdivision (firstCrossing in raycast.cpp) to go on, and
   // z[i] NaN. z[i] and from[i] both NaN: no crossing. Returns the number of ray bounds made.
   int piecewiseCrossings(const double* x, const double* y, double zlo, const double* zhi, int count,
-                         int pieces, const double* guess, double* z, double* from) const;
+                         int pieces, const double* guess, double* z, double* from,
+                         uint64_t active = kAllActive) const;
   // H along the ray (x, y) of the cube, into `out` (its storage reused).
   void ray(double x, double y, RayFunction& out) const;
   const Mat4d& inverse() const { return inverse_; }

@@ -142,7 +142,7 @@ class Caster {
         for (int x = 0; x < (w.size >> l); ++x) updateNode(l, x, y);
   }
 
-  void run() { cell(top_, 0, 0, -1, 1); }
+  void run() { cell(top_, 0, 0, -1, 1, kAllActive); }
 
  private:
   float& node(int level, int x, int y) {
@@ -153,8 +153,10 @@ class Caster {
                              std::max(node(l - 1, 2 * x, 2 * y + 1), node(l - 1, 2 * x + 1, 2 * y + 1)));
   }
 
-  // The window of 2^level pixels at (lx, ly) (window-local), its cells in depth [zlo, zhi].
-  void cell(int level, int lx, int ly, double zlo, double zhi) {
+  // The window of 2^level pixels at (lx, ly) (window-local), its cells in depth [zlo, zhi];
+  // `active`: the form's perturbations that may be positive there (ProjectedFreeForm::bound) —
+  // the others are left out of its bounds and rays.
+  void cell(int level, int lx, int ly, double zlo, double zhi, uint64_t active) {
     const int n = 1 << level;
     const int gx0 = w_.x0 + lx, gy0 = w_.y0 + ly;
     const int gx1 = std::min(gx0 + n, w_.width) - 1, gy1 = std::min(gy0 + n, w_.height) - 1;
@@ -175,11 +177,12 @@ class Caster {
       // each ray's span decide, and the crossing is refined directly.
       Interval value, slope;
       ++stats_.depthTests;
-      form_.bound(x, y, {zlo, zhi}, value, slope);
+      uint64_t positive = active;  // of those, the ones that may be positive in the window
+      form_.bound(x, y, {zlo, zhi}, value, slope, &positive);
       if (!value.containsZero()) return;
       // The rays read their own pixels' depths, never the masking pyramid: a hit writes its
       // pixel's node, and the window's ancestors are brought up to date once, after its rays.
-      if (rayWindow(lx, ly, n, gx0, gy0, gx1, gy1, zlo, zhi, !slope.containsZero()))
+      if (rayWindow(lx, ly, n, gx0, gy0, gx1, gy1, zlo, zhi, !slope.containsZero(), positive))
         refreshAbove(level, lx, ly);
       return;
     }
@@ -190,7 +193,8 @@ class Caster {
     constexpr int kSlabs = 16;
     bool holds[kSlabs];
     stats_.depthTests += kSlabs;
-    form_.slabsHolding(x, y, zlo, zhi, kSlabs, holds);
+    uint64_t positive;  // the perturbations that may be positive in the cell: its children's
+    form_.slabsHolding(x, y, zlo, zhi, kSlabs, holds, active, &positive);
     const int h = n / 2;
     for (int s = 0; s < kSlabs;) {
       if (!holds[s]) {
@@ -202,7 +206,8 @@ class Caster {
       const double nlo = zlo + (zhi - zlo) * s / kSlabs;
       const double nhi = e == kSlabs ? zhi : zlo + (zhi - zlo) * e / kSlabs;
       // Step 3: the four children, in this range.
-      for (int c = 0; c < 4; ++c) cell(level - 1, lx + (c & 1) * h, ly + (c >> 1) * h, nlo, nhi);
+      for (int c = 0; c < 4; ++c)
+        cell(level - 1, lx + (c & 1) * h, ly + (c >> 1) * h, nlo, nhi, positive);
       s = e;
     }
   }
@@ -215,7 +220,7 @@ class Caster {
   // a ray whose H may turn within a piece goes on alone from there (firstCrossing). True if any
   // pixel took a hit.
   bool rayWindow(int lx, int ly, int n, int gx0, int gy0, int gx1, int gy1, double zlo, double zhi,
-                 bool monotonic) {
+                 bool monotonic, uint64_t active) {
     double* const x = lanes_.x;
     double* const y = lanes_.y;
     double* const end = lanes_.end;
@@ -239,10 +244,10 @@ class Caster {
       }
     stats_.pixels += uint64_t(count);
     if (monotonic) {
-      form_.monotonicCrossings(x, y, zlo, end, count, guess, z);
+      form_.monotonicCrossings(x, y, zlo, end, count, guess, z, active);
     } else {
       stats_.depthTests +=
-          uint64_t(form_.piecewiseCrossings(x, y, zlo, end, count, kPieces, guess, z, from));
+          uint64_t(form_.piecewiseCrossings(x, y, zlo, end, count, kPieces, guess, z, from, active));
       for (int i = 0; i < count; ++i)
         if (!std::isnan(from[i])) {
           form_.ray(x[i], y[i], ray_);

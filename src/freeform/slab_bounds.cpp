@@ -25,6 +25,7 @@ namespace hn = hwy::HWY_NAMESPACE;
 
 using DD = hn::CappedTag<double, 16>;
 using VD = hn::Vec<DD>;
+using MD = hn::Mask<DD>;
 
 struct Lanes {  // an Interval per lane
   VD lo, hi;
@@ -68,32 +69,54 @@ HWY_INLINE Lanes QuadricBound(DD d, const Quadric& q, const Box& box, const Lane
           hn::Add(hn::Add(hi, linear), hn::Set(d, quadratic.hi))};
 }
 
+// h + w·max(0, v)³·u⁻⁴ (ProjectedFreeForm::boundNode's term for a perturbation bounded by v).
+HWY_INLINE Lanes AddPerturbation(DD d, const Lanes& h, const Lanes& v, const Lanes& invU4,
+                                 double w) {
+  const VD zero = hn::Zero(d);
+  const VD pLo = hn::Max(v.lo, zero), pHi = hn::Max(v.hi, zero);
+  const VD cLo = hn::Mul(hn::Mul(pLo, pLo), pLo), cHi = hn::Mul(hn::Mul(pHi, pHi), pHi);
+  // Interval product, then the weight.
+  const VD p0 = hn::Mul(cLo, invU4.lo), p1 = hn::Mul(cLo, invU4.hi);
+  const VD p2 = hn::Mul(cHi, invU4.lo), p3 = hn::Mul(cHi, invU4.hi);
+  const VD mLo = hn::Min(hn::Min(p0, p1), hn::Min(p2, p3));
+  const VD mHi = hn::Max(hn::Max(p0, p1), hn::Max(p2, p3));
+  const VD vw = hn::Set(d, w);
+  const VD tLo = hn::Mul(w >= 0 ? mLo : mHi, vw), tHi = hn::Mul(w >= 0 ? mHi : mLo, vw);
+  return {hn::Add(h.lo, tLo), hn::Add(h.hi, tHi)};
+}
+
 // ProjectedFreeForm::boundNode for the lanes' z: the node's quadric plus its perturbations'
 // w·max(0, H_c)³·u⁻⁴.
 Lanes NodeBound(DD d, const ProjectedFreeForm::Node* nodes, uint32_t i, const Box& box,
                 const Lanes& z, const Lanes& invU4) {
   Lanes h = QuadricBound(d, nodes[i].q, box, z);
+  for (uint32_t c = i + 1; c < nodes[i].end; c = nodes[c].end)
+    h = AddPerturbation(d, h, NodeBound(d, nodes, c, box, z, invU4), invU4, nodes[c].weight);
+  return h;
+}
+
+// The root's bound: its quadric, and the terms of the perturbations `take` holds (the others are
+// 0 here); `positive` gains the bits of those that may be positive in a lane of `lanes`.
+Lanes RootBound(DD d, const ProjectedFreeForm::Node* nodes, const Box& box, const Lanes& z,
+                const Lanes& invU4, uint64_t take, MD lanes, uint64_t& positive) {
+  Lanes h = QuadricBound(d, nodes[0].q, box, z);
   const VD zero = hn::Zero(d);
-  for (uint32_t c = i + 1; c < nodes[i].end; c = nodes[c].end) {
+  int k = 0;
+  for (uint32_t c = 1; c < nodes[0].end; c = nodes[c].end, ++k) {
+    if (k < 64 && (take >> k & 1) == 0) continue;
     const Lanes v = NodeBound(d, nodes, c, box, z, invU4);
-    const VD pLo = hn::Max(v.lo, zero), pHi = hn::Max(v.hi, zero);
-    const VD cLo = hn::Mul(hn::Mul(pLo, pLo), pLo), cHi = hn::Mul(hn::Mul(pHi, pHi), pHi);
-    // Interval product, then the weight.
-    const VD p0 = hn::Mul(cLo, invU4.lo), p1 = hn::Mul(cLo, invU4.hi);
-    const VD p2 = hn::Mul(cHi, invU4.lo), p3 = hn::Mul(cHi, invU4.hi);
-    const VD mLo = hn::Min(hn::Min(p0, p1), hn::Min(p2, p3));
-    const VD mHi = hn::Max(hn::Max(p0, p1), hn::Max(p2, p3));
-    const double w = nodes[c].weight;
-    const VD vw = hn::Set(d, w);
-    const VD tLo = hn::Mul(w >= 0 ? mLo : mHi, vw), tHi = hn::Mul(w >= 0 ? mHi : mLo, vw);
-    h = {hn::Add(h.lo, tLo), hn::Add(h.hi, tHi)};
+    if (k < 64 && !hn::AllFalse(d, hn::And(lanes, hn::Gt(v.hi, zero))))
+      positive |= uint64_t(1) << k;
+    h = AddPerturbation(d, h, v, invU4, nodes[c].weight);
   }
   return h;
 }
 
 void SlabsHolding(const ProjectedFreeForm::Node* nodes, const Quadric* clips, size_t clipCount,
                   const double* w, Interval x, Interval y, double zlo, double zhi, int count,
-                  bool* holds) {
+                  bool* holds, uint64_t take, uint64_t* active) {
+  uint64_t positive = 0;
+  bool everything = false;  // a slab reaches behind the eye: no perturbation ruled out
   const DD d;
   const size_t n = hn::Lanes(d);
   const Box box{0.5 * (x.lo + x.hi), 0.5 * (y.lo + y.hi), 0.5 * (x.hi - x.lo), 0.5 * (y.hi - y.lo)};
@@ -113,7 +136,9 @@ void SlabsHolding(const ProjectedFreeForm::Node* nodes, const Quadric* clips, si
     const auto behind = hn::Not(hn::Gt(uLo, zero));
     const VD lo2 = hn::Mul(uLo, uLo), hi2 = hn::Mul(uHi, uHi);
     const Lanes invU4{hn::Div(one, hn::Mul(hi2, hi2)), hn::Div(one, hn::Mul(lo2, lo2))};
-    Lanes h = NodeBound(d, nodes, 0, box, z, invU4);
+    const MD inRange = hn::FirstN(d, size_t(count) - s0);
+    if (!hn::AllFalse(d, hn::And(inRange, behind))) everything = true;
+    Lanes h = RootBound(d, nodes, box, z, invU4, take, inRange, positive);
     for (size_t k = 0; k < clipCount; ++k) {
       const Lanes b = QuadricBound(d, clips[k], box, z);
       h = {hn::Min(h.lo, b.lo), hn::Min(h.hi, b.hi)};
@@ -127,6 +152,7 @@ void SlabsHolding(const ProjectedFreeForm::Node* nodes, const Quadric* clips, si
     hn::Store(hn::IfThenElseZero(hn::Or(behind, contains), one), d, out);
     for (size_t i = 0; i < n && s0 + i < size_t(count); ++i) holds[s0 + i] = out[i] != 0;
   }
+  if (active) *active = everything ? take : positive;
 }
 
 }  // namespace HWY_NAMESPACE
@@ -139,10 +165,10 @@ namespace sv::freeform {
 HWY_EXPORT(SlabsHolding);
 
 void ProjectedFreeForm::slabsHolding(Interval x, Interval y, double zlo, double zhi, int count,
-                                     bool* holds) const {
+                                     bool* holds, uint64_t take, uint64_t* active) const {
   HWY_DYNAMIC_DISPATCH(SlabsHolding)
   (nodes_.data(), clips_.data(), clips_.size(), inverse_.m[3].data(), x, y, zlo, zhi,
-   std::clamp(count, 1, 16), holds);
+   std::clamp(count, 1, 16), holds, take, active);
 }
 
 }  // namespace sv::freeform

@@ -40,8 +40,12 @@ struct Rays {
   size_t lanes;
   VD u0;
   double u1;
+  uint64_t active;  // the root's perturbations taken into H (ProjectedFreeForm::bound)
   VD b(size_t q, DD d) const { return hn::Load(d, coefficients + (2 * q) * lanes); }
   VD c(size_t q, DD d) const { return hn::Load(d, coefficients + (2 * q + 1) * lanes); }
+  // Whether child c, the k-th perturbation of node i, is part of H: every child of a
+  // perturbation is; of the root, those `active` holds (the rest are 0 over the rays).
+  bool takes(uint32_t i, int k) const { return i != 0 || k >= 64 || (active >> k & 1) != 0; }
 };
 
 // RayFunction::evaluateNode with the slope.
@@ -50,7 +54,9 @@ VD EvaluateNode(DD d, const Rays& r, uint32_t i, VD z, VD invU4, VD du4, VD& slo
   const VD b = r.b(i, d);
   VD h = hn::Add(hn::Mul(hn::Add(hn::Mul(hn::Set(d, a), z), b), z), r.c(i, d));
   slope = hn::Add(hn::Mul(hn::Set(d, 2 * a), z), b);
+  int k = 0;
   for (uint32_t c = i + 1; c < r.nodes[i].end; c = r.nodes[c].end) {
+    if (!r.takes(i, k++)) continue;
     VD dv;
     const VD v = EvaluateNode(d, r, c, z, invU4, du4, dv);
     const MD positive = hn::Gt(v, hn::Zero(d));
@@ -137,7 +143,9 @@ void NodeBoundSlope(DD d, const Rays& r, uint32_t i, const Lanes& z, const Lanes
   const Lanes s = Scale(d, z, 2 * a);
   slope = {hn::Add(s.lo, b), hn::Add(s.hi, b)};
   const VD zero = hn::Zero(d);
+  int k = 0;
   for (uint32_t c = i + 1; c < r.nodes[i].end; c = r.nodes[c].end) {
+    if (!r.takes(i, k++)) continue;
     Lanes v, dv;
     NodeBoundSlope(d, r, c, z, u4, u5, v, dv);
     const double w = r.nodes[c].weight;
@@ -195,9 +203,18 @@ double* CoefficientStorage(size_t doubles) {
 
 // ProjectedFreeForm::ray for the lanes' rays (vx, vy): each quadric along z, into `coefficients`.
 Rays SetUpRays(DD d, const ProjectedFreeForm::Node* nodes, const Quadric* clips, size_t clipCount,
-               const double* w, VD vx, VD vy, double* coefficients) {
-  const size_t n = hn::Lanes(d), quadrics = nodes[0].end + clipCount;
-  for (size_t q = 0; q < quadrics; ++q) {
+               const double* w, uint64_t active, VD vx, VD vy, double* coefficients) {
+  const size_t n = hn::Lanes(d);
+  const Rays rays{nodes,
+                  clips,
+                  clipCount,
+                  coefficients,
+                  n,
+                  hn::Add(hn::Add(hn::Mul(hn::Set(d, w[0]), vx), hn::Mul(hn::Set(d, w[1]), vy)),
+                          hn::Set(d, w[3])),
+                  w[2],
+                  active};
+  const auto alongZ = [&](size_t q) {
     const auto& k = q < nodes[0].end ? nodes[q].q.c : clips[q - nodes[0].end].c;
     const VD b = hn::Add(hn::Add(hn::Mul(hn::Set(d, k[4]), vx), hn::Mul(hn::Set(d, k[5]), vy)),
                          hn::Set(d, k[8]));
@@ -207,15 +224,15 @@ Rays SetUpRays(DD d, const ProjectedFreeForm::Node* nodes, const Quadric* clips,
     const VD c = hn::Add(hn::Add(hn::Mul(cx, vx), hn::Mul(cy, vy)), hn::Set(d, k[9]));
     hn::Store(b, d, coefficients + (2 * q) * n);
     hn::Store(c, d, coefficients + (2 * q + 1) * n);
-  }
-  return {nodes,
-          clips,
-          clipCount,
-          coefficients,
-          n,
-          hn::Add(hn::Add(hn::Mul(hn::Set(d, w[0]), vx), hn::Mul(hn::Set(d, w[1]), vy)),
-                  hn::Set(d, w[3])),
-          w[2]};
+  };
+  // The root, the perturbations taken into H with their own, and the clips.
+  alongZ(0);
+  int k = 0;
+  for (uint32_t c = 1; c < nodes[0].end; c = nodes[c].end)
+    if (rays.takes(0, k++))
+      for (uint32_t q = c; q < nodes[c].end; ++q) alongZ(q);
+  for (size_t q = nodes[0].end; q < nodes[0].end + clipCount; ++q) alongZ(q);
+  return rays;
 }
 
 // newtonConverged (freeform.h) for the lanes' step lengths s and the steps before them.
@@ -288,11 +305,11 @@ void ForEachVector(DD d, const double* x, const double* y, double zlo, const dou
 void MonotonicCrossings(const ProjectedFreeForm::Node* nodes, const Quadric* clips,
                         size_t clipCount, const double* w, const double* x, const double* y,
                         double zlo, const double* zhi, int count, const double* guess,
-                        double* out) {
+                        double* out, uint64_t active) {
   const DD d;
   double* coefficients = CoefficientStorage(2 * (nodes[0].end + clipCount) * hn::Lanes(d));
   ForEachVector(d, x, y, zlo, zhi, count, [&](size_t s0, size_t m, VD vx, VD vy, VD vz) {
-    const Rays rays = SetUpRays(d, nodes, clips, clipCount, w, vx, vy, coefficients);
+    const Rays rays = SetUpRays(d, nodes, clips, clipCount, w, active, vx, vy, coefficients);
     const VD a = hn::Set(d, zlo), b = vz, zero = hn::Zero(d), g = LoadPadded(d, guess, s0, m, 0);
     const MD span = hn::Lt(a, b);
     // Step 1: Newton alone from the guesses. H is monotonic over each span, so a zero Newton
@@ -327,7 +344,7 @@ void MonotonicCrossings(const ProjectedFreeForm::Node* nodes, const Quadric* cli
 int PiecewiseCrossings(const ProjectedFreeForm::Node* nodes, const Quadric* clips, size_t clipCount,
                        const double* w, const double* x, const double* y, double zlo,
                        const double* zhi, int count, int pieces, const double* guess, double* out,
-                       double* from) {
+                       double* from, uint64_t active) {
   const DD d;
   double* coefficients = CoefficientStorage(2 * (nodes[0].end + clipCount) * hn::Lanes(d));
   // The pieces divide [zlo, the farthest span end] of all the rays, whatever the lane count.
@@ -335,7 +352,7 @@ int PiecewiseCrossings(const ProjectedFreeForm::Node* nodes, const Quadric* clip
   for (int i = 0; i < count; ++i) zMax = std::max(zMax, zhi[i]);
   int bounds = 0;
   ForEachVector(d, x, y, zlo, zhi, count, [&](size_t s0, size_t m, VD vx, VD vy, VD vz) {
-    const Rays rays = SetUpRays(d, nodes, clips, clipCount, w, vx, vy, coefficients);
+    const Rays rays = SetUpRays(d, nodes, clips, clipCount, w, active, vx, vy, coefficients);
     const VD zero = hn::Zero(d), nan = hn::Set(d, std::numeric_limits<double>::quiet_NaN());
     VD found = nan, next = nan;
     MD pending = hn::Lt(hn::Set(d, zlo), vz);
@@ -384,18 +401,19 @@ HWY_EXPORT(PiecewiseCrossings);
 
 void ProjectedFreeForm::monotonicCrossings(const double* x, const double* y, double zlo,
                                            const double* zhi, int count, const double* guess,
-                                           double* z) const {
+                                           double* z, uint64_t active) const {
   HWY_DYNAMIC_DISPATCH(MonotonicCrossings)
   (nodes_.data(), clips_.data(), clips_.size(), inverse_.m[3].data(), x, y, zlo, zhi,
-   std::clamp(count, 0, 16), guess, z);
+   std::clamp(count, 0, 16), guess, z, active);
 }
 
 int ProjectedFreeForm::piecewiseCrossings(const double* x, const double* y, double zlo,
                                           const double* zhi, int count, int pieces,
-                                          const double* guess, double* z, double* from) const {
+                                          const double* guess, double* z, double* from,
+                                          uint64_t active) const {
   return HWY_DYNAMIC_DISPATCH(PiecewiseCrossings)(
       nodes_.data(), clips_.data(), clips_.size(), inverse_.m[3].data(), x, y, zlo, zhi,
-      std::clamp(count, 0, 16), std::max(pieces, 1), guess, z, from);
+      std::clamp(count, 0, 16), std::max(pieces, 1), guess, z, from, active);
 }
 
 }  // namespace sv::freeform
