@@ -124,34 +124,13 @@ constexpr int kPieces = 8;
 class Caster {
  public:
   Caster(const ProjectedFreeForm& form, uint32_t id, const CastWindow& w, const CastSettings& s,
-         CastStats& stats)
-      : form_(form), id_(id), w_(w), settings_(s), stats_(stats) {
-    top_ = std::countr_zero(unsigned(w.size));
-    // Step 0: the masking pyramid — per window of every level, the largest depth its pixels hold
-    // (pixels beyond the raster hold −∞: they never need a surface).
-    zmax_.resize(size_t(top_) + 1);
-    for (int l = 0; l <= top_; ++l) zmax_[size_t(l)].assign(size_t(1) << (2 * (top_ - l)), 0.0f);
-    for (int y = 0; y < w.size; ++y)
-      for (int x = 0; x < w.size; ++x)
-        zmax_[0][size_t(y * w.size + x)] =
-            w.x0 + x < w.width && w.y0 + y < w.height
-                ? w.depth[size_t(y) * size_t(w.stride) + size_t(x)]
-                : -std::numeric_limits<float>::infinity();
-    for (int l = 1; l <= top_; ++l)
-      for (int y = 0; y < (w.size >> l); ++y)
-        for (int x = 0; x < (w.size >> l); ++x) updateNode(l, x, y);
-  }
+         MaskingPyramid& pyramid, CastStats& stats)
+      : form_(form), id_(id), w_(w), settings_(s), pyramid_(pyramid), stats_(stats) {}
 
-  void run() { cell(top_, 0, 0, -1, 1, kAllActive); }
+  void run() { cell(pyramid_.top(), 0, 0, -1, 1, kAllActive); }
 
  private:
-  float& node(int level, int x, int y) {
-    return zmax_[size_t(level)][size_t(y * (w_.size >> level) + x)];
-  }
-  void updateNode(int l, int x, int y) {
-    node(l, x, y) = std::max(std::max(node(l - 1, 2 * x, 2 * y), node(l - 1, 2 * x + 1, 2 * y)),
-                             std::max(node(l - 1, 2 * x, 2 * y + 1), node(l - 1, 2 * x + 1, 2 * y + 1)));
-  }
+  float& node(int level, int x, int y) { return pyramid_.node(level, x, y); }
 
   // The window of 2^level pixels at (lx, ly) (window-local), its cells in depth [zlo, zhi];
   // `active`: the form's perturbations that may be positive there (ProjectedFreeForm::bound) —
@@ -298,23 +277,14 @@ class Caster {
     return true;
   }
 
-  // Recomputes the nodes above the window of 2^level pixels at (lx, ly): every node of it at the
-  // levels up to its own, then its single ancestor at each level above.
-  void refreshAbove(int level, int lx, int ly) {
-    for (int l = 1; l <= top_; ++l) {
-      const int span = l <= level ? 1 << (level - l) : 1;
-      for (int y = 0; y < span; ++y)
-        for (int x = 0; x < span; ++x) updateNode(l, (lx >> l) + x, (ly >> l) + y);
-    }
-  }
+  void refreshAbove(int level, int lx, int ly) { pyramid_.refreshAbove(level, lx, ly); }
 
   const ProjectedFreeForm& form_;
   uint32_t id_;
   const CastWindow& w_;
   const CastSettings& settings_;
+  MaskingPyramid& pyramid_;
   CastStats& stats_;
-  int top_ = 0;
-  std::vector<std::vector<float>> zmax_;  // [level][y · (size >> level) + x]
   RayFunction ray_;  // the current pixel's
   struct {           // rayWindow's rays (only the first `count` of each are read)
     double x[16], y[16], end[16], guess[16], z[16], from[16];
@@ -325,12 +295,49 @@ class Caster {
 
 }  // namespace
 
+MaskingPyramid::MaskingPyramid(const CastWindow& w) : size_(w.size) {
+  top_ = std::countr_zero(unsigned(w.size));
+  levels_.resize(size_t(top_) + 1);
+  for (int l = 0; l <= top_; ++l) levels_[size_t(l)].resize(size_t(1) << (2 * (top_ - l)));
+  // Level 0: the depths, row by row; pixels beyond the raster hold −∞ (they never need a
+  // surface).
+  const int columns = std::clamp(w.width - w.x0, 0, w.size);
+  for (int y = 0; y < w.size; ++y) {
+    float* row = &node(0, 0, y);
+    const int inside = w.y0 + y < w.height ? columns : 0;
+    std::copy_n(w.depth + size_t(y) * size_t(w.stride), inside, row);
+    std::fill(row + inside, row + w.size, -std::numeric_limits<float>::infinity());
+  }
+  for (int l = 1; l <= top_; ++l)
+    for (int y = 0; y < (w.size >> l); ++y)
+      for (int x = 0; x < (w.size >> l); ++x) update(l, x, y);
+}
+
+void MaskingPyramid::update(int l, int x, int y) {
+  node(l, x, y) =
+      std::max(std::max(node(l - 1, 2 * x, 2 * y), node(l - 1, 2 * x + 1, 2 * y)),
+               std::max(node(l - 1, 2 * x, 2 * y + 1), node(l - 1, 2 * x + 1, 2 * y + 1)));
+}
+
+void MaskingPyramid::refreshAbove(int level, int lx, int ly) {
+  for (int l = 1; l <= top_; ++l) {
+    const int span = l <= level ? 1 << (level - l) : 1;
+    for (int y = 0; y < span; ++y)
+      for (int x = 0; x < span; ++x) update(l, (lx >> l) + x, (ly >> l) + y);
+  }
+}
+
 void castWindow(const ProjectedFreeForm& form, uint32_t id, const CastWindow& window,
-                const CastSettings& settings, CastStats& stats) {
+                const CastSettings& settings, CastStats& stats, MaskingPyramid* pyramid) {
   // Counted locally: the callers' per-thread totals may share a cache line, and counting into
   // them directly made one line bounce between the cores on every bound (2/3 of a frame).
   CastStats local;
-  Caster(form, id, window, settings, local).run();
+  if (pyramid) {
+    Caster(form, id, window, settings, *pyramid, local).run();
+  } else {
+    MaskingPyramid own(window);
+    Caster(form, id, window, settings, own, local).run();
+  }
   stats.add(local);
 }
 

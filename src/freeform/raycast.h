@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include "freeform/freeform.h"
 
@@ -60,11 +61,33 @@ struct CastSettings {
   bool adaptiveSamples = true;
 };
 
+// The masking pyramid of a window (SPEC §12, multi-level masking): per square of every level,
+// the largest depth its pixels hold. Built from the window's depths; castWindow keeps it up to
+// date as its hits lower them, so the forms cast one after another into a window share one
+// (nothing else may write the window's depths meanwhile).
+class MaskingPyramid {
+ public:
+  explicit MaskingPyramid(const CastWindow& window);
+  int top() const { return top_; }  // the level of the whole window: size = 2^top
+  float& node(int level, int x, int y) {
+    return levels_[size_t(level)][size_t(y * (size_ >> level) + x)];
+  }
+  // Recomputes the nodes above the square of 2^level pixels at (lx, ly): every node of it at
+  // the levels up to its own, then its single ancestor at each level above.
+  void refreshAbove(int level, int lx, int ly);
+
+ private:
+  void update(int level, int x, int y);
+  int size_ = 0, top_ = 0;
+  std::vector<std::vector<float>> levels_;  // [level][y · (size >> level) + x]
+};
+
 // Casts `form` (number `id`) into the window: every pixel whose ray meets the surface at a window
 // depth below the one it holds takes the first such hit (the first zero of H along the ray in
-// [−1, 1], found to double precision once bracketed). Returns nothing; adds to `stats`.
+// [−1, 1], found to double precision once bracketed). `pyramid`: the window's, shared with the
+// forms cast into it before (nullptr: one is built for this call). Adds to `stats`.
 void castWindow(const ProjectedFreeForm& form, uint32_t id, const CastWindow& window,
-                const CastSettings& settings, CastStats& stats);
+                const CastSettings& settings, CastStats& stats, MaskingPyramid* pyramid = nullptr);
 
 // One ray of the cube (x, y): the first crossing of `form` beyond cube depth `from` and nearer
 // than `depth` (window depth) takes `depth`, `object` (= id) and `cubeZ`. `from`: where the form's

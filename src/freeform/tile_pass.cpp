@@ -135,12 +135,12 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
     w.stride = kTileSize;
     w.offsetX = dx;
     w.offsetY = dy;
-    for (uint32_t f : listed) {
-      if (marchSteps_ > 0)
-        marchWindow(forms_[f].projected, f, w, marchSteps_, stats);
-      else
-        castWindow(forms_[f].projected, f, w, settings_, stats);
+    if (marchSteps_ > 0) {
+      for (uint32_t f : listed) marchWindow(forms_[f].projected, f, w, marchSteps_, stats);
+      return;
     }
+    MaskingPyramid pyramid(w);  // one for all the forms
+    for (uint32_t f : listed) castWindow(forms_[f].projected, f, w, settings_, stats, &pyramid);
   };
   auto planeOf = [&](int k) {
     const size_t at = plane * size_t(k);

@@ -43,23 +43,29 @@ struct Buffers {
         object(size_t(w) * h, kNoHit) {}
 };
 
+// The 64×64 window of `b` at (x0, y0).
+CastWindow windowOf(Buffers& b, int x0, int y0) {
+  CastWindow w;
+  w.width = b.width;
+  w.height = b.height;
+  w.x0 = x0;
+  w.y0 = y0;
+  w.size = 64;
+  const size_t at = size_t(y0) * size_t(b.width) + size_t(x0);
+  w.depth = b.depth.data() + at;
+  w.cubeZ = b.cubeZ.data() + at;
+  w.object = b.object.data() + at;
+  w.stride = b.width;
+  return w;
+}
+
 // Casts `form` over the whole raster in 64×64 windows (or marches it, steps > 0).
 CastStats cast(const ProjectedFreeForm& form, uint32_t id, Buffers& b, bool masking = true,
                int steps = 0) {
   CastStats stats;
   for (int y0 = 0; y0 < b.height; y0 += 64)
     for (int x0 = 0; x0 < b.width; x0 += 64) {
-      CastWindow w;
-      w.width = b.width;
-      w.height = b.height;
-      w.x0 = x0;
-      w.y0 = y0;
-      w.size = 64;
-      const size_t at = size_t(y0) * size_t(b.width) + size_t(x0);
-      w.depth = b.depth.data() + at;
-      w.cubeZ = b.cubeZ.data() + at;
-      w.object = b.object.data() + at;
-      w.stride = b.width;
+      const CastWindow w = windowOf(b, x0, y0);
       if (steps > 0)
         marchWindow(form, id, w, steps, stats);
       else
@@ -313,8 +319,9 @@ TEST(RayCast, PiecewiseCrossingsAreTheEntriesOnEveryTarget) {
   EXPECT_GE(targets, 1);
 }
 
-// A sculpture: masking skips hidden cells but never changes a pixel; the fixed-step marcher finds
-// the same surface where its steps do not skip it.
+// A sculpture: masking skips hidden cells but never changes a pixel, with a masking pyramid per
+// form or one shared by the forms of a window; the fixed-step marcher finds the same surface
+// where its steps do not skip it.
 TEST(RayCast, MaskingChangesNothingAndTheMarcherAgrees) {
   const int w = 96, h = 64;
   FreeForm f;
@@ -336,6 +343,19 @@ TEST(RayCast, MaskingChangesNothingAndTheMarcherAgrees) {
   ps.add(cast(*floor, 2, plain, false));
   EXPECT_EQ(masked.depth, plain.depth);
   EXPECT_EQ(masked.object, plain.object);
+  // Both forms cast window by window into one masking pyramid per window (as the tile pass
+  // does): the same buffers.
+  Buffers shared(w, h);
+  for (int y0 = 0; y0 < h; y0 += 64)
+    for (int x0 = 0; x0 < w; x0 += 64) {
+      const CastWindow window = windowOf(shared, x0, y0);
+      MaskingPyramid pyramid(window);
+      CastStats stats;
+      castWindow(*g, 1, window, CastSettings{}, stats, &pyramid);
+      castWindow(*floor, 2, window, CastSettings{}, stats, &pyramid);
+    }
+  EXPECT_EQ(shared.depth, masked.depth);
+  EXPECT_EQ(shared.object, masked.object);
   EXPECT_GT(ms.maskedCells, 0u);
   EXPECT_LT(ms.depthTests, ps.depthTests);
   cast(*g, 1, marched, true, 2048);
