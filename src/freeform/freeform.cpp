@@ -205,14 +205,28 @@ void alongZ(const Quadric& q, double x, double y, double& a, double& b, double& 
 }
 }  // namespace
 
-void ProjectedFreeForm::ray(double x, double y, RayFunction& out) const {
+void ProjectedFreeForm::ray(double x, double y, RayFunction& out, uint64_t active) const {
+  // The nodes in preorder, without the root's perturbations `active` leaves out (and their own):
+  // the indices after a left-out subtree move down by its size.
   out.nodes_.resize(nodes_.size());
-  for (size_t i = 0; i < nodes_.size(); ++i) {
-    RayFunction::Node& n = out.nodes_[i];
+  uint32_t kept = 0, shift = 0;
+  const auto keep = [&](uint32_t i) {
+    RayFunction::Node& n = out.nodes_[kept++];
     alongZ(nodes_[i].q, x, y, n.a, n.b, n.c);
     n.weight = nodes_[i].weight;
-    n.end = nodes_[i].end;
+    n.end = nodes_[i].end - shift;
+  };
+  keep(0);
+  int k = 0;
+  for (uint32_t c = 1; c < nodes_[0].end; c = nodes_[c].end, ++k) {
+    if (k < 64 && (active >> k & 1) == 0) {
+      shift += nodes_[c].end - c;
+      continue;
+    }
+    for (uint32_t i = c; i < nodes_[c].end; ++i) keep(i);
   }
+  out.nodes_[0].end = kept;
+  out.nodes_.resize(kept);
   out.clips_.resize(clips_.size());
   for (size_t i = 0; i < clips_.size(); ++i) {
     RayFunction::Node& n = out.clips_[i];

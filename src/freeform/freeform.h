@@ -138,8 +138,9 @@ class ProjectedFreeForm {
   int piecewiseCrossings(const double* x, const double* y, double zlo, const double* zhi, int count,
                          int pieces, const double* guess, double* z, double* from,
                          uint64_t active = kAllActive) const;
-  // H along the ray (x, y) of the cube, into `out` (its storage reused).
-  void ray(double x, double y, RayFunction& out) const;
+  // H along the ray (x, y) of the cube, into `out` (its storage reused); without the root's
+  // perturbations `active` leaves out (known to be 0 along the ray, see bound).
+  void ray(double x, double y, RayFunction& out, uint64_t active = kAllActive) const;
   const Mat4d& inverse() const { return inverse_; }
 
   // The quadrics in preorder: a node's perturbations follow it, its subtree ends at `end`.

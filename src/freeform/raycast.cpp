@@ -229,7 +229,7 @@ class Caster {
           uint64_t(form_.piecewiseCrossings(x, y, zlo, end, count, kPieces, guess, z, from, active));
       for (int i = 0; i < count; ++i)
         if (!std::isnan(from[i])) {
-          form_.ray(x[i], y[i], ray_);
+          form_.ray(x[i], y[i], ray_, active);
           if (!firstCrossing(ray_, from[i], end[i], std::numeric_limits<double>::quiet_NaN(), z[i],
                              stats_))
             z[i] = std::numeric_limits<double>::quiet_NaN();

@@ -267,6 +267,52 @@ TEST(Projected, SlabBoundsEqualTheScalarBoundOnEveryTarget) {
   EXPECT_GE(targets, 1);
 }
 
+// A ray without the perturbations a box's bound rules out (ProjectedFreeForm::ray's `active`) is
+// the same function inside the box, value and slope, bit for bit — and the form's own value.
+TEST(Projected, RaysWithoutRuledOutPerturbationsAreTheSameFunction) {
+  const FreeForm f = bumpySphere();
+  std::array<Vec3d, 5> frustum = {
+      Vec3d{-1, -1, 3}, {1, -1, 3}, {-1, 1, 3}, {-5, -5, -1}, {5, 5, -1}};
+  std::array<Vec3d, 5> cube = {Vec3d{-1, -1, -1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}, {1, 1, 1}};
+  const std::optional<ProjectedFreeForm> g =
+      ProjectedFreeForm::make(f, *projectiveFromFivePoints(frustum, cube));
+  ASSERT_TRUE(g);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(0, 1);
+  int ruledOut = 0;
+  RayFunction all, some;
+  const Mat4d toCube = *projectiveFromFivePoints(frustum, cube);
+  int differs = 0;  // samples where the bump is positive: leaving it out would change H there
+  for (int trial = 0; trial < 2000; ++trial) {
+    // Small boxes about points in the bump (object centre (0.9, 0, 0), radius 0.5).
+    const double size = std::exp2(-3 - u(rng) * 5);
+    const Vec3d c = toCube.transformPoint(Vec3d{0.9, 0, 0} + randomPoint(rng, 0.35));
+    const Interval x{c.x - size / 2, c.x + size / 2}, y{c.y - size / 2, c.y + size / 2},
+        z{c.z - size / 2, c.z + size / 2};
+    Interval value, slope;
+    uint64_t active = kAllActive;
+    g->bound(x, y, z, value, slope, &active);
+    if (active == kAllActive) continue;
+    ++ruledOut;
+    for (int k = 0; k < 4; ++k) {
+      const double rx = x.lo + size * u(rng), ry = y.lo + size * u(rng), rz = z.lo + size * u(rng);
+      g->ray(rx, ry, all);
+      g->ray(rx, ry, some, active);
+      double s1, s2;
+      EXPECT_EQ(all.evaluate(rz, s1), some.evaluate(rz, s2)) << "trial " << trial;
+      EXPECT_EQ(s1, s2) << "trial " << trial;
+      EXPECT_EQ(all.evaluate(rz), some.evaluate(rz)) << "trial " << trial;
+      const double h = g->evaluate({rx, ry, rz});  // the form itself, at the point
+      EXPECT_NEAR(some.evaluate(rz), h, 1e-9 * (1 + std::fabs(h))) << "trial " << trial;
+      RayFunction base;  // every perturbation left out
+      g->ray(rx, ry, base, 0);
+      differs += all.evaluate(rz) != base.evaluate(rz) ? 1 : 0;
+    }
+  }
+  EXPECT_GT(ruledOut, 500);
+  EXPECT_GT(differs, 500);  // the perturbations kept matter where they were kept
+}
+
 // The projected form has the object's surface and inside: H = u²·F' at corresponding points.
 TEST(Projected, HasTheSameSignAsTheObjectFormAtCorrespondingPoints) {
   const FreeForm f = bumpySphere();
