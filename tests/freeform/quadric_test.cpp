@@ -34,6 +34,15 @@ FreeForm bumpySphere() {
   return f;
 }
 
+// The map of a perspective frustum — a camera at z = 4 looking down −z — onto the cube.
+Mat4d frustumToCube() {
+  const std::array<Vec3d, 5> frustum = {
+      Vec3d{-1, -1, 3}, {1, -1, 3}, {-1, 1, 3}, {-5, -5, -1}, {5, 5, -1}};
+  const std::array<Vec3d, 5> cube = {
+      Vec3d{-1, -1, -1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}, {1, 1, 1}};
+  return *projectiveFromFivePoints(frustum, cube);
+}
+
 // A capped cylinder: the cylinder's inside cut by two half-spaces; the gradient is the active
 // term's.
 TEST(Quadric, ClipsIntersectInsides) {
@@ -179,9 +188,7 @@ TEST(Interval, BoundsContainSampledValues) {
   // Cut by two clips as well (set-theoretic intersection): min(F', C_1, C_2).
   f.clips = {Quadric::halfSpace({0, 1, 0}, 0.7), Quadric::cylinder({0, 0, 0}, {0, 1, 0}, 1.1)};
   // A perspective map: the frustum of a camera at z = 4 looking down −z onto the cube.
-  std::array<Vec3d, 5> frustum = {Vec3d{-1, -1, 3}, {1, -1, 3}, {-1, 1, 3}, {-5, -5, -1}, {5, 5, -1}};
-  std::array<Vec3d, 5> cube = {Vec3d{-1, -1, -1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}, {1, 1, 1}};
-  const std::optional<ProjectedFreeForm> g = ProjectedFreeForm::make(f, *projectiveFromFivePoints(frustum, cube));
+  const std::optional<ProjectedFreeForm> g = ProjectedFreeForm::make(f, frustumToCube());
   ASSERT_TRUE(g);
   for (int trial = 0; trial < 2000; ++trial) {
     const double size = std::exp2(-u(rng) * 10);
@@ -208,11 +215,7 @@ TEST(Interval, BoundsContainSampledValues) {
 TEST(Projected, SlabBoundsEqualTheScalarBoundOnEveryTarget) {
   FreeForm f = bumpySphere();
   f.clips = {Quadric::halfSpace({0, 1, 0}, 0.7)};
-  std::array<Vec3d, 5> frustum = {
-      Vec3d{-1, -1, 3}, {1, -1, 3}, {-1, 1, 3}, {-5, -5, -1}, {5, 5, -1}};
-  std::array<Vec3d, 5> cube = {Vec3d{-1, -1, -1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}, {1, 1, 1}};
-  const std::optional<ProjectedFreeForm> g =
-      ProjectedFreeForm::make(f, *projectiveFromFivePoints(frustum, cube));
+  const std::optional<ProjectedFreeForm> g = ProjectedFreeForm::make(f, frustumToCube());
   ASSERT_TRUE(g);
   int targets = 0;
   for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
@@ -271,17 +274,13 @@ TEST(Projected, SlabBoundsEqualTheScalarBoundOnEveryTarget) {
 // the same function inside the box, value and slope, bit for bit — and the form's own value.
 TEST(Projected, RaysWithoutRuledOutPerturbationsAreTheSameFunction) {
   const FreeForm f = bumpySphere();
-  std::array<Vec3d, 5> frustum = {
-      Vec3d{-1, -1, 3}, {1, -1, 3}, {-1, 1, 3}, {-5, -5, -1}, {5, 5, -1}};
-  std::array<Vec3d, 5> cube = {Vec3d{-1, -1, -1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}, {1, 1, 1}};
-  const std::optional<ProjectedFreeForm> g =
-      ProjectedFreeForm::make(f, *projectiveFromFivePoints(frustum, cube));
+  const std::optional<ProjectedFreeForm> g = ProjectedFreeForm::make(f, frustumToCube());
   ASSERT_TRUE(g);
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(0, 1);
   int ruledOut = 0;
   RayFunction all, some;
-  const Mat4d toCube = *projectiveFromFivePoints(frustum, cube);
+  const Mat4d toCube = frustumToCube();
   int differs = 0;  // samples where the bump is positive: leaving it out would change H there
   for (int trial = 0; trial < 2000; ++trial) {
     // Small boxes about points in the bump (object centre (0.9, 0, 0), radius 0.5).
@@ -316,9 +315,7 @@ TEST(Projected, RaysWithoutRuledOutPerturbationsAreTheSameFunction) {
 // The projected form has the object's surface and inside: H = u²·F' at corresponding points.
 TEST(Projected, HasTheSameSignAsTheObjectFormAtCorrespondingPoints) {
   const FreeForm f = bumpySphere();
-  std::array<Vec3d, 5> frustum = {Vec3d{-1, -1, 3}, {1, -1, 3}, {-1, 1, 3}, {-5, -5, -1}, {5, 5, -1}};
-  std::array<Vec3d, 5> cube = {Vec3d{-1, -1, -1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}, {1, 1, 1}};
-  const Mat4d m = *projectiveFromFivePoints(frustum, cube);
+  const Mat4d m = frustumToCube();
   const std::optional<ProjectedFreeForm> g = ProjectedFreeForm::make(f, m);
   ASSERT_TRUE(g);
   std::mt19937 rng(5);
