@@ -127,7 +127,12 @@ class Caster {
          MaskingPyramid& pyramid, CastStats& stats)
       : form_(form), id_(id), w_(w), settings_(s), pyramid_(pyramid), stats_(stats) {}
 
-  void run() { cell(pyramid_.top(), 0, 0, -1, 1, kAllActive); }
+  // Casts the form; returns the perturbations that may be positive anywhere in the window (all
+  // where the whole window was never bounded).
+  uint64_t run() {
+    cell(pyramid_.top(), 0, 0, -1, 1, kAllActive);
+    return windowActive_;
+  }
 
  private:
   float& node(int level, int x, int y) { return pyramid_.node(level, x, y); }
@@ -174,6 +179,7 @@ class Caster {
     stats_.depthTests += kSlabs;
     uint64_t positive;  // the perturbations that may be positive in the cell: its children's
     form_.slabsHolding(x, y, zlo, zhi, kSlabs, holds, active, &positive);
+    if (level == pyramid_.top()) windowActive_ = positive;
     const int h = n / 2;
     for (int s = 0; s < kSlabs;) {
       if (!holds[s]) {
@@ -285,6 +291,7 @@ class Caster {
   const CastSettings& settings_;
   MaskingPyramid& pyramid_;
   CastStats& stats_;
+  uint64_t windowActive_ = kAllActive;  // run()'s
   RayFunction ray_;  // the current pixel's
   struct {           // rayWindow's rays (only the first `count` of each are read)
     double x[16], y[16], end[16], guess[16], z[16], from[16];
@@ -328,16 +335,19 @@ void MaskingPyramid::refreshAbove(int level, int lx, int ly) {
 }
 
 void castWindow(const ProjectedFreeForm& form, uint32_t id, const CastWindow& window,
-                const CastSettings& settings, CastStats& stats, MaskingPyramid* pyramid) {
+                const CastSettings& settings, CastStats& stats, MaskingPyramid* pyramid,
+                uint64_t* active) {
   // Counted locally: the callers' per-thread totals may share a cache line, and counting into
   // them directly made one line bounce between the cores on every bound (2/3 of a frame).
   CastStats local;
+  uint64_t positive;
   if (pyramid) {
-    Caster(form, id, window, settings, *pyramid, local).run();
+    positive = Caster(form, id, window, settings, *pyramid, local).run();
   } else {
     MaskingPyramid own(window);
-    Caster(form, id, window, settings, own, local).run();
+    positive = Caster(form, id, window, settings, own, local).run();
   }
+  if (active) *active = positive;
   stats.add(local);
 }
 

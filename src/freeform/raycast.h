@@ -85,9 +85,12 @@ class MaskingPyramid {
 // Casts `form` (number `id`) into the window: every pixel whose ray meets the surface at a window
 // depth below the one it holds takes the first such hit (the first zero of H along the ray in
 // [−1, 1], found to double precision once bracketed). `pyramid`: the window's, shared with the
-// forms cast into it before (nullptr: one is built for this call). Adds to `stats`.
+// forms cast into it before (nullptr: one is built for this call). `active` (if given): the
+// form's perturbations that may be positive anywhere in the window (ProjectedFreeForm::bound) —
+// the others are 0 at all its hits. Adds to `stats`.
 void castWindow(const ProjectedFreeForm& form, uint32_t id, const CastWindow& window,
-                const CastSettings& settings, CastStats& stats, MaskingPyramid* pyramid = nullptr);
+                const CastSettings& settings, CastStats& stats, MaskingPyramid* pyramid = nullptr,
+                uint64_t* active = nullptr);
 
 // One ray of the cube (x, y): the first crossing of `form` beyond cube depth `from` and nearer
 // than `depth` (window depth) takes `depth`, `object` (= id) and `cubeZ`. `from`: where the form's

@@ -74,11 +74,15 @@ HWY_INLINE V3 QuadricGradient(DD d, const Quadric& q, const V3& p) {
           row(2 * c[2], p.z, c[4], p.x, c[5], p.y, c[8])};
 }
 
-// FreeForm::evaluate and FreeForm::gradient of node i's subtree (without clips).
-VD ValueAndGradient(DD d, const ProjectedFreeForm::Node* nodes, uint32_t i, const V3& p, V3& g) {
+// FreeForm::evaluate and FreeForm::gradient of node i's subtree (without clips); of the root's
+// perturbations, those `active` holds.
+VD ValueAndGradient(DD d, const ProjectedFreeForm::Node* nodes, uint32_t i, const V3& p, V3& g,
+                    uint64_t active = kAllActive) {
   VD f = QuadricValue(d, nodes[i].q, p);
   g = QuadricGradient(d, nodes[i].q, p);
-  for (uint32_t c = i + 1; c < nodes[i].end; c = nodes[c].end) {
+  int k = 0;
+  for (uint32_t c = i + 1; c < nodes[i].end; c = nodes[c].end, ++k) {
+    if (k < 64 && (active >> k & 1) == 0) continue;
     V3 gc;
     const VD v = ValueAndGradient(d, nodes, c, p, gc);
     const MD positive = hn::Gt(v, hn::Zero(d));
@@ -94,7 +98,7 @@ VD ValueAndGradient(DD d, const ProjectedFreeForm::Node* nodes, uint32_t i, cons
 
 void SurfaceAt(const ProjectedFreeForm& object, const Mat4d& cubeToObject, const Mat4d& objectToEye,
                const Mat4d& normalToEye, const double* x, const double* y, const double* z,
-               int count, SurfaceLanes& out) {
+               int count, SurfaceLanes& out, uint64_t active) {
   const DD d;
   const size_t n = hn::Lanes(d);
   const ProjectedFreeForm::Node* nodes = object.nodes().data();
@@ -106,7 +110,7 @@ void SurfaceAt(const ProjectedFreeForm& object, const Mat4d& cubeToObject, const
     const V3 q{hn::Load(d, in[0] + i), hn::Load(d, in[1] + i), hn::Load(d, in[2] + i)};
     const V3 p = TransformPoint(d, cubeToObject, q);
     V3 g;
-    VD f = ValueAndGradient(d, nodes, 0, p, g);
+    VD f = ValueAndGradient(d, nodes, 0, p, g, active);
     // With clips, the gradient of whichever term is the minimum.
     for (const Quadric& clip : object.clips()) {
       const VD v = QuadricValue(d, clip, p);
@@ -152,9 +156,10 @@ SurfacePoints::SurfacePoints(const FreeForm& form, const Mat4d& cubeToObject,
       normalToEye_(normalToEye) {}
 
 void SurfacePoints::at(const double* x, const double* y, const double* z, int count,
-                       SurfaceLanes& out) const {
+                       SurfaceLanes& out, uint64_t active) const {
   HWY_DYNAMIC_DISPATCH(SurfaceAt)
-  (object_, cubeToObject_, objectToEye_, normalToEye_, x, y, z, std::clamp(count, 0, 16), out);
+  (object_, cubeToObject_, objectToEye_, normalToEye_, x, y, z, std::clamp(count, 0, 16), out,
+   active);
 }
 
 }  // namespace sv::freeform

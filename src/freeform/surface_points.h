@@ -26,7 +26,10 @@ class SurfacePoints {
   // The hits at cube points (x[i], y[i], z[i]), i < count ≤ 16. Each lane performs the double
   // operations of Mat4d::transformPoint, FreeForm::gradient and normalize in the same order, so
   // the values are theirs bit for bit, on every target (tests/freeform).
-  void at(const double* x, const double* y, const double* z, int count, SurfaceLanes& out) const;
+  // `active`: the root's perturbations that may be positive at these points (castWindow's); the
+  // others, 0 there, are left out.
+  void at(const double* x, const double* y, const double* z, int count, SurfaceLanes& out,
+          uint64_t active = kAllActive) const;
 
  private:
   ProjectedFreeForm object_;  // the form flattened, in object space (the identity map)

@@ -140,8 +140,15 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
       return;
     }
     MaskingPyramid pyramid(w);  // one for all the forms
-    for (uint32_t f : listed) castWindow(forms_[f].projected, f, w, settings_, stats, &pyramid);
+    for (size_t i = 0; i < listed.size(); ++i) {
+      uint64_t active;
+      castWindow(forms_[listed[i]].projected, listed[i], w, settings_, stats, &pyramid, &active);
+      scratch.active[i] |= active;
+    }
   };
+  // Per listed form, the perturbations that may be positive at its hits in the tile (the union
+  // over the casts; all of them where samples are cast ray by ray, beyond the windows' bounds).
+  scratch.active.assign(listed.size(), 0);
   auto planeOf = [&](int k) {
     const size_t at = plane * size_t(k);
     return std::make_tuple(scratch.depth.data() + at, scratch.object.data() + at,
@@ -153,6 +160,7 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
       cast(0, 0, kTileSize, d, o, z, offsetX_[k], offsetY_[k]);
     }
   } else {
+    scratch.active.assign(listed.size(), kAllActive);
     // Centres, against the farthest of each pixel's samples (a polygon covering part of the
     // pixel must not hide the form from the whole of it).
     scratch.centreDepth.resize(plane);
@@ -308,7 +316,7 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
         qz[i] = scratch.cubeZ[plane * size_t(p.sample) + size_t(p.ly * kTileSize + p.lx)];
       }
       SurfaceLanes& hit = scratch.surface;
-      surfaces_[f].at(qx, qy, qz, count, hit);
+      surfaces_[f].at(qx, qy, qz, count, hit, scratch.active[place]);
       const int per = textured ? 1 : count;
       for (int first = 0; first < count; first += per) {
         shade::Fragments frag;

@@ -62,6 +62,7 @@ class FreeFormFrame {
     std::vector<int> lastPixel;                 // per listed form: the last pixel pending
     SurfaceLanes surface;
     std::vector<double> columnX, rowY;  // per sample: the tile's columns' cube x, rows' cube y
+    std::vector<uint64_t> active;       // per listed form: its perturbations that may be positive
   };
 
   // Casts the forms listed for tile (tileX, tileY) into its buffers — `samples` depth and colour

@@ -1,11 +1,13 @@
 // SurfacePoints (SPEC §12, the leaf's point and normal): the SIMD lanes give what the scalar
 // transformPoint, FreeForm::gradient and normalize give, bit for bit, on every compiled target —
-// for a form with a dent, a nested bump and clips (whose gradient is the active term's).
+// for a form with a dent, a nested bump and clips (whose gradient is the active term's) — also
+// leaving out the perturbations a bound about the points rules out.
 #include "freeform/surface_points.h"
 
 #include <gtest/gtest.h>
 #include <hwy/targets.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -35,7 +37,9 @@ TEST(SurfacePoints, LanesEqualTheScalarFormulasOnEveryTarget) {
   const SurfacePoints surface(f, cubeToObject, toEye, normalToEye);
   std::mt19937 rng(9);
   std::uniform_real_distribution<double> u(-1.3, 1.3);
-  int targets = 0, clipped = 0, bumped = 0;
+  int targets = 0, clipped = 0, bumped = 0, ruledOut = 0;
+  const std::optional<ProjectedFreeForm> projected = ProjectedFreeForm::make(f, toCube);
+  ASSERT_TRUE(projected);
   for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
     hwy::SetSupportedTargetsForTest(target);
     ++targets;
@@ -46,8 +50,25 @@ TEST(SurfacePoints, LanesEqualTheScalarFormulasOnEveryTarget) {
         const Vec3d q = toCube.transformPoint({u(rng), u(rng), u(rng)});
         x[i] = q.x, y[i] = q.y, z[i] = q.z;
       }
-      SurfaceLanes out;
+      SurfaceLanes out, masked;
       surface.at(x, y, z, count, out);
+      // Leaving out the perturbations a box about the points rules out changes no bit.
+      Interval bx{x[0], x[0]}, by{y[0], y[0]}, bz{z[0], z[0]};
+      for (int i = 1; i < count; ++i) {
+        bx = {std::min(bx.lo, x[i]), std::max(bx.hi, x[i])};
+        by = {std::min(by.lo, y[i]), std::max(by.hi, y[i])};
+        bz = {std::min(bz.lo, z[i]), std::max(bz.hi, z[i])};
+      }
+      Interval value, slope;
+      uint64_t active = kAllActive;
+      projected->bound(bx, by, bz, value, slope, &active);
+      ruledOut += active != kAllActive ? 1 : 0;
+      surface.at(x, y, z, count, masked, active);
+      for (int k = 0; k < 3; ++k)
+        for (int i = 0; i < count; ++i) {
+          EXPECT_EQ(masked.normal[k][i], out.normal[k][i]) << "round " << round;
+          EXPECT_EQ(masked.gradient[k][i], out.gradient[k][i]) << "round " << round;
+        }
       for (int i = 0; i < count; ++i) {
         const Vec3d p = cubeToObject.transformPoint({x[i], y[i], z[i]});
         const Vec3d g = f.gradient(p);
@@ -77,6 +98,7 @@ TEST(SurfacePoints, LanesEqualTheScalarFormulasOnEveryTarget) {
   // The clip's gradient and the perturbations' terms were both exercised.
   EXPECT_GT(clipped, 50 * targets);
   EXPECT_GT(bumped, 20 * targets);
+  EXPECT_GT(ruledOut, 20 * targets);  // and perturbations were left out
 }
 
 }  // namespace
