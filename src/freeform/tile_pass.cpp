@@ -304,13 +304,10 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
     const bool textured = form.material.texture != nullptr;
     for (size_t begin = 0; begin < pending.size(); begin += shade::kMaxFragments) {
       const int count = int(std::min<size_t>(shade::kMaxFragments, pending.size() - begin));
-      // Per fragment: its sample's raster position and cube point.
-      double sx[shade::kMaxFragments], sy[shade::kMaxFragments];
+      // Per fragment: its sample's cube point.
       double qx[shade::kMaxFragments], qy[shade::kMaxFragments], qz[shade::kMaxFragments];
       for (int i = 0; i < count; ++i) {
         const Scratch::Pending& p = pending[begin + size_t(i)];
-        sx[i] = ox + p.lx + 0.5 + offsetX_[p.sample];
-        sy[i] = oy + p.ly + 0.5 + offsetY_[p.sample];
         qx[i] = scratch.columnX[size_t(p.sample * kTileSize + p.lx)];
         qy[i] = scratch.rowY[size_t(p.sample * kTileSize + p.ly)];
         qz[i] = scratch.cubeZ[plane * size_t(p.sample) + size_t(p.ly * kTileSize + p.lx)];
@@ -342,6 +339,9 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
           const Vec3d gradient{hit.gradient[0][first], hit.gradient[1][first],
                                hit.gradient[2][first]};
           const double z = qz[first];
+          const Scratch::Pending& p = pending[begin + size_t(first)];
+          const double sx = ox + p.lx + 0.5 + offsetX_[p.sample];  // the sample, in pixels
+          const double sy = oy + p.ly + 0.5 + offsetY_[p.sample];
           auto onTangentPlane = [&](double px, double py, double& u, double& v) {
             const Vec3d a = form.projected.toObject({2 * px / width_ - 1, 1 - 2 * py / height_, z});
             const Vec3d b = form.projected.toObject(
@@ -353,8 +353,8 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
             v = x.z * form.uvScale[1];
           };
           double ux, vx, uy, vy;
-          onTangentPlane(sx[first] + 1, sy[first], ux, vx);
-          onTangentPlane(sx[first], sy[first] + 1, uy, vy);
+          onTangentPlane(sx + 1, sy, ux, vx);
+          onTangentPlane(sx, sy + 1, uy, vy);
           frag.udx = float(ux - point.x * form.uvScale[0]);
           frag.vdx = float(vx - point.z * form.uvScale[1]);
           frag.udy = float(uy - point.x * form.uvScale[0]);
