@@ -146,9 +146,10 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
       scratch.active[i] |= active;
     }
   };
-  // Per listed form, the perturbations that may be positive at its hits in the tile (the union
-  // over the casts; all of them where samples are cast ray by ray, beyond the windows' bounds).
-  scratch.active.assign(listed.size(), 0);
+  // Per listed form, the perturbations that may be positive at its hits in the tile: the union
+  // over the casts; all of them where rays are marched or samples cast ray by ray (beyond the
+  // windows' bounds).
+  scratch.active.assign(listed.size(), marchSteps_ > 0 ? kAllActive : 0);
   auto planeOf = [&](int k) {
     const size_t at = plane * size_t(k);
     return std::make_tuple(scratch.depth.data() + at, scratch.object.data() + at,

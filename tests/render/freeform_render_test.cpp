@@ -256,6 +256,33 @@ TEST(FreeFormRender, ProjectedTextureMatchesTheSameTextureOnPolygons) {
   EXPECT_GT(psnr, 45);  // measured 55.9 dB (float rounding of the footprint and coordinates)
 }
 
+// The fixed-step baseline (RenderOptions::FreeFormMethod::march) shades what it finds as ray
+// casting does: a lit sphere with a bump and a dent, whose normals come from the perturbations,
+// renders nearly the same image both ways (the marcher's misses are thin rims).
+TEST(FreeFormRender, MarchedFormsAreShadedAsCastOnes) {
+  scene::Scene s = sphereOnGround();
+  s.light.enabled = true;
+  s.materials[0].unlit = false;
+  scene::FreeFormNode& ball = s.freeForms[0].form;
+  ball.perturbations.resize(2);
+  ball.perturbations[0].quadric = freeform::Quadric::sphere({0.5, 1.2, 0.6}, 0.45).c;
+  ball.perturbations[1].quadric = freeform::Quadric::sphere({-0.6, 0.5, 0.7}, 0.4).c;
+  ball.perturbations[1].weight = -1;
+  RenderOptions o;
+  o.width = 160;
+  o.height = 120;
+  o.threads = 2;
+  Image cast, marched;
+  ASSERT_TRUE(Renderer(o).render(s, cast).ok());
+  o.freeFormMethod = RenderOptions::FreeFormMethod::march;
+  o.marchSteps = 2048;
+  ASSERT_TRUE(Renderer(o).render(s, marched).ok());
+  int differing = 0;
+  for (size_t i = 0; i < cast.rgb.size(); ++i)
+    differing += std::abs(int(cast.rgb[i]) - int(marched.rgb[i])) > 2;
+  EXPECT_LT(differing, 30) << "channels differing by more than 2";
+}
+
 // The polygon baseline: the same scene with its free forms tessellated at a quarter pixel's
 // chord error renders nearly the image of ray casting them.
 TEST(FreeFormRender, TessellatedSceneRendersNearlyTheSameImage) {
