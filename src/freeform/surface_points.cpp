@@ -98,7 +98,7 @@ VD ValueAndGradient(DD d, const ProjectedFreeForm::Node* nodes, uint32_t i, cons
 
 void SurfaceAt(const ProjectedFreeForm& object, const Mat4d& cubeToObject, const Mat4d& objectToEye,
                const Mat4d& normalToEye, const double* x, const double* y, const double* z,
-               int count, SurfaceLanes& out, uint64_t active) {
+               int count, double uScale, double vScale, SurfaceLanes& out, uint64_t active) {
   const DD d;
   const size_t n = hn::Lanes(d);
   const ProjectedFreeForm::Node* nodes = object.nodes().data();
@@ -136,6 +136,14 @@ void SurfaceAt(const ProjectedFreeForm& object, const Mat4d& cubeToObject, const
     double(*outs[4])[16] = {out.point, out.gradient, out.normal, out.eye};
     for (int k = 0; k < 4; ++k)
       for (int c = 0; c < 3; ++c) hn::Store(lanes[k][c], d, outs[k][c] + i);
+    // The floats shading reads (round to nearest, as float(double) does).
+    const hn::Rebind<float, DD> df;
+    hn::Store(hn::DemoteTo(df, hn::Mul(p.x, hn::Set(d, uScale))), df, out.u + i);
+    hn::Store(hn::DemoteTo(df, hn::Mul(p.z, hn::Set(d, vScale))), df, out.v + i);
+    for (int c = 0; c < 3; ++c) {
+      hn::Store(hn::DemoteTo(df, lanes[2][c]), df, out.normalF[c] + i);
+      hn::Store(hn::DemoteTo(df, lanes[3][c]), df, out.eyeF[c] + i);
+    }
   }
 }
 
@@ -149,17 +157,20 @@ namespace sv::freeform {
 HWY_EXPORT(SurfaceAt);
 
 SurfacePoints::SurfacePoints(const FreeForm& form, const Mat4d& cubeToObject,
-                             const Mat4d& objectToEye, const Mat4d& normalToEye)
+                             const Mat4d& objectToEye, const Mat4d& normalToEye, double uScale,
+                             double vScale)
     : object_(*ProjectedFreeForm::make(form, Mat4d{})),  // the identity is never singular
       cubeToObject_(cubeToObject),
       objectToEye_(objectToEye),
-      normalToEye_(normalToEye) {}
+      normalToEye_(normalToEye),
+      uScale_(uScale),
+      vScale_(vScale) {}
 
 void SurfacePoints::at(const double* x, const double* y, const double* z, int count,
                        SurfaceLanes& out, uint64_t active) const {
   HWY_DYNAMIC_DISPATCH(SurfaceAt)
-  (object_, cubeToObject_, objectToEye_, normalToEye_, x, y, z, std::clamp(count, 0, 16), out,
-   active);
+  (object_, cubeToObject_, objectToEye_, normalToEye_, x, y, z, std::clamp(count, 0, 16), uScale_,
+   vScale_, out, active);
 }
 
 }  // namespace sv::freeform

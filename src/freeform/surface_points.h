@@ -14,14 +14,19 @@ struct SurfaceLanes {
   alignas(64) double gradient[3][16];  // FreeForm::gradient at the point
   alignas(64) double normal[3][16];    // eye space, unit, outward (−∇F carried by normalToEye)
   alignas(64) double eye[3][16];       // eye space
+  // As shading reads them (shade::Fragments' attributes): float(point.x·uScale),
+  // float(point.z·vScale) — the texture projected along the object's y axis — and the normal
+  // and eye position, each rounded to float.
+  alignas(64) float u[16], v[16], normalF[3][16], eyeF[3][16];
 };
 
 class SurfacePoints {
  public:
   // `form` in object space; `cubeToObject` the map of the cube (ProjectedFreeForm::inverse);
   // `objectToEye` and its inverse transpose `normalToEye` (3×3 part) carry points and normals.
+  // `uScale`, `vScale`: the texture coordinates' scales (SurfaceLanes::u, v).
   SurfacePoints(const FreeForm& form, const Mat4d& cubeToObject, const Mat4d& objectToEye,
-                const Mat4d& normalToEye);
+                const Mat4d& normalToEye, double uScale = 1, double vScale = 1);
 
   // The hits at cube points (x[i], y[i], z[i]), i < count ≤ 16. Each lane performs the double
   // operations of Mat4d::transformPoint, FreeForm::gradient and normalize in the same order, so
@@ -34,6 +39,7 @@ class SurfacePoints {
  private:
   ProjectedFreeForm object_;  // the form flattened, in object space (the identity map)
   Mat4d cubeToObject_, objectToEye_, normalToEye_;
+  double uScale_, vScale_;
 };
 
 }  // namespace sv::freeform

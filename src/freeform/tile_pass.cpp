@@ -23,7 +23,8 @@ void FreeFormFrame::prepare(std::vector<ShadedForm> forms, int width, int height
   forms_ = std::move(forms);
   surfaces_.clear();
   for (const ShadedForm& f : forms_)
-    surfaces_.emplace_back(f.form, f.projected.inverse(), f.objectToEye, f.normalToEye);
+    surfaces_.emplace_back(f.form, f.projected.inverse(), f.objectToEye, f.normalToEye,
+                           f.uvScale[0], f.uvScale[1]);
   width_ = width;
   height_ = height;
   samples_ = samples;
@@ -319,20 +320,15 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
       for (int first = 0; first < count; first += per) {
         shade::Fragments frag;
         frag.count = per;
-        for (int j = 0; j < per; ++j) {
-          const int i = first + j;
-          frag.q[j] = 1;  // attributes are given as themselves (w = 1)
-          for (int ch = 0; ch < 3; ++ch) frag.color[ch][j] = form.color[ch];
-          frag.attribute[shade::kU][j] = float(hit.point[0][i] * form.uvScale[0]);
-          frag.attribute[shade::kV][j] = float(hit.point[2][i] * form.uvScale[1]);
-          frag.attribute[shade::kNormalX][j] = float(hit.normal[0][i]);
-          frag.attribute[shade::kNormalY][j] = float(hit.normal[1][i]);
-          frag.attribute[shade::kNormalZ][j] = float(hit.normal[2][i]);
-          frag.attribute[shade::kEyeX][j] = float(hit.eye[0][i]);
-          frag.attribute[shade::kEyeY][j] = float(hit.eye[1][i]);
-          frag.attribute[shade::kEyeZ][j] = float(hit.eye[2][i]);
-          frag.attribute[shade::kAlpha][j] = 1;
+        std::fill_n(frag.q, per, 1.0f);  // attributes are given as themselves (w = 1)
+        for (int ch = 0; ch < 3; ++ch) std::fill_n(frag.color[ch], per, form.color[ch]);
+        std::copy_n(hit.u + first, per, frag.attribute[shade::kU]);
+        std::copy_n(hit.v + first, per, frag.attribute[shade::kV]);
+        for (int c = 0; c < 3; ++c) {
+          std::copy_n(hit.normalF[c] + first, per, frag.attribute[shade::kNormalX + c]);
+          std::copy_n(hit.eyeF[c] + first, per, frag.attribute[shade::kEyeX + c]);
         }
+        std::fill_n(frag.attribute[shade::kAlpha], per, 1.0f);
         if (textured) {
           // The footprint (SPEC §7): where the next pixel's rays, right and down, meet the
           // tangent plane at the hit — the texture coordinates' derivatives per pixel.

@@ -34,7 +34,7 @@ TEST(SurfacePoints, LanesEqualTheScalarFormulasOnEveryTarget) {
   Mat4d toEye;
   toEye.m = {{{0.8, 0, 0.6, 0.5}, {0, 1, 0, -0.2}, {-0.6, 0, 0.8, -4}, {0, 0, 0, 1}}};
   const Mat4d normalToEye = toEye.inverse()->transposed();
-  const SurfacePoints surface(f, cubeToObject, toEye, normalToEye);
+  const SurfacePoints surface(f, cubeToObject, toEye, normalToEye, 2.0, 0.5);
   std::mt19937 rng(9);
   std::uniform_real_distribution<double> u(-1.3, 1.3);
   int targets = 0, clipped = 0, bumped = 0, ruledOut = 0;
@@ -87,6 +87,13 @@ TEST(SurfacePoints, LanesEqualTheScalarFormulasOnEveryTarget) {
               << hwy::TargetName(target) << " " << k << " lane " << i;
           EXPECT_EQ(got[k][2][i], want[k].z)
               << hwy::TargetName(target) << " " << k << " lane " << i;
+        }
+        // The floats shading reads: the doubles rounded (u, v scaled by 2 and 0.5).
+        EXPECT_EQ(out.u[i], float(p.x * 2.0));
+        EXPECT_EQ(out.v[i], float(p.z * 0.5));
+        for (int c = 0; c < 3; ++c) {
+          EXPECT_EQ(out.normalF[c][i], float(out.normal[c][i]));
+          EXPECT_EQ(out.eyeF[c][i], float(out.eye[c][i]));
         }
         clipped += f.clips[0].evaluate(p) < f.base.evaluate(p) ? 1 : 0;
         bumped += bump.evaluate(p) > 0 ? 1 : 0;
