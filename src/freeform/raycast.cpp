@@ -218,6 +218,14 @@ class Caster {
       columns[p] = cubeX(gx0 + p, w_.width, w_.offsetX);
       rows[p] = cubeY(gy0 + p, w_.height, w_.offsetY);
     }
+    // Where Newton starts: the surface is coherent, so from this form's hits in the pixels just
+    // left of the ray's row or above its column — the nearer — extrapolated linearly from the
+    // next pixel out where that holds one too; else from the form's last hit in the tile.
+    Neighbours left[4], above[4];
+    for (int p = 0; p < n; ++p) {
+      left[p] = neighbours(lx - 1, ly + p, -1, 0);
+      above[p] = neighbours(lx + p, ly - 1, 0, -1);
+    }
     int count = 0;
     for (int py = 0; py < n && gy0 + py <= gy1; ++py)
       for (int px = 0; px < n && gx0 + px <= gx1; ++px, ++count) {
@@ -225,7 +233,11 @@ class Caster {
         x[count] = columns[px];
         y[count] = rows[py];
         end[count] = std::min(zhi, 2.0 * double(w_.depth[at[count]]) - 1);
-        guess[count] = guessAt(lx, ly, px, py);
+        const Neighbours& first = px <= py ? left[py] : above[px];
+        const Neighbours& second = px <= py ? above[px] : left[py];
+        guess[count] = first.hits > 0    ? first.guess(px <= py ? px + 1 : py + 1)
+                       : second.hits > 0 ? second.guess(px <= py ? py + 1 : px + 1)
+                                         : guess_;
       }
     stats_.pixels += uint64_t(count);
     if (monotonic) {
@@ -251,27 +263,25 @@ class Caster {
     return hits;
   }
 
-  // Where Newton starts for pixel (px, py) of the window at (lx, ly): the surface is coherent, so
-  // from this form's hits in the pixels just left of the window's row or above its column —
-  // the nearer — extrapolated linearly from the next pixel out where that holds one too; else
-  // from the form's last hit in the tile.
-  double guessAt(int lx, int ly, int px, int py) const {
-    const auto hitAt = [&](int qx, int qy, double& z) {
-      if (qx < 0 || qy < 0 || !w_.object || !w_.cubeZ) return false;
-      const size_t k = size_t(qy) * size_t(w_.stride) + size_t(qx);
+  // This form's hits at the pixel (qx, qy) and the next one out, (qx + dx, qy + dy): how many
+  // of the two in a row (0, 1 or 2) and their cube depths.
+  struct Neighbours {
+    int hits = 0;
+    double z1 = 0, z2 = 0;
+    // The depth extrapolated `steps` pixels on from the first.
+    double guess(int steps) const { return hits == 2 ? z1 + (z1 - z2) * steps : z1; }
+  };
+  Neighbours neighbours(int qx, int qy, int dx, int dy) const {
+    Neighbours nb;
+    const auto hitAt = [&](int px, int py, double& z) {
+      if (px < 0 || py < 0 || !w_.object || !w_.cubeZ) return false;
+      const size_t k = size_t(py) * size_t(w_.stride) + size_t(px);
       if (w_.object[k] != id_) return false;
       z = w_.cubeZ[k];
       return true;
     };
-    double z1, z2;
-    for (int side = 0; side < 2; ++side) {
-      const bool left = (side == 0) == (px <= py);
-      const int dx = left ? -1 : 0, dy = left ? 0 : -1, steps = left ? px + 1 : py + 1;
-      const int qx = left ? lx - 1 : lx + px, qy = left ? ly + py : ly - 1;
-      if (!hitAt(qx, qy, z1)) continue;
-      return hitAt(qx + dx, qy + dy, z2) ? z1 + (z1 - z2) * steps : z1;
-    }
-    return guess_;
+    if (hitAt(qx, qy, nb.z1)) nb.hits = hitAt(qx + dx, qy + dy, nb.z2) ? 2 : 1;
+    return nb;
   }
 
   // Takes the hit where it is nearer; the pixel's node follows (its ancestors: refreshAbove).
