@@ -138,6 +138,11 @@ class ProjectedFreeForm {
   int piecewiseCrossings(const double* x, const double* y, double zlo, const double* zhi, int count,
                          int pieces, const double* guess, double* z, double* from,
                          uint64_t active = kAllActive) const;
+  // bound(x[i], y[i], z, value[i], slope[i], &active[i]) with active[i] = `take` on entry, for
+  // up to 16 windows of one depth range, each window a SIMD lane (slab_bounds.cpp): the same
+  // operations in the same order, so the same bits, on every target.
+  void boundWindows(const Interval* x, const Interval* y, int count, Interval z, uint64_t take,
+                    Interval* value, Interval* slope, uint64_t* active) const;
   // H along the ray (x, y) of the cube, into `out` (its storage reused); without the root's
   // perturbations `active` leaves out (known to be 0 along the ray, see bound).
   void ray(double x, double y, RayFunction& out, uint64_t active = kAllActive) const;

@@ -140,7 +140,14 @@ class Caster {
   // The window of 2^level pixels at (lx, ly) (window-local), its cells in depth [zlo, zhi];
   // `active`: the form's perturbations that may be positive there (ProjectedFreeForm::bound) —
   // the others are left out of its bounds and rays.
-  void cell(int level, int lx, int ly, double zlo, double zhi, uint64_t active) {
+  // `given`: the window's bound (value, slope and perturbations that may be positive) where its
+  // parent worked it out with its siblings' (boundWindows), for windows cast ray by ray.
+  struct WindowBound {
+    Interval value, slope;
+    uint64_t active;
+  };
+  void cell(int level, int lx, int ly, double zlo, double zhi, uint64_t active,
+            const WindowBound* given = nullptr) {
     const int n = 1 << level;
     const int gx0 = w_.x0 + lx, gy0 = w_.y0 + ly;
     const int gx1 = std::min(gx0 + n, w_.width) - 1, gy1 = std::min(gy0 + n, w_.height) - 1;
@@ -159,14 +166,16 @@ class Caster {
     if (level <= kRayLevel) {
       // A window where ∂H/∂z keeps its sign meets each of its rays at most once: the ends of
       // each ray's span decide, and the crossing is refined directly.
-      Interval value, slope;
+      WindowBound b{{}, {}, active};  // of those, the ones that may be positive in the window
       ++stats_.depthTests;
-      uint64_t positive = active;  // of those, the ones that may be positive in the window
-      form_.bound(x, y, {zlo, zhi}, value, slope, &positive);
-      if (!value.containsZero()) return;
+      if (given)
+        b = *given;
+      else
+        form_.bound(x, y, {zlo, zhi}, b.value, b.slope, &b.active);
+      if (!b.value.containsZero()) return;
       // The rays read their own pixels' depths, never the masking pyramid: a hit writes its
       // pixel's node, and the window's ancestors are brought up to date once, after its rays.
-      if (rayWindow(lx, ly, n, gx0, gy0, gx1, gy1, zlo, zhi, !slope.containsZero(), positive))
+      if (rayWindow(lx, ly, n, gx0, gy0, gx1, gy1, zlo, zhi, !b.slope.containsZero(), b.active))
         refreshAbove(level, lx, ly);
       return;
     }
@@ -190,9 +199,26 @@ class Caster {
       while (e < kSlabs && holds[e]) ++e;
       const double nlo = zlo + (zhi - zlo) * s / kSlabs;
       const double nhi = e == kSlabs ? zhi : zlo + (zhi - zlo) * e / kSlabs;
-      // Step 3: the four children, in this range.
+      // Step 3: the four children, in this range — the bounds of those cast ray by ray worked
+      // out together, a window per SIMD lane.
+      WindowBound bounds[4];
+      if (level - 1 == kRayLevel) {
+        Interval cx[4], cy[4], value[4], slope[4];
+        uint64_t positives[4];
+        for (int c = 0; c < 4; ++c) {  // as cell() bounds them (children off the raster: any)
+          const int cx0 = w_.x0 + lx + (c & 1) * h, cy0 = w_.y0 + ly + (c >> 1) * h;
+          const int cx1 = std::min(cx0 + h, w_.width) - 1, cy1 = std::min(cy0 + h, w_.height) - 1;
+          cx[c] = {cubeX(cx0, w_.width, w_.offsetX),
+                   cubeX(std::max(cx0, cx1), w_.width, w_.offsetX)};
+          cy[c] = {cubeY(std::max(cy0, cy1), w_.height, w_.offsetY),
+                   cubeY(cy0, w_.height, w_.offsetY)};
+        }
+        form_.boundWindows(cx, cy, 4, {nlo, nhi}, positive, value, slope, positives);
+        for (int c = 0; c < 4; ++c) bounds[c] = {value[c], slope[c], positives[c]};
+      }
       for (int c = 0; c < 4; ++c)
-        cell(level - 1, lx + (c & 1) * h, ly + (c >> 1) * h, nlo, nhi, positive);
+        cell(level - 1, lx + (c & 1) * h, ly + (c >> 1) * h, nlo, nhi, positive,
+             level - 1 == kRayLevel ? &bounds[c] : nullptr);
       s = e;
     }
   }

@@ -11,25 +11,22 @@
 // Based on: SPEC §12 (seed 003: binary subdivision in depth, cells rejected by bounds).
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "freeform/slab_bounds.cpp"
-#include <algorithm>
-#include <cmath>
-
-#include "freeform/freeform.h"
+// clang-format off: foreach_target.h first, the per-target -inl.h headers after it
 #include "hwy/foreach_target.h"  // IWYU pragma: keep
 #include "hwy/highway.h"
+// clang-format on
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "freeform/freeform.h"
+#include "freeform/interval_lanes-inl.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace sv::freeform {
 namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
-
-using DD = hn::CappedTag<double, 16>;
-using VD = hn::Vec<DD>;
-using MD = hn::Mask<DD>;
-
-struct Lanes {  // an Interval per lane
-  VD lo, hi;
-};
 
 // The window x × y as Quadric::bound reads it: centre and half-widths.
 struct Box {
@@ -70,8 +67,8 @@ HWY_INLINE Lanes QuadricBound(DD d, const Quadric& q, const Box& box, const Lane
 }
 
 // h + w·max(0, v)³·u⁻⁴ (ProjectedFreeForm::boundNode's term for a perturbation bounded by v).
-HWY_INLINE Lanes AddPerturbation(DD d, const Lanes& h, const Lanes& v, const Lanes& invU4,
-                                 double w) {
+HWY_INLINE Lanes WithPerturbation(DD d, const Lanes& h, const Lanes& v, const Lanes& invU4,
+                                  double w) {
   const VD zero = hn::Zero(d);
   const VD pLo = hn::Max(v.lo, zero), pHi = hn::Max(v.hi, zero);
   const VD cLo = hn::Mul(hn::Mul(pLo, pLo), pLo), cHi = hn::Mul(hn::Mul(pHi, pHi), pHi);
@@ -91,7 +88,7 @@ Lanes NodeBound(DD d, const ProjectedFreeForm::Node* nodes, uint32_t i, const Bo
                 const Lanes& z, const Lanes& invU4) {
   Lanes h = QuadricBound(d, nodes[i].q, box, z);
   for (uint32_t c = i + 1; c < nodes[i].end; c = nodes[c].end)
-    h = AddPerturbation(d, h, NodeBound(d, nodes, c, box, z, invU4), invU4, nodes[c].weight);
+    h = WithPerturbation(d, h, NodeBound(d, nodes, c, box, z, invU4), invU4, nodes[c].weight);
   return h;
 }
 
@@ -107,7 +104,7 @@ Lanes RootBound(DD d, const ProjectedFreeForm::Node* nodes, const Box& box, cons
     const Lanes v = NodeBound(d, nodes, c, box, z, invU4);
     if (k < 64 && !hn::AllFalse(d, hn::And(lanes, hn::Gt(v.hi, zero))))
       positive |= uint64_t(1) << k;
-    h = AddPerturbation(d, h, v, invU4, nodes[c].weight);
+    h = WithPerturbation(d, h, v, invU4, nodes[c].weight);
   }
   return h;
 }
@@ -155,6 +152,146 @@ void SlabsHolding(const ProjectedFreeForm::Node* nodes, const Quadric* clips, si
   if (active) *active = everything ? take : positive;
 }
 
+// --- Windows of one depth range, a window per lane (ProjectedFreeForm::boundWindows) ---
+
+// Per lane, the window x × y as Quadric::bound reads it.
+struct Boxes {
+  VD xc, yc, rx, ry;
+  Lanes x, y;
+};
+
+// Quadric::bound(x, y, z) for the lanes' windows and one z.
+Lanes BoxBound(DD d, const Quadric& q, const Boxes& box, Interval z) {
+  const auto& c = q.c;
+  const auto k = [&](int i) { return hn::Set(d, c[size_t(i)]); };
+  const VD b = hn::Add(hn::Add(hn::Mul(k(4), box.xc), hn::Mul(k(5), box.yc)), k(8));
+  const VD kk = hn::Add(
+      hn::Add(hn::Mul(hn::Add(hn::Add(hn::Mul(k(0), box.xc), hn::Mul(k(3), box.yc)), k(6)), box.xc),
+              hn::Mul(hn::Add(hn::Mul(k(1), box.yc), k(7)), box.yc)),
+      k(9));
+  // quadraticRange(C, b, k, z)
+  const auto f = [&](VD v) { return hn::Add(hn::Mul(hn::Add(hn::Mul(k(2), v), b), v), kk); };
+  const VD zlo = hn::Set(d, z.lo), zhi = hn::Set(d, z.hi);
+  const VD fLo = f(zlo), fHi = f(zhi);
+  VD lo = hn::Min(fLo, fHi), hi = hn::Max(fLo, fHi);
+  if (c[2] != 0) {
+    const VD vertex = hn::Div(hn::Neg(b), hn::Set(d, 2 * c[2]));
+    const MD within = hn::And(hn::Lt(zlo, vertex), hn::Lt(vertex, zhi));
+    const VD fv = f(vertex);
+    lo = hn::IfThenElse(within, hn::Min(lo, fv), lo);
+    hi = hn::IfThenElse(within, hn::Max(hi, fv), hi);
+  }
+  const VD gx0 =
+      hn::Add(hn::Add(hn::Mul(hn::Set(d, 2 * c[0]), box.xc), hn::Mul(k(3), box.yc)), k(6));
+  const VD gy0 =
+      hn::Add(hn::Add(hn::Mul(hn::Set(d, 2 * c[1]), box.yc), hn::Mul(k(3), box.xc)), k(7));
+  const VD gx =
+      hn::Max(hn::Abs(hn::Add(gx0, hn::Mul(k(4), zlo))), hn::Abs(hn::Add(gx0, hn::Mul(k(4), zhi))));
+  const VD gy =
+      hn::Max(hn::Abs(hn::Add(gy0, hn::Mul(k(5), zlo))), hn::Abs(hn::Add(gy0, hn::Mul(k(5), zhi))));
+  const VD linear = hn::Add(hn::Mul(gx, box.rx), hn::Mul(gy, box.ry));
+  // {0, rx²}·A + {0, ry²}·B + {−1, 1}·(|D|·rx·ry)
+  const VD zero = hn::Zero(d);
+  const Lanes a2 = Scale(d, {zero, hn::Mul(box.rx, box.rx)}, c[0]);
+  const Lanes b2 = Scale(d, {zero, hn::Mul(box.ry, box.ry)}, c[1]);
+  const VD dd = hn::Mul(hn::Mul(hn::Set(d, std::fabs(c[3])), box.rx), box.ry);
+  const Lanes quadratic = Sum(Sum(a2, b2), {hn::Neg(dd), dd});
+  return {hn::Add(hn::Sub(lo, linear), quadratic.lo), hn::Add(hn::Add(hi, linear), quadratic.hi)};
+}
+
+// z·2C + x·E + y·F + I: a quadric's ∂/∂z over the lanes' windows.
+HWY_INLINE Lanes SlopeZ(DD d, const Quadric& q, const Boxes& box, Interval z) {
+  const Interval zc = z * (2 * q.c[2]);
+  return Sum(Sum(Sum({hn::Set(d, zc.lo), hn::Set(d, zc.hi)}, Scale(d, box.x, q.c[4])),
+                 Scale(d, box.y, q.c[5])),
+             {hn::Set(d, q.c[8]), hn::Set(d, q.c[8])});
+}
+
+struct Powers {  // u⁻⁴ and u⁻⁵ per lane
+  Lanes u4, u5;
+};
+
+// ProjectedFreeForm::boundNodeSlope for the lanes' windows.
+void BoxNodeSlope(DD d, const ProjectedFreeForm::Node* nodes, uint32_t i, const Boxes& box,
+                  Interval z, const Powers& inv, double u1, Lanes& value, Lanes& slope) {
+  value = BoxBound(d, nodes[i].q, box, z);
+  slope = SlopeZ(d, nodes[i].q, box, z);
+  for (uint32_t c = i + 1; c < nodes[i].end; c = nodes[c].end) {
+    Lanes v, dv;
+    BoxNodeSlope(d, nodes, c, box, z, inv, u1, v, dv);
+    AddPerturbation(d, v, dv, nodes[c].weight, inv.u4, inv.u5, u1, value, slope);
+  }
+}
+
+void BoundWindows(const ProjectedFreeForm::Node* nodes, const Quadric* clips, size_t clipCount,
+                  const double* w, const Interval* x, const Interval* y, int count, Interval z,
+                  uint64_t take, Interval* value, Interval* slope, uint64_t* active) {
+  const DD d;
+  const size_t n = hn::Lanes(d);
+  const double inf = std::numeric_limits<double>::infinity();
+  for (size_t s0 = 0; s0 < size_t(count); s0 += n) {
+    const size_t m = std::min(n, size_t(count) - s0);
+    alignas(64) double in[4][16] = {};
+    for (size_t i = 0; i < m; ++i) {
+      in[0][i] = x[s0 + i].lo, in[1][i] = x[s0 + i].hi;
+      in[2][i] = y[s0 + i].lo, in[3][i] = y[s0 + i].hi;
+    }
+    Boxes box;
+    box.x = {hn::Load(d, in[0]), hn::Load(d, in[1])};
+    box.y = {hn::Load(d, in[2]), hn::Load(d, in[3])};
+    const VD half = hn::Set(d, 0.5);
+    box.xc = hn::Mul(half, hn::Add(box.x.lo, box.x.hi));
+    box.yc = hn::Mul(half, hn::Add(box.y.lo, box.y.hi));
+    box.rx = hn::Mul(half, hn::Sub(box.x.hi, box.x.lo));
+    box.ry = hn::Mul(half, hn::Sub(box.y.hi, box.y.lo));
+    // u = x·w0 + y·w1 + z·w2 + w3
+    const Interval zw = z * w[2];
+    const Lanes u = Sum(Sum(Sum(Scale(d, box.x, w[0]), Scale(d, box.y, w[1])),
+                            {hn::Set(d, zw.lo), hn::Set(d, zw.hi)}),
+                        {hn::Set(d, w[3]), hn::Set(d, w[3])});
+    const MD front = hn::Gt(u.lo, hn::Zero(d));
+    const VD one = hn::Set(d, 1.0), lo2 = hn::Mul(u.lo, u.lo), hi2 = hn::Mul(u.hi, u.hi);
+    const Powers inv{{hn::Div(one, hn::Mul(hi2, hi2)), hn::Div(one, hn::Mul(lo2, lo2))},
+                     {hn::Div(one, hn::Mul(hn::Mul(hi2, hi2), u.hi)),
+                      hn::Div(one, hn::Mul(hn::Mul(lo2, lo2), u.lo))}};
+    // The root, noting per lane which perturbations may be positive.
+    uint64_t lanesActive[16];
+    std::fill_n(lanesActive, n, take);
+    Lanes h = BoxBound(d, nodes[0].q, box, z), dh = SlopeZ(d, nodes[0].q, box, z);
+    int k = 0;
+    for (uint32_t c = 1; c < nodes[0].end; c = nodes[c].end, ++k) {
+      if (k < 64 && (take >> k & 1) == 0) continue;
+      Lanes v, dv;
+      BoxNodeSlope(d, nodes, c, box, z, inv, w[2], v, dv);
+      if (k < 64) {
+        alignas(64) double hiv[16];
+        hn::Store(v.hi, d, hiv);
+        for (size_t i = 0; i < m; ++i)
+          if (hiv[i] <= 0) lanesActive[i] &= ~(uint64_t(1) << k);
+      }
+      AddPerturbation(d, v, dv, nodes[c].weight, inv.u4, inv.u5, w[2], h, dh);
+    }
+    for (size_t j = 0; j < clipCount; ++j) {  // freeform.cpp's takeMinimum
+      TakeMinimum(BoxBound(d, clips[j], box, z), SlopeZ(d, clips[j], box, z), h, dh);
+    }
+    h = Widened(d, h);
+    dh = Widened(d, dh);
+    alignas(64) double out[4][16], inFront[16];
+    hn::Store(h.lo, d, out[0]);
+    hn::Store(h.hi, d, out[1]);
+    hn::Store(dh.lo, d, out[2]);
+    hn::Store(dh.hi, d, out[3]);
+    hn::Store(hn::IfThenElseZero(front, one), d, inFront);
+    for (size_t i = 0; i < m; ++i) {
+      // Behind the eye (u ≤ 0 somewhere): everything, and no perturbation ruled out.
+      const bool ok = inFront[i] != 0;
+      value[s0 + i] = ok ? Interval{out[0][i], out[1][i]} : Interval{-inf, inf};
+      slope[s0 + i] = ok ? Interval{out[2][i], out[3][i]} : Interval{-inf, inf};
+      active[s0 + i] = ok ? lanesActive[i] : take;
+    }
+  }
+}
+
 }  // namespace HWY_NAMESPACE
 }  // namespace sv::freeform
 HWY_AFTER_NAMESPACE();
@@ -163,6 +300,15 @@ HWY_AFTER_NAMESPACE();
 namespace sv::freeform {
 
 HWY_EXPORT(SlabsHolding);
+HWY_EXPORT(BoundWindows);
+
+void ProjectedFreeForm::boundWindows(const Interval* x, const Interval* y, int count, Interval z,
+                                     uint64_t take, Interval* value, Interval* slope,
+                                     uint64_t* active) const {
+  HWY_DYNAMIC_DISPATCH(BoundWindows)
+  (nodes_.data(), clips_.data(), clips_.size(), inverse_.m[3].data(), x, y,
+   std::clamp(count, 0, 16), z, take, value, slope, active);
+}
 
 void ProjectedFreeForm::slabsHolding(Interval x, Interval y, double zlo, double zhi, int count,
                                      bool* holds, uint64_t take, uint64_t* active) const {

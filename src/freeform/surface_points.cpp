@@ -5,21 +5,20 @@
 // Based on: SPEC §12 (seed 003: at a leaf, the normal from the gradient).
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "freeform/surface_points.cpp"
-#include "freeform/surface_points.h"
+// clang-format off: foreach_target.h first, the per-target -inl.h headers after it
+#include "hwy/foreach_target.h"  // IWYU pragma: keep
+#include "hwy/highway.h"
+// clang-format on
 
 #include <algorithm>
 
-#include "hwy/foreach_target.h"  // IWYU pragma: keep
-#include "hwy/highway.h"
+#include "freeform/interval_lanes-inl.h"
+#include "freeform/surface_points.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace sv::freeform {
 namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
-
-using DD = hn::CappedTag<double, 16>;
-using VD = hn::Vec<DD>;
-using MD = hn::Mask<DD>;
 
 struct V3 {
   VD x, y, z;

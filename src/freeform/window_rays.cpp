@@ -7,6 +7,11 @@
 // Based on: SPEC §12 (seed 003: at a leaf, the surface point along the ray).
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "freeform/window_rays.cpp"
+// clang-format off: foreach_target.h first, the per-target -inl.h headers after it
+#include "hwy/foreach_target.h"  // IWYU pragma: keep
+#include "hwy/highway.h"
+// clang-format on
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -14,24 +19,15 @@
 #include <vector>
 
 #include "freeform/freeform.h"
-#include "hwy/foreach_target.h"  // IWYU pragma: keep
-#include "hwy/highway.h"
+#include "freeform/interval_lanes-inl.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace sv::freeform {
 namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-using DD = hn::CappedTag<double, 16>;
-using VD = hn::Vec<DD>;
-using MD = hn::Mask<DD>;
-
 // The lanes' rays: per quadric (the nodes, then the clips) its b and c along z (alongZ in
 // freeform.cpp; a is the quadric's own C), and u = u0 + u1·z.
-struct Lanes {  // an Interval per lane
-  VD lo, hi;
-};
-
 struct Rays {
   const ProjectedFreeForm::Node* nodes;
   const Quadric* clips;
@@ -111,29 +107,6 @@ HWY_INLINE Lanes QuadraticRange(DD d, double a, VD b, VD c, VD zA, VD zB) {
   return {lo, hi};
 }
 
-// Interval arithmetic per lane (quadric.h's operators).
-HWY_INLINE Lanes Scale(DD d, const Lanes& a, double s) {
-  const VD v = hn::Set(d, s);
-  return s >= 0 ? Lanes{hn::Mul(a.lo, v), hn::Mul(a.hi, v)}
-                : Lanes{hn::Mul(a.hi, v), hn::Mul(a.lo, v)};
-}
-HWY_INLINE Lanes Sum(const Lanes& a, const Lanes& b) {
-  return {hn::Add(a.lo, b.lo), hn::Add(a.hi, b.hi)};
-}
-HWY_INLINE Lanes Product(const Lanes& a, const Lanes& b) {
-  const VD p0 = hn::Mul(a.lo, b.lo), p1 = hn::Mul(a.lo, b.hi);
-  const VD p2 = hn::Mul(a.hi, b.lo), p3 = hn::Mul(a.hi, b.hi);
-  return {hn::Min(hn::Min(p0, p1), hn::Min(p2, p3)), hn::Max(hn::Max(p0, p1), hn::Max(p2, p3))};
-}
-HWY_INLINE MD ContainsZero(DD d, const Lanes& a) {
-  return hn::And(hn::Le(a.lo, hn::Zero(d)), hn::Ge(a.hi, hn::Zero(d)));
-}
-HWY_INLINE Lanes Widened(DD d, const Lanes& h) {  // freeform.cpp's widened
-  const VD margin = hn::Add(hn::Mul(hn::Set(d, 1e-12), hn::Add(hn::Abs(h.lo), hn::Abs(h.hi))),
-                            hn::Set(d, 1e-300));
-  return {hn::Sub(h.lo, margin), hn::Add(h.hi, margin)};
-}
-
 // RayFunction::boundNodeSlope for the lanes' [zA, zB], with freeform.cpp's addPerturbation.
 void NodeBoundSlope(DD d, const Rays& r, uint32_t i, const Lanes& z, const Lanes& u4,
                     const Lanes& u5, Lanes& value, Lanes& slope) {
@@ -142,24 +115,12 @@ void NodeBoundSlope(DD d, const Rays& r, uint32_t i, const Lanes& z, const Lanes
   value = QuadraticRange(d, a, b, r.c(i, d), z.lo, z.hi);
   const Lanes s = Scale(d, z, 2 * a);
   slope = {hn::Add(s.lo, b), hn::Add(s.hi, b)};
-  const VD zero = hn::Zero(d);
   int k = 0;
   for (uint32_t c = i + 1; c < r.nodes[i].end; c = r.nodes[c].end) {
     if (!r.takes(i, k++)) continue;
     Lanes v, dv;
     NodeBoundSlope(d, r, c, z, u4, u5, v, dv);
-    const double w = r.nodes[c].weight;
-    // w·max(0, v)³·u⁻⁴, and its slope w·(3p²·p'·u⁻⁴ − 4p³·u'·u⁻⁵).
-    const Lanes p{hn::Max(v.lo, zero), hn::Max(v.hi, zero)};
-    const MD active = hn::Gt(p.hi, zero);
-    const Lanes dp{hn::IfThenElseZero(active, dv.lo), hn::IfThenElseZero(active, dv.hi)};
-    const Lanes cube{hn::Mul(hn::Mul(p.lo, p.lo), p.lo), hn::Mul(hn::Mul(p.hi, p.hi), p.hi)};
-    const Lanes square{hn::Mul(p.lo, p.lo), hn::Mul(p.hi, p.hi)};  // exact: p ≥ 0
-    value = Sum(value, Scale(d, Product(cube, u4), w));
-    slope = Sum(slope, Scale(d,
-                             Sum(Scale(d, Product(Product(square, dp), u4), 3),
-                                 Scale(d, Product(cube, u5), -4 * r.u1)),
-                             w));
+    AddPerturbation(d, v, dv, r.nodes[c].weight, u4, u5, r.u1, value, slope);
   }
 }
 
@@ -174,19 +135,12 @@ MD BoundLanes(DD d, const Rays& r, const Lanes& z, Lanes& value, Lanes& slope) {
                  hn::Div(one, hn::Mul(hn::Mul(lo2, lo2), u.lo))};
   NodeBoundSlope(d, r, 0, z, u4, u5, value, slope);
   const size_t nodeCount = r.nodes[0].end;
-  for (size_t k = 0; k < r.clipCount; ++k) {  // freeform.cpp's takeMinimum
+  for (size_t k = 0; k < r.clipCount; ++k) {
     const double a = r.clips[k].c[2];
     const VD b = r.b(nodeCount + k, d);
     const Lanes clip = QuadraticRange(d, a, b, r.c(nodeCount + k, d), z.lo, z.hi);
     const Lanes s = Scale(d, z, 2 * a);
-    const Lanes clipSlope{hn::Add(s.lo, b), hn::Add(s.hi, b)};
-    const MD below = hn::Lt(clip.hi, value.lo);
-    const MD overlap = hn::AndNot(below, hn::Le(clip.lo, value.hi));
-    slope = {hn::IfThenElse(below, clipSlope.lo,
-                            hn::IfThenElse(overlap, hn::Min(slope.lo, clipSlope.lo), slope.lo)),
-             hn::IfThenElse(below, clipSlope.hi,
-                            hn::IfThenElse(overlap, hn::Max(slope.hi, clipSlope.hi), slope.hi))};
-    value = {hn::Min(value.lo, clip.lo), hn::Min(value.hi, clip.hi)};
+    TakeMinimum(clip, {hn::Add(s.lo, b), hn::Add(s.hi, b)}, value, slope);
   }
   value = Widened(d, value);
   slope = Widened(d, slope);

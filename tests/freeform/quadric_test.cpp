@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <random>
+#include <string>
 
 #include "freeform/freeform.h"
 
@@ -208,19 +209,34 @@ TEST(Interval, BoundsContainSampledValues) {
   }
 }
 
+// The bumpy sphere cut by a half-space, in the frustum's cube.
+ProjectedFreeForm clippedBumpySphere() {
+  FreeForm f = bumpySphere();
+  f.clips = {Quadric::halfSpace({0, 1, 0}, 0.7)};
+  return *ProjectedFreeForm::make(f, frustumToCube());
+}
+
+// Runs fn(target) with each compiled SIMD target selected; returns how many ran.
+template <class Fn>
+int forEveryTarget(const Fn& fn) {
+  int targets = 0;
+  for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
+    hwy::SetSupportedTargetsForTest(target);
+    ++targets;
+    fn(target);
+  }
+  hwy::SetSupportedTargetsForTest(0);
+  return targets;
+}
+
 // The SIMD slab bounds (slab_bounds.cpp) answer as the scalar bound does, slab by slab, on every
 // compiled target — for boxes of every size, a form with a dent, a nested bump and clips, and
 // boxes reaching behind the eye (u ≤ 0), where the bound is everything — and leaving out the
 // perturbations they rule out over a box changes no answer.
 TEST(Projected, SlabBoundsEqualTheScalarBoundOnEveryTarget) {
-  FreeForm f = bumpySphere();
-  f.clips = {Quadric::halfSpace({0, 1, 0}, 0.7)};
-  const std::optional<ProjectedFreeForm> g = ProjectedFreeForm::make(f, frustumToCube());
-  ASSERT_TRUE(g);
-  int targets = 0;
-  for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
-    hwy::SetSupportedTargetsForTest(target);
-    ++targets;
+  const ProjectedFreeForm form = clippedBumpySphere();
+  const ProjectedFreeForm* g = &form;
+  const int targets = forEveryTarget([&](int64_t target) {
     std::mt19937 rng(6);
     std::uniform_real_distribution<double> u(0, 1);
     int held = 0, rejected = 0, ruledOut = 0;
@@ -265,8 +281,57 @@ TEST(Projected, SlabBoundsEqualTheScalarBoundOnEveryTarget) {
     EXPECT_GT(held, 300);
     EXPECT_GT(rejected, 1000);
     EXPECT_GT(ruledOut, 300);  // perturbations were left out often
-  }
-  hwy::SetSupportedTargetsForTest(0);
+  });
+  EXPECT_GE(targets, 1);
+}
+
+// The SIMD window bounds (boundWindows) are the scalar bound with its slope and perturbation mask,
+// bit for bit, window by window, on every compiled target — with and without a mask to take,
+// for windows reaching behind the eye too.
+TEST(Projected, WindowBoundsEqualTheScalarBoundOnEveryTarget) {
+  const ProjectedFreeForm form = clippedBumpySphere();
+  const ProjectedFreeForm* g = &form;
+  const int targets = forEveryTarget([&](int64_t target) {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> u(0, 1);
+    int holding = 0, monotonic = 0, ruledOut = 0;
+    for (int trial = 0; trial < 500; ++trial) {
+      const int count = 1 + trial % 16;
+      // Windows about a point of the sphere the bumps sit on (some behind the eye).
+      const double size = std::exp2(-4 - u(rng) * 6);
+      const Vec3d r = randomPoint(rng, 1);
+      const Vec3d c = frustumToCube().transformPoint(r * (1 / std::sqrt(dot(r, r))));
+      const double zlo = trial % 10 == 0 ? -3 + u(rng) : c.z - size * u(rng);
+      const Interval z{zlo, zlo + 2 * size * u(rng) + 1e-9};
+      const uint64_t take = trial % 3 == 0 ? ~uint64_t(2) : kAllActive;
+      Interval x[16], y[16], value[16], slope[16];
+      uint64_t active[16];
+      for (int i = 0; i < count; ++i) {
+        const double x0 = c.x + 4 * size * (u(rng) - 0.5), y0 = c.y + 4 * size * (u(rng) - 0.5);
+        x[i] = {x0, x0 + size * u(rng)};
+        y[i] = {y0, y0 + size * u(rng)};
+      }
+      g->boundWindows(x, y, count, z, take, value, slope, active);
+      for (int i = 0; i < count; ++i) {
+        Interval v, s;
+        uint64_t a = take;
+        g->bound(x[i], y[i], z, v, s, &a);
+        const std::string where =
+            std::string(hwy::TargetName(target)) + " trial " + std::to_string(trial);
+        EXPECT_EQ(value[i].lo, v.lo) << where;
+        EXPECT_EQ(value[i].hi, v.hi) << where;
+        EXPECT_EQ(slope[i].lo, s.lo) << where;
+        EXPECT_EQ(slope[i].hi, s.hi) << where;
+        EXPECT_EQ(active[i], a) << where;
+        holding += v.containsZero() ? 1 : 0;
+        monotonic += v.containsZero() && !s.containsZero() ? 1 : 0;
+        ruledOut += a != take ? 1 : 0;
+      }
+    }
+    EXPECT_GT(holding, 100);  // the windows meet the surface, monotonic or not, often enough
+    EXPECT_GT(monotonic, 20);
+    EXPECT_GT(ruledOut, 200);
+  });
   EXPECT_GE(targets, 1);
 }
 
