@@ -55,10 +55,13 @@ double refineBracket(const RayFunction& f, double a, double b, double fa, double
 // ~1e-4 of a pixel at 1080p — and is taken as a miss.
 constexpr double kBracket = 0x1p-16;
 
-// A ray gives up after this many spans of its binary tree (and takes no hit): only a degenerate
-// function — zero, or within rounding of zero, along a long stretch of the ray — comes near it
-// (tests/render: a quadric that is zero everywhere); a surface crossing costs some 2·16 spans.
-constexpr int kSpanBudget = 128;
+// A ray gives up after this many spans of its binary tree (and takes no hit in that range): a
+// degenerate function — zero, or within rounding of zero, along a long stretch of the ray —
+// reaches it (tests/render: a quadric that is zero everywhere). A plain crossing costs some 2·16
+// spans, but a ray grazing the crease where a perturbation meets its base, where H turns within
+// 5e-5 of 0 before it crosses, took ~200 on BENCH.md's freeform-one; with 128 it gave up and took
+// the back surface (tests/render: RaysGrazingACreaseFindTheFirstCrossing).
+constexpr int kSpanBudget = 1024;
 
 // A crossing at cube depth z of form `id`, taken where it is nearer than the pixel's depth:
 // depth, object and cube depth (those given) written. True if taken.
