@@ -1,8 +1,10 @@
-// ProjectedFreeForm::slabsHolding: the bounds of one screen window's slabs in depth (the binary
-// tree in depth of Caster::cell, raycast.cpp, and of FreeFormFrame::markTiles), every slab a SIMD
-// lane (Highway, per target). The window's x and y are the same for all its slabs, so what depends
-// on them alone — per quadric, its centre's quadratic in z and the gradient's linear terms — is
-// worked out once per window instead of once per slab.
+// Bounds of the free-form caster in SIMD lanes (Highway, per target). ProjectedFreeForm::
+// slabsHolding: one screen window's slabs in depth (the binary tree in depth of Caster::cell,
+// raycast.cpp, and of FreeFormFrame::markTiles), every slab a lane; the window's x and y are the
+// same for all its slabs, so what depends on them alone — per quadric, its centre's quadratic in z
+// and the gradient's linear terms — is worked out once per window instead of once per slab.
+// ProjectedFreeForm::boundWindows: the bound with its slope of several windows over one depth
+// range (the four 4×4 windows of an 8×8 cell), every window a lane.
 //
 // Each lane performs the operations of ProjectedFreeForm::bound (freeform.cpp) and Quadric::bound
 // (quadric.cpp) in the same order, and the build does not contract them into FMAs, so every target

@@ -1,8 +1,10 @@
-// ProjectedFreeForm::monotonicCrossings: the rays of a small window over which H is monotonic in
-// depth — most of a free form's pixels — solved together, every ray a SIMD lane (Highway, per
-// target). Each lane performs the operations of ProjectedFreeForm::ray, RayFunction::evaluate
-// (freeform.cpp) and refineBracket (raycast.cpp) in the same order; lanes that have converged wait,
-// masked, for the others, so a lane's result never depends on its neighbours or on the lane count.
+// The rays of a 4×4 window solved together, every ray a SIMD lane (Highway, per target):
+// ProjectedFreeForm::monotonicCrossings, where H is monotonic in depth over the window — most of
+// a free form's pixels — and piecewiseCrossings, where it may turn (silhouettes), each ray
+// bounding its own pieces of depth (RayFunction::bound in lanes). Each lane performs the
+// operations of ProjectedFreeForm::ray, RayFunction::evaluate and bound (freeform.cpp) and
+// refineBracket (raycast.cpp) in the same order; lanes that are done wait, masked, for the others,
+// so a lane's result never depends on its neighbours or on the lane count.
 //
 // Based on: SPEC §12 (seed 003: at a leaf, the surface point along the ray).
 #undef HWY_TARGET_INCLUDE
