@@ -149,20 +149,36 @@ class Caster {
     Interval value, slope;
     uint64_t active;
   };
+  // The window of 2^level pixels at (lx, ly): its raster pixels [gx0, gx1] × [gy0, gy1] (empty
+  // off the raster) and the cube box of their rays.
+  struct Box {
+    int gx0, gy0, gx1, gy1;
+    Interval x, y;
+    bool empty() const { return gx0 > gx1 || gy0 > gy1; }
+  };
+  Box boxOf(int level, int lx, int ly) const {
+    Box b;
+    b.gx0 = w_.x0 + lx, b.gy0 = w_.y0 + ly;
+    b.gx1 = std::min(b.gx0 + (1 << level), w_.width) - 1;
+    b.gy1 = std::min(b.gy0 + (1 << level), w_.height) - 1;
+    b.x = {cubeX(b.gx0, w_.width, w_.offsetX), cubeX(b.gx1, w_.width, w_.offsetX)};
+    b.y = {cubeY(b.gy1, w_.height, w_.offsetY), cubeY(b.gy0, w_.height, w_.offsetY)};
+    return b;
+  }
+
   void cell(int level, int lx, int ly, double zlo, double zhi, uint64_t active,
             const WindowBound* given = nullptr) {
     const int n = 1 << level;
-    const int gx0 = w_.x0 + lx, gy0 = w_.y0 + ly;
-    const int gx1 = std::min(gx0 + n, w_.width) - 1, gy1 = std::min(gy0 + n, w_.height) - 1;
-    if (gx0 > gx1 || gy0 > gy1) return;
+    const Box box = boxOf(level, lx, ly);
+    if (box.empty()) return;
+    const int gx0 = box.gx0, gy0 = box.gy0, gx1 = box.gx1, gy1 = box.gy1;
     ++stats_.cells;
     // Step 1: multi-level masking — every pixel already holds a nearer surface.
     if (settings_.masking && windowDepth(zlo) >= double(node(level, lx >> level, ly >> level))) {
       ++stats_.maskedCells;
       return;
     }
-    const Interval x{cubeX(gx0, w_.width, w_.offsetX), cubeX(gx1, w_.width, w_.offsetX)};
-    const Interval y{cubeY(gy1, w_.height, w_.offsetY), cubeY(gy0, w_.height, w_.offsetY)};
+    const Interval x = box.x, y = box.y;
     // Small windows: every pixel's own ray (RayFunction) is cheaper than bounding the window's
     // 2×2 and 1×1 subwindows in x, y and z (measured: levels 1 and 2 were 2.5 of the ~2.7 window
     // bounds per pixel on BENCH.md's freeform).
@@ -208,13 +224,10 @@ class Caster {
       if (level - 1 == kRayLevel) {
         Interval cx[4], cy[4], value[4], slope[4];
         uint64_t positives[4];
-        for (int c = 0; c < 4; ++c) {  // as cell() bounds them (children off the raster: any)
-          const int cx0 = w_.x0 + lx + (c & 1) * h, cy0 = w_.y0 + ly + (c >> 1) * h;
-          const int cx1 = std::min(cx0 + h, w_.width) - 1, cy1 = std::min(cy0 + h, w_.height) - 1;
-          cx[c] = {cubeX(cx0, w_.width, w_.offsetX),
-                   cubeX(std::max(cx0, cx1), w_.width, w_.offsetX)};
-          cy[c] = {cubeY(std::max(cy0, cy1), w_.height, w_.offsetY),
-                   cubeY(cy0, w_.height, w_.offsetY)};
+        for (int c = 0; c < 4; ++c) {  // children off the raster are never read
+          const Box child = boxOf(level - 1, lx + (c & 1) * h, ly + (c >> 1) * h);
+          cx[c] = child.x;
+          cy[c] = child.y;
         }
         form_.boundWindows(cx, cy, 4, {nlo, nhi}, positive, value, slope, positives);
         for (int c = 0; c < 4; ++c) bounds[c] = {value[c], slope[c], positives[c]};
