@@ -10,9 +10,6 @@
 namespace sv::freeform {
 namespace {
 
-// Cube coordinates of pixel centres (raycast.h), moved by a sample offset d (pixels).
-double cubeX(int px, int width, double d) { return 2.0 * (px + 0.5 + d) / width - 1; }
-double cubeY(int py, int height, double d) { return 1 - 2.0 * (py + 0.5 + d) / height; }
 double windowDepth(double z) { return 0.5 * (z + 1); }
 
 bool inside(double h) { return h >= 0; }

@@ -21,6 +21,11 @@ namespace sv::freeform {
 
 inline constexpr uint32_t kNoHit = ~0u;
 
+// The cube coordinates of the ray of pixel column px / row py, moved by a sample offset d
+// (pixels; 0: the centre) — the mapping above.
+inline double cubeX(int px, int width, double d) { return 2.0 * (px + 0.5 + d) / width - 1; }
+inline double cubeY(int py, int height, double d) { return 1 - 2.0 * (py + 0.5 + d) / height; }
+
 // A square window of the raster and its buffers: pixels [x0, x0 + size) × [y0, y0 + size) (clipped
 // to the raster), size a power of two up to 64; per pixel, at index (py − y0)·stride + (px − x0):
 // window depth (read: a hit must be nearer; written on a hit), the object hit and its exact cube z.

@@ -197,10 +197,9 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
           if (px < 0 || py < 0 || px >= width_ || py >= height_) continue;
           const size_t r = size_t(ry) * kRing + size_t(rx);
           for (size_t i = 0; i < listed.size(); ++i)
-            castRay(forms_[listed[i]].projected, listed[i], 2.0 * (px + 0.5) / width_ - 1,
-                    1 - 2.0 * (py + 0.5) / height_, nearest[i],
-                    std::numeric_limits<double>::quiet_NaN(), cd[r], co[r], ignored, scratch.ray,
-                    local);
+            castRay(forms_[listed[i]].projected, listed[i], cubeX(px, width_, 0),
+                    cubeY(py, height_, 0), nearest[i], std::numeric_limits<double>::quiet_NaN(),
+                    cd[r], co[r], ignored, scratch.ray, local);
         }
       stats.add(local);
     }
@@ -256,8 +255,8 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
         CastStats local;
         for (int k = 0; k < s; ++k) {
           auto [d, obj, z] = planeOf(k);
-          const double x = 2.0 * (ox + lx + 0.5 + offsetX_[k]) / width_ - 1;
-          const double y = 1 - 2.0 * (oy + ly + 0.5 + offsetY_[k]) / height_;
+          const double x = cubeX(ox + lx, width_, offsetX_[k]);
+          const double y = cubeY(oy + ly, height_, offsetY_[k]);
           for (int c = 0; c < count; ++c)
             castRay(forms_[seen[c]].projected, seen[c], x, y, from[c], hint[c], d[p], obj[p],
                     z[p], scratch.ray, local);
@@ -289,13 +288,13 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
         scratch.pending[i].push_back({lx, ly, k});
       }
     }
-  // The cube x of every column and y of every row, per sample (the rays' own, raycast.h).
+  // The cube x of every column and y of every row, per sample (the rays' own).
   scratch.columnX.resize(size_t(kTileSize) * size_t(s));
   scratch.rowY.resize(size_t(kTileSize) * size_t(s));
   for (int k = 0; k < s; ++k)
     for (int i = 0; i < kTileSize; ++i) {
-      scratch.columnX[size_t(k * kTileSize + i)] = 2.0 * (ox + i + 0.5 + offsetX_[k]) / width_ - 1;
-      scratch.rowY[size_t(k * kTileSize + i)] = 1 - 2.0 * (oy + i + 0.5 + offsetY_[k]) / height_;
+      scratch.columnX[size_t(k * kTileSize + i)] = cubeX(ox + i, width_, offsetX_[k]);
+      scratch.rowY[size_t(k * kTileSize + i)] = cubeY(oy + i, height_, offsetY_[k]);
     }
   for (size_t place = 0; place < listed.size(); ++place) {
     const uint32_t f = listed[place];
