@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstdint>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace sv::output {
 
@@ -55,16 +59,44 @@ void prepareImage(int width, int height, Image& image) {
   image.rgb.resize(size_t(image.width) * image.height * 3);
 }
 
+void writeImageRow(const uint8_t* src, int n, uint8_t* dst) {
+  int i = 0;
+#if defined(__SSE2__)
+  if ((reinterpret_cast<uintptr_t>(dst) & 15) == 0)
+    for (; i + 16 <= n; i += 16)
+      _mm_stream_si128(reinterpret_cast<__m128i*>(dst + i),
+                       _mm_loadu_si128(reinterpret_cast<const __m128i*>(src + i)));
+#endif
+  std::copy(src + i, src + n, dst + i);
+}
+
+void finishImageRows() {
+#if defined(__SSE2__)
+  _mm_sfence();
+#endif
+}
+
 void resolveTile(const uint16_t* color, int tileX, int tileY, const GammaTable& gamma,
                  Image& image) {
-  constexpr int g = raster::kBlockPixels, b = 2 * raster::kBlockPixels;
-  forEachTileRow(color, tileX, tileY, image, [&](uint8_t* out, const uint16_t* src, int n) {
-    for (int i = 0; i < n; ++i) {
-      out[3 * i] = gamma.table[src[i]];
-      out[3 * i + 1] = gamma.table[src[g + i]];
-      out[3 * i + 2] = gamma.table[src[b + i]];
-    }
-  });
+  using namespace raster;
+  constexpr int g = kBlockPixels, b = 2 * kBlockPixels;
+  const int x0 = tileX * kTileSize, y0 = tileY * kTileSize;
+  const int w = std::min(kTileSize, image.width - x0), h = std::min(kTileSize, image.height - y0);
+  // Each row put together in a buffer, then written out whole (writeImageRow).
+  alignas(64) uint8_t row[3 * kTileSize];
+  for (int y = 0; y < h; ++y) {
+    const uint16_t* src = color + size_t(y >> kBlockLog2) * kBlocksPerTileSide * kColorPerBlock +
+                          (y & (kBlockSize - 1)) * kBlockSize;
+    for (int x = 0; x < w; x += kBlockSize, src += kColorPerBlock)
+      for (int i = 0; i < kBlockSize; ++i) {
+        uint8_t* out = row + 3 * (x + i);
+        out[0] = gamma.table[src[i]];
+        out[1] = gamma.table[src[g + i]];
+        out[2] = gamma.table[src[b + i]];
+      }
+    writeImageRow(row, 3 * w, image.pixel(x0, y0 + y));
+  }
+  finishImageRows();
 }
 
 namespace {

@@ -1,7 +1,7 @@
 // The resolve of anti-aliased tiles (N sample planes per 4×4 block, raster/framebuffer.h): each
 // pixel the rounded mean of its samples in linear light, the 1×1 box filter of SPEC §5, then gamma.
-// The plane sums run in SIMD lanes (Highway, dispatched once per tile); the table look-ups and
-// byte stores per pixel stay scalar.
+// The plane sums run in SIMD lanes (Highway, dispatched once per tile); the table look-ups per
+// pixel stay scalar, into a row buffer written to the image whole (writeImageRow).
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "output/resolve_samples.cpp"
 #include "hwy/foreach_target.h"  // IWYU pragma: keep
@@ -44,6 +44,7 @@ void ResolveSampleTile(const uint16_t* color, const int32_t* sums, int tileX, in
   // A row of blocks at a time: the means of all its blocks, then its four image rows left to right
   // (writing block by block, four rows at once, was slower: the image rows fill sequentially).
   alignas(64) uint16_t mean[kBlocksPerTileSide][kColorPerBlock];
+  alignas(64) uint8_t row[3 * kTileSize];  // an image row, written out whole (writeImageRow)
   const int blocksX = (w + kBlockSize - 1) / kBlockSize;
   for (int by = 0; by < h; by += kBlockSize) {
     for (int b = 0; b < blocksX; ++b) {
@@ -67,12 +68,13 @@ void ResolveSampleTile(const uint16_t* color, const int32_t* sums, int tileX, in
     }
     const int rows = std::min(kBlockSize, h - by);
     for (int py = 0; py < rows; ++py) {
-      uint8_t* dst = rgb + size_t(y0 + by + py) * stride + size_t(x0) * 3;
-      for (int b = 0; b < blocksX; ++b, dst += 3 * kBlockSize)
-        StoreBlockRow(dst, mean[b] + py * kBlockSize, std::min(kBlockSize, w - b * kBlockSize),
-                      gamma.table.data());
+      for (int b = 0; b < blocksX; ++b)
+        StoreBlockRow(row + 3 * kBlockSize * b, mean[b] + py * kBlockSize,
+                      std::min(kBlockSize, w - b * kBlockSize), gamma.table.data());
+      writeImageRow(row, 3 * w, rgb + size_t(y0 + by + py) * stride + size_t(x0) * 3);
     }
   }
+  finishImageRows();
 }
 
 }  // namespace HWY_NAMESPACE

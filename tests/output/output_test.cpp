@@ -5,6 +5,7 @@
 #include <fstream>
 
 #include "output/resolve.h"
+#include "raster/framebuffer.h"
 #include "synthvis/image.h"
 
 namespace sv {
@@ -79,6 +80,38 @@ TEST(Gamma, SrgbTablesMatchTheStandardAtKnownPoints) {
   EXPECT_EQ(g.table[int(0.2140 * 65535)], 127);  // linear 0.2140 → sRGB 0.49996 → 127.49
   EXPECT_EQ(g.table[int(0.2159 * 65535)], 128);  // sRGB 128/255 is linear 0.21586
   for (int i = 1; i < 65536; ++i) ASSERT_GE(g.table[i], g.table[i - 1]);  // monotonic
+}
+
+// Every pixel of full and partial tiles, in images whose rows start at every alignment (the
+// resolve streams rows where the image allows and copies the rest).
+TEST(Resolve, TilePixelsAreTheirColoursThroughTheTable) {
+  const auto g = output::GammaTable::srgb();
+  for (const int width : {64, 70, 128, 133}) {
+    const int height = 67;
+    Image image;
+    output::prepareImage(width, height, image);
+    std::fill(image.rgb.begin(), image.rgb.end(), uint8_t(0xAB));
+    const int tilesX = (width + raster::kTileSize - 1) / raster::kTileSize;
+    const int tilesY = (height + raster::kTileSize - 1) / raster::kTileSize;
+    std::vector<uint16_t> color(size_t(raster::kTilePixels) * 3);
+    auto value = [&](int x, int y, int ch) {
+      return uint16_t((x * 977 + y * 131 + ch * 7919) * 13);
+    };
+    for (int ty = 0; ty < tilesY; ++ty)
+      for (int tx = 0; tx < tilesX; ++tx) {
+        for (int ly = 0; ly < raster::kTileSize; ++ly)
+          for (int lx = 0; lx < raster::kTileSize; ++lx)
+            for (int ch = 0; ch < 3; ++ch)
+              color[raster::FrameBuffer::colorOffset(lx, ly, ch)] =
+                  value(tx * raster::kTileSize + lx, ty * raster::kTileSize + ly, ch);
+        output::resolveTile(color.data(), tx, ty, g, image);
+      }
+    for (int y = 0; y < height; ++y)
+      for (int x = 0; x < width; ++x)
+        for (int ch = 0; ch < 3; ++ch)
+          ASSERT_EQ(image.pixel(x, y)[ch], g.table[value(x, y, ch)])
+              << "width " << width << " pixel " << x << "," << y << " channel " << ch;
+  }
 }
 
 }  // namespace
