@@ -137,11 +137,11 @@ void SurfaceAt(const ProjectedFreeForm& object, const Mat4d& cubeToObject, const
       for (int c = 0; c < 3; ++c) hn::Store(lanes[k][c], d, outs[k][c] + i);
     // The floats shading reads (round to nearest, as float(double) does).
     const hn::Rebind<float, DD> df;
-    hn::Store(hn::DemoteTo(df, hn::Mul(p.x, hn::Set(d, uScale))), df, out.u + i);
-    hn::Store(hn::DemoteTo(df, hn::Mul(p.z, hn::Set(d, vScale))), df, out.v + i);
+    hn::Store(hn::DemoteTo(df, hn::Mul(p.x, hn::Set(d, uScale))), df, out.floats[out.kU] + i);
+    hn::Store(hn::DemoteTo(df, hn::Mul(p.z, hn::Set(d, vScale))), df, out.floats[out.kV] + i);
     for (int c = 0; c < 3; ++c) {
-      hn::Store(hn::DemoteTo(df, lanes[2][c]), df, out.normalF[c] + i);
-      hn::Store(hn::DemoteTo(df, lanes[3][c]), df, out.eyeF[c] + i);
+      hn::Store(hn::DemoteTo(df, lanes[2][c]), df, out.floats[out.kNormal + c] + i);
+      hn::Store(hn::DemoteTo(df, lanes[3][c]), df, out.floats[out.kEye + c] + i);
     }
   }
 }

@@ -14,10 +14,12 @@ struct SurfaceLanes {
   alignas(64) double gradient[3][16];  // FreeForm::gradient at the point
   alignas(64) double normal[3][16];    // eye space, unit, outward (−∇F carried by normalToEye)
   alignas(64) double eye[3][16];       // eye space
-  // As shading reads them (shade::Fragments' attributes): float(point.x·uScale),
-  // float(point.z·vScale) — the texture projected along the object's y axis — and the normal
-  // and eye position, each rounded to float.
-  alignas(64) float u[16], v[16], normalF[3][16], eyeF[3][16];
+  // As shading reads them, in the order of shade::Attribute from kU, so that they are copied into
+  // shade::Fragments::attribute whole: float(point.x·uScale), float(point.z·vScale) — the
+  // texture projected along the object's y axis — then the normal and the eye position, each
+  // rounded to float.
+  static constexpr int kU = 0, kV = 1, kNormal = 2, kEye = 5, kFloats = 8;
+  alignas(64) float floats[kFloats][16];
 };
 
 class SurfacePoints {

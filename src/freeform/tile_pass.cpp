@@ -296,10 +296,41 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
       scratch.columnX[size_t(k * kTileSize + i)] = cubeX(ox + i, width_, offsetX_[k]);
       scratch.rowY[size_t(k * kTileSize + i)] = cubeY(oy + i, height_, offsetY_[k]);
     }
+  static_assert(int(shade::kU) == SurfaceLanes::kU && int(shade::kV) == SurfaceLanes::kV &&
+                    int(shade::kNormalX) == SurfaceLanes::kNormal &&
+                    int(shade::kEyeX) == SurfaceLanes::kEye &&
+                    int(shade::kEyeZ) + 1 == SurfaceLanes::kFloats,
+                "SurfaceLanes::floats are shading's attributes from kU on, in its order");
   for (size_t place = 0; place < listed.size(); ++place) {
     const uint32_t f = listed[place];
     const ShadedForm& form = forms_[f];
     const std::vector<Scratch::Pending>& pending = scratch.pending[place];
+    if (pending.empty()) continue;
+    // What all the form's fragments share, set once: attributes given as themselves (w = 1),
+    // the form's colour, opaque.
+    shade::Fragments frag;
+    std::fill_n(frag.q, shade::kMaxFragments, 1.0f);
+    for (int ch = 0; ch < 3; ++ch)
+      std::fill_n(frag.color[ch], shade::kMaxFragments, form.color[ch]);
+    std::fill_n(frag.attribute[shade::kAlpha], shade::kMaxFragments, 1.0f);
+    // Step 3: depth and colour to every sample of the pixel this form took — fragments [first,
+    // first + n) of `out`, pending from `begin` on.
+    auto writeBack = [&](size_t begin, int first, int n, const float(*out)[shade::kMaxFragments]) {
+      alignas(64) uint16_t c16[3][shade::kMaxFragments];
+      for (int ch = 0; ch < 3; ++ch)
+        for (int j = 0; j < n; ++j)
+          c16[ch][j] = uint16_t(std::lrint(std::clamp(out[ch][j], 0.0f, 1.0f) * 65535.0f));
+      for (int j = 0; j < n; ++j) {
+        const Scratch::Pending& p = pending[begin + size_t(first + j)];
+        for (int k = p.sample; k < s; ++k) {
+          const size_t at = plane * size_t(k) + size_t(p.ly * kTileSize + p.lx);
+          if (scratch.object[at] != f) continue;
+          depth[FrameBuffer::depthOffset(p.lx, p.ly, s, k)] = scratch.depth[at];
+          for (int ch = 0; ch < 3; ++ch)
+            color[FrameBuffer::colorOffset(p.lx, p.ly, ch, s, k)] = c16[ch][j];
+        }
+      }
+    };
     // Textured forms are shaded a pixel at a time: each has its own footprint (Fragments carries
     // one gradient per call — a triangle's, constant over it).
     const bool textured = form.material.texture != nullptr;
@@ -315,63 +346,46 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
       }
       SurfaceLanes& hit = scratch.surface;
       surfaces_[f].at(qx, qy, qz, count, hit, scratch.active[place]);
-      const int per = textured ? 1 : count;
-      for (int first = 0; first < count; first += per) {
-        shade::Fragments frag;
-        frag.count = per;
-        std::fill_n(frag.q, per, 1.0f);  // attributes are given as themselves (w = 1)
-        for (int ch = 0; ch < 3; ++ch) std::fill_n(frag.color[ch], per, form.color[ch]);
-        std::copy_n(hit.u + first, per, frag.attribute[shade::kU]);
-        std::copy_n(hit.v + first, per, frag.attribute[shade::kV]);
-        for (int c = 0; c < 3; ++c) {
-          std::copy_n(hit.normalF[c] + first, per, frag.attribute[shade::kNormalX + c]);
-          std::copy_n(hit.eyeF[c] + first, per, frag.attribute[shade::kEyeX + c]);
-        }
-        std::fill_n(frag.attribute[shade::kAlpha], per, 1.0f);
-        if (textured) {
-          // The footprint (SPEC §7): where the next pixel's rays, right and down, meet the
-          // tangent plane at the hit — the texture coordinates' derivatives per pixel.
-          const Vec3d point{hit.point[0][first], hit.point[1][first], hit.point[2][first]};
-          const Vec3d gradient{hit.gradient[0][first], hit.gradient[1][first],
-                               hit.gradient[2][first]};
-          const double z = qz[first];
-          const Scratch::Pending& p = pending[begin + size_t(first)];
-          const double sx = ox + p.lx + 0.5 + offsetX_[p.sample];  // the sample, in pixels
-          const double sy = oy + p.ly + 0.5 + offsetY_[p.sample];
-          auto onTangentPlane = [&](double px, double py, double& u, double& v) {
-            const Vec3d a = form.projected.toObject({2 * px / width_ - 1, 1 - 2 * py / height_, z});
-            const Vec3d b = form.projected.toObject(
-                {2 * px / width_ - 1, 1 - 2 * py / height_, std::min(1.0, z + 1e-3 * (1 - z))});
-            const double den = dot(gradient, b - a);
-            const double t = std::fabs(den) > 1e-300 ? dot(gradient, point - a) / den : 0;
-            const Vec3d x = a + (b - a) * std::clamp(t, -1e6, 1e6);
-            u = x.x * form.uvScale[0];
-            v = x.z * form.uvScale[1];
-          };
-          double ux, vx, uy, vy;
-          onTangentPlane(sx + 1, sy, ux, vx);
-          onTangentPlane(sx, sy + 1, uy, vy);
-          frag.udx = float(ux - point.x * form.uvScale[0]);
-          frag.vdx = float(vx - point.z * form.uvScale[1]);
-          frag.udy = float(uy - point.x * form.uvScale[0]);
-          frag.vdy = float(vy - point.z * form.uvScale[1]);
-        }
-        float out[4][shade::kMaxFragments];
+      float out[4][shade::kMaxFragments];
+      if (!textured) {
+        frag.count = count;
+        std::copy_n(&hit.floats[0][0], SurfaceLanes::kFloats * 16, &frag.attribute[shade::kU][0]);
         shade::shadeFragments(form.material, *environment_, frag, out);
-        // Step 3: depth and colour to every sample of the pixel this form took.
-        for (int j = 0; j < per; ++j) {
-          const Scratch::Pending& p = pending[begin + size_t(first + j)];
-          uint16_t c16[3];
-          for (int ch = 0; ch < 3; ++ch)
-            c16[ch] = uint16_t(std::lrint(std::clamp(out[ch][j], 0.0f, 1.0f) * 65535.0f));
-          for (int k = p.sample; k < s; ++k) {
-            const size_t at = plane * size_t(k) + size_t(p.ly * kTileSize + p.lx);
-            if (scratch.object[at] != f) continue;
-            depth[FrameBuffer::depthOffset(p.lx, p.ly, s, k)] = scratch.depth[at];
-            for (int ch = 0; ch < 3; ++ch)
-              color[FrameBuffer::colorOffset(p.lx, p.ly, ch, s, k)] = c16[ch];
-          }
-        }
+        writeBack(begin, 0, count, out);
+        continue;
+      }
+      for (int first = 0; first < count; ++first) {
+        frag.count = 1;
+        for (int a = 0; a < SurfaceLanes::kFloats; ++a)
+          frag.attribute[shade::kU + a][0] = hit.floats[a][first];
+        // The footprint (SPEC §7): where the next pixel's rays, right and down, meet the
+        // tangent plane at the hit — the texture coordinates' derivatives per pixel.
+        const Vec3d point{hit.point[0][first], hit.point[1][first], hit.point[2][first]};
+        const Vec3d gradient{hit.gradient[0][first], hit.gradient[1][first],
+                             hit.gradient[2][first]};
+        const double z = qz[first];
+        const Scratch::Pending& p = pending[begin + size_t(first)];
+        const double sx = ox + p.lx + 0.5 + offsetX_[p.sample];  // the sample, in pixels
+        const double sy = oy + p.ly + 0.5 + offsetY_[p.sample];
+        auto onTangentPlane = [&](double px, double py, double& u, double& v) {
+          const Vec3d a = form.projected.toObject({2 * px / width_ - 1, 1 - 2 * py / height_, z});
+          const Vec3d b = form.projected.toObject(
+              {2 * px / width_ - 1, 1 - 2 * py / height_, std::min(1.0, z + 1e-3 * (1 - z))});
+          const double den = dot(gradient, b - a);
+          const double t = std::fabs(den) > 1e-300 ? dot(gradient, point - a) / den : 0;
+          const Vec3d x = a + (b - a) * std::clamp(t, -1e6, 1e6);
+          u = x.x * form.uvScale[0];
+          v = x.z * form.uvScale[1];
+        };
+        double ux, vx, uy, vy;
+        onTangentPlane(sx + 1, sy, ux, vx);
+        onTangentPlane(sx, sy + 1, uy, vy);
+        frag.udx = float(ux - point.x * form.uvScale[0]);
+        frag.vdx = float(vx - point.z * form.uvScale[1]);
+        frag.udy = float(uy - point.x * form.uvScale[0]);
+        frag.vdy = float(vy - point.z * form.uvScale[1]);
+        shade::shadeFragments(form.material, *environment_, frag, out);
+        writeBack(begin, first, 1, out);
       }
     }
   }

@@ -89,11 +89,11 @@ TEST(SurfacePoints, LanesEqualTheScalarFormulasOnEveryTarget) {
               << hwy::TargetName(target) << " " << k << " lane " << i;
         }
         // The floats shading reads: the doubles rounded (u, v scaled by 2 and 0.5).
-        EXPECT_EQ(out.u[i], float(p.x * 2.0));
-        EXPECT_EQ(out.v[i], float(p.z * 0.5));
+        EXPECT_EQ(out.floats[out.kU][i], float(p.x * 2.0));
+        EXPECT_EQ(out.floats[out.kV][i], float(p.z * 0.5));
         for (int c = 0; c < 3; ++c) {
-          EXPECT_EQ(out.normalF[c][i], float(out.normal[c][i]));
-          EXPECT_EQ(out.eyeF[c][i], float(out.eye[c][i]));
+          EXPECT_EQ(out.floats[out.kNormal + c][i], float(out.normal[c][i]));
+          EXPECT_EQ(out.floats[out.kEye + c][i], float(out.eye[c][i]));
         }
         clipped += f.clips[0].evaluate(p) < f.base.evaluate(p) ? 1 : 0;
         bumped += bump.evaluate(p) > 0 ? 1 : 0;
