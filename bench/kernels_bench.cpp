@@ -7,6 +7,7 @@
 //   edge-mask table look-up (AA)   → masks/s
 //   whole frame, BENCH.md tris     → triangles/s
 //   texture samples, per filter    → samples/s (scalar Texture::sample, SIMD sampleBlock)
+//   resolve, a 1080p frame's tiles → pixels/s (16-bit linear tiles to the 8-bit sRGB image)
 // The tile and frame benchmarks take the samples per pixel as their last argument (1 = point
 // sampling; 4, 16 = anti-aliasing with sub-pixel masks, issue 4).
 #include <benchmark/benchmark.h>
@@ -14,12 +15,13 @@
 #include <array>
 #include <random>
 
+#include "bench_scenes.h"
+#include "output/resolve.h"
 #include "raster/coverage_masks.h"
 #include "raster/framebuffer.h"
 #include "raster/rasterizer.h"
-#include "texture/texture.h"
 #include "render/frame_renderer.h"
-#include "bench_scenes.h"
+#include "texture/texture.h"
 
 namespace sv {
 namespace {
@@ -219,6 +221,30 @@ BENCHMARK(BM_FrameTris)
     ->Args({100000, 10, 4})
     ->Args({10000, 1000, 4})
     ->Unit(benchmark::kMillisecond);
+
+// The resolve of every tile of a 1920×1080 frame into its image, from tiles of smooth colours
+// with some noise, as rendered frames have (each tile its own buffer, as the frame buffer holds
+// them).
+void BM_ResolveFrame(benchmark::State& state) {
+  constexpr int kW = 1920, kH = 1080;
+  const int tilesX = (kW + raster::kTileSize - 1) / raster::kTileSize;
+  const int tilesY = (kH + raster::kTileSize - 1) / raster::kTileSize;
+  std::mt19937 rng(7);
+  std::vector<uint16_t> color(size_t(tilesX) * tilesY * raster::kTilePixels * 3);
+  for (size_t i = 0; i < color.size(); ++i) color[i] = uint16_t(i / 7 % 50000 + rng() % 256);
+  const output::GammaTable gamma = output::GammaTable::srgb();
+  Image image;
+  output::prepareImage(kW, kH, image);
+  for (auto _ : state) {
+    for (int t = 0; t < tilesX * tilesY; ++t)
+      output::resolveTile(color.data() + size_t(t) * raster::kTilePixels * 3, t % tilesX,
+                          t / tilesX, gamma, image);
+    benchmark::DoNotOptimize(image.rgb.data());
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(state.iterations() * int64_t(kW) * kH);
+}
+BENCHMARK(BM_ResolveFrame);
 
 }  // namespace
 }  // namespace sv
