@@ -2,6 +2,7 @@
 #include "freeform/tile_pass.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <tuple>
@@ -268,25 +269,46 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
   // Step 2: shading, once per pixel and form that took some of its samples — at the first such
   // sample's hit (the centre with one sample) — 16 fragments of one form to a call; their surface
   // points and normals 16 at a time (SurfacePoints).
-  // The pixels to shade, per listed form (by its place in the list), in one pass over the tile.
+  // The pixels to shade, per listed form (by its place in the list), in one pass over the tile's
+  // 4×4 blocks: a block all of whose samples one form took is shaded as one batch and written
+  // back whole (the frame buffer holds a block's samples together); the others pixel by pixel.
   scratch.pending.resize(std::max(scratch.pending.size(), listed.size()));
+  scratch.wholeBlocks.resize(std::max(scratch.wholeBlocks.size(), listed.size()));
   scratch.place.resize(forms_.size());
   scratch.lastPixel.assign(listed.size(), -1);
   for (size_t i = 0; i < listed.size(); ++i) {
     scratch.pending[i].clear();
+    scratch.wholeBlocks[i].clear();
     scratch.place[listed[i]] = uint32_t(i);
   }
-  for (int ly = 0; ly < kTileSize && oy + ly < height_; ++ly)
-    for (int lx = 0; lx < kTileSize && ox + lx < width_; ++lx) {
-      const int p = ly * kTileSize + lx;
-      for (int k = 0; k < s; ++k) {
-        const uint32_t o = scratch.object[plane * size_t(k) + size_t(p)];
-        if (o == kNoHit) continue;
-        const uint32_t i = scratch.place[o];
-        if (scratch.lastPixel[i] == p) continue;  // shaded at an earlier sample of the pixel
-        scratch.lastPixel[i] = p;
-        scratch.pending[i].push_back({lx, ly, k});
+  constexpr int kBlock = raster::kBlockSize;
+  for (int by = 0; by < kTileSize && oy + by < height_; by += kBlock)
+    for (int bx = 0; bx < kTileSize && ox + bx < width_; bx += kBlock) {
+      const uint32_t first = scratch.object[size_t(by * kTileSize + bx)];
+      bool whole = first != kNoHit && oy + by + kBlock <= height_ && ox + bx + kBlock <= width_;
+      for (int k = 0; k < s && whole; ++k)
+        for (int r = 0; r < kBlock && whole; ++r) {
+          const uint32_t* row =
+              scratch.object.data() + plane * size_t(k) + size_t((by + r) * kTileSize + bx);
+          for (int c = 0; c < kBlock; ++c) whole &= row[c] == first;
+        }
+      if (whole) {
+        scratch.wholeBlocks[scratch.place[first]].push_back(
+            (by / kBlock) * raster::kBlocksPerTileSide + bx / kBlock);
+        continue;
       }
+      for (int ly = by; ly < by + kBlock && oy + ly < height_; ++ly)
+        for (int lx = bx; lx < bx + kBlock && ox + lx < width_; ++lx) {
+          const int p = ly * kTileSize + lx;
+          for (int k = 0; k < s; ++k) {
+            const uint32_t o = scratch.object[plane * size_t(k) + size_t(p)];
+            if (o == kNoHit) continue;
+            const uint32_t i = scratch.place[o];
+            if (scratch.lastPixel[i] == p) continue;  // shaded at an earlier sample of the pixel
+            scratch.lastPixel[i] = p;
+            scratch.pending[i].push_back({lx, ly, k});
+          }
+        }
     }
   // The cube x of every column and y of every row, per sample (the rays' own).
   scratch.columnX.resize(size_t(kTileSize) * size_t(s));
@@ -301,11 +323,13 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
                     int(shade::kEyeX) == SurfaceLanes::kEye &&
                     int(shade::kEyeZ) + 1 == SurfaceLanes::kFloats,
                 "SurfaceLanes::floats are shading's attributes from kU on, in its order");
+  static_assert(shade::kMaxFragments == raster::kBlockPixels, "a whole block is one batch");
   for (size_t place = 0; place < listed.size(); ++place) {
     const uint32_t f = listed[place];
     const ShadedForm& form = forms_[f];
     const std::vector<Scratch::Pending>& pending = scratch.pending[place];
-    if (pending.empty()) continue;
+    const std::vector<int>& wholeBlocks = scratch.wholeBlocks[place];
+    if (pending.empty() && wholeBlocks.empty()) continue;
     // What all the form's fragments share, set once: attributes given as themselves (w = 1),
     // the form's colour, opaque.
     shade::Fragments frag;
@@ -313,15 +337,34 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
     for (int ch = 0; ch < 3; ++ch)
       std::fill_n(frag.color[ch], shade::kMaxFragments, form.color[ch]);
     std::fill_n(frag.attribute[shade::kAlpha], shade::kMaxFragments, 1.0f);
-    // Step 3: depth and colour to every sample of the pixel this form took — fragments [first,
-    // first + n) of `out`, pending from `begin` on.
-    auto writeBack = [&](size_t begin, int first, int n, const float(*out)[shade::kMaxFragments]) {
+    // Step 3: depth and colour to every sample of the pixels this form took — fragments
+    // [0, n) of `out`, the pixels batch[first …]; `block` ≥ 0: the batch is that whole block,
+    // lanes in its order, written plane by plane.
+    auto writeBack = [&](const Scratch::Pending* batch, int first, int n, int block,
+                         const float(*out)[shade::kMaxFragments]) {
+      // To 16 bits, to nearest (ties to even, as lrint): adding 2^23 leaves the rounded value
+      // in the float's low bits (a loop the compiler vectorizes).
       alignas(64) uint16_t c16[3][shade::kMaxFragments];
       for (int ch = 0; ch < 3; ++ch)
-        for (int j = 0; j < n; ++j)
-          c16[ch][j] = uint16_t(std::lrint(std::clamp(out[ch][j], 0.0f, 1.0f) * 65535.0f));
+        for (int j = 0; j < shade::kMaxFragments; ++j)
+          c16[ch][j] = uint16_t(
+              std::bit_cast<uint32_t>(std::clamp(out[ch][j], 0.0f, 1.0f) * 65535.0f + 8388608.0f));
+      if (block >= 0) {
+        const int bx = (block % raster::kBlocksPerTileSide) * kBlock;
+        const int by = (block / raster::kBlocksPerTileSide) * kBlock;
+        for (int k = 0; k < s; ++k) {
+          float* d = depth + FrameBuffer::depthOffset(bx, by, s, k);
+          for (int r = 0; r < kBlock; ++r)
+            std::copy_n(
+                scratch.depth.data() + plane * size_t(k) + size_t((by + r) * kTileSize + bx),
+                kBlock, d + r * kBlock);
+          std::copy_n(&c16[0][0], raster::kColorPerBlock,
+                      color + FrameBuffer::colorOffset(bx, by, 0, s, k));
+        }
+        return;
+      }
       for (int j = 0; j < n; ++j) {
-        const Scratch::Pending& p = pending[begin + size_t(first + j)];
+        const Scratch::Pending& p = batch[first + j];
         for (int k = p.sample; k < s; ++k) {
           const size_t at = plane * size_t(k) + size_t(p.ly * kTileSize + p.lx);
           if (scratch.object[at] != f) continue;
@@ -334,12 +377,12 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
     // Textured forms are shaded a pixel at a time: each has its own footprint (Fragments carries
     // one gradient per call — a triangle's, constant over it).
     const bool textured = form.material.texture != nullptr;
-    for (size_t begin = 0; begin < pending.size(); begin += shade::kMaxFragments) {
-      const int count = int(std::min<size_t>(shade::kMaxFragments, pending.size() - begin));
+    // A batch of `count` pixels (`block` as for writeBack).
+    auto shadeBatch = [&](const Scratch::Pending* batch, int count, int block) {
       // Per fragment: its sample's cube point.
       double qx[shade::kMaxFragments], qy[shade::kMaxFragments], qz[shade::kMaxFragments];
       for (int i = 0; i < count; ++i) {
-        const Scratch::Pending& p = pending[begin + size_t(i)];
+        const Scratch::Pending& p = batch[i];
         qx[i] = scratch.columnX[size_t(p.sample * kTileSize + p.lx)];
         qy[i] = scratch.rowY[size_t(p.sample * kTileSize + p.ly)];
         qz[i] = scratch.cubeZ[plane * size_t(p.sample) + size_t(p.ly * kTileSize + p.lx)];
@@ -351,8 +394,8 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
         frag.count = count;
         std::copy_n(&hit.floats[0][0], SurfaceLanes::kFloats * 16, &frag.attribute[shade::kU][0]);
         shade::shadeFragments(form.material, *environment_, frag, out);
-        writeBack(begin, 0, count, out);
-        continue;
+        writeBack(batch, 0, count, block, out);
+        return;
       }
       for (int first = 0; first < count; ++first) {
         frag.count = 1;
@@ -364,7 +407,7 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
         const Vec3d gradient{hit.gradient[0][first], hit.gradient[1][first],
                              hit.gradient[2][first]};
         const double z = qz[first];
-        const Scratch::Pending& p = pending[begin + size_t(first)];
+        const Scratch::Pending& p = batch[first];
         const double sx = ox + p.lx + 0.5 + offsetX_[p.sample];  // the sample, in pixels
         const double sy = oy + p.ly + 0.5 + offsetY_[p.sample];
         auto onTangentPlane = [&](double px, double py, double& u, double& v) {
@@ -385,9 +428,21 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
         frag.udy = float(uy - point.x * form.uvScale[0]);
         frag.vdy = float(vy - point.z * form.uvScale[1]);
         shade::shadeFragments(form.material, *environment_, frag, out);
-        writeBack(begin, first, 1, out);
+        writeBack(batch, first, 1, -1, out);
       }
+    };
+    for (const int block : wholeBlocks) {
+      // Its pixels in the block's lane order, each shaded at its first sample.
+      Scratch::Pending batch[shade::kMaxFragments];
+      const int bx = (block % raster::kBlocksPerTileSide) * kBlock;
+      const int by = (block / raster::kBlocksPerTileSide) * kBlock;
+      for (int i = 0; i < shade::kMaxFragments; ++i)
+        batch[i] = {bx + i % kBlock, by + i / kBlock, 0};
+      shadeBatch(batch, shade::kMaxFragments, textured ? -1 : block);
     }
+    for (size_t begin = 0; begin < pending.size(); begin += shade::kMaxFragments)
+      shadeBatch(pending.data() + begin,
+                 int(std::min<size_t>(shade::kMaxFragments, pending.size() - begin)), -1);
   }
 }
 

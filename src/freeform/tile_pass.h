@@ -58,6 +58,7 @@ class FreeFormFrame {
       int lx, ly, sample;
     };
     std::vector<std::vector<Pending>> pending;  // per listed form
+    std::vector<std::vector<int>> wholeBlocks;  // per listed form: the blocks it took whole
     std::vector<uint32_t> place;                // per form: its place in the tile's list
     std::vector<int> lastPixel;                 // per listed form: the last pixel pending
     SurfaceLanes surface;
