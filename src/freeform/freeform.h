@@ -138,6 +138,14 @@ class ProjectedFreeForm {
   int piecewiseCrossings(const double* x, const double* y, double zlo, const double* zhi, int count,
                          int pieces, const double* guess, double* z, double* from,
                          uint64_t active = kAllActive) const;
+  // Rays (x[i], y[i]) whose H may turn in [zlo, zhi[i]] but which likely cross near guess[i] (a
+  // neighbour's hit): Newton alone from the guess, as monotonicCrossings begins, and a zero it
+  // converges to in the span kept only where the ray's own bound (RayFunction::bound) over
+  // [zlo, zero] shows H monotonic there — then it is the ray's first crossing. z[i] is that zero,
+  // or NaN where none was proven (a NaN guess: not tried), for piecewiseCrossings to decide.
+  // Returns the number of ray bounds made.
+  int provenCrossings(const double* x, const double* y, double zlo, const double* zhi, int count,
+                      const double* guess, double* z, uint64_t active = kAllActive) const;
   // bound(x[i], y[i], z, value[i], slope[i], &active[i]) with active[i] = `take` on entry, for
   // up to 16 windows of one depth range, each window a SIMD lane (slab_bounds.cpp): the same
   // operations in the same order, so the same bits, on every target.

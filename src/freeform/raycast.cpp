@@ -265,7 +265,9 @@ class Caster {
       left[p] = neighbours(lx - 1, ly + p, -1, 0);
       above[p] = neighbours(lx + p, ly - 1, 0, -1);
     }
+    constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
     int count = 0;
+    bool near[16];  // the guess is a neighbour's hit (not only the tile's last one)
     for (int py = 0; py < n && gy0 + py <= gy1; ++py)
       for (int px = 0; px < n && gx0 + px <= gx1; ++px, ++count) {
         at[count] = size_t(ly + py) * size_t(w_.stride) + size_t(lx + px);
@@ -274,6 +276,7 @@ class Caster {
         end[count] = std::min(zhi, 2.0 * double(w_.depth[at[count]]) - 1);
         const Neighbours& first = px <= py ? left[py] : above[px];
         const Neighbours& second = px <= py ? above[px] : left[py];
+        near[count] = first.hits > 0 || second.hits > 0;
         guess[count] = first.hits > 0    ? first.guess(px <= py ? px + 1 : py + 1)
                        : second.hits > 0 ? second.guess(px <= py ? py + 1 : px + 1)
                                          : guess_;
@@ -282,15 +285,32 @@ class Caster {
     if (monotonic) {
       form_.monotonicCrossings(x, y, zlo, end, count, guess, z, active);
     } else {
-      stats_.depthTests +=
-          uint64_t(form_.piecewiseCrossings(x, y, zlo, end, count, kPieces, guess, z, from, active));
+      // H may turn. Most such windows lie wholly on the surface, their slope bound only loose
+      // over the run of slabs: rays with a neighbour's hit first try Newton from it, a zero kept
+      // where the ray's own bound proves it the first (provenCrossings); the others are taken
+      // in pieces, and a ray whose H may turn within a piece goes on alone from there.
+      double tried[16];
+      for (int i = 0; i < count; ++i) tried[i] = near[i] ? guess[i] : kNaN;
+      stats_.depthTests += uint64_t(form_.provenCrossings(x, y, zlo, end, count, tried, z, active));
+      // The rays left, packed (their indices in `place`), in pieces.
+      double px[16], py[16], pend[16], pguess[16], pz[16];
+      int place[16], rest = 0;
       for (int i = 0; i < count; ++i)
-        if (!std::isnan(from[i])) {
-          form_.ray(x[i], y[i], ray_, active);
-          if (!firstCrossing(ray_, from[i], end[i], std::numeric_limits<double>::quiet_NaN(), z[i],
-                             stats_))
-            z[i] = std::numeric_limits<double>::quiet_NaN();
+        if (std::isnan(z[i])) {
+          place[rest] = i;
+          px[rest] = x[i], py[rest] = y[i], pend[rest] = end[i], pguess[rest] = guess[i];
+          ++rest;
         }
+      if (rest > 0)
+        stats_.depthTests += uint64_t(
+            form_.piecewiseCrossings(px, py, zlo, pend, rest, kPieces, pguess, pz, from, active));
+      for (int j = 0; j < rest; ++j) {
+        const int i = place[j];
+        z[i] = pz[j];
+        if (std::isnan(from[j])) continue;
+        form_.ray(x[i], y[i], ray_, active);
+        if (!firstCrossing(ray_, from[j], end[i], kNaN, z[i], stats_)) z[i] = kNaN;
+      }
     }
     bool hits = false;
     for (int i = 0, py = 0; py < n && gy0 + py <= gy1; ++py)

@@ -258,6 +258,28 @@ void ForEachVector(DD d, const double* x, const double* y, double zlo, const dou
   }
 }
 
+// Newton alone from guesses g (lanes `span`, where g lies in [a, b]): up to four steps, a lane
+// settled when a step lands in [a, b] and has converged (newtonConverged), its zero in `found`
+// (NaN in the other lanes); lanes whose step leaves the span, or slow ones, stay unsettled.
+HWY_INLINE MD NewtonFromGuesses(DD d, const Rays& rays, VD a, VD b, VD g, MD span, VD& found) {
+  const VD zero = hn::Zero(d);
+  MD open = hn::And(span, Within(g, a, b)), settled = hn::Lt(zero, zero);
+  VD z = g, previous = zero, slope;
+  found = hn::Set(d, std::numeric_limits<double>::quiet_NaN());
+  for (int i = 0; i < 4 && !hn::AllFalse(d, open); ++i) {
+    const VD fz = Evaluate(d, rays, z, slope);
+    const VD step = hn::Div(fz, slope), next = hn::Sub(z, step), s = hn::Abs(step);
+    const MD converged = hn::And(hn::And(open, hn::And(hn::Ge(next, a), hn::Le(next, b))),
+                                 NewtonConverged(d, s, previous));
+    found = hn::IfThenElse(converged, next, found);
+    settled = hn::Or(settled, converged);
+    open = hn::AndNot(converged, hn::And(open, Within(next, a, b)));
+    previous = s;
+    z = next;
+  }
+  return settled;
+}
+
 void MonotonicCrossings(const ProjectedFreeForm::Node* nodes, const Quadric* clips,
                         size_t clipCount, const double* w, const double* x, const double* y,
                         double zlo, const double* zhi, int count, const double* guess,
@@ -270,23 +292,13 @@ void MonotonicCrossings(const ProjectedFreeForm::Node* nodes, const Quadric* cli
     const MD span = hn::Lt(a, b);
     // Step 1: Newton alone from the guesses. H is monotonic over each span, so a zero Newton
     // converges to inside it is the span's only crossing — no need to bracket it first.
-    MD open = hn::And(span, Within(g, a, b)), settled = hn::Lt(zero, zero);
-    VD z = g, found = hn::Set(d, std::numeric_limits<double>::quiet_NaN()), previous = zero, slope;
-    for (int i = 0; i < 4 && !hn::AllFalse(d, open); ++i) {
-      const VD fz = Evaluate(d, rays, z, slope);
-      const VD step = hn::Div(fz, slope), next = hn::Sub(z, step), s = hn::Abs(step);
-      const MD converged = hn::And(hn::And(open, hn::And(hn::Ge(next, a), hn::Le(next, b))),
-                                   NewtonConverged(d, s, previous));
-      found = hn::IfThenElse(converged, next, found);
-      settled = hn::Or(settled, converged);
-      open = hn::AndNot(converged, hn::And(open, Within(next, a, b)));  // left: step 2 decides
-      previous = s;
-      z = next;
-    }
+    VD found;
+    const MD settled = NewtonFromGuesses(d, rays, a, b, g, span, found);
     // Step 2: the other rays — no guess inside, Newton leaving the span or slow — bracketed: H
     // has opposite signs at the span's ends, refined as refineBracket refines.
     const MD rest = hn::AndNot(settled, span);
     if (!hn::AllFalse(d, rest)) {
+      VD slope;
       const VD fa = Evaluate(d, rays, a, slope), fb = Evaluate(d, rays, b, slope);
       const MD crossing = hn::And(rest, hn::Xor(hn::Ge(fa, zero), hn::Ge(fb, zero)));
       found = hn::IfThenElse(settled, found, Refine(d, rays, a, b, fa, fb, crossing, g));
@@ -295,6 +307,33 @@ void MonotonicCrossings(const ProjectedFreeForm::Node* nodes, const Quadric* cli
     hn::Store(found, d, result);
     std::copy_n(result, m, out + s0);
   });
+}
+
+int ProvenCrossings(const ProjectedFreeForm::Node* nodes, const Quadric* clips, size_t clipCount,
+                    const double* w, const double* x, const double* y, double zlo,
+                    const double* zhi, int count, const double* guess, double* out,
+                    uint64_t active) {
+  const DD d;
+  double* coefficients = CoefficientStorage(2 * (nodes[0].end + clipCount) * hn::Lanes(d));
+  int bounds = 0;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  ForEachVector(d, x, y, zlo, zhi, count, [&](size_t s0, size_t m, VD vx, VD vy, VD vz) {
+    const Rays rays = SetUpRays(d, nodes, clips, clipCount, w, active, vx, vy, coefficients);
+    const VD a = hn::Set(d, zlo), g = LoadPadded(d, guess, s0, m, nan);
+    VD found;
+    MD settled = NewtonFromGuesses(d, rays, a, vz, g, hn::Lt(a, vz), found);
+    if (!hn::AllFalse(d, settled)) {
+      // The proof: H monotonic over [zlo, zero] — no zero before this one.
+      bounds += int(hn::CountTrue(d, settled));
+      Lanes value, slope;
+      const MD valid = BoundLanes(d, rays, {a, hn::IfThenElse(settled, found, a)}, value, slope);
+      settled = hn::And(settled, hn::AndNot(ContainsZero(d, slope), valid));
+    }
+    alignas(64) double result[16];
+    hn::Store(hn::IfThenElse(settled, found, hn::Set(d, nan)), d, result);
+    std::copy_n(result, m, out + s0);
+  });
+  return bounds;
 }
 
 int PiecewiseCrossings(const ProjectedFreeForm::Node* nodes, const Quadric* clips, size_t clipCount,
@@ -354,6 +393,7 @@ namespace sv::freeform {
 
 HWY_EXPORT(MonotonicCrossings);
 HWY_EXPORT(PiecewiseCrossings);
+HWY_EXPORT(ProvenCrossings);
 
 void ProjectedFreeForm::monotonicCrossings(const double* x, const double* y, double zlo,
                                            const double* zhi, int count, const double* guess,
@@ -361,6 +401,14 @@ void ProjectedFreeForm::monotonicCrossings(const double* x, const double* y, dou
   HWY_DYNAMIC_DISPATCH(MonotonicCrossings)
   (nodes_.data(), clips_.data(), clips_.size(), inverse_.m[3].data(), x, y, zlo, zhi,
    std::clamp(count, 0, 16), guess, z, active);
+}
+
+int ProjectedFreeForm::provenCrossings(const double* x, const double* y, double zlo,
+                                       const double* zhi, int count, const double* guess, double* z,
+                                       uint64_t active) const {
+  return HWY_DYNAMIC_DISPATCH(ProvenCrossings)(nodes_.data(), clips_.data(), clips_.size(),
+                                               inverse_.m[3].data(), x, y, zlo, zhi,
+                                               std::clamp(count, 0, 16), guess, z, active);
 }
 
 int ProjectedFreeForm::piecewiseCrossings(const double* x, const double* y, double zlo,

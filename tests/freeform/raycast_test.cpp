@@ -155,16 +155,59 @@ TEST(RayCast, HitsMatchAnalyticRayQuadricIntersectionsForEveryKind) {
   }
 }
 
-// The results of each SIMD target, bit for bit those of the first one tried.
-void expectSameAsFirstTarget(const std::vector<double>& results, std::vector<double>& first,
-                             int64_t target, int& targets) {
-  if (targets++ == 0) {
-    first = results;
-    return;
+// Runs body(target, results) on every compiled SIMD target: the results of each, bit for bit those
+// of the first one tried.
+template <class Body>
+void onEveryTarget(const Body& body) {
+  std::vector<double> first;
+  int targets = 0;
+  for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
+    hwy::SetSupportedTargetsForTest(target);
+    std::vector<double> results;
+    body(target, results);
+    if (targets++ == 0) {
+      first = results;
+      continue;
+    }
+    ASSERT_EQ(results.size(), first.size());
+    EXPECT_EQ(0, std::memcmp(results.data(), first.data(), first.size() * sizeof(double)))
+        << hwy::TargetName(target) << " differs from the first target";
   }
-  ASSERT_EQ(results.size(), first.size());
-  EXPECT_EQ(0, std::memcmp(results.data(), first.data(), first.size() * sizeof(double)))
-      << hwy::TargetName(target) << " differs from the first target";
+  hwy::SetSupportedTargetsForTest(0);
+  EXPECT_GE(targets, 1);
+}
+
+// A sphere with a bump, so that a ray's bound has a perturbation's terms.
+FreeForm bumpedSphere() {
+  FreeForm f;
+  f.base = Quadric::sphere({0.2, -0.1, 0}, 1.2);
+  FreeForm bump;
+  bump.base = Quadric::sphere({0.2, -0.1, 1.2}, 0.4);
+  f.perturbations.push_back(bump);
+  return f;
+}
+
+// The truth for a ray (x, y) of g: the first sign change of H in [from, zhi], by fine steps and
+// bisection; NaN if none.
+double firstSignChange(const ProjectedFreeForm& g, double x, double y, double zhi,
+                       double from = -1) {
+  RayFunction ray;
+  g.ray(x, y, ray);
+  double a = from, fa = ray.evaluate(a);
+  for (int k = 1; k <= 4096; ++k) {
+    const double b = std::min(zhi, from + (1 - from) * k / 4096), fb = ray.evaluate(b);
+    if ((fa >= 0) != (fb >= 0)) {
+      double lo = a, hi = b;
+      for (int it = 0; it < 80; ++it) {
+        const double m = 0.5 * (lo + hi);
+        ((ray.evaluate(m) >= 0) == (fa >= 0) ? lo : hi) = m;
+      }
+      return lo;
+    }
+    if (b >= zhi) break;
+    a = b, fa = fb;
+  }
+  return NAN;
 }
 
 // ProjectedFreeForm::monotonicCrossings: rays into a sphere, each over the span from the near
@@ -181,12 +224,8 @@ TEST(RayCast, MonotonicCrossingsAreTheEntriesOnEveryTarget) {
   ASSERT_TRUE(g);
   std::mt19937 rng(8);
   std::uniform_int_distribution<int> pixel(0, w - 1);
-  std::vector<double> first;  // every result of the first target, in order
-  int targets = 0;
-  for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
-    hwy::SetSupportedTargetsForTest(target);
+  onEveryTarget([&](int64_t target, std::vector<double>& results) {
     rng.seed(8);
-    std::vector<double> results;
     int entries = 0, misses = 0;
     for (int round = 0; round < 200; ++round) {
       const int count = 1 + round % 16;
@@ -229,10 +268,7 @@ TEST(RayCast, MonotonicCrossingsAreTheEntriesOnEveryTarget) {
     }
     EXPECT_GT(entries, 300);
     EXPECT_GT(misses, 200);
-    expectSameAsFirstTarget(results, first, target, targets);
-  }
-  hwy::SetSupportedTargetsForTest(0);
-  EXPECT_GE(targets, 1);
+  });
 }
 
 // ProjectedFreeForm::piecewiseCrossings: rays into a sphere over the whole depth (entry and exit,
@@ -241,21 +277,11 @@ TEST(RayCast, MonotonicCrossingsAreTheEntriesOnEveryTarget) {
 // same bits on every compiled target, and both ways of finding a hit taken.
 TEST(RayCast, PiecewiseCrossingsAreTheEntriesOnEveryTarget) {
   const int w = 64, h = 64;
-  FreeForm f;
-  f.base = Quadric::sphere({0.2, -0.1, 0}, 1.2);
-  FreeForm bump;  // a bump, so that the ray's bound has a perturbation's terms
-  bump.base = Quadric::sphere({0.2, -0.1, 1.2}, 0.4);
-  f.perturbations.push_back(bump);
-  const Mat4d toCube = cameraToCube(w, h);
-  const auto g = ProjectedFreeForm::make(f, toCube);
+  const auto g = ProjectedFreeForm::make(bumpedSphere(), cameraToCube(w, h));
   ASSERT_TRUE(g);
-  std::vector<double> first;
-  int targets = 0;
-  for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
-    hwy::SetSupportedTargetsForTest(target);
+  onEveryTarget([&](int64_t target, std::vector<double>& results) {
     std::mt19937 rng(10);
     std::uniform_int_distribution<int> pixel(0, w - 1);
-    std::vector<double> results;
     int inLanes = 0, handedOver = 0, misses = 0;
     for (int round = 0; round < 200; ++round) {
       const int count = 1 + round % 16;
@@ -281,23 +307,7 @@ TEST(RayCast, PiecewiseCrossingsAreTheEntriesOnEveryTarget) {
           castRay(*g, 1, x[i], y[i], from[i], NAN, depth, object, hit, ray, stats);
           if (object == kNoHit) hit = NAN;
         }
-        // The truth: the first sign change of H along the ray, by fine steps and bisection.
-        RayFunction ray;
-        g->ray(x[i], y[i], ray);
-        double want = NAN, a = -1, fa = ray.evaluate(a);
-        for (int k = 1; k <= 4096 && std::isnan(want); ++k) {
-          const double b = std::min(zhi[i], -1 + 2.0 * k / 4096), fb = ray.evaluate(b);
-          if ((fa >= 0) != (fb >= 0)) {
-            double lo = a, hi = b;
-            for (int it = 0; it < 80; ++it) {
-              const double m = 0.5 * (lo + hi);
-              ((ray.evaluate(m) >= 0) == (fa >= 0) ? lo : hi) = m;
-            }
-            want = lo;
-          }
-          if (b >= zhi[i]) break;
-          a = b, fa = fb;
-        }
+        const double want = firstSignChange(*g, x[i], y[i], zhi[i]);
         if (std::isnan(want)) {
           EXPECT_TRUE(std::isnan(hit))
               << hwy::TargetName(target) << " round " << round << " ray " << i;
@@ -313,10 +323,61 @@ TEST(RayCast, PiecewiseCrossingsAreTheEntriesOnEveryTarget) {
     EXPECT_GT(inLanes, 100);
     EXPECT_GT(handedOver, 20);
     EXPECT_GT(misses, 200);
-    expectSameAsFirstTarget(results, first, target, targets);
-  }
-  hwy::SetSupportedTargetsForTest(0);
-  EXPECT_GE(targets, 1);
+  });
+}
+
+// ProjectedFreeForm::provenCrossings: rays into a bumped sphere over the whole depth (H turns
+// along them), Newton from a guess near the entry (a neighbour's hit), at the exit (a zero that
+// is not the first), far off or none: every zero it keeps is the ray's first crossing (so never
+// an exit); most of those guessed near the entry are kept. The same bits on every compiled
+// target.
+TEST(RayCast, ProvenCrossingsAreOnlyFirstCrossingsOnEveryTarget) {
+  const int w = 64, h = 64;
+  const auto g = ProjectedFreeForm::make(bumpedSphere(), cameraToCube(w, h));
+  ASSERT_TRUE(g);
+  onEveryTarget([&](int64_t target, std::vector<double>& results) {
+    std::mt19937 rng(12);
+    std::uniform_int_distribution<int> pixel(0, w - 1);
+    std::uniform_real_distribution<double> jitter(-1e-4, 1e-4);
+    int nearKept = 0, nearTried = 0, exitsTried = 0;
+    for (int round = 0; round < 400; ++round) {
+      const int count = 1 + round % 16;
+      double x[16], y[16], zhi[16], z[16], guess[16], want[16];
+      int kind[16];
+      for (int i = 0; i < count; ++i) {
+        x[i] = 2.0 * (pixel(rng) + 0.5) / w - 1;
+        y[i] = 1 - 2.0 * (pixel(rng) + 0.5) / h;
+        zhi[i] = 1;
+        want[i] = firstSignChange(*g, x[i], y[i], zhi[i]);
+        // The exit: the next sign change beyond the entry.
+        const double exit =
+            std::isnan(want[i]) ? NAN : firstSignChange(*g, x[i], y[i], zhi[i], want[i] + 1e-6);
+        kind[i] = (round + i) % 4;
+        guess[i] = kind[i] == 0   ? want[i] + jitter(rng)
+                   : kind[i] == 1 ? exit
+                   : kind[i] == 2 ? NAN
+                                  : 0.95;
+        if (kind[i] == 1 && !std::isnan(exit)) ++exitsTried;
+      }
+      g->provenCrossings(x, y, -1, zhi, count, guess, z);
+      for (int i = 0; i < count; ++i) {
+        results.push_back(z[i]);
+        if (std::isnan(z[i])) continue;
+        ASSERT_FALSE(std::isnan(want[i]))
+            << hwy::TargetName(target) << " round " << round << " ray " << i << " kept a zero";
+        EXPECT_NEAR(z[i], want[i], 1e-9)
+            << hwy::TargetName(target) << " round " << round << " ray " << i;
+      }
+      for (int i = 0; i < count; ++i)
+        if (kind[i] == 0 && !std::isnan(want[i])) {
+          ++nearTried;
+          nearKept += std::isnan(z[i]) ? 0 : 1;
+        }
+    }
+    EXPECT_GT(nearTried, 150);
+    EXPECT_GT(exitsTried, 150);
+    EXPECT_GT(nearKept, nearTried * 3 / 4) << nearKept << " of " << nearTried;
+  });
 }
 
 // A sculpture: masking skips hidden cells but never changes a pixel, with a masking pyramid per
