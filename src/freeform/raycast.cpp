@@ -125,7 +125,16 @@ class Caster {
  public:
   Caster(const ProjectedFreeForm& form, uint32_t id, const CastWindow& w, const CastSettings& s,
          MaskingPyramid& pyramid, CastStats& stats)
-      : form_(form), id_(id), w_(w), settings_(s), pyramid_(pyramid), stats_(stats) {}
+      : form_(form), id_(id), w_(w), settings_(s), pyramid_(pyramid), stats_(stats) {
+    // The rays' cube x of every column and y of every row of the window, worked out once (a
+    // division each; the cells and ray windows read them many times over).
+    columns_.resize(size_t(std::max(w.size, 0)));
+    rows_.resize(columns_.size());
+    for (int i = 0; i < w.size; ++i) {
+      columns_[size_t(i)] = cubeX(w.x0 + i, w.width, w.offsetX);
+      rows_[size_t(i)] = cubeY(w.y0 + i, w.height, w.offsetY);
+    }
+  }
 
   // Casts the form; returns the perturbations that may be positive anywhere in the window (all
   // where the whole window was never bounded).
@@ -158,8 +167,8 @@ class Caster {
     b.gx0 = w_.x0 + lx, b.gy0 = w_.y0 + ly;
     b.gx1 = std::min(b.gx0 + (1 << level), w_.width) - 1;
     b.gy1 = std::min(b.gy0 + (1 << level), w_.height) - 1;
-    b.x = {cubeX(b.gx0, w_.width, w_.offsetX), cubeX(b.gx1, w_.width, w_.offsetX)};
-    b.y = {cubeY(b.gy1, w_.height, w_.offsetY), cubeY(b.gy0, w_.height, w_.offsetY)};
+    b.x = {columns_[size_t(lx)], columns_[size_t(b.gx1 - w_.x0)]};
+    b.y = {rows_[size_t(b.gy1 - w_.y0)], rows_[size_t(ly)]};
     return b;
   }
 
@@ -252,11 +261,8 @@ class Caster {
     double* const z = lanes_.z;
     double* const from = lanes_.from;
     size_t* const at = lanes_.at;
-    double columns[4], rows[4];
-    for (int p = 0; p < n; ++p) {
-      columns[p] = cubeX(gx0 + p, w_.width, w_.offsetX);
-      rows[p] = cubeY(gy0 + p, w_.height, w_.offsetY);
-    }
+    const double* const columns = columns_.data() + lx;
+    const double* const rows = rows_.data() + ly;
     // Where Newton starts: the surface is coherent, so from this form's hits in the pixels just
     // left of the ray's row or above its column — the nearer — extrapolated linearly from the
     // next pixel out where that holds one too; else from the form's last hit in the tile.
@@ -367,6 +373,7 @@ class Caster {
     size_t at[16];
   } lanes_;
   double guess_ = std::numeric_limits<double>::quiet_NaN();  // the last hit (monotonicWindow)
+  std::vector<double> columns_, rows_;  // the rays' cube x, y per column and row
 };
 
 }  // namespace
