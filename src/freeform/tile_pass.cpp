@@ -20,7 +20,7 @@ using raster::kTileSize;
 void FreeFormFrame::prepare(std::vector<ShadedForm> forms, int width, int height, int samples,
                             const int32_t* sampleOffsetX, const int32_t* sampleOffsetY,
                             const shade::Environment* environment, const CastSettings& settings,
-                            int marchSteps) {
+                            int marchSteps, core::ThreadPool* pool) {
   forms_ = std::move(forms);
   surfaces_.clear();
   for (const ShadedForm& f : forms_)
@@ -42,7 +42,21 @@ void FreeFormFrame::prepare(std::vector<ShadedForm> forms, int width, int height
   tileNearest_.assign(tileForms_.size(), {});
   int size = kTileSize;
   while (size < width || size < height) size *= 2;
-  for (uint32_t f = 0; f < forms_.size(); ++f) markTiles(f, 0, 0, size, -1, 1);
+  // Each form's tiles found on its own (in parallel), then listed in the order of the forms.
+  marks_.resize(forms_.size());
+  const auto mark = [&](size_t f, int) {
+    marks_[f].clear();
+    markTiles(uint32_t(f), 0, 0, size, -1, 1, marks_[f]);
+  };
+  if (pool)
+    pool->parallelFor(forms_.size(), mark);
+  else
+    for (size_t f = 0; f < forms_.size(); ++f) mark(f, 0);
+  for (uint32_t f = 0; f < forms_.size(); ++f)
+    for (const Mark& m : marks_[f]) {
+      tileForms_[m.tile].push_back(f);
+      tileNearest_[m.tile].push_back(m.nearest);
+    }
   // Nearest first; ties in the order of the scene (stable), so the frame never depends on more
   // than the scene.
   for (size_t t = 0; t < tileForms_.size(); ++t) {
@@ -66,7 +80,8 @@ void FreeFormFrame::prepare(std::vector<ShadedForm> forms, int width, int height
 // Step 0 of a frame, per form: the screen quadtree from the whole raster down to tiles, with the
 // eight-slab depth tree (the caster uses sixteen), over whole pixel squares (every sample of a pixel lies in
 // its square).
-void FreeFormFrame::markTiles(uint32_t f, int x0, int y0, int size, double zlo, double zhi) {
+void FreeFormFrame::markTiles(uint32_t f, int x0, int y0, int size, double zlo, double zhi,
+                              std::vector<Mark>& marks) const {
   if (x0 >= width_ || y0 >= height_) return;
   const int x1 = std::min(x0 + size, width_), y1 = std::min(y0 + size, height_);
   const Interval x{2.0 * x0 / width_ - 1, 2.0 * x1 / width_ - 1};
@@ -82,15 +97,14 @@ void FreeFormFrame::markTiles(uint32_t f, int x0, int y0, int size, double zlo, 
   }
   if (first < 0) return;
   if (size == kTileSize) {
-    const size_t t = size_t(y0 / kTileSize) * size_t(tilesX_) + size_t(x0 / kTileSize);
-    tileForms_[t].push_back(f);
-    tileNearest_[t].push_back(zlo + (zhi - zlo) * first / kSlabs);
+    marks.push_back({uint32_t(y0 / kTileSize) * uint32_t(tilesX_) + uint32_t(x0 / kTileSize),
+                     zlo + (zhi - zlo) * first / kSlabs});
     return;
   }
   const double nlo = zlo + (zhi - zlo) * first / kSlabs;
   const double nhi = last + 1 == kSlabs ? zhi : zlo + (zhi - zlo) * (last + 1) / kSlabs;
   const int h = size / 2;
-  for (int c = 0; c < 4; ++c) markTiles(f, x0 + (c & 1) * h, y0 + (c >> 1) * h, h, nlo, nhi);
+  for (int c = 0; c < 4; ++c) markTiles(f, x0 + (c & 1) * h, y0 + (c >> 1) * h, h, nlo, nhi, marks);
 }
 
 void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color,

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/thread_pool.h"
 #include "freeform/raycast.h"
 #include "freeform/surface_points.h"
 #include "shade/shading.h"
@@ -34,11 +35,12 @@ class FreeFormFrame {
  public:
   // Finds, for every form, the tiles of the width × height raster (64-pixel tiles) whose pixel
   // squares its surface may cross, by the same bounds the caster uses, windows of the screen
-  // subdivided from the whole raster down to tiles.
+  // subdivided from the whole raster down to tiles — the forms shared among `pool`'s threads
+  // (nullptr: this one), the result the same.
   void prepare(std::vector<ShadedForm> forms, int width, int height, int samples,
                const int32_t* sampleOffsetX, const int32_t* sampleOffsetY,
-               const shade::Environment* environment, const CastSettings& settings,
-               int marchSteps);
+               const shade::Environment* environment, const CastSettings& settings, int marchSteps,
+               core::ThreadPool* pool = nullptr);
 
   bool empty() const { return forms_.empty(); }
   size_t size() const { return forms_.size(); }
@@ -73,7 +75,13 @@ class FreeFormFrame {
                 CastStats& stats) const;
 
  private:
-  void markTiles(uint32_t form, int x0, int y0, int size, double zlo, double zhi);
+  // A tile form `form` may show in, with the nearest cube depth its bounds allow there.
+  struct Mark {
+    uint32_t tile;
+    double nearest;
+  };
+  void markTiles(uint32_t form, int x0, int y0, int size, double zlo, double zhi,
+                 std::vector<Mark>& marks) const;
 
   std::vector<ShadedForm> forms_;
   std::vector<SurfacePoints> surfaces_;  // per form: its hits' points and normals
@@ -87,6 +95,7 @@ class FreeFormFrame {
   std::vector<std::vector<uint32_t>> tileForms_;
   // The nearest cube depth each listed form's bounds allow in the tile, in the same order.
   std::vector<std::vector<double>> tileNearest_;
+  std::vector<std::vector<Mark>> marks_;  // per form (prepare's)
 };
 
 }  // namespace sv::freeform

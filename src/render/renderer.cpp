@@ -589,7 +589,8 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
         fs.height, o.samples, cov ? cov->offsetX : nullptr, cov ? cov->offsetY : nullptr,
         &shading.environment,
         freeform::CastSettings{.masking = true, .adaptiveSamples = !o.freeFormEverySample},
-        o.freeFormMethod == RenderOptions::FreeFormMethod::march ? o.marchSteps : 0);
+        o.freeFormMethod == RenderOptions::FreeFormMethod::march ? o.marchSteps : 0,
+        &impl_->frame.pool());
     const int threads = impl_->frame.pool().threadCount();
     impl_->freeFormScratch.resize(size_t(threads));
     impl_->freeFormStats.assign(size_t(threads), freeform::CastStats{});
