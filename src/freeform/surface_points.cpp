@@ -97,7 +97,8 @@ VD ValueAndGradient(DD d, const ProjectedFreeForm::Node* nodes, uint32_t i, cons
 
 void SurfaceAt(const ProjectedFreeForm& object, const Mat4d& cubeToObject, const Mat4d& objectToEye,
                const Mat4d& normalToEye, const double* x, const double* y, const double* z,
-               int count, double uScale, double vScale, SurfaceLanes& out, uint64_t active) {
+               int count, double uScale, double vScale, SurfaceLanes& out, uint64_t active,
+               float (*floats)[16]) {
   const DD d;
   const size_t n = hn::Lanes(d);
   const ProjectedFreeForm::Node* nodes = object.nodes().data();
@@ -137,11 +138,11 @@ void SurfaceAt(const ProjectedFreeForm& object, const Mat4d& cubeToObject, const
       for (int c = 0; c < 3; ++c) hn::Store(lanes[k][c], d, outs[k][c] + i);
     // The floats shading reads (round to nearest, as float(double) does).
     const hn::Rebind<float, DD> df;
-    hn::Store(hn::DemoteTo(df, hn::Mul(p.x, hn::Set(d, uScale))), df, out.floats[out.kU] + i);
-    hn::Store(hn::DemoteTo(df, hn::Mul(p.z, hn::Set(d, vScale))), df, out.floats[out.kV] + i);
+    hn::Store(hn::DemoteTo(df, hn::Mul(p.x, hn::Set(d, uScale))), df, floats[out.kU] + i);
+    hn::Store(hn::DemoteTo(df, hn::Mul(p.z, hn::Set(d, vScale))), df, floats[out.kV] + i);
     for (int c = 0; c < 3; ++c) {
-      hn::Store(hn::DemoteTo(df, lanes[2][c]), df, out.floats[out.kNormal + c] + i);
-      hn::Store(hn::DemoteTo(df, lanes[3][c]), df, out.floats[out.kEye + c] + i);
+      hn::Store(hn::DemoteTo(df, lanes[2][c]), df, floats[out.kNormal + c] + i);
+      hn::Store(hn::DemoteTo(df, lanes[3][c]), df, floats[out.kEye + c] + i);
     }
   }
 }
@@ -166,10 +167,10 @@ SurfacePoints::SurfacePoints(const FreeForm& form, const Mat4d& cubeToObject,
       vScale_(vScale) {}
 
 void SurfacePoints::at(const double* x, const double* y, const double* z, int count,
-                       SurfaceLanes& out, uint64_t active) const {
+                       SurfaceLanes& out, uint64_t active, float (*floats)[16]) const {
   HWY_DYNAMIC_DISPATCH(SurfaceAt)
   (object_, cubeToObject_, objectToEye_, normalToEye_, x, y, z, std::clamp(count, 0, 16), uScale_,
-   vScale_, out, active);
+   vScale_, out, active, floats ? floats : out.floats);
 }
 
 }  // namespace sv::freeform

@@ -34,9 +34,10 @@ class SurfacePoints {
   // operations of Mat4d::transformPoint, FreeForm::gradient and normalize in the same order, so
   // the values are theirs bit for bit, on every target (tests/freeform).
   // `active`: the root's perturbations that may be positive at these points (castWindow's); the
-  // others, 0 there, are left out.
+  // others, 0 there, are left out. `floats` (if given): where SurfaceLanes::floats go instead —
+  // straight into shading's fragments (shade::Fragments::attribute from kU).
   void at(const double* x, const double* y, const double* z, int count, SurfaceLanes& out,
-          uint64_t active = kAllActive) const;
+          uint64_t active = kAllActive, float (*floats)[16] = nullptr) const;
 
  private:
   ProjectedFreeForm object_;  // the form flattened, in object space (the identity map)

@@ -337,6 +337,7 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
                     int(shade::kEyeX) == SurfaceLanes::kEye &&
                     int(shade::kEyeZ) + 1 == SurfaceLanes::kFloats,
                 "SurfaceLanes::floats are shading's attributes from kU on, in its order");
+  static_assert(shade::kMaxFragments == 16, "fragments are SurfaceLanes' 16 lanes");
   static_assert(shade::kMaxFragments == raster::kBlockPixels, "a whole block is one batch");
   for (size_t place = 0; place < listed.size(); ++place) {
     const uint32_t f = listed[place];
@@ -391,26 +392,38 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
     // Textured forms are shaded a pixel at a time: each has its own footprint (Fragments carries
     // one gradient per call — a triangle's, constant over it).
     const bool textured = form.material.texture != nullptr;
-    // A batch of `count` pixels (`block` as for writeBack).
+    // A batch of `count` pixels: batch[0 … count), or (untextured forms only) whole block
+    // `block` ≥ 0, batch unused.
     auto shadeBatch = [&](const Scratch::Pending* batch, int count, int block) {
       // Per fragment: its sample's cube point.
       double qx[shade::kMaxFragments], qy[shade::kMaxFragments], qz[shade::kMaxFragments];
-      for (int i = 0; i < count; ++i) {
-        const Scratch::Pending& p = batch[i];
-        qx[i] = scratch.columnX[size_t(p.sample * kTileSize + p.lx)];
-        qy[i] = scratch.rowY[size_t(p.sample * kTileSize + p.ly)];
-        qz[i] = scratch.cubeZ[plane * size_t(p.sample) + size_t(p.ly * kTileSize + p.lx)];
+      if (block >= 0) {  // a whole block: its first samples, row by row
+        const int bx = (block % raster::kBlocksPerTileSide) * kBlock;
+        const int by = (block / raster::kBlocksPerTileSide) * kBlock;
+        for (int r = 0; r < kBlock; ++r) {
+          std::copy_n(scratch.columnX.data() + bx, kBlock, qx + r * kBlock);
+          std::fill_n(qy + r * kBlock, kBlock, scratch.rowY[size_t(by + r)]);
+          std::copy_n(scratch.cubeZ.data() + size_t((by + r) * kTileSize + bx), kBlock,
+                      qz + r * kBlock);
+        }
+      } else {
+        for (int i = 0; i < count; ++i) {
+          const Scratch::Pending& p = batch[i];
+          qx[i] = scratch.columnX[size_t(p.sample * kTileSize + p.lx)];
+          qy[i] = scratch.rowY[size_t(p.sample * kTileSize + p.ly)];
+          qz[i] = scratch.cubeZ[plane * size_t(p.sample) + size_t(p.ly * kTileSize + p.lx)];
+        }
       }
       SurfaceLanes& hit = scratch.surface;
-      surfaces_[f].at(qx, qy, qz, count, hit, scratch.active[place]);
       float out[4][shade::kMaxFragments];
       if (!textured) {
+        surfaces_[f].at(qx, qy, qz, count, hit, scratch.active[place], frag.attribute + shade::kU);
         frag.count = count;
-        std::copy_n(&hit.floats[0][0], SurfaceLanes::kFloats * 16, &frag.attribute[shade::kU][0]);
         shade::shadeFragments(form.material, *environment_, frag, out);
         writeBack(batch, 0, count, block, out);
         return;
       }
+      surfaces_[f].at(qx, qy, qz, count, hit, scratch.active[place]);
       for (int first = 0; first < count; ++first) {
         frag.count = 1;
         for (int a = 0; a < SurfaceLanes::kFloats; ++a)
@@ -446,13 +459,17 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
       }
     };
     for (const int block : wholeBlocks) {
-      // Its pixels in the block's lane order, each shaded at its first sample.
+      if (!textured) {
+        shadeBatch(nullptr, shade::kMaxFragments, block);
+        continue;
+      }
+      // Textured, pixel by pixel: the block's pixels in its lane order, at their first samples.
       Scratch::Pending batch[shade::kMaxFragments];
       const int bx = (block % raster::kBlocksPerTileSide) * kBlock;
       const int by = (block / raster::kBlocksPerTileSide) * kBlock;
       for (int i = 0; i < shade::kMaxFragments; ++i)
         batch[i] = {bx + i % kBlock, by + i / kBlock, 0};
-      shadeBatch(batch, shade::kMaxFragments, textured ? -1 : block);
+      shadeBatch(batch, shade::kMaxFragments, -1);
     }
     for (size_t begin = 0; begin < pending.size(); begin += shade::kMaxFragments)
       shadeBatch(pending.data() + begin,
