@@ -46,44 +46,70 @@ struct Rays {
   bool takes(uint32_t i, int k) const { return i != 0 || k >= 64 || (active >> k & 1) != 0; }
 };
 
-// RayFunction::evaluateNode with the slope.
-VD EvaluateNode(DD d, const Rays& r, uint32_t i, VD z, VD invU4, VD du4, VD& slope) {
-  const double a = r.nodes[i].q.c[2];
-  const VD b = r.b(i, d);
-  VD h = hn::Add(hn::Mul(hn::Add(hn::Mul(hn::Set(d, a), z), b), z), r.c(i, d));
-  slope = hn::Add(hn::Mul(hn::Set(d, 2 * a), z), b);
-  int k = 0;
-  for (uint32_t c = i + 1; c < r.nodes[i].end; c = r.nodes[c].end) {
-    if (!r.takes(i, k++)) continue;
-    VD dv;
-    const VD v = EvaluateNode(d, r, c, z, invU4, du4, dv);
-    const MD positive = hn::Gt(v, hn::Zero(d));
-    const VD w = hn::Set(d, r.nodes[c].weight), v2 = hn::Mul(v, v);
-    const VD dh = hn::Mul(hn::Mul(hn::Mul(w, v2), v), invU4);
-    const VD ds = hn::Mul(w, hn::Add(hn::Mul(hn::Mul(hn::Mul(hn::Set(d, 3.0), v2), dv), invU4),
-                                     hn::Mul(hn::Mul(v2, v), du4)));
-    h = hn::IfThenElse(positive, hn::Add(h, dh), h);
-    slope = hn::IfThenElse(positive, hn::Add(slope, ds), slope);
+// Newton's method along a ray is a chain of dependent steps — each waits on its evaluation and
+// on two divisions — so one vector of rays at a time leaves the core idle most of the time.
+// kGroup vectors are solved together instead, their chains interleaved operation by operation
+// (each lane still does exactly the single-vector operations: same bits).
+constexpr int kGroup = 2;
+
+// RayFunction::evaluateNode with the slope, for K vectors' rays r[k] at z[k].
+template <int K>
+void EvaluateNodes(DD d, const Rays* r, uint32_t i, const VD* z, const VD* invU4, const VD* du4,
+                   VD* h, VD* slope) {
+  const double a = r[0].nodes[i].q.c[2];
+  for (int k = 0; k < K; ++k) {
+    const VD b = r[k].b(i, d);
+    h[k] = hn::Add(hn::Mul(hn::Add(hn::Mul(hn::Set(d, a), z[k]), b), z[k]), r[k].c(i, d));
+    slope[k] = hn::Add(hn::Mul(hn::Set(d, 2 * a), z[k]), b);
   }
-  return h;
+  int n = 0;
+  for (uint32_t c = i + 1; c < r[0].nodes[i].end; c = r[0].nodes[c].end) {
+    if (!r[0].takes(i, n++)) continue;
+    VD v[K], dv[K];
+    EvaluateNodes<K>(d, r, c, z, invU4, du4, v, dv);
+    const VD w = hn::Set(d, r[0].nodes[c].weight);
+    for (int k = 0; k < K; ++k) {
+      const MD positive = hn::Gt(v[k], hn::Zero(d));
+      const VD v2 = hn::Mul(v[k], v[k]);
+      const VD dh = hn::Mul(hn::Mul(hn::Mul(w, v2), v[k]), invU4[k]);
+      const VD ds =
+          hn::Mul(w, hn::Add(hn::Mul(hn::Mul(hn::Mul(hn::Set(d, 3.0), v2), dv[k]), invU4[k]),
+                             hn::Mul(hn::Mul(v2, v[k]), du4[k])));
+      h[k] = hn::IfThenElse(positive, hn::Add(h[k], dh), h[k]);
+      slope[k] = hn::IfThenElse(positive, hn::Add(slope[k], ds), slope[k]);
+    }
+  }
 }
 
-// RayFunction::evaluate(z, slope).
-HWY_INLINE VD Evaluate(DD d, const Rays& r, VD z, VD& slope) {
-  const VD u = hn::Add(r.u0, hn::Mul(hn::Set(d, r.u1), z));
-  const VD u2 = hn::Mul(u, u);
-  const VD invU4 = hn::Div(hn::Set(d, 1.0), hn::Mul(u2, u2));
-  const VD du4 = hn::Div(hn::Mul(hn::Set(d, -4 * r.u1), invU4), u);
-  VD h = EvaluateNode(d, r, 0, z, invU4, du4, slope);
-  const size_t nodeCount = r.nodes[0].end;
-  for (size_t k = 0; k < r.clipCount; ++k) {
-    const double a = r.clips[k].c[2];
-    const VD b = r.b(nodeCount + k, d);
-    const VD v = hn::Add(hn::Mul(hn::Add(hn::Mul(hn::Set(d, a), z), b), z), r.c(nodeCount + k, d));
-    const MD below = hn::Lt(v, h);
-    h = hn::IfThenElse(below, v, h);
-    slope = hn::IfThenElse(below, hn::Add(hn::Mul(hn::Set(d, 2 * a), z), b), slope);
+// RayFunction::evaluate(z, slope) for K vectors' rays r[k] at z[k].
+template <int K>
+HWY_INLINE void EvaluateGroup(DD d, const Rays* r, const VD* z, VD* h, VD* slope) {
+  VD invU4[K], du4[K];
+  for (int k = 0; k < K; ++k) {
+    const VD u = hn::Add(r[k].u0, hn::Mul(hn::Set(d, r[k].u1), z[k]));
+    const VD u2 = hn::Mul(u, u);
+    invU4[k] = hn::Div(hn::Set(d, 1.0), hn::Mul(u2, u2));
+    du4[k] = hn::Div(hn::Mul(hn::Set(d, -4 * r[k].u1), invU4[k]), u);
   }
+  EvaluateNodes<K>(d, r, 0, z, invU4, du4, h, slope);
+  const size_t nodeCount = r[0].nodes[0].end;
+  for (size_t c = 0; c < r[0].clipCount; ++c) {
+    const double a = r[0].clips[c].c[2];
+    for (int k = 0; k < K; ++k) {
+      const VD b = r[k].b(nodeCount + c, d);
+      const VD v = hn::Add(hn::Mul(hn::Add(hn::Mul(hn::Set(d, a), z[k]), b), z[k]),
+                           r[k].c(nodeCount + c, d));
+      const MD below = hn::Lt(v, h[k]);
+      h[k] = hn::IfThenElse(below, v, h[k]);
+      slope[k] = hn::IfThenElse(below, hn::Add(hn::Mul(hn::Set(d, 2 * a), z[k]), b), slope[k]);
+    }
+  }
+}
+
+// RayFunction::evaluate(z, slope) for one vector of rays.
+HWY_INLINE VD Evaluate(DD d, const Rays& r, VD z, VD& slope) {
+  VD h;
+  EvaluateGroup<1>(d, &r, &z, &h, &slope);
   return h;
 }
 
@@ -258,26 +284,66 @@ void ForEachVector(DD d, const double* x, const double* y, double zlo, const dou
   }
 }
 
-// Newton alone from guesses g (lanes `span`, where g lies in [a, b]): up to four steps, a lane
-// settled when a step lands in [a, b] and has converged (newtonConverged), its zero in `found`
-// (NaN in the other lanes); lanes whose step leaves the span, or slow ones, stay unsettled.
-HWY_INLINE MD NewtonFromGuesses(DD d, const Rays& rays, VD a, VD b, VD g, MD span, VD& found) {
+// Newton alone from guesses g[k] (lanes span[k], where g lies in [a, b[k]]), the kGroup vectors
+// together: up to four steps, a lane settled when a step lands in [a, b] and has converged
+// (newtonConverged), its zero in found[k] (NaN in the other lanes); lanes whose step leaves the
+// span, or slow ones, stay unsettled. A lane's steps are its own: others still going change
+// nothing in it.
+HWY_INLINE void NewtonFromGuesses(DD d, const Rays* rays, VD a, const VD* b, const VD* g,
+                                  const MD* span, VD* found, MD* settled) {
   const VD zero = hn::Zero(d);
-  MD open = hn::And(span, Within(g, a, b)), settled = hn::Lt(zero, zero);
-  VD z = g, previous = zero, slope;
-  found = hn::Set(d, std::numeric_limits<double>::quiet_NaN());
-  for (int i = 0; i < 4 && !hn::AllFalse(d, open); ++i) {
-    const VD fz = Evaluate(d, rays, z, slope);
-    const VD step = hn::Div(fz, slope), next = hn::Sub(z, step), s = hn::Abs(step);
-    const MD converged = hn::And(hn::And(open, hn::And(hn::Ge(next, a), hn::Le(next, b))),
-                                 NewtonConverged(d, s, previous));
-    found = hn::IfThenElse(converged, next, found);
-    settled = hn::Or(settled, converged);
-    open = hn::AndNot(converged, hn::And(open, Within(next, a, b)));
-    previous = s;
-    z = next;
+  MD open[kGroup];
+  VD z[kGroup], previous[kGroup];
+  bool any = false;
+  for (int k = 0; k < kGroup; ++k) {
+    open[k] = hn::And(span[k], Within(g[k], a, b[k]));
+    settled[k] = hn::Lt(zero, zero);
+    z[k] = g[k];
+    previous[k] = zero;
+    found[k] = hn::Set(d, std::numeric_limits<double>::quiet_NaN());
+    any = any || !hn::AllFalse(d, open[k]);
   }
-  return settled;
+  for (int i = 0; i < 4 && any; ++i) {
+    VD fz[kGroup], slope[kGroup];
+    EvaluateGroup<kGroup>(d, rays, z, fz, slope);
+    any = false;
+    for (int k = 0; k < kGroup; ++k) {
+      const VD step = hn::Div(fz[k], slope[k]), next = hn::Sub(z[k], step), s = hn::Abs(step);
+      const MD converged = hn::And(hn::And(open[k], hn::And(hn::Ge(next, a), hn::Le(next, b[k]))),
+                                   NewtonConverged(d, s, previous[k]));
+      found[k] = hn::IfThenElse(converged, next, found[k]);
+      settled[k] = hn::Or(settled[k], converged);
+      open[k] = hn::AndNot(converged, hn::And(open[k], Within(next, a, b[k])));
+      previous[k] = s;
+      z[k] = next;
+      any = any || !hn::AllFalse(d, open[k]);
+    }
+  }
+}
+
+// The lanes' own rays, x[i], y[i] and span ends zhi[i] for i < count, kGroup vectors of `n` at a
+// time, each set up (SetUpRays) in its own part of `coefficients` (`stride` doubles each): lanes
+// past `count` are rays with an empty span (zhi = zlo), inactive throughout. body(s0, m, rays, vz,
+// k): vector k's rays begin at ray s0, m of them its own (0: none).
+template <class Body>
+void ForEachGroup(DD d, const ProjectedFreeForm::Node* nodes, const Quadric* clips,
+                  size_t clipCount, const double* w, uint64_t active, const double* x,
+                  const double* y, double zlo, const double* zhi, int count, double* coefficients,
+                  size_t stride, const Body& body) {
+  const size_t n = hn::Lanes(d);
+  for (size_t g0 = 0; g0 < size_t(count); g0 += kGroup * n) {
+    Rays rays[kGroup];
+    VD vz[kGroup];
+    size_t s0[kGroup], m[kGroup];
+    for (int k = 0; k < kGroup; ++k) {
+      s0[k] = g0 + size_t(k) * n;
+      m[k] = s0[k] < size_t(count) ? std::min(n, size_t(count) - s0[k]) : 0;
+      vz[k] = LoadPadded(d, zhi, s0[k], m[k], zlo);
+      rays[k] = SetUpRays(d, nodes, clips, clipCount, w, active, LoadPadded(d, x, s0[k], m[k], 0),
+                          LoadPadded(d, y, s0[k], m[k], 0), coefficients + size_t(k) * stride);
+    }
+    body(s0, m, rays, vz);
+  }
 }
 
 void MonotonicCrossings(const ProjectedFreeForm::Node* nodes, const Quadric* clips,
@@ -285,28 +351,39 @@ void MonotonicCrossings(const ProjectedFreeForm::Node* nodes, const Quadric* cli
                         double zlo, const double* zhi, int count, const double* guess,
                         double* out, uint64_t active) {
   const DD d;
-  double* coefficients = CoefficientStorage(2 * (nodes[0].end + clipCount) * hn::Lanes(d));
-  ForEachVector(d, x, y, zlo, zhi, count, [&](size_t s0, size_t m, VD vx, VD vy, VD vz) {
-    const Rays rays = SetUpRays(d, nodes, clips, clipCount, w, active, vx, vy, coefficients);
-    const VD a = hn::Set(d, zlo), b = vz, zero = hn::Zero(d), g = LoadPadded(d, guess, s0, m, 0);
-    const MD span = hn::Lt(a, b);
-    // Step 1: Newton alone from the guesses. H is monotonic over each span, so a zero Newton
-    // converges to inside it is the span's only crossing — no need to bracket it first.
-    VD found;
-    const MD settled = NewtonFromGuesses(d, rays, a, b, g, span, found);
-    // Step 2: the other rays — no guess inside, Newton leaving the span or slow — bracketed: H
-    // has opposite signs at the span's ends, refined as refineBracket refines.
-    const MD rest = hn::AndNot(settled, span);
-    if (!hn::AllFalse(d, rest)) {
-      VD slope;
-      const VD fa = Evaluate(d, rays, a, slope), fb = Evaluate(d, rays, b, slope);
-      const MD crossing = hn::And(rest, hn::Xor(hn::Ge(fa, zero), hn::Ge(fb, zero)));
-      found = hn::IfThenElse(settled, found, Refine(d, rays, a, b, fa, fb, crossing, g));
-    }
-    alignas(64) double result[16];
-    hn::Store(found, d, result);
-    std::copy_n(result, m, out + s0);
-  });
+  const size_t stride = 2 * (nodes[0].end + clipCount) * hn::Lanes(d);
+  double* coefficients = CoefficientStorage(kGroup * stride);
+  ForEachGroup(d, nodes, clips, clipCount, w, active, x, y, zlo, zhi, count, coefficients, stride,
+               [&](const size_t* s0, const size_t* m, const Rays* rays, const VD* b) {
+                 const VD a = hn::Set(d, zlo), zero = hn::Zero(d);
+                 VD g[kGroup], found[kGroup];
+                 MD span[kGroup], settled[kGroup];
+                 for (int k = 0; k < kGroup; ++k) {
+                   g[k] = LoadPadded(d, guess, s0[k], m[k], 0);
+                   span[k] = hn::Lt(a, b[k]);
+                 }
+                 // Step 1: Newton alone from the guesses. H is monotonic over each span, so a zero
+                 // Newton converges to inside it is the span's only crossing — no need to bracket
+                 // it first.
+                 NewtonFromGuesses(d, rays, a, b, g, span, found, settled);
+                 for (int k = 0; k < kGroup && m[k] > 0; ++k) {
+                   // Step 2: the other rays — no guess inside, Newton leaving the span or slow —
+                   // bracketed: H has opposite signs at the span's ends, refined as refineBracket
+                   // refines.
+                   const MD rest = hn::AndNot(settled[k], span[k]);
+                   if (!hn::AllFalse(d, rest)) {
+                     VD slope;
+                     const VD fa = Evaluate(d, rays[k], a, slope),
+                              fb = Evaluate(d, rays[k], b[k], slope);
+                     const MD crossing = hn::And(rest, hn::Xor(hn::Ge(fa, zero), hn::Ge(fb, zero)));
+                     found[k] = hn::IfThenElse(settled[k], found[k],
+                                               Refine(d, rays[k], a, b[k], fa, fb, crossing, g[k]));
+                   }
+                   alignas(64) double result[16];
+                   hn::Store(found[k], d, result);
+                   std::copy_n(result, m[k], out + s0[k]);
+                 }
+               });
 }
 
 int ProvenCrossings(const ProjectedFreeForm::Node* nodes, const Quadric* clips, size_t clipCount,
@@ -314,25 +391,34 @@ int ProvenCrossings(const ProjectedFreeForm::Node* nodes, const Quadric* clips, 
                     const double* zhi, int count, const double* guess, double* out,
                     uint64_t active) {
   const DD d;
-  double* coefficients = CoefficientStorage(2 * (nodes[0].end + clipCount) * hn::Lanes(d));
+  const size_t stride = 2 * (nodes[0].end + clipCount) * hn::Lanes(d);
+  double* coefficients = CoefficientStorage(kGroup * stride);
   int bounds = 0;
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  ForEachVector(d, x, y, zlo, zhi, count, [&](size_t s0, size_t m, VD vx, VD vy, VD vz) {
-    const Rays rays = SetUpRays(d, nodes, clips, clipCount, w, active, vx, vy, coefficients);
-    const VD a = hn::Set(d, zlo), g = LoadPadded(d, guess, s0, m, nan);
-    VD found;
-    MD settled = NewtonFromGuesses(d, rays, a, vz, g, hn::Lt(a, vz), found);
-    if (!hn::AllFalse(d, settled)) {
-      // The proof: H monotonic over [zlo, zero] — no zero before this one.
-      bounds += int(hn::CountTrue(d, settled));
-      Lanes value, slope;
-      const MD valid = BoundLanes(d, rays, {a, hn::IfThenElse(settled, found, a)}, value, slope);
-      settled = hn::And(settled, hn::AndNot(ContainsZero(d, slope), valid));
-    }
-    alignas(64) double result[16];
-    hn::Store(hn::IfThenElse(settled, found, hn::Set(d, nan)), d, result);
-    std::copy_n(result, m, out + s0);
-  });
+  ForEachGroup(d, nodes, clips, clipCount, w, active, x, y, zlo, zhi, count, coefficients, stride,
+               [&](const size_t* s0, const size_t* m, const Rays* rays, const VD* vz) {
+                 const VD a = hn::Set(d, zlo);
+                 VD g[kGroup], found[kGroup];
+                 MD span[kGroup], settled[kGroup];
+                 for (int k = 0; k < kGroup; ++k) {
+                   g[k] = LoadPadded(d, guess, s0[k], m[k], nan);
+                   span[k] = hn::Lt(a, vz[k]);
+                 }
+                 NewtonFromGuesses(d, rays, a, vz, g, span, found, settled);
+                 for (int k = 0; k < kGroup && m[k] > 0; ++k) {
+                   if (!hn::AllFalse(d, settled[k])) {
+                     // The proof: H monotonic over [zlo, zero] — no zero before this one.
+                     bounds += int(hn::CountTrue(d, settled[k]));
+                     Lanes value, slope;
+                     const MD valid = BoundLanes(
+                         d, rays[k], {a, hn::IfThenElse(settled[k], found[k], a)}, value, slope);
+                     settled[k] = hn::And(settled[k], hn::AndNot(ContainsZero(d, slope), valid));
+                   }
+                   alignas(64) double result[16];
+                   hn::Store(hn::IfThenElse(settled[k], found[k], hn::Set(d, nan)), d, result);
+                   std::copy_n(result, m[k], out + s0[k]);
+                 }
+               });
   return bounds;
 }
 
