@@ -321,7 +321,7 @@ class Caster {
     bool hits = false;
     for (int i = 0, py = 0; py < n && gy0 + py <= gy1; ++py)
       for (int px = 0; px < n && gx0 + px <= gx1; ++px, ++i)
-        if (!std::isnan(z[i]) && hit(lx + px, ly + py, at[i], z[i])) {
+        if (!std::isnan(z[i]) && hit(lx + px, ly + py, at[i], z[i], active)) {
           hits = true;
           guess_ = z[i];
         }
@@ -350,11 +350,13 @@ class Caster {
   }
 
   // Takes the hit where it is nearer; the pixel's node follows (its ancestors: refreshAbove).
-  bool hit(int lx, int ly, size_t at, double z) {
+  // `active`: the perturbations that may be positive in the window of the hit (CastWindow's).
+  bool hit(int lx, int ly, size_t at, double z, uint64_t active) {
     if (!takeHit(z, id_, w_.depth[at], w_.object ? w_.object + at : nullptr,
                  w_.cubeZ ? w_.cubeZ + at : nullptr, stats_))
       return false;
     node(0, lx, ly) = w_.depth[at];
+    if (w_.active) w_.active[at] = active;
     return true;
   }
 

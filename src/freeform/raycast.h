@@ -35,6 +35,10 @@ struct CastWindow {
   float* depth = nullptr;
   uint32_t* object = nullptr;
   double* cubeZ = nullptr;
+  // If given, per pixel (same indexing): on a hit, the form's perturbations that may be positive
+  // in the ray window it came from (ProjectedFreeForm::bound's `active`) — the others are 0 at
+  // the hit, and its shading leaves them out.
+  uint64_t* active = nullptr;
   int stride = 0;
   // The rays leave every pixel at this offset from its centre, in pixels: a sample of the
   // anti-aliasing pattern (SPEC §5), or 0 for point sampling.

@@ -66,6 +66,8 @@ class FreeFormFrame {
     SurfaceLanes surface;
     std::vector<double> columnX, rowY;  // per sample: the tile's columns' cube x, rows' cube y
     std::vector<uint64_t> active;       // per listed form: its perturbations that may be positive
+    std::vector<uint64_t>
+        pixelActive;  // per sample plane and pixel: its hit's (CastWindow::active)
   };
 
   // Casts the forms listed for tile (tileX, tileY) into its buffers — `samples` depth and colour

@@ -380,6 +380,50 @@ TEST(RayCast, ProvenCrossingsAreOnlyFirstCrossingsOnEveryTarget) {
   });
 }
 
+// CastWindow::active: every hit keeps the perturbations that may be positive in its ray window;
+// each one left out is ≤ 0 at the hit (so it adds nothing there, nor to the gradient), and on a
+// sphere with six bumps most hits leave most out.
+TEST(RayCast, HitsKeepThePerturbationsThatMayBePositiveThere) {
+  const int w = 128, h = 128;
+  FreeForm f;
+  f.base = Quadric::sphere({0, 0, 0}, 1);
+  for (int i = 0; i < 6; ++i) {
+    const double a = i * M_PI / 3;
+    FreeForm bump;
+    bump.base = Quadric::sphere({0.9 * std::cos(a), 0.9 * std::sin(a), 0.3}, 0.45);
+    f.perturbations.push_back(bump);
+  }
+  const Mat4d toCube = cameraToCube(w, h);
+  const auto g = ProjectedFreeForm::make(f, toCube);
+  ASSERT_TRUE(g);
+  Buffers b(w, h);
+  std::vector<uint64_t> active(size_t(w) * h, 0);
+  CastStats stats;
+  for (int y0 = 0; y0 < h; y0 += 64)
+    for (int x0 = 0; x0 < w; x0 += 64) {
+      CastWindow window = windowOf(b, x0, y0);
+      window.active = active.data() + size_t(y0) * w + size_t(x0);
+      castWindow(*g, 1, window, CastSettings{}, stats);
+    }
+  int hits = 0, leftOut = 0;
+  for (int py = 0; py < h; ++py)
+    for (int px = 0; px < w; ++px) {
+      const size_t at = size_t(py) * w + size_t(px);
+      if (b.object[at] != 1) continue;
+      ++hits;
+      const Vec3d p =
+          g->toObject({2.0 * (px + 0.5) / w - 1, 1 - 2.0 * (py + 0.5) / h, b.cubeZ[at]});
+      for (int k = 0; k < 6; ++k) {
+        if (active[at] >> k & 1) continue;
+        ++leftOut;
+        EXPECT_LE(f.perturbations[size_t(k)].base.evaluate(p), 1e-9)
+            << "pixel " << px << "," << py << " perturbation " << k;
+      }
+    }
+  EXPECT_GT(hits, 2000);
+  EXPECT_GT(leftOut, 4 * hits);
+}
+
 // A sculpture: masking skips hidden cells but never changes a pixel, with a masking pyramid per
 // form or one shared by the forms of a window; the fixed-step marcher finds the same surface
 // where its steps do not skip it.
