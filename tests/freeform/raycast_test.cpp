@@ -177,6 +177,19 @@ void onEveryTarget(const Body& body) {
   EXPECT_GE(targets, 1);
 }
 
+// A unit sphere with six bumps around it, toward the camera.
+FreeForm sculpture() {
+  FreeForm f;
+  f.base = Quadric::sphere({0, 0, 0}, 1);
+  for (int i = 0; i < 6; ++i) {
+    const double a = i * M_PI / 3;
+    FreeForm bump;
+    bump.base = Quadric::sphere({0.9 * std::cos(a), 0.9 * std::sin(a), 0.3}, 0.45);
+    f.perturbations.push_back(bump);
+  }
+  return f;
+}
+
 // A sphere with a bump, so that a ray's bound has a perturbation's terms.
 FreeForm bumpedSphere() {
   FreeForm f;
@@ -385,14 +398,7 @@ TEST(RayCast, ProvenCrossingsAreOnlyFirstCrossingsOnEveryTarget) {
 // sphere with six bumps most hits leave most out.
 TEST(RayCast, HitsKeepThePerturbationsThatMayBePositiveThere) {
   const int w = 128, h = 128;
-  FreeForm f;
-  f.base = Quadric::sphere({0, 0, 0}, 1);
-  for (int i = 0; i < 6; ++i) {
-    const double a = i * M_PI / 3;
-    FreeForm bump;
-    bump.base = Quadric::sphere({0.9 * std::cos(a), 0.9 * std::sin(a), 0.3}, 0.45);
-    f.perturbations.push_back(bump);
-  }
+  const FreeForm f = sculpture();
   const Mat4d toCube = cameraToCube(w, h);
   const auto g = ProjectedFreeForm::make(f, toCube);
   ASSERT_TRUE(g);
@@ -429,14 +435,7 @@ TEST(RayCast, HitsKeepThePerturbationsThatMayBePositiveThere) {
 // where its steps do not skip it.
 TEST(RayCast, MaskingChangesNothingAndTheMarcherAgrees) {
   const int w = 96, h = 64;
-  FreeForm f;
-  f.base = Quadric::sphere({0, 0, 0}, 1);
-  for (int i = 0; i < 6; ++i) {
-    const double a = i * M_PI / 3;
-    FreeForm bump;
-    bump.base = Quadric::sphere({0.9 * std::cos(a), 0.9 * std::sin(a), 0.3}, 0.45);
-    f.perturbations.push_back(bump);
-  }
+  const FreeForm f = sculpture();
   FreeForm ground;
   ground.base = Quadric::halfSpace({0, 1, 0}, -0.7);
   const Mat4d toCube = cameraToCube(w, h);
