@@ -381,16 +381,27 @@ class Caster {
 }  // namespace
 
 MaskingPyramid::MaskingPyramid(const CastWindow& w) : size_(w.size) {
+  constexpr int kTileRow = 64;  // the tile pass's windows
   top_ = std::countr_zero(unsigned(w.size));
-  levels_.resize(size_t(top_) + 1);
-  for (int l = 0; l <= top_; ++l) levels_[size_t(l)].resize(size_t(1) << (2 * (top_ - l)));
+  offset_.resize(size_t(top_) + 1);
+  size_t total = 0;
+  for (int l = 0; l <= top_; ++l) {
+    offset_[size_t(l)] = total;
+    total += size_t(1) << (2 * (top_ - l));
+  }
+  nodes_.resize(total);
   // Level 0: the depths, row by row; pixels beyond the raster hold −∞ (they never need a
   // surface).
   const int columns = std::clamp(w.width - w.x0, 0, w.size);
   for (int y = 0; y < w.size; ++y) {
     float* row = &node(0, 0, y);
     const int inside = w.y0 + y < w.height ? columns : 0;
-    std::copy_n(w.depth + size_t(y) * size_t(w.stride), inside, row);
+    const float* depth = w.depth + size_t(y) * size_t(w.stride);
+    if (inside == kTileRow && w.size == kTileRow) {  // the common row, copied inline
+      std::copy_n(depth, kTileRow, row);
+      continue;
+    }
+    std::copy_n(depth, inside, row);
     std::fill(row + inside, row + w.size, -std::numeric_limits<float>::infinity());
   }
   for (int l = 1; l <= top_; ++l)

@@ -79,7 +79,7 @@ class MaskingPyramid {
   explicit MaskingPyramid(const CastWindow& window);
   int top() const { return top_; }  // the level of the whole window: size = 2^top
   float& node(int level, int x, int y) {
-    return levels_[size_t(level)][size_t(y * (size_ >> level) + x)];
+    return nodes_[offset_[size_t(level)] + size_t(y * (size_ >> level) + x)];
   }
   // Recomputes the nodes above the square of 2^level pixels at (lx, ly): every node of it at
   // the levels up to its own, then its single ancestor at each level above.
@@ -88,7 +88,8 @@ class MaskingPyramid {
  private:
   void update(int level, int x, int y);
   int size_ = 0, top_ = 0;
-  std::vector<std::vector<float>> levels_;  // [level][y · (size >> level) + x]
+  std::vector<float> nodes_;  // level by level: [offset_[level] + y · (size >> level) + x]
+  std::vector<size_t> offset_;
 };
 
 // Casts `form` (number `id`) into the window: every pixel whose ray meets the surface at a window
