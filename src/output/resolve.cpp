@@ -4,6 +4,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
@@ -51,6 +52,27 @@ void forEachTileRow(const uint16_t* color, int tileX, int tileY, Image& image, F
   }
 }
 
+// Whether every pixel of a one-sample tile holds the same colour: its first block's channels
+// each one value, and every block the same as the first (compared 8 bytes at a time, stopping at
+// the first difference).
+bool uniformTile(const uint16_t* color) {
+  using namespace raster;
+  for (int ch = 0; ch < 3; ++ch)
+    for (int i = 1; i < kBlockPixels; ++i)
+      if (color[ch * kBlockPixels + i] != color[ch * kBlockPixels]) return false;
+  constexpr int kWords = kColorPerBlock * int(sizeof(uint16_t)) / 8;
+  uint64_t first[kWords];
+  std::memcpy(first, color, sizeof first);
+  for (int block = 1; block < kBlocksPerTileSide * kBlocksPerTileSide; ++block) {
+    uint64_t words[kWords];
+    std::memcpy(words, color + size_t(block) * kColorPerBlock, sizeof words);
+    uint64_t differ = 0;
+    for (int i = 0; i < kWords; ++i) differ |= words[i] ^ first[i];
+    if (differ) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 void prepareImage(int width, int height, Image& image) {
@@ -84,6 +106,14 @@ void resolveTile(const uint16_t* color, int tileX, int tileY, const GammaTable& 
   const int w = std::min(kTileSize, image.width - x0), h = std::min(kTileSize, image.height - y0);
   // Each row put together in a buffer, then written out whole (writeImageRow).
   alignas(64) uint8_t row[3 * kTileSize];
+  if (w == kTileSize && h == kTileSize && uniformTile(color)) {
+    // One colour (a tile of background): one look-up per channel, the same row 64 times.
+    for (int x = 0; x < kTileSize; ++x)
+      for (int ch = 0; ch < 3; ++ch) row[3 * x + ch] = gamma.table[color[ch * kBlockPixels]];
+    for (int y = 0; y < h; ++y) writeImageRow(row, 3 * w, image.pixel(x0, y0 + y));
+    finishImageRows();
+    return;
+  }
   for (int y = 0; y < h; ++y) {
     const uint16_t* src = color + size_t(y >> kBlockLog2) * kBlocksPerTileSide * kColorPerBlock +
                           (y & (kBlockSize - 1)) * kBlockSize;

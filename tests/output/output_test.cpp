@@ -82,20 +82,30 @@ TEST(Gamma, SrgbTablesMatchTheStandardAtKnownPoints) {
   for (int i = 1; i < 65536; ++i) ASSERT_GE(g.table[i], g.table[i - 1]);  // monotonic
 }
 
-// Every pixel of full and partial tiles, in images whose rows start at every alignment (the
-// resolve streams rows where the image allows and copies the rest).
+// Every pixel of full and partial tiles, of one colour or many, in images whose rows start at
+// every alignment (the resolve streams rows where the image allows and copies the rest).
 TEST(Resolve, TilePixelsAreTheirColoursThroughTheTable) {
   const auto g = output::GammaTable::srgb();
-  for (const int width : {64, 70, 128, 133}) {
-    const int height = 67;
+  for (const int width : {64, 70, 133, 200}) {
+    const int height = 131;
     Image image;
     output::prepareImage(width, height, image);
     std::fill(image.rgb.begin(), image.rgb.end(), uint8_t(0xAB));
     const int tilesX = (width + raster::kTileSize - 1) / raster::kTileSize;
     const int tilesY = (height + raster::kTileSize - 1) / raster::kTileSize;
     std::vector<uint16_t> color(size_t(raster::kTilePixels) * 3);
+    // Tiles of one colour, of one colour but their last pixel, and of many colours.
     auto value = [&](int x, int y, int ch) {
-      return uint16_t((x * 977 + y * 131 + ch * 7919) * 13);
+      const int tx = x / raster::kTileSize, ty = y / raster::kTileSize;
+      const int lx = x % raster::kTileSize, ly = y % raster::kTileSize;
+      switch ((tx + ty) % 3) {
+        case 0:
+          return uint16_t(1234 + ch * 20000);
+        case 1:
+          return uint16_t(lx == 63 && ly == 63 ? 60000 : 1234 + ch * 20000);
+        default:
+          return uint16_t((x * 977 + y * 131 + ch * 7919) * 13);
+      }
     };
     for (int ty = 0; ty < tilesY; ++ty)
       for (int tx = 0; tx < tilesX; ++tx) {
