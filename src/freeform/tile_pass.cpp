@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <tuple>
 
@@ -368,12 +369,16 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
     auto writeBack = [&](const Scratch::Pending* batch, int first, int n, int block,
                          const float(*out)[shade::kMaxFragments]) {
       // To 16 bits, to nearest (ties to even, as lrint): adding 2^23 leaves the rounded value
-      // in the float's low bits (a loop the compiler vectorizes).
+      // in the float's low bits. shadeFragments's colours lie in [0, 1] already; with no clamp
+      // the loop is one the compiler vectorizes.
       alignas(64) uint16_t c16[3][shade::kMaxFragments];
       for (int ch = 0; ch < 3; ++ch)
-        for (int j = 0; j < shade::kMaxFragments; ++j)
-          c16[ch][j] = uint16_t(
-              std::bit_cast<uint32_t>(std::clamp(out[ch][j], 0.0f, 1.0f) * 65535.0f + 8388608.0f));
+        for (int j = 0; j < shade::kMaxFragments; ++j) {
+          const float v = out[ch][j] * 65535.0f + 8388608.0f;
+          uint32_t bits;
+          std::memcpy(&bits, &v, sizeof bits);
+          c16[ch][j] = uint16_t(bits);
+        }
       if (block >= 0) {
         const int bx = (block % raster::kBlocksPerTileSide) * kBlock;
         const int by = (block / raster::kBlocksPerTileSide) * kBlock;
