@@ -102,10 +102,15 @@ void SurfaceAt(const ProjectedFreeForm& object, const Mat4d& cubeToObject, const
   const DD d;
   const size_t n = hn::Lanes(d);
   const ProjectedFreeForm::Node* nodes = object.nodes().data();
-  alignas(64) double in[3][16] = {};
-  std::copy_n(x, count, in[0]);
-  std::copy_n(y, count, in[1]);
-  std::copy_n(z, count, in[2]);
+  // The hits, and zeros up to the last vector's end (the whole array cleared cost a `rep stos`
+  // per call).
+  alignas(64) double in[3][16];
+  const size_t padded = (size_t(count) + n - 1) / n * n;
+  const double* const from[3] = {x, y, z};
+  for (int c = 0; c < 3; ++c) {
+    std::copy_n(from[c], count, in[c]);
+    std::fill(in[c] + count, in[c] + padded, 0.0);
+  }
   for (size_t i = 0; i < size_t(count); i += n) {
     const V3 q{hn::Load(d, in[0] + i), hn::Load(d, in[1] + i), hn::Load(d, in[2] + i)};
     const V3 p = TransformPoint(d, cubeToObject, q);
