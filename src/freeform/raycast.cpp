@@ -417,7 +417,7 @@ void MaskingPyramid::update(int l, int x, int y) {
 
 void MaskingPyramid::refreshAbove(int level, int lx, int ly) {
   int l = 1;
-  if (level == 2 && top_ >= 2) {
+  if (level == 2 && top_ >= 2 && (lx & 3) == 0 && (ly & 3) == 0) {
     // A ray window of 4×4 (every hit's): its four 2×2 nodes and its own straight from its 16
     // pixels' rows, without update's index arithmetic for each.
     const size_t width0 = size_t(size_), width1 = width0 / 2;

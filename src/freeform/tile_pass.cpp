@@ -2,7 +2,6 @@
 #include "freeform/tile_pass.h"
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -358,7 +357,10 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
     if (pending.empty() && wholeBlocks.empty()) continue;
     // What all the form's fragments share, set once: attributes given as themselves (w = 1),
     // the form's colour, opaque.
+    // (Every lane set: a batch of fewer than 16 leaves the rest as they are, and shading and the
+    // write-back's rounding run over all 16.)
     shade::Fragments frag;
+    std::fill_n(&frag.attribute[0][0], shade::kAttributeCount * shade::kMaxFragments, 0.0f);
     std::fill_n(frag.q, shade::kMaxFragments, 1.0f);
     for (int ch = 0; ch < 3; ++ch)
       std::fill_n(frag.color[ch], shade::kMaxFragments, form.color[ch]);
