@@ -47,9 +47,9 @@ struct Rays {
 };
 
 // Newton's method along a ray is a chain of dependent steps — each waits on its evaluation and
-// on two divisions — so one vector of rays at a time leaves the core idle most of the time.
-// kGroup vectors are solved together instead, their chains interleaved operation by operation
-// (each lane still does exactly the single-vector operations: same bits).
+// on two divisions — so kGroup vectors of rays are solved together, their chains interleaved
+// operation by operation (each lane still does exactly the single-vector operations: same bits;
+// measured 1–2 % faster than one vector at a time).
 constexpr int kGroup = 2;
 
 // RayFunction::evaluateNode with the slope, for K vectors' rays r[k] at z[k].
@@ -323,8 +323,8 @@ HWY_INLINE void NewtonFromGuesses(DD d, const Rays* rays, VD a, const VD* b, con
 
 // The lanes' own rays, x[i], y[i] and span ends zhi[i] for i < count, kGroup vectors of `n` at a
 // time, each set up (SetUpRays) in its own part of `coefficients` (`stride` doubles each): lanes
-// past `count` are rays with an empty span (zhi = zlo), inactive throughout. body(s0, m, rays, vz,
-// k): vector k's rays begin at ray s0, m of them its own (0: none).
+// past `count` are rays with an empty span (zhi = zlo), inactive throughout. body(s0, m, rays, vz)
+// takes arrays of kGroup: vector k's rays begin at ray s0[k], m[k] of them its own (0: none).
 template <class Body>
 void ForEachGroup(DD d, const ProjectedFreeForm::Node* nodes, const Quadric* clips,
                   size_t clipCount, const double* w, uint64_t active, const double* x,
