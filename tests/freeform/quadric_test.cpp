@@ -9,6 +9,7 @@
 #include <random>
 #include <string>
 
+#include "every_target.h"
 #include "freeform/freeform.h"
 
 namespace sv::freeform {
@@ -214,19 +215,6 @@ ProjectedFreeForm clippedBumpySphere() {
   FreeForm f = bumpySphere();
   f.clips = {Quadric::halfSpace({0, 1, 0}, 0.7)};
   return *ProjectedFreeForm::make(f, frustumToCube());
-}
-
-// Runs fn(target) with each compiled SIMD target selected; returns how many ran.
-template <class Fn>
-int forEveryTarget(const Fn& fn) {
-  int targets = 0;
-  for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
-    hwy::SetSupportedTargetsForTest(target);
-    ++targets;
-    fn(target);
-  }
-  hwy::SetSupportedTargetsForTest(0);
-  return targets;
 }
 
 // The SIMD slab bounds (slab_bounds.cpp) answer as the scalar bound does, slab by slab, on every

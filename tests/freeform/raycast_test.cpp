@@ -12,6 +12,7 @@
 #include <random>
 #include <vector>
 
+#include "every_target.h"
 #include "freeform/tessellate.h"
 
 namespace sv::freeform {
@@ -153,28 +154,6 @@ TEST(RayCast, HitsMatchAnalyticRayQuadricIntersectionsForEveryKind) {
     EXPECT_LE(mismatched, 2) << s.name;
     EXPECT_LE(worst, 1e-3) << s.name << ": error in cells";
   }
-}
-
-// Runs body(target, results) on every compiled SIMD target: the results of each, bit for bit those
-// of the first one tried.
-template <class Body>
-void onEveryTarget(const Body& body) {
-  std::vector<double> first;
-  int targets = 0;
-  for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
-    hwy::SetSupportedTargetsForTest(target);
-    std::vector<double> results;
-    body(target, results);
-    if (targets++ == 0) {
-      first = results;
-      continue;
-    }
-    ASSERT_EQ(results.size(), first.size());
-    EXPECT_EQ(0, std::memcmp(results.data(), first.data(), first.size() * sizeof(double)))
-        << hwy::TargetName(target) << " differs from the first target";
-  }
-  hwy::SetSupportedTargetsForTest(0);
-  EXPECT_GE(targets, 1);
 }
 
 // A unit sphere with six bumps around it, toward the camera.

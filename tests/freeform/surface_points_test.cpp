@@ -11,6 +11,8 @@
 #include <cmath>
 #include <random>
 
+#include "every_target.h"
+
 namespace sv::freeform {
 namespace {
 
@@ -37,12 +39,10 @@ TEST(SurfacePoints, LanesEqualTheScalarFormulasOnEveryTarget) {
   const SurfacePoints surface(f, cubeToObject, toEye, normalToEye, 2.0, 0.5);
   std::mt19937 rng(9);
   std::uniform_real_distribution<double> u(-1.3, 1.3);
-  int targets = 0, clipped = 0, bumped = 0, ruledOut = 0;
+  int clipped = 0, bumped = 0, ruledOut = 0;
   const std::optional<ProjectedFreeForm> projected = ProjectedFreeForm::make(f, toCube);
   ASSERT_TRUE(projected);
-  for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
-    hwy::SetSupportedTargetsForTest(target);
-    ++targets;
+  const int targets = forEveryTarget([&](int64_t target) {
     for (int round = 0; round < 300; ++round) {
       const int count = 1 + round % 16;
       double x[16], y[16], z[16];
@@ -99,8 +99,7 @@ TEST(SurfacePoints, LanesEqualTheScalarFormulasOnEveryTarget) {
         bumped += bump.evaluate(p) > 0 ? 1 : 0;
       }
     }
-  }
-  hwy::SetSupportedTargetsForTest(0);
+  });
   EXPECT_GE(targets, 1);
   // The clip's gradient and the perturbations' terms were both exercised.
   EXPECT_GT(clipped, 50 * targets);
