@@ -115,6 +115,9 @@ std::optional<ProjectedFreeForm> ProjectedFreeForm::make(const FreeForm& form,
   p.inverse_ = *inverse;
   flatten(form, *inverse, p.nodes_);
   for (const Quadric& c : form.clips) p.clips_.push_back(c.transformedByInverse(*inverse));
+  const size_t perturbations = form.perturbations.size();
+  p.manyPerturbations_ = perturbations > 64;
+  p.rootPerturbations_ = perturbations >= 64 ? kAllActive : (uint64_t(1) << perturbations) - 1;
   return p;
 }
 

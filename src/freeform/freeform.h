@@ -146,6 +146,19 @@ class ProjectedFreeForm {
   // Returns the number of ray bounds made.
   int provenCrossings(const double* x, const double* y, double zlo, const double* zhi, int count,
                       const double* guess, double* z, uint64_t active = kAllActive) const;
+  // Whether H is its quadrics alone where `active` (bound's) holds none of the root's
+  // perturbations: the root's quadric and the clips, each a quadratic along any ray of the cube
+  // (a projective map keeps a quadric's order, SPEC §12) — so quadricCrossings solves its rays.
+  bool quadricsAlone(uint64_t active) const {
+    return (active & rootPerturbations_) == 0 && !manyPerturbations_;
+  }
+  // Rays (x[i], y[i]), i < count ≤ 16, where H is its quadrics alone (quadricsAlone): z[i] is
+  // the first crossing of H = min(root, clips) in (zlo, zhi[i]] in closed form — each quadric's
+  // roots by the stable quadratic formula, the first that is an entry into every other quadric's
+  // inside (an exit from one, where the ray starts inside) — or NaN where there is none (a
+  // tangent touch is none). Every ray a SIMD lane, each on its own: the same bits on every target.
+  void quadricCrossings(const double* x, const double* y, double zlo, const double* zhi, int count,
+                        double* z) const;
   // bound(x[i], y[i], z, value[i], slope[i], &active[i]) with active[i] = `take` on entry, for
   // up to 16 windows of one depth range, each window a SIMD lane (slab_bounds.cpp): the same
   // operations in the same order, so the same bits, on every target.
@@ -175,6 +188,8 @@ class ProjectedFreeForm {
   std::vector<Node> nodes_;
   std::vector<Quadric> clips_;  // transformed like the nodes: min(H, u²·C_k) = u²·min(F', C_k)
   Mat4d inverse_;
+  uint64_t rootPerturbations_ = 0;  // a bit per root perturbation (the first 64, as `active`)
+  bool manyPerturbations_ = false;  // more than 64: the later ones are always in H
 };
 
 }  // namespace sv::freeform

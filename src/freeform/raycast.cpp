@@ -246,12 +246,11 @@ class Caster {
   }
 
   // The rays of a window of n × n pixels (n ≤ 4) at (lx, ly), raster pixels [gx0, gx1] ×
-  // [gy0, gy1], over [zlo, zhi], solved together, Newton starting from the last hit of this form
-  // in the tile (the surface is coherent). `monotonic`: the window's slope bound says each ray
-  // crosses at most once (ProjectedFreeForm::monotonicCrossings). Otherwise — silhouettes, mostly
-  // — the rays' spans are taken in pieces, each ray bounding its own (piecewiseCrossings), and
-  // a ray whose H may turn within a piece goes on alone from there (firstCrossing). True if any
-  // pixel took a hit.
+  // [gy0, gy1], over [zlo, zhi], solved together. Where no perturbation reaches the window, in
+  // closed form (quadricCrossings); else by Newton, starting from neighbours' hits or the last
+  // hit of this form in the tile (the surface is coherent). `monotonic`: the window's slope bound
+  // says each ray crosses at most once (ProjectedFreeForm::monotonicCrossings); otherwise —
+  // silhouettes, mostly — turningCrossings. True if any pixel took a hit.
   bool rayWindow(int lx, int ly, int n, int gx0, int gy0, int gx1, int gy1, double zlo, double zhi,
                  bool monotonic, uint64_t active) {
     double* const x = lanes_.x;
@@ -259,64 +258,45 @@ class Caster {
     double* const end = lanes_.end;
     double* const guess = lanes_.guess;
     double* const z = lanes_.z;
-    double* const from = lanes_.from;
     size_t* const at = lanes_.at;
     const double* const columns = columns_.data() + lx;
     const double* const rows = rows_.data() + ly;
-    // Where Newton starts: the surface is coherent, so from this form's hits in the pixels just
-    // left of the ray's row or above its column — the nearer — extrapolated linearly from the
-    // next pixel out where that holds one too; else from the form's last hit in the tile.
-    Neighbours left[4], above[4];
-    for (int p = 0; p < n; ++p) {
-      left[p] = neighbours(lx - 1, ly + p, -1, 0);
-      above[p] = neighbours(lx + p, ly - 1, 0, -1);
-    }
-    constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
     int count = 0;
-    bool near[16];  // the guess is a neighbour's hit (not only the tile's last one)
     for (int py = 0; py < n && gy0 + py <= gy1; ++py)
       for (int px = 0; px < n && gx0 + px <= gx1; ++px, ++count) {
         at[count] = size_t(ly + py) * size_t(w_.stride) + size_t(lx + px);
         x[count] = columns[px];
         y[count] = rows[py];
         end[count] = std::min(zhi, 2.0 * double(w_.depth[at[count]]) - 1);
-        const Neighbours& first = px <= py ? left[py] : above[px];
-        const Neighbours& second = px <= py ? above[px] : left[py];
-        near[count] = first.hits > 0 || second.hits > 0;
-        guess[count] = first.hits > 0    ? first.guess(px <= py ? px + 1 : py + 1)
-                       : second.hits > 0 ? second.guess(px <= py ? py + 1 : px + 1)
-                                         : guess_;
       }
     stats_.pixels += uint64_t(count);
-    if (monotonic) {
-      form_.monotonicCrossings(x, y, zlo, end, count, guess, z, active);
+    if (form_.quadricsAlone(active)) {
+      // No perturbation reaches the window: H along each ray is the root's quadratic (and the
+      // clips'), solved in closed form — no guess, no bound, whatever the slope.
+      form_.quadricCrossings(x, y, zlo, end, count, z);
     } else {
-      // H may turn. Most such windows lie wholly on the surface, their slope bound only loose
-      // over the run of slabs: rays with a neighbour's hit first try Newton from it, a zero kept
-      // where the ray's own bound proves it the first (provenCrossings); the others are taken
-      // in pieces, and a ray whose H may turn within a piece goes on alone from there.
-      double tried[16];
-      for (int i = 0; i < count; ++i) tried[i] = near[i] ? guess[i] : kNaN;
-      stats_.depthTests += uint64_t(form_.provenCrossings(x, y, zlo, end, count, tried, z, active));
-      // The rays left, packed (their indices in `place`), in pieces.
-      double px[16], py[16], pend[16], pguess[16], pz[16];
-      int place[16], rest = 0;
-      for (int i = 0; i < count; ++i)
-        if (std::isnan(z[i])) {
-          place[rest] = i;
-          px[rest] = x[i], py[rest] = y[i], pend[rest] = end[i], pguess[rest] = guess[i];
-          ++rest;
-        }
-      if (rest > 0)
-        stats_.depthTests += uint64_t(
-            form_.piecewiseCrossings(px, py, zlo, pend, rest, kPieces, pguess, pz, from, active));
-      for (int j = 0; j < rest; ++j) {
-        const int i = place[j];
-        z[i] = pz[j];
-        if (std::isnan(from[j])) continue;
-        form_.ray(x[i], y[i], ray_, active);
-        if (!firstCrossing(ray_, from[j], end[i], kNaN, z[i], stats_)) z[i] = kNaN;
+      // Where Newton starts: the surface is coherent, so from this form's hits in the pixels
+      // just left of the ray's row or above its column — the nearer — extrapolated linearly from
+      // the next pixel out where that holds one too; else from the form's last hit in the tile.
+      Neighbours left[4], above[4];
+      for (int p = 0; p < n; ++p) {
+        left[p] = neighbours(lx - 1, ly + p, -1, 0);
+        above[p] = neighbours(lx + p, ly - 1, 0, -1);
       }
+      bool near[16];  // the guess is a neighbour's hit (not only the tile's last one)
+      for (int i = 0, py = 0; py < n && gy0 + py <= gy1; ++py)
+        for (int px = 0; px < n && gx0 + px <= gx1; ++px, ++i) {
+          const Neighbours& first = px <= py ? left[py] : above[px];
+          const Neighbours& second = px <= py ? above[px] : left[py];
+          near[i] = first.hits > 0 || second.hits > 0;
+          guess[i] = first.hits > 0    ? first.guess(px <= py ? px + 1 : py + 1)
+                     : second.hits > 0 ? second.guess(px <= py ? py + 1 : px + 1)
+                                       : guess_;
+        }
+      if (monotonic)
+        form_.monotonicCrossings(x, y, zlo, end, count, guess, z, active);
+      else
+        turningCrossings(zlo, count, near, active);
     }
     bool hits = false;
     for (int i = 0, py = 0; py < n && gy0 + py <= gy1; ++py)
@@ -326,6 +306,43 @@ class Caster {
           guess_ = z[i];
         }
     return hits;
+  }
+
+  // rayWindow's rays (lanes_, the first `count`) where H may turn. Most such windows lie wholly
+  // on the surface, their slope bound only loose over the run of slabs: rays with a neighbour's
+  // hit (`near`) first try Newton from it, a zero kept where the ray's own bound proves it the
+  // first (provenCrossings); the others are taken in pieces, and a ray whose H may turn within a
+  // piece goes on alone from there.
+  void turningCrossings(double zlo, int count, const bool* near, uint64_t active) {
+    constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+    const double* const x = lanes_.x;
+    const double* const y = lanes_.y;
+    const double* const end = lanes_.end;
+    const double* const guess = lanes_.guess;
+    double* const z = lanes_.z;
+    double* const from = lanes_.from;
+    double tried[16];
+    for (int i = 0; i < count; ++i) tried[i] = near[i] ? guess[i] : kNaN;
+    stats_.depthTests += uint64_t(form_.provenCrossings(x, y, zlo, end, count, tried, z, active));
+    // The rays left, packed (their indices in `place`), in pieces.
+    double px[16], py[16], pend[16], pguess[16], pz[16];
+    int place[16], rest = 0;
+    for (int i = 0; i < count; ++i)
+      if (std::isnan(z[i])) {
+        place[rest] = i;
+        px[rest] = x[i], py[rest] = y[i], pend[rest] = end[i], pguess[rest] = guess[i];
+        ++rest;
+      }
+    if (rest > 0)
+      stats_.depthTests += uint64_t(
+          form_.piecewiseCrossings(px, py, zlo, pend, rest, kPieces, pguess, pz, from, active));
+    for (int j = 0; j < rest; ++j) {
+      const int i = place[j];
+      z[i] = pz[j];
+      if (std::isnan(from[j])) continue;
+      form_.ray(x[i], y[i], ray_, active);
+      if (!firstCrossing(ray_, from[j], end[i], kNaN, z[i], stats_)) z[i] = kNaN;
+    }
   }
 
   // This form's hits at the pixel (qx, qy) and the next one out, (qx + dx, qy + dy): how many

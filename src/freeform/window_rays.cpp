@@ -386,6 +386,61 @@ void MonotonicCrossings(const ProjectedFreeForm::Node* nodes, const Quadric* cli
                });
 }
 
+void QuadricCrossings(const ProjectedFreeForm::Node* nodes, const Quadric* clips, size_t clipCount,
+                      const double* w, const double* x, const double* y, double zlo,
+                      const double* zhi, int count, double* out) {
+  const DD d;
+  const size_t nodeCount = nodes[0].end;
+  double* coefficients = CoefficientStorage(2 * (nodeCount + clipCount) * hn::Lanes(d));
+  // The quadrics: the root (j = 0) and the clips (j = 1 …), each a·z² + b·z + c along a ray.
+  const size_t quadrics = 1 + clipCount;
+  const auto slot = [&](size_t j) { return j == 0 ? size_t(0) : nodeCount + j - 1; };
+  const auto squared = [&](size_t j) { return j == 0 ? nodes[0].q.c[2] : clips[j - 1].c[2]; };
+  ForEachVector(d, x, y, zlo, zhi, count, [&](size_t s0, size_t m, VD vx, VD vy, VD end) {
+    // No root perturbation taken (active 0): SetUpRays sets the root's and the clips' b and c.
+    const Rays rays = SetUpRays(d, nodes, clips, clipCount, w, 0, vx, vy, coefficients);
+    const VD zero = hn::Zero(d), start = hn::Set(d, zlo);
+    const auto value = [&](size_t j, VD z) {
+      return hn::Add(hn::Mul(hn::Add(hn::Mul(hn::Set(d, squared(j)), z), rays.b(slot(j), d)), z),
+                     rays.c(slot(j), d));
+    };
+    const auto inSpan = [&](VD z) { return hn::And(hn::Gt(z, start), hn::Le(z, end)); };
+    // Inside at zlo (H, the least of the quadrics, ≥ 0): the crossing is the first exit from any
+    // of them; outside, the first entry into one where all the others are inside.
+    VD h = value(0, start);
+    for (size_t j = 1; j < quadrics; ++j) h = hn::Min(h, value(j, start));
+    const MD startInside = hn::Ge(h, zero);
+    VD first = hn::Set(d, std::numeric_limits<double>::infinity());
+    for (size_t j = 0; j < quadrics; ++j) {
+      const VD b = rays.b(slot(j), d), c = rays.c(slot(j), d);
+      // The stable quadratic formula: t = −(b + sign(b)·√D)/2, the roots t/a and c/t. The entry
+      // (where the quadric turns positive, its slope +√D) is (−b + √D)/(2a), the exit
+      // (−b − √D)/(2a): c/t and t/a where b ≥ 0, the other way round where b < 0. With a = 0,
+      // c/t = −c/b is the one root and t/a is ±∞ or NaN, never in the span. D ≤ 0: no sign
+      // change (a tangent touch is none).
+      const VD disc = hn::Sub(hn::Mul(b, b), hn::Mul(hn::Set(d, 4 * squared(j)), c));
+      const MD real = hn::Gt(disc, zero);
+      const VD root = hn::CopySign(hn::Sqrt(hn::Max(disc, zero)), b);
+      const VD t = hn::Mul(hn::Set(d, -0.5), hn::Add(b, root));
+      const VD r1 = hn::Div(t, hn::Set(d, squared(j))), r2 = hn::Div(c, t);
+      const MD nonNegative = hn::Ge(b, zero);
+      const VD entry = hn::IfThenElse(nonNegative, r2, r1);
+      const VD exit = hn::IfThenElse(nonNegative, r1, r2);
+      MD entering = hn::AndNot(startInside, hn::And(real, inSpan(entry)));
+      for (size_t i = 0; i < quadrics && !hn::AllFalse(d, entering); ++i)
+        if (i != j) entering = hn::And(entering, hn::Ge(value(i, entry), zero));
+      const MD exiting = hn::And(startInside, hn::And(real, inSpan(exit)));
+      first = hn::IfThenElse(entering, hn::Min(first, entry), first);
+      first = hn::IfThenElse(exiting, hn::Min(first, exit), first);
+    }
+    alignas(64) double result[16];
+    hn::Store(hn::IfThenElse(hn::Le(first, end), first,
+                             hn::Set(d, std::numeric_limits<double>::quiet_NaN())),
+              d, result);
+    std::copy_n(result, m, out + s0);
+  });
+}
+
 int ProvenCrossings(const ProjectedFreeForm::Node* nodes, const Quadric* clips, size_t clipCount,
                     const double* w, const double* x, const double* y, double zlo,
                     const double* zhi, int count, const double* guess, double* out,
@@ -480,6 +535,7 @@ namespace sv::freeform {
 HWY_EXPORT(MonotonicCrossings);
 HWY_EXPORT(PiecewiseCrossings);
 HWY_EXPORT(ProvenCrossings);
+HWY_EXPORT(QuadricCrossings);
 
 void ProjectedFreeForm::monotonicCrossings(const double* x, const double* y, double zlo,
                                            const double* zhi, int count, const double* guess,
@@ -487,6 +543,13 @@ void ProjectedFreeForm::monotonicCrossings(const double* x, const double* y, dou
   HWY_DYNAMIC_DISPATCH(MonotonicCrossings)
   (nodes_.data(), clips_.data(), clips_.size(), inverse_.m[3].data(), x, y, zlo, zhi,
    std::clamp(count, 0, 16), guess, z, active);
+}
+
+void ProjectedFreeForm::quadricCrossings(const double* x, const double* y, double zlo,
+                                         const double* zhi, int count, double* z) const {
+  HWY_DYNAMIC_DISPATCH(QuadricCrossings)
+  (nodes_.data(), clips_.data(), clips_.size(), inverse_.m[3].data(), x, y, zlo, zhi,
+   std::clamp(count, 0, 16), z);
 }
 
 int ProjectedFreeForm::provenCrossings(const double* x, const double* y, double zlo,

@@ -372,6 +372,84 @@ TEST(RayCast, ProvenCrossingsAreOnlyFirstCrossingsOnEveryTarget) {
   });
 }
 
+// ProjectedFreeForm::quadricCrossings: rays of a capped cylinder (a quadric and two clips) over
+// spans from the near plane or from a depth partway in — so starting in front of it, inside it or
+// past it — give the first sign change of H: entries through the side and through a cap, exits
+// where the span starts inside, nothing for misses and empty spans. The same bits on every
+// compiled target.
+TEST(RayCast, QuadricCrossingsAreTheFirstSignChangesOnEveryTarget) {
+  const int w = 64, h = 64;
+  const Vec3d axis{0.3, 0.5, 0.8};
+  FreeForm f;
+  f.base = Quadric::cylinder({0, 0, 0}, axis, 1.1);
+  f.clips = {Quadric::halfSpace(axis, 1.3), Quadric::halfSpace(axis * -1.0, 1.3)};
+  const auto g = ProjectedFreeForm::make(f, cameraToCube(w, h));
+  ASSERT_TRUE(g);
+  EXPECT_TRUE(g->quadricsAlone(0));
+  EXPECT_TRUE(g->quadricsAlone(kAllActive));  // no perturbations at all
+  onEveryTarget([&](int64_t target, std::vector<double>& results) {
+    std::mt19937 rng(14);
+    std::uniform_int_distribution<int> pixel(0, w - 1);
+    std::uniform_real_distribution<double> depth(-1, 0.99);
+    int side = 0, caps = 0, exits = 0, misses = 0, disagree = 0;
+    for (int round = 0; round < 300; ++round) {
+      const int count = 1 + round % 16;
+      const double zlo = round % 2 == 0 ? -1 : depth(rng);
+      double x[16], y[16], zhi[16], z[16];
+      for (int i = 0; i < count; ++i) {
+        x[i] = 2.0 * (pixel(rng) + 0.5) / w - 1;
+        y[i] = 1 - 2.0 * (pixel(rng) + 0.5) / h;
+        zhi[i] = i % 7 == 6 ? zlo : 1;  // some spans are empty
+      }
+      g->quadricCrossings(x, y, zlo, zhi, count, z);
+      for (int i = 0; i < count; ++i) {
+        results.push_back(z[i]);
+        const double want =
+            zhi[i] > zlo ? firstSignChange(*g, x[i], y[i], zhi[i], zlo) : double(NAN);
+        if (std::isnan(want) != std::isnan(z[i])) {
+          ++disagree;  // only a ray grazing the surface within the truth's step may
+          continue;
+        }
+        if (std::isnan(want)) {
+          ++misses;
+          continue;
+        }
+        EXPECT_NEAR(z[i], want, 1e-9)
+            << hwy::TargetName(target) << " round " << round << " ray " << i;
+        const Vec3d p = g->toObject({x[i], y[i], z[i]});
+        if (f.base.evaluate(p) < 0 || g->evaluate({x[i], y[i], zlo}) >= 0)
+          ++exits;  // leaves the cylinder here, or started inside it
+        else if (std::fabs(f.base.evaluate(p)) < 1e-6)
+          ++side;
+        else
+          ++caps;
+      }
+    }
+    EXPECT_LE(disagree, 2);
+    EXPECT_GT(side, 150);
+    EXPECT_GT(caps, 200);
+    EXPECT_GT(exits, 30);
+    EXPECT_GT(misses, 500);
+  });
+}
+
+// quadricsAlone: H is its quadrics alone only where no root perturbation is active — and never
+// with more root perturbations than `active` has bits for.
+TEST(RayCast, QuadricsAloneOnlyWhereNoPerturbationIsActive) {
+  const auto g = ProjectedFreeForm::make(bumpedSphere(), cameraToCube(64, 64));
+  ASSERT_TRUE(g);
+  EXPECT_TRUE(g->quadricsAlone(0));
+  EXPECT_FALSE(g->quadricsAlone(1));
+  EXPECT_FALSE(g->quadricsAlone(kAllActive));
+  EXPECT_TRUE(g->quadricsAlone(~uint64_t(1)));  // bits of perturbations the form lacks
+  FreeForm many;
+  many.base = Quadric::sphere({0, 0, 0}, 1);
+  for (int i = 0; i < 65; ++i) many.perturbations.push_back(bumpedSphere().perturbations[0]);
+  const auto m = ProjectedFreeForm::make(many, cameraToCube(64, 64));
+  ASSERT_TRUE(m);
+  EXPECT_FALSE(m->quadricsAlone(0));  // the 65th is always taken
+}
+
 // CastWindow::active: every hit keeps the perturbations that may be positive in its ray window;
 // each one left out is ≤ 0 at the hit (so it adds nothing there, nor to the gradient), and on a
 // sphere with six bumps most hits leave most out.
