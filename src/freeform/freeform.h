@@ -152,8 +152,8 @@ class ProjectedFreeForm {
   bool quadricsAlone(uint64_t active) const {
     return (active & rootPerturbations_) == 0 && !manyPerturbations_;
   }
-  // Rays (x[i], y[i]), i < count ≤ 16, where H is its quadrics alone (quadricsAlone): z[i] is
-  // the first crossing of H = min(root, clips) in (zlo, zhi[i]] in closed form — each quadric's
+  // Rays (x[i], y[i]), i < count (any count), where H is its quadrics alone (quadricsAlone): z[i]
+  // is the first crossing of H = min(root, clips) in (zlo, zhi[i]] in closed form — each quadric's
   // roots by the stable quadratic formula, the first that is an entry into every other quadric's
   // inside (an exit from one, where the ray starts inside) — or NaN where there is none (a
   // tangent touch is none). Every ray a SIMD lane, each on its own: the same bits on every target.

@@ -116,6 +116,11 @@ bool firstCrossing(const RayFunction& ray, double zlo, double zhi, double hint, 
 
 // Windows of 2^kRayLevel pixels and less are cast ray by ray.
 constexpr int kRayLevel = 2;
+// Cells of 2^kQuadricLevel pixels and less that no perturbation reaches are solved ray by ray in
+// closed form, without their children's bounds (Caster::cell). Measured on BENCH.md's freeform /
+// freeform-one against the 4×4 ray windows alone: 8×8 cells ×0.942 / ×0.943; 16×16 ×1.029 /
+// ×0.997 against 8×8 (their empty parts cost more rays than the bounds save).
+constexpr int kQuadricLevel = 3;
 // Rays whose H may turn (Caster::rayWindow) take their spans in this many pieces (measured on
 // BENCH.md's freeform / freeform-one against 8: 2 pieces ×1.13 / ×1.10 slower, 4 ×1.01 / ×1.03,
 // 16 ×1.10 / ×1.03).
@@ -214,6 +219,21 @@ class Caster {
     uint64_t positive;  // the perturbations that may be positive in the cell: its children's
     form_.slabsHolding(x, y, zlo, zhi, kSlabs, holds, active, &positive);
     if (level == pyramid_.top()) windowActive_ = positive;
+    if (level <= kQuadricLevel && form_.quadricsAlone(positive)) {
+      // No perturbation reaches the cell: its rays are solved in closed form, all at once, over
+      // the slabs from the first that may hold the surface to the last (those between hold no
+      // crossing) — without the children's bounds.
+      int first = 0, last = kSlabs - 1;
+      while (first < kSlabs && !holds[first]) ++first;
+      if (first == kSlabs) return;
+      while (!holds[last]) --last;
+      const double from = zlo + (zhi - zlo) * first / kSlabs;
+      const double to = last == kSlabs - 1 ? zhi : zlo + (zhi - zlo) * (last + 1) / kSlabs;
+      const int count = windowRays(lx, ly, n, gx0, gy0, gx1, gy1, to);
+      form_.quadricCrossings(lanes_.x, lanes_.y, from, lanes_.end, count, lanes_.z);
+      if (takeHits(lx, ly, n, gx0, gy0, gx1, gy1, positive)) refreshAbove(level, lx, ly);
+      return;
+    }
     const int h = n / 2;
     for (int s = 0; s < kSlabs;) {
       if (!holds[s]) {
@@ -245,6 +265,39 @@ class Caster {
     }
   }
 
+  // The rays of the window of n × n pixels at (lx, ly), raster pixels [gx0, gx1] × [gy0, gy1],
+  // into lanes_ row by row: where each begins in the tile (at), its cube x and y, and the end of
+  // its span — zhi, or the depth its pixel already holds if nearer. Returns how many.
+  int windowRays(int lx, int ly, int n, int gx0, int gy0, int gx1, int gy1, double zhi) {
+    const double* const columns = columns_.data() + lx;
+    const double* const rows = rows_.data() + ly;
+    int count = 0;
+    for (int py = 0; py < n && gy0 + py <= gy1; ++py)
+      for (int px = 0; px < n && gx0 + px <= gx1; ++px, ++count) {
+        const size_t at = size_t(ly + py) * size_t(w_.stride) + size_t(lx + px);
+        lanes_.at[count] = at;
+        lanes_.x[count] = columns[px];
+        lanes_.y[count] = rows[py];
+        lanes_.end[count] = std::min(zhi, 2.0 * double(w_.depth[at]) - 1);
+      }
+    stats_.pixels += uint64_t(count);
+    return count;
+  }
+
+  // The crossings lanes_.z of windowRays' rays taken where nearer, `active` kept with each (the
+  // perturbations that may be positive in the window). True if any pixel took a hit.
+  bool takeHits(int lx, int ly, int n, int gx0, int gy0, int gx1, int gy1, uint64_t active) {
+    const double* const z = lanes_.z;
+    bool hits = false;
+    for (int i = 0, py = 0; py < n && gy0 + py <= gy1; ++py)
+      for (int px = 0; px < n && gx0 + px <= gx1; ++px, ++i)
+        if (!std::isnan(z[i]) && hit(lx + px, ly + py, lanes_.at[i], z[i], active)) {
+          hits = true;
+          guess_ = z[i];
+        }
+    return hits;
+  }
+
   // The rays of a window of n × n pixels (n ≤ 4) at (lx, ly), raster pixels [gx0, gx1] ×
   // [gy0, gy1], over [zlo, zhi], solved together. Where no perturbation reaches the window, in
   // closed form (quadricCrossings); else by Newton, starting from neighbours' hits or the last
@@ -253,23 +306,12 @@ class Caster {
   // silhouettes, mostly — turningCrossings. True if any pixel took a hit.
   bool rayWindow(int lx, int ly, int n, int gx0, int gy0, int gx1, int gy1, double zlo, double zhi,
                  bool monotonic, uint64_t active) {
-    double* const x = lanes_.x;
-    double* const y = lanes_.y;
-    double* const end = lanes_.end;
+    const int count = windowRays(lx, ly, n, gx0, gy0, gx1, gy1, zhi);
+    const double* const x = lanes_.x;
+    const double* const y = lanes_.y;
+    const double* const end = lanes_.end;
     double* const guess = lanes_.guess;
     double* const z = lanes_.z;
-    size_t* const at = lanes_.at;
-    const double* const columns = columns_.data() + lx;
-    const double* const rows = rows_.data() + ly;
-    int count = 0;
-    for (int py = 0; py < n && gy0 + py <= gy1; ++py)
-      for (int px = 0; px < n && gx0 + px <= gx1; ++px, ++count) {
-        at[count] = size_t(ly + py) * size_t(w_.stride) + size_t(lx + px);
-        x[count] = columns[px];
-        y[count] = rows[py];
-        end[count] = std::min(zhi, 2.0 * double(w_.depth[at[count]]) - 1);
-      }
-    stats_.pixels += uint64_t(count);
     if (form_.quadricsAlone(active)) {
       // No perturbation reaches the window: H along each ray is the root's quadratic (and the
       // clips'), solved in closed form — no guess, no bound, whatever the slope.
@@ -298,14 +340,7 @@ class Caster {
       else
         turningCrossings(zlo, count, near, active);
     }
-    bool hits = false;
-    for (int i = 0, py = 0; py < n && gy0 + py <= gy1; ++py)
-      for (int px = 0; px < n && gx0 + px <= gx1; ++px, ++i)
-        if (!std::isnan(z[i]) && hit(lx + px, ly + py, at[i], z[i], active)) {
-          hits = true;
-          guess_ = z[i];
-        }
-    return hits;
+    return takeHits(lx, ly, n, gx0, gy0, gx1, gy1, active);
   }
 
   // rayWindow's rays (lanes_, the first `count`) where H may turn. Most such windows lie wholly
@@ -387,9 +422,12 @@ class Caster {
   CastStats& stats_;
   uint64_t windowActive_ = kAllActive;  // run()'s
   RayFunction ray_;  // the current pixel's
-  struct {           // rayWindow's rays (only the first `count` of each are read)
-    double x[16], y[16], end[16], guess[16], z[16], from[16];
-    size_t at[16];
+  // windowRays' rays (only the first `count` of each are read): up to a cell of
+  // 2^kQuadricLevel pixels square; guess and from, rayWindow's only.
+  static constexpr int kMaxRays = 1 << (2 * kQuadricLevel);
+  struct {
+    double x[kMaxRays], y[kMaxRays], end[kMaxRays], z[kMaxRays], guess[16], from[16];
+    size_t at[kMaxRays];
   } lanes_;
   double guess_ = std::numeric_limits<double>::quiet_NaN();  // the last hit (monotonicWindow)
   std::vector<double> columns_, rows_;  // the rays' cube x, y per column and row

@@ -549,7 +549,7 @@ void ProjectedFreeForm::quadricCrossings(const double* x, const double* y, doubl
                                          const double* zhi, int count, double* z) const {
   HWY_DYNAMIC_DISPATCH(QuadricCrossings)
   (nodes_.data(), clips_.data(), clips_.size(), inverse_.m[3].data(), x, y, zlo, zhi,
-   std::clamp(count, 0, 16), z);
+   std::max(count, 0), z);
 }
 
 int ProjectedFreeForm::provenCrossings(const double* x, const double* y, double zlo,

@@ -372,9 +372,9 @@ TEST(RayCast, ProvenCrossingsAreOnlyFirstCrossingsOnEveryTarget) {
   });
 }
 
-// ProjectedFreeForm::quadricCrossings: rays of a capped cylinder (a quadric and two clips) over
-// spans from the near plane or from a depth partway in — so starting in front of it, inside it or
-// past it — give the first sign change of H: entries through the side and through a cap, exits
+// ProjectedFreeForm::quadricCrossings: up to 64 rays of a capped cylinder (a quadric and two clips)
+// over spans from the near plane or from a depth partway in — so starting in front of it, inside it
+// or past it — give the first sign change of H: entries through the side and through a cap, exits
 // where the span starts inside, nothing for misses and empty spans. The same bits on every
 // compiled target.
 TEST(RayCast, QuadricCrossingsAreTheFirstSignChangesOnEveryTarget) {
@@ -393,9 +393,9 @@ TEST(RayCast, QuadricCrossingsAreTheFirstSignChangesOnEveryTarget) {
     std::uniform_real_distribution<double> depth(-1, 0.99);
     int side = 0, caps = 0, exits = 0, misses = 0, disagree = 0;
     for (int round = 0; round < 300; ++round) {
-      const int count = 1 + round % 16;
+      const int count = 1 + round % 64;  // a ray window's 16, or a cell's 64
       const double zlo = round % 2 == 0 ? -1 : depth(rng);
-      double x[16], y[16], zhi[16], z[16];
+      double x[64], y[64], zhi[64], z[64];
       for (int i = 0; i < count; ++i) {
         x[i] = 2.0 * (pixel(rng) + 0.5) / w - 1;
         y[i] = 1 - 2.0 * (pixel(rng) + 0.5) / h;
