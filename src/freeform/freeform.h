@@ -44,6 +44,21 @@ struct FreeForm {
 class ProjectedFreeForm;
 struct InversePowers;
 
+// Where ProjectedFreeForm::quadricHits takes its hits: a window's per-pixel rows (pixel (i, j) at
+// j·stride + i; object, cubeZ and active optional) and the masking pyramid's finest level
+// (j·nodeStride + i), each hit writing its depth to both, `id`, its cube depth and `activeBits`.
+struct HitRows {
+  float* depth = nullptr;
+  uint32_t* object = nullptr;
+  double* cubeZ = nullptr;
+  uint64_t* active = nullptr;
+  size_t stride = 0;
+  float* node = nullptr;
+  size_t nodeStride = 0;
+  uint32_t id = 0;
+  uint64_t activeBits = 0;
+};
+
 // Every perturbation of a form taken as possibly active (ProjectedFreeForm::bound's `active`).
 inline constexpr uint64_t kAllActive = ~uint64_t(0);
 
@@ -159,6 +174,13 @@ class ProjectedFreeForm {
   // tangent touch is none). Every ray a SIMD lane, each on its own: the same bits on every target.
   void quadricCrossings(const double* x, const double* y, double zlo, const double* zhi, int count,
                         double* z) const;
+  // quadricCrossings for the 8 × 8 rays columns[i] × rows[j] (cube x and y), each over
+  // (zlo, min(zhi, the cube depth its pixel holds)], every crossing taken where its window
+  // depth, rounded to float, is nearer than the pixel's — into `to`, a row of rays at a time.
+  // Returns how many were taken; `last` becomes the cube depth of the last in raster order (left
+  // as it is if none).
+  int quadricHits(const double* columns, const double* rows, double zlo, double zhi,
+                  const HitRows& to, double& last) const;
   // bound(x[i], y[i], z, value[i], slope[i], &active[i]) with active[i] = `take` on entry, for
   // up to 16 windows of one depth range, each window a SIMD lane (slab_bounds.cpp): the same
   // operations in the same order, so the same bits, on every target.

@@ -395,58 +395,118 @@ void MonotonicCrossings(const ProjectedFreeForm::Node* nodes, const Quadric* cli
                });
 }
 
+// The lanes' first crossings of H = min(root, clips) in (zlo, end] (the rays set up by SetUpRays
+// without perturbations): NaN where there is none. ProjectedFreeForm::quadricCrossings.
+HWY_INLINE VD QuadricZeros(DD d, const Rays& rays, const ProjectedFreeForm::Node* nodes,
+                           const Quadric* clips, size_t clipCount, double zlo, VD end) {
+  // The quadrics: the root (j = 0) and the clips (j = 1 …), each a·z² + b·z + c along a ray.
+  const size_t nodeCount = nodes[0].end, quadrics = 1 + clipCount;
+  const auto slot = [&](size_t j) { return j == 0 ? size_t(0) : nodeCount + j - 1; };
+  const auto squared = [&](size_t j) { return j == 0 ? nodes[0].q.c[2] : clips[j - 1].c[2]; };
+  const VD zero = hn::Zero(d), start = hn::Set(d, zlo);
+  const auto value = [&](size_t j, VD z) {
+    return hn::Add(hn::Mul(hn::Add(hn::Mul(hn::Set(d, squared(j)), z), rays.b(slot(j), d)), z),
+                   rays.c(slot(j), d));
+  };
+  const auto inSpan = [&](VD z) { return hn::And(hn::Gt(z, start), hn::Le(z, end)); };
+  // Inside at zlo (H, the least of the quadrics, ≥ 0): the crossing is the first exit from any
+  // of them; outside, the first entry into one where all the others are inside.
+  VD h = value(0, start);
+  for (size_t j = 1; j < quadrics; ++j) h = hn::Min(h, value(j, start));
+  const MD startInside = hn::Ge(h, zero);
+  VD first = hn::Set(d, std::numeric_limits<double>::infinity());
+  for (size_t j = 0; j < quadrics; ++j) {
+    const VD b = rays.b(slot(j), d), c = rays.c(slot(j), d);
+    // The stable quadratic formula: t = −(b + sign(b)·√D)/2, the roots t/a and c/t. The entry
+    // (where the quadric turns positive, its slope +√D) is (−b + √D)/(2a), the exit
+    // (−b − √D)/(2a): c/t and t/a where b ≥ 0, the other way round where b < 0. With a = 0,
+    // c/t = −c/b is the one root and t/a is ±∞ or NaN, never in the span. D ≤ 0: no sign
+    // change (a tangent touch is none).
+    const VD disc = hn::Sub(hn::Mul(b, b), hn::Mul(hn::Set(d, 4 * squared(j)), c));
+    const MD real = hn::Gt(disc, zero);
+    const VD root = hn::CopySign(hn::Sqrt(hn::Max(disc, zero)), b);
+    const VD t = hn::Mul(hn::Set(d, -0.5), hn::Add(b, root));
+    const VD r1 = hn::Div(t, hn::Set(d, squared(j))), r2 = hn::Div(c, t);
+    const MD nonNegative = hn::Ge(b, zero);
+    const VD entry = hn::IfThenElse(nonNegative, r2, r1);
+    const VD exit = hn::IfThenElse(nonNegative, r1, r2);
+    MD entering = hn::AndNot(startInside, hn::And(real, inSpan(entry)));
+    for (size_t i = 0; i < quadrics && !hn::AllFalse(d, entering); ++i)
+      if (i != j) entering = hn::And(entering, hn::Ge(value(i, entry), zero));
+    const MD exiting = hn::And(startInside, hn::And(real, inSpan(exit)));
+    first = hn::IfThenElse(entering, hn::Min(first, entry), first);
+    first = hn::IfThenElse(exiting, hn::Min(first, exit), first);
+  }
+  return hn::IfThenElse(hn::Le(first, end), first,
+                        hn::Set(d, std::numeric_limits<double>::quiet_NaN()));
+}
+
 void QuadricCrossings(const ProjectedFreeForm::Node* nodes, const Quadric* clips, size_t clipCount,
                       const double* w, const double* x, const double* y, double zlo,
                       const double* zhi, int count, double* out) {
   const DD d;
-  const size_t nodeCount = nodes[0].end;
-  double* coefficients = CoefficientStorage(2 * (nodeCount + clipCount) * hn::Lanes(d));
-  // The quadrics: the root (j = 0) and the clips (j = 1 …), each a·z² + b·z + c along a ray.
-  const size_t quadrics = 1 + clipCount;
-  const auto slot = [&](size_t j) { return j == 0 ? size_t(0) : nodeCount + j - 1; };
-  const auto squared = [&](size_t j) { return j == 0 ? nodes[0].q.c[2] : clips[j - 1].c[2]; };
+  double* coefficients = CoefficientStorage(2 * (nodes[0].end + clipCount) * hn::Lanes(d));
   ForEachVector(d, x, y, zlo, zhi, count, [&](size_t s0, size_t m, VD vx, VD vy, VD end) {
     // No root perturbation taken (active 0): SetUpRays sets the root's and the clips' b and c.
     const Rays rays = SetUpRays(d, nodes, clips, clipCount, w, 0, vx, vy, coefficients);
-    const VD zero = hn::Zero(d), start = hn::Set(d, zlo);
-    const auto value = [&](size_t j, VD z) {
-      return hn::Add(hn::Mul(hn::Add(hn::Mul(hn::Set(d, squared(j)), z), rays.b(slot(j), d)), z),
-                     rays.c(slot(j), d));
-    };
-    const auto inSpan = [&](VD z) { return hn::And(hn::Gt(z, start), hn::Le(z, end)); };
-    // Inside at zlo (H, the least of the quadrics, ≥ 0): the crossing is the first exit from any
-    // of them; outside, the first entry into one where all the others are inside.
-    VD h = value(0, start);
-    for (size_t j = 1; j < quadrics; ++j) h = hn::Min(h, value(j, start));
-    const MD startInside = hn::Ge(h, zero);
-    VD first = hn::Set(d, std::numeric_limits<double>::infinity());
-    for (size_t j = 0; j < quadrics; ++j) {
-      const VD b = rays.b(slot(j), d), c = rays.c(slot(j), d);
-      // The stable quadratic formula: t = −(b + sign(b)·√D)/2, the roots t/a and c/t. The entry
-      // (where the quadric turns positive, its slope +√D) is (−b + √D)/(2a), the exit
-      // (−b − √D)/(2a): c/t and t/a where b ≥ 0, the other way round where b < 0. With a = 0,
-      // c/t = −c/b is the one root and t/a is ±∞ or NaN, never in the span. D ≤ 0: no sign
-      // change (a tangent touch is none).
-      const VD disc = hn::Sub(hn::Mul(b, b), hn::Mul(hn::Set(d, 4 * squared(j)), c));
-      const MD real = hn::Gt(disc, zero);
-      const VD root = hn::CopySign(hn::Sqrt(hn::Max(disc, zero)), b);
-      const VD t = hn::Mul(hn::Set(d, -0.5), hn::Add(b, root));
-      const VD r1 = hn::Div(t, hn::Set(d, squared(j))), r2 = hn::Div(c, t);
-      const MD nonNegative = hn::Ge(b, zero);
-      const VD entry = hn::IfThenElse(nonNegative, r2, r1);
-      const VD exit = hn::IfThenElse(nonNegative, r1, r2);
-      MD entering = hn::AndNot(startInside, hn::And(real, inSpan(entry)));
-      for (size_t i = 0; i < quadrics && !hn::AllFalse(d, entering); ++i)
-        if (i != j) entering = hn::And(entering, hn::Ge(value(i, entry), zero));
-      const MD exiting = hn::And(startInside, hn::And(real, inSpan(exit)));
-      first = hn::IfThenElse(entering, hn::Min(first, entry), first);
-      first = hn::IfThenElse(exiting, hn::Min(first, exit), first);
-    }
-    StoreFirst(d,
-               hn::IfThenElse(hn::Le(first, end), first,
-                              hn::Set(d, std::numeric_limits<double>::quiet_NaN())),
-               m, out + s0);
+    StoreFirst(d, QuadricZeros(d, rays, nodes, clips, clipCount, zlo, end), m, out + s0);
   });
+}
+
+// A row of 8 pixels is a whole number of vectors on every target.
+static_assert(HWY_LANES(double) <= 8 && 8 % HWY_LANES(double) == 0);
+
+int QuadricHits(const ProjectedFreeForm::Node* nodes, const Quadric* clips, size_t clipCount,
+                const double* w, const double* columns, const double* rows, double zlo, double zhi,
+                const HitRows& to, double* last) {
+  const DD d;
+  const hn::Rebind<float, DD> df;
+  const hn::Rebind<uint32_t, DD> du;
+  const hn::RebindToUnsigned<DD> d64;
+  const size_t n = hn::Lanes(d);
+  double* coefficients = CoefficientStorage(2 * (nodes[0].end + clipCount) * n);
+  const VD one = hn::Set(d, 1.0), half = hn::Set(d, 0.5);
+  int hits = 0;
+  for (size_t r = 0; r < 8; ++r) {
+    const VD vy = hn::Set(d, rows[r]);
+    float* const depth = to.depth + r * to.stride;
+    float* const node = to.node + r * to.nodeStride;
+    for (size_t c = 0; c < 8; c += n) {
+      // The span ends at the depth the pixel holds, if nearer (Caster::windowRays).
+      const auto held = hn::LoadU(df, depth + c);
+      const VD end =
+          hn::Min(hn::Set(d, zhi), hn::Sub(hn::Mul(hn::Set(d, 2.0), hn::PromoteTo(d, held)), one));
+      const Rays rays =
+          SetUpRays(d, nodes, clips, clipCount, w, 0, hn::LoadU(d, columns + c), vy, coefficients);
+      const VD z = QuadricZeros(d, rays, nodes, clips, clipCount, zlo, end);
+      // takeHit (raycast.cpp): the window depth, rounded to float, where nearer (never a NaN's).
+      const auto nearer = hn::DemoteTo(df, hn::Mul(half, hn::Add(z, one)));
+      const auto taken = hn::Lt(nearer, held);
+      if (hn::AllFalse(df, taken)) continue;
+      const MD takenD =
+          hn::Gt(hn::PromoteTo(d, hn::IfThenElseZero(taken, hn::Set(df, 1.0f))), hn::Zero(d));
+      hn::BlendedStore(nearer, taken, df, depth + c);
+      hn::BlendedStore(nearer, taken, df, node + c);
+      if (to.object)
+        hn::BlendedStore(hn::Set(du, to.id), hn::RebindMask(du, taken), du,
+                         to.object + r * to.stride + c);
+      if (to.cubeZ) hn::BlendedStore(z, takenD, d, to.cubeZ + r * to.stride + c);
+      if (to.active)
+        hn::BlendedStore(hn::Set(d64, to.activeBits), hn::RebindMask(d64, takenD), d64,
+                         to.active + r * to.stride + c);
+      hits += int(hn::CountTrue(d, takenD));
+      // The last one taken, in raster order: the highest lane of this vector.
+      uint8_t bits[8] = {};
+      hn::StoreMaskBits(d, takenD, bits);
+      int lane = 0;
+      for (size_t i = 0; i < n; ++i)
+        if (bits[i / 8] >> (i % 8) & 1) lane = int(i);
+      alignas(64) double zs[8];
+      hn::Store(z, d, zs);
+      *last = zs[lane];
+    }
+  }
+  return hits;
 }
 
 int ProvenCrossings(const ProjectedFreeForm::Node* nodes, const Quadric* clips, size_t clipCount,
@@ -540,6 +600,7 @@ HWY_EXPORT(MonotonicCrossings);
 HWY_EXPORT(PiecewiseCrossings);
 HWY_EXPORT(ProvenCrossings);
 HWY_EXPORT(QuadricCrossings);
+HWY_EXPORT(QuadricHits);
 
 void ProjectedFreeForm::monotonicCrossings(const double* x, const double* y, double zlo,
                                            const double* zhi, int count, const double* guess,
@@ -554,6 +615,13 @@ void ProjectedFreeForm::quadricCrossings(const double* x, const double* y, doubl
   HWY_DYNAMIC_DISPATCH(QuadricCrossings)
   (nodes_.data(), clips_.data(), clips_.size(), inverse_.m[3].data(), x, y, zlo, zhi,
    std::max(count, 0), z);
+}
+
+int ProjectedFreeForm::quadricHits(const double* columns, const double* rows, double zlo,
+                                   double zhi, const HitRows& to, double& last) const {
+  return HWY_DYNAMIC_DISPATCH(QuadricHits)(nodes_.data(), clips_.data(), clips_.size(),
+                                           inverse_.m[3].data(), columns, rows, zlo, zhi, to,
+                                           &last);
 }
 
 int ProjectedFreeForm::provenCrossings(const double* x, const double* y, double zlo,

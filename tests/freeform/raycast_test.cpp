@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstring>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "every_target.h"
@@ -372,6 +373,15 @@ TEST(RayCast, ProvenCrossingsAreOnlyFirstCrossingsOnEveryTarget) {
   });
 }
 
+// A cylinder capped at both ends (a quadric and two clips), tilted toward the camera.
+FreeForm cappedCylinder() {
+  const Vec3d axis{0.3, 0.5, 0.8};
+  FreeForm f;
+  f.base = Quadric::cylinder({0, 0, 0}, axis, 1.1);
+  f.clips = {Quadric::halfSpace(axis, 1.3), Quadric::halfSpace(axis * -1.0, 1.3)};
+  return f;
+}
+
 // ProjectedFreeForm::quadricCrossings: up to 64 rays of a capped cylinder (a quadric and two clips)
 // over spans from the near plane or from a depth partway in — so starting in front of it, inside it
 // or past it — give the first sign change of H: entries through the side and through a cap, exits
@@ -379,10 +389,7 @@ TEST(RayCast, ProvenCrossingsAreOnlyFirstCrossingsOnEveryTarget) {
 // compiled target.
 TEST(RayCast, QuadricCrossingsAreTheFirstSignChangesOnEveryTarget) {
   const int w = 64, h = 64;
-  const Vec3d axis{0.3, 0.5, 0.8};
-  FreeForm f;
-  f.base = Quadric::cylinder({0, 0, 0}, axis, 1.1);
-  f.clips = {Quadric::halfSpace(axis, 1.3), Quadric::halfSpace(axis * -1.0, 1.3)};
+  const FreeForm f = cappedCylinder();
   const auto g = ProjectedFreeForm::make(f, cameraToCube(w, h));
   ASSERT_TRUE(g);
   EXPECT_TRUE(g->quadricsAlone(0));
@@ -430,6 +437,92 @@ TEST(RayCast, QuadricCrossingsAreTheFirstSignChangesOnEveryTarget) {
     EXPECT_GT(caps, 200);
     EXPECT_GT(exits, 30);
     EXPECT_GT(misses, 500);
+  });
+}
+
+// ProjectedFreeForm::quadricHits: an 8×8 block of rays takes exactly the crossings
+// quadricCrossings finds for it, where nearer than its pixels' depths (the window depth rounded
+// to float, as the caster's takeHit) — depth and masking node, object, cube depth and active bits
+// written there and nowhere else, with or without the optional buffers, at any row strides; the
+// last hit taken in raster order reported. The same bits on every compiled target.
+TEST(RayCast, QuadricHitsTakeTheNearerCrossingsOnEveryTarget) {
+  const int w = 64, h = 64;
+  const auto g = ProjectedFreeForm::make(cappedCylinder(), cameraToCube(w, h));
+  ASSERT_TRUE(g);
+  onEveryTarget([&](int64_t target, std::vector<double>& results) {
+    std::mt19937 rng(16);
+    std::uniform_int_distribution<int> origin(0, w - 8);
+    std::uniform_real_distribution<double> unit(0, 1);
+    int taken = 0, behind = 0;
+    for (int round = 0; round < 200; ++round) {
+      const int x0 = origin(rng), y0 = origin(rng);
+      const double zlo = round % 3 == 0 ? -1 : -1 + unit(rng), zhi = round % 5 == 0 ? 0.95 : 1;
+      double columns[8], rows[8];
+      for (int i = 0; i < 8; ++i) {
+        columns[i] = 2.0 * (x0 + i + 0.5) / w - 1;
+        rows[i] = 1 - 2.0 * (y0 + i + 0.5) / h;
+      }
+      // Buffers wider than the block (strides 11 and 13), pixels holding depths near and far.
+      const size_t stride = 11, nodeStride = 13;
+      std::vector<float> depth(8 * stride), node(8 * nodeStride, -1.0f);
+      for (float& v : depth) v = unit(rng) < 0.3 ? 1.0f : float(0.5 + 0.5 * unit(rng));
+      std::vector<uint32_t> object(8 * stride, kNoHit);
+      std::vector<double> cubeZ(8 * stride, -7);
+      std::vector<uint64_t> active(8 * stride, 5);
+      const bool optional = round % 4 != 1;
+      HitRows to;
+      to.depth = depth.data();
+      to.object = optional ? object.data() : nullptr;
+      to.cubeZ = optional ? cubeZ.data() : nullptr;
+      to.active = optional ? active.data() : nullptr;
+      to.stride = stride;
+      to.node = node.data();
+      to.nodeStride = nodeStride;
+      to.id = 9;
+      to.activeBits = 0x30;
+      const std::vector<float> before = depth;
+      double last = -5, lastWanted = -5;
+      const int hits = g->quadricHits(columns, rows, zlo, zhi, to, last);
+      int wanted = 0;
+      for (int j = 0; j < 8; ++j)
+        for (int i = 0; i < 8; ++i) {
+          const size_t at = size_t(j) * stride + size_t(i);
+          const double end = std::min(zhi, 2.0 * double(before[at]) - 1);
+          double z;
+          g->quadricCrossings(&columns[i], &rows[j], zlo, &end, 1, &z);
+          const float d = float(0.5 * (z + 1));
+          const std::string where = std::string(hwy::TargetName(target)) + " round " +
+                                    std::to_string(round) + " pixel " + std::to_string(i) + "," +
+                                    std::to_string(j);
+          if (d < before[at]) {
+            ++wanted;
+            lastWanted = z;
+            EXPECT_EQ(depth[at], d) << where;
+            EXPECT_EQ(node[size_t(j) * nodeStride + size_t(i)], d) << where;
+            if (optional) {
+              EXPECT_EQ(object[at], 9u) << where;
+              EXPECT_EQ(cubeZ[at], z) << where;
+              EXPECT_EQ(active[at], 0x30u) << where;
+            }
+          } else {
+            double open;  // the crossing with the pixel's depth left out
+            g->quadricCrossings(&columns[i], &rows[j], zlo, &zhi, 1, &open);
+            behind += std::isnan(open) ? 0 : 1;
+            EXPECT_EQ(depth[at], before[at]) << where;
+            EXPECT_EQ(node[size_t(j) * nodeStride + size_t(i)], -1.0f) << where;
+            EXPECT_EQ(object[at], kNoHit) << where;
+            EXPECT_EQ(cubeZ[at], -7) << where;
+            EXPECT_EQ(active[at], 5u) << where;
+          }
+        }
+      EXPECT_EQ(hits, wanted) << "round " << round;
+      EXPECT_EQ(last, lastWanted) << "round " << round;
+      taken += hits;
+      results.insert(results.end(), cubeZ.begin(), cubeZ.end());
+      for (float v : depth) results.push_back(v);
+    }
+    EXPECT_GT(taken, 1000);
+    EXPECT_GT(behind, 100);  // surfaces behind what the pixels hold, left there
   });
 }
 
