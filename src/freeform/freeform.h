@@ -181,6 +181,15 @@ class ProjectedFreeForm {
   // as it is if none).
   int quadricHits(const double* columns, const double* rows, double zlo, double zhi,
                   const HitRows& to, double& last) const;
+  // The first crossing of H along the ray (x, y) in [zlo, zhi] — of those `active` holds, the
+  // root's perturbations taken — bracketed: spans split into 8 pieces at a time, bounded together
+  // (RayFunction::bound's bounds, a piece per SIMD lane), taken depth first and front to back; a
+  // piece no bound lets hold a zero is dropped, a monotonic one — or one `narrowest` wide or
+  // less — is decided by the signs of H at its ends, others are split again. True if found:
+  // bracket = {a, b, H(a), H(b)}, the signs of H(a) and H(b) different (for refining). At most
+  // `budget` spans are split; `bounds` gains the pieces bounded. The same on every target.
+  bool crossingBracket(double x, double y, double zlo, double zhi, uint64_t active,
+                       double narrowest, int budget, double bracket[4], int& bounds) const;
   // bound(x[i], y[i], z, value[i], slope[i], &active[i]) with active[i] = `take` on entry, for
   // up to 16 windows of one depth range, each window a SIMD lane (slab_bounds.cpp): the same
   // operations in the same order, so the same bits, on every target.

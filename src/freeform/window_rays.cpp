@@ -589,6 +589,85 @@ int PiecewiseCrossings(const ProjectedFreeForm::Node* nodes, const Quadric* clip
   return bounds;
 }
 
+// ProjectedFreeForm::crossingBracket: one ray's spans split into kFan pieces at a time, the
+// pieces bounded together (a piece per lane; kFan / lanes vectors), depth first, front to back.
+bool CrossingBracket(const ProjectedFreeForm::Node* nodes, const Quadric* clips, size_t clipCount,
+                     const double* w, double x, double y, double zlo, double zhi, uint64_t active,
+                     double narrowest, int budget, double* bracket, int* bounds) {
+  constexpr int kFan = 8, kDepth = 24;
+  const DD d;
+  const size_t n = hn::Lanes(d);
+  static_assert(HWY_LANES(double) <= kFan && kFan % HWY_LANES(double) == 0);
+  double* coefficients = CoefficientStorage(2 * (nodes[0].end + clipCount) * n);
+  const Rays rays =
+      SetUpRays(d, nodes, clips, clipCount, w, active, hn::Set(d, x), hn::Set(d, y), coefficients);
+  // A span [a, b] being taken: its pieces' ends z[0 … kFan], those that may hold a zero and
+  // those where H is monotonic (bit k: piece k), the next piece to take, H at the ends (once
+  // needed).
+  struct Span {
+    double z[kFan + 1];
+    uint32_t holds, monotonic;
+    int next;
+    bool valued;
+    double f[kFan + 1];
+  };
+  Span stack[kDepth];
+  int depth = 0;
+  const auto open = [&](double a, double b) {
+    Span& s = stack[depth++];
+    for (int k = 0; k < kFan; ++k) s.z[k] = a + (b - a) * k / kFan;
+    s.z[kFan] = b;
+    s.holds = s.monotonic = 0;
+    s.next = 0;
+    s.valued = false;
+    for (size_t k0 = 0; k0 < size_t(kFan); k0 += n) {
+      Lanes value, slope;
+      const MD valid =
+          BoundLanes(d, rays, {hn::LoadU(d, s.z + k0), hn::LoadU(d, s.z + k0 + 1)}, value, slope);
+      const MD holds = hn::Or(hn::Not(valid), ContainsZero(d, value));
+      const MD monotonic = hn::AndNot(ContainsZero(d, slope), hn::And(holds, valid));
+      uint8_t bits[2][8] = {};
+      hn::StoreMaskBits(d, holds, bits[0]);
+      hn::StoreMaskBits(d, monotonic, bits[1]);
+      for (size_t i = 0; i < n; ++i) {
+        s.holds |= uint32_t(bits[0][i / 8] >> (i % 8) & 1) << (k0 + i);
+        s.monotonic |= uint32_t(bits[1][i / 8] >> (i % 8) & 1) << (k0 + i);
+      }
+    }
+    *bounds += kFan;
+    --budget;
+  };
+  open(zlo, zhi);
+  while (depth > 0) {
+    Span& s = stack[depth - 1];
+    while (s.next < kFan && !(s.holds >> s.next & 1)) ++s.next;
+    if (s.next == kFan) {
+      --depth;
+      continue;
+    }
+    const int k = s.next++;
+    const double a = s.z[k], b = s.z[k + 1];
+    if ((s.monotonic >> k & 1) || b - a <= narrowest || depth == kDepth) {
+      // One zero at most (or a bracket too narrow to split): the ends decide, as firstCrossing's.
+      if (!s.valued) {
+        for (size_t k0 = 0; k0 <= size_t(kFan); k0 += n) {
+          VD slope;
+          const VD f =
+              Evaluate(d, rays, LoadPadded(d, s.z, k0, std::min(n, kFan + 1 - k0), b), slope);
+          StoreFirst(d, f, std::min(n, kFan + 1 - k0), s.f + k0);
+        }
+        s.valued = true;
+      }
+      if ((s.f[k] >= 0) == (s.f[k + 1] >= 0)) continue;
+      bracket[0] = a, bracket[1] = b, bracket[2] = s.f[k], bracket[3] = s.f[k + 1];
+      return true;
+    }
+    if (budget == 0) return false;
+    open(a, b);
+  }
+  return false;
+}
+
 }  // namespace HWY_NAMESPACE
 }  // namespace sv::freeform
 HWY_AFTER_NAMESPACE();
@@ -601,6 +680,7 @@ HWY_EXPORT(PiecewiseCrossings);
 HWY_EXPORT(ProvenCrossings);
 HWY_EXPORT(QuadricCrossings);
 HWY_EXPORT(QuadricHits);
+HWY_EXPORT(CrossingBracket);
 
 void ProjectedFreeForm::monotonicCrossings(const double* x, const double* y, double zlo,
                                            const double* zhi, int count, const double* guess,
@@ -622,6 +702,14 @@ int ProjectedFreeForm::quadricHits(const double* columns, const double* rows, do
   return HWY_DYNAMIC_DISPATCH(QuadricHits)(nodes_.data(), clips_.data(), clips_.size(),
                                            inverse_.m[3].data(), columns, rows, zlo, zhi, to,
                                            &last);
+}
+
+bool ProjectedFreeForm::crossingBracket(double x, double y, double zlo, double zhi, uint64_t active,
+                                        double narrowest, int budget, double bracket[4],
+                                        int& bounds) const {
+  return HWY_DYNAMIC_DISPATCH(CrossingBracket)(nodes_.data(), clips_.data(), clips_.size(),
+                                               inverse_.m[3].data(), x, y, zlo, zhi, active,
+                                               narrowest, budget, bracket, &bounds);
 }
 
 int ProjectedFreeForm::provenCrossings(const double* x, const double* y, double zlo,

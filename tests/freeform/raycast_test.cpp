@@ -319,6 +319,54 @@ TEST(RayCast, PiecewiseCrossingsAreTheEntriesOnEveryTarget) {
   });
 }
 
+// ProjectedFreeForm::crossingBracket: rays into a bumped sphere from spans starting in front of
+// it or partway in (H turns along them) get a bracket of their first sign change — H of opposite
+// signs at its ends — or none where they have none; a budget of one split decides some of them
+// and not others. The same bits on every compiled target.
+TEST(RayCast, CrossingBracketsHoldTheFirstSignChangeOnEveryTarget) {
+  const int w = 64, h = 64;
+  const auto g = ProjectedFreeForm::make(bumpedSphere(), cameraToCube(w, h));
+  ASSERT_TRUE(g);
+  onEveryTarget([&](int64_t target, std::vector<double>& results) {
+    std::mt19937 rng(18);
+    std::uniform_int_distribution<int> pixel(0, w - 1);
+    std::uniform_real_distribution<double> depth(-1, 0.5);
+    int found = 0, misses = 0, disagree = 0, cutShort = 0;
+    for (int round = 0; round < 1500; ++round) {
+      const double x = 2.0 * (pixel(rng) + 0.5) / w - 1, y = 1 - 2.0 * (pixel(rng) + 0.5) / h;
+      const double zlo = round % 2 == 0 ? -1 : depth(rng), zhi = round % 3 == 0 ? 0.6 : 1;
+      const double want = firstSignChange(*g, x, y, zhi, zlo);
+      double bracket[4] = {NAN, NAN, NAN, NAN};
+      int bounds = 0;
+      const bool got =
+          g->crossingBracket(x, y, zlo, zhi, kAllActive, 0x1p-16, 256, bracket, bounds);
+      EXPECT_EQ(bounds % 8, 0);
+      results.insert(results.end(), bracket, bracket + 4);
+      if (got != !std::isnan(want)) {
+        ++disagree;  // only a ray grazing the surface within the truth's step may
+        continue;
+      }
+      if (!got) {
+        ++misses;
+        continue;
+      }
+      ++found;
+      const std::string where =
+          std::string(hwy::TargetName(target)) + " round " + std::to_string(round);
+      EXPECT_LE(bracket[0], want + 1e-12) << where;
+      EXPECT_GE(bracket[1], want - 1e-12) << where;
+      EXPECT_NE(bracket[2] >= 0, bracket[3] >= 0) << where;
+      int few = 0;
+      if (!g->crossingBracket(x, y, zlo, zhi, kAllActive, 0x1p-16, 1, bracket, few)) ++cutShort;
+    }
+    EXPECT_LE(disagree, 3);
+    EXPECT_GT(found, 300);
+    EXPECT_GT(misses, 300);
+    EXPECT_GT(cutShort, 50);     // crossings a first split leaves undecided
+    EXPECT_LT(cutShort, found);  // and those it decides
+  });
+}
+
 // ProjectedFreeForm::provenCrossings: rays into a bumped sphere over the whole depth (H turns
 // along them), Newton from a guess near the entry (a neighbour's hit), at the exit (a zero that
 // is not the first), far off or none: every zero it keeps is the ray's first crossing (so never
