@@ -55,6 +55,8 @@ class FreeFormFrame {
     std::vector<double> centreZ;
     std::vector<uint32_t> ringObject;  // the centres with a one-pixel ring around the tile
     std::vector<float> ringDepth;
+    std::vector<uint8_t> pixelState;    // per pixel: what its samples take (drawTile)
+    std::vector<float> bandLo, bandHi;  // per pixel: its form's depth band
     RayFunction ray;
     struct Pending {  // a pixel to shade, and its first sample the form took
       int lx, ly, sample;
