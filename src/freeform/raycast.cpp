@@ -52,13 +52,14 @@ double refineBracket(const RayFunction& f, double a, double b, double fa, double
 // ~1e-4 of a pixel at 1080p — and is taken as a miss.
 constexpr double kBracket = 0x1p-16;
 
-// A ray gives up after this many spans of its binary tree (and takes no hit in that range): a
-// degenerate function — zero, or within rounding of zero, along a long stretch of the ray —
-// reaches it (tests/render: a quadric that is zero everywhere). A plain crossing costs some 2·16
-// spans, but a ray grazing the crease where a perturbation meets its base, where H turns within
-// 5e-5 of 0 before it crosses, took ~200 on BENCH.md's freeform-one; with 128 it gave up and took
-// the back surface (tests/render: RaysGrazingACreaseFindTheFirstCrossing).
-constexpr int kSpanBudget = 1024;
+// A ray gives up after splitting this many spans into eight (ProjectedFreeForm::crossingBracket)
+// and takes no hit in that range: a degenerate function — zero, or within rounding of zero, along
+// a long stretch of the ray — reaches it (tests/render: a quadric that is zero everywhere). A
+// plain crossing costs a few splits, but a ray grazing the crease where a perturbation meets its
+// base, where H turns within 5e-5 of 0 before it crosses, took ~200 halvings of a binary tree on
+// BENCH.md's freeform-one (with 128 it gave up and took the back surface; tests/render:
+// RaysGrazingACreaseFindTheFirstCrossing).
+constexpr int kSplitBudget = 256;
 
 // A crossing at cube depth z of form `id`, taken where it is nearer than the pixel's depth:
 // depth, object and cube depth (those given) written. True if taken.
@@ -73,50 +74,38 @@ bool takeHit(double z, uint32_t id, float& depth, uint32_t* object, double* cube
   return true;
 }
 
-// One ray's binary tree in depth on its own function (RayFunction: exact per-quadric bounds), front
-// to back: the first zero of H in [zlo, zhi]. A span where H is monotonic (its slope bound excludes
-// 0) holds at most one zero, refined when its ends differ in sign; others are halved down to
-// kBracket. With a `hint` (a neighbour's hit), the span around it is tried right after the one
-// in front of it. False if there is none (or the span budget ran out).
-bool firstCrossing(const RayFunction& ray, double zlo, double zhi, double hint, double& z,
-                   CastStats& stats) {
-  struct Span {
-    double a, b;
-  };
-  Span stack[80];
-  int n = 0;
+// One ray's first zero of H in [zlo, zhi] (the root's perturbations `active` holds taken):
+// its spans split eight pieces at a time in SIMD lanes (ProjectedFreeForm::crossingBracket, its
+// bounds exact per quadric), the bracket refined from `hint` where it lies inside (refineBracket,
+// on `ray`, set up here). With a `hint` (a neighbour's hit), the span around it is taken on its
+// own, right after the one in front of it: the crossing is likely there. False if there is none
+// (or the split budget ran out).
+bool firstCrossing(const ProjectedFreeForm& form, double x, double y, uint64_t active, double zlo,
+                   double zhi, double hint, RayFunction& ray, double& z, CastStats& stats) {
+  double spans[4] = {zlo, zhi};
+  int ends = 2;
   if (hint > zlo && hint < zhi) {
     const double d = 1e-4 * (zhi - zlo);
     const double a = std::max(zlo, hint - d), b = std::min(zhi, hint + d);
-    if (b < zhi) stack[n++] = {b, zhi};
-    stack[n++] = {a, b};
-    if (zlo < a) stack[n++] = {zlo, a};
-  } else {
-    stack[n++] = {zlo, zhi};
+    ends = 0;
+    if (zlo < a) spans[ends++] = zlo;
+    spans[ends++] = a;
+    spans[ends++] = b;
+    if (b < zhi) spans[ends++] = zhi;
   }
-  for (int spans = 0; n > 0 && spans < kSpanBudget; ++spans) {
-    const Span s = stack[--n];
-    Interval value, slope;
-    ++stats.depthTests;
-    ray.bound(s.a, s.b, value, slope);
-    if (!value.containsZero()) continue;
-    const bool monotonic = !slope.containsZero();
-    if (monotonic || s.b - s.a <= kBracket || n + 2 > 80) {
-      const double fa = ray.evaluate(s.a), fb = ray.evaluate(s.b);
-      if (inside(fa) == inside(fb)) continue;  // monotonic: no zero; else a touch, a miss
-      z = refineBracket(ray, s.a, s.b, fa, fb, hint);
-      return true;
-    }
-    const double m = 0.5 * (s.a + s.b);
-    stack[n++] = {m, s.b};  // the far half waits
-    stack[n++] = {s.a, m};
+  for (int i = 0; i + 1 < ends; ++i) {
+    double bracket[4];
+    int bounds = 0;
+    const bool found = form.crossingBracket(x, y, spans[i], spans[i + 1], active, kBracket,
+                                            kSplitBudget, bracket, bounds);
+    stats.depthTests += uint64_t(bounds);
+    if (!found) continue;
+    form.ray(x, y, ray, active);
+    z = refineBracket(ray, bracket[0], bracket[1], bracket[2], bracket[3], hint);
+    return true;
   }
   return false;
 }
-
-// Spans a ray handed over by piecewiseCrossings may split into eight (ProjectedFreeForm::
-// crossingBracket) before it gives up: as deep as kSpanBudget halvings reach, and more.
-constexpr int kSplitBudget = kSpanBudget / 4;
 
 // Windows of 2^kRayLevel pixels and less are cast ray by ray.
 constexpr int kRayLevel = 2;
@@ -413,17 +402,10 @@ class Caster {
       const int i = place[j];
       z[i] = pz[j];
       if (std::isnan(from[j])) continue;
-      // The ray's own subdivision, eight pieces at a time in SIMD lanes (measured on BENCH.md's
-      // freeform / freeform-one against firstCrossing's halves one at a time: ×0.959 / ×0.934).
-      double bracket[4];
-      int bounds = 0;
-      z[i] = kNaN;
-      if (form_.crossingBracket(x[i], y[i], from[j], end[i], active, kBracket, kSplitBudget,
-                                bracket, bounds)) {
-        form_.ray(x[i], y[i], ray_, active);
-        z[i] = refineBracket(ray_, bracket[0], bracket[1], bracket[2], bracket[3]);
-      }
-      stats_.depthTests += uint64_t(bounds);
+      // The ray's own subdivision, eight pieces at a time (measured on BENCH.md's freeform /
+      // freeform-one against halves one at a time: ×0.959 / ×0.934).
+      if (!firstCrossing(form_, x[i], y[i], active, from[j], end[i], kNaN, ray_, z[i], stats_))
+        z[i] = kNaN;
     }
   }
 
@@ -565,9 +547,22 @@ void castRay(const ProjectedFreeForm& form, uint32_t id, double x, double y, dou
   ++stats.pixels;
   const double zlo = std::max(-1.0, from), zhi = std::min(1.0, 2.0 * double(depth) - 1);
   if (!(zlo < zhi)) return;
-  form.ray(x, y, ray);
+  // The ray's own bound over its span: none of it may hold the surface, or only some of the
+  // perturbations may be positive along it (the others are 0 there) — where none, H is its
+  // quadrics alone, solved in closed form.
+  Interval value, slope;
+  uint64_t active = kAllActive;
+  ++stats.depthTests;
+  form.bound({x, x}, {y, y}, {zlo, zhi}, value, slope, &active);
+  if (!value.containsZero()) return;
   double z;
-  if (firstCrossing(ray, zlo, zhi, hint, z, stats)) takeHit(z, id, depth, &object, &cubeZ, stats);
+  if (form.quadricsAlone(active)) {
+    form.quadricCrossings(&x, &y, zlo, &zhi, 1, &z);
+    if (!std::isnan(z)) takeHit(z, id, depth, &object, &cubeZ, stats);
+    return;
+  }
+  if (firstCrossing(form, x, y, active, zlo, zhi, hint, ray, z, stats))
+    takeHit(z, id, depth, &object, &cubeZ, stats);
 }
 
 void marchWindow(const ProjectedFreeForm& form, uint32_t id, const CastWindow& window, int steps,
