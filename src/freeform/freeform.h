@@ -165,8 +165,12 @@ class ProjectedFreeForm {
   // perturbations: the root's quadric and the clips, each a quadratic along any ray of the cube
   // (a projective map keeps a quadric's order, SPEC §12) — so quadricCrossings solves its rays.
   bool quadricsAlone(uint64_t active) const {
-    return (active & rootPerturbations_) == 0 && !manyPerturbations_;
+    return (active & rootPerturbations_) == 0 && !manyPerturbations_ &&
+           clips_.size() <= kMaxClipsSolved;
   }
+  // Forms with more clips than this are never their quadrics alone (quadricCrossings holds the
+  // quadrics in registers).
+  static constexpr size_t kMaxClipsSolved = 7;
   // Rays (x[i], y[i]), i < count (any count), where H is its quadrics alone (quadricsAlone): z[i]
   // is the first crossing of H = min(root, clips) in (zlo, zhi[i]] in closed form — each quadric's
   // roots by the stable quadratic formula, the first that is an entry into every other quadric's

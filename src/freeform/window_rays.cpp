@@ -183,6 +183,17 @@ double* CoefficientStorage(size_t doubles) {
                                    ~uintptr_t(63));
 }
 
+// Quadric q along the lanes' rays (vx, vy): C·z² + b·z + c (ProjectedFreeForm::ray's b and c).
+HWY_INLINE void AlongZ(DD d, const Quadric& q, VD vx, VD vy, VD& b, VD& c) {
+  const auto& k = q.c;
+  b = hn::Add(hn::Add(hn::Mul(hn::Set(d, k[4]), vx), hn::Mul(hn::Set(d, k[5]), vy)),
+              hn::Set(d, k[8]));
+  const VD cx = hn::Add(hn::Add(hn::Mul(hn::Set(d, k[0]), vx), hn::Mul(hn::Set(d, k[3]), vy)),
+                        hn::Set(d, k[6]));
+  const VD cy = hn::Add(hn::Mul(hn::Set(d, k[1]), vy), hn::Set(d, k[7]));
+  c = hn::Add(hn::Add(hn::Mul(cx, vx), hn::Mul(cy, vy)), hn::Set(d, k[9]));
+}
+
 // ProjectedFreeForm::ray for the lanes' rays (vx, vy): each quadric along z, into `coefficients`.
 Rays SetUpRays(DD d, const ProjectedFreeForm::Node* nodes, const Quadric* clips, size_t clipCount,
                const double* w, uint64_t active, VD vx, VD vy, double* coefficients) {
@@ -197,13 +208,8 @@ Rays SetUpRays(DD d, const ProjectedFreeForm::Node* nodes, const Quadric* clips,
                   w[2],
                   active};
   const auto alongZ = [&](size_t q) {
-    const auto& k = q < nodes[0].end ? nodes[q].q.c : clips[q - nodes[0].end].c;
-    const VD b = hn::Add(hn::Add(hn::Mul(hn::Set(d, k[4]), vx), hn::Mul(hn::Set(d, k[5]), vy)),
-                         hn::Set(d, k[8]));
-    const VD cx = hn::Add(hn::Add(hn::Mul(hn::Set(d, k[0]), vx), hn::Mul(hn::Set(d, k[3]), vy)),
-                          hn::Set(d, k[6]));
-    const VD cy = hn::Add(hn::Mul(hn::Set(d, k[1]), vy), hn::Set(d, k[7]));
-    const VD c = hn::Add(hn::Add(hn::Mul(cx, vx), hn::Mul(cy, vy)), hn::Set(d, k[9]));
+    VD b, c;
+    AlongZ(d, q < nodes[0].end ? nodes[q].q : clips[q - nodes[0].end], vx, vy, b, c);
     hn::Store(b, d, coefficients + (2 * q) * n);
     hn::Store(c, d, coefficients + (2 * q + 1) * n);
   };
@@ -395,18 +401,15 @@ void MonotonicCrossings(const ProjectedFreeForm::Node* nodes, const Quadric* cli
                });
 }
 
-// The lanes' first crossings of H = min(root, clips) in (zlo, end] (the rays set up by SetUpRays
-// without perturbations): NaN where there is none. ProjectedFreeForm::quadricCrossings.
-HWY_INLINE VD QuadricZeros(DD d, const Rays& rays, const ProjectedFreeForm::Node* nodes,
-                           const Quadric* clips, size_t clipCount, double zlo, VD end) {
-  // The quadrics: the root (j = 0) and the clips (j = 1 …), each a·z² + b·z + c along a ray.
-  const size_t nodeCount = nodes[0].end, quadrics = 1 + clipCount;
-  const auto slot = [&](size_t j) { return j == 0 ? size_t(0) : nodeCount + j - 1; };
-  const auto squared = [&](size_t j) { return j == 0 ? nodes[0].q.c[2] : clips[j - 1].c[2]; };
+// The lanes' first crossings of H = min(root, clips) in (zlo, end], the quadrics (the root, then
+// the clips: `quadrics` ≤ kMaxQuadrics of them) given along the rays as squared[j]·z² + b[j]·z +
+// c[j] (AlongZ): NaN where there is none. ProjectedFreeForm::quadricCrossings.
+constexpr size_t kMaxQuadrics = 1 + ProjectedFreeForm::kMaxClipsSolved;
+HWY_INLINE VD QuadricZeros(DD d, size_t quadrics, const double* squared, const VD* bs, const VD* cs,
+                           double zlo, VD end) {
   const VD zero = hn::Zero(d), start = hn::Set(d, zlo);
   const auto value = [&](size_t j, VD z) {
-    return hn::Add(hn::Mul(hn::Add(hn::Mul(hn::Set(d, squared(j)), z), rays.b(slot(j), d)), z),
-                   rays.c(slot(j), d));
+    return hn::Add(hn::Mul(hn::Add(hn::Mul(hn::Set(d, squared[j]), z), bs[j]), z), cs[j]);
   };
   const auto inSpan = [&](VD z) { return hn::And(hn::Gt(z, start), hn::Le(z, end)); };
   // Inside at zlo (H, the least of the quadrics, ≥ 0): the crossing is the first exit from any
@@ -416,17 +419,17 @@ HWY_INLINE VD QuadricZeros(DD d, const Rays& rays, const ProjectedFreeForm::Node
   const MD startInside = hn::Ge(h, zero);
   VD first = hn::Set(d, std::numeric_limits<double>::infinity());
   for (size_t j = 0; j < quadrics; ++j) {
-    const VD b = rays.b(slot(j), d), c = rays.c(slot(j), d);
+    const VD b = bs[j], c = cs[j];
     // The stable quadratic formula: t = −(b + sign(b)·√D)/2, the roots t/a and c/t. The entry
     // (where the quadric turns positive, its slope +√D) is (−b + √D)/(2a), the exit
     // (−b − √D)/(2a): c/t and t/a where b ≥ 0, the other way round where b < 0. With a = 0,
     // c/t = −c/b is the one root and t/a is ±∞ or NaN, never in the span. D ≤ 0: no sign
     // change (a tangent touch is none).
-    const VD disc = hn::Sub(hn::Mul(b, b), hn::Mul(hn::Set(d, 4 * squared(j)), c));
+    const VD disc = hn::Sub(hn::Mul(b, b), hn::Mul(hn::Set(d, 4 * squared[j]), c));
     const MD real = hn::Gt(disc, zero);
     const VD root = hn::CopySign(hn::Sqrt(hn::Max(disc, zero)), b);
     const VD t = hn::Mul(hn::Set(d, -0.5), hn::Add(b, root));
-    const VD r1 = hn::Div(t, hn::Set(d, squared(j))), r2 = hn::Div(c, t);
+    const VD r1 = hn::Div(t, hn::Set(d, squared[j])), r2 = hn::Div(c, t);
     const MD nonNegative = hn::Ge(b, zero);
     const VD entry = hn::IfThenElse(nonNegative, r2, r1);
     const VD exit = hn::IfThenElse(nonNegative, r1, r2);
@@ -441,15 +444,34 @@ HWY_INLINE VD QuadricZeros(DD d, const Rays& rays, const ProjectedFreeForm::Node
                         hn::Set(d, std::numeric_limits<double>::quiet_NaN()));
 }
 
+// The root's quadric and the clips (at most kMaxQuadrics in all), and their C.
+struct QuadricList {
+  const Quadric* q[kMaxQuadrics];
+  double squared[kMaxQuadrics];
+  size_t count;
+  QuadricList(const ProjectedFreeForm::Node* nodes, const Quadric* clips, size_t clipCount)
+      : count(std::min(1 + clipCount, kMaxQuadrics)) {
+    for (size_t j = 0; j < count; ++j) {
+      q[j] = j == 0 ? &nodes[0].q : &clips[j - 1];
+      squared[j] = q[j]->c[2];
+    }
+  }
+  // The first crossings along the lanes' rays (vx, vy) in (zlo, end] (QuadricZeros), the
+  // quadrics' b and c held in registers.
+  VD zeros(DD d, VD vx, VD vy, double zlo, VD end) const {
+    VD b[kMaxQuadrics], c[kMaxQuadrics];
+    for (size_t j = 0; j < count; ++j) AlongZ(d, *q[j], vx, vy, b[j], c[j]);
+    return QuadricZeros(d, count, squared, b, c, zlo, end);
+  }
+};
+
 void QuadricCrossings(const ProjectedFreeForm::Node* nodes, const Quadric* clips, size_t clipCount,
-                      const double* w, const double* x, const double* y, double zlo,
-                      const double* zhi, int count, double* out) {
+                      const double* x, const double* y, double zlo, const double* zhi, int count,
+                      double* out) {
   const DD d;
-  double* coefficients = CoefficientStorage(2 * (nodes[0].end + clipCount) * hn::Lanes(d));
+  const QuadricList quadrics(nodes, clips, clipCount);
   ForEachVector(d, x, y, zlo, zhi, count, [&](size_t s0, size_t m, VD vx, VD vy, VD end) {
-    // No root perturbation taken (active 0): SetUpRays sets the root's and the clips' b and c.
-    const Rays rays = SetUpRays(d, nodes, clips, clipCount, w, 0, vx, vy, coefficients);
-    StoreFirst(d, QuadricZeros(d, rays, nodes, clips, clipCount, zlo, end), m, out + s0);
+    StoreFirst(d, quadrics.zeros(d, vx, vy, zlo, end), m, out + s0);
   });
 }
 
@@ -457,14 +479,14 @@ void QuadricCrossings(const ProjectedFreeForm::Node* nodes, const Quadric* clips
 static_assert(HWY_LANES(double) <= 8 && 8 % HWY_LANES(double) == 0);
 
 int QuadricHits(const ProjectedFreeForm::Node* nodes, const Quadric* clips, size_t clipCount,
-                const double* w, const double* columns, const double* rows, double zlo, double zhi,
+                const double* columns, const double* rows, double zlo, double zhi,
                 const HitRows& to, double* last) {
   const DD d;
   const hn::Rebind<float, DD> df;
   const hn::Rebind<uint32_t, DD> du;
   const hn::RebindToUnsigned<DD> d64;
   const size_t n = hn::Lanes(d);
-  double* coefficients = CoefficientStorage(2 * (nodes[0].end + clipCount) * n);
+  const QuadricList quadrics(nodes, clips, clipCount);
   const VD one = hn::Set(d, 1.0), half = hn::Set(d, 0.5);
   int hits = 0;
   for (size_t r = 0; r < 8; ++r) {
@@ -476,9 +498,7 @@ int QuadricHits(const ProjectedFreeForm::Node* nodes, const Quadric* clips, size
       const auto held = hn::LoadU(df, depth + c);
       const VD end =
           hn::Min(hn::Set(d, zhi), hn::Sub(hn::Mul(hn::Set(d, 2.0), hn::PromoteTo(d, held)), one));
-      const Rays rays =
-          SetUpRays(d, nodes, clips, clipCount, w, 0, hn::LoadU(d, columns + c), vy, coefficients);
-      const VD z = QuadricZeros(d, rays, nodes, clips, clipCount, zlo, end);
+      const VD z = quadrics.zeros(d, hn::LoadU(d, columns + c), vy, zlo, end);
       // takeHit (raycast.cpp): the window depth, rounded to float, where nearer (never a NaN's).
       const auto nearer = hn::DemoteTo(df, hn::Mul(half, hn::Add(z, one)));
       const auto taken = hn::Lt(nearer, held);
@@ -693,15 +713,13 @@ void ProjectedFreeForm::monotonicCrossings(const double* x, const double* y, dou
 void ProjectedFreeForm::quadricCrossings(const double* x, const double* y, double zlo,
                                          const double* zhi, int count, double* z) const {
   HWY_DYNAMIC_DISPATCH(QuadricCrossings)
-  (nodes_.data(), clips_.data(), clips_.size(), inverse_.m[3].data(), x, y, zlo, zhi,
-   std::max(count, 0), z);
+  (nodes_.data(), clips_.data(), clips_.size(), x, y, zlo, zhi, std::max(count, 0), z);
 }
 
 int ProjectedFreeForm::quadricHits(const double* columns, const double* rows, double zlo,
                                    double zhi, const HitRows& to, double& last) const {
-  return HWY_DYNAMIC_DISPATCH(QuadricHits)(nodes_.data(), clips_.data(), clips_.size(),
-                                           inverse_.m[3].data(), columns, rows, zlo, zhi, to,
-                                           &last);
+  return HWY_DYNAMIC_DISPATCH(QuadricHits)(nodes_.data(), clips_.data(), clips_.size(), columns,
+                                           rows, zlo, zhi, to, &last);
 }
 
 bool ProjectedFreeForm::crossingBracket(double x, double y, double zlo, double zhi, uint64_t active,
