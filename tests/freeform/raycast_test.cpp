@@ -575,7 +575,8 @@ TEST(RayCast, QuadricHitsTakeTheNearerCrossingsOnEveryTarget) {
 }
 
 // quadricsAlone: H is its quadrics alone only where no root perturbation is active — and never
-// with more root perturbations than `active` has bits for.
+// with more root perturbations than `active` has bits for, nor with more clips than the closed
+// form holds.
 TEST(RayCast, QuadricsAloneOnlyWhereNoPerturbationIsActive) {
   const auto g = ProjectedFreeForm::make(bumpedSphere(), cameraToCube(64, 64));
   ASSERT_TRUE(g);
@@ -589,6 +590,12 @@ TEST(RayCast, QuadricsAloneOnlyWhereNoPerturbationIsActive) {
   const auto m = ProjectedFreeForm::make(many, cameraToCube(64, 64));
   ASSERT_TRUE(m);
   EXPECT_FALSE(m->quadricsAlone(0));  // the 65th is always taken
+  FreeForm clipped = cappedCylinder();
+  while (clipped.clips.size() <= ProjectedFreeForm::kMaxClipsSolved)
+    clipped.clips.push_back(Quadric::halfSpace({0, 0, 1}, 2.0 + double(clipped.clips.size())));
+  const auto c = ProjectedFreeForm::make(clipped, cameraToCube(64, 64));
+  ASSERT_TRUE(c);
+  EXPECT_FALSE(c->quadricsAlone(0));  // more clips than the closed form holds
 }
 
 // CastWindow::active: every hit keeps the perturbations that may be positive in its ray window;
