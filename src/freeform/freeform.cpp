@@ -287,30 +287,4 @@ double RayFunction::evaluate(double z) const {
   return h;
 }
 
-void RayFunction::boundNodeSlope(uint32_t i, Interval z, const InversePowers& inv,
-                                 Interval& value, Interval& slope) const {
-  const Node& n = nodes_[i];
-  value = quadraticRange(n.a, n.b, n.c, z);
-  slope = z * (2 * n.a) + n.b;
-  for (uint32_t c = i + 1; c < n.end; c = nodes_[c].end) {
-    Interval v, dv;
-    boundNodeSlope(c, z, inv, v, dv);
-    addPerturbation(v, dv, nodes_[c].weight, inv, u1_, value, slope);
-  }
-}
-
-void RayFunction::bound(double z0, double z1, Interval& value, Interval& slope) const {
-  const Interval z{z0, z1}, u = z * u1_ + u0_;
-  if (!(u.lo > 0)) {
-    value = slope = {-kInf, kInf};
-    return;
-  }
-  boundNodeSlope(0, z, inversePowers(u), value, slope);
-  for (const Node& c : clips_)
-    takeMinimum(quadraticRange(c.a, c.b, c.c, z),
-                z * (2 * c.a) + c.b, value, slope);
-  value = widened(value);
-  slope = widened(slope);
-}
-
 }  // namespace sv::freeform

@@ -80,14 +80,12 @@ inline bool newtonConverged(double step, double previous) {
 
 // H along one ray of the cube — x and y fixed, z free — where every quadric is a quadratic in z and
 // u is linear: evaluation costs a few operations per quadric, and bounds over a z interval are
-// exact per quadric (quadraticRange). Built by ProjectedFreeForm::ray; reused from ray to ray.
+// exact per quadric (quadraticRange; the rays' bounds are taken in SIMD lanes, window_rays.cpp's
+// BoundLanes). Built by ProjectedFreeForm::ray; reused from ray to ray.
 class RayFunction {
  public:
   double evaluate(double z) const;
   double evaluate(double z, double& slope) const;  // and dH/dz there (Newton's method)
-  // A range containing H over [z0, z1], and one of dH/dz there, widened for rounding: where the
-  // slope excludes 0, H is monotonic there and has at most one zero.
-  void bound(double z0, double z1, Interval& value, Interval& slope) const;
   // Cube depth ↔ eye depth along this ray: t = 1/u(z), u linear in z (ProjectedFreeForm).
   double eyeDepth(double z) const { return 1 / (u0_ + u1_ * z); }
   double cubeDepth(double t) const { return (1 / t - u0_) / u1_; }
@@ -100,8 +98,6 @@ class RayFunction {
   };
   double evaluateNode(uint32_t i, double z, double invU4) const;
   double evaluateNode(uint32_t i, double z, double invU4, double du4, double& slope) const;
-  void boundNodeSlope(uint32_t i, Interval z, const InversePowers& inv, Interval& value,
-                      Interval& slope) const;
   std::vector<Node> nodes_;
   std::vector<Node> clips_;
   double u0_ = 1, u1_ = 0;  // u(z) = u0 + u1·z
@@ -146,18 +142,18 @@ class ProjectedFreeForm {
                           uint64_t active = kAllActive) const;
   // The same for rays whose H may turn in [zlo, zhi[i]] (a window's slope bound holds 0): each
   // ray's span is cut at `pieces` equal steps of [zlo, max zhi] and taken front to back; the
-  // ray's own bound (RayFunction::bound) over a piece rejects it, or says H is monotonic there
-  // — a crossing, if the ends differ in sign, is z[i] — or neither: from[i] is where that
-  // piece begins, for the ray's own subdivision (firstCrossing in raycast.cpp) to go on, and
-  // z[i] NaN. z[i] and from[i] both NaN: no crossing. Returns the number of ray bounds made.
+  // ray's own bound (exact per quadric along the ray) over a piece rejects it, or says H is
+  // monotonic there — a crossing, if the ends differ in sign, is z[i] — or neither: from[i] is
+  // where that piece begins, for the ray's own subdivision (firstCrossing in raycast.cpp) to go on,
+  // and z[i] NaN. z[i] and from[i] both NaN: no crossing. Returns the number of ray bounds made.
   int piecewiseCrossings(const double* x, const double* y, double zlo, const double* zhi, int count,
                          int pieces, const double* guess, double* z, double* from,
                          uint64_t active = kAllActive) const;
   // Rays (x[i], y[i]) whose H may turn in [zlo, zhi[i]] but which likely cross near guess[i] (a
   // neighbour's hit): Newton alone from the guess, as monotonicCrossings begins, and a zero it
-  // converges to in the span kept only where the ray's own bound (RayFunction::bound) over
-  // [zlo, zero] shows H monotonic there — then it is the ray's first crossing. z[i] is that zero,
-  // or NaN where none was proven (a NaN guess: not tried), for piecewiseCrossings to decide.
+  // converges to in the span kept only where the ray's own bound (exact per quadric along the ray)
+  // over [zlo, zero] shows H monotonic there — then it is the ray's first crossing. z[i] is that
+  // zero, or NaN where none was proven (a NaN guess: not tried), for piecewiseCrossings to decide.
   // Returns the number of ray bounds made.
   int provenCrossings(const double* x, const double* y, double zlo, const double* zhi, int count,
                       const double* guess, double* z, uint64_t active = kAllActive) const;
@@ -187,9 +183,9 @@ class ProjectedFreeForm {
                   const HitRows& to, double& last) const;
   // The first crossing of H along the ray (x, y) in [zlo, zhi] — of those `active` holds, the
   // root's perturbations taken — bracketed: spans split into 8 pieces at a time, bounded together
-  // (RayFunction::bound's bounds, a piece per SIMD lane), taken depth first and front to back; a
-  // piece no bound lets hold a zero is dropped, a monotonic one — or one `narrowest` wide or
-  // less — is decided by the signs of H at its ends, others are split again. True if found:
+  // (the ray's own bounds, exact per quadric, a piece per SIMD lane), taken depth first and front
+  // to back; a piece no bound lets hold a zero is dropped, a monotonic one — or one `narrowest`
+  // wide or less — is decided by the signs of H at its ends, others are split again. True if found:
   // bracket = {a, b, H(a), H(b)}, the signs of H(a) and H(b) different (for refining). At most
   // `budget` spans are split; `bounds` gains the pieces bounded. The same on every target.
   bool crossingBracket(double x, double y, double zlo, double zhi, uint64_t active,

@@ -1,10 +1,12 @@
-// The rays of a 4×4 window solved together, every ray a SIMD lane (Highway, per target):
-// ProjectedFreeForm::monotonicCrossings, where H is monotonic in depth over the window — most of
-// a free form's pixels — and piecewiseCrossings, where it may turn (silhouettes), each ray
-// bounding its own pieces of depth (RayFunction::bound in lanes). Each lane performs the
-// operations of ProjectedFreeForm::ray, RayFunction::evaluate and bound (freeform.cpp) and
-// refineBracket (raycast.cpp) in the same order; lanes that are done wait, masked, for the others,
-// so a lane's result never depends on its neighbours or on the lane count.
+// Rays solved together, every ray a SIMD lane (Highway, per target): a 4×4 window's —
+// ProjectedFreeForm::monotonicCrossings, where H is monotonic in depth over the window, and
+// provenCrossings / piecewiseCrossings, where it may turn (silhouettes), each ray bounding its own
+// pieces of depth (BoundLanes: each quadric's exact range along the ray, the perturbations
+// through their quadrics' bounds); quadricCrossings and quadricHits, the closed form where no
+// perturbation reaches the rays; and crossingBracket, one ray's span split eight pieces at a time.
+// Each lane performs the operations of ProjectedFreeForm::ray, RayFunction::evaluate
+// (freeform.cpp) and refineBracket (raycast.cpp) in the same order; lanes that are done wait,
+// masked, for the others, so a lane's result never depends on its neighbours or on the lane count.
 //
 // Based on: SPEC §12 (seed 003: at a leaf, the surface point along the ray).
 #undef HWY_TARGET_INCLUDE
@@ -135,7 +137,8 @@ HWY_INLINE Lanes QuadraticRange(DD d, double a, VD b, VD c, VD zA, VD zB) {
   return {lo, hi};
 }
 
-// RayFunction::boundNodeSlope for the lanes' [zA, zB], with freeform.cpp's addPerturbation.
+// A node's bound and slope bound over the lanes' [zA, zB] of their rays: its quadratic's exact
+// range, plus its perturbations' terms (freeform.cpp's addPerturbation).
 void NodeBoundSlope(DD d, const Rays& r, uint32_t i, const Lanes& z, const Lanes& u4,
                     const Lanes& u5, Lanes& value, Lanes& slope) {
   const double a = r.nodes[i].q.c[2];
@@ -152,8 +155,9 @@ void NodeBoundSlope(DD d, const Rays& r, uint32_t i, const Lanes& z, const Lanes
   }
 }
 
-// RayFunction::bound(value, slope) over the lanes' [zA, zB]; false lanes: u ≤ 0 somewhere (behind
-// the eye), where the bound is everything.
+// A range containing H over the lanes' [zA, zB] of their rays, and one of dH/dz there, widened for
+// rounding (where the slope excludes 0, H is monotonic and has at most one zero); false lanes: u ≤
+// 0 somewhere (behind the eye), where the bound is everything.
 MD BoundLanes(DD d, const Rays& r, const Lanes& z, Lanes& value, Lanes& slope) {
   const Lanes zu = Scale(d, z, r.u1);
   const Lanes u{hn::Add(zu.lo, r.u0), hn::Add(zu.hi, r.u0)};
