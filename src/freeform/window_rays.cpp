@@ -672,7 +672,7 @@ bool CrossingBracket(const ProjectedFreeForm::Node* nodes, const Quadric* clips,
     const int k = s.next++;
     const double a = s.z[k], b = s.z[k + 1];
     if ((s.monotonic >> k & 1) || b - a <= narrowest || depth == kDepth) {
-      // One zero at most (or a bracket too narrow to split): the ends decide, as firstCrossing's.
+      // One zero at most (or a bracket too narrow to split): the signs at the ends decide.
       if (!s.valued) {
         for (size_t k0 = 0; k0 <= size_t(kFan); k0 += n) {
           VD slope;
