@@ -742,7 +742,8 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
   struct Batch {
     uint32_t id = kNoTriangle;
     int count = 0;
-    alignas(64) int32_t pixel[kBlockPixels];
+    // Room for a whole vector appended past a count of up to 15 (the scan below).
+    alignas(64) int32_t pixel[2 * kBlockPixels];
   };
   struct Queued {
     shade::Fragments fragments;
@@ -842,21 +843,43 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
     b.count = 0;
   };
 
-  for (int block = 0; block < kTilePixels / kBlockPixels; ++block) {
-    uint32_t* visible = ctx.visible + size_t(block) * kBlockPixels;
-    for (int l = 0; l < kBlockPixels; ++l) {
-      const uint32_t id = visible[l];
-      if (id == kNoTriangle) continue;
-      visible[l] = kNoTriangle;
-      ++ctx.stats->fragments;
-      Batch& b = slots[(id * 0x9E3779B1u) >> 26];  // 64 slots by a multiplicative hash
-      if (b.id != id) {
+  // The tile's records a vector at a time: each triangle in a vector takes all its pixels there
+  // at once (a compress of their numbers), so the work goes with the triangles a block holds, not
+  // with its pixels. A batch's pixels stay in scan order.
+  const hn::RebindToUnsigned<decltype(df)> du;
+  const auto none = hn::Set(du, kNoTriangle);
+  for (int start = 0; start < kTilePixels; start += int(n)) {
+    uint32_t* visible = ctx.visible + start;
+    const auto ids = hn::LoadU(du, visible);
+    auto left = hn::Ne(ids, none);
+    if (hn::AllFalse(du, left)) continue;
+    hn::StoreU(none, du, visible);
+    ctx.stats->fragments += hn::CountTrue(du, left);
+    alignas(64) uint32_t id[kBlockPixels];
+    hn::Store(ids, du, id);
+    const auto pixels = hn::Iota(di, start);
+    do {
+      const uint32_t t = id[hn::FindKnownFirstTrue(du, left)];
+      const auto mine = hn::And(left, hn::Eq(ids, hn::Set(du, t)));
+      left = hn::AndNot(mine, left);
+      Batch& b = slots[(t * 0x9E3779B1u) >> 26];  // 64 slots by a multiplicative hash
+      if (b.id != t) {
         if (b.count) emit(b);
-        b.id = id;
+        b.id = t;
       }
-      b.pixel[b.count++] = block * kBlockPixels + l;
-      if (b.count == kBlockPixels) emit(b);
-    }
+      hn::StoreU(hn::Compress(pixels, hn::RebindMask(di, mine)), di, b.pixel + b.count);
+      b.count += int(hn::CountTrue(du, mine));
+      if (b.count >= kBlockPixels) {
+        const int rest = b.count - kBlockPixels;
+        b.count = kBlockPixels;
+        emit(b);
+        if (rest) {
+          std::copy_n(b.pixel + kBlockPixels, rest, b.pixel);
+          b.id = t;
+          b.count = rest;
+        }
+      }
+    } while (!hn::AllFalse(du, left));
   }
   for (Batch& b : slots)
     if (b.count) emit(b);
