@@ -758,7 +758,17 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
   int queued = 0;
 
   // Writes lanes [0, count) of 16-bit colour c16 to their pixels.
-  auto store = [&](const int32_t* pixel, int count, const uint16_t (*c16)[kBlockPixels]) {
+  auto store = [&](const int32_t* pixel, int count, const uint16_t(*c16)[kBlockPixels]) {
+    // A batch's pixels are distinct and in scan order: 16 from a block-aligned first to first + 15
+    // are that block, lane for lane.
+    if (count == kBlockPixels && (pixel[0] & (kBlockPixels - 1)) == 0 &&
+        pixel[kBlockPixels - 1] == pixel[0] + kBlockPixels - 1) {
+      uint16_t* dst = ctx.color + size_t(pixel[0] >> (2 * kBlockLog2)) * kColorPerBlock;
+      for (int ch = 0; ch < kColorChannels; ++ch)
+        for (size_t i = 0; i < size_t(kBlockPixels); i += n)
+          hn::StoreU(hn::Load(du16, c16[ch] + i), du16, dst + ch * kBlockPixels + i);
+      return;
+    }
     for (int l = 0; l < count; ++l) {
       const int32_t p = pixel[l];
       uint16_t* dst = ctx.color + size_t(p >> (2 * kBlockLog2)) * kColorPerBlock +
@@ -785,12 +795,13 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
     const TriangleSetup& t = ctx.setups[b.id];
     const AttributeSetup& a = ctx.attributes[b.id];
     // Unused lanes repeat the last pixel: valid positions, no extra texels.
-    for (int l = b.count; l < kBlockPixels; ++l) b.pixel[l] = b.pixel[b.count - 1];
+    const auto lastPixel = hn::Set(di, b.pixel[b.count - 1]);
     const unsigned used = a.material ? shade::attributesUsed(*a.material, *ctx.environment) : 0;
     Queued* q = a.material ? &queue[queued] : nullptr;
     alignas(64) uint16_t c16[kColorChannels][kBlockPixels];
     for (size_t i = 0; i < size_t(kBlockPixels); i += n) {
-      const auto p = hn::Load(di, b.pixel + i);
+      const auto p = hn::IfThenElse(hn::FirstN(di, size_t(std::max(b.count - int(i), 0))),
+                                    hn::Load(di, b.pixel + i), lastPixel);
       const auto block = hn::ShiftRight<2 * kBlockLog2>(p);
       const auto lane = hn::And(p, hn::Set(di, kBlockPixels - 1));
       const auto x = hn::Or(hn::ShiftLeft<kBlockLog2>(hn::And(block, hn::Set(di, kBlocksPerTileSide - 1))),
@@ -850,6 +861,25 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
   const auto none = hn::Set(du, kNoTriangle);
   for (int start = 0; start < kTilePixels; start += int(n)) {
     uint32_t* visible = ctx.visible + start;
+    if ((start & (kBlockPixels - 1)) == 0) {
+      // A block one triangle holds whole is a batch by itself, lane for lane (store's vector path).
+      const uint32_t first = visible[0];
+      bool whole = first != kNoTriangle;
+      for (size_t i = 0; whole && i < size_t(kBlockPixels); i += n)
+        whole = hn::AllTrue(du, hn::Eq(hn::LoadU(du, visible + i), hn::Set(du, first)));
+      if (whole) {
+        for (size_t i = 0; i < size_t(kBlockPixels); i += n) hn::StoreU(none, du, visible + i);
+        ctx.stats->fragments += kBlockPixels;
+        Batch b;
+        b.id = first;
+        b.count = kBlockPixels;
+        for (size_t i = 0; i < size_t(kBlockPixels); i += n)
+          hn::Store(hn::Iota(di, start + int(i)), di, b.pixel + i);
+        emit(b);
+        start += kBlockPixels - int(n);
+        continue;
+      }
+    }
     const auto ids = hn::LoadU(du, visible);
     auto left = hn::Ne(ids, none);
     if (hn::AllFalse(du, left)) continue;
