@@ -859,6 +859,8 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
   // with its pixels. A batch's pixels stay in scan order.
   const hn::RebindToUnsigned<decltype(df)> du;
   const auto none = hn::Set(du, kNoTriangle);
+  // (Highway's Iota builds its vector in memory, lane by lane: made once, not per block.)
+  const auto laneIndex = hn::Iota(di, 0);
   for (int start = 0; start < kTilePixels; start += int(n)) {
     uint32_t* visible = ctx.visible + start;
     if ((start & (kBlockPixels - 1)) == 0) {
@@ -874,7 +876,7 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
         b.id = first;
         b.count = kBlockPixels;
         for (size_t i = 0; i < size_t(kBlockPixels); i += n)
-          hn::Store(hn::Iota(di, start + int(i)), di, b.pixel + i);
+          hn::Store(hn::Add(laneIndex, hn::Set(di, start + int(i))), di, b.pixel + i);
         emit(b);
         start += kBlockPixels - int(n);
         continue;
@@ -887,7 +889,7 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
     ctx.stats->fragments += hn::CountTrue(du, left);
     alignas(64) uint32_t id[kBlockPixels];
     hn::Store(ids, du, id);
-    const auto pixels = hn::Iota(di, start);
+    const auto pixels = hn::Add(laneIndex, hn::Set(di, start));
     do {
       const uint32_t t = id[hn::FindKnownFirstTrue(du, left)];
       const auto mine = hn::And(left, hn::Eq(ids, hn::Set(du, t)));
