@@ -246,28 +246,27 @@ void prefetchBox(const Texture& t, Filter filter, float lod, float xMin, float x
   auto wrap = [pow2](int i, int n, Wrap mode) {
     return pow2 && mode == Wrap::repeat ? i & (n - 1) : wrapIndex(i, n, mode);
   };
-  auto level = [&](int j) {
-    const float scale = std::ldexp(1.0f, -j);
-    const int w = table.width[j], h = table.height[j];
-    const size_t stride = size_t(w) + 1;
-    const PackedTexel* base = t.texels() + table.offset[j];
-    // The cells' corners run from ⌊min⌋ to ⌊max⌋ + 1; a line holds 16 texels.
-    const int x0i = int(std::floor(xMin * scale)),
-              x1i = std::min(int(std::floor(xMax * scale)) + 1, x0i + 31);
-    const int y0i = int(std::floor(yMin * scale)),
-              y1i = std::min(int(std::floor(yMax * scale)) + 1, y0i + 31);
-    const int xa = wrap(x0i, w, t.wrapX()), xb = wrap(x1i, w, t.wrapX());
-    for (int y = y0i; y <= y1i; ++y) {
-      const PackedTexel* row = base + size_t(wrap(y, h, t.wrapY())) * stride;
-      prefetch(row + xa);
-      for (int x = x0i + 16; x < x1i; x += 16) prefetch(row + wrap(x, w, t.wrapX()));
-      // The row's last texel, unless it shares the first one's line.
-      if ((reinterpret_cast<uintptr_t>(row + xa) ^ reinterpret_cast<uintptr_t>(row + xb)) >= 64)
-        prefetch(row + xb);
-    }
-  };
-  level(k);
-  if (trilinear && k < last && l != float(k)) level(k + 1);
+  // Level k only: the trilinear filters' coarser level k + 1 has a quarter of the lines, which
+  // neighbouring blocks mostly share, and requesting them cost more than it hid (×0.96 a frame
+  // on tris 10k × 1000 px, docs/performance.md).
+  const float scale = std::ldexp(1.0f, -k);
+  const int w = table.width[k], h = table.height[k];
+  const size_t stride = size_t(w) + 1;
+  const PackedTexel* base = t.texels() + table.offset[k];
+  // The cells' corners run from ⌊min⌋ to ⌊max⌋ + 1; a line holds 16 texels.
+  const int x0i = int(std::floor(xMin * scale)),
+            x1i = std::min(int(std::floor(xMax * scale)) + 1, x0i + 31);
+  const int y0i = int(std::floor(yMin * scale)),
+            y1i = std::min(int(std::floor(yMax * scale)) + 1, y0i + 31);
+  const int xa = wrap(x0i, w, t.wrapX()), xb = wrap(x1i, w, t.wrapX());
+  for (int y = y0i; y <= y1i; ++y) {
+    const PackedTexel* row = base + size_t(wrap(y, h, t.wrapY())) * stride;
+    prefetch(row + xa);
+    for (int x = x0i + 16; x < x1i; x += 16) prefetch(row + wrap(x, w, t.wrapX()));
+    // The row's last texel, unless it shares the first one's line.
+    if ((reinterpret_cast<uintptr_t>(row + xa) ^ reinterpret_cast<uintptr_t>(row + xb)) >= 64)
+      prefetch(row + xb);
+  }
 }
 
 int anisotropicProbes(const Footprint& f, float x0, float y0, float& lod, float* x, float* y) {

@@ -164,9 +164,9 @@ void sampleBlock(const Texture& texture, Filter filter, const float* lod, const 
 
 // Requests the cache lines that sampling points inside the box [xMin, xMax] × [yMin, yMax] (level-0
 // texels) at level of detail `lod` with `filter` will read, so that they arrive while other work
-// runs: on the level the sampler picks for `lod` (and the next, for the trilinear filters), the
-// texels under the box (at most 32 × 32 of them). For points close together — a block of pixels —
-// that is a few lines per row. Coordinates past kMaxTexelCoordinate request nothing.
+// runs: on the level the sampler picks for `lod` (for the trilinear filters the finer of their
+// two), the texels under the box (at most 32 × 32 of them). For points close together — a block of
+// pixels — that is a few lines per row. Coordinates past kMaxTexelCoordinate request nothing.
 void prefetchBox(const Texture& texture, Filter filter, float lod, float xMin, float xMax,
                  float yMin, float yMax);
 
