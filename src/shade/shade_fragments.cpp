@@ -11,12 +11,12 @@
 // SIMD target (tests/shade/shade_test.cpp).
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "shade/shade_fragments.cpp"
-#include "hwy/foreach_target.h"  // IWYU pragma: keep
-#include "hwy/highway.h"
-
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
+#include "hwy/foreach_target.h"  // IWYU pragma: keep
+#include "hwy/highway.h"
 #include "shade/shading.h"
 #include "texture/footprint.h"
 #include "texture/sample_block-inl.h"
@@ -116,6 +116,7 @@ void TextureCoordinates(const MaterialShading& m, const Fragments& f, TexCoords&
   const size_t live = size_t(std::clamp(f.count, 0, kMaxFragments));
   const VF big = hn::Set(df, texture::kMaxTexelCoordinate);
   VF xMin = big, yMin = big, xMax = hn::Neg(big), yMax = hn::Neg(big);
+  float major0 = 0;  // the first lane's σ₁², for the prefetch
   for (size_t i = 0; i < size_t(kMaxFragments); i += lanes) {
     // Outside the triangle (extrapolated AA centroids) q may reach 0: keep w finite.
     const VF q = hn::Max(hn::Load(df, f.q + i), hn::Set(df, 1e-30f));
@@ -144,17 +145,28 @@ void TextureCoordinates(const MaterialShading& m, const Fragments& f, TexCoords&
     const VF disc =
         hn::Max(hn::Sub(hn::Mul(s, s), hn::Mul(hn::Set(df, 4.0f), hn::Mul(det, det))), zero);
     const VF major2 = hn::Mul(hn::Add(s, hn::Sqrt(disc)), hn::Set(df, 0.5f));
+    if (i == 0) major0 = hn::GetLane(major2);
     // ½·log2(σ₁²), at least 0; a degenerate or non-finite footprint reads level 0.
     VF l = hn::Mul(log2(df, hn::Max(major2, one)), hn::Set(df, 0.5f));
     l = hn::IfThenElseZero(hn::Lt(l, hn::Set(df, 64.0f)), l);  // also false for NaN
     if (m.levelZero) l = zero;
     hn::Store(l, df, out.lod + i);
   }
-  // The texels the samplers will read, requested now (the caller shades a queue's work later).
-  if (box)
-    texture::prefetchBox(*m.texture, m.filter, out.lod[0], hn::GetLane(hn::MinOfLanes(df, xMin)),
-                         hn::GetLane(hn::MaxOfLanes(df, xMax)), hn::GetLane(hn::MinOfLanes(df, yMin)),
-                         hn::GetLane(hn::MaxOfLanes(df, yMax)));
+  // The texels the samplers will read, requested now (the caller shades a queue's work later):
+  // on the level the first lane reads, found from the exponent of its σ₁² (½·log2 σ₁² rounded
+  // down, or to nearest for the single-level filters) rather than from its level of detail, whose
+  // logarithm the request would otherwise wait for. Near a level's edge the two may differ by
+  // one, which costs the request its use but changes nothing else.
+  if (box) {
+    const int e =
+        major0 >= 1.0f && major0 < 1e30f ? int(std::bit_cast<uint32_t>(major0) >> 23) - 127 : 0;
+    const bool nearestLevel =
+        m.filter != texture::Filter::trilinear && m.filter != texture::Filter::trilinearThreePoint;
+    const int k = m.levelZero ? 0 : (e + (nearestLevel ? 1 : 0)) >> 1;
+    texture::prefetchBox(
+        *m.texture, k, hn::GetLane(hn::MinOfLanes(df, xMin)), hn::GetLane(hn::MaxOfLanes(df, xMax)),
+        hn::GetLane(hn::MinOfLanes(df, yMin)), hn::GetLane(hn::MaxOfLanes(df, yMax)));
+  }
 }
 
 void ShadeFragments(const MaterialShading& m, const Environment& env, const Fragments& f,

@@ -230,25 +230,18 @@ inline void prefetch(const void* p) {
 
 }  // namespace
 
-void prefetchBox(const Texture& t, Filter filter, float lod, float xMin, float xMax, float yMin,
-                 float yMax) {
+void prefetchBox(const Texture& t, int k, float xMin, float xMax, float yMin, float yMax) {
   // Also false for NaN.
   if (!(xMin <= xMax && yMin <= yMax && std::fabs(xMin) <= kMaxTexelCoordinate &&
         std::fabs(xMax) <= kMaxTexelCoordinate && std::fabs(yMin) <= kMaxTexelCoordinate &&
         std::fabs(yMax) <= kMaxTexelCoordinate))
     return;
-  const int last = t.levelCount() - 1;
-  const bool trilinear = filter == Filter::trilinear || filter == Filter::trilinearThreePoint;
-  const float l = std::clamp(lod >= 0 ? lod : 0.0f, 0.0f, float(last));  // NaN → 0
-  const int k = trilinear ? int(l) : std::min(int(l + 0.5f), last);
+  k = std::clamp(k, 0, t.levelCount() - 1);
   const Texture::LevelTable& table = t.levelTable();
   const bool pow2 = t.powerOfTwo();
   auto wrap = [pow2](int i, int n, Wrap mode) {
     return pow2 && mode == Wrap::repeat ? i & (n - 1) : wrapIndex(i, n, mode);
   };
-  // Level k only: the trilinear filters' coarser level k + 1 has a quarter of the lines, which
-  // neighbouring blocks mostly share, and requesting them cost more than it hid (×0.96 a frame
-  // on tris 10k × 1000 px, docs/performance.md).
   const float scale = std::ldexp(1.0f, -k);
   const int w = table.width[k], h = table.height[k];
   const size_t stride = size_t(w) + 1;

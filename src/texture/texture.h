@@ -162,13 +162,13 @@ Level nextLevel(const Level& level, Wrap wrapX, Wrap wrapY);
 void sampleBlock(const Texture& texture, Filter filter, const float* lod, const float* x0,
                  const float* y0, int count, float out[4][16]);
 
-// Requests the cache lines that sampling points inside the box [xMin, xMax] × [yMin, yMax] (level-0
-// texels) at level of detail `lod` with `filter` will read, so that they arrive while other work
-// runs: on the level the sampler picks for `lod` (for the trilinear filters the finer of their
-// two), the texels under the box (at most 32 × 32 of them). For points close together — a block of
-// pixels — that is a few lines per row. Coordinates past kMaxTexelCoordinate request nothing.
-void prefetchBox(const Texture& texture, Filter filter, float lod, float xMin, float xMax,
-                 float yMin, float yMax);
+// Requests the cache lines of level k (clamped to the pyramid) under the box [xMin, xMax] ×
+// [yMin, yMax] (level-0 texels; at most 32 × 32 texels of level k), so that a sampler reading
+// points inside the box there finds them arrived. For points close together — a block of pixels —
+// that is a few lines per row. Coordinates past kMaxTexelCoordinate request nothing. The
+// trilinear filters read level k + 1 as well; its lines are a quarter as many and mostly shared
+// by neighbouring blocks, and requesting them cost more than it hid (docs/performance.md).
+void prefetchBox(const Texture& texture, int k, float xMin, float xMax, float yMin, float yMax);
 
 // The probes of Texture::anisotropic for `footprint` at (x0, y0): returns their number n
 // (1…Texture::kMaxProbes) and writes their level of detail and level-0 positions x[0…n), y[0…n).
