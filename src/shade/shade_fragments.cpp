@@ -160,12 +160,13 @@ void TextureCoordinates(const MaterialShading& m, const Fragments& f, TexCoords&
   if (box) {
     const int e =
         major0 >= 1.0f && major0 < 1e30f ? int(std::bit_cast<uint32_t>(major0) >> 23) - 127 : 0;
-    const bool nearestLevel =
-        m.filter != texture::Filter::trilinear && m.filter != texture::Filter::trilinearThreePoint;
-    const int k = m.levelZero ? 0 : (e + (nearestLevel ? 1 : 0)) >> 1;
+    const bool trilinear =
+        m.filter == texture::Filter::trilinear || m.filter == texture::Filter::trilinearThreePoint;
+    const int k = m.levelZero ? 0 : (e + (trilinear ? 0 : 1)) >> 1;
     texture::prefetchBox(
-        *m.texture, k, hn::GetLane(hn::MinOfLanes(df, xMin)), hn::GetLane(hn::MaxOfLanes(df, xMax)),
-        hn::GetLane(hn::MinOfLanes(df, yMin)), hn::GetLane(hn::MaxOfLanes(df, yMax)));
+        *m.texture, k, trilinear && !m.levelZero, hn::GetLane(hn::MinOfLanes(df, xMin)),
+        hn::GetLane(hn::MaxOfLanes(df, xMax)), hn::GetLane(hn::MinOfLanes(df, yMin)),
+        hn::GetLane(hn::MaxOfLanes(df, yMax)));
   }
 }
 

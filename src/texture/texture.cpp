@@ -230,7 +230,8 @@ inline void prefetch(const void* p) {
 
 }  // namespace
 
-void prefetchBox(const Texture& t, int k, float xMin, float xMax, float yMin, float yMax) {
+void prefetchBox(const Texture& t, int k, bool coarser, float xMin, float xMax, float yMin,
+                 float yMax) {
   // Also false for NaN.
   if (!(xMin <= xMax && yMin <= yMax && std::fabs(xMin) <= kMaxTexelCoordinate &&
         std::fabs(xMax) <= kMaxTexelCoordinate && std::fabs(yMin) <= kMaxTexelCoordinate &&
@@ -260,6 +261,16 @@ void prefetchBox(const Texture& t, int k, float xMin, float xMax, float yMin, fl
     if ((reinterpret_cast<uintptr_t>(row + xa) ^ reinterpret_cast<uintptr_t>(row + xb)) >= 64)
       prefetch(row + xb);
   }
+  if (!coarser || k + 1 >= t.levelCount()) return;
+  // Level k + 1: one line a row, under the box's centre.
+  const float half = 0.5f * scale;
+  const int w1 = table.width[k + 1], h1 = table.height[k + 1];
+  const PackedTexel* base1 = t.texels() + table.offset[k + 1];
+  const int xc = wrap(int(std::floor(0.5f * (xMin + xMax) * half)), w1, t.wrapX());
+  const int y0c = int(std::floor(yMin * half)),
+            y1c = std::min(int(std::floor(yMax * half)) + 1, y0c + 31);
+  for (int y = y0c; y <= y1c; ++y)
+    prefetch(base1 + size_t(wrap(y, h1, t.wrapY())) * (size_t(w1) + 1) + xc);
 }
 
 int anisotropicProbes(const Footprint& f, float x0, float y0, float& lod, float* x, float* y) {
