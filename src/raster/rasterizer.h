@@ -78,9 +78,9 @@ enum class ShadeMode : uint8_t {
 
 // Pixel shading's record for one triangle (ShadeMode::material): its attribute planes in
 // shade::Attribute order, with the same origin as its TriangleSetup's planes, and its material.
-struct AttributeSetup {
-  geometry::Plane planes[shade::kAttributeCount];
+struct alignas(64) AttributeSetup {
   const shade::MaterialShading* material = nullptr;  // nullptr: Gouraud colour, as ShadeMode::gouraud
+  geometry::Plane planes[shade::kAttributeCount];
 };
 
 // One tile's work: triangles in submission order, given as lists of indices into `setups`.

@@ -32,14 +32,14 @@
 
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "raster/tile_kernel.cpp"
-#include "hwy/foreach_target.h"  // IWYU pragma: keep
-#include "hwy/cache_control.h"
-#include "hwy/highway.h"
-
 #include <algorithm>
 #include <bit>
+#include <cstddef>
 #include <cstring>
 
+#include "hwy/cache_control.h"
+#include "hwy/foreach_target.h"  // IWYU pragma: keep
+#include "hwy/highway.h"
 #include "raster/framebuffer.h"
 #include "raster/occupancy.h"
 #include "raster/rasterizer.h"
@@ -1792,6 +1792,11 @@ void drawLists(const TileWork& w, RasterStats& stats) {
   // otherwise bound by their cache misses. (Before records were grouped by tile this was half the
   // tile time on 10-px triangles; now 2 ahead measures the same as 1 and better than 4 or 8.)
   constexpr uint32_t kPrefetchDistance = 2;
+  // Pixel shading's records (AttributeSetup): the planes that share the material's line.
+  constexpr int kPlanesInFirstLine = (64 - int(sizeof(void*))) / int(sizeof(geometry::Plane));
+  static_assert(offsetof(AttributeSetup, planes) == sizeof(void*) && alignof(AttributeSetup) == 64);
+  const shade::MaterialShading* lastMaterial = nullptr;
+  bool wideRecords = true;
   // Object-space culling: the object last tested, and whether it was hidden. A hidden object stays
   // hidden (occupancy only grows and depth bounds only fall), so the answer holds across lists.
   uint32_t lastObject = kNoObject;
@@ -1828,8 +1833,11 @@ void drawLists(const TileWork& w, RasterStats& stats) {
         for (size_t line = 0; line < sizeof(TriangleSetup); line += 64) hwy::Prefetch(next + line);
         // Pixel shading's record sits at the same index (TileWork::attributes).
         if (kShade == ShadeMode::material) {
-          next = reinterpret_cast<const char*>(w.attributes + ahead);
-          for (size_t line = 0; line < sizeof(AttributeSetup); line += 64) hwy::Prefetch(next + line);
+          // The record's first line holds the material and the texture planes; the second the
+          // rest, requested while the materials seen last read any of it.
+          const char* record = reinterpret_cast<const char*>(w.attributes + ahead);
+          hwy::Prefetch(record);
+          if (wideRecords) hwy::Prefetch(record + 64);
         }
       }
       const TriangleSetup& t = w.setups[list[i]];
@@ -1837,6 +1845,11 @@ void drawLists(const TileWork& w, RasterStats& stats) {
       if constexpr (kShade == ShadeMode::material) {
         // Per triangle: shaded per pixel when it has a material, else plain Gouraud.
         const AttributeSetup& a = w.attributes[list[i]];
+        if (a.material != lastMaterial) {
+          lastMaterial = a.material;
+          wideRecords = a.material && (shade::attributesUsed(*a.material, *w.environment) >>
+                                       kPlanesInFirstLine) != 0;
+        }
         const shade::AlphaUse alpha = a.material ? a.material->alpha : shade::AlphaUse::opaque;
         if (deferred && alpha == shade::AlphaUse::opaque) {
           drawTriangle<PixelOp::visibility, false>(t, *use, nullptr, list[i], boxes != nullptr);
