@@ -81,6 +81,10 @@ enum class ShadeMode : uint8_t {
 struct alignas(64) AttributeSetup {
   const shade::MaterialShading* material = nullptr;  // nullptr: Gouraud colour, as ShadeMode::gouraud
   geometry::Plane planes[shade::kAttributeCount];
+  // The record is two cache lines; the first holds the material and the first planes (a
+  // textured material's u and v). Whether shading reads the second, by attributesUsed's bits:
+  static constexpr int kFirstLinePlanes = int((64 - sizeof(void*)) / sizeof(geometry::Plane));
+  static bool readsSecondLine(unsigned used) { return (used >> kFirstLinePlanes) != 0; }
 };
 
 // One tile's work: triangles in submission order, given as lists of indices into `setups`.

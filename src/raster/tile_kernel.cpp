@@ -1792,8 +1792,6 @@ void drawLists(const TileWork& w, RasterStats& stats) {
   // otherwise bound by their cache misses. (Before records were grouped by tile this was half the
   // tile time on 10-px triangles; now 2 ahead measures the same as 1 and better than 4 or 8.)
   constexpr uint32_t kPrefetchDistance = 2;
-  // Pixel shading's records (AttributeSetup): the planes that share the material's line.
-  constexpr int kPlanesInFirstLine = (64 - int(sizeof(void*))) / int(sizeof(geometry::Plane));
   static_assert(offsetof(AttributeSetup, planes) == sizeof(void*) && alignof(AttributeSetup) == 64);
   const shade::MaterialShading* lastMaterial = nullptr;
   bool wideRecords = true;
@@ -1847,8 +1845,8 @@ void drawLists(const TileWork& w, RasterStats& stats) {
         const AttributeSetup& a = w.attributes[list[i]];
         if (a.material != lastMaterial) {
           lastMaterial = a.material;
-          wideRecords = a.material && (shade::attributesUsed(*a.material, *w.environment) >>
-                                       kPlanesInFirstLine) != 0;
+          wideRecords = a.material && AttributeSetup::readsSecondLine(
+                                          shade::attributesUsed(*a.material, *w.environment));
         }
         const shade::AlphaUse alpha = a.material ? a.material->alpha : shade::AlphaUse::opaque;
         if (deferred && alpha == shade::AlphaUse::opaque) {
