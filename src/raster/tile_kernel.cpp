@@ -848,7 +848,7 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
       if (a.material->texture) shade::textureCoordinates(*a.material, f, q->coordinates);
       q->material = a.material;
       q->count = b.count;
-      std::copy_n(b.pixel, kBlockPixels, q->pixel);
+      std::copy_n(b.pixel, b.count, q->pixel);  // (store reads no further)
       if (++queued == kQueue) finishQueue();
     } else {
       store(b.pixel, b.count, c16);
@@ -1848,8 +1848,12 @@ void drawLists(const TileWork& w, RasterStats& stats) {
         const AttributeSetup& a = w.attributes[list[i]];
         if (a.material != lastMaterial) {
           lastMaterial = a.material;
-          wideRecords = a.material && AttributeSetup::readsSecondLine(
-                                          shade::attributesUsed(*a.material, *w.environment));
+          // Triangles shaded as they are drawn (anti-aliased, or not opaque) read every plane
+          // (computeAttributeLanes); deferred ones only those their material uses.
+          wideRecords =
+              a.material &&
+              (!deferred || a.material->alpha != shade::AlphaUse::opaque ||
+               AttributeSetup::readsSecondLine(shade::attributesUsed(*a.material, *w.environment)));
         }
         const shade::AlphaUse alpha = a.material ? a.material->alpha : shade::AlphaUse::opaque;
         if (deferred && alpha == shade::AlphaUse::opaque) {

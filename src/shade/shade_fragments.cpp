@@ -158,8 +158,9 @@ void TextureCoordinates(const MaterialShading& m, const Fragments& f, TexCoords&
   // logarithm the request would otherwise wait for. Near a level's edge the two may differ by
   // one, which costs the request its use but changes nothing else.
   if (box) {
-    const int e =
-        major0 >= 1.0f && major0 < 1e30f ? int(std::bit_cast<uint32_t>(major0) >> 23) - 127 : 0;
+    const int e = major0 >= 1.0f && std::isfinite(major0)
+                      ? int(std::bit_cast<uint32_t>(major0) >> 23) - 127
+                      : 0;
     const bool trilinear =
         m.filter == texture::Filter::trilinear || m.filter == texture::Filter::trilinearThreePoint;
     const int k = m.levelZero ? 0 : (e + (trilinear ? 0 : 1)) >> 1;
