@@ -32,14 +32,15 @@
 
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "raster/tile_kernel.cpp"
+#include "hwy/foreach_target.h"  // IWYU pragma: keep
+#include "hwy/cache_control.h"
+#include "hwy/highway.h"
+
 #include <algorithm>
 #include <bit>
 #include <cstddef>
 #include <cstring>
 
-#include "hwy/cache_control.h"
-#include "hwy/foreach_target.h"  // IWYU pragma: keep
-#include "hwy/highway.h"
 #include "raster/framebuffer.h"
 #include "raster/occupancy.h"
 #include "raster/rasterizer.h"

@@ -11,12 +11,13 @@
 // SIMD target (tests/shade/shade_test.cpp).
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "shade/shade_fragments.cpp"
+#include "hwy/foreach_target.h"  // IWYU pragma: keep
+#include "hwy/highway.h"
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
 
-#include "hwy/foreach_target.h"  // IWYU pragma: keep
-#include "hwy/highway.h"
 #include "shade/shading.h"
 #include "texture/footprint.h"
 #include "texture/sample_block-inl.h"
