@@ -731,9 +731,12 @@ void occupancyView(const Occupancy& occ, uint16_t* color) {
 // from anywhere in the tile, so that a batch fills the SIMD lanes even for triangles of a few
 // pixels (a batch per 4×4 block and triangle shaded 3 lanes for every pixel on tris 100k × 10
 // px); open batches sit in a small table by triangle, and a batch leaves it when full or when
-// another triangle needs its slot. Pixel-shaded batches then wait in a queue, so that the texels
-// each will read have been requested (shade::textureCoordinates) a whole queue's work earlier.
-// A pixel's planes are evaluated at it directly, (c0 + dx·X) + dy·Y. docs/performance.md.
+// another triangle needs its slot. A pixel-shaded batch that leaves it short of 16 (a triangle
+// of 10 pixels fills about 7 lanes) has its attributes and texture coordinates evaluated and
+// joins other triangles' pixels of its material in the mixer, which passes on whole batches.
+// Pixel-shaded batches then wait in a queue, so that the texels each will read have been
+// requested (shade::textureCoordinates) a whole queue's work earlier. A pixel's planes are
+// evaluated at it directly, (c0 + dx·X) + dy·Y. docs/performance.md.
 HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
   const hn::CappedTag<float, kBlockPixels> df;
   const hn::RebindToSigned<decltype(df)> di;
@@ -751,7 +754,25 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
     shade::TexCoords coordinates;
     const shade::MaterialShading* material;
     int count;
+    bool ordered;  // one triangle's pixels, in scan order (store's vector path may apply)
     alignas(64) int32_t pixel[kBlockPixels];
+  };
+  // Pixels of one material from batches of fewer than 16 — triangles of a few pixels, or the
+  // last pixels of larger ones — gathered with what shading needs of them (their attributes,
+  // texture coordinates and levels of detail, each from its own triangle) until they fill a
+  // queued batch, so that a 10-pixel triangle does not shade 16 lanes of its own. Room for 15
+  // waiting lanes and a whole vector appended.
+  static constexpr int kMixLanes = 2 * kBlockPixels;
+  struct Mixer {
+    const shade::MaterialShading* material = nullptr;
+    int count = 0;
+    alignas(64) float q[kMixLanes];
+    alignas(64) float color[3][kMixLanes];
+    alignas(64) float attribute[shade::kAttributeCount][kMixLanes];
+    alignas(64) float lod[kMixLanes];
+    alignas(64) float x0[kMixLanes];
+    alignas(64) float y0[kMixLanes];
+    alignas(64) int32_t pixel[kMixLanes];
   };
   // 256 open batches: a 64 × 64 tile of 10-pixel triangles holds about 400, and with 64 slots
   // their hash collisions emitted many batches half empty (256 slots: ×0.96 a frame on tris
@@ -760,12 +781,14 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
   Batch slots[kSlots];
   Queued queue[kQueue];
   int queued = 0;
+  Mixer mix;
 
   // Writes lanes [0, count) of 16-bit colour c16 to their pixels.
-  auto store = [&](const int32_t* pixel, int count, const uint16_t(*c16)[kBlockPixels]) {
-    // A batch's pixels are distinct and in scan order: 16 from a block-aligned first to first + 15
-    // are that block, lane for lane.
-    if (count == kBlockPixels && (pixel[0] & (kBlockPixels - 1)) == 0 &&
+  auto store = [&](const int32_t* pixel, int count, bool ordered,
+                   const uint16_t(*c16)[kBlockPixels]) {
+    // One triangle's pixels are distinct and in scan order: 16 from a block-aligned first to
+    // first + 15 are that block, lane for lane.
+    if (ordered && count == kBlockPixels && (pixel[0] & (kBlockPixels - 1)) == 0 &&
         pixel[kBlockPixels - 1] == pixel[0] + kBlockPixels - 1) {
       uint16_t* dst = ctx.color + size_t(pixel[0] >> (2 * kBlockLog2)) * kColorPerBlock;
       for (int ch = 0; ch < kColorChannels; ++ch)
@@ -790,19 +813,58 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
         for (size_t i = 0; i < size_t(kBlockPixels); i += n)
           hn::Store(hn::DemoteTo(du16, unitToLanes(df, hn::Load(df, rgba[ch] + i))), du16,
                     c16[ch] + i);
-      store(q.pixel, q.count, c16);
+      store(q.pixel, q.count, q.ordered, c16);
     }
     queued = 0;
   };
-  // Shades (Gouraud) or queues (material) batch b and empties it.
-  auto emit = [&](Batch& b) {
+  auto enqueue = [&](const shade::MaterialShading* material, int count, bool ordered) {
+    Queued& q = queue[queued];
+    q.material = material;
+    q.count = count;
+    q.ordered = ordered;
+    if (++queued == kQueue) finishQueue();
+  };
+  // The lanes [from, from + 16) of the mixer's array to lanes [0, 16) of to (the last valid one,
+  // `count` − 1, repeated past it), and the lanes after them down to [0, 16).
+  auto shipLanes = [&](float* from, float* to, int count) {
+    const auto last = hn::Set(df, from[count - 1]);
+    for (size_t i = 0; i < size_t(kBlockPixels); i += n) {
+      hn::Store(hn::IfThenElse(hn::FirstN(df, size_t(std::max(count - int(i), 0))),
+                               hn::Load(df, from + i), last),
+                df, to + i);
+      hn::Store(hn::Load(df, from + kBlockPixels + i), df, from + i);
+    }
+  };
+  // Queues the mixer's first 16 lanes (or all it has) and moves the rest down.
+  auto shipMix = [&] {
+    const int count = std::min(mix.count, kBlockPixels);
+    Queued& q = queue[queued];
+    shade::Fragments& f = q.fragments;
+    f.count = kBlockPixels;
+    const unsigned used = shade::attributesUsed(*mix.material, *ctx.environment);
+    shipLanes(mix.q, f.q, count);
+    for (int ch = 0; ch < kColorChannels; ++ch) shipLanes(mix.color[ch], f.color[ch], count);
+    for (int k = 0; k < shade::kAttributeCount; ++k)
+      if (used & (1u << k)) shipLanes(mix.attribute[k], f.attribute[k], count);
+    if (mix.material->texture) {
+      shipLanes(mix.lod, q.coordinates.lod, count);
+      shipLanes(mix.x0, q.coordinates.x0, count);
+      shipLanes(mix.y0, q.coordinates.y0, count);
+    }
+    for (size_t i = 0; i < size_t(kBlockPixels); i += n) {
+      hn::Store(hn::Load(di, mix.pixel + i), di, q.pixel + i);
+      hn::Store(hn::Load(di, mix.pixel + kBlockPixels + i), di, mix.pixel + i);
+    }
+    mix.count -= count;
+    enqueue(mix.material, count, false);
+  };
+  // The attributes of batch b's pixels into f (material) or their Gouraud colour into c16; unused
+  // lanes repeat the last pixel: valid positions, no extra texels.
+  auto evaluate = [&](const Batch& b, shade::Fragments* f, uint16_t(*c16)[kBlockPixels]) {
     const TriangleSetup& t = ctx.setups[b.id];
     const AttributeSetup& a = ctx.attributes[b.id];
-    // Unused lanes repeat the last pixel: valid positions, no extra texels.
     const auto lastPixel = hn::Set(di, b.pixel[b.count - 1]);
-    const unsigned used = a.material ? shade::attributesUsed(*a.material, *ctx.environment) : 0;
-    Queued* q = a.material ? &queue[queued] : nullptr;
-    alignas(64) uint16_t c16[kColorChannels][kBlockPixels];
+    const unsigned used = f ? shade::attributesUsed(*a.material, *ctx.environment) : 0;
     for (size_t i = 0; i < size_t(kBlockPixels); i += n) {
       const auto p = hn::IfThenElse(hn::FirstN(di, size_t(std::max(b.count - int(i), 0))),
                                     hn::Load(di, b.pixel + i), lastPixel);
@@ -821,38 +883,72 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
       };
       const auto qv = at(t.invW);
       const Plane* color[kColorChannels] = {&t.red, &t.green, &t.blue};
-      if (!q) {
+      if (!f) {
         // shadeBlock's Gouraud colour.
         const auto w = hn::Div(hn::Set(df, 1.0f), qv);
         for (int ch = 0; ch < kColorChannels; ++ch)
           hn::Store(hn::DemoteTo(du16, colorToLanes(df, at(*color[ch]), w)), du16, c16[ch] + i);
         continue;
       }
-      shade::Fragments& f = q->fragments;
-      hn::Store(qv, df, f.q + i);
+      hn::Store(qv, df, f->q + i);
       const auto w = hn::Div(hn::Set(df, 1.0f), hn::Max(qv, hn::Set(df, 1e-30f)));
       for (int ch = 0; ch < kColorChannels; ++ch)
         hn::Store(hn::Min(hn::Max(hn::Mul(at(*color[ch]), w), hn::Zero(df)), hn::Set(df, 1.0f)), df,
-                  f.color[ch] + i);
+                  f->color[ch] + i);
       for (int k = 0; k < shade::kAttributeCount; ++k)
-        if (used & (1u << k)) hn::Store(at(a.planes[k]), df, f.attribute[k] + i);
+        if (used & (1u << k)) hn::Store(at(a.planes[k]), df, f->attribute[k] + i);
     }
-    if (q) {
-      shade::Fragments& f = q->fragments;
-      f.count = kBlockPixels;
-      f.qdx = t.invW.dx;
-      f.qdy = t.invW.dy;
-      f.udx = a.planes[shade::kU].dx;
-      f.udy = a.planes[shade::kU].dy;
-      f.vdx = a.planes[shade::kV].dx;
-      f.vdy = a.planes[shade::kV].dy;
-      if (a.material->texture) shade::textureCoordinates(*a.material, f, q->coordinates);
-      q->material = a.material;
-      q->count = b.count;
-      std::copy_n(b.pixel, b.count, q->pixel);  // (store reads no further)
-      if (++queued == kQueue) finishQueue();
+    if (f) {
+      f->count = kBlockPixels;
+      f->qdx = t.invW.dx;
+      f->qdy = t.invW.dy;
+      f->udx = a.planes[shade::kU].dx;
+      f->udy = a.planes[shade::kU].dy;
+      f->vdx = a.planes[shade::kV].dx;
+      f->vdy = a.planes[shade::kV].dy;
+    }
+  };
+  // Shades (Gouraud) or queues (material) batch b and empties it: a whole batch (or one to be
+  // filtered anisotropically, which reads the triangle's gradients) as a queue entry of its own,
+  // a partial one through the mixer. Texels are requested (shade::textureCoordinates) as the
+  // batch is evaluated, one bounding box per triangle.
+  auto emit = [&](Batch& b) {
+    const shade::MaterialShading* material = ctx.attributes[b.id].material;
+    if (!material) {
+      alignas(64) uint16_t c16[kColorChannels][kBlockPixels];
+      evaluate(b, nullptr, c16);
+      store(b.pixel, b.count, true, c16);
+    } else if (b.count == kBlockPixels || material->anisotropic) {
+      Queued& q = queue[queued];
+      evaluate(b, &q.fragments, nullptr);
+      if (material->texture) shade::textureCoordinates(*material, q.fragments, q.coordinates);
+      std::copy_n(b.pixel, b.count, q.pixel);  // (store reads no further)
+      enqueue(material, b.count, true);
     } else {
-      store(b.pixel, b.count, c16);
+      shade::Fragments f;
+      shade::TexCoords tc;
+      evaluate(b, &f, nullptr);
+      if (material->texture) shade::textureCoordinates(*material, f, tc);
+      if (mix.count && mix.material != material) shipMix();
+      mix.material = material;
+      const unsigned used = shade::attributesUsed(*material, *ctx.environment);
+      auto append = [&](const float* from, float* to) {
+        for (size_t i = 0; i < size_t(kBlockPixels); i += n)
+          hn::StoreU(hn::Load(df, from + i), df, to + mix.count + i);
+      };
+      append(f.q, mix.q);
+      for (int ch = 0; ch < kColorChannels; ++ch) append(f.color[ch], mix.color[ch]);
+      for (int k = 0; k < shade::kAttributeCount; ++k)
+        if (used & (1u << k)) append(f.attribute[k], mix.attribute[k]);
+      if (material->texture) {
+        append(tc.lod, mix.lod);
+        append(tc.x0, mix.x0);
+        append(tc.y0, mix.y0);
+      }
+      for (size_t i = 0; i < size_t(kBlockPixels); i += n)
+        hn::StoreU(hn::Load(di, b.pixel + i), di, mix.pixel + mix.count + i);
+      mix.count += b.count;
+      if (mix.count >= kBlockPixels) shipMix();
     }
     b.id = kNoTriangle;
     b.count = 0;
@@ -919,6 +1015,7 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
   }
   for (Batch& b : slots)
     if (b.count) emit(b);
+  if (mix.count) shipMix();
   finishQueue();
 }
 

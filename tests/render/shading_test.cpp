@@ -312,6 +312,70 @@ TEST(Shading, TexturedFramesAreIdenticalForAnyThreadCount) {
     }
 }
 
+// Deferred shading gathers the pixels of triangles too small to fill a batch into shared
+// batches of one material. Tiny triangles that alternate between a red-textured and a
+// green-textured material must each keep their own: every pixel as in the same frame drawn with
+// untextured red and green triangles (which are not pixel-shaded).
+TEST(Shading, TinyTrianglesOfTwoMaterialsKeepTheirOwnTexture) {
+  auto build = [](bool textured) {
+    scene::Scene s = emptyScene();
+    const Vec4 colours[2] = {{1, 0, 0, 1}, {0, 1, 0, 1}};
+    scene::Mesh meshes[2];
+    for (int k = 0; k < 2; ++k) {
+      if (textured) {
+        texture::Level level;
+        level.width = level.height = 4;
+        const Vec4 c = colours[k];
+        level.texels.assign(16, {uint16_t(c.x * 65535), uint16_t(c.y * 65535), 0, 65535});
+        s.textures.push_back(
+            {k ? "green" : "red", std::make_shared<texture::Texture>(level, texture::Wrap::repeat,
+                                                                     texture::Wrap::repeat)});
+      }
+      scene::Material m;
+      m.texture = textured ? k : -1;
+      m.unlit = true;
+      s.materials.push_back(m);
+      meshes[k].material = k;
+    }
+    // A 40 × 30 grid of cells about 4 px wide, each cell's two triangles of different materials.
+    const int nx = 40, ny = 30;
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        const float x0 = -1.6f + 3.2f * float(i) / nx, x1 = -1.6f + 3.2f * float(i + 1) / nx;
+        const float y0 = -1.2f + 2.4f * float(j) / ny, y1 = -1.2f + 2.4f * float(j + 1) / ny;
+        const Vec3 corner[4] = {{x0, y0, -2}, {x1, y0, -2}, {x1, y1, -2}, {x0, y1, -2}};
+        const int tri[2][3] = {{0, 1, 2}, {0, 2, 3}};
+        for (int t = 0; t < 2; ++t) {
+          scene::Mesh& m = meshes[(i + j + t) % 2];
+          for (int v : tri[t]) {
+            m.indices.push_back(uint32_t(m.positions.size()));
+            m.positions.push_back(corner[v]);
+            m.uvs.push_back({0.5f, 0.5f});
+            m.colors.push_back(textured ? Vec4{1, 1, 1, 1} : colours[(i + j + t) % 2]);
+            m.normals.push_back({0, 0, 1});
+          }
+        }
+      }
+    for (scene::Mesh& m : meshes) {
+      s.meshes.push_back(m);
+      s.instances.push_back({int(s.meshes.size()) - 1, Mat4{}});
+    }
+    return s;
+  };
+  const Image expected = render(build(false), 160, 120);
+  const Image img = render(build(true), 160, 120);
+  int red = 0, green = 0, differing = 0;
+  for (size_t i = 0; i < img.rgb.size(); i += 3) {
+    red += img.rgb[i] > 128;
+    green += img.rgb[i + 1] > 128;
+    differing += (img.rgb[i] > 128) != (expected.rgb[i] > 128) ||
+                 (img.rgb[i + 1] > 128) != (expected.rgb[i + 1] > 128);
+  }
+  EXPECT_EQ(differing, 0);
+  EXPECT_GT(red, 160 * 120 / 3);
+  EXPECT_GT(green, 160 * 120 / 3);
+}
+
 TEST(Shading, AntiAliasedTexturingAgreesWithPointSamplingInsideSurfaces) {
   // Pixel shading with sub-pixel masks (forward, colour once per pixel) against the deferred
   // shading of one sample: inside a textured, lit, fogged quad the two shade the same centres.
