@@ -731,9 +731,9 @@ void occupancyView(const Occupancy& occ, uint16_t* color) {
 // from anywhere in the tile, so that a batch fills the SIMD lanes even for triangles of a few
 // pixels (a batch per 4×4 block and triangle shaded 3 lanes for every pixel on tris 100k × 10
 // px); open batches sit in a small table by triangle, and a batch leaves it when full or when
-// another triangle needs its slot. A pixel-shaded batch that leaves it short of 16 (a triangle
-// of 10 pixels fills about 7 lanes) has its attributes and texture coordinates evaluated and
-// joins other triangles' pixels of its material in the mixer, which passes on whole batches.
+// another triangle needs its slot. A pixel-shaded batch that leaves it short of 16 (on tris 100k
+// × 10 px a batch held 7.2 pixels on average) has its attributes and texture coordinates evaluated
+// and joins other triangles' pixels of its material in the mixer, which passes on whole batches.
 // Pixel-shaded batches then wait in a queue, so that the texels each will read have been
 // requested (shade::textureCoordinates) a whole queue's work earlier. A pixel's planes are
 // evaluated at it directly, (c0 + dx·X) + dy·Y. docs/performance.md.
@@ -754,20 +754,19 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
     shade::TexCoords coordinates;
     const shade::MaterialShading* material;
     int count;
-    bool ordered;  // one triangle's pixels, in scan order (store's vector path may apply)
     alignas(64) int32_t pixel[kBlockPixels];
   };
   // Pixels of one material from batches of fewer than 16 — triangles of a few pixels, or the
   // last pixels of larger ones — gathered with what shading needs of them (their attributes,
   // texture coordinates and levels of detail, each from its own triangle) until they fill a
   // queued batch, so that a 10-pixel triangle does not shade 16 lanes of its own. Room for 15
-  // waiting lanes and a whole vector appended.
+  // waiting lanes and a whole batch appended (an append writes 16 lanes).
   static constexpr int kMixLanes = 2 * kBlockPixels;
   struct Mixer {
     const shade::MaterialShading* material = nullptr;
     int count = 0;
     alignas(64) float q[kMixLanes];
-    alignas(64) float color[3][kMixLanes];
+    alignas(64) float color[kColorChannels][kMixLanes];
     alignas(64) float attribute[shade::kAttributeCount][kMixLanes];
     alignas(64) float lod[kMixLanes];
     alignas(64) float x0[kMixLanes];
@@ -784,12 +783,17 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
   Mixer mix;
 
   // Writes lanes [0, count) of 16-bit colour c16 to their pixels.
-  auto store = [&](const int32_t* pixel, int count, bool ordered,
-                   const uint16_t(*c16)[kBlockPixels]) {
-    // One triangle's pixels are distinct and in scan order: 16 from a block-aligned first to
-    // first + 15 are that block, lane for lane.
-    if (ordered && count == kBlockPixels && (pixel[0] & (kBlockPixels - 1)) == 0 &&
-        pixel[kBlockPixels - 1] == pixel[0] + kBlockPixels - 1) {
+  // (Highway's Iota builds its vector in memory, lane by lane: made once, not per block.)
+  const auto laneIndex = hn::Iota(di, 0);
+  auto store = [&](const int32_t* pixel, int count, const uint16_t(*c16)[kBlockPixels]) {
+    // 16 lanes that are one block's pixels in order, whether one triangle's or several's: three
+    // vector stores.
+    bool block = count == kBlockPixels && (pixel[0] & (kBlockPixels - 1)) == 0 &&
+                 pixel[kBlockPixels - 1] == pixel[0] + kBlockPixels - 1;
+    for (size_t i = 0; block && i < size_t(kBlockPixels); i += n)
+      block = hn::AllTrue(
+          di, hn::Eq(hn::Load(di, pixel + i), hn::Add(laneIndex, hn::Set(di, pixel[0] + int(i)))));
+    if (block) {
       uint16_t* dst = ctx.color + size_t(pixel[0] >> (2 * kBlockLog2)) * kColorPerBlock;
       for (int ch = 0; ch < kColorChannels; ++ch)
         for (size_t i = 0; i < size_t(kBlockPixels); i += n)
@@ -813,26 +817,25 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
         for (size_t i = 0; i < size_t(kBlockPixels); i += n)
           hn::Store(hn::DemoteTo(du16, unitToLanes(df, hn::Load(df, rgba[ch] + i))), du16,
                     c16[ch] + i);
-      store(q.pixel, q.count, q.ordered, c16);
+      store(q.pixel, q.count, c16);
     }
     queued = 0;
   };
-  auto enqueue = [&](const shade::MaterialShading* material, int count, bool ordered) {
+  auto enqueue = [&](const shade::MaterialShading* material, int count) {
     Queued& q = queue[queued];
     q.material = material;
     q.count = count;
-    q.ordered = ordered;
     if (++queued == kQueue) finishQueue();
   };
-  // The lanes [from, from + 16) of the mixer's array to lanes [0, 16) of to (the last valid one,
-  // `count` − 1, repeated past it), and the lanes after them down to [0, 16).
-  auto shipLanes = [&](float* from, float* to, int count) {
+  // Lanes [0, 16) of one of the mixer's arrays to `to` (lanes from `count` on repeat lane
+  // count − 1), and, when more are waiting, lanes [16, 32) down to [0, 16).
+  auto shipLanes = [&](float* from, float* to, int count, bool rest) {
     const auto last = hn::Set(df, from[count - 1]);
     for (size_t i = 0; i < size_t(kBlockPixels); i += n) {
       hn::Store(hn::IfThenElse(hn::FirstN(df, size_t(std::max(count - int(i), 0))),
                                hn::Load(df, from + i), last),
                 df, to + i);
-      hn::Store(hn::Load(df, from + kBlockPixels + i), df, from + i);
+      if (rest) hn::Store(hn::Load(df, from + kBlockPixels + i), df, from + i);
     }
   };
   // Queues the mixer's first 16 lanes (or all it has) and moves the rest down.
@@ -841,22 +844,23 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
     Queued& q = queue[queued];
     shade::Fragments& f = q.fragments;
     f.count = kBlockPixels;
+    const bool rest = mix.count > kBlockPixels;
     const unsigned used = shade::attributesUsed(*mix.material, *ctx.environment);
-    shipLanes(mix.q, f.q, count);
-    for (int ch = 0; ch < kColorChannels; ++ch) shipLanes(mix.color[ch], f.color[ch], count);
+    shipLanes(mix.q, f.q, count, rest);
+    for (int ch = 0; ch < kColorChannels; ++ch) shipLanes(mix.color[ch], f.color[ch], count, rest);
     for (int k = 0; k < shade::kAttributeCount; ++k)
-      if (used & (1u << k)) shipLanes(mix.attribute[k], f.attribute[k], count);
+      if (used & (1u << k)) shipLanes(mix.attribute[k], f.attribute[k], count, rest);
     if (mix.material->texture) {
-      shipLanes(mix.lod, q.coordinates.lod, count);
-      shipLanes(mix.x0, q.coordinates.x0, count);
-      shipLanes(mix.y0, q.coordinates.y0, count);
+      shipLanes(mix.lod, q.coordinates.lod, count, rest);
+      shipLanes(mix.x0, q.coordinates.x0, count, rest);
+      shipLanes(mix.y0, q.coordinates.y0, count, rest);
     }
     for (size_t i = 0; i < size_t(kBlockPixels); i += n) {
       hn::Store(hn::Load(di, mix.pixel + i), di, q.pixel + i);
-      hn::Store(hn::Load(di, mix.pixel + kBlockPixels + i), di, mix.pixel + i);
+      if (rest) hn::Store(hn::Load(di, mix.pixel + kBlockPixels + i), di, mix.pixel + i);
     }
     mix.count -= count;
-    enqueue(mix.material, count, false);
+    enqueue(mix.material, count);
   };
   // The attributes of batch b's pixels into f (material) or their Gouraud colour into c16; unused
   // lanes repeat the last pixel: valid positions, no extra texels.
@@ -911,19 +915,19 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
   // Shades (Gouraud) or queues (material) batch b and empties it: a whole batch (or one to be
   // filtered anisotropically, which reads the triangle's gradients) as a queue entry of its own,
   // a partial one through the mixer. Texels are requested (shade::textureCoordinates) as the
-  // batch is evaluated, one bounding box per triangle.
+  // batch is evaluated, one bounding box per batch (so a mixed batch's come in several).
   auto emit = [&](Batch& b) {
     const shade::MaterialShading* material = ctx.attributes[b.id].material;
     if (!material) {
       alignas(64) uint16_t c16[kColorChannels][kBlockPixels];
       evaluate(b, nullptr, c16);
-      store(b.pixel, b.count, true, c16);
-    } else if (b.count == kBlockPixels || material->anisotropic) {
+      store(b.pixel, b.count, c16);
+    } else if (b.count == kBlockPixels || (material->texture && material->anisotropic)) {
       Queued& q = queue[queued];
       evaluate(b, &q.fragments, nullptr);
       if (material->texture) shade::textureCoordinates(*material, q.fragments, q.coordinates);
       std::copy_n(b.pixel, b.count, q.pixel);  // (store reads no further)
-      enqueue(material, b.count, true);
+      enqueue(material, b.count);
     } else {
       shade::Fragments f;
       shade::TexCoords tc;
@@ -959,8 +963,6 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
   // with its pixels. A batch's pixels stay in scan order.
   const hn::RebindToUnsigned<decltype(df)> du;
   const auto none = hn::Set(du, kNoTriangle);
-  // (Highway's Iota builds its vector in memory, lane by lane: made once, not per block.)
-  const auto laneIndex = hn::Iota(di, 0);
   for (int start = 0; start < kTilePixels; start += int(n)) {
     uint32_t* visible = ctx.visible + start;
     if ((start & (kBlockPixels - 1)) == 0) {

@@ -2,6 +2,7 @@
 // an analytic ray-plane intersection, translucency and cut-outs, Phong against its formula, fog,
 // and identical bytes for any thread count.
 #include <gtest/gtest.h>
+#include <hwy/targets.h>
 
 #include <cmath>
 #include <memory>
@@ -313,24 +314,32 @@ TEST(Shading, TexturedFramesAreIdenticalForAnyThreadCount) {
 }
 
 // Deferred shading gathers the pixels of triangles too small to fill a batch into shared
-// batches of one material. Tiny triangles that alternate between a red-textured and a
-// green-textured material must each keep their own: every pixel as in the same frame drawn with
-// untextured red and green triangles (which are not pixel-shaded).
-TEST(Shading, TinyTrianglesOfTwoMaterialsKeepTheirOwnTexture) {
-  auto build = [](bool textured) {
+// batches of one material. Tiny triangles, each reading a texel of its own (nearest, at the
+// texel's centre), alternate between two materials whose textures hold the same colours with the
+// channels rotated: every pixel must show its own triangle's texel of its own material's texture —
+// as in the same frame drawn untextured with those colours as vertex colours (which is not pixel
+// shaded) — on every SIMD target.
+TEST(Shading, TinyTrianglesKeepTheirOwnTexelAndMaterialInSharedBatches) {
+  constexpr int kSide = 32;  // texels a side: 1024 colours
+  texture::Level levels[2];
+  for (int k = 0; k < 2; ++k) {
+    levels[k].width = levels[k].height = kSide;
+    for (int i = 0; i < kSide * kSide; ++i) {
+      const uint16_t c[3] = {srgbTo16(8 * (i % kSide) + 4), srgbTo16(8 * (i / kSide) + 4),
+                             srgbTo16(128)};
+      // Material 1's texture: the channels rotated, so its colour always differs from 0's.
+      levels[k].texels.push_back(k ? texture::Texel{c[2], c[0], c[1], 65535}
+                                   : texture::Texel{c[0], c[1], c[2], 65535});
+    }
+  }
+  auto build = [&](bool textured) {
     scene::Scene s = emptyScene();
-    const Vec4 colours[2] = {{1, 0, 0, 1}, {0, 1, 0, 1}};
     scene::Mesh meshes[2];
     for (int k = 0; k < 2; ++k) {
-      if (textured) {
-        texture::Level level;
-        level.width = level.height = 4;
-        const Vec4 c = colours[k];
-        level.texels.assign(16, {uint16_t(c.x * 65535), uint16_t(c.y * 65535), 0, 65535});
-        s.textures.push_back(
-            {k ? "green" : "red", std::make_shared<texture::Texture>(level, texture::Wrap::repeat,
-                                                                     texture::Wrap::repeat)});
-      }
+      if (textured)
+        s.textures.push_back({k ? "rotated" : "plain",
+                              std::make_shared<texture::Texture>(levels[k], texture::Wrap::repeat,
+                                                                 texture::Wrap::repeat)});
       scene::Material m;
       m.texture = textured ? k : -1;
       m.unlit = true;
@@ -339,19 +348,25 @@ TEST(Shading, TinyTrianglesOfTwoMaterialsKeepTheirOwnTexture) {
     }
     // A 40 × 30 grid of cells about 4 px wide, each cell's two triangles of different materials.
     const int nx = 40, ny = 30;
+    int triangle = 0;
     for (int j = 0; j < ny; ++j)
       for (int i = 0; i < nx; ++i) {
         const float x0 = -1.6f + 3.2f * float(i) / nx, x1 = -1.6f + 3.2f * float(i + 1) / nx;
         const float y0 = -1.2f + 2.4f * float(j) / ny, y1 = -1.2f + 2.4f * float(j + 1) / ny;
         const Vec3 corner[4] = {{x0, y0, -2}, {x1, y0, -2}, {x1, y1, -2}, {x0, y1, -2}};
         const int tri[2][3] = {{0, 1, 2}, {0, 2, 3}};
-        for (int t = 0; t < 2; ++t) {
-          scene::Mesh& m = meshes[(i + j + t) % 2];
+        for (int t = 0; t < 2; ++t, ++triangle) {
+          const int k = (i + j + t) % 2;
+          const int texel = (triangle * 37) % (kSide * kSide);
+          const texture::Color4 c =
+              texture::unpackTexel(texture::packTexel(levels[k].texels[size_t(texel)]));
+          scene::Mesh& m = meshes[k];
           for (int v : tri[t]) {
             m.indices.push_back(uint32_t(m.positions.size()));
             m.positions.push_back(corner[v]);
-            m.uvs.push_back({0.5f, 0.5f});
-            m.colors.push_back(textured ? Vec4{1, 1, 1, 1} : colours[(i + j + t) % 2]);
+            m.uvs.push_back(
+                {(float(texel % kSide) + 0.5f) / kSide, (float(texel / kSide) + 0.5f) / kSide});
+            m.colors.push_back(textured ? Vec4{1, 1, 1, 1} : Vec4{c.r, c.g, c.b, 1});
             m.normals.push_back({0, 0, 1});
           }
         }
@@ -362,18 +377,23 @@ TEST(Shading, TinyTrianglesOfTwoMaterialsKeepTheirOwnTexture) {
     }
     return s;
   };
-  const Image expected = render(build(false), 160, 120);
-  const Image img = render(build(true), 160, 120);
-  int red = 0, green = 0, differing = 0;
-  for (size_t i = 0; i < img.rgb.size(); i += 3) {
-    red += img.rgb[i] > 128;
-    green += img.rgb[i + 1] > 128;
-    differing += (img.rgb[i] > 128) != (expected.rgb[i] > 128) ||
-                 (img.rgb[i + 1] > 128) != (expected.rgb[i + 1] > 128);
+  const scene::Scene plain = build(false), textured = build(true);
+  int targets = 0;
+  for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
+    hwy::SetSupportedTargetsForTest(target);
+    ++targets;
+    const Image expected = render(plain, 160, 120, 2, scene::TextureFilter::nearest);
+    const Image img = render(textured, 160, 120, 2, scene::TextureFilter::nearest);
+    int differing = 0, lit = 0;
+    for (size_t i = 0; i < img.rgb.size(); ++i) {
+      differing += std::abs(int(img.rgb[i]) - int(expected.rgb[i])) > 1;
+      lit += img.rgb[i] > 0;
+    }
+    EXPECT_EQ(differing, 0) << hwy::TargetName(target);
+    EXPECT_GT(lit, int(img.rgb.size()) * 3 / 4) << hwy::TargetName(target);
   }
-  EXPECT_EQ(differing, 0);
-  EXPECT_GT(red, 160 * 120 / 3);
-  EXPECT_GT(green, 160 * 120 / 3);
+  hwy::SetSupportedTargetsForTest(0);
+  EXPECT_GE(targets, 1);
 }
 
 TEST(Shading, AntiAliasedTexturingAgreesWithPointSamplingInsideSurfaces) {
