@@ -782,9 +782,9 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
   int queued = 0;
   Mixer mix;
 
-  // Writes lanes [0, count) of 16-bit colour c16 to their pixels.
   // (Highway's Iota builds its vector in memory, lane by lane: made once, not per block.)
   const auto laneIndex = hn::Iota(di, 0);
+  // Writes lanes [0, count) of 16-bit colour c16 to their pixels.
   auto store = [&](const int32_t* pixel, int count, const uint16_t(*c16)[kBlockPixels]) {
     // 16 lanes that are one block's pixels in order, whether one triangle's or several's: three
     // vector stores.
