@@ -165,10 +165,10 @@ void TextureCoordinates(const MaterialShading& m, const Fragments& f, TexCoords&
     const bool trilinear =
         m.filter == texture::Filter::trilinear || m.filter == texture::Filter::trilinearThreePoint;
     const int k = m.levelZero ? 0 : (e + (trilinear ? 0 : 1)) >> 1;
-    texture::prefetchBox(
-        *m.texture, k, trilinear && !m.levelZero, hn::GetLane(hn::MinOfLanes(df, xMin)),
-        hn::GetLane(hn::MaxOfLanes(df, xMax)), hn::GetLane(hn::MinOfLanes(df, yMin)),
-        hn::GetLane(hn::MaxOfLanes(df, yMax)));
+    texture::HWY_NAMESPACE::BlockSampler(*m.texture)
+        .prefetch(k, trilinear && !m.levelZero, hn::GetLane(hn::MinOfLanes(df, xMin)),
+                  hn::GetLane(hn::MaxOfLanes(df, xMax)), hn::GetLane(hn::MinOfLanes(df, yMin)),
+                  hn::GetLane(hn::MaxOfLanes(df, yMax)));
   }
 }
 

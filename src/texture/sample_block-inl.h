@@ -16,6 +16,11 @@
 #define SV_TEXTURE_SAMPLE_BLOCK_INL_H_
 #endif
 
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+
 #include "hwy/highway.h"
 #include "texture/texture.h"
 
@@ -194,6 +199,33 @@ class BlockSampler {
     return mix(mix(r3, t, r2, t1f), g, mix(r4, t, r1, t1f), hn::Sub(onef, g));
   }
 
+  // Requests the cache lines of level k (clamped to the pyramid) under the box [xMin, xMax] ×
+  // [yMin, yMax] (level-0 texels; at most 32 × 32 texels of level k), so that a sampler reading
+  // points inside the box there finds them arrived. For points close together — a block of
+  // pixels — that is a few lines per row. With `coarser` (the trilinear filters) also level
+  // k + 1's rows under the box, one line each — the line under the box's centre: that level's box
+  // is half as wide and mostly within a line, and every line of it cost more to request than it
+  // hid (docs/performance.md). Coordinates past kMaxTexelCoordinate request nothing.
+  void prefetch(int k, bool coarser, float xMin, float xMax, float yMin, float yMax) const {
+    // Also false for NaN.
+    if (!(xMin <= xMax && yMin <= yMax && std::fabs(xMin) <= kMaxTexelCoordinate &&
+          std::fabs(xMax) <= kMaxTexelCoordinate && std::fabs(yMin) <= kMaxTexelCoordinate &&
+          std::fabs(yMax) <= kMaxTexelCoordinate))
+      return;
+    const int last = t_.levelCount() - 1;
+    k = std::clamp(k, 0, last);
+    // 2^-k exactly (k < kMaxLevels).
+    const float scale = std::bit_cast<float>(uint32_t(127 - k) << 23);
+    // The cells' corners run from ⌊min⌋ to ⌊max⌋ + 1.
+    const int x0 = int(std::floor(xMin * scale)), y0 = int(std::floor(yMin * scale));
+    requestRows(k, y0, std::min(int(std::floor(yMax * scale)) + 1, y0 + 31), x0,
+                std::min(int(std::floor(xMax * scale)) + 1, x0 + 31));
+    if (!coarser || k == last) return;
+    const float half = 0.5f * scale;
+    const int xc = int(std::floor(0.5f * (xMin + xMax) * half)), yc = int(std::floor(yMin * half));
+    requestRows(k + 1, yc, std::min(int(std::floor(yMax * half)) + 1, yc + 31), xc, xc);
+  }
+
   Lanes4 sample(Filter filter, VF lod, VF x0, VF y0) const {
     const DF df;
     const DI di;
@@ -224,6 +256,45 @@ class BlockSampler {
   }
 
  private:
+  // A prefetch the compiler keeps: GCC counts __builtin_prefetch as having no side effect and
+  // deletes a loop that does nothing else; the empty asm statement that takes the address is a use
+  // it must keep.
+  static void request(const void* p) {
+    __builtin_prefetch(p, 0, 3);
+    asm volatile("" : : "r"(p));
+  }
+
+  // Requests, in rows y0…y1 of level k (before wrapping), the lines of columns x0 and x1 (x0 ≤
+  // x1 ≤ x0 + 31), and of column x0 + 16 when they lie further apart than a line. The rows' starts
+  // are computed in lanes, and each row's two lines requested even when they are one: the scalar
+  // loop this replaced, with a wrap and a test per row, cost more than the requests
+  // (docs/performance.md).
+  void requestRows(int k, int y0, int y1, int x0, int x1) const {
+    const DI di;
+    const int n = int(hn::Lanes(di));
+    const VI width = hn::Set(di, table_.width[k]);
+    auto column = [&](int x) { return hn::GetLane(wrap(hn::Set(di, x), width, t_.wrapX())); };
+    const int32_t* a = words_ + column(x0);
+    const int32_t* b = words_ + column(x1);
+    const bool wide = x1 - x0 > 16;
+    const int32_t* m = words_ + (wide ? column(x0 + 16) : 0);
+    const VI stride = hn::Add(width, hn::Set(di, 1)), height = hn::Set(di, table_.height[k]);
+    const VI offset = hn::Set(di, table_.offset[k]);
+    alignas(64) static constexpr int32_t kLane[16] = {0, 1, 2,  3,  4,  5,  6,  7,
+                                                      8, 9, 10, 11, 12, 13, 14, 15};
+    alignas(64) int32_t start[16];
+    for (int y = y0; y <= y1; y += n) {
+      const VI row = wrap(hn::Add(hn::Set(di, y), hn::Load(di, kLane)), height, t_.wrapY());
+      hn::Store(hn::Add(offset, hn::Mul(row, stride)), di, start);
+      const int count = std::min(n, y1 - y + 1);
+      for (int i = 0; i < count; ++i) {
+        request(a + start[i]);
+        request(b + start[i]);
+        if (wide) request(m + start[i]);
+      }
+    }
+  }
+
   const Texture& t_;
   const Texture::LevelTable& table_;
   const bool pow2_;

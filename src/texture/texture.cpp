@@ -218,61 +218,6 @@ Color4 Texture::trilinearThreePoint(float lod, float x0, float y0) const {
                      [&](int k, float x, float y) { return threePoint(k, x, y); });
 }
 
-namespace {
-
-// A prefetch the compiler keeps: GCC counts __builtin_prefetch as no side effect and deletes a
-// loop that does nothing else (with -fno-math-errno even one calling floor); the empty asm
-// statement that takes the address is a use it must keep.
-inline void prefetch(const void* p) {
-  __builtin_prefetch(p, 0, 3);
-  asm volatile("" : : "r"(p));
-}
-
-}  // namespace
-
-void prefetchBox(const Texture& t, int k, bool coarser, float xMin, float xMax, float yMin,
-                 float yMax) {
-  // Also false for NaN.
-  if (!(xMin <= xMax && yMin <= yMax && std::fabs(xMin) <= kMaxTexelCoordinate &&
-        std::fabs(xMax) <= kMaxTexelCoordinate && std::fabs(yMin) <= kMaxTexelCoordinate &&
-        std::fabs(yMax) <= kMaxTexelCoordinate))
-    return;
-  k = std::clamp(k, 0, t.levelCount() - 1);
-  const Texture::LevelTable& table = t.levelTable();
-  const bool pow2 = t.powerOfTwo();
-  auto wrap = [pow2](int i, int n, Wrap mode) {
-    return pow2 && mode == Wrap::repeat ? i & (n - 1) : wrapIndex(i, n, mode);
-  };
-  const float scale = std::ldexp(1.0f, -k);
-  const int w = table.width[k], h = table.height[k];
-  const size_t stride = size_t(w) + 1;
-  const PackedTexel* base = t.texels() + table.offset[k];
-  // The cells' corners run from ⌊min⌋ to ⌊max⌋ + 1; a line holds 16 texels.
-  const int x0i = int(std::floor(xMin * scale)),
-            x1i = std::min(int(std::floor(xMax * scale)) + 1, x0i + 31);
-  const int y0i = int(std::floor(yMin * scale)),
-            y1i = std::min(int(std::floor(yMax * scale)) + 1, y0i + 31);
-  const int xa = wrap(x0i, w, t.wrapX()), xb = wrap(x1i, w, t.wrapX());
-  for (int y = y0i; y <= y1i; ++y) {
-    const PackedTexel* row = base + size_t(wrap(y, h, t.wrapY())) * stride;
-    prefetch(row + xa);
-    for (int x = x0i + 16; x < x1i; x += 16) prefetch(row + wrap(x, w, t.wrapX()));
-    // The row's last texel, unless it shares the first one's line.
-    if ((reinterpret_cast<uintptr_t>(row + xa) ^ reinterpret_cast<uintptr_t>(row + xb)) >= 64)
-      prefetch(row + xb);
-  }
-  if (!coarser || k + 1 >= t.levelCount()) return;
-  // Level k + 1: one line a row, under the box's centre.
-  const float half = 0.5f * scale;
-  const int w1 = table.width[k + 1], h1 = table.height[k + 1];
-  const PackedTexel* base1 = t.texels() + table.offset[k + 1];
-  const int xc = wrap(int(std::floor(0.5f * (xMin + xMax) * half)), w1, t.wrapX());
-  const int y0c = int(std::floor(yMin * half)),
-            y1c = std::min(int(std::floor(yMax * half)) + 1, y0c + 31);
-  for (int y = y0c; y <= y1c; ++y)
-    prefetch(base1 + size_t(wrap(y, h1, t.wrapY())) * (size_t(w1) + 1) + xc);
-}
-
 int anisotropicProbes(const Footprint& f, float x0, float y0, float& lod, float* x, float* y) {
   const double major = std::max(f.major, 1e-9), minor = std::max(f.minor, 1e-9);
   const int n = int(std::clamp(std::ceil(major / minor), 1.0, double(Texture::kMaxProbes)));

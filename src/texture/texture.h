@@ -162,16 +162,6 @@ Level nextLevel(const Level& level, Wrap wrapX, Wrap wrapY);
 void sampleBlock(const Texture& texture, Filter filter, const float* lod, const float* x0,
                  const float* y0, int count, float out[4][16]);
 
-// Requests the cache lines of level k (clamped to the pyramid) under the box [xMin, xMax] ×
-// [yMin, yMax] (level-0 texels; at most 32 × 32 texels of level k), so that a sampler reading
-// points inside the box there finds them arrived. For points close together — a block of pixels —
-// that is a few lines per row. With `coarser` (the trilinear filters) also level k + 1's rows
-// under the box, one line each — the line under the box's centre: that level's box is half as
-// wide and mostly within a line, and every line of it cost more to request than it hid
-// (docs/performance.md). Coordinates past kMaxTexelCoordinate request nothing.
-void prefetchBox(const Texture& texture, int k, bool coarser, float xMin, float xMax, float yMin,
-                 float yMax);
-
 // The probes of Texture::anisotropic for `footprint` at (x0, y0): returns their number n
 // (1…Texture::kMaxProbes) and writes their level of detail and level-0 positions x[0…n), y[0…n).
 int anisotropicProbes(const Footprint& footprint, float x0, float y0, float& lod, float* x,
