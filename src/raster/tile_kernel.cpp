@@ -780,7 +780,12 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
   Batch slots[kSlots];
   Queued queue[kQueue];
   int queued = 0;
-  Mixer mix;
+  // (Zeroed: the vector mixer below reads its arrays whole, waiting lanes or not.)
+  Mixer mix{};
+  // Where a vector holds a whole batch, the mixer joins batches by turning lanes in registers;
+  // through memory, lanes written at an offset and read back whole wait for those stores to retire
+  // (store-to-load forwarding fails). Narrower vectors append through memory.
+  constexpr bool kRotate = hn::MaxLanes(df) == size_t(kBlockPixels);
 
   // (Highway's Iota builds its vector in memory, lane by lane: made once, not per block.)
   const auto laneIndex = hn::Iota(di, 0);
@@ -936,23 +941,58 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
       if (mix.count && mix.material != material) shipMix();
       mix.material = material;
       const unsigned used = shade::attributesUsed(*material, *ctx.environment);
-      auto append = [&](const float* from, float* to) {
+      if constexpr (kRotate) {
+        // The batch turned by the mixer's count: its first lanes land after those waiting, and
+        // the lanes that do not fit are then already at the start, where they wait in turn.
+        const bool full = mix.count + b.count >= kBlockPixels;
+        Queued& q = queue[queued];
+        const auto keep = hn::FirstN(di, size_t(mix.count));
+        const auto turn =
+            hn::And(hn::Sub(laneIndex, hn::Set(di, mix.count)), hn::Set(di, kBlockPixels - 1));
+        auto join = [&](auto d, const auto* from, auto* held, auto* to) {
+          const auto r = hn::TableLookupLanes(hn::Load(d, from), hn::IndicesFromVec(d, turn));
+          const auto c = hn::IfThenElse(hn::RebindMask(d, keep), hn::Load(d, held), r);
+          if (full) hn::Store(c, d, to);
+          hn::Store(full ? r : c, d, held);
+        };
+        join(df, f.q, mix.q, q.fragments.q);
+        for (int ch = 0; ch < kColorChannels; ++ch)
+          join(df, f.color[ch], mix.color[ch], q.fragments.color[ch]);
+        for (int k = 0; k < shade::kAttributeCount; ++k)
+          if (used & (1u << k))
+            join(df, f.attribute[k], mix.attribute[k], q.fragments.attribute[k]);
+        if (material->texture) {
+          join(df, tc.lod, mix.lod, q.coordinates.lod);
+          join(df, tc.x0, mix.x0, q.coordinates.x0);
+          join(df, tc.y0, mix.y0, q.coordinates.y0);
+        }
+        join(di, b.pixel, mix.pixel, q.pixel);
+        if (full) {
+          q.fragments.count = kBlockPixels;
+          mix.count += b.count - kBlockPixels;
+          enqueue(material, kBlockPixels);
+        } else {
+          mix.count += b.count;
+        }
+      } else {
+        auto append = [&](const float* from, float* to) {
+          for (size_t i = 0; i < size_t(kBlockPixels); i += n)
+            hn::StoreU(hn::Load(df, from + i), df, to + mix.count + i);
+        };
+        append(f.q, mix.q);
+        for (int ch = 0; ch < kColorChannels; ++ch) append(f.color[ch], mix.color[ch]);
+        for (int k = 0; k < shade::kAttributeCount; ++k)
+          if (used & (1u << k)) append(f.attribute[k], mix.attribute[k]);
+        if (material->texture) {
+          append(tc.lod, mix.lod);
+          append(tc.x0, mix.x0);
+          append(tc.y0, mix.y0);
+        }
         for (size_t i = 0; i < size_t(kBlockPixels); i += n)
-          hn::StoreU(hn::Load(df, from + i), df, to + mix.count + i);
-      };
-      append(f.q, mix.q);
-      for (int ch = 0; ch < kColorChannels; ++ch) append(f.color[ch], mix.color[ch]);
-      for (int k = 0; k < shade::kAttributeCount; ++k)
-        if (used & (1u << k)) append(f.attribute[k], mix.attribute[k]);
-      if (material->texture) {
-        append(tc.lod, mix.lod);
-        append(tc.x0, mix.x0);
-        append(tc.y0, mix.y0);
+          hn::StoreU(hn::Load(di, b.pixel + i), di, mix.pixel + mix.count + i);
+        mix.count += b.count;
+        if (mix.count >= kBlockPixels) shipMix();
       }
-      for (size_t i = 0; i < size_t(kBlockPixels); i += n)
-        hn::StoreU(hn::Load(di, b.pixel + i), di, mix.pixel + mix.count + i);
-      mix.count += b.count;
-      if (mix.count >= kBlockPixels) shipMix();
     }
     b.id = kNoTriangle;
     b.count = 0;
