@@ -182,6 +182,7 @@ void ShadeFragments(const MaterialShading& m, const Environment& env, const Frag
   TexCoords computed;
   if (m.texture && !given) TextureCoordinates(m, f, computed, false);
   const TexCoords& tc = given ? *given : computed;
+  const bool opaqueTexture = m.texture && m.texture->opaque();
   if (m.texture && m.anisotropic) {
     // The elliptical footprint per pixel (footprint.h), probes along its major axis.
     const float width = float(m.texture->level(0).width);
@@ -213,12 +214,19 @@ void ShadeFragments(const MaterialShading& m, const Environment& env, const Frag
               : texture::HWY_NAMESPACE::BlockSampler(*m.texture)
                     .sample(m.filter, hn::Load(df, tc.lod + i), hn::Load(df, tc.x0 + i),
                             hn::Load(df, tc.y0 + i));
-      // Texels are premultiplied; the surface colour is the straight one (0 where alpha is 0).
-      const VF inv = hn::IfThenElseZero(hn::Gt(t.a, zero), hn::Div(one, t.a));
-      c.x = hn::Mul(c.x, hn::Mul(t.r, inv));
-      c.y = hn::Mul(c.y, hn::Mul(t.g, inv));
-      c.z = hn::Mul(c.z, hn::Mul(t.b, inv));
-      alpha = hn::Mul(alpha, t.a);
+      if (opaqueTexture) {
+        // Alpha exactly 1 (Texture::opaque): nothing to divide or multiply by.
+        c.x = hn::Mul(c.x, t.r);
+        c.y = hn::Mul(c.y, t.g);
+        c.z = hn::Mul(c.z, t.b);
+      } else {
+        // Texels are premultiplied; the surface colour is the straight one (0 where alpha is 0).
+        const VF inv = hn::IfThenElseZero(hn::Gt(t.a, zero), hn::Div(one, t.a));
+        c.x = hn::Mul(c.x, hn::Mul(t.r, inv));
+        c.y = hn::Mul(c.y, hn::Mul(t.g, inv));
+        c.z = hn::Mul(c.z, hn::Mul(t.b, inv));
+        alpha = hn::Mul(alpha, t.a);
+      }
     }
     V3 eye{zero, zero, zero};
     if (m.phong || env.fog)

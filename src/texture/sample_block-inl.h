@@ -49,6 +49,7 @@ class BlockSampler {
       : t_(t),
         table_(t.levelTable()),
         pow2_(t.powerOfTwo()),
+        opaque_(t.opaque()),
         pairs_(reinterpret_cast<const int64_t*>(t.texels())),
         words_(reinterpret_cast<const int32_t*>(t.texels())) {}
 
@@ -86,7 +87,9 @@ class BlockSampler {
     return hn::IfThenElse(hn::Lt(m, n), m, hn::Sub(hn::Sub(period, one), m));
   }
 
-  // Packed texels as floats 0…1: texture.cpp's unpackTexel, the same two steps per channel.
+  // Packed texels as floats 0…1: texture.cpp's unpackTexel, the same two steps per channel; alpha
+  // 1 without reading it for an opaque texture (kOpaque, Texture::opaque).
+  template <bool kOpaque>
   static Lanes4 unpack(VI t) {
     const DI di;
     const DF df;
@@ -97,9 +100,11 @@ class BlockSampler {
       c = hn::And(c, byte);
       return hn::Mul(hn::ConvertTo(df, hn::Mul(c, c)), colourScale);
     };
-    const VI alpha = hn::BitCast(di, hn::ShiftRight<24>(hn::BitCast(du, t)));
-    return {colour(t), colour(hn::ShiftRight<8>(t)), colour(hn::ShiftRight<16>(t)),
-            hn::Mul(hn::ConvertTo(df, alpha), hn::Set(df, 1.0f / 255.0f))};
+    VF a = hn::Set(df, 1.0f);
+    if constexpr (!kOpaque)
+      a = hn::Mul(hn::ConvertTo(df, hn::BitCast(di, hn::ShiftRight<24>(hn::BitCast(du, t)))),
+                  hn::Set(df, 1.0f / 255.0f));
+    return {colour(t), colour(hn::ShiftRight<8>(t)), colour(hn::ShiftRight<16>(t)), a};
   }
 
   // The texel at `index` (into Texture::texels()) of every lane.
@@ -125,15 +130,21 @@ class BlockSampler {
 #endif
   }
 
+  // Blends; for an opaque texture alpha stays a's (1), unblended.
+  template <bool kOpaque>
   static Lanes4 mix(const Lanes4& a, VF wa, const Lanes4& b, VF wb) {
-    return {hn::Add(hn::Mul(a.r, wa), hn::Mul(b.r, wb)), hn::Add(hn::Mul(a.g, wa), hn::Mul(b.g, wb)),
-            hn::Add(hn::Mul(a.b, wa), hn::Mul(b.b, wb)), hn::Add(hn::Mul(a.a, wa), hn::Mul(b.a, wb))};
+    return {hn::Add(hn::Mul(a.r, wa), hn::Mul(b.r, wb)),
+            hn::Add(hn::Mul(a.g, wa), hn::Mul(b.g, wb)),
+            hn::Add(hn::Mul(a.b, wa), hn::Mul(b.b, wb)),
+            kOpaque ? a.a : hn::Add(hn::Mul(a.a, wa), hn::Mul(b.a, wb))};
   }
+  template <bool kOpaque>
   static Lanes4 mix3(const Lanes4& a, VF wa, const Lanes4& b, VF wb, const Lanes4& c, VF wc) {
     auto one = [&](VF x, VF y, VF z) {
       return hn::Add(hn::Add(hn::Mul(x, wa), hn::Mul(y, wb)), hn::Mul(z, wc));
     };
-    return {one(a.r, b.r, c.r), one(a.g, b.g, c.g), one(a.b, b.b, c.b), one(a.a, b.a, c.a)};
+    return {one(a.r, b.r, c.r), one(a.g, b.g, c.g), one(a.b, b.b, c.b),
+            kOpaque ? a.a : one(a.a, b.a, c.a)};
   }
   static Lanes4 select(hn::Mask<DF> m, const Lanes4& a, const Lanes4& b) {  // m ? a : b
     return {hn::IfThenElse(m, a.r, b.r), hn::IfThenElse(m, a.g, b.g), hn::IfThenElse(m, a.b, b.b),
@@ -147,6 +158,7 @@ class BlockSampler {
 
   // One level per lane (k), at that level's coordinates (x, y). Each coordinate is wrapped once
   // and each row's start computed once, whatever the number of texels read.
+  template <bool kOpaque>
   Lanes4 sampleLevel(Filter filter, VI k, VF x, VF y) const {
     const DF df;
     const DI di;
@@ -159,7 +171,7 @@ class BlockSampler {
     auto row = [&](VI yi) { return hn::Add(l.offset, hn::Mul(wrap(yi, l.height, wy), stride)); };
     if (filter == Filter::nearest) {
       const VF half = hn::Set(df, 0.5f);
-      return unpack(
+      return unpack<kOpaque>(
           fetch(hn::Add(row(hn::ConvertTo(di, hn::Floor(hn::Add(y, half)))),
                         wrap(hn::ConvertTo(di, hn::Floor(hn::Add(x, half))), l.width, wx))));
     }
@@ -184,19 +196,20 @@ class BlockSampler {
       t4 = fetch(hn::Add(row1, x0));
     }
     const VF g = hn::Sub(x, fx), t = hn::Sub(y, fy), onef = hn::Set(df, 1.0f);
-    const Lanes4 r1 = unpack(t1), r3 = unpack(t3);
+    const Lanes4 r1 = unpack<kOpaque>(t1), r3 = unpack<kOpaque>(t3);
     if (filter == Filter::threePoint || filter == Filter::trilinearThreePoint) {
       // Three texels per lane, as the seed intends: R4 above the diagonal, R2 below it. The
       // weights are texture.cpp's for the lane's triangle.
       const auto upper = hn::Ge(t, g);
-      const Lanes4 r24 = unpack(hn::IfThenElse(hn::RebindMask(di, upper), t4, t2));
-      return mix3(r3, hn::IfThenElse(upper, g, t), r24,
-                  hn::IfThenElse(upper, hn::Sub(t, g), hn::Sub(g, t)), r1,
-                  hn::IfThenElse(upper, hn::Sub(onef, t), hn::Sub(onef, g)));
+      const Lanes4 r24 = unpack<kOpaque>(hn::IfThenElse(hn::RebindMask(di, upper), t4, t2));
+      return mix3<kOpaque>(r3, hn::IfThenElse(upper, g, t), r24,
+                           hn::IfThenElse(upper, hn::Sub(t, g), hn::Sub(g, t)), r1,
+                           hn::IfThenElse(upper, hn::Sub(onef, t), hn::Sub(onef, g)));
     }
-    const Lanes4 r2 = unpack(t2), r4 = unpack(t4);
+    const Lanes4 r2 = unpack<kOpaque>(t2), r4 = unpack<kOpaque>(t4);
     const VF t1f = hn::Sub(onef, t);
-    return mix(mix(r3, t, r2, t1f), g, mix(r4, t, r1, t1f), hn::Sub(onef, g));
+    return mix<kOpaque>(mix<kOpaque>(r3, t, r2, t1f), g, mix<kOpaque>(r4, t, r1, t1f),
+                        hn::Sub(onef, g));
   }
 
   // Requests the cache lines of level k (clamped to the pyramid) under the box [xMin, xMax] ×
@@ -226,7 +239,15 @@ class BlockSampler {
     requestRows(k + 1, yc, std::min(int(std::floor(yMax * half)) + 1, yc + 31), xc, xc);
   }
 
+  // Texture::sample's values (by `filter`, at level of detail lod and level-0 coordinates x0, y0),
+  // bit for bit, in every lane.
   Lanes4 sample(Filter filter, VF lod, VF x0, VF y0) const {
+    return opaque_ ? sampleAs<true>(filter, lod, x0, y0) : sampleAs<false>(filter, lod, x0, y0);
+  }
+
+ private:
+  template <bool kOpaque>
+  Lanes4 sampleAs(Filter filter, VF lod, VF x0, VF y0) const {
     const DF df;
     const DI di;
     const int last = t_.levelCount() - 1;
@@ -242,7 +263,7 @@ class BlockSampler {
     // 2^-k exactly: the float with exponent 127 − k.
     const VF scale = hn::BitCast(df, hn::ShiftLeft<23>(hn::Sub(hn::Set(di, 127), k)));
     const VF x = hn::Mul(x0, scale), y = hn::Mul(y0, scale);
-    const Lanes4 a = sampleLevel(filter, k, x, y);
+    const Lanes4 a = sampleLevel<kOpaque>(filter, k, x, y);
     if (!trilinear) return a;
     const VF t = hn::Sub(lod, hn::ConvertTo(df, k));
     const auto single =
@@ -251,11 +272,10 @@ class BlockSampler {
     if (hn::AllTrue(df, single)) return a;
     const VI k1 = hn::Min(hn::Add(k, hn::Set(di, 1)), hn::Set(di, last));
     const VF half = hn::Set(df, 0.5f);
-    const Lanes4 b = sampleLevel(filter, k1, hn::Mul(x, half), hn::Mul(y, half));
-    return select(single, a, mix(a, hn::Sub(hn::Set(df, 1.0f), t), b, t));
+    const Lanes4 b = sampleLevel<kOpaque>(filter, k1, hn::Mul(x, half), hn::Mul(y, half));
+    return select(single, a, mix<kOpaque>(a, hn::Sub(hn::Set(df, 1.0f), t), b, t));
   }
 
- private:
   // A prefetch the compiler keeps: GCC counts __builtin_prefetch as having no side effect and
   // deletes a loop that does nothing else; the empty asm statement that takes the address is a use
   // it must keep.
@@ -298,6 +318,7 @@ class BlockSampler {
   const Texture& t_;
   const Texture::LevelTable& table_;
   const bool pow2_;
+  const bool opaque_;
   const int64_t* pairs_;
   const int32_t* words_;
 };

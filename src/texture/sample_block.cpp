@@ -80,6 +80,8 @@ void anisotropicBlock(const Texture& texture, const Footprint* footprints, const
   if (filled) flush();
   for (int ch = 0; ch < 4; ++ch)
     for (int i = 0; i < 16; ++i) out[ch][i] = i < count ? sum[ch][i] * weight[i] : 0.0f;
+  // As Texture::anisotropic: an opaque texture's alpha is exactly 1.
+  if (texture.opaque()) std::fill_n(out[3], count, 1.0f);
 }
 }  // namespace sv::texture
 #endif

@@ -113,6 +113,8 @@ Texture::Texture(Level base, Wrap wrapX, Wrap wrapY) : wrapX_(wrapX), wrapY_(wra
   }
   auto pow2 = [](int n) { return (n & (n - 1)) == 0; };
   powerOfTwo_ = pow2(info_[0].width) && pow2(info_[0].height);
+  opaque_ =
+      std::all_of(texels_.begin(), texels_.end(), [](PackedTexel p) { return p >> 24 == 255; });
 }
 
 LevelView Texture::level(int k) const {
@@ -138,7 +140,7 @@ float saneCoordinate(float x) { return std::fabs(x) <= kMaxTexelCoordinate ? x :
 Color4 Texture::nearest(int k, float x, float y) const {
   x = saneCoordinate(x);
   y = saneCoordinate(y);
-  return texel(k, int(std::floor(x + 0.5f)), int(std::floor(y + 0.5f)));
+  return opaqueAlpha(texel(k, int(std::floor(x + 0.5f)), int(std::floor(y + 0.5f))));
 }
 
 namespace {
@@ -164,7 +166,7 @@ Color4 Texture::bilinear(int k, float x, float y) const {
   const auto [x0, y0, g, t] = cellAt(x, y);
   const Color4 r1 = texel(k, x0, y0), r2 = texel(k, x0 + 1, y0);
   const Color4 r3 = texel(k, x0 + 1, y0 + 1), r4 = texel(k, x0, y0 + 1);
-  return mix(mix(r3, t, r2, 1 - t), g, mix(r4, t, r1, 1 - t), 1 - g);
+  return opaqueAlpha(mix(mix(r3, t, r2, 1 - t), g, mix(r4, t, r1, 1 - t), 1 - g));
 }
 
 Color4 Texture::threePoint(int k, float x, float y) const {
@@ -172,8 +174,8 @@ Color4 Texture::threePoint(int k, float x, float y) const {
   //   Θ ≥ γ: R = γ·R3 + (Θ − γ)·R4 + (1 − Θ)·R1;   Θ < γ: R = Θ·R3 + (γ − Θ)·R2 + (1 − γ)·R1.
   const auto [x0, y0, g, t] = cellAt(x, y);
   const Color4 r1 = texel(k, x0, y0), r3 = texel(k, x0 + 1, y0 + 1);
-  if (t >= g) return mix3(r3, g, texel(k, x0, y0 + 1), t - g, r1, 1 - t);
-  return mix3(r3, t, texel(k, x0 + 1, y0), g - t, r1, 1 - g);
+  if (t >= g) return opaqueAlpha(mix3(r3, g, texel(k, x0, y0 + 1), t - g, r1, 1 - t));
+  return opaqueAlpha(mix3(r3, t, texel(k, x0 + 1, y0), g - t, r1, 1 - g));
 }
 
 namespace {
@@ -210,12 +212,13 @@ Color4 Texture::sample(Filter filter, float lod, float x0, float y0) const {
 }
 
 Color4 Texture::trilinear(float lod, float x0, float y0) const {
-  return blendLevels(*this, lod, x0, y0, [&](int k, float x, float y) { return bilinear(k, x, y); });
+  return opaqueAlpha(
+      blendLevels(*this, lod, x0, y0, [&](int k, float x, float y) { return bilinear(k, x, y); }));
 }
 
 Color4 Texture::trilinearThreePoint(float lod, float x0, float y0) const {
-  return blendLevels(*this, lod, x0, y0,
-                     [&](int k, float x, float y) { return threePoint(k, x, y); });
+  return opaqueAlpha(blendLevels(*this, lod, x0, y0,
+                                 [&](int k, float x, float y) { return threePoint(k, x, y); }));
 }
 
 int anisotropicProbes(const Footprint& f, float x0, float y0, float& lod, float* x, float* y) {
@@ -236,7 +239,7 @@ Color4 Texture::anisotropic(const Footprint& f, float x0, float y0) const {
   Color4 sum;
   for (int i = 0; i < n; ++i) sum = mix(sum, 1.0f, trilinear(lod, x[i], y[i]), 1.0f);
   const float w = 1.0f / float(n);
-  return {sum.r * w, sum.g * w, sum.b * w, sum.a * w};
+  return opaqueAlpha({sum.r * w, sum.g * w, sum.b * w, sum.a * w});
 }
 
 namespace {

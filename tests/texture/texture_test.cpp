@@ -16,7 +16,8 @@
 namespace sv::texture {
 namespace {
 
-Level randomLevel(int w, int h, unsigned seed) {
+// Random texels; with `opaque`, alpha 1 everywhere (Texture::opaque).
+Level randomLevel(int w, int h, unsigned seed, bool opaque = false) {
   std::mt19937 rng(seed);
   Level l;
   l.width = w;
@@ -24,7 +25,7 @@ Level randomLevel(int w, int h, unsigned seed) {
   l.texels.resize(size_t(w) * size_t(h));
   for (Texel& t : l.texels)
     t = {uint16_t(rng() & 0xFFFF), uint16_t(rng() & 0xFFFF), uint16_t(rng() & 0xFFFF),
-         uint16_t(rng() & 0xFFFF)};
+         uint16_t(opaque ? 0xFFFF : rng() & 0xFFFF)};
   return l;
 }
 
@@ -218,50 +219,53 @@ TEST(Samplers, SimdBlockEqualsScalarOnEveryTarget) {
   int targets = 0;
   for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
     hwy::SetSupportedTargetsForTest(target);
-    // Odd sizes, and powers of two (whose wrapping is a mask).
+    // Odd sizes, and powers of two (whose wrapping is a mask); translucent and opaque texels.
     for (const auto& [w, h] : {std::pair{37, 20}, std::pair{64, 16}})
-    for (Wrap wrap : {Wrap::repeat, Wrap::clamp, Wrap::mirror}) {
-      const Texture tex(randomLevel(w, h, 5), wrap, Wrap(2 - int(wrap)));
-      for (Filter f : filters)
-        for (int round = 0; round < 40; ++round) {
-          float lod[16], x[16], y[16], out[4][16];
-          for (int i = 0; i < 16; ++i) {
-            lod[i] = u(rng) * 8 - 1;
-            x[i] = u(rng) * 200 - 80;
-            y[i] = u(rng) * 120 - 50;
-          }
-          if (round % 3 == 1) {
-            // A cluster of points, as a block of pixels gives: inside the image the sampler reads
-            // each row's two texels as one pair, and at the right edge the row's border copy.
-            const float cx = u(rng) * float(w + 6) - 3, cy = u(rng) * float(h + 6) - 3;
-            const float level = u(rng) * 3;
-            for (int i = 0; i < 16; ++i) {
-              lod[i] = level;
-              x[i] = cx + u(rng) * 3;
-              y[i] = cy + u(rng) * 3;
+      for (Wrap wrap : {Wrap::repeat, Wrap::clamp, Wrap::mirror})
+        for (bool opaque : {false, true}) {
+          const Texture tex(randomLevel(w, h, 5, opaque), wrap, Wrap(2 - int(wrap)));
+          ASSERT_EQ(tex.opaque(), opaque);
+          for (Filter f : filters)
+            for (int round = 0; round < 40; ++round) {
+              float lod[16], x[16], y[16], out[4][16];
+              for (int i = 0; i < 16; ++i) {
+                lod[i] = u(rng) * 8 - 1;
+                x[i] = u(rng) * 200 - 80;
+                y[i] = u(rng) * 120 - 50;
+              }
+              if (round % 3 == 1) {
+                // A cluster of points, as a block of pixels gives: inside the image the sampler
+                // reads each row's two texels as one pair, and at the right edge the row's border
+                // copy.
+                const float cx = u(rng) * float(w + 6) - 3, cy = u(rng) * float(h + 6) - 3;
+                const float level = u(rng) * 3;
+                for (int i = 0; i < 16; ++i) {
+                  lod[i] = level;
+                  x[i] = cx + u(rng) * 3;
+                  y[i] = cy + u(rng) * 3;
+                }
+              }
+              if (round == 0) {
+                lod[0] = std::nanf("");
+                x[1] = std::nanf("");
+                y[2] = 3e9f;
+                x[3] = -1e20f;
+                lod[4] = 100;
+                lod[5] = 2;  // an exact level: no blend
+              }
+              const int count = 1 + round % 16;
+              sampleBlock(tex, f, lod, x, y, count, out);
+              for (int i = 0; i < count; ++i) {
+                const Color4 c = tex.sample(f, lod[i], x[i], y[i]);
+                const float expect[4] = {c.r, c.g, c.b, c.a};
+                for (int ch = 0; ch < 4; ++ch)
+                  ASSERT_EQ(std::memcmp(&out[ch][i], &expect[ch], sizeof(float)), 0)
+                      << hwy::TargetName(target) << " filter " << int(f) << " wrap " << int(wrap)
+                      << " opaque " << opaque << " point " << i << " channel " << ch << ": "
+                      << out[ch][i] << " vs " << expect[ch];
+              }
             }
-          }
-          if (round == 0) {
-            lod[0] = std::nanf("");
-            x[1] = std::nanf("");
-            y[2] = 3e9f;
-            x[3] = -1e20f;
-            lod[4] = 100;
-            lod[5] = 2;  // an exact level: no blend
-          }
-          const int count = 1 + round % 16;
-          sampleBlock(tex, f, lod, x, y, count, out);
-          for (int i = 0; i < count; ++i) {
-            const Color4 c = tex.sample(f, lod[i], x[i], y[i]);
-            const float expect[4] = {c.r, c.g, c.b, c.a};
-            for (int ch = 0; ch < 4; ++ch)
-              ASSERT_EQ(std::memcmp(&out[ch][i], &expect[ch], sizeof(float)), 0)
-                  << hwy::TargetName(target) << " filter " << int(f) << " wrap " << int(wrap)
-                  << " point " << i << " channel " << ch << ": " << out[ch][i] << " vs "
-                  << expect[ch];
-          }
         }
-    }
     ++targets;
   }
   hwy::SetSupportedTargetsForTest(0);
@@ -289,11 +293,13 @@ std::vector<uint8_t> encodePng(int w, int h, uint32_t format, const void* pixels
 TEST(Samplers, AnisotropicBlockEqualsScalarOnEveryTarget) {
   std::mt19937 rng(8);
   std::uniform_real_distribution<float> u(0, 1);
-  const Texture tex(randomLevel(64, 48, 2), Wrap::repeat, Wrap::clamp);
+  const Texture translucent(randomLevel(64, 48, 2), Wrap::repeat, Wrap::clamp);
+  const Texture opaque(randomLevel(64, 48, 2, true), Wrap::repeat, Wrap::clamp);
   int targets = 0;
   for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
     hwy::SetSupportedTargetsForTest(target);
     for (int round = 0; round < 60; ++round) {
+      const Texture& tex = round % 2 ? opaque : translucent;
       Footprint fp[16];
       float x[16], y[16], out[4][16];
       for (int i = 0; i < 16; ++i) {
@@ -325,6 +331,37 @@ TEST(Samplers, AnisotropicBlockEqualsScalarOnEveryTarget) {
   }
   hwy::SetSupportedTargetsForTest(0);
   EXPECT_GE(targets, 1);
+}
+
+// An opaque texture reads alpha exactly 1 with every filter, without reading alpha: the seed's
+// three-point blend of ones, γ·1 + (Θ − γ)·1 + (1 − Θ)·1, comes out an ulp off 1 at some
+// weights, and shading divides the colour by alpha. One translucent texel anywhere in the pyramid
+// makes the texture translucent.
+TEST(Samplers, OpaqueTextureReadsAlphaExactlyOne) {
+  const Texture tex(randomLevel(16, 16, 4, true), Wrap::repeat, Wrap::repeat);
+  ASSERT_TRUE(tex.opaque());
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<float> u(0, 1);
+  const Filter filters[] = {Filter::nearest, Filter::threePoint, Filter::bilinear,
+                            Filter::trilinearThreePoint, Filter::trilinear};
+  int offOne = 0;
+  for (int i = 0; i < 2000; ++i) {
+    // Small coordinates: their fractions, the blend weights, keep all their bits.
+    const float lod = u(rng) * 4, x = u(rng) * 3, y = u(rng) * 3;
+    for (Filter f : filters) ASSERT_EQ(tex.sample(f, lod, x, y).a, 1.0f) << int(f);
+    Footprint fp;
+    fp.minor = 0.5 + u(rng);
+    fp.major = fp.minor * (1 + 8 * u(rng));
+    fp.axisX = 0.6;
+    fp.axisY = 0.8;
+    ASSERT_EQ(tex.anisotropic(fp, x, y).a, 1.0f);
+    const float a = u(rng), b = u(rng), g = std::min(a, b), t = std::max(a, b);
+    offOne += (1.0f * g + 1.0f * (t - g)) + 1.0f * (1.0f - t) != 1.0f;
+  }
+  EXPECT_GT(offOne, 0) << "no weights show the rounding the rule guards against";
+  Level one = randomLevel(16, 16, 4, true);
+  one.texels[37].a = 65000;
+  EXPECT_FALSE(Texture(std::move(one), Wrap::repeat, Wrap::repeat).opaque());
 }
 
 TEST(TextureImage, PngDecodesToLinearLightWithPremultipliedAlpha) {
