@@ -785,7 +785,7 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
   // Where a vector holds a whole batch, the mixer joins batches by turning lanes in registers;
   // through memory, lanes written at an offset and read back whole wait for those stores to retire
   // (store-to-load forwarding fails). Narrower vectors append through memory.
-  constexpr bool kRotate = hn::MaxLanes(df) == size_t(kBlockPixels);
+  constexpr bool kRotate = !HWY_HAVE_SCALABLE && hn::MaxLanes(df) == size_t(kBlockPixels);
 
   // (Highway's Iota builds its vector in memory, lane by lane: made once, not per block.)
   const auto laneIndex = hn::Iota(di, 0);

@@ -6,7 +6,8 @@
 // detail, so level sizes and offsets are gathered per lane. Texels are 32-bit words (texture.h,
 // PackedTexel); a bilinear cell's two texels in a row are one 64-bit word — rows carry a copy of
 // their wrapped neighbour at column `width` — and are gathered as such, half the gathers of
-// fetching each texel.
+// fetching each texel. The shading stage also requests a block's texel lines here (prefetch) a
+// queue of blocks before it samples them.
 //
 // Per-target include guard (Highway's convention for -inl.h files).
 #if defined(SV_TEXTURE_SAMPLE_BLOCK_INL_H_) == defined(HWY_TARGET_TOGGLE)
@@ -38,7 +39,7 @@ struct Lanes4 {
   VF r, g, b, a;
 };
 
-// Per-lane level geometry, and the texture's wrap modes.
+// Per-lane level geometry.
 struct LevelLanes {
   VI width, height, offset;
 };
@@ -286,8 +287,9 @@ class BlockSampler {
 
   // Requests, in rows y0…y1 of level k (before wrapping), the lines of columns x0 and x1 (x0 ≤
   // x1 ≤ x0 + 31), and of column x0 + 16 when they lie further apart than a line. The rows' starts
-  // are computed in lanes, and each row's two lines requested even when they are one: the scalar
-  // loop this replaced, with a wrap and a test per row, cost more than the requests
+  // are computed in lanes, and each row's two lines requested even when they are one (a test per
+  // row would be guessed wrong half the time) — unless x0 = x1, the same column: the scalar loop
+  // this replaced, with a wrap and a test per row, cost more than the requests
   // (docs/performance.md).
   void requestRows(int k, int y0, int y1, int x0, int x1) const {
     const DI di;
@@ -296,7 +298,7 @@ class BlockSampler {
     auto column = [&](int x) { return hn::GetLane(wrap(hn::Set(di, x), width, t_.wrapX())); };
     const int32_t* a = words_ + column(x0);
     const int32_t* b = words_ + column(x1);
-    const bool wide = x1 - x0 > 16;
+    const bool two = x1 != x0, wide = x1 - x0 > 16;
     const int32_t* m = words_ + (wide ? column(x0 + 16) : 0);
     const VI stride = hn::Add(width, hn::Set(di, 1)), height = hn::Set(di, table_.height[k]);
     const VI offset = hn::Set(di, table_.offset[k]);
@@ -309,7 +311,7 @@ class BlockSampler {
       const int count = std::min(n, y1 - y + 1);
       for (int i = 0; i < count; ++i) {
         request(a + start[i]);
-        request(b + start[i]);
+        if (two) request(b + start[i]);
         if (wide) request(m + start[i]);
       }
     }

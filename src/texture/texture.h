@@ -142,8 +142,9 @@ class Texture {
   // True when level 0's sides are powers of two (then so are every level's, and wrapping is a mask).
   bool powerOfTwo() const { return powerOfTwo_; }
   // True when every texel's alpha code is 255. Every sampler, scalar and SIMD, then returns alpha
-  // exactly 1 without reading or blending it: less work, and the seed's three-point blend of ones
-  // comes out an ulp off 1 at some weights (shading divides the colour by alpha).
+  // exactly 1 — the SIMD sampler without unpacking or blending it, the scalar ones by setting it
+  // after the blend: less work, and the seed's three-point blend of ones comes out an ulp off 1 at
+  // some weights (shading divides the colour by alpha).
   bool opaque() const { return opaque_; }
 
  private:
