@@ -2054,7 +2054,12 @@ namespace sv::raster {
 HWY_EXPORT(RasterizeTile);
 
 void rasterizeTile(const TileWork& work, RasterStats& stats) {
-  HWY_DYNAMIC_DISPATCH(RasterizeTile)(work, stats);
+  // The kernel counts into its own stack's copy: callers keep neighbouring tiles' statistics next
+  // to each other, and two threads counting windows into one cache line slowed whole frames
+  // (false sharing; docs/performance.md).
+  RasterStats local;
+  HWY_DYNAMIC_DISPATCH(RasterizeTile)(work, local);
+  stats.add(local);
 }
 }  // namespace sv::raster
 #endif
