@@ -917,10 +917,16 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
       f->vdy = a.planes[shade::kV].dy;
     }
   };
+  // The triangle of the last whole batch: a run of one triangle's whole blocks requests its
+  // texels with its first block only. The blocks after it read texels next to those already read
+  // (a block's box overlaps its neighbour's by about half); their requests cost more than the
+  // misses they hid (tris 10k × 1000 px textured ×0.954, docs/performance.md).
+  uint32_t requestedWhole = kNoTriangle;
   // Shades (Gouraud) or queues (material) batch b and empties it: a whole batch (or one to be
   // filtered anisotropically, which reads the triangle's gradients) as a queue entry of its own,
   // a partial one through the mixer. Texels are requested (shade::textureCoordinates) as the
-  // batch is evaluated, one bounding box per batch (so a mixed batch's come in several).
+  // batch is evaluated, one bounding box per batch (so a mixed batch's come in several; a whole
+  // batch's only when it starts a run, above).
   auto emit = [&](Batch& b) {
     const shade::MaterialShading* material = ctx.attributes[b.id].material;
     if (!material) {
@@ -930,7 +936,9 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
     } else if (b.count == kBlockPixels || (material->texture && material->anisotropic)) {
       Queued& q = queue[queued];
       evaluate(b, &q.fragments, nullptr);
-      if (material->texture) shade::textureCoordinates(*material, q.fragments, q.coordinates);
+      if (material->texture)
+        shade::textureCoordinates(*material, q.fragments, q.coordinates, b.id != requestedWhole);
+      requestedWhole = b.id;
       std::copy_n(b.pixel, b.count, q.pixel);  // (store reads no further)
       enqueue(material, b.count);
     } else {

@@ -299,8 +299,9 @@ void shadeFragments(const MaterialShading& m, const Environment& env, const Frag
   HWY_DYNAMIC_DISPATCH(ShadeFragments)(m, env, f, nullptr, out);
 }
 
-void textureCoordinates(const MaterialShading& m, const Fragments& f, TexCoords& out) {
-  HWY_DYNAMIC_DISPATCH(TextureCoordinates)(m, f, out, true);
+void textureCoordinates(const MaterialShading& m, const Fragments& f, TexCoords& out,
+                        bool request) {
+  HWY_DYNAMIC_DISPATCH(TextureCoordinates)(m, f, out, request);
 }
 
 void shadeFragments(const MaterialShading& m, const Environment& env, const Fragments& f,

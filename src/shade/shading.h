@@ -87,13 +87,15 @@ void shadeFragments(const MaterialShading& m, const Environment& env, const Frag
 
 // Shading in two steps, so that texture memory is requested well before it is read: first the
 // texture coordinates (level-0 texels) and levels of detail of every fragment, with a prefetch of
-// the texels they will read; later the shading with them. The result is shadeFragments's.
+// the texels they will read (unless `request` is false); later the shading with them. The result
+// is shadeFragments's.
 struct TexCoords {
   alignas(64) float lod[kMaxFragments];
   alignas(64) float x0[kMaxFragments];
   alignas(64) float y0[kMaxFragments];
 };
-void textureCoordinates(const MaterialShading& m, const Fragments& f, TexCoords& out);
+void textureCoordinates(const MaterialShading& m, const Fragments& f, TexCoords& out,
+                        bool request = true);
 void shadeFragments(const MaterialShading& m, const Environment& env, const Fragments& f,
                     const TexCoords& coordinates, float out[4][kMaxFragments]);
 
