@@ -394,7 +394,12 @@ struct Renderer::Impl {
   output::LinearImage linear;  // the box-resolved frame, for the tent filter
   freeform::FreeFormFrame freeForms;
   std::vector<freeform::FreeFormFrame::Scratch> freeFormScratch;  // per worker
-  std::vector<freeform::CastStats> freeFormStats;                 // per worker
+  // Per worker, a cache line each: workers count into theirs while casting, and two workers'
+  // counters in one line would make each write wait for the other core (false sharing).
+  struct alignas(64) WorkerCastStats {
+    freeform::CastStats counts;
+  };
+  std::vector<WorkerCastStats> freeFormStats;
 };
 
 Renderer::Renderer(const RenderOptions& options) : impl_(std::make_unique<Impl>(options)) {}
@@ -593,19 +598,19 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
         &impl_->frame.pool());
     const int threads = impl_->frame.pool().threadCount();
     impl_->freeFormScratch.resize(size_t(threads));
-    impl_->freeFormStats.assign(size_t(threads), freeform::CastStats{});
+    impl_->freeFormStats.assign(size_t(threads), Impl::WorkerCastStats{});
     const int tilesAcross = tilesX;
     fs.afterOpaque = [&, tilesAcross](int tile, int worker, float* depth, uint16_t* color) {
       impl_->freeForms.drawTile(tile % tilesAcross, tile / tilesAcross, depth, color,
                                 impl_->freeFormScratch[size_t(worker)],
-                                impl_->freeFormStats[size_t(worker)]);
+                                impl_->freeFormStats[size_t(worker)].counts);
     };
   }
   output::prepareImage(o.width, o.height, image);
   impl_->frame.render(p, fs, stats);
   if (fs.afterOpaque) {
     freeform::CastStats cast;
-    for (const freeform::CastStats& s : impl_->freeFormStats) cast.add(s);
+    for (const Impl::WorkerCastStats& s : impl_->freeFormStats) cast.add(s.counts);
     stats.freeForms += impl_->freeForms.size();
     stats.freeFormCells += cast.cells;
     stats.freeFormMaskedCells += cast.maskedCells;
