@@ -920,7 +920,7 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
   // The triangle of the last whole batch: a run of one triangle's whole blocks requests its
   // texels with its first block only. The blocks after it read texels next to those already read
   // (a block's box overlaps its neighbour's by about half); their requests cost more than the
-  // misses they hid (tris 10k × 1000 px textured ×0.954, docs/performance.md).
+  // misses they hid (tris 10k × 1000 px textured ×0.946, docs/performance.md).
   uint32_t requestedWhole = kNoTriangle;
   // Shades (Gouraud) or queues (material) batch b and empties it: a whole batch (or one to be
   // filtered anisotropically, which reads the triangle's gradients) as a queue entry of its own,
