@@ -326,7 +326,8 @@ SetupOutcome setupTriangle(const ClipVertex& v0, const ClipVertex& v1, const Cli
 
 void attributePlanes(const ClipVertex& v0, const ClipVertex& v1, const ClipVertex& v2,
                      const Viewport& viewport, const TriangleSetup& setup,
-                     const float* const values[3], int count, Plane* out, unsigned used) {
+                     const float* const values[3], int count, Plane* out, unsigned used,
+                     const uint8_t* slots) {
   // The same λ as setupTriangle's steps 3, 4 and 8 for this (drawn, so valid) triangle.
   const ClipVertex* const v[3] = {&v0, &v1, &v2};
   const ScreenVertex s[3] = {snapVertex(v0, viewport), snapVertex(v1, viewport),
@@ -360,8 +361,9 @@ void attributePlanes(const ClipVertex& v0, const ClipVertex& v1, const ClipVerte
       out[a] = Plane{};
       continue;
     }
-    const double f[3] = {values[0][a] * lambda.invW[0], values[1][a] * lambda.invW[1],
-                         values[2][a] * lambda.invW[2]};
+    const size_t at = slots ? slots[a] : size_t(a);
+    const double f[3] = {values[0][at] * lambda.invW[0], values[1][at] * lambda.invW[1],
+                         values[2][at] * lambda.invW[2]};
     out[a] = makePlane(lambda.g, f, lambda.scale, px, py);
   }
 }

@@ -124,9 +124,10 @@ SetupOutcome setupTriangle(const ClipVertex& v0, const ClipVertex& v1, const Cli
                            const Viewport& viewport, CullMode cull, TriangleSetup& out);
 
 // Pixel shading's extra planes (attributePlanes'), asked of setupTriangles for the triangles it
-// draws. Vertex v's values are values[v·valueStride, v·valueStride + count) (strides in floats);
-// drawn record r's planes go to out + r·outStride (a stride in bytes, so that they may sit in a
-// larger record), the planes not in `used` set to zero.
+// draws. Vertex v's value of attribute a is values[v·valueStride + slots[a]] (strides in floats;
+// without `slots`, + a: every attribute stored); drawn record r's planes go to out + r·outStride (a
+// stride in bytes, so that they may sit in a larger record), the planes not in `used` set to zero.
+// Only the slots of the attributes in `used` are read.
 struct AttributeRequest {
   const float* values = nullptr;
   size_t valueStride = 0;
@@ -134,6 +135,7 @@ struct AttributeRequest {
   unsigned used = 0;
   Plane* out = nullptr;
   size_t outStride = 0;
+  const uint8_t* slots = nullptr;  // [count], or null for slots[a] = a
 };
 inline constexpr int kMaxAttributePlanes = 16;
 
@@ -149,11 +151,13 @@ size_t setupTriangles(const ClipVertex* vertices, const uint32_t* indices, size_
                       const AttributeRequest* attributes = nullptr);
 
 // Pixel shading's extra parameters (SPEC §2): `count` planes of value/w for per-vertex values
-// values[k][0 … count) of vertex k, relative to the same origin (minX, minY) as `setup`'s planes —
-// the functions setupTriangle gives the colour. `setup` is the triangle's drawn record. Only the
-// planes whose bit is set in `used` are computed; the others are set to zero (nothing reads them).
+// values[k][slots[a]] of vertex k (slots null: values[k][a]), a ∈ [0, count), relative to the same
+// origin (minX, minY) as `setup`'s planes — the functions setupTriangle gives the colour. `setup`
+// is the triangle's drawn record. Only the planes whose bit is set in `used` are computed; the
+// others are set to zero (nothing reads them).
 void attributePlanes(const ClipVertex& v0, const ClipVertex& v1, const ClipVertex& v2,
                      const Viewport& viewport, const TriangleSetup& setup,
-                     const float* const values[3], int count, Plane* out, unsigned used = ~0u);
+                     const float* const values[3], int count, Plane* out, unsigned used = ~0u,
+                     const uint8_t* slots = nullptr);
 
 }  // namespace sv::geometry

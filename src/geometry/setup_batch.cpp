@@ -44,7 +44,8 @@ size_t SetupTriangles(const ClipVertex* vertices, const uint32_t* indices, size_
     const float* values[3];
     for (int k = 0; k < 3; ++k) values[k] = attributes->values + idx[k] * attributes->valueStride;
     attributePlanes(vertices[idx[0]], vertices[idx[1]], vertices[idx[2]], viewport, out[record],
-                    values, attributes->count, planesOf(record), attributes->used);
+                    values, attributes->count, planesOf(record), attributes->used,
+                    attributes->slots);
   };
   if (N >= 2 && N <= size_t(kMaxLanes)) {
     alignas(64) double in[3][7][kMaxLanes];  // vertex k, component x y z w r g b, lane
@@ -174,11 +175,12 @@ size_t SetupTriangles(const ClipVertex* vertices, const uint32_t* indices, size_
       for (int a = 0; laneAttributes && a < attributes->count; ++a) {
         if (!(attributes->used >> a & 1)) continue;
         alignas(64) double value[3][kMaxLanes];
+        const size_t at = attributes->slots ? attributes->slots[a] : size_t(a);
         for (size_t l = 0; l < N; ++l)
           for (int k = 0; k < 3; ++k)
-            value[k][l] = double(attributes->values[indices[(t + l) * 3 + size_t(k)] *
-                                                        attributes->valueStride +
-                                                    size_t(a)]);
+            value[k][l] = double(
+                attributes
+                    ->values[indices[(t + l) * 3 + size_t(k)] * attributes->valueStride + at]);
         for (int k = 0; k < 3; ++k) f[k] = hn::Mul(hn::Load(d, value[k]), invW[k]);
         planeTo(f, ao[a]);
       }

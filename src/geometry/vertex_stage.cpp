@@ -8,7 +8,7 @@ namespace sv::geometry {
 
 bool transformVertices(const scene::Mesh& mesh, const scene::Material& material, const Mat4& model,
                        const VertexContext& context, size_t begin, size_t end, ClipVertex* out,
-                       shade::VertexAttributes* attributes) {
+                       float* attributes, const shade::AttributeLayout* layout) {
   bool finite = true;
   const Mat4 mvp = context.viewProj * model;
   const Mat4 modelView = context.view * model;
@@ -45,23 +45,34 @@ bool transformVertices(const scene::Mesh& mesh, const scene::Material& material,
     *out++ = {c.x, c.y, c.z, c.w, std::clamp(color.x * intensity.x, 0.0f, 1.0f),
               std::clamp(color.y * intensity.y, 0.0f, 1.0f),
               std::clamp(color.z * intensity.z, 0.0f, 1.0f), alpha};
-    if (attributes) {
-      shade::VertexAttributes& a = *attributes++;
-      const Vec2 uv = mesh.uvs.empty() ? Vec2{0, 0} : mesh.uvs[i];
-      // Phong's normal; a mesh without normals (or an unlit material) gets none and is not lit.
-      const Vec3 n = lit && material.phong
-                         ? normalize(normalToEye.transformDirection(mesh.normals[i]))
-                         : Vec3{0, 0, 0};
-      const Vec3 e = modelView.transformPoint(p);
-      a.value[shade::kU] = uv.x * material.uvScale.x;
-      a.value[shade::kV] = uv.y * material.uvScale.y;
-      a.value[shade::kNormalX] = n.x;
-      a.value[shade::kNormalY] = n.y;
-      a.value[shade::kNormalZ] = n.z;
-      a.value[shade::kEyeX] = e.x;
-      a.value[shade::kEyeY] = e.y;
-      a.value[shade::kEyeZ] = e.z;
-      a.value[shade::kAlpha] = alpha;
+    if (attributes && layout->stored) {
+      float* a = attributes;
+      attributes += layout->stride;
+      auto put = [&](int k, float value) {
+        if (layout->stored >> k & 1) a[layout->slot[k]] = value;
+      };
+      if (layout->stored & (1u << shade::kU | 1u << shade::kV)) {
+        const Vec2 uv = mesh.uvs.empty() ? Vec2{0, 0} : mesh.uvs[i];
+        put(shade::kU, uv.x * material.uvScale.x);
+        put(shade::kV, uv.y * material.uvScale.y);
+      }
+      if (layout->stored &
+          (1u << shade::kNormalX | 1u << shade::kNormalY | 1u << shade::kNormalZ)) {
+        // Phong's normal; a mesh without normals (or an unlit material) gets none and is not lit.
+        const Vec3 n = lit && material.phong
+                           ? normalize(normalToEye.transformDirection(mesh.normals[i]))
+                           : Vec3{0, 0, 0};
+        put(shade::kNormalX, n.x);
+        put(shade::kNormalY, n.y);
+        put(shade::kNormalZ, n.z);
+      }
+      if (layout->stored & (1u << shade::kEyeX | 1u << shade::kEyeY | 1u << shade::kEyeZ)) {
+        const Vec3 e = modelView.transformPoint(p);
+        put(shade::kEyeX, e.x);
+        put(shade::kEyeY, e.y);
+        put(shade::kEyeZ, e.z);
+      }
+      put(shade::kAlpha, alpha);
     }
   }
   return finite;

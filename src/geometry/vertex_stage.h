@@ -20,7 +20,7 @@ struct VertexContext {
 
 // Writes the clip-space vertices of mesh vertices [begin, end) to out[0 … end − begin), and, when
 // `attributes` is not null, their pixel-shading attributes (shade::Attribute: uv, eye-space normal
-// and position, alpha) to attributes[0 … end − begin).
+// and position, alpha) that `layout` stores, vertex i's at attributes[i·layout.stride + slot].
 // `model` places the mesh in the world. Colour = material colour × vertex colour × light intensity,
 // where intensity = ambient + (1 − ambient)·Σ max(0, n·l)·lightColour over the directional light
 // and the point lights when the mesh has normals, the light is enabled and the material is lit
@@ -31,7 +31,7 @@ struct VertexContext {
 // positions are read anyway: the renderer skips it in validate).
 bool transformVertices(const scene::Mesh& mesh, const scene::Material& material, const Mat4& model,
                        const VertexContext& context, size_t begin, size_t end, ClipVertex* out,
-                       shade::VertexAttributes* attributes = nullptr);
+                       float* attributes = nullptr, const shade::AttributeLayout* layout = nullptr);
 
 // The bound of an object whose vertices lie in the box [lo, hi] placed by `mvp` (object → clip):
 // the projected corners' pixel box, widened by two pixels for vertex rounding and sample

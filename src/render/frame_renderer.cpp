@@ -158,8 +158,9 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
         const shade::MaterialShading* material = call ? call->material : nullptr;
         geometry::AttributeRequest request;
         if (pixelShading && material) {
-          request.values = packets.attributes.data()->value;
-          request.valueStride = sizeof(shade::VertexAttributes) / sizeof(float);
+          request.values = packets.attributes.data();
+          request.valueStride = size_t(packets.attributeLayout.stride);
+          request.slots = packets.attributeLayout.slot;
           request.count = shade::kAttributeCount;
           request.used = shade::attributesUsed(*material, *settings.environment);
           request.out = scratch.attributes[n].planes;

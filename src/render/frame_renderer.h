@@ -32,8 +32,10 @@ struct DrawCall {
 // The plain input of a frame: vertices after the projective transform and triangles indexing them.
 struct DrawPackets {
   std::vector<geometry::ClipVertex> vertices;
-  // Per vertex, for pixel shading: as many as `vertices` when some call has a material, else empty.
-  std::vector<shade::VertexAttributes> attributes;
+  // For pixel shading, when some call has a material (else empty): per vertex, the attributes
+  // `attributeLayout` stores, attributeLayout.stride floats a vertex.
+  std::vector<float> attributes;
+  shade::AttributeLayout attributeLayout;
   std::vector<uint32_t> indices;  // 3 per triangle, each < vertices.size()
   std::vector<DrawCall> calls;    // in submission order
 };

@@ -450,6 +450,7 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
   constexpr size_t kVertexChunk = 1 << 14;
   std::vector<VertexJob> jobs;
   size_t vertexCount = 0;
+  unsigned stored = 0;  // the attributes some material reads (shade::AttributeLayout)
   // Every mesh's bounds, for the draw order and the objects' screen bounds, when they are needed.
   const bool masking = o.hsr != RenderOptions::Hsr::zbuffer && o.debugView != DebugView::overdraw;
   bool anyTranslucent = false;
@@ -487,6 +488,7 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
                                                         : geometry::CullMode::none;
       if (pixelShading && (mat.needsPixelShading() || shading.environment.fog))
         call.material = shading.of(mesh.material, !mesh.normals.empty());
+      if (call.material) stored |= shade::attributesUsed(*call.material, shading.environment);
       if (masking)
         call.bounded = geometry::boundObject(vertexContext.viewProj * inst.transform,
                                              boxes[size_t(inst.mesh)][0],
@@ -504,15 +506,18 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
       vertexCount += mesh.positions.size();
     }
   p.vertices.resize(vertexCount);
-  p.attributes.resize(pixelShading ? vertexCount : 0);
+  // Only the attributes some material reads (shade::AttributeLayout).
+  p.attributeLayout = shade::AttributeLayout::of(pixelShading ? stored : 0);
+  const size_t stride = size_t(p.attributeLayout.stride);
+  p.attributes.resize(vertexCount * stride);
   std::vector<uint8_t> finite(jobs.size());
   impl_->frame.pool().parallelFor(jobs.size(), [&](size_t j, int) {
     const VertexJob& job = jobs[j];
     const scene::Mesh& mesh = scene.meshes[job.instance->mesh];
-    finite[j] = geometry::transformVertices(mesh, materialOf(mesh), job.instance->transform,
-                                            vertexContext, job.begin, job.end,
-                                            p.vertices.data() + job.out,
-                                            pixelShading ? p.attributes.data() + job.out : nullptr);
+    finite[j] = geometry::transformVertices(
+        mesh, materialOf(mesh), job.instance->transform, vertexContext, job.begin, job.end,
+        p.vertices.data() + job.out, stride ? p.attributes.data() + job.out * stride : nullptr,
+        &p.attributeLayout);
   });
   if (std::find(finite.begin(), finite.end(), 0) != finite.end()) return invalidVertexData();
   stats.vertexMs = msSince(t0);

@@ -258,6 +258,64 @@ TEST(Setup, ApertureBoxSpansEveryPixelSquareTheTriangleReaches) {
   }
 }
 
+// Attributes stored packed (only the used ones, at their slots) give the planes they give stored
+// whole, in the batch and one by one.
+TEST(Setup, PackedAttributesGiveTheSamePlanes) {
+  const int w = 640, h = 480;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(0, 1);
+  std::vector<ClipVertex> v;
+  for (int t = 0; t < 300; ++t) {
+    const double cx = u(rng) * w, cy = u(rng) * h, size = 2 + u(rng) * 200;
+    for (int k = 0; k < 3; ++k)
+      v.push_back(pixelVertex(cx + (u(rng) - 0.5) * size, cy + (u(rng) - 0.5) * size, w, h, u(rng),
+                              0.2f + 3 * u(rng), u(rng), u(rng), u(rng)));
+  }
+  std::vector<uint32_t> indices(v.size());
+  for (size_t i = 0; i < indices.size(); ++i) indices[i] = uint32_t(i);
+  const size_t count = v.size() / 3;
+  constexpr int kValues = 5;
+  constexpr unsigned kUsed = 0b10101;
+  const uint8_t slots[kValues] = {0, 9, 1, 9, 2};  // 9: never read
+  std::vector<float> whole(v.size() * kValues), packed(v.size() * 3);
+  for (size_t i = 0; i < v.size(); ++i) {
+    for (int a = 0; a < kValues; ++a) {
+      whole[i * kValues + size_t(a)] = u(rng) * 4 - 2;
+      if (kUsed >> a & 1) packed[i * 3 + slots[a]] = whole[i * kValues + size_t(a)];
+    }
+  }
+  const geometry::Viewport vp{w, h, false};
+  auto planes = [&](const float* values, size_t stride, const uint8_t* slot) {
+    std::vector<TriangleSetup> setups(count);
+    std::vector<geometry::Plane> out(count * kValues, {7, 7, 7});
+    geometry::AttributeRequest request{
+        values, stride, kValues, kUsed, out.data(), sizeof(geometry::Plane) * kValues, slot};
+    uint64_t outcomes[geometry::kSetupOutcomes] = {};
+    const size_t n =
+        geometry::setupTriangles(v.data(), indices.data(), count, vp, geometry::CullMode::none,
+                                 setups.data(), outcomes, 0, &request);
+    out.resize(n * kValues);
+    // One by one, the same request's values.
+    for (size_t r = 0; r < n; ++r) {
+      const size_t t = setups[r].triangle;
+      const float* vals[3] = {values + 3 * t * stride, values + (3 * t + 1) * stride,
+                              values + (3 * t + 2) * stride};
+      geometry::Plane one[kValues];
+      geometry::attributePlanes(v[3 * t], v[3 * t + 1], v[3 * t + 2], vp, setups[r], vals, kValues,
+                                one, kUsed, slot);
+      for (int a = 0; a < kValues; ++a)
+        EXPECT_EQ(0, std::memcmp(&one[a], &out[r * kValues + size_t(a)], sizeof one[a]));
+    }
+    return out;
+  };
+  const std::vector<geometry::Plane> a = planes(whole.data(), kValues, nullptr);
+  const std::vector<geometry::Plane> b = planes(packed.data(), 3, slots);
+  ASSERT_EQ(a.size(), b.size());
+  ASSERT_GT(a.size(), size_t(kValues) * 200);
+  for (size_t i = 0; i < a.size(); ++i)  // (the unused planes are zero in both)
+    ASSERT_EQ(0, std::memcmp(&a[i], &b[i], sizeof a[i])) << i;
+}
+
 // setupTriangles (SIMD lanes) must give setupTriangle's records bit for bit, on every SIMD target,
 // in every regime: small and large, culled either way, degenerate, behind and across the eye,
 // beyond the far plane, outside the guard band, NaN and infinite —
