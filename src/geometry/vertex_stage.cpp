@@ -1,28 +1,52 @@
 // Based on: SPEC §8 (seed 002: Gouraud intensity, seed 003: the diffuse term n·l).
+//
+// Vertices are transformed several at once in SIMD lanes (Highway, dispatched per call), with
+// exactly the operations, in exactly the order, of the one-vertex code (VertexRun::vertex), so
+// every vertex gets the same bits whichever path takes it (tests/geometry/vertex_stage_test.cpp);
+// a range's last vertices, fewer than a vector, go through the one-vertex code itself.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "geometry/vertex_stage.cpp"
 #include "geometry/vertex_stage.h"
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <limits>
 
+#include "hwy/foreach_target.h"  // IWYU pragma: keep
+#include "hwy/highway.h"
+
+#ifndef SV_GEOMETRY_VERTEX_RUN
+#define SV_GEOMETRY_VERTEX_RUN
 namespace sv::geometry {
+namespace {
 
-bool transformVertices(const scene::Mesh& mesh, const scene::Material& material, const Mat4& model,
-                       const VertexContext& context, size_t begin, size_t end, ClipVertex* out,
-                       float* attributes, const shade::AttributeLayout* layout) {
-  bool finite = true;
-  const Mat4 mvp = context.viewProj * model;
-  const Mat4 modelView = context.view * model;
-  const Mat4 normalToWorld = model.normalMatrix();
-  const Mat4 normalToEye = modelView.normalMatrix();
-  const scene::Light& light = *context.light;
-  const bool hasLights = light.enabled || (context.pointLights && !context.pointLights->empty());
-  const bool lit = hasLights && !material.unlit && !mesh.normals.empty();
-  const bool vertexLit = lit && !material.phong;
-  const Vec3 toLight = normalize(-light.direction);
-  const Vec4 base = material.baseColor;
-  for (size_t i = begin; i < end; ++i) {
+// What every vertex of one call shares, and the one-vertex transform.
+struct VertexRun {
+  VertexRun(const scene::Mesh& mesh_, const scene::Material& material_, const Mat4& model_,
+            const VertexContext& context_, const shade::AttributeLayout* layout_)
+      : mesh(mesh_),
+        material(material_),
+        model(model_),
+        context(context_),
+        layout(layout_),
+        mvp(context_.viewProj * model_),
+        modelView(context_.view * model_),
+        normalToWorld(model_.normalMatrix()),
+        normalToEye(modelView.normalMatrix()),
+        light(*context_.light) {
+    const bool hasLights = light.enabled || (context.pointLights && !context.pointLights->empty());
+    lit = hasLights && !material.unlit && !mesh.normals.empty();
+    vertexLit = lit && !material.phong;
+    toLight = normalize(-light.direction);
+    base = material.baseColor;
+  }
+
+  // Vertex i to *out, and its attributes to a[layout slots] when `a` is not null. Returns whether
+  // its position is finite.
+  bool vertex(size_t i, ClipVertex* out, float* a) const {
     const Vec3 p = mesh.positions[i];
-    finite &= isFinite(p);
+    const bool finite = isFinite(p);
     const Vec4 c = mvp * Vec4{p.x, p.y, p.z, 1};
     Vec4 color = base;
     if (!mesh.colors.empty()) {
@@ -42,12 +66,15 @@ bool transformVertices(const scene::Mesh& mesh, const scene::Material& material,
       intensity = Vec3{light.ambient, light.ambient, light.ambient} + diffuse * (1 - light.ambient);
     }
     const float alpha = std::clamp(color.w, 0.0f, 1.0f);
-    *out++ = {c.x, c.y, c.z, c.w, std::clamp(color.x * intensity.x, 0.0f, 1.0f),
-              std::clamp(color.y * intensity.y, 0.0f, 1.0f),
-              std::clamp(color.z * intensity.z, 0.0f, 1.0f), alpha};
-    if (attributes && layout->stored) {
-      float* a = attributes;
-      attributes += layout->stride;
+    *out = {c.x,
+            c.y,
+            c.z,
+            c.w,
+            std::clamp(color.x * intensity.x, 0.0f, 1.0f),
+            std::clamp(color.y * intensity.y, 0.0f, 1.0f),
+            std::clamp(color.z * intensity.z, 0.0f, 1.0f),
+            alpha};
+    if (a && layout->stored) {
       auto put = [&](int k, float value) {
         if (layout->stored >> k & 1) a[layout->slot[k]] = value;
       };
@@ -74,8 +101,194 @@ bool transformVertices(const scene::Mesh& mesh, const scene::Material& material,
       }
       put(shade::kAlpha, alpha);
     }
+    return finite;
   }
+
+  const scene::Mesh& mesh;
+  const scene::Material& material;
+  const Mat4& model;
+  const VertexContext& context;
+  const shade::AttributeLayout* layout;
+  const Mat4 mvp, modelView, normalToWorld, normalToEye;
+  const scene::Light& light;
+  bool lit = false, vertexLit = false;
+  Vec3 toLight;
+  Vec4 base;
+};
+
+}  // namespace
+}  // namespace sv::geometry
+#endif  // SV_GEOMETRY_VERTEX_RUN
+
+HWY_BEFORE_NAMESPACE();
+namespace sv::geometry {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+static_assert(sizeof(Vec2) == 2 * sizeof(float) && sizeof(Vec3) == 3 * sizeof(float) &&
+                  sizeof(Vec4) == 4 * sizeof(float),
+              "meshes' arrays are read as interleaved floats");
+using DF = hn::CappedTag<float, 16>;
+using VF = hn::Vec<DF>;
+
+struct V3 {
+  VF x, y, z;
+};
+
+// The scalar code's operations lane by lane (math.h): products summed left to right, std::max(0,
+// v), std::clamp(v, 0, 1) and normalize as compare-and-select (their NaN results too).
+HWY_INLINE V3 transform(DF df, const Mat4& m, const V3& v, float w) {
+  // m·(x, y, z, w): m[3][r]·w is exact for w = 1, and ±0 for w = 0 (kept: it can turn −0 to +0).
+  auto row = [&](int r) {
+    return hn::Add(
+        hn::Add(hn::Add(hn::Mul(hn::Set(df, m.m[0][r]), v.x), hn::Mul(hn::Set(df, m.m[1][r]), v.y)),
+                hn::Mul(hn::Set(df, m.m[2][r]), v.z)),
+        hn::Set(df, m.m[3][r] * w));
+  };
+  return {row(0), row(1), row(2)};
+}
+HWY_INLINE VF dot3(const V3& a, const V3& b) {
+  return hn::Add(hn::Add(hn::Mul(a.x, b.x), hn::Mul(a.y, b.y)), hn::Mul(a.z, b.z));
+}
+HWY_INLINE VF dot3(DF df, const V3& a, Vec3 b) {
+  return dot3(a, V3{hn::Set(df, b.x), hn::Set(df, b.y), hn::Set(df, b.z)});
+}
+HWY_INLINE V3 normalized(DF df, const V3& a) {
+  const VF l = hn::Sqrt(dot3(a, a));
+  const VF inv = hn::Div(hn::Set(df, 1.0f), l);
+  const auto positive = hn::Gt(l, hn::Zero(df));
+  return {hn::IfThenElse(positive, hn::Mul(a.x, inv), a.x),
+          hn::IfThenElse(positive, hn::Mul(a.y, inv), a.y),
+          hn::IfThenElse(positive, hn::Mul(a.z, inv), a.z)};
+}
+HWY_INLINE VF positivePart(DF df, VF v) {  // std::max(0.0f, v)
+  return hn::IfThenElse(hn::Lt(hn::Zero(df), v), v, hn::Zero(df));
+}
+HWY_INLINE VF unitClamp(DF df, VF v) {  // std::clamp(v, 0.0f, 1.0f)
+  const VF one = hn::Set(df, 1.0f);
+  return hn::IfThenElse(hn::Lt(v, hn::Zero(df)), hn::Zero(df),
+                        hn::IfThenElse(hn::Lt(one, v), one, v));
+}
+
+bool TransformVertices(const scene::Mesh& mesh, const scene::Material& material, const Mat4& model,
+                       const VertexContext& context, size_t begin, size_t end, ClipVertex* out,
+                       float* attributes, const shade::AttributeLayout* layout) {
+  const VertexRun run(mesh, material, model, context, layout);
+  const DF df;
+  const size_t N = hn::Lanes(df);
+  const unsigned stored = attributes && layout ? layout->stored : 0;
+  const size_t stride = stored ? size_t(layout->stride) : 0;
+  const VF big = hn::Set(df, std::numeric_limits<float>::max());
+  auto finiteLanes = hn::Eq(big, big);
+  alignas(64) float position[4 * 16], color[4 * 16], attribute[shade::kAttributeCount][16];
+  size_t i = begin;
+  for (; i + N <= end; i += N) {
+    V3 p;
+    hn::LoadInterleaved3(df, &mesh.positions[i].x, p.x, p.y, p.z);
+    finiteLanes = hn::And(finiteLanes,
+                          hn::And(hn::Le(hn::Abs(p.x), big),
+                                  hn::And(hn::Le(hn::Abs(p.y), big), hn::Le(hn::Abs(p.z), big))));
+    const V3 c = transform(df, run.mvp, p, 1.0f);
+    auto cw = hn::Add(hn::Add(hn::Add(hn::Mul(hn::Set(df, run.mvp.m[0][3]), p.x),
+                                      hn::Mul(hn::Set(df, run.mvp.m[1][3]), p.y)),
+                              hn::Mul(hn::Set(df, run.mvp.m[2][3]), p.z)),
+                      hn::Set(df, run.mvp.m[3][3]));
+    VF r = hn::Set(df, run.base.x), g = hn::Set(df, run.base.y), b = hn::Set(df, run.base.z),
+       a = hn::Set(df, run.base.w);
+    if (!mesh.colors.empty()) {
+      VF vr, vg, vb, va;
+      hn::LoadInterleaved4(df, &mesh.colors[i].x, vr, vg, vb, va);
+      r = hn::Mul(r, vr), g = hn::Mul(g, vg), b = hn::Mul(b, vb), a = hn::Mul(a, va);
+    }
+    if (run.vertexLit) {
+      V3 n;
+      hn::LoadInterleaved3(df, &mesh.normals[i].x, n.x, n.y, n.z);
+      n = normalized(df, transform(df, run.normalToWorld, n, 0.0f));
+      const scene::Light& light = run.light;
+      V3 diffuse{hn::Zero(df), hn::Zero(df), hn::Zero(df)};
+      if (light.enabled) {
+        const VF d = positivePart(df, dot3(df, n, run.toLight));
+        diffuse = {hn::Mul(hn::Set(df, light.color.x), d), hn::Mul(hn::Set(df, light.color.y), d),
+                   hn::Mul(hn::Set(df, light.color.z), d)};
+      }
+      if (context.pointLights && !context.pointLights->empty()) {
+        const V3 world = transform(df, model, p, 1.0f);
+        for (const scene::PointLight& pl : *context.pointLights) {
+          const V3 l = normalized(df, V3{hn::Sub(hn::Set(df, pl.position.x), world.x),
+                                         hn::Sub(hn::Set(df, pl.position.y), world.y),
+                                         hn::Sub(hn::Set(df, pl.position.z), world.z)});
+          const VF d = positivePart(df, dot3(n, l));
+          diffuse = {hn::Add(diffuse.x, hn::Mul(hn::Set(df, pl.color.x), d)),
+                     hn::Add(diffuse.y, hn::Mul(hn::Set(df, pl.color.y), d)),
+                     hn::Add(diffuse.z, hn::Mul(hn::Set(df, pl.color.z), d))};
+        }
+      }
+      const VF ambient = hn::Set(df, light.ambient), rest = hn::Set(df, 1 - light.ambient);
+      r = hn::Mul(r, hn::Add(ambient, hn::Mul(diffuse.x, rest)));
+      g = hn::Mul(g, hn::Add(ambient, hn::Mul(diffuse.y, rest)));
+      b = hn::Mul(b, hn::Add(ambient, hn::Mul(diffuse.z, rest)));
+    }
+    // (Unlit: the scalar code's colour × 1, which is exact.)
+    a = unitClamp(df, a);
+    hn::StoreInterleaved4(c.x, c.y, c.z, cw, df, position);
+    hn::StoreInterleaved4(unitClamp(df, r), unitClamp(df, g), unitClamp(df, b), a, df, color);
+    ClipVertex* o = out + (i - begin);
+    for (size_t j = 0; j < N; ++j) {
+      std::memcpy(&o[j].x, position + 4 * j, 4 * sizeof(float));
+      std::memcpy(&o[j].r, color + 4 * j, 4 * sizeof(float));
+    }
+    if (!stored) continue;
+    auto put = [&](int k, VF v) {
+      if (stored >> k & 1) hn::Store(v, df, attribute[k]);
+    };
+    if (stored & (1u << shade::kU | 1u << shade::kV)) {
+      VF u = hn::Zero(df), v = hn::Zero(df);
+      if (!mesh.uvs.empty()) hn::LoadInterleaved2(df, &mesh.uvs[i].x, u, v);
+      put(shade::kU, hn::Mul(u, hn::Set(df, material.uvScale.x)));
+      put(shade::kV, hn::Mul(v, hn::Set(df, material.uvScale.y)));
+    }
+    if (stored & (1u << shade::kNormalX | 1u << shade::kNormalY | 1u << shade::kNormalZ)) {
+      V3 n{hn::Zero(df), hn::Zero(df), hn::Zero(df)};
+      if (run.lit && material.phong) {
+        hn::LoadInterleaved3(df, &mesh.normals[i].x, n.x, n.y, n.z);
+        n = normalized(df, transform(df, run.normalToEye, n, 0.0f));
+      }
+      put(shade::kNormalX, n.x);
+      put(shade::kNormalY, n.y);
+      put(shade::kNormalZ, n.z);
+    }
+    if (stored & (1u << shade::kEyeX | 1u << shade::kEyeY | 1u << shade::kEyeZ)) {
+      const V3 e = transform(df, run.modelView, p, 1.0f);
+      put(shade::kEyeX, e.x);
+      put(shade::kEyeY, e.y);
+      put(shade::kEyeZ, e.z);
+    }
+    put(shade::kAlpha, a);
+    float* dst = attributes + (i - begin) * stride;
+    for (int k = 0; k < shade::kAttributeCount; ++k)
+      if (stored >> k & 1)
+        for (size_t j = 0; j < N; ++j) dst[j * stride + layout->slot[k]] = attribute[k][j];
+  }
+  bool finite = hn::AllTrue(df, finiteLanes);
+  for (; i < end; ++i)
+    finite &=
+        run.vertex(i, out + (i - begin), stored ? attributes + (i - begin) * stride : nullptr);
   return finite;
+}
+
+}  // namespace HWY_NAMESPACE
+}  // namespace sv::geometry
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace sv::geometry {
+HWY_EXPORT(TransformVertices);
+
+bool transformVertices(const scene::Mesh& mesh, const scene::Material& material, const Mat4& model,
+                       const VertexContext& context, size_t begin, size_t end, ClipVertex* out,
+                       float* attributes, const shade::AttributeLayout* layout) {
+  return HWY_DYNAMIC_DISPATCH(TransformVertices)(mesh, material, model, context, begin, end, out,
+                                                 attributes, layout);
 }
 
 bool boundObject(const Mat4& mvp, Vec3 lo, Vec3 hi, const Viewport& viewport, ObjectBound& out) {
@@ -114,3 +327,4 @@ bool boundObject(const Mat4& mvp, Vec3 lo, Vec3 hi, const Viewport& viewport, Ob
 }
 
 }  // namespace sv::geometry
+#endif

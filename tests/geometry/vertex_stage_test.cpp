@@ -1,0 +1,106 @@
+// The vertex stage (SPEC §1 stage 3, §8): its SIMD lanes give every vertex the bits the one-vertex
+// code gives it (a range shorter than a vector takes that code), on every target, for every
+// combination of colours, lights, Phong normals and stored attributes.
+#include "geometry/vertex_stage.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include "hwy/targets.h"
+#include "synthvis/math.h"
+
+namespace sv {
+namespace {
+
+using geometry::ClipVertex;
+
+scene::Mesh randomMesh(std::mt19937& rng, size_t n, bool colors, bool normals, bool uvs) {
+  std::uniform_real_distribution<float> pos(-3, 3), unit(0, 1), dir(-1, 1);
+  scene::Mesh m;
+  for (size_t i = 0; i < n; ++i) {
+    m.positions.push_back({pos(rng), pos(rng), pos(rng) - 8});
+    if (colors) m.colors.push_back({unit(rng), unit(rng), unit(rng), 1.5f * unit(rng) - 0.25f});
+    if (normals) m.normals.push_back({dir(rng), dir(rng), dir(rng)});
+    if (uvs) m.uvs.push_back({4 * unit(rng), 4 * unit(rng)});
+  }
+  // Values that test the exact-bits cases: a zero normal (normalize leaves it), negative zeros.
+  if (normals) m.normals[3] = {0, 0, 0};
+  m.positions[5] = {-0.0f, 0.0f, -4.0f};
+  if (normals) m.normals[7] = {-0.0f, 1.0f, -0.0f};
+  return m;
+}
+
+TEST(VertexStage, LanesEqualTheOneVertexCodeOnEveryTarget) {
+  std::mt19937 rng(7);
+  const size_t n = 77;  // several vectors of every width and a tail
+  const Mat4 view = Mat4::lookAt({1, 2, 3}, {0, 0, -8}, {0, 1, 0});
+  const Mat4 proj = Mat4::perspective(1.0f, 1.5f, 0.1f, 100.0f);
+  const Mat4 model = Mat4::translation({0.5f, -0.25f, 1}) * Mat4::rotation({1, 2, 0.5f}, 0.7f) *
+                     Mat4::scaling({1.5f, 0.75f, 1.25f});
+  const std::vector<scene::PointLight> points = {{{2, 3, -5}, {0.8f, 0.5f, 0.3f}},
+                                                 {{-4, 1, -9}, {0.2f, 0.9f, 0.6f}}};
+  int cases = 0;
+  for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
+    hwy::SetSupportedTargetsForTest(target);
+    for (int variant = 0; variant < 32; ++variant) {
+      const bool colors = variant & 1, normals = variant & 2, phong = variant & 4,
+                 lightOn = variant & 8, withPoints = variant & 16;
+      const scene::Mesh mesh = randomMesh(rng, n, colors, normals, variant % 3 != 0);
+      scene::Material material;
+      material.baseColor = {0.9f, 0.7f, 0.5f, 0.8f};
+      material.phong = phong;
+      material.uvScale = {2.5f, 0.75f};
+      scene::Light light;
+      light.enabled = lightOn;
+      const geometry::VertexContext context{view, proj * view, &light,
+                                            withPoints ? &points : nullptr};
+      for (unsigned stored :
+           {0u, (1u << shade::kU) | (1u << shade::kV), (1u << shade::kAttributeCount) - 1}) {
+        const shade::AttributeLayout layout = shade::AttributeLayout::of(stored);
+        const size_t stride = size_t(layout.stride);
+        std::vector<ClipVertex> lanes(n), one(n);
+        std::vector<float> lanesA(n * stride + 1, -1), oneA(n * stride + 1, -1);
+        ASSERT_TRUE(geometry::transformVertices(mesh, material, model, context, 0, n, lanes.data(),
+                                                stride ? lanesA.data() : nullptr, &layout));
+        for (size_t i = 0; i < n; ++i)
+          ASSERT_TRUE(geometry::transformVertices(mesh, material, model, context, i, i + 1, &one[i],
+                                                  stride ? &oneA[i * stride] : nullptr, &layout));
+        for (size_t i = 0; i < n; ++i)
+          ASSERT_EQ(std::memcmp(&lanes[i], &one[i], sizeof(ClipVertex)), 0)
+              << hwy::TargetName(target) << " variant " << variant << " vertex " << i;
+        ASSERT_EQ(std::memcmp(lanesA.data(), oneA.data(), lanesA.size() * sizeof(float)), 0)
+            << hwy::TargetName(target) << " variant " << variant << " attributes " << stored;
+        ++cases;
+      }
+    }
+  }
+  hwy::SetSupportedTargetsForTest(0);
+  EXPECT_GE(cases, 96);
+}
+
+TEST(VertexStage, ANonFinitePositionIsReportedFromTheLanesAndTheTail) {
+  std::mt19937 rng(3);
+  const Mat4 view = Mat4::lookAt({0, 0, 0}, {0, 0, -1}, {0, 1, 0});
+  const geometry::VertexContext context{view, Mat4::perspective(1.0f, 1.0f, 0.1f, 100.0f) * view,
+                                        nullptr, nullptr};
+  scene::Light light;
+  const geometry::VertexContext lit{context.view, context.viewProj, &light, nullptr};
+  for (size_t bad : {size_t(2), size_t(40), size_t(63)}) {
+    scene::Mesh mesh = randomMesh(rng, 64, true, false, false);
+    mesh.positions[bad].y = bad == 40 ? std::nanf("") : INFINITY;
+    std::vector<ClipVertex> out(64);
+    EXPECT_FALSE(geometry::transformVertices(mesh, scene::Material{}, Mat4::identity(), lit, 0, 64,
+                                             out.data()))
+        << bad;
+    EXPECT_TRUE(geometry::transformVertices(mesh, scene::Material{}, Mat4::identity(), lit, 0, bad,
+                                            out.data()))
+        << bad;
+  }
+}
+
+}  // namespace
+}  // namespace sv
