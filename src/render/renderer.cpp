@@ -433,23 +433,25 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
 
   auto t0 = Clock::now();
   render::DrawPackets& p = impl_->packets;
-  // Vertices and attributes are resized below and every one is written by the vertex stage:
-  // not cleared first, so that a frame of the same size does not zero megabytes for nothing.
-  p.indices.clear();
+  // Vertices, attributes and indices are resized below and every one is written by the vertex
+  // stage: not cleared first, so that a frame of the same size does not zero megabytes for nothing.
   p.calls.clear();
   const scene::Material defaultMaterial;
   auto materialOf = [&](const scene::Mesh& mesh) -> const scene::Material& {
     return mesh.material >= 0 ? scene.materials[mesh.material] : defaultMaterial;
   };
-  // Lay out every instance's vertices and triangles, then transform the vertices in parallel
-  // chunks (each chunk writes its own range).
+  // Lay out every instance's vertices and triangles, then transform the vertices and copy the
+  // indices (offset to the frame's vertex numbering, and range-checked) in parallel chunks, each
+  // writing its own range.
   struct VertexJob {
     const scene::Instance* instance;
+    bool indices;  // else vertices
     size_t begin, end, out;
+    uint32_t base;  // the instance's first vertex in the frame (indices)
   };
-  constexpr size_t kVertexChunk = 1 << 14;
+  constexpr size_t kVertexChunk = 1 << 14, kIndexChunk = 1 << 16;
   std::vector<VertexJob> jobs;
-  size_t vertexCount = 0;
+  size_t vertexCount = 0, indexCount = 0;
   unsigned stored = 0;  // the attributes some material reads (shade::AttributeLayout)
   // Every mesh's bounds, for the draw order and the objects' screen bounds, when they are needed.
   const bool masking = o.hsr != RenderOptions::Hsr::zbuffer && o.debugView != DebugView::overdraw;
@@ -476,13 +478,17 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
       if ((mat.alphaMode == scene::AlphaMode::blend) != translucentPass) continue;
       // Indices are 32-bit; a frame of more vertices or triangles than that cannot be expressed.
       if (vertexCount + mesh.positions.size() > (size_t(1) << 31) ||
-          p.indices.size() + mesh.indices.size() > (size_t(1) << 31))
+          indexCount + mesh.indices.size() > (size_t(1) << 31))
         return Error{"", "", "scene too large for one frame (over 2^31 vertices or indices)"};
+      const auto base = static_cast<uint32_t>(vertexCount);
       for (size_t b = 0; b < mesh.positions.size(); b += kVertexChunk)
+        jobs.push_back({&inst, false, b, std::min(mesh.positions.size(), b + kVertexChunk),
+                        vertexCount + b, base});
+      for (size_t b = 0; b < mesh.indices.size(); b += kIndexChunk)
         jobs.push_back(
-            {&inst, b, std::min(mesh.positions.size(), b + kVertexChunk), vertexCount + b});
+            {&inst, true, b, std::min(mesh.indices.size(), b + kIndexChunk), indexCount + b, base});
       render::DrawCall call;
-      call.firstTriangle = static_cast<uint32_t>(p.indices.size() / 3);
+      call.firstTriangle = static_cast<uint32_t>(indexCount / 3);
       call.triangleCount = static_cast<uint32_t>(mesh.triangleCount());
       call.cull = o.cullBackFaces && !mat.doubleSided ? geometry::CullMode::back
                                                         : geometry::CullMode::none;
@@ -490,30 +496,33 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
         call.material = shading.of(mesh.material, !mesh.normals.empty());
       if (call.material) stored |= shade::attributesUsed(*call.material, shading.environment);
       if (masking)
-        call.bounded = geometry::boundObject(vertexContext.viewProj * inst.transform,
-                                             boxes[size_t(inst.mesh)][0],
-                                             boxes[size_t(inst.mesh)][1], boundViewport, call.bound);
-      const uint32_t base = static_cast<uint32_t>(vertexCount);
-      const size_t at = p.indices.size();
-      p.indices.resize(at + mesh.indices.size());
-      uint32_t maxIndex = 0;
-      for (size_t i = 0; i < mesh.indices.size(); ++i) {
-        maxIndex = std::max(maxIndex, mesh.indices[i]);
-        p.indices[at + i] = base + mesh.indices[i];
-      }
-      if (!mesh.indices.empty() && maxIndex >= mesh.positions.size()) return invalidVertexData();
+        call.bounded = geometry::boundObject(
+            vertexContext.viewProj * inst.transform, boxes[size_t(inst.mesh)][0],
+            boxes[size_t(inst.mesh)][1], boundViewport, call.bound);
       p.calls.push_back(call);
       vertexCount += mesh.positions.size();
+      indexCount += mesh.indices.size();
     }
   p.vertices.resize(vertexCount);
+  p.indices.resize(indexCount);
   // Only the attributes some material reads (shade::AttributeLayout).
   p.attributeLayout = shade::AttributeLayout::of(pixelShading ? stored : 0);
   const size_t stride = size_t(p.attributeLayout.stride);
   p.attributes.resize(vertexCount * stride);
-  std::vector<uint8_t> finite(jobs.size());
+  std::vector<uint8_t> finite(jobs.size());  // positions finite, indices in range
   impl_->frame.pool().parallelFor(jobs.size(), [&](size_t j, int) {
     const VertexJob& job = jobs[j];
     const scene::Mesh& mesh = scene.meshes[job.instance->mesh];
+    if (job.indices) {
+      uint32_t maxIndex = 0;
+      uint32_t* out = p.indices.data() + job.out;
+      for (size_t i = job.begin; i < job.end; ++i) {
+        maxIndex = std::max(maxIndex, mesh.indices[i]);
+        out[i - job.begin] = job.base + mesh.indices[i];
+      }
+      finite[j] = maxIndex < mesh.positions.size();
+      return;
+    }
     finite[j] = geometry::transformVertices(
         mesh, materialOf(mesh), job.instance->transform, vertexContext, job.begin, job.end,
         p.vertices.data() + job.out, stride ? p.attributes.data() + job.out * stride : nullptr,

@@ -104,7 +104,7 @@ TEST(Render, OptionsOutOfRangeAreRejectedWithTheReason) {
 TEST(Render, BadVertexDataIsRefusedWithTheOffenderNamed) {
   scene::Scene base = scene::demoScene();
   ASSERT_FALSE(base.meshes.empty());
-  // A mesh large enough for several vertex chunks (2^14 vertices each).
+  // A mesh large enough for several vertex chunks (2^14 vertices each) and index chunks (2^16).
   scene::Mesh big;
   big.name = "big";
   for (int i = 0; i < 40000; ++i) {
@@ -144,6 +144,12 @@ TEST(Render, BadVertexDataIsRefusedWithTheOffenderNamed) {
     EXPECT_NE(c.error().str().find("indices[3001] = 40000 is out of range (40000 vertices)"),
               std::string::npos)
         << c.error().str();
+    range = base;  // in the mesh's second chunk of indices (2^16 each)
+    range.meshes[m].indices[100000] = 40001;
+    const Status d = r.render(range, img);
+    ASSERT_FALSE(d.ok());
+    EXPECT_NE(d.error().str().find("indices[100000] = 40001 is out of range"), std::string::npos)
+        << d.error().str();
     ASSERT_TRUE(r.render(base, img).ok());  // and the renderer is fine afterwards
   }
 }
