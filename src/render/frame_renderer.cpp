@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 
+#include "core/streaming.h"
+
 namespace sv::render {
 namespace {
 
@@ -189,8 +191,8 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
       // Pixel shading's planes, stored as the setup records are (grouped by tile): a tile finds
       // each triangle's from its list entry and reads them in runs, as it reads the records.
       if (pixelShading)
-        for (uint32_t p = 0; p < n; ++p)
-          attributes_[storageBase + p] = scratch.attributes[scratch.bins.order[p]];
+        core::gatherStreaming(attributes_.data() + storageBase, scratch.attributes.data(),
+                              scratch.bins.order.data(), n);
       counts[chunk] = c;
     });
     for (int i = 0; i < chunks; ++i) {
