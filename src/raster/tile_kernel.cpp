@@ -1021,7 +1021,6 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
         whole = hn::AllTrue(du, hn::Eq(hn::LoadU(du, visible + i), hn::Set(du, first)));
       if (whole) {
         for (size_t i = 0; i < size_t(kBlockPixels); i += n) hn::StoreU(none, du, visible + i);
-        ctx.stats->fragments += kBlockPixels;
         Batch b;
         b.id = first;
         b.count = kBlockPixels;
@@ -1036,7 +1035,6 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
     auto left = hn::Ne(ids, none);
     if (hn::AllFalse(du, left)) continue;
     hn::StoreU(none, du, visible);
-    ctx.stats->fragments += hn::CountTrue(du, left);
     alignas(64) uint32_t id[kBlockPixels];
     hn::Store(ids, du, id);
     const auto pixels = hn::Add(laneIndex, hn::Set(di, start));

@@ -313,6 +313,42 @@ TEST(Shading, TexturedFramesAreIdenticalForAnyThreadCount) {
     }
 }
 
+// The frame statistics count each rasterized pixel once however it is shaded: deferred shading
+// (which shades the visible pixels after the tile's triangles are drawn) adds no fragments of its
+// own, so a textured frame reports the fragments of the same frame in Gouraud colours.
+TEST(Shading, DeferredShadingCountsEachFragmentOnce) {
+  scene::Scene s = emptyScene();
+  texture::Level level =
+      texture::generateTexture(texture::Pattern::noise, 64, {0, 0, 0, 1}, {1, 1, 1, 1}, 5);
+  s.textures.push_back({"noise", std::make_shared<texture::Texture>(level, texture::Wrap::repeat,
+                                                                    texture::Wrap::repeat)});
+  scene::Material m;
+  m.texture = 0;
+  s.materials.push_back(m);
+  for (int i = 0; i < 30; ++i) {
+    const float a = float(i) * 0.9f;
+    addQuad(s, {std::sin(a) * 2, std::cos(a * 1.3f) * 1.5f, -4 - float(i % 5)},
+            {0.8f * std::cos(a), 0.3f, 0.2f}, {0.1f, 0.9f, -0.5f * std::sin(a)}, 0);
+  }
+  // (No material of the frame needs pixel shading: drawn in Gouraud colours as they are
+  // rasterized.)
+  scene::Scene plain = s;
+  plain.materials = {scene::Material{}};
+  plain.textures.clear();
+  for (scene::Mesh& mesh : plain.meshes) mesh.material = 0;
+  RenderOptions o;
+  o.width = 160;
+  o.height = 120;
+  FrameStats textured, gouraud;
+  Image img;
+  ASSERT_TRUE(Renderer(o).render(s, img, &textured).ok());
+  ASSERT_TRUE(Renderer(o).render(plain, img, &gouraud).ok());
+  EXPECT_GT(gouraud.fragments, 2000u);
+  EXPECT_EQ(textured.fragments, gouraud.fragments)
+      << textured.fragments << " " << gouraud.fragments;
+  EXPECT_EQ(textured.hiddenFragments, gouraud.hiddenFragments);
+}
+
 // Deferred shading gathers the pixels of triangles too small to fill a batch into shared
 // batches of one material. Tiny triangles, each reading a texel of its own (nearest, at the
 // texel's centre), alternate between two materials whose textures hold the same colours with the
