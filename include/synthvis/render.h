@@ -97,6 +97,10 @@ struct FrameStats {
   // Hybrid masking: tile passes (a tile per batch) in which it woke — a tile starts as the plain
   // Z-buffer and masks once the depth test has hidden enough (docs/hidden-surfaces.md).
   uint64_t hybridWoken = 0;
+  // Deferred pixel shading's passes (one a tile per batch, and one before each translucent
+  // triangle): those that found each triangle's pixels from the list of the blocks it won, and
+  // those that scanned the whole tile (many or large triangles; docs/performance.md).
+  uint64_t shadedByList = 0, shadedByScan = 0;
   uint64_t occludedWindows = 0;    // windows triangles were dropped from as occupied (priority)
   uint64_t occludedTriangles = 0;  // triangles dropped whole from a tile (their box occupied)
   uint64_t occludedObjects = 0;    // objects dropped whole from a tile (their bound occupied)

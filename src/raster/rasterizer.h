@@ -30,6 +30,8 @@ struct RasterStats {
                                        // anti-aliasing) and reached the depth test
   uint64_t hiddenFragments = 0;        // … of which the depth test passed none
   uint64_t hybridWoken = 0;           // tile passes in which hybrid masking woke (drawLists)
+  uint64_t shadedByList = 0;  // deferred shading passes that read the tile kernel's WinnerList
+  uint64_t shadedByScan = 0;  // … that scanned the tile
 
   void add(const RasterStats& o) {
     for (int i = 0; i < kStatLevels; ++i) windows[i] += o.windows[i];
@@ -41,6 +43,8 @@ struct RasterStats {
     fragments += o.fragments;
     hiddenFragments += o.hiddenFragments;
     hybridWoken += o.hybridWoken;
+    shadedByList += o.shadedByList;
+    shadedByScan += o.shadedByScan;
   }
 };
 

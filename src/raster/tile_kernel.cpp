@@ -74,6 +74,35 @@ enum class PixelOp : uint8_t { overdraw, gouraud, material, visibility, levels }
 // Visibility: "no triangle recorded since the last shading pass".
 constexpr uint32_t kNoTriangle = ~0u;
 
+// Deferred shading's list of the triangles that won pixels since the last shading pass, in draw
+// order, each with its box in the tile's 4×4 blocks: shadeVisible reads the blocks of each box for
+// the pixels that still record the triangle — the triangle's pixels, batched without searching the
+// tile for them. Scanning the whole tile costs the same however many triangles there are, the
+// list's reads grow with their boxes' blocks: past kBudget blocks in all (4 a block — large
+// triangles, or several layers) the scan is the cheaper. docs/performance.md.
+struct WinnerList {
+  static constexpr int kBudget = 4 * kBlocksPerTileSide * kBlocksPerTileSide;
+  struct Entry {
+    uint32_t id;                 // setup storage index
+    uint8_t bx0, by0, bx1, by1;  // the box's first and last block column and row
+  };
+  int count = 0, blocks = 0;
+  Entry entry[kBudget];  // (a box holds a block at least)
+
+  // Triangle `id`, which won pixels in the tile-local pixel box [x0, x1] × [y0, y1].
+  void add(uint32_t id, int x0, int y0, int x1, int y1) {
+    if (blocks > kBudget) return;  // the scan's, for the rest of the pass
+    const int bx0 = x0 >> kBlockLog2, by0 = y0 >> kBlockLog2;
+    const int bx1 = x1 >> kBlockLog2, by1 = y1 >> kBlockLog2;
+    blocks += (bx1 - bx0 + 1) * (by1 - by0 + 1);
+    if (blocks <= kBudget)
+      entry[count++] = {id, uint8_t(bx0), uint8_t(by0), uint8_t(bx1), uint8_t(by1)};
+  }
+  // Whether shadeVisible reads the list rather than scanning the tile.
+  bool useful() const { return blocks <= kBudget; }
+  void reset() { count = blocks = 0; }
+};
+
 struct TileContext {
   int originX, originY;  // pixel coordinates of the tile's top-left pixel
   float* depth;
@@ -97,6 +126,8 @@ struct TileContext {
   int32_t* sums = nullptr;
   float* clearPlanes = nullptr;
   int32_t clearColor[kColorChannels] = {};
+  // Deferred shading: the triangles that won pixels, or nullptr (WinnerList).
+  WinnerList* winners = nullptr;
 };
 
 // Adds `count` samples of colour `c` (16-bit values in int32 lanes) to a block's colour sums in
@@ -730,13 +761,15 @@ void occupancyView(const Occupancy& occ, uint16_t* color) {
 // Gouraud colour), and clears the records. Pixels are batched by triangle, up to 16 to a batch
 // from anywhere in the tile, so that a batch fills the SIMD lanes even for triangles of a few
 // pixels (a batch per 4×4 block and triangle shaded 3 lanes for every pixel on tris 100k × 10
-// px); open batches sit in a small table by triangle, and a batch leaves it when full or when
-// another triangle needs its slot. A pixel-shaded batch that leaves it short of 16 (on tris 100k
-// × 10 px a batch held 7.2 pixels on average) has its attributes and texture coordinates evaluated
-// and joins other triangles' pixels of its material in the mixer, which passes on whole batches.
-// Pixel-shaded batches then wait in a queue, so that the texels each will read have been
-// requested (shade::textureCoordinates) a whole queue's work earlier. A pixel's planes are
-// evaluated at it directly, (c0 + dx·X) + dy·Y. docs/performance.md.
+// px). A triangle's pixels are found in the blocks of its box (WinnerList), triangle after
+// triangle; where the list is over its budget, by a scan of the tile, with open batches in a small
+// table by triangle, a batch leaving it when full or when another triangle needs its slot. A
+// pixel-shaded batch that leaves it short of 16 (on tris 100k × 10 px a batch held 7.2 pixels on
+// average) has its attributes and texture coordinates evaluated and joins other triangles' pixels
+// of its material in the mixer, which passes on whole batches. Pixel-shaded batches then wait in a
+// queue, so that the texels each will read have been requested (shade::textureCoordinates) a whole
+// queue's work earlier. A pixel's planes are evaluated at it directly, (c0 + dx·X) + dy·Y.
+// docs/performance.md.
 HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
   const hn::CappedTag<float, kBlockPixels> df;
   const hn::RebindToSigned<decltype(df)> di;
@@ -1006,11 +1039,70 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
     b.count = 0;
   };
 
-  // The tile's records a vector at a time: each triangle in a vector takes all its pixels there
-  // at once (a compress of their numbers), so the work goes with the triangles a block holds, not
-  // with its pixels. A batch's pixels stay in scan order.
   const hn::RebindToUnsigned<decltype(df)> du;
   const auto none = hn::Set(du, kNoTriangle);
+  // Appends the lanes `mine` of `pixels` to triangle t's batch b, which leaves when full (the rest
+  // start its next).
+  auto take = [&](Batch& b, uint32_t t, auto pixels, auto mine) {
+    hn::StoreU(hn::Compress(pixels, hn::RebindMask(di, mine)), di, b.pixel + b.count);
+    b.count += int(hn::CountTrue(du, mine));
+    if (b.count >= kBlockPixels) {
+      const int rest = b.count - kBlockPixels;
+      b.count = kBlockPixels;
+      emit(b);
+      std::copy_n(b.pixel + kBlockPixels, rest, b.pixel);
+      b.id = t;
+      b.count = rest;
+    }
+  };
+  WinnerList* list = ctx.winners;
+  if (list && list->useful()) {
+    ++ctx.stats->shadedByList;
+    // Each triangle's blocks, in draw order (WinnerList): the pixels of a block that still record
+    // the triangle are its own, taken by one compare and one compress; a block it holds whole is a
+    // batch by itself, lane for lane (store's vector path). A batch's pixels stay in scan order.
+    Batch b;
+    for (int e = 0; e < list->count; ++e) {
+      const WinnerList::Entry entry = list->entry[e];
+      if (b.count) emit(b);
+      b.id = entry.id;
+      const auto id = hn::Set(du, entry.id);
+      for (int by = entry.by0; by <= entry.by1; ++by)
+        for (int bx = entry.bx0; bx <= entry.bx1; ++bx) {
+          const int block = by * kBlocksPerTileSide + bx;
+          uint32_t* visible = ctx.visible + block * kBlockPixels;
+          const int first = block * kBlockPixels;
+          bool whole = b.count == 0;
+          for (size_t i = 0; whole && i < size_t(kBlockPixels); i += n)
+            whole = hn::AllTrue(du, hn::Eq(hn::LoadU(du, visible + i), id));
+          if (whole) {
+            for (size_t i = 0; i < size_t(kBlockPixels); i += n) {
+              hn::StoreU(none, du, visible + i);
+              hn::Store(hn::Add(laneIndex, hn::Set(di, first + int(i))), di, b.pixel + i);
+            }
+            b.count = kBlockPixels;
+            emit(b);
+            b.id = entry.id;
+            continue;
+          }
+          for (size_t i = 0; i < size_t(kBlockPixels); i += n) {
+            const auto mine = hn::Eq(hn::LoadU(du, visible + i), id);
+            hn::BlendedStore(none, mine, du, visible + i);
+            take(b, entry.id, hn::Add(laneIndex, hn::Set(di, first + int(i))), mine);
+          }
+        }
+    }
+    if (b.count) emit(b);
+    if (mix.count) shipMix();
+    finishQueue();
+    list->reset();
+    return;
+  }
+  if (list) list->reset();
+  ++ctx.stats->shadedByScan;
+  // Otherwise the tile's records a vector at a time: each triangle in a vector takes all its
+  // pixels there at once (a compress of their numbers), so the work goes with the triangles a block
+  // holds, not with its pixels. A batch's pixels stay in scan order.
   for (int start = 0; start < kTilePixels; start += int(n)) {
     uint32_t* visible = ctx.visible + start;
     if ((start & (kBlockPixels - 1)) == 0) {
@@ -1047,18 +1139,7 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
         if (b.count) emit(b);
         b.id = t;
       }
-      hn::StoreU(hn::Compress(pixels, hn::RebindMask(di, mine)), di, b.pixel + b.count);
-      b.count += int(hn::CountTrue(du, mine));
-      if (b.count >= kBlockPixels) {
-        const int rest = b.count - kBlockPixels;
-        b.count = kBlockPixels;
-        emit(b);
-        if (rest) {
-          std::copy_n(b.pixel + kBlockPixels, rest, b.pixel);
-          b.id = t;
-          b.count = rest;
-        }
-      }
+      take(b, t, pixels, mine);
     } while (!hn::AllFalse(du, left));
   }
   for (Batch& b : slots)
@@ -1894,6 +1975,8 @@ void drawLists(const TileWork& w, RasterStats& stats) {
                         kShade == ShadeMode::overdraw || w.masking == Masking::none ? nullptr
                                                                                     : w.occupancy,
                         w.masking == Masking::hybrid};
+  WinnerList winners;
+  if (deferred) ctx.winners = &winners;
   alignas(64) float clearPlanes[64 * kBlockPixels];
   if (w.sums) {
     std::fill_n(clearPlanes, ctx.samples * kBlockPixels, w.clearDepth);
@@ -2004,6 +2087,11 @@ void drawLists(const TileWork& w, RasterStats& stats) {
         const shade::AlphaUse alpha = a.material ? a.material->alpha : shade::AlphaUse::opaque;
         if (deferred && alpha == shade::AlphaUse::opaque) {
           drawTriangle<PixelOp::visibility, false>(t, *use, nullptr, list[i], boxes != nullptr);
+          if (stats.fragments - fragmentsBefore > stats.hiddenFragments - hiddenBefore)
+            winners.add(list[i], std::max(t.minX - ctx.originX, 0),
+                        std::max(t.minY - ctx.originY, 0),
+                        std::min(t.maxX - ctx.originX, kTileSize - 1),
+                        std::min(t.maxY - ctx.originY, kTileSize - 1));
           pending = true;
           wakeIfHidden(fragmentsBefore, hiddenBefore);
           continue;

@@ -283,6 +283,8 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
   stats.fragments += total.fragments;
   stats.hiddenFragments += total.hiddenFragments;
   stats.hybridWoken += total.hybridWoken;
+  stats.shadedByList += total.shadedByList;
+  stats.shadedByScan += total.shadedByScan;
 }
 
 }  // namespace sv::render

@@ -354,7 +354,9 @@ TEST(Shading, DeferredShadingCountsEachFragmentOnce) {
 // texel's centre), alternate between two materials whose textures hold the same colours with the
 // channels rotated: every pixel must show its own triangle's texel of its own material's texture —
 // as in the same frame drawn untextured with those colours as vertex colours (which is not pixel
-// shaded) — on every SIMD target.
+// shaded) — on every SIMD target. Alone, some of the grid's tiles find each triangle's pixels from
+// the list of the blocks it won; behind four screen-filling layers (drawn first, each hiding the
+// one before), which fill that list's budget, all scan the tile: both ways must give that image.
 TEST(Shading, TinyTrianglesKeepTheirOwnTexelAndMaterialInSharedBatches) {
   constexpr int kSide = 32;  // texels a side: 1024 colours
   texture::Level levels[2];
@@ -368,7 +370,7 @@ TEST(Shading, TinyTrianglesKeepTheirOwnTexelAndMaterialInSharedBatches) {
                                    : texture::Texel{c[0], c[1], c[2], 65535});
     }
   }
-  auto build = [&](bool textured) {
+  auto build = [&](bool textured, int layers) {
     scene::Scene s = emptyScene();
     scene::Mesh meshes[2];
     for (int k = 0; k < 2; ++k) {
@@ -381,6 +383,24 @@ TEST(Shading, TinyTrianglesKeepTheirOwnTexelAndMaterialInSharedBatches) {
       m.unlit = true;
       s.materials.push_back(m);
       meshes[k].material = k;
+    }
+    // A vertex of mesh m reading texel `texel` (nearest, at its centre), or untextured, colour c.
+    auto vertex = [&](scene::Mesh& m, const Vec3& p, int texel, const texture::Color4& c) {
+      m.indices.push_back(uint32_t(m.positions.size()));
+      m.positions.push_back(p);
+      m.uvs.push_back(
+          {(float(texel % kSide) + 0.5f) / kSide, (float(texel / kSide) + 0.5f) / kSide});
+      m.colors.push_back(textured ? Vec4{1, 1, 1, 1} : Vec4{c.r, c.g, c.b, 1});
+      m.normals.push_back({0, 0, 1});
+    };
+    // The layers behind: material 0's texel 5 all over, farthest first.
+    const int backdrop = 5;
+    const texture::Color4 b =
+        texture::unpackTexel(texture::packTexel(levels[0].texels[size_t(backdrop)]));
+    for (int l = 0; l < layers; ++l) {
+      const float z = -6.0f + 0.5f * float(l);
+      const Vec3 corner[4] = {{-20, -20, z}, {20, -20, z}, {20, 20, z}, {-20, 20, z}};
+      for (int v : {0, 1, 2, 0, 2, 3}) vertex(meshes[0], corner[v], backdrop, b);
     }
     // A 40 × 30 grid of cells about 4 px wide, each cell's two triangles of different materials.
     const int nx = 40, ny = 30;
@@ -396,15 +416,7 @@ TEST(Shading, TinyTrianglesKeepTheirOwnTexelAndMaterialInSharedBatches) {
           const int texel = (triangle * 37) % (kSide * kSide);
           const texture::Color4 c =
               texture::unpackTexel(texture::packTexel(levels[k].texels[size_t(texel)]));
-          scene::Mesh& m = meshes[k];
-          for (int v : tri[t]) {
-            m.indices.push_back(uint32_t(m.positions.size()));
-            m.positions.push_back(corner[v]);
-            m.uvs.push_back(
-                {(float(texel % kSide) + 0.5f) / kSide, (float(texel / kSide) + 0.5f) / kSide});
-            m.colors.push_back(textured ? Vec4{1, 1, 1, 1} : Vec4{c.r, c.g, c.b, 1});
-            m.normals.push_back({0, 0, 1});
-          }
+          for (int v : tri[t]) vertex(meshes[k], corner[v], texel, c);
         }
       }
     for (scene::Mesh& m : meshes) {
@@ -413,20 +425,36 @@ TEST(Shading, TinyTrianglesKeepTheirOwnTexelAndMaterialInSharedBatches) {
     }
     return s;
   };
-  const scene::Scene plain = build(false), textured = build(true);
+  RenderOptions o;
+  o.width = 160;
+  o.height = 120;
+  o.threads = 2;
+  o.textureFilter = scene::TextureFilter::nearest;
   int targets = 0;
   for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
     hwy::SetSupportedTargetsForTest(target);
     ++targets;
-    const Image expected = render(plain, 160, 120, 2, scene::TextureFilter::nearest);
-    const Image img = render(textured, 160, 120, 2, scene::TextureFilter::nearest);
-    int differing = 0, lit = 0;
-    for (size_t i = 0; i < img.rgb.size(); ++i) {
-      differing += std::abs(int(img.rgb[i]) - int(expected.rgb[i])) > 1;
-      lit += img.rgb[i] > 0;
+    for (int layers : {0, 4}) {
+      Image expected, img;
+      FrameStats stats;
+      ASSERT_TRUE(Renderer(o).render(build(false, layers), expected).ok());
+      ASSERT_TRUE(Renderer(o).render(build(true, layers), img, &stats).ok());
+      int differing = 0, lit = 0;
+      for (size_t i = 0; i < img.rgb.size(); ++i) {
+        differing += std::abs(int(img.rgb[i]) - int(expected.rgb[i])) > 1;
+        lit += img.rgb[i] > 0;
+      }
+      EXPECT_EQ(differing, 0) << hwy::TargetName(target) << ", " << layers << " layers";
+      EXPECT_GT(lit, int(img.rgb.size()) * 3 / 4) << hwy::TargetName(target);
+      // Which way the six tiles found their pixels: alone, the narrow tiles of the right column
+      // (32 px wide, ~260 triangles) from the list — the others hold too many triangles' blocks
+      // and scan; behind the layers, all scan.
+      EXPECT_EQ(stats.shadedByList + stats.shadedByScan, 6u);
+      if (layers)
+        EXPECT_EQ(stats.shadedByList, 0u);
+      else
+        EXPECT_GE(stats.shadedByList, 2u);
     }
-    EXPECT_EQ(differing, 0) << hwy::TargetName(target);
-    EXPECT_GT(lit, int(img.rgb.size()) * 3 / 4) << hwy::TargetName(target);
   }
   hwy::SetSupportedTargetsForTest(0);
   EXPECT_GE(targets, 1);
