@@ -98,8 +98,9 @@ struct FrameStats {
   // Z-buffer and masks once the depth test has hidden enough (docs/hidden-surfaces.md).
   uint64_t hybridWoken = 0;
   // Deferred pixel shading's passes (one a tile per batch, and one before each translucent
-  // triangle): those that found each triangle's pixels from the list of the blocks it won, and
-  // those that scanned the whole tile (many or large triangles; docs/performance.md).
+  // triangle): those that found each triangle's pixels from a list of the triangles that won
+  // pixels, each with its box, and those that scanned the whole tile (many or large triangles,
+  // whose boxes hold more blocks than the scan reads; docs/performance.md).
   uint64_t shadedByList = 0, shadedByScan = 0;
   uint64_t occludedWindows = 0;    // windows triangles were dropped from as occupied (priority)
   uint64_t occludedTriangles = 0;  // triangles dropped whole from a tile (their box occupied)
