@@ -1055,6 +1055,18 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
       b.count = rest;
     }
   };
+  // Block `first`'s 16 pixels, all triangle t's, as a batch b by itself, lane for lane (store's
+  // vector path), their records cleared; b is left open for t.
+  auto takeWhole = [&](Batch& b, uint32_t t, int first) {
+    for (size_t i = 0; i < size_t(kBlockPixels); i += n) {
+      hn::StoreU(none, du, ctx.visible + first + i);
+      hn::Store(hn::Add(laneIndex, hn::Set(di, first + int(i))), di, b.pixel + i);
+    }
+    b.id = t;
+    b.count = kBlockPixels;
+    emit(b);
+    b.id = t;
+  };
   WinnerList* list = ctx.winners;
   if (list && list->useful()) {
     ++ctx.stats->shadedByList;
@@ -1076,13 +1088,7 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
           for (size_t i = 0; whole && i < size_t(kBlockPixels); i += n)
             whole = hn::AllTrue(du, hn::Eq(hn::LoadU(du, visible + i), id));
           if (whole) {
-            for (size_t i = 0; i < size_t(kBlockPixels); i += n) {
-              hn::StoreU(none, du, visible + i);
-              hn::Store(hn::Add(laneIndex, hn::Set(di, first + int(i))), di, b.pixel + i);
-            }
-            b.count = kBlockPixels;
-            emit(b);
-            b.id = entry.id;
+            takeWhole(b, entry.id, first);
             continue;
           }
           for (size_t i = 0; i < size_t(kBlockPixels); i += n) {
@@ -1093,57 +1099,49 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
         }
     }
     if (b.count) emit(b);
-    if (mix.count) shipMix();
-    finishQueue();
-    list->reset();
-    return;
+  } else {
+    ++ctx.stats->shadedByScan;
+    // Otherwise the tile's records a vector at a time: each triangle in a vector takes all its
+    // pixels there at once (a compress of their numbers), so the work goes with the triangles a
+    // block holds, not with its pixels. A batch's pixels stay in scan order.
+    for (int start = 0; start < kTilePixels; start += int(n)) {
+      uint32_t* visible = ctx.visible + start;
+      if ((start & (kBlockPixels - 1)) == 0) {
+        // A block one triangle holds whole (takeWhole).
+        const uint32_t first = visible[0];
+        bool whole = first != kNoTriangle;
+        for (size_t i = 0; whole && i < size_t(kBlockPixels); i += n)
+          whole = hn::AllTrue(du, hn::Eq(hn::LoadU(du, visible + i), hn::Set(du, first)));
+        if (whole) {
+          Batch b;
+          takeWhole(b, first, start);
+          start += kBlockPixels - int(n);
+          continue;
+        }
+      }
+      const auto ids = hn::LoadU(du, visible);
+      auto left = hn::Ne(ids, none);
+      if (hn::AllFalse(du, left)) continue;
+      hn::StoreU(none, du, visible);
+      alignas(64) uint32_t id[kBlockPixels];
+      hn::Store(ids, du, id);
+      const auto pixels = hn::Add(laneIndex, hn::Set(di, start));
+      do {
+        const uint32_t t = id[hn::FindKnownFirstTrue(du, left)];
+        const auto mine = hn::And(left, hn::Eq(ids, hn::Set(du, t)));
+        left = hn::AndNot(mine, left);
+        Batch& b = slots[(t * 0x9E3779B1u) >> (32 - kSlotBits)];  // a multiplicative hash
+        if (b.id != t) {
+          if (b.count) emit(b);
+          b.id = t;
+        }
+        take(b, t, pixels, mine);
+      } while (!hn::AllFalse(du, left));
+    }
+    for (Batch& b : slots)
+      if (b.count) emit(b);
   }
   if (list) list->reset();
-  ++ctx.stats->shadedByScan;
-  // Otherwise the tile's records a vector at a time: each triangle in a vector takes all its
-  // pixels there at once (a compress of their numbers), so the work goes with the triangles a block
-  // holds, not with its pixels. A batch's pixels stay in scan order.
-  for (int start = 0; start < kTilePixels; start += int(n)) {
-    uint32_t* visible = ctx.visible + start;
-    if ((start & (kBlockPixels - 1)) == 0) {
-      // A block one triangle holds whole is a batch by itself, lane for lane (store's vector path).
-      const uint32_t first = visible[0];
-      bool whole = first != kNoTriangle;
-      for (size_t i = 0; whole && i < size_t(kBlockPixels); i += n)
-        whole = hn::AllTrue(du, hn::Eq(hn::LoadU(du, visible + i), hn::Set(du, first)));
-      if (whole) {
-        for (size_t i = 0; i < size_t(kBlockPixels); i += n) hn::StoreU(none, du, visible + i);
-        Batch b;
-        b.id = first;
-        b.count = kBlockPixels;
-        for (size_t i = 0; i < size_t(kBlockPixels); i += n)
-          hn::Store(hn::Add(laneIndex, hn::Set(di, start + int(i))), di, b.pixel + i);
-        emit(b);
-        start += kBlockPixels - int(n);
-        continue;
-      }
-    }
-    const auto ids = hn::LoadU(du, visible);
-    auto left = hn::Ne(ids, none);
-    if (hn::AllFalse(du, left)) continue;
-    hn::StoreU(none, du, visible);
-    alignas(64) uint32_t id[kBlockPixels];
-    hn::Store(ids, du, id);
-    const auto pixels = hn::Add(laneIndex, hn::Set(di, start));
-    do {
-      const uint32_t t = id[hn::FindKnownFirstTrue(du, left)];
-      const auto mine = hn::And(left, hn::Eq(ids, hn::Set(du, t)));
-      left = hn::AndNot(mine, left);
-      Batch& b = slots[(t * 0x9E3779B1u) >> (32 - kSlotBits)];  // a multiplicative hash
-      if (b.id != t) {
-        if (b.count) emit(b);
-        b.id = t;
-      }
-      take(b, t, pixels, mine);
-    } while (!hn::AllFalse(du, left));
-  }
-  for (Batch& b : slots)
-    if (b.count) emit(b);
   if (mix.count) shipMix();
   finishQueue();
 }
