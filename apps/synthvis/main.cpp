@@ -1,7 +1,8 @@
 // synthvis — command-line front end.
 //
 //   synthvis render [SCENE] -o out.png [--width W] [--height H] [--threads T] [--camera I]
-//                   [--no-cull] [--debug-view overdraw|levels|occupancy] [--gamma G] [--supersample K]
+//                   [--no-cull] [--debug-view overdraw|levels|occupancy] [--gamma G] [--supersample
+//                   K]
 //                   [--aa 1|4|8|16|64] [--filter box|tent3]
 //                   [--texture-filter point|nearest|tri3|bilinear|trilinear3|trilinear|aniso]
 //                   [--hsr zbuffer|priority|hybrid]
@@ -9,20 +10,22 @@
 //                  [--order random|f2b|b2f] [--shade gouraud|textured] [--fog]
 //                  [--texture-filter F] [--hsr zbuffer|priority|hybrid] [--width W] [--height H]
 //                  [--threads T] [--frames F] [--warmup W] [--seed S] [--aa S] [--gl-aa S]
-//                  [--filter box|tent3]
+//                  [--filter box|tent3] [--repeat N]
 //                  [--renderer synthvis|gl|both] [--gl-readback] [--json FILE] [--html DIR]
 //                  [--image FILE]
 //   synthvis gen tris|layers|grazing -o scene.glb [--count N] [--area A] [--depth D] [--layers D]
 //                [--order O] [--seed S] [--width W] [--height H] [--shade gouraud|textured]
 //   synthvis truth [SCENE] -o truth.png [--samples 256] [--width W] [--height H] [--threads T]
-//   synthvis truth … [--edges MASK.png]; synthvis compare IMAGE.png REFERENCE.png [--edges MASK.png]
-//   (shared BENCH.md defines the scenes and the JSON fields)
+//   synthvis truth … [--edges MASK.png]; synthvis compare IMAGE.png REFERENCE.png [--edges
+//   MASK.png] (shared BENCH.md defines the scenes and the JSON fields)
 //
 // Errors print one line, "synthvis: <file>: <problem>", and exit with status 1 (2 for usage).
+#include <fmt/format.h>
+
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <fmt/format.h>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
@@ -145,6 +148,7 @@ struct BenchArgs {
   std::string image;
   int frames = 10;
   int warmup = 2;
+  int repeat = 1;  // measurements of each scene (each with its warm-up and timed frames)
   int aa = 1;
   int glAa = -1;  // -1: as --aa, capped at llvmpipe's 4
   std::string filter = "box";
@@ -186,6 +190,40 @@ sv::Result<sv::reference::BenchCase> generatorCase(const std::string& kind, cons
   return c;
 }
 
+// After --repeat N measurements of one scene: each renderer's median frame time over them (the
+// median of their medians) and the ratio's median and range. Returns the repetition whose ratio
+// (or, for one renderer, whose first renderer's time) is the median — the lower middle one for an
+// even N.
+size_t printRepeatMedians(const std::vector<sv::reference::CaseResult>& repeats) {
+  const size_t n = repeats.size();
+  auto key = [&](size_t k) {
+    const auto& runs = repeats[k].runs;
+    return runs.size() > 1 ? runs[1].medianMs / runs[0].medianMs : runs[0].medianMs;
+  };
+  std::vector<size_t> order(n);
+  for (size_t k = 0; k < n; ++k) order[k] = k;
+  std::sort(order.begin(), order.end(), [&](size_t x, size_t y) { return key(x) < key(y); });
+  const size_t middle = order[(n - 1) / 2];
+  std::string line = fmt::format("median of {} repeats:", n);
+  for (size_t r = 0; r < repeats[0].runs.size(); ++r) {
+    std::vector<double> ms;
+    for (const auto& c : repeats) ms.push_back(c.runs[r].medianMs);
+    std::sort(ms.begin(), ms.end());
+    const double mid = n % 2 ? ms[n / 2] : 0.5 * (ms[n / 2 - 1] + ms[n / 2]);
+    line += fmt::format("  {} {:.2f} ms ({:.2f}–{:.2f})", repeats[0].runs[r].renderer, mid,
+                        ms.front(), ms.back());
+  }
+  if (repeats[0].runs.size() > 1) {
+    std::vector<double> ratio;
+    for (size_t k = 0; k < n; ++k) ratio.push_back(key(k));
+    std::sort(ratio.begin(), ratio.end());
+    const double mid = n % 2 ? ratio[n / 2] : 0.5 * (ratio[n / 2 - 1] + ratio[n / 2]);
+    line += fmt::format("  ratio {:.2f}x ({:.2f}–{:.2f})", mid, ratio.front(), ratio.back());
+  }
+  fmt::print("{}\n", line);
+  return middle;
+}
+
 int runBench(BenchArgs a) {
   namespace ref = sv::reference;
   a.options.samples = a.aa == 0 ? 1 : a.aa;
@@ -214,6 +252,8 @@ int runBench(BenchArgs a) {
                                      a.renderer)});
   if (auto order = sv::scene::parseSubmitOrder(a.generator.order); !order)
     return fail(order.error());
+  if (a.repeat < 1 || a.repeat > 100)
+    return fail({"", "", fmt::format("--repeat {}: must be 1…100", a.repeat)});
   if (a.glAa == -1) a.glAa = a.aa >= 2 ? std::min(a.aa, 4) : 0;
   if (a.glAa != 0 && a.glAa != 2 && a.glAa != 4 && a.glAa != 8 && a.glAa != 16)
     return fail({"", "", fmt::format("--gl-aa {}: the reference's samples per pixel must be 0, 2, "
@@ -267,21 +307,31 @@ int runBench(BenchArgs a) {
   nlohmann::json rows = nlohmann::json::array();
   for (size_t i = 0; i < cases.size(); ++i) {
     if (cases.size() > 1) fmt::print("[{}/{}] {} …\n", i + 1, cases.size(), cases[i].name);
-    std::fflush(stdout);
-    auto r = runner.run(cases[i]);
-    if (!r) {
-      sv::Error e = r.error();
-      if (e.file.empty() && !cases[i].file.empty()) e.file = cases[i].file;
-      return fail(e);
+    std::vector<ref::CaseResult> repeats;
+    for (int k = 0; k < a.repeat; ++k) {
+      if (a.repeat > 1) fmt::print("repeat {}/{}\n", k + 1, a.repeat);
+      std::fflush(stdout);
+      auto r = runner.run(cases[i]);
+      if (!r) {
+        sv::Error e = r.error();
+        if (e.file.empty() && !cases[i].file.empty()) e.file = cases[i].file;
+        return fail(e);
+      }
+      const ref::CaseResult& cr = r.value();
+      if (k == 0 && !cr.params.contains("file"))
+        fmt::print("{}: {} triangles, mean area {:.1f} px, depth complexity {:.2f}\n", cr.name,
+                   cr.triangles, cr.meanArea, cr.depthComplexity);
+      fmt::print("{}\n", ref::summaryLine(cr));
+      if (settings.synthvis) fmt::print("  synthvis last frame: {}\n", cr.runs[0].stats.summary());
+      for (auto& row : ref::jsonRows(cr, settings)) {
+        if (a.repeat > 1) row["repeat"] = k + 1;
+        rows.push_back(row);
+      }
+      repeats.push_back(std::move(r).value());
     }
-    const ref::CaseResult& cr = r.value();
-    if (!cr.params.contains("file"))
-      fmt::print("{}: {} triangles, mean area {:.1f} px, depth complexity {:.2f}\n", cr.name,
-                 cr.triangles, cr.meanArea, cr.depthComplexity);
-    fmt::print("{}\n", ref::summaryLine(cr));
-    if (settings.synthvis) fmt::print("  synthvis last frame: {}\n", cr.runs[0].stats.summary());
-    for (auto& row : ref::jsonRows(cr, settings)) rows.push_back(row);
-    results.push_back(std::move(r).value());
+    // The pages and images show the repetition the median line names.
+    const size_t median = a.repeat > 1 ? printRepeatMedians(repeats) : 0;
+    results.push_back(std::move(repeats[median]));
   }
 
   if (!a.image.empty())
@@ -455,6 +505,11 @@ int main(int argc, char** argv) {
   bench->add_option("--threads", b.options.threads, "worker threads")->capture_default_str();
   bench->add_option("--frames", b.frames, "timed frames")->capture_default_str();
   bench->add_option("--warmup", b.warmup, "untimed frames first")->capture_default_str();
+  bench
+      ->add_option("--repeat", b.repeat,
+                   "measure each scene N times (warm-up and timed frames each) and print the "
+                   "medians over them, with the ratio's range")
+      ->capture_default_str();
   bench->add_option("--aa", b.aa, "synthvis: samples per pixel (1, 4, 8, 16, 64)")
       ->capture_default_str();
   bench->add_option("--gl-aa", b.glAa,

@@ -111,6 +111,30 @@ TEST(Cli, BenchWritesTheJsonFieldsBenchMdNames) {
     EXPECT_NE(text.find(key), std::string::npos) << key;
 }
 
+// --repeat N: each measurement printed and written as a JSON row numbered by its repeat, then the
+// medians over them; an impossible count is a one-line error.
+TEST(Cli, BenchRepeatPrintsEachMeasurementAndTheirMedian) {
+  const std::string json = (tempDir() / "repeat.json").string();
+  const CliRun r =
+      run("bench tris --count 500 --area 20 --width 160 --height 120 --frames 2 "
+          "--warmup 0 --repeat 3 --json " +
+          json);
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("repeat 3/3"), std::string::npos) << r.out;
+  const size_t median = r.out.find("median of 3 repeats:  synthvis ");
+  ASSERT_NE(median, std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("ratio", median), std::string::npos) << r.out;  // one renderer: no ratio
+  std::ifstream f(json);
+  const nlohmann::json rows = nlohmann::json::parse(f);
+  ASSERT_TRUE(rows.is_array()) << rows.dump();
+  ASSERT_EQ(rows.size(), 3u);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(rows[k]["repeat"], k + 1);
+    EXPECT_EQ(rows[k]["renderer"], "synthvis");
+  }
+  expectOneLineError(run("bench tris --repeat 0"), "", "--repeat 0: must be 1…100");
+}
+
 // Side by side with the gl reference when it can start here; otherwise the line says why and the
 // run goes on with synthvis alone. (Mesa's driver leaks a little at unload: no leak check.)
 TEST(Cli, BenchBothRenderersWritesARowEachWithPsnrAndAnHtmlPage) {
