@@ -87,7 +87,9 @@ struct alignas(64) AttributeSetup {
   geometry::Plane planes[shade::kAttributeCount];
   // The record is two cache lines; the first holds the material and the first planes (a
   // textured material's u and v). Whether shading reads the second, by attributesUsed's bits:
-  static constexpr int kFirstLinePlanes = int((64 - sizeof(void*)) / sizeof(geometry::Plane));
+  static constexpr size_t kLineBytes = 64;
+  static constexpr int kFirstLinePlanes =
+      int((kLineBytes - sizeof(void*)) / sizeof(geometry::Plane));
   static bool readsSecondLine(unsigned used) { return (used >> kFirstLinePlanes) != 0; }
 };
 

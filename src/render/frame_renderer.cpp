@@ -99,6 +99,16 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
   setups_.resize(std::max<size_t>(setups_.size(), firstBatch));
   const bool pixelShading = settings.shade == raster::ShadeMode::material;
   if (pixelShading) attributes_.resize(std::max<size_t>(attributes_.size(), firstBatch));
+  // How much of each pixel-shading record binning stores: the second line only when some material
+  // of the frame reads it (AttributeSetup).
+  unsigned attributesRead = 0;
+  if (pixelShading)
+    for (const DrawCall& call : packets.calls)
+      if (call.material)
+        attributesRead |= shade::attributesUsed(*call.material, *settings.environment);
+  const size_t recordBytes = raster::AttributeSetup::readsSecondLine(attributesRead)
+                                 ? sizeof(raster::AttributeSetup)
+                                 : raster::AttributeSetup::kLineBytes;
   scratch_.resize(size_t(pool_.threadCount()));
   const bool masking = settings.masking != raster::Masking::none;
   for (WorkerScratch& w : scratch_) {
@@ -197,10 +207,12 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
                        storageBase, scratch.bins, masking ? scratch.objects.data() : nullptr,
                        boxes);
       // Pixel shading's planes, stored as the setup records are (grouped by tile): a tile finds
-      // each triangle's from its list entry and reads them in runs, as it reads the records.
+      // each triangle's from its list entry and reads them in runs, as it reads the records. Only
+      // their first line when no material of the frame reads the second (a textured, unlit
+      // frame's): half the bytes streamed (tris 100k × 10 px textured ×0.964).
       if (pixelShading)
         core::gatherStreaming(attributes_.data() + storageBase, scratch.attributes.data(),
-                              scratch.bins.order.data(), n);
+                              scratch.bins.order.data(), n, recordBytes);
       counts[chunk] = c;
     });
     for (int i = 0; i < chunks; ++i) {

@@ -1,9 +1,12 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
+#include "core/streaming.h"
 #include "core/thread_pool.h"
 #include "synthvis/math.h"
 
@@ -23,6 +26,38 @@ TEST(ThreadPool, RunsEveryItemExactlyOnceForAnyThreadCount) {
       for (size_t i = 0; i < count; ++i) EXPECT_EQ(hits[i].load(), 1) << threads << " " << i;
     }
   }
+}
+
+// Binning's record copy: element k takes src[order[k]] whole, or only its first `prefix` bytes
+// with the rest of dst untouched — by the streaming path (aligned) and the plain one (not).
+TEST(Streaming, GatherCopiesWholeRecordsOrTheirPrefixInTheGivenOrder) {
+  struct alignas(64) Record {
+    uint8_t bytes[128];
+  };
+  std::vector<Record> src(5);
+  for (size_t r = 0; r < src.size(); ++r)
+    for (size_t b = 0; b < sizeof(Record); ++b) src[r].bytes[b] = uint8_t(r * 31 + b);
+  const uint32_t order[] = {3, 0, 4, 1};
+  for (size_t prefix : {sizeof(Record), size_t(64), size_t(16)}) {
+    std::vector<Record> dst(4);
+    for (Record& d : dst) std::fill(std::begin(d.bytes), std::end(d.bytes), uint8_t(0xEE));
+    core::gatherStreaming(dst.data(), src.data(), order, 4, prefix);
+    for (size_t k = 0; k < 4; ++k)
+      for (size_t b = 0; b < sizeof(Record); ++b)
+        ASSERT_EQ(dst[k].bytes[b], b < prefix ? src[order[k]].bytes[b] : 0xEE)
+            << "prefix " << prefix << " element " << k << " byte " << b;
+  }
+  // Elements of 12 bytes (not whole 16-byte units) take the plain path; a prefix that is not a
+  // multiple of 16 copies them whole.
+  struct Small {
+    uint32_t v[3];
+  };
+  const std::vector<Small> from = {{{1, 2, 3}}, {{4, 5, 6}}};
+  std::vector<Small> to(2, Small{{9, 9, 9}});
+  const uint32_t swap[] = {1, 0};
+  core::gatherStreaming(to.data(), from.data(), swap, 2, 8);
+  EXPECT_EQ(to[0].v[2], 6u);
+  EXPECT_EQ(to[1].v[0], 1u);
 }
 
 TEST(Mat4, NormalMatrixKeepsNormalsPerpendicularUnderNonUniformScale) {
