@@ -822,6 +822,16 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
 
   // (Highway's Iota builds its vector in memory, lane by lane: made once, not per block.)
   const auto laneIndex = hn::Iota(di, 0);
+  // shade::attributesUsed of the material last asked about (batches run in long runs of one).
+  const shade::MaterialShading* usedMaterial = nullptr;
+  unsigned usedBits = 0;
+  auto attributesOf = [&](const shade::MaterialShading* m) {
+    if (m != usedMaterial) {
+      usedMaterial = m;
+      usedBits = shade::attributesUsed(*m, *ctx.environment);
+    }
+    return usedBits;
+  };
   // Writes lanes [0, count) of 16-bit colour c16 to their pixels.
   auto store = [&](const int32_t* pixel, int count, const uint16_t(*c16)[kBlockPixels]) {
     // 16 lanes that are one block's pixels in order, whether one triangle's or several's: three
@@ -883,7 +893,7 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
     shade::Fragments& f = q.fragments;
     f.count = kBlockPixels;
     const bool rest = mix.count > kBlockPixels;
-    const unsigned used = shade::attributesUsed(*mix.material, *ctx.environment);
+    const unsigned used = attributesOf(mix.material);
     shipLanes(mix.q, f.q, count, rest);
     for (int ch = 0; ch < kColorChannels; ++ch) shipLanes(mix.color[ch], f.color[ch], count, rest);
     for (int k = 0; k < shade::kAttributeCount; ++k)
@@ -906,7 +916,7 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
     const TriangleSetup& t = ctx.setups[b.id];
     const AttributeSetup& a = ctx.attributes[b.id];
     const auto lastPixel = hn::Set(di, b.pixel[b.count - 1]);
-    const unsigned used = f ? shade::attributesUsed(*a.material, *ctx.environment) : 0;
+    const unsigned used = f ? attributesOf(a.material) : 0;
     for (size_t i = 0; i < size_t(kBlockPixels); i += n) {
       const auto p = hn::IfThenElse(hn::FirstN(di, size_t(std::max(b.count - int(i), 0))),
                                     hn::Load(di, b.pixel + i), lastPixel);
@@ -981,7 +991,7 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
       if (material->texture) shade::textureCoordinates(*material, f, tc);
       if (mix.count && mix.material != material) shipMix();
       mix.material = material;
-      const unsigned used = shade::attributesUsed(*material, *ctx.environment);
+      const unsigned used = attributesOf(material);
       if constexpr (kRotate) {
         // The batch turned by the mixer's count: its first lanes land after those waiting, and
         // the lanes that do not fit are then already at the start, where they wait in turn.
