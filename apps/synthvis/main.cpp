@@ -1,9 +1,8 @@
 // synthvis — command-line front end.
 //
 //   synthvis render [SCENE] -o out.png [--width W] [--height H] [--threads T] [--camera I]
-//                   [--no-cull] [--debug-view overdraw|levels|occupancy] [--gamma G] [--supersample
-//                   K]
-//                   [--aa 1|4|8|16|64] [--filter box|tent3]
+//                   [--no-cull] [--debug-view overdraw|levels|occupancy] [--gamma G]
+//                   [--supersample K] [--aa 1|4|8|16|64] [--filter box|tent3]
 //                   [--texture-filter point|nearest|tri3|bilinear|trilinear3|trilinear|aniso]
 //                   [--hsr zbuffer|priority|hybrid]
 //   synthvis bench SCENE|--suite quick|full [--count N] [--area A] [--depth D] [--layers D]
@@ -16,8 +15,9 @@
 //   synthvis gen tris|layers|grazing -o scene.glb [--count N] [--area A] [--depth D] [--layers D]
 //                [--order O] [--seed S] [--width W] [--height H] [--shade gouraud|textured]
 //   synthvis truth [SCENE] -o truth.png [--samples 256] [--width W] [--height H] [--threads T]
-//   synthvis truth … [--edges MASK.png]; synthvis compare IMAGE.png REFERENCE.png [--edges
-//   MASK.png] (shared BENCH.md defines the scenes and the JSON fields)
+//   synthvis truth … [--edges MASK.png]
+//   synthvis compare IMAGE.png REFERENCE.png [--edges MASK.png]
+//   (shared BENCH.md defines the scenes and the JSON fields)
 //
 // Errors print one line, "synthvis: <file>: <problem>", and exit with status 1 (2 for usage).
 #include <fmt/format.h>

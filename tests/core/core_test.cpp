@@ -29,7 +29,8 @@ TEST(ThreadPool, RunsEveryItemExactlyOnceForAnyThreadCount) {
 }
 
 // Binning's record copy: element k takes src[order[k]] whole, or only its first `prefix` bytes
-// with the rest of dst untouched — by the streaming path (aligned) and the plain one (not).
+// with the rest of dst untouched (the streaming path: 16-byte multiples, aligned); elements of
+// other sizes are copied plainly, and whole when the prefix is no multiple of 16.
 TEST(Streaming, GatherCopiesWholeRecordsOrTheirPrefixInTheGivenOrder) {
   struct alignas(64) Record {
     uint8_t bytes[128];
