@@ -399,6 +399,9 @@ struct AttributeLanes {
   float c0[shade::kAttributeCount], dx[shade::kAttributeCount], dy[shade::kAttributeCount];
 };
 
+// Every plane, used or not: the lanes of planes the material does not read are never read either
+// (blockFragments takes only attributesUsed's), and those planes may hold stale values — binning
+// stores a record's second line only when some material of the frame reads it (AttributeSetup).
 HWY_INLINE void computeAttributeLanes(const AttributeSetup& a, AttributeLanes& out) {
   const hn::CappedTag<float, kBlockPixels> df;
   const hn::RebindToSigned<decltype(df)> di;
