@@ -100,13 +100,9 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
   const bool pixelShading = settings.shade == raster::ShadeMode::material;
   if (pixelShading) attributes_.resize(std::max<size_t>(attributes_.size(), firstBatch));
   // How much of each pixel-shading record binning stores: the second line only when some material
-  // of the frame reads it (AttributeSetup).
-  unsigned attributesRead = 0;
-  if (pixelShading)
-    for (const DrawCall& call : packets.calls)
-      if (call.material)
-        attributesRead |= shade::attributesUsed(*call.material, *settings.environment);
-  const size_t recordBytes = raster::AttributeSetup::readsSecondLine(attributesRead)
+  // of the frame reads it (AttributeSetup) — the layout's attributes are all the frame's
+  // materials read.
+  const size_t recordBytes = raster::AttributeSetup::readsSecondLine(packets.attributeLayout.stored)
                                  ? sizeof(raster::AttributeSetup)
                                  : raster::AttributeSetup::kLineBytes;
   scratch_.resize(size_t(pool_.threadCount()));

@@ -33,7 +33,8 @@ struct DrawCall {
 struct DrawPackets {
   std::vector<geometry::ClipVertex> vertices;
   // For pixel shading, when some call has a material (else empty): per vertex, the attributes
-  // `attributeLayout` stores, attributeLayout.stride floats a vertex.
+  // `attributeLayout` stores, attributeLayout.stride floats a vertex — the union of those the
+  // calls' materials read (shade::attributesUsed).
   std::vector<float> attributes;
   shade::AttributeLayout attributeLayout;
   std::vector<uint32_t> indices;  // 3 per triangle, each < vertices.size()
