@@ -190,40 +190,6 @@ sv::Result<sv::reference::BenchCase> generatorCase(const std::string& kind, cons
   return c;
 }
 
-// After --repeat N measurements of one scene: each renderer's median frame time over them (the
-// median of their medians) and the ratio's median and range. Returns the repetition whose ratio
-// (or, for one renderer, whose first renderer's time) is the median — the lower middle one for an
-// even N.
-size_t printRepeatMedians(const std::vector<sv::reference::CaseResult>& repeats) {
-  const size_t n = repeats.size();
-  auto key = [&](size_t k) {
-    const auto& runs = repeats[k].runs;
-    return runs.size() > 1 ? runs[1].medianMs / runs[0].medianMs : runs[0].medianMs;
-  };
-  std::vector<size_t> order(n);
-  for (size_t k = 0; k < n; ++k) order[k] = k;
-  std::sort(order.begin(), order.end(), [&](size_t x, size_t y) { return key(x) < key(y); });
-  const size_t middle = order[(n - 1) / 2];
-  std::string line = fmt::format("median of {} repeats:", n);
-  for (size_t r = 0; r < repeats[0].runs.size(); ++r) {
-    std::vector<double> ms;
-    for (const auto& c : repeats) ms.push_back(c.runs[r].medianMs);
-    std::sort(ms.begin(), ms.end());
-    const double mid = n % 2 ? ms[n / 2] : 0.5 * (ms[n / 2 - 1] + ms[n / 2]);
-    line += fmt::format("  {} {:.2f} ms ({:.2f}–{:.2f})", repeats[0].runs[r].renderer, mid,
-                        ms.front(), ms.back());
-  }
-  if (repeats[0].runs.size() > 1) {
-    std::vector<double> ratio;
-    for (size_t k = 0; k < n; ++k) ratio.push_back(key(k));
-    std::sort(ratio.begin(), ratio.end());
-    const double mid = n % 2 ? ratio[n / 2] : 0.5 * (ratio[n / 2 - 1] + ratio[n / 2]);
-    line += fmt::format("  ratio {:.2f}x ({:.2f}–{:.2f})", mid, ratio.front(), ratio.back());
-  }
-  fmt::print("{}\n", line);
-  return middle;
-}
-
 int runBench(BenchArgs a) {
   namespace ref = sv::reference;
   a.options.samples = a.aa == 0 ? 1 : a.aa;
@@ -330,7 +296,8 @@ int runBench(BenchArgs a) {
       repeats.push_back(std::move(r).value());
     }
     // The pages and images show the repetition the median line names.
-    const size_t median = a.repeat > 1 ? printRepeatMedians(repeats) : 0;
+    size_t median = 0;
+    if (a.repeat > 1) fmt::print("{}\n", ref::repeatSummaryLine(repeats, median));
     results.push_back(std::move(repeats[median]));
   }
 

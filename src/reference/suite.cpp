@@ -314,6 +314,33 @@ std::string summaryLine(const CaseResult& r) {
   return line;
 }
 
+std::string repeatSummaryLine(const std::vector<CaseResult>& repeats, size_t& middle) {
+  auto key = [&](size_t k) {
+    const auto& runs = repeats[k].runs;
+    return runs.size() > 1 ? runs[1].medianMs / runs[0].medianMs : runs[0].medianMs;
+  };
+  std::vector<size_t> order(repeats.size());
+  for (size_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::sort(order.begin(), order.end(), [&](size_t x, size_t y) { return key(x) < key(y); });
+  middle = order[(order.size() - 1) / 2];
+  auto medianAndRange = [](const std::vector<double>& v, const char* unit) {
+    const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
+    return fmt::format("{:.2f}{} ({:.2f}–{:.2f})", median(v), unit, *lo, *hi);
+  };
+  std::string line = fmt::format("median of {} repeats:", repeats.size());
+  for (size_t r = 0; r < repeats[0].runs.size(); ++r) {
+    std::vector<double> ms;
+    for (const CaseResult& c : repeats) ms.push_back(c.runs[r].medianMs);
+    line += fmt::format("  {} {}", repeats[0].runs[r].renderer, medianAndRange(ms, " ms"));
+  }
+  if (repeats[0].runs.size() > 1) {
+    std::vector<double> ratio;
+    for (size_t k = 0; k < repeats.size(); ++k) ratio.push_back(key(k));
+    line += "  ratio " + medianAndRange(ratio, "x");
+  }
+  return line;
+}
+
 namespace {
 
 std::string escape(const std::string& s) {

@@ -108,6 +108,12 @@ nlohmann::json jsonRows(const CaseResult& r, const BenchSettings& s);
 // One line per renderer and case, as the CLI prints them.
 std::string summaryLine(const CaseResult& r);
 
+// After several measurements of one case (bench --repeat): each renderer's median frame time over
+// them (the median of their medians) with its range, and the ratio's median and range. `middle`
+// is set to the measurement whose ratio (or, for one renderer, whose time) is the median — the
+// lower middle one for an even count. `repeats` is not empty.
+std::string repeatSummaryLine(const std::vector<CaseResult>& repeats, size_t& middle);
+
 // Writes DIR/index.html (table, plots, the two images of every case side by side), the plots
 // DIR/ratio.svg and DIR/time-{triangles,area,depth}.svg, and the images
 // DIR/<case>-<renderer>.png (the case name reduced to letters, digits, '_' and '-').
