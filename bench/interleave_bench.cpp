@@ -15,11 +15,11 @@
 
 #include <thread>
 
+#include "bench_scenes.h"
 #include "raster/binner.h"
 #include "raster/framebuffer.h"
 #include "raster/rasterizer.h"
 #include "render/frame_renderer.h"
-#include "bench_scenes.h"
 
 namespace sv {
 namespace {
@@ -27,7 +27,8 @@ namespace {
 constexpr int kWidth = 1920, kHeight = 1080;
 
 void BM_Tiles(benchmark::State& state) {
-  const render::DrawPackets packets = bench::trisPackets(int(state.range(0)), double(state.range(1)), kWidth, kHeight);
+  const render::DrawPackets packets =
+      bench::trisPackets(int(state.range(0)), double(state.range(1)), kWidth, kHeight);
   render::FrameRenderer fr(2);
   render::FrameSettings fs;
   fs.width = kWidth;
@@ -116,7 +117,8 @@ struct SparseProcessor {
 };
 
 void BM_Interleave(benchmark::State& state) {
-  const render::DrawPackets packets = bench::trisPackets(int(state.range(0)), double(state.range(1)), kWidth, kHeight);
+  const render::DrawPackets packets =
+      bench::trisPackets(int(state.range(0)), double(state.range(1)), kWidth, kHeight);
   const geometry::Viewport viewport{kWidth, kHeight};
   const size_t count = packets.indices.size() / 3;
   std::vector<geometry::TriangleSetup> dense(count);
@@ -155,8 +157,16 @@ void BM_Interleave(benchmark::State& state) {
       benchmark::Counter(double(count) * state.iterations(), benchmark::Counter::kIsRate);
 }
 
-BENCHMARK(BM_Tiles)->Args({100000, 10})->Args({10000, 1000})->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_Interleave)->Args({100000, 10})->Args({10000, 1000})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Tiles)
+    ->Args({100000, 10})
+    ->Args({10000, 1000})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_Interleave)
+    ->Args({100000, 10})
+    ->Args({10000, 1000})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 }  // namespace
 }  // namespace sv

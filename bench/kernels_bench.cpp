@@ -40,12 +40,11 @@ std::vector<geometry::TriangleSetup> tileTriangles(double area, int count, bool 
   while (int(out.size()) < count) {
     const double x = u(rng) * 64, y = u(rng) * 64, a = u(rng) * 6.283;
     geometry::TriangleSetup t;
-    if (geometry::setupTriangle(at(x, y, 64, 64, float(u(rng))),
-                                at(x + leg * std::cos(a), y + leg * std::sin(a), 64, 64, 0.5f),
-                                at(x + leg * std::cos(a + 1.571), y + leg * std::sin(a + 1.571), 64,
-                                   64, 0.5f),
-                                {64, 64, aperture}, geometry::CullMode::none,
-                                t) == geometry::SetupOutcome::drawn)
+    if (geometry::setupTriangle(
+            at(x, y, 64, 64, float(u(rng))),
+            at(x + leg * std::cos(a), y + leg * std::sin(a), 64, 64, 0.5f),
+            at(x + leg * std::cos(a + 1.571), y + leg * std::sin(a + 1.571), 64, 64, 0.5f),
+            {64, 64, aperture}, geometry::CullMode::none, t) == geometry::SetupOutcome::drawn)
       out.push_back(t);
   }
   return out;
@@ -73,8 +72,8 @@ void rasterTile(benchmark::State& state, double area) {
   for (auto _ : state) raster::rasterizeTile(w, stats);
   state.counters["triangles/s"] =
       benchmark::Counter(double(count) * state.iterations(), benchmark::Counter::kIsRate);
-  state.counters["pixels/s"] = benchmark::Counter(
-      double(stats.fragments), benchmark::Counter::kIsRate);
+  state.counters["pixels/s"] =
+      benchmark::Counter(double(stats.fragments), benchmark::Counter::kIsRate);
   // Coverage tests: every window classified, every 4×4 leaf's 16 pixel-centre tests.
   uint64_t windows = 0;
   for (uint64_t n : stats.windows) windows += n;
@@ -132,8 +131,8 @@ void BM_SetupTrianglesBatched(benchmark::State& state) {
                                                       {1920, 1080}, geometry::CullMode::none,
                                                       out.data(), outcomes));
   }
-  state.counters["triangles/s"] = benchmark::Counter(double(out.size()) * state.iterations(),
-                                                     benchmark::Counter::kIsRate);
+  state.counters["triangles/s"] =
+      benchmark::Counter(double(out.size()) * state.iterations(), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_SetupTrianglesBatched);
 
@@ -201,7 +200,8 @@ BENCHMARK(BM_TextureSample)->ArgsProduct({{0, 1, 2, 3, 4}, {0, 1}, {64, 1024}});
 // BENCH.md tris through setup, binning and tiles (no vertex stage, no resolve), 1 thread, with
 // the given samples per pixel.
 void BM_FrameTris(benchmark::State& state) {
-  const render::DrawPackets packets = bench::trisPackets(int(state.range(0)), double(state.range(1)));
+  const render::DrawPackets packets =
+      bench::trisPackets(int(state.range(0)), double(state.range(1)));
   render::FrameRenderer fr(1);
   render::FrameSettings fs;
   fs.width = 1920;
@@ -211,9 +211,8 @@ void BM_FrameTris(benchmark::State& state) {
     FrameStats stats;
     fr.render(packets, fs, stats);
   }
-  state.counters["triangles/s"] =
-      benchmark::Counter(double(packets.indices.size() / 3) * state.iterations(),
-                         benchmark::Counter::kIsRate);
+  state.counters["triangles/s"] = benchmark::Counter(
+      double(packets.indices.size() / 3) * state.iterations(), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_FrameTris)
     ->Args({100000, 10, 1})

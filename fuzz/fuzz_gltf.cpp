@@ -9,6 +9,7 @@
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace sv::scene;
   std::string bytes(reinterpret_cast<const char*>(data), size);
-  fuzz::checkResult(loadGltfFromMemory(bytes, "/nonexistent-synthvis-fuzz/model.gltf", fuzz::fuzzOptions()));
+  fuzz::checkResult(
+      loadGltfFromMemory(bytes, "/nonexistent-synthvis-fuzz/model.gltf", fuzz::fuzzOptions()));
   return 0;
 }

@@ -8,6 +8,7 @@
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace sv::scene;
   std::string text(reinterpret_cast<const char*>(data), size);
-  fuzz::checkResult(parseJsonScene(text, "/nonexistent-synthvis-fuzz/scene.json", fuzz::fuzzOptions()));
+  fuzz::checkResult(
+      parseJsonScene(text, "/nonexistent-synthvis-fuzz/scene.json", fuzz::fuzzOptions()));
   return 0;
 }

@@ -53,19 +53,78 @@ uint64_t hashName(std::string_view s) {
 
 // Tokens of the three formats, spliced in so that mutations reach past the first syntax check.
 constexpr std::string_view kTokens[] = {
-    "{", "}", "[", "]", ",", ":", "\"", "null", "true", "false", "-", "e", ".", "\n", " ", "\\",
-    "\"synthvis\": 1", "\"objects\"", "\"mesh\"", "\"primitive\"", "\"sphere\"", "\"checker\"",
-    "\"transform\"", "\"matrix\"", "\"rotate\"", "\"segments\"", "\"squares\"", "\"material\"",
-    "\"accessors\"", "\"bufferViews\"", "\"buffers\"", "\"byteOffset\"", "\"byteStride\"",
-    "\"byteLength\"", "\"count\"", "\"componentType\"", "\"indices\"", "\"nodes\"", "\"children\"",
-    "\"mode\"", "\"scene\"", "\"camera\"", "glTF", "JSON", "BIN", "v ", "vn ", "vt ", "f ", "o ",
-    "g ", "usemtl ", "mtllib ", "/", "//", "l ", "p ",
+    "{",
+    "}",
+    "[",
+    "]",
+    ",",
+    ":",
+    "\"",
+    "null",
+    "true",
+    "false",
+    "-",
+    "e",
+    ".",
+    "\n",
+    " ",
+    "\\",
+    "\"synthvis\": 1",
+    "\"objects\"",
+    "\"mesh\"",
+    "\"primitive\"",
+    "\"sphere\"",
+    "\"checker\"",
+    "\"transform\"",
+    "\"matrix\"",
+    "\"rotate\"",
+    "\"segments\"",
+    "\"squares\"",
+    "\"material\"",
+    "\"accessors\"",
+    "\"bufferViews\"",
+    "\"buffers\"",
+    "\"byteOffset\"",
+    "\"byteStride\"",
+    "\"byteLength\"",
+    "\"count\"",
+    "\"componentType\"",
+    "\"indices\"",
+    "\"nodes\"",
+    "\"children\"",
+    "\"mode\"",
+    "\"scene\"",
+    "\"camera\"",
+    "glTF",
+    "JSON",
+    "BIN",
+    "v ",
+    "vn ",
+    "vt ",
+    "f ",
+    "o ",
+    "g ",
+    "usemtl ",
+    "mtllib ",
+    "/",
+    "//",
+    "l ",
+    "p ",
 };
 constexpr std::string_view kNumbers[] = {
-    "0", "-1", "1", "2", "3", "4096", "4097", "65535", "65536", "2147483647", "-2147483648",
-    "4294967295", "4294967296", "18446744073709551615", "1e308", "1e999", "-0", "0.5", "1e-40",
+    "0",           "-1",
+    "1",           "2",
+    "3",           "4096",
+    "4097",        "65535",
+    "65536",       "2147483647",
+    "-2147483648", "4294967295",
+    "4294967296",  "18446744073709551615",
+    "1e308",       "1e999",
+    "-0",          "0.5",
+    "1e-40",
 };
-constexpr uint8_t kBytes[] = {0, 1, 0x7f, 0x80, 0xff, '{', '}', '[', ']', '"', '\n', ' ', '0', '9', '-', '/'};
+constexpr uint8_t kBytes[] = {0,   1,   0x7f, 0x80, 0xff, '{', '}', '[',
+                              ']', '"', '\n', ' ',  '0',  '9', '-', '/'};
 
 // Inputs never grow past this, so stacked insertions cannot snowball.
 constexpr size_t kMaxInput = size_t(1) << 20;
@@ -96,7 +155,8 @@ void mutate(std::string& s, XorShift64Star& random) {
       case 5:  // duplicate a span elsewhere
         if (!s.empty()) {
           size_t from = random.below(s.size());
-          std::string span = s.substr(from, 1 + random.below(std::min<size_t>(256, s.size() - from)));
+          std::string span =
+              s.substr(from, 1 + random.below(std::min<size_t>(256, s.size() - from)));
           s.insert(random.below(s.size() + 1), span);
         }
         break;
@@ -104,7 +164,8 @@ void mutate(std::string& s, XorShift64Star& random) {
         size_t d = s.find_first_of("0123456789", at);
         if (d == std::string::npos) break;
         size_t end = s.find_first_not_of("0123456789.eE+-", d);
-        s.replace(d, (end == std::string::npos ? s.size() : end) - d, kNumbers[random.below(std::size(kNumbers))]);
+        s.replace(d, (end == std::string::npos ? s.size() : end) - d,
+                  kNumbers[random.below(std::size(kNumbers))]);
         break;
       }
       default:  // splice in a format token
@@ -152,9 +213,10 @@ int main(int argc, char** argv) {
     } else if (arg == "--verbose") {
       verbose = true;
     } else if (arg.starts_with("-")) {
-      std::fprintf(stderr,
-                   "usage: %s [--mutations N] [--seed S] [--verbose] [--only M] [--save DIR] PATH...\n",
-                   argv[0]);
+      std::fprintf(
+          stderr,
+          "usage: %s [--mutations N] [--seed S] [--verbose] [--only M] [--save DIR] PATH...\n",
+          argv[0]);
       return 2;
     } else if (std::filesystem::is_directory(argv[i])) {
       for (const auto& entry : std::filesystem::recursive_directory_iterator(argv[i]))
@@ -203,6 +265,7 @@ int main(int argc, char** argv) {
   }
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::printf("%s: %zu files, %zu runs, %.2f s, no failures\n", argv[0], files.size(), runs, seconds);
+  std::printf("%s: %zu files, %zu runs, %.2f s, no failures\n", argv[0], files.size(), runs,
+              seconds);
   return 0;
 }

@@ -81,7 +81,8 @@ int runRender(const RenderArgs& a) {
   if (!hsr) return fail(hsr.error());
   o.hsr = hsr.value();
   if (a.freeform != "raycast" && a.freeform != "march")
-    return fail({"", "", fmt::format("unknown free-form method '{}' (raycast or march)", a.freeform)});
+    return fail(
+        {"", "", fmt::format("unknown free-form method '{}' (raycast or march)", a.freeform)});
   o.freeFormMethod = a.freeform == "march" ? sv::RenderOptions::FreeFormMethod::march
                                            : sv::RenderOptions::FreeFormMethod::raycast;
   if (!a.debugView.empty()) {
@@ -93,8 +94,9 @@ int runRender(const RenderArgs& a) {
     else if (a.debugView == "occupancy")
       o.debugView = DebugView::occupancy;
     else
-      return fail({"", "", fmt::format("unknown debug view '{}' (overdraw, levels or occupancy)",
-                                       a.debugView)});
+      return fail(
+          {"", "",
+           fmt::format("unknown debug view '{}' (overdraw, levels or occupancy)", a.debugView)});
   }
   if (sv::Status s = sv::validate(o); !s) return fail(s.error());
 
@@ -124,7 +126,8 @@ struct GeneratorArgs {
 
 void addGeneratorOptions(CLI::App* app, GeneratorArgs& g) {
   app->add_option("--count", g.tris.count, "tris: number of triangles")->capture_default_str();
-  app->add_option("--area", g.tris.area, "tris: mean projected area, pixels")->capture_default_str();
+  app->add_option("--area", g.tris.area, "tris: mean projected area, pixels")
+      ->capture_default_str();
   app->add_option("--depth", g.tris.depth, "tris: depth complexity (0 = whole screen)")
       ->capture_default_str();
   app->add_option("--layers", g.layers, "layers: depth complexity D")->capture_default_str();
@@ -164,16 +167,18 @@ const char* missingGenerator(const std::string& name) {
   return nullptr;
 }
 
-// The case for generator `kind` (tris, layers or grazing) with the given parameters; an error names a
-// generator that needs a later feature, or an unknown one.
-sv::Result<sv::reference::BenchCase> generatorCase(const std::string& kind, const GeneratorArgs& g) {
+// The case for generator `kind` (tris, layers or grazing) with the given parameters; an error names
+// a generator that needs a later feature, or an unknown one.
+sv::Result<sv::reference::BenchCase> generatorCase(const std::string& kind,
+                                                   const GeneratorArgs& g) {
   if (const char* needs = missingGenerator(kind))
     return sv::Error{"", "", fmt::format("generator '{}' needs {}, not built yet", kind, needs)};
   if (kind != "tris" && kind != "layers" && kind != "grazing" && kind != "freeform" &&
       kind != "freeform-one")
-    return sv::Error{"", "", fmt::format("unknown generator '{}' (tris, layers, grazing, freeform, "
-                                         "freeform-one)",
-                                         kind)};
+    return sv::Error{"", "",
+                     fmt::format("unknown generator '{}' (tris, layers, grazing, freeform, "
+                                 "freeform-one)",
+                                 kind)};
   auto order = sv::scene::parseSubmitOrder(g.order);
   if (!order) return order.error();
   sv::reference::BenchCase c;
@@ -213,17 +218,20 @@ int runBench(BenchArgs a) {
   if (a.renderer.empty()) a.renderer = a.suite.empty() ? "synthvis" : "both";
   if (a.renderer != "synthvis" && a.renderer != "gl" && a.renderer != "both" &&
       a.renderer != "sphere-trace" && a.renderer != "tessellated")
-    return fail({"", "", fmt::format("unknown renderer '{}' (synthvis, gl, both, sphere-trace or "
-                                     "tessellated)",
-                                     a.renderer)});
+    return fail({"", "",
+                 fmt::format("unknown renderer '{}' (synthvis, gl, both, sphere-trace or "
+                             "tessellated)",
+                             a.renderer)});
   if (auto order = sv::scene::parseSubmitOrder(a.generator.order); !order)
     return fail(order.error());
   if (a.repeat < 1 || a.repeat > 100)
     return fail({"", "", fmt::format("--repeat {}: must be 1…100", a.repeat)});
   if (a.glAa == -1) a.glAa = a.aa >= 2 ? std::min(a.aa, 4) : 0;
   if (a.glAa != 0 && a.glAa != 2 && a.glAa != 4 && a.glAa != 8 && a.glAa != 16)
-    return fail({"", "", fmt::format("--gl-aa {}: the reference's samples per pixel must be 0, 2, "
-                                     "4, 8 or 16", a.glAa)});
+    return fail({"", "",
+                 fmt::format("--gl-aa {}: the reference's samples per pixel must be 0, 2, "
+                             "4, 8 or 16",
+                             a.glAa)});
 
   std::vector<ref::BenchCase> cases;
   if (!a.suite.empty()) {
@@ -232,8 +240,8 @@ int runBench(BenchArgs a) {
     cases = std::move(c).value();
   } else {
     ref::BenchCase c;
-    if (a.scene == "tris" || a.scene == "layers" || a.scene == "grazing" ||
-        a.scene == "freeform" || a.scene == "freeform-one" || missingGenerator(a.scene)) {
+    if (a.scene == "tris" || a.scene == "layers" || a.scene == "grazing" || a.scene == "freeform" ||
+        a.scene == "freeform-one" || missingGenerator(a.scene)) {
       auto g = generatorCase(a.scene, a.generator);
       if (!g) return fail(g.error());
       c = g.value();
@@ -400,9 +408,10 @@ int runCompare(const std::string& imagePath, const std::string& referencePath,
                                         edgesPath.empty() ? nullptr : &mask.value());
   if (!d) return fail({imagePath, "", d.error().message});
   const auto& r = d.value();
-  fmt::print("all pixels ({}): RMSE {:.6f}, PSNR {:.2f} dB | edge pixels ({}): RMSE {:.6f}, "
-             "PSNR {:.2f} dB (linear light)\n",
-             r.pixels, r.rmse, r.psnrDb, r.edgePixels, r.edgeRmse, r.edgePsnrDb);
+  fmt::print(
+      "all pixels ({}): RMSE {:.6f}, PSNR {:.2f} dB | edge pixels ({}): RMSE {:.6f}, "
+      "PSNR {:.2f} dB (linear light)\n",
+      r.pixels, r.rmse, r.psnrDb, r.edgePixels, r.edgeRmse, r.edgePsnrDb);
   return 0;
 }
 
@@ -414,7 +423,8 @@ int main(int argc, char** argv) {
 
   RenderArgs r;
   CLI::App* render = app.add_subcommand("render", "render a scene to an image");
-  render->add_option("scene", r.scene, "scene file (.json, .gltf, .glb, .obj); default: built-in demo");
+  render->add_option("scene", r.scene,
+                     "scene file (.json, .gltf, .glb, .obj); default: built-in demo");
   render->add_option("-o,--output", r.output, "output image (.png or .ppm)")->capture_default_str();
   render->add_option("--width", r.options.width, "image width in pixels")->capture_default_str();
   render->add_option("--height", r.options.height, "image height in pixels")->capture_default_str();
@@ -426,46 +436,55 @@ int main(int argc, char** argv) {
   render->add_option("--debug-view", r.debugView,
                      "false-colour diagnostic image: overdraw, levels or occupancy (with --hsr "
                      "priority or hybrid)");
-  render->add_option("--supersample", r.options.supersample,
-                     "render k×k samples per pixel and average them (1, 2, 4, 8, 16)")
+  render
+      ->add_option("--supersample", r.options.supersample,
+                   "render k×k samples per pixel and average them (1, 2, 4, 8, 16)")
       ->capture_default_str();
-  render->add_option("--aa", r.options.samples,
-                     "anti-aliasing: samples per pixel, 1 (none), 4, 8, 16 or 64")
+  render
+      ->add_option("--aa", r.options.samples,
+                   "anti-aliasing: samples per pixel, 1 (none), 4, 8, 16 or 64")
       ->capture_default_str();
   render->add_option("--filter", r.filter, "resolve filter: box or tent3 (3x3 triangle)")
       ->capture_default_str();
-  render->add_option("--hsr", r.hsr,
-                     "hidden surfaces: zbuffer, priority (masking; the scene's order is the "
-                     "priority, nearest first) or hybrid (masking with depth: any order)")
+  render
+      ->add_option("--hsr", r.hsr,
+                   "hidden surfaces: zbuffer, priority (masking; the scene's order is the "
+                   "priority, nearest first) or hybrid (masking with depth: any order)")
       ->capture_default_str();
-  render->add_option("--texture-filter", r.textureFilter,
-                     "texture sampling for materials that do not choose: point, nearest, tri3, "
-                     "bilinear, trilinear3, trilinear or aniso")
+  render
+      ->add_option("--texture-filter", r.textureFilter,
+                   "texture sampling for materials that do not choose: point, nearest, tri3, "
+                   "bilinear, trilinear3, trilinear or aniso")
       ->capture_default_str();
-  render->add_option("--freeform", r.freeform,
-                     "free forms: raycast (multi-level ray casting) or march (the fixed-step "
-                     "baseline, --march-steps steps of eye depth per ray)")
+  render
+      ->add_option("--freeform", r.freeform,
+                   "free forms: raycast (multi-level ray casting) or march (the fixed-step "
+                   "baseline, --march-steps steps of eye depth per ray)")
       ->capture_default_str();
   render->add_option("--march-steps", r.options.marchSteps, "--freeform march: steps per ray")
       ->capture_default_str();
-  render->add_option("--gamma", r.options.gamma,
-                     "display gamma G (encoded = linear^(1/G)); default 0 = sRGB")
+  render
+      ->add_option("--gamma", r.options.gamma,
+                   "display gamma G (encoded = linear^(1/G)); default 0 = sRGB")
       ->capture_default_str();
 
   BenchArgs b;
-  CLI::App* bench = app.add_subcommand("bench", "time whole frames of a benchmark scene (BENCH.md)");
+  CLI::App* bench =
+      app.add_subcommand("bench", "time whole frames of a benchmark scene (BENCH.md)");
   bench->add_option("scene", b.scene,
                     "generator (tris, layers, grazing, freeform, freeform-one) or scene file");
   bench->add_option("--suite", b.suite, "a named suite of scenes: quick or full");
   addGeneratorOptions(bench, b.generator);
-  bench->add_option("--shade", b.shade,
-                    "generated scenes: gouraud, or textured (BENCH.md's 1024x1024 texture)")
+  bench
+      ->add_option("--shade", b.shade,
+                   "generated scenes: gouraud, or textured (BENCH.md's 1024x1024 texture)")
       ->capture_default_str();
   bench->add_flag("--fog", b.fog, "generated scenes: BENCH.md's fog (haze, beta 0.1 per unit)");
   bench->add_option("--hsr", b.hsr, "hidden surfaces: zbuffer, priority or hybrid")
       ->capture_default_str();
-  bench->add_option("--texture-filter", b.textureFilter,
-                    "nearest, tri3, bilinear, trilinear3, trilinear or aniso")
+  bench
+      ->add_option("--texture-filter", b.textureFilter,
+                   "nearest, tri3, bilinear, trilinear3, trilinear or aniso")
       ->capture_default_str();
   bench->add_option("--width", b.options.width, "image width")->capture_default_str();
   bench->add_option("--height", b.options.height, "image height")->capture_default_str();
@@ -479,12 +498,14 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   bench->add_option("--aa", b.aa, "synthvis: samples per pixel (1, 4, 8, 16, 64)")
       ->capture_default_str();
-  bench->add_option("--gl-aa", b.glAa,
-                    "the gl reference's multisamples (0, 2, 4, 8, 16); default: as --aa, at most 4");
+  bench->add_option(
+      "--gl-aa", b.glAa,
+      "the gl reference's multisamples (0, 2, 4, 8, 16); default: as --aa, at most 4");
   bench->add_option("--filter", b.filter, "synthvis resolve filter: box or tent3")
       ->capture_default_str();
-  bench->add_option("--supersample", b.options.supersample,
-                    "synthvis: k×k samples per pixel, averaged (1, 2, 4, 8, 16)")
+  bench
+      ->add_option("--supersample", b.options.supersample,
+                   "synthvis: k×k samples per pixel, averaged (1, 2, 4, 8, 16)")
       ->capture_default_str();
   bench->add_flag("--gl-readback", b.glReadback,
                   "count the gl reference's read-back of the image in its frame time");
@@ -494,12 +515,14 @@ int main(int argc, char** argv) {
                     "tessellated: against its free forms as triangles (the gl reference always "
                     "draws those); "
                     "default: synthvis for a scene, both for a suite");
-  bench->add_option("--march-steps", b.options.marchSteps,
-                    "sphere-trace: depth steps per ray of the fixed-step marcher")
+  bench
+      ->add_option("--march-steps", b.options.marchSteps,
+                   "sphere-trace: depth steps per ray of the fixed-step marcher")
       ->capture_default_str();
   bench->add_option("--json", b.json, "write the results as JSON to this file");
   bench->add_option("--html", b.html, "write an HTML page with plots and images to this directory");
-  bench->add_option("--image", b.image, "write the last frame of the last scene to this image file");
+  bench->add_option("--image", b.image,
+                    "write the last frame of the last scene to this image file");
 
   GenArgs g;
   CLI::App* gen = app.add_subcommand("gen", "write a BENCH.md scene as glTF (.glb or .gltf)");
@@ -521,8 +544,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   truth->add_option("--width", tr.options.width, "image width in pixels")->capture_default_str();
   truth->add_option("--height", tr.options.height, "image height in pixels")->capture_default_str();
-  truth->add_option("--threads", tr.options.threads, "worker threads (0 = all)")->capture_default_str();
-  truth->add_option("--camera", tr.options.camera, "index of the scene camera")->capture_default_str();
+  truth->add_option("--threads", tr.options.threads, "worker threads (0 = all)")
+      ->capture_default_str();
+  truth->add_option("--camera", tr.options.camera, "index of the scene camera")
+      ->capture_default_str();
   truth->add_flag("--no-cull", tr.noCull, "draw back faces of single-sided materials too");
   truth->add_option("--edges", tr.edges, "also write the edge mask (pixels an edge crosses)");
 
@@ -530,9 +555,11 @@ int main(int argc, char** argv) {
   CLI::App* compare = app.add_subcommand(
       "compare", "RMSE and PSNR of IMAGE against REFERENCE in linear light, all and edge pixels");
   compare->add_option("image", compareImage, "PNG image")->required();
-  compare->add_option("reference", compareReference, "PNG reference, e.g. from `truth`")->required();
-  compare->add_option("--edges", compareEdges, "edge mask from `truth --edges` (default: pixels "
-                                               "whose neighbours differ in the reference)");
+  compare->add_option("reference", compareReference, "PNG reference, e.g. from `truth`")
+      ->required();
+  compare->add_option("--edges", compareEdges,
+                      "edge mask from `truth --edges` (default: pixels "
+                      "whose neighbours differ in the reference)");
 
   try {
     app.parse(argc, argv);

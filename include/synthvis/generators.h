@@ -18,7 +18,8 @@ const char* submitOrderName(SubmitOrder order);
 struct TrisParams {
   int count = 10000;
   double area = 100;  // mean projected area in pixels
-  double depth = 0;   // 0: centroids over the whole screen; else a centred region of area count·area/depth
+  double depth =
+      0;  // 0: centroids over the whole screen; else a centred region of area count·area/depth
   SubmitOrder order = SubmitOrder::random;
   uint64_t seed = 1;
   int width = 1920;  // the raster the areas refer to

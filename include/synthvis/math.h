@@ -71,7 +71,7 @@ struct Mat4 {
             m[0][2] * v.x + m[1][2] * v.y + m[2][2] * v.z + m[3][2] * v.w,
             m[0][3] * v.x + m[1][3] * v.y + m[2][3] * v.z + m[3][3] * v.w};
   }
-  Vec3 transformPoint(Vec3 p) const;     // w = 1, no divide
+  Vec3 transformPoint(Vec3 p) const;      // w = 1, no divide
   Vec3 transformDirection(Vec3 d) const;  // w = 0
   // The inverse transpose of the upper 3×3, for normals. Returns identity when singular.
   Mat4 normalMatrix() const;

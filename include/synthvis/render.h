@@ -18,9 +18,9 @@ inline constexpr int kMaxThreads = 256;
 struct RenderOptions {
   int width = 1280;
   int height = 720;
-  int threads = 0;             // worker threads in all; 0 = one per hardware thread
-  bool cullBackFaces = true;   // for materials that are not double-sided
-  int camera = 0;              // index into Scene::cameras (a default camera if there is none)
+  int threads = 0;            // worker threads in all; 0 = one per hardware thread
+  bool cullBackFaces = true;  // for materials that are not double-sided
+  int camera = 0;             // index into Scene::cameras (a default camera if there is none)
   // False-colour diagnostics instead of the image (one sample per pixel): how many triangles
   // covered each pixel (no depth test); where the visible triangle's subdivision stopped (the
   // window size it was filled at, or a 4×4 leaf tested pixel by pixel); which windows masking

@@ -21,7 +21,8 @@ class Texture;  // src/texture/texture.h: a decoded image, its MIP pyramid and w
 namespace sv::scene {
 
 // How a texture map is sampled (SPEC §7; docs/quality.md compares them): nearest texel; the seed's
-// three-point interpolation ("tri3"); bilinear; the trilinear blends of those between pyramid levels
+// three-point interpolation ("tri3"); bilinear; the trilinear blends of those between pyramid
+// levels
 // ("trilinear3", "trilinear"); anisotropic (trilinear probes along the pixel footprint's major
 // axis); `point`, the nearest texel of the full-resolution image, no pyramid (aliases: the
 // reference that, supersampled, gives docs/quality.md's ground truth). `inherit` (materials

@@ -60,7 +60,8 @@ void ThreadPool::workerLoop(int worker) {
     for (int i = 0; i < kSpin && generation_.load(std::memory_order_acquire) == seen; ++i) pause();
     {
       std::unique_lock lock(mutex_);
-      wake_.wait(lock, [&] { return stop_ || generation_.load(std::memory_order_relaxed) != seen; });
+      wake_.wait(lock,
+                 [&] { return stop_ || generation_.load(std::memory_order_relaxed) != seen; });
       if (stop_) return;
       seen = generation_.load(std::memory_order_relaxed);
     }

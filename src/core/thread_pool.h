@@ -46,7 +46,7 @@ class ThreadPool {
   const std::function<void(size_t, int)>* job_ = nullptr;
   size_t count_ = 0;
   std::atomic<size_t> next_{0};
-  std::atomic<int> busy_{0};            // workers still inside the current job
+  std::atomic<int> busy_{0};             // workers still inside the current job
   std::atomic<unsigned> generation_{0};  // bumped per job so sleeping workers see a new one
   bool stop_ = false;
 };

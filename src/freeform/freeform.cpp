@@ -84,8 +84,7 @@ Vec3d FreeForm::gradient(Vec3d p) const {
 
 Interval FreeForm::bound(Interval x, Interval y, Interval z) const {
   Interval f = base.bound(x, y, z);
-  for (const FreeForm& q : perturbations)
-    f = f + cube(positivePart(q.bound(x, y, z))) * q.weight;
+  for (const FreeForm& q : perturbations) f = f + cube(positivePart(q.bound(x, y, z))) * q.weight;
   for (const Quadric& c : clips) {
     const Interval b = c.bound(x, y, z);
     f = {std::min(f.lo, b.lo), std::min(f.hi, b.hi)};
@@ -169,8 +168,8 @@ void ProjectedFreeForm::boundNodeSlope(uint32_t i, Interval x, Interval y, Inter
   }
 }
 
-void ProjectedFreeForm::bound(Interval x, Interval y, Interval z, Interval& value,
-                              Interval& slope, uint64_t* active) const {
+void ProjectedFreeForm::bound(Interval x, Interval y, Interval z, Interval& value, Interval& slope,
+                              uint64_t* active) const {
   const auto& w = inverse_.m[3];
   const Interval u = x * w[0] + y * w[1] + z * w[2] + w[3];
   const uint64_t take = active ? *active : kAllActive;

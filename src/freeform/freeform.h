@@ -212,8 +212,8 @@ class ProjectedFreeForm {
  private:
   double evaluateNode(uint32_t i, Vec3d q, double invU4) const;
   Interval boundNode(uint32_t i, Interval x, Interval y, Interval z, Interval invU4) const;
-  void boundNodeSlope(uint32_t i, Interval x, Interval y, Interval z,
-                      const InversePowers& inv, Interval& value, Interval& slope) const;
+  void boundNodeSlope(uint32_t i, Interval x, Interval y, Interval z, const InversePowers& inv,
+                      Interval& value, Interval& slope) const;
   static void flatten(const FreeForm& form, const Mat4d& inverse, std::vector<Node>& out);
 
   std::vector<Node> nodes_;

@@ -67,7 +67,8 @@ struct Interval {
   }
   friend Interval operator*(Interval a, Interval b) {
     const double p0 = a.lo * b.lo, p1 = a.lo * b.hi, p2 = a.hi * b.lo, p3 = a.hi * b.hi;
-    return {std::min(std::min(p0, p1), std::min(p2, p3)), std::max(std::max(p0, p1), std::max(p2, p3))};
+    return {std::min(std::min(p0, p1), std::min(p2, p3)),
+            std::max(std::max(p0, p1), std::max(p2, p3))};
   }
 };
 // Exact: [0, …] when a contains 0.
@@ -98,7 +99,6 @@ inline Interval quadraticRange(double a, Interval b, Interval c, Interval t) {
   return {std::min(r0.lo, r1.lo) + c.lo, std::max(r0.hi, r1.hi) + c.hi};
 }
 
-
 // F(x, y, z) = Ax² + By² + Cz² + Dxy + Exz + Fyz + Gx + Hy + Iz + K: coefficients in this order.
 struct Quadric {
   std::array<double, 10> c{};
@@ -128,8 +128,8 @@ struct Quadric {
   Mat4d matrix() const;
   static Quadric fromMatrix(const Mat4d& s);  // reads the symmetric part
   // The quadric of the image of this one's points under the map `inverse`⁻¹: S' = M^{-T} S M^{-1}
-  // with M^{-1} = `inverse` given. Then F'(q) = (u(q))²·F(p) for q the image of p, where u(q) is the
-  // w of M^{-1}·(q, 1) — the same sign, so the same surface and inside.
+  // with M^{-1} = `inverse` given. Then F'(q) = (u(q))²·F(p) for q the image of p, where u(q) is
+  // the w of M^{-1}·(q, 1) — the same sign, so the same surface and inside.
   Quadric transformedByInverse(const Mat4d& inverse) const;
 };
 

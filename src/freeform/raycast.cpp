@@ -450,7 +450,7 @@ class Caster {
   MaskingPyramid& pyramid_;
   CastStats& stats_;
   uint64_t windowActive_ = kAllActive;  // run()'s
-  RayFunction ray_;  // the current pixel's
+  RayFunction ray_;                     // the current pixel's
   // windowRays' rays (only the first `count` of each are read): up to a cell of
   // 2^kQuadricLevel pixels square; guess and from, rayWindow's only.
   static constexpr int kMaxRays = 1 << (2 * kQuadricLevel);

@@ -77,7 +77,7 @@ struct CastSettings {
 class MaskingPyramid {
  public:
   explicit MaskingPyramid(const CastWindow& window);
-  int top() const { return top_; }  // the level of the whole window: size = 2^top
+  int top() const { return top_; }    // the level of the whole window: size = 2^top
   int size() const { return size_; }  // its pixels per row, level 0's nodes per row
   float& node(int level, int x, int y) {
     return nodes_[offset_[size_t(level)] + size_t(y * (size_ >> level) + x)];

@@ -150,8 +150,7 @@ class Tessellator {
 
 }  // namespace
 
-std::optional<Box> surfaceBounds(const FreeForm& form, double extent, int levels,
-                                 bool& unbounded) {
+std::optional<Box> surfaceBounds(const FreeForm& form, double extent, int levels, bool& unbounded) {
   Search s(form, extent);
   s.collect({Vec3d{-extent, -extent, -extent}, Vec3d{extent, extent, extent}}, levels);
   unbounded = s.unbounded;

@@ -78,8 +78,8 @@ void FreeFormFrame::prepare(std::vector<ShadedForm> forms, int width, int height
 }
 
 // Step 0 of a frame, per form: the screen quadtree from the whole raster down to tiles, with the
-// eight-slab depth tree (the caster uses sixteen), over whole pixel squares (every sample of a pixel lies in
-// its square).
+// eight-slab depth tree (the caster uses sixteen), over whole pixel squares (every sample of a
+// pixel lies in its square).
 void FreeFormFrame::markTiles(uint32_t f, int x0, int y0, int size, double zlo, double zhi,
                               std::vector<Mark>& marks) const {
   if (x0 >= width_ || y0 >= height_) return;
@@ -107,8 +107,8 @@ void FreeFormFrame::markTiles(uint32_t f, int x0, int y0, int size, double zlo, 
   for (int c = 0; c < 4; ++c) markTiles(f, x0 + (c & 1) * h, y0 + (c >> 1) * h, h, nlo, nhi, marks);
 }
 
-void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color,
-                             Scratch& scratch, CastStats& stats) const {
+void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color, Scratch& scratch,
+                             CastStats& stats) const {
   const size_t tile = size_t(tileY) * size_t(tilesX_) + size_t(tileX);
   const std::vector<uint32_t>& listed = tileForms_[tile];
   if (listed.empty()) return;
@@ -212,8 +212,10 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
     float* cd = scratch.ringDepth.data();
     for (int ly = 0; ly < kTileSize; ++ly)
       for (int lx = 0; lx < kTileSize; ++lx) {
-        co[size_t(ly + 1) * kRing + size_t(lx + 1)] = scratch.centreObject[size_t(ly) * kTileSize + size_t(lx)];
-        cd[size_t(ly + 1) * kRing + size_t(lx + 1)] = scratch.centreDepth[size_t(ly) * kTileSize + size_t(lx)];
+        co[size_t(ly + 1) * kRing + size_t(lx + 1)] =
+            scratch.centreObject[size_t(ly) * kTileSize + size_t(lx)];
+        cd[size_t(ly + 1) * kRing + size_t(lx + 1)] =
+            scratch.centreDepth[size_t(ly) * kTileSize + size_t(lx)];
       }
     {
       CastStats local;
@@ -309,8 +311,8 @@ void FreeFormFrame::drawTile(int tileX, int tileY, float* depth, uint16_t* color
           const double x = cubeX(ox + lx, width_, offsetX_[k]);
           const double y = cubeY(oy + ly, height_, offsetY_[k]);
           for (int c = 0; c < count; ++c)
-            castRay(forms_[seen[c]].projected, seen[c], x, y, from[c], hint[c], d[p], obj[p],
-                    z[p], scratch.ray, local);
+            castRay(forms_[seen[c]].projected, seen[c], x, y, from[c], hint[c], d[p], obj[p], z[p],
+                    scratch.ray, local);
         }
         stats.add(local);
       }

@@ -19,10 +19,10 @@ namespace sv::freeform {
 
 // One free-form object as the pass draws it.
 struct ShadedForm {
-  FreeForm form;                 // object space: the gradient gives the normal
-  ProjectedFreeForm projected;   // in the cube: what is cast
-  Mat4d objectToEye;             // for the eye-space position (fog, point lights, specular)
-  Mat4d normalToEye;             // the inverse transpose of objectToEye's 3×3 part
+  FreeForm form;                // object space: the gradient gives the normal
+  ProjectedFreeForm projected;  // in the cube: what is cast
+  Mat4d objectToEye;            // for the eye-space position (fog, point lights, specular)
+  Mat4d normalToEye;            // the inverse transpose of objectToEye's 3×3 part
   shade::MaterialShading material;
   float color[3] = {1, 1, 1};  // linear base colour
   // material.texture: projected along the object's y axis, u = x·uvScale[0], v = z·uvScale[1]

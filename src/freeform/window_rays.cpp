@@ -369,8 +369,8 @@ void ForEachGroup(DD d, const ProjectedFreeForm::Node* nodes, const Quadric* cli
 
 void MonotonicCrossings(const ProjectedFreeForm::Node* nodes, const Quadric* clips,
                         size_t clipCount, const double* w, const double* x, const double* y,
-                        double zlo, const double* zhi, int count, const double* guess,
-                        double* out, uint64_t active) {
+                        double zlo, const double* zhi, int count, const double* guess, double* out,
+                        uint64_t active) {
   const DD d;
   const size_t stride = 2 * (nodes[0].end + clipCount) * hn::Lanes(d);
   double* coefficients = CoefficientStorage(kGroup * stride);
@@ -542,29 +542,29 @@ int ProvenCrossings(const ProjectedFreeForm::Node* nodes, const Quadric* clips, 
   double* coefficients = CoefficientStorage(kGroup * stride);
   int bounds = 0;
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  ForEachGroup(d, nodes, clips, clipCount, w, active, x, y, zlo, zhi, count, coefficients, stride,
-               [&](const size_t* s0, const size_t* m, const Rays* rays, const VD* vz) {
-                 const VD a = hn::Set(d, zlo);
-                 VD g[kGroup], found[kGroup];
-                 MD span[kGroup], settled[kGroup];
-                 for (int k = 0; k < kGroup; ++k) {
-                   g[k] = LoadPadded(d, guess, s0[k], m[k], nan);
-                   span[k] = hn::Lt(a, vz[k]);
-                 }
-                 NewtonFromGuesses(d, rays, a, vz, g, span, found, settled);
-                 for (int k = 0; k < kGroup && m[k] > 0; ++k) {
-                   if (!hn::AllFalse(d, settled[k])) {
-                     // The proof: H monotonic over [zlo, zero] — no zero before this one.
-                     bounds += int(hn::CountTrue(d, settled[k]));
-                     Lanes value, slope;
-                     const MD valid = BoundLanes(
-                         d, rays[k], {a, hn::IfThenElse(settled[k], found[k], a)}, value, slope);
-                     settled[k] = hn::And(settled[k], hn::AndNot(ContainsZero(d, slope), valid));
-                   }
-                   StoreFirst(d, hn::IfThenElse(settled[k], found[k], hn::Set(d, nan)), m[k],
-                              out + s0[k]);
-                 }
-               });
+  ForEachGroup(
+      d, nodes, clips, clipCount, w, active, x, y, zlo, zhi, count, coefficients, stride,
+      [&](const size_t* s0, const size_t* m, const Rays* rays, const VD* vz) {
+        const VD a = hn::Set(d, zlo);
+        VD g[kGroup], found[kGroup];
+        MD span[kGroup], settled[kGroup];
+        for (int k = 0; k < kGroup; ++k) {
+          g[k] = LoadPadded(d, guess, s0[k], m[k], nan);
+          span[k] = hn::Lt(a, vz[k]);
+        }
+        NewtonFromGuesses(d, rays, a, vz, g, span, found, settled);
+        for (int k = 0; k < kGroup && m[k] > 0; ++k) {
+          if (!hn::AllFalse(d, settled[k])) {
+            // The proof: H monotonic over [zlo, zero] — no zero before this one.
+            bounds += int(hn::CountTrue(d, settled[k]));
+            Lanes value, slope;
+            const MD valid =
+                BoundLanes(d, rays[k], {a, hn::IfThenElse(settled[k], found[k], a)}, value, slope);
+            settled[k] = hn::And(settled[k], hn::AndNot(ContainsZero(d, slope), valid));
+          }
+          StoreFirst(d, hn::IfThenElse(settled[k], found[k], hn::Set(d, nan)), m[k], out + s0[k]);
+        }
+      });
   return bounds;
 }
 

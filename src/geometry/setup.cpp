@@ -18,13 +18,13 @@
 //
 // Exactness. The inside test uses integer edges. For an edge whose two vertices are in front of the
 // eye and within the guard band, the edge is rebuilt from the vertices' projections snapped to
-// 1/256 px: A = y_i − y_j, B = x_j − x_i, C = x_i·y_j − x_j·y_i, exact in int64 (budget in setup.h);
-// adj_k = w_i·w_j·(that edge), so the sign — and the inside test — is unchanged by the divide.
-// Other edges (a vertex behind the eye or far outside the screen, and the near/far planes) are the
-// homogeneous cross products in double, scaled by a power of two and rounded to the same integer
-// form. Either way an edge depends only on its two vertices and is computed in a canonical order,
-// so the neighbour across a shared edge gets exactly the negated coefficients: shared edges are
-// watertight.
+// 1/256 px: A = y_i − y_j, B = x_j − x_i, C = x_i·y_j − x_j·y_i, exact in int64 (budget in
+// setup.h); adj_k = w_i·w_j·(that edge), so the sign — and the inside test — is unchanged by the
+// divide. Other edges (a vertex behind the eye or far outside the screen, and the near/far planes)
+// are the homogeneous cross products in double, scaled by a power of two and rounded to the same
+// integer form. Either way an edge depends only on its two vertices and is computed in a canonical
+// order, so the neighbour across a shared edge gets exactly the negated coefficients: shared edges
+// are watertight.
 #include "geometry/setup.h"
 
 #include <algorithm>
@@ -135,7 +135,7 @@ struct ScreenVertex {
 // Always inlined into setup: called out of line, its 12-byte result went back through the stack
 // with mismatched store and load sizes (store-forwarding stalls), 12 % of a 100k × 10 px frame.
 [[gnu::always_inline]] inline ScreenVertex snapVertex(const ClipVertex& c,
-                                                     const Viewport& viewport) {
+                                                      const Viewport& viewport) {
   ScreenVertex s;
   if (!(c.w > 0) || !std::isfinite(c.x) || !std::isfinite(c.y) || !std::isfinite(c.w)) return s;
   const double invW = 1.0 / c.w;
@@ -253,9 +253,10 @@ SetupOutcome setupTriangle(const ClipVertex& v0, const ClipVertex& v1, const Cli
   if ((cull == CullMode::back && !front) || (cull == CullMode::front && front))
     return SetupOutcome::culledFacing;
 
-  // Step 6: bounding box of the pixels reached (centres, or squares with an aperture). Only snapped triangles have a trustworthy one: with a
-  // vertex behind the eye the projected corners do not bound the triangle (pitfall 7), so the
-  // subdivision starts from the whole raster, as SPEC §3 does.
+  // Step 6: bounding box of the pixels reached (centres, or squares with an aperture). Only snapped
+  // triangles have a trustworthy one: with a vertex behind the eye the projected corners do not
+  // bound the triangle (pitfall 7), so the subdivision starts from the whole raster, as SPEC §3
+  // does.
   int64_t minX = 0, minY = 0, maxX = viewport.width - 1, maxY = viewport.height - 1;
   out.small = false;
   if (allSnapped) {

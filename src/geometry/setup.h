@@ -14,8 +14,8 @@ namespace sv::geometry {
 
 // ---- Fixed-point budget (RASTER-NOTES.md pitfall 1) ------------------------------------------
 // Positions are snapped to 1/256 pixel (24.8). Exact integer edges are used for vertices in front
-// of the eye whose projection lies within the guard band |x|, |y| < 2^15 px; the raster itself is at
-// most 8192 × 8192 (2^13). Budget, with F = 8 sub-pixel bits:
+// of the eye whose projection lies within the guard band |x|, |y| < 2^15 px; the raster itself is
+// at most 8192 × 8192 (2^13). Budget, with F = 8 sub-pixel bits:
 //   snapped coordinate           |x_f| < 2^(15+8)            = 2^23
 //   edge coefficient A = y_i − y_j  |A| < 2^24;  per-pixel step 2^8·A < 2^32
 //   constant C = x_i·y_j − x_j·y_i  |C| < 2^47
@@ -34,7 +34,8 @@ inline constexpr int kMaxEdges = 5;  // three sides, the near plane and the far 
 // centres of a 64-px tile that meets the box (widened by 1 px for the anti-aliasing aperture), so
 // within 96 + 65 px of every vertex on each axis; |e| ≤ 2·(96·2^8)·(161·2^8) ≈ 2.026·10^9, and the
 // aperture's constants add at most 128·(|A| + |B|) ≈ 6.3·10^6: below 2^31 with 5 % to spare.
-// (64 px before; 96 px moved tris 10k × 1000 px from the int64 to the int32 path, docs/performance.md.)
+// (64 px before; 96 px moved tris 10k × 1000 px from the int64 to the int32 path,
+// docs/performance.md.)
 static_assert(2.0 * (kSmallExtent * 256.0) * ((kSmallExtent + 65) * 256.0) +
                       128.0 * 2 * kSmallExtent * 256.0 <
                   2147483647.0,
@@ -79,7 +80,9 @@ struct Viewport {
 // The bounding box of pixels a triangle can reach spans [ceil((x0 − low)/256), floor((x1 − high)/
 // 256)] for snapped extremes x0, x1 (24.8): centres at 256·p + 128 give low = high = 128; pixel
 // squares [256·p, 256·p + 256) with samples strictly inside give low = 255, high = 1.
-inline int boxInsetLow(const Viewport& v) { return v.pixelAperture ? kSubPixelScale - 1 : kSubPixelScale / 2; }
+inline int boxInsetLow(const Viewport& v) {
+  return v.pixelAperture ? kSubPixelScale - 1 : kSubPixelScale / 2;
+}
 inline int boxInsetHigh(const Viewport& v) { return kSubPixelScale - boxInsetLow(v); }
 
 // Object-space culling (SPEC §4, seed 004): the screen box and nearest depth of a whole object,
@@ -107,7 +110,6 @@ struct TriangleSetup {
   // then edge values fit int32 wherever the rasterizer evaluates them (budget above).
   bool small;
 };
-
 
 enum class SetupOutcome : uint8_t {  // numbered from 0, in this order
   drawn,

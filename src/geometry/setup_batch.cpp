@@ -145,7 +145,7 @@ size_t SetupTriangles(const ClipVertex* vertices, const uint32_t* indices, size_
       const auto scale = hn::Div(one, area2);
       const auto px0 = hn::Add(bx0, half), py0 = hn::Add(by0, half);
       // The plane of f (per vertex: value/w) into rows[0, 3): c0, dx, dy.
-      auto planeTo = [&](const hn::Vec<decltype(d)> f[3], double (*rows)[kMaxLanes]) {
+      auto planeTo = [&](const hn::Vec<decltype(d)> f[3], double(*rows)[kMaxLanes]) {
         const auto a = hn::Mul(hn::Add(hn::Add(hn::Mul(f[0], g[0][0]), hn::Mul(f[1], g[1][0])),
                                        hn::Mul(f[2], g[2][0])),
                                scale);

@@ -1,8 +1,8 @@
 // PNG through libpng's simplified API (no setjmp across C++ frames); PPM by hand.
+#include <fmt/format.h>
 #include <png.h>
 
 #include <cstdio>
-#include <fmt/format.h>
 #include <memory>
 
 #include "synthvis/image.h"
@@ -69,7 +69,8 @@ namespace {
 
 // Both readers: `png` has begun reading (from a file or from memory); `name` is for messages.
 Result<Image> finishPngRead(png_image& png, const std::string& name) {
-  if (png.width == 0 || png.height == 0 || png.width > kMaxImageSide || png.height > kMaxImageSide) {
+  if (png.width == 0 || png.height == 0 || png.width > kMaxImageSide ||
+      png.height > kMaxImageSide) {
     png_image_free(&png);
     return Error{name, "", fmt::format("PNG size {}x{} is out of range", png.width, png.height)};
   }

@@ -190,8 +190,8 @@ void forEachBlockMean(const uint16_t* color, int tileX, int tileY, int factor, i
 
 }  // namespace
 
-void resolveTileLinear(const uint16_t* color, const int32_t* sums, int tileX, int tileY,
-                       int factor, int samples, LinearImage& linear) {
+void resolveTileLinear(const uint16_t* color, const int32_t* sums, int tileX, int tileY, int factor,
+                       int samples, LinearImage& linear) {
   auto store = [&](int x, int y, const uint16_t* mean) {
     std::copy_n(mean, 3, linear.rgb.data() + (size_t(y) * size_t(linear.width) + size_t(x)) * 3);
   };
@@ -236,8 +236,8 @@ void resolveDebugTile(const uint16_t* color, int tileX, int tileY, DebugPalette 
                       Image& image) {
   static constexpr uint8_t kCount[6][3] = {{0, 0, 0},     {30, 60, 220}, {0, 200, 220},
                                            {40, 200, 40}, {240, 220, 0}, {230, 30, 30}};
-  static constexpr uint8_t kLevel[7][3] = {{0, 0, 0},    {128, 128, 128}, {30, 60, 220},
-                                           {0, 200, 220}, {40, 200, 40},  {240, 220, 0},
+  static constexpr uint8_t kLevel[7][3] = {{0, 0, 0},     {128, 128, 128}, {30, 60, 220},
+                                           {0, 200, 220}, {40, 200, 40},   {240, 220, 0},
                                            {230, 30, 30}};
   const bool count = palette == DebugPalette::count;
   forEachTileRow(color, tileX, tileY, image, [&](uint8_t* out, const uint16_t* src, int n) {

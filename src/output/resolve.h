@@ -65,8 +65,8 @@ struct LinearImage {
 // Box-resolves one tile into `linear` (sized for the image) instead of the display image, for any
 // of the layouts above: `factor` × `factor` pixels per image pixel (supersampling) or `samples`
 // samples per pixel (one of the two is 1); `sums` as resolveSampleTile.
-void resolveTileLinear(const uint16_t* color, const int32_t* sums, int tileX, int tileY,
-                       int factor, int samples, LinearImage& linear);
+void resolveTileLinear(const uint16_t* color, const int32_t* sums, int tileX, int tileY, int factor,
+                       int samples, LinearImage& linear);
 
 // The 3×3 triangle (tent) filter of seed 002 (SPEC §5) over the box-resolved frame, weights
 // [1 2 1]ᵀ[1 2 1] / 16 in linear light, edges clamped; then gamma. Writes rows [rowBegin, rowEnd)

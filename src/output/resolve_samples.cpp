@@ -4,12 +4,11 @@
 // pixel stay scalar, into a row buffer written to the image whole (writeImageRow).
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "output/resolve_samples.cpp"
-#include "hwy/foreach_target.h"  // IWYU pragma: keep
-#include "hwy/highway.h"
-
 #include <algorithm>
 #include <bit>
 
+#include "hwy/foreach_target.h"  // IWYU pragma: keep
+#include "hwy/highway.h"
 #include "output/resolve.h"
 
 HWY_BEFORE_NAMESPACE();
@@ -52,9 +51,9 @@ void ResolveSampleTile(const uint16_t* color, const int32_t* sums, int tileX, in
       if (sums) {  // the sums of the planes, kept as they were drawn
         const int32_t* sum = sums + index * kColorPerBlock;
         for (size_t i = 0; i < size_t(kColorPerBlock); i += n)
-          hn::Store(hn::DemoteTo(d16, hn::ShiftRightSame(hn::Add(hn::LoadU(d32, sum + i), half),
-                                                         shift)),
-                    d16, mean[b] + i);
+          hn::Store(
+              hn::DemoteTo(d16, hn::ShiftRightSame(hn::Add(hn::LoadU(d32, sum + i), half), shift)),
+              d16, mean[b] + i);
         continue;
       }
       const uint16_t* block = color + index * samples * kColorPerBlock;

@@ -48,7 +48,8 @@ void Binner::binChunk(int chunk, const geometry::TriangleSetup* records, uint32_
     for (int ty = ty0; ty <= ty1; ++ty)
       for (int tx = tx0; tx <= tx1; ++tx) fn(ty * tilesX_ + tx);
   };
-  for (uint32_t i = 0; i < n; ++i) forEachTile(records[i], [&](int tile) { ++out.offsets[tile + 1]; });
+  for (uint32_t i = 0; i < n; ++i)
+    forEachTile(records[i], [&](int tile) { ++out.offsets[tile + 1]; });
   for (int k = 0; k < tiles_; ++k) out.offsets[k + 1] += out.offsets[k];
   out.entries.resize(out.offsets[size_t(tiles_)]);
   // The optional parallel arrays are placed in the same pass, at the entries' positions.

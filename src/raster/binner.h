@@ -12,8 +12,8 @@
 // scattered records (docs/performance.md).
 #pragma once
 
-#include <cstdint>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "geometry/setup.h"
@@ -62,9 +62,10 @@ class Binner {
   }
 
  private:
-  // A chunk's lists, one after the other in tile order: tile t's is entries[offsets[t], offsets[t+1]).
-  // Filled by a counting pass and a placing pass: two flat arrays per chunk instead of a vector per
-  // tile and chunk (the same speed on tris 100k×10, far fewer allocations at 8192² rasters).
+  // A chunk's lists, one after the other in tile order: tile t's is entries[offsets[t],
+  // offsets[t+1]). Filled by a counting pass and a placing pass: two flat arrays per chunk instead
+  // of a vector per tile and chunk (the same speed on tris 100k×10, far fewer allocations at 8192²
+  // rasters).
   struct ChunkLists {
     std::vector<uint32_t> offsets, entries, objects;
     std::vector<Box> boxes;

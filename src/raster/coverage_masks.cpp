@@ -1,6 +1,6 @@
 // Based on: SPEC §5 (seed 000: masks from a table indexed by distance and slope); Schilling 1991
-// (A new simple and efficient antialiasing with subpixel masks: masks chosen by area); Microsoft, D3D11 standard
-// multisample patterns (D3D11_STANDARD_MULTISAMPLE_PATTERN) for 8 and 16 samples.
+// (A new simple and efficient antialiasing with subpixel masks: masks chosen by area); Microsoft,
+// D3D11 standard multisample patterns (D3D11_STANDARD_MULTISAMPLE_PATTERN) for 8 and 16 samples.
 #include "raster/coverage_masks.h"
 
 #include <algorithm>
@@ -68,20 +68,39 @@ const SamplePattern* samplePattern(int count) {
   static const SamplePattern one{1, {{0.0, 0.0}}};
   static const SamplePattern four =
       fromSixteenths({{-2, -6}, {6, -2}, {-6, 2}, {2, 6}}, 0.0);  // rotated grid
-  static const SamplePattern eight = fromSixteenths(
-      {{1, -3}, {-1, 3}, {5, 1}, {-3, -5}, {-5, 5}, {-7, -1}, {3, -7}, {7, 7}}, 0.0);
-  static const SamplePattern sixteen = fromSixteenths(
-      {{1, 1}, {-1, -3}, {-3, 2}, {4, -1}, {-5, -2}, {2, 5}, {5, 3}, {3, -5}, {-2, 6}, {0, -7},
-       {-4, -6}, {-6, 4}, {-8, 0}, {7, -4}, {6, 7}, {-7, -8}},
-      1.0 / 32);
+  static const SamplePattern eight =
+      fromSixteenths({{1, -3}, {-1, 3}, {5, 1}, {-3, -5}, {-5, 5}, {-7, -1}, {3, -7}, {7, 7}}, 0.0);
+  static const SamplePattern sixteen = fromSixteenths({{1, 1},
+                                                       {-1, -3},
+                                                       {-3, 2},
+                                                       {4, -1},
+                                                       {-5, -2},
+                                                       {2, 5},
+                                                       {5, 3},
+                                                       {3, -5},
+                                                       {-2, 6},
+                                                       {0, -7},
+                                                       {-4, -6},
+                                                       {-6, 4},
+                                                       {-8, 0},
+                                                       {7, -4},
+                                                       {6, 7},
+                                                       {-7, -8}},
+                                                      1.0 / 32);
   static const SamplePattern sixtyFour = jittered8x8();
   switch (count) {
-    case 1: return &one;
-    case 4: return &four;
-    case 8: return &eight;
-    case 16: return &sixteen;
-    case 64: return &sixtyFour;
-    default: return nullptr;
+    case 1:
+      return &one;
+    case 4:
+      return &four;
+    case 8:
+      return &eight;
+    case 16:
+      return &sixteen;
+    case 64:
+      return &sixtyFour;
+    default:
+      return nullptr;
   }
 }
 
@@ -104,8 +123,8 @@ EdgeMaskTable::EdgeMaskTable(const SamplePattern& pattern)
         // The k = round(N·A) samples farthest inside (largest v; ties by sample index).
         std::vector<std::pair<double, int>> v(static_cast<size_t>(count_));
         for (int s = 0; s < count_; ++s)
-          v[size_t(s)] = {nx * pattern.offsets[size_t(s)][0] + ny * pattern.offsets[size_t(s)][1] + d,
-                          s};
+          v[size_t(s)] = {
+              nx * pattern.offsets[size_t(s)][0] + ny * pattern.offsets[size_t(s)][1] + d, s};
         const int k = int(std::lround(halfPlaneArea(nx, ny, d) * count_));
         std::stable_sort(v.begin(), v.end(),
                          [](const auto& a, const auto& b) { return a.first > b.first; });
@@ -137,7 +156,11 @@ uint64_t EdgeMaskTable::mask(double a, double b, double c) const {
 }
 
 CoverageTables::CoverageTables(const SamplePattern& p)
-    : samples(p.count), words(p.count > 32 ? 2 : 1), pattern(&p), centroid(p.count >= 16), table(p) {
+    : samples(p.count),
+      words(p.count > 32 ? 2 : 1),
+      pattern(&p),
+      centroid(p.count >= 16),
+      table(p) {
   for (int s = 0; s < p.count; ++s) {
     offsetX[s] = int32_t(std::lround(p.offsets[size_t(s)][0] * 256));  // exact: 1/256 grid
     offsetY[s] = int32_t(std::lround(p.offsets[size_t(s)][1] * 256));
@@ -155,11 +178,16 @@ const CoverageTables* CoverageTables::forCount(int samples) {
   static const CoverageTables four(*samplePattern(4)), eight(*samplePattern(8)),
       sixteen(*samplePattern(16)), sixtyFour(*samplePattern(64));
   switch (samples) {
-    case 4: return &four;
-    case 8: return &eight;
-    case 16: return &sixteen;
-    case 64: return &sixtyFour;
-    default: return nullptr;
+    case 4:
+      return &four;
+    case 8:
+      return &eight;
+    case 16:
+      return &sixteen;
+    case 64:
+      return &sixtyFour;
+    default:
+      return nullptr;
   }
 }
 

@@ -21,8 +21,8 @@
 // number of samples truly inside, the extra (or missing) ones are those nearest the edge.
 //
 // Precision. Within a cell d moves by 1/(2·kDistanceSteps) and, through t, v by less than
-// 1/(2·kSlopeSteps) (|∂v/∂t| = |sx ∓ sy| < 1); the area moves by at most twice that (the chord is at
-// most √2 long, and the L1-normalized normal at least 1/√2 long): kAreaError.
+// 1/(2·kSlopeSteps) (|∂v/∂t| = |sx ∓ sy| < 1); the area moves by at most twice that (the chord is
+// at most √2 long, and the L1-normalized normal at least 1/√2 long): kAreaError.
 //
 // Complementarity (RASTER-NOTES pitfall 4). Only the cells with d > 0 are computed; the reversed
 // edge's entry — opposite quadrant, mirrored distance cell — is set to the complement. Hence

@@ -5,16 +5,15 @@
 // stored whole and cropped on output. Inside a tile, 4×4-pixel blocks are stored one after the
 // other in row-major block order, and inside a block the 16 pixels in row-major order — so a block,
 // the rasterizer's leaf, is one contiguous run of 16 values, one or a few SIMD vectors.
-// Colour is planar per block (16 R, 16 G, 16 B, as uint16 linear light 0…65535), so the kernels never
-// interleave; output applies gamma through look-up tables (SPEC §8).
-// With N samples per pixel (anti-aliasing, SPEC §5) a block holds N such *sample planes* one after
-// the other: plane s is the 16 pixels' sample s, laid out exactly as a 1-sample block. The kernel
-// then tests depth and writes colour one plane — 16 pixels — per vector, and the resolve sums the
-// planes. Memory per pixel: N × (4 bytes of depth + 6 of colour).
-// Colour sums (TileWork::sums): where every sample is written at most once (priority masking,
-// opaque), a pixel's colour is kept instead as the sum of its N samples' 16-bit values, 3 int32
-// per pixel laid out as one plane (block by block, 16 R, 16 G, 16 B) — what the resolve would
-// have summed, so the image is the same bit for bit.
+// Colour is planar per block (16 R, 16 G, 16 B, as uint16 linear light 0…65535), so the kernels
+// never interleave; output applies gamma through look-up tables (SPEC §8). With N samples per pixel
+// (anti-aliasing, SPEC §5) a block holds N such *sample planes* one after the other: plane s is the
+// 16 pixels' sample s, laid out exactly as a 1-sample block. The kernel then tests depth and writes
+// colour one plane — 16 pixels — per vector, and the resolve sums the planes. Memory per pixel: N ×
+// (4 bytes of depth + 6 of colour). Colour sums (TileWork::sums): where every sample is written at
+// most once (priority masking, opaque), a pixel's colour is kept instead as the sum of its N
+// samples' 16-bit values, 3 int32 per pixel laid out as one plane (block by block, 16 R, 16 G, 16
+// B) — what the resolve would have summed, so the image is the same bit for bit.
 #pragma once
 
 #include <cstddef>
@@ -69,7 +68,9 @@ class FrameBuffer {
     return color_.get() + size_t(tile) * kTilePixels * kColorChannels * samples_;
   }
   // The tile's colour sums; nullptr unless allocated (resize with `sums`).
-  int32_t* tileSums(int tile) { return sums_ ? sums_.get() + size_t(tile) * kSumsPerTile : nullptr; }
+  int32_t* tileSums(int tile) {
+    return sums_ ? sums_.get() + size_t(tile) * kSumsPerTile : nullptr;
+  }
 
   // Offsets of sample s of pixel (x, y) inside its tile's depth and colour arrays, for a buffer of
   // `samples` samples per pixel.

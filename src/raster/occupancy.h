@@ -129,7 +129,8 @@ class Occupancy {
     }
     if (pixels_[b] == 0xFFFF) return;  // full already (its bound is kept by lowerZmax)
     pixels_[b] = uint16_t(pixels_[b] | mask);
-    if (pixels_[b] == 0xFFFF) markFull(kMinLevel, lx, ly, depth ? maxOf(depth, kBlockPixels) : kNoBound);
+    if (pixels_[b] == 0xFFFF)
+      markFull(kMinLevel, lx, ly, depth ? maxOf(depth, kBlockPixels) : kNoBound);
   }
 
   // Adds occupied samples (anti-aliasing), `mask[w][pixel]` in the coverage masks' words; a pixel

@@ -29,7 +29,7 @@ struct RasterStats {
   uint64_t fragments = 0;              // pixels that passed coverage (some sample, with
                                        // anti-aliasing) and reached the depth test
   uint64_t hiddenFragments = 0;        // … of which the depth test passed none
-  uint64_t hybridWoken = 0;           // tile passes in which hybrid masking woke (drawLists)
+  uint64_t hybridWoken = 0;            // tile passes in which hybrid masking woke (drawLists)
   uint64_t shadedByList = 0;  // deferred shading passes that read the tile kernel's WinnerList
   uint64_t shadedByScan = 0;  // … that scanned the tile
 
@@ -83,7 +83,8 @@ enum class ShadeMode : uint8_t {
 // Pixel shading's record for one triangle (ShadeMode::material): its attribute planes in
 // shade::Attribute order, with the same origin as its TriangleSetup's planes, and its material.
 struct alignas(64) AttributeSetup {
-  const shade::MaterialShading* material = nullptr;  // nullptr: Gouraud colour, as ShadeMode::gouraud
+  const shade::MaterialShading* material =
+      nullptr;  // nullptr: Gouraud colour, as ShadeMode::gouraud
   geometry::Plane planes[shade::kAttributeCount];
   // The record is two cache lines; the first holds the material and the first planes (a
   // textured material's u and v). Whether shading reads the second, by attributesUsed's bits:
@@ -96,7 +97,7 @@ struct alignas(64) AttributeSetup {
 // One tile's work: triangles in submission order, given as lists of indices into `setups`.
 struct TileWork {
   int tileX = 0, tileY = 0;  // tile coordinates (pixel origin = 64·tileX, 64·tileY)
-  float* depth = nullptr;     // the tile's buffers, laid out as FrameBuffer describes
+  float* depth = nullptr;    // the tile's buffers, laid out as FrameBuffer describes
   uint16_t* color = nullptr;
   // Colour sums instead of sample planes (FrameBuffer, "colour sums"): anti-aliased priority
   // masking where every triangle is opaque and nothing reads the tile but the resolve, so each

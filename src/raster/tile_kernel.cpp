@@ -8,13 +8,14 @@
 // Symbols. For an edge e(px, py) = c + sX·px + sY·py (setup.h), a window of n×n pixels is kept by
 // the value tl of e at the centre of its top-left pixel. Seed 000's coverage function is
 //     d = e(x_c, y_c) + ε,   ε = (|A|·a + |B|·b)/2,   a = b = n − 1 (α = β = 0: point sampling)
-// — the largest value of e over the window's pixel centres. With sX⁺ = max(sX, 0), sX⁻ = min(sX, 0):
+// — the largest value of e over the window's pixel centres. With sX⁺ = max(sX, 0), sX⁻ = min(sX,
+// 0):
 //     d      = tl + (sX⁺ + sY⁺)·(n − 1)        d < 0   → the window is outside: reject
 //     d − 2ε = tl + (sX⁻ + sY⁻)·(n − 1)        d ≥ 2ε  → inside this edge: drop the edge below here
-// A child of size h = n/2 at (cx, cy) ∈ {0,1}² has tl' = tl + cx·sX·h + cy·sY·h (seed 000 eq. 1), so
-// its d' = d − h·|sX|·e_A − h·|sY|·e_B + … is seed 000's eq. 8 with the ε of the child folded in; we
-// carry tl rather than d because it is the same for every level's ε (one add per edge per child,
-// as the seed counts). All in exact int64 (budget in geometry/setup.h).
+// A child of size h = n/2 at (cx, cy) ∈ {0,1}² has tl' = tl + cx·sX·h + cy·sY·h (seed 000 eq. 1),
+// so its d' = d − h·|sX|·e_A − h·|sY|·e_B + … is seed 000's eq. 8 with the ε of the child folded
+// in; we carry tl rather than d because it is the same for every level's ε (one add per edge per
+// child, as the seed counts). All in exact int64 (budget in geometry/setup.h).
 //
 // Departure from the seed: the last two levels (2×2 and 1×1 windows) are unrolled into one 4×4 leaf
 // whose 16 pixel centres are tested at once in SIMD lanes; the result is the same set of pixels.
@@ -32,15 +33,14 @@
 
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "raster/tile_kernel.cpp"
-#include "hwy/foreach_target.h"  // IWYU pragma: keep
-#include "hwy/cache_control.h"
-#include "hwy/highway.h"
-
 #include <algorithm>
 #include <bit>
 #include <cstddef>
 #include <cstring>
 
+#include "hwy/cache_control.h"
+#include "hwy/foreach_target.h"  // IWYU pragma: keep
+#include "hwy/highway.h"
 #include "raster/framebuffer.h"
 #include "raster/occupancy.h"
 #include "raster/rasterizer.h"
@@ -108,8 +108,8 @@ struct TileContext {
   float* depth;
   uint16_t* color;
   RasterStats* stats;
-  const CoverageTables* coverage;  // anti-aliasing, or nullptr
-  int samples;                     // per pixel: 1, or coverage->samples
+  const CoverageTables* coverage;         // anti-aliasing, or nullptr
+  int samples;                            // per pixel: 1, or coverage->samples
   const shade::Environment* environment;  // ShadeMode::material
   // ShadeMode::material at one sample: the winning triangle per pixel (setup storage index, or
   // kNoTriangle), laid out as depth; and the records it indexes.
@@ -203,7 +203,8 @@ HWY_INLINE void countBlock(uint32_t mask, uint16_t* color) {
   for (; mask; mask &= mask - 1) ++color[std::countr_zero(mask)];
 }
 
-// The five plane values (c0 + dx·X) + dy·Y at a block's top-left pixel (gx, gy), one lane per plane.
+// The five plane values (c0 + dx·X) + dy·Y at a block's top-left pixel (gx, gy), one lane per
+// plane.
 HWY_INLINE void blockBases(const TriangleSetup& t, const PlaneLanes& lanes, int gx, int gy,
                            float* base) {
   const hn::CappedTag<float, 8> d8;
@@ -221,8 +222,9 @@ template <class DF, class V>
 HWY_INLINE auto colorToLanes(DF df, V cw, V w) {
   const hn::RebindToSigned<DF> di;
   const auto c = hn::Min(hn::Max(hn::Mul(cw, w), hn::Zero(df)), hn::Set(df, 1.0f));
-  return hn::And(hn::BitCast(di, hn::Add(hn::Mul(c, hn::Set(df, 65535.0f)), hn::Set(df, 8388608.0f))),
-                 hn::Set(di, 0xFFFF));
+  return hn::And(
+      hn::BitCast(di, hn::Add(hn::Mul(c, hn::Set(df, 65535.0f)), hn::Set(df, 8388608.0f))),
+      hn::Set(di, 0xFFFF));
 }
 
 // Channel ch at the pixel centres of lanes i… .
@@ -238,7 +240,7 @@ HWY_INLINE auto colorLanes(DF df, const PlaneLanes& lanes, const float* base, in
 // Returns how many of the pixels failed the depth test (hidden fragments, as every depth-testing
 // block operation here: hybrid masking wakes on them, drawLists).
 HWY_INLINE int shadeBlock(const TriangleSetup& t, const PlaneLanes& lanes, uint32_t mask, int gx,
-                           int gy, float* depth, uint16_t* color) {
+                          int gy, float* depth, uint16_t* color) {
   const hn::CappedTag<float, kBlockPixels> df;
   const hn::RebindToSigned<decltype(df)> di;
   const hn::Rebind<uint16_t, decltype(df)> du;
@@ -259,21 +261,23 @@ HWY_INLINE int shadeBlock(const TriangleSetup& t, const PlaneLanes& lanes, uint3
     if (hn::AllFalse(df, pass)) continue;
     hn::StoreU(hn::IfThenElse(pass, z, zOld), df, depth + i);
     // SPEC §2: perspective-correct colour = (colour/w) / (1/w).
-    const auto w = hn::Div(
-        one, hn::Add(hn::Set(df, base[kInvW]), hn::LoadU(df, lanes.offset[kInvW] + i)));
+    const auto w =
+        hn::Div(one, hn::Add(hn::Set(df, base[kInvW]), hn::LoadU(df, lanes.offset[kInvW] + i)));
     const auto passI = hn::RebindMask(di, pass);
     for (int ch = 0; ch < kColorChannels; ++ch) {
       uint16_t* dst = color + ch * kBlockPixels + i;
       const auto old = hn::PromoteTo(di, hn::LoadU(du, dst));
-      hn::StoreU(hn::DemoteTo(du, hn::IfThenElse(passI, colorLanes(df, lanes, base, ch, i, w), old)),
-                 du, dst);
+      hn::StoreU(
+          hn::DemoteTo(du, hn::IfThenElse(passI, colorLanes(df, lanes, base, ch, i, w), old)), du,
+          dst);
     }
   }
   return hidden;
 }
 
 // The centroid of each lane's covered samples relative to its pixel centre, in pixels (zero for a
-// lane whose samples are all covered): (Σ offsets in 1/256 px, an exact integer) · (1 / (count · 256)).
+// lane whose samples are all covered): (Σ offsets in 1/256 px, an exact integer) · (1 / (count ·
+// 256)).
 template <class DF, class VU, class V>
 HWY_INLINE void centroidOffsets(DF df, const CoverageTables& cov, VU m0, VU m1, V& cx, V& cy) {
   const hn::RebindToSigned<DF> di;
@@ -288,8 +292,9 @@ HWY_INLINE void centroidOffsets(DF df, const CoverageTables& cov, VU m0, VU m1, 
     count = hn::Sub(count, hn::VecFromMask(di, covered));
   }
   const auto partial = hn::RebindMask(df, hn::Lt(count, hn::Set(di, samples)));
-  const auto scale = hn::Div(hn::Set(df, 1.0f), hn::Mul(hn::ConvertTo(df, hn::Max(count, hn::Set(di, 1))),
-                                                        hn::Set(df, 256.0f)));
+  const auto scale =
+      hn::Div(hn::Set(df, 1.0f),
+              hn::Mul(hn::ConvertTo(df, hn::Max(count, hn::Set(di, 1))), hn::Set(df, 256.0f)));
   cx = hn::IfThenElseZero(partial, hn::Mul(hn::ConvertTo(df, sx), scale));
   cy = hn::IfThenElseZero(partial, hn::Mul(hn::ConvertTo(df, sy), scale));
 }
@@ -308,11 +313,11 @@ HWY_INLINE void centroidOffsets(DF df, const CoverageTables& cov, VU m0, VU m1, 
 // With `sums` (TileWork::sums) the samples are tested against `depth` alone, which then holds the
 // clear depth, and added to the sums instead of written.
 HWY_INLINE int shadeBlockSamples(const TriangleSetup& t, const PlaneLanes& lanes,
-                                  const CoverageTables& cov, const float* sampleDepth,
-                                  const uint32_t (*masks)[kBlockPixels], int gx, int gy,
-                                  float* depth, uint16_t* color,
-                                  const uint32_t (*shading)[kBlockPixels], int32_t* sums,
-                                  const int32_t* clearColor) {
+                                 const CoverageTables& cov, const float* sampleDepth,
+                                 const uint32_t (*masks)[kBlockPixels], int gx, int gy,
+                                 float* depth, uint16_t* color,
+                                 const uint32_t (*shading)[kBlockPixels], int32_t* sums,
+                                 const int32_t* clearColor) {
   const int samples = cov.samples;
   // The words of a full mask.
   const uint32_t fullWord0 = fullSampleWord(samples, 0), fullWord1 = fullSampleWord(samples, 1);
@@ -455,7 +460,8 @@ HWY_INLINE void blockFragments(const TriangleSetup& t, const PlaneLanes& lanes,
     hn::StoreU(q, df, f.q + i);
     const auto w = hn::Div(one, hn::Max(q, hn::Set(df, 1e-30f)));
     for (int ch = 0; ch < kColorChannels; ++ch) {
-      const auto cw = at(base[kRed + ch], lanes.offset[kRed + ch], lanes.dx[kRed + ch], lanes.dy[kRed + ch]);
+      const auto cw =
+          at(base[kRed + ch], lanes.offset[kRed + ch], lanes.dx[kRed + ch], lanes.dy[kRed + ch]);
       hn::StoreU(hn::Min(hn::Max(hn::Mul(cw, w), zero), one), df, f.color[ch] + i);
     }
     for (int p = 0; p < shade::kAttributeCount; ++p)
@@ -469,8 +475,9 @@ HWY_INLINE void blockFragments(const TriangleSetup& t, const PlaneLanes& lanes,
 template <class DF, class V>
 HWY_INLINE auto unitToLanes(DF df, V c) {
   const hn::RebindToSigned<DF> di;
-  return hn::And(hn::BitCast(di, hn::Add(hn::Mul(c, hn::Set(df, 65535.0f)), hn::Set(df, 8388608.0f))),
-                 hn::Set(di, 0xFFFF));
+  return hn::And(
+      hn::BitCast(di, hn::Add(hn::Mul(c, hn::Set(df, 65535.0f)), hn::Set(df, 8388608.0f))),
+      hn::Set(di, 0xFFFF));
 }
 
 // Writes shaded colour `rgba` to the lanes of one sample plane set in `pass`: the colour itself, or
@@ -498,9 +505,9 @@ HWY_INLINE void storeShaded(DF df, M pass, bool blend, const float (*rgba)[kBloc
 
 // One 4×4 block at one sample per pixel; returns the pixels hidden by the depth test.
 HWY_INLINE int shadeBlockMaterial(const TriangleSetup& t, const PlaneLanes& lanes,
-                                   const AttributeLanes& al, const AttributeSetup& a,
-                                   const shade::Environment& env, uint32_t mask, int gx, int gy,
-                                   float* depth, uint16_t* color, uint32_t* visible) {
+                                  const AttributeLanes& al, const AttributeSetup& a,
+                                  const shade::Environment& env, uint32_t mask, int gx, int gy,
+                                  float* depth, uint16_t* color, uint32_t* visible) {
   const hn::CappedTag<float, kBlockPixels> df;
   const hn::RebindToSigned<decltype(df)> di;
   const size_t n = hn::Lanes(df);
@@ -518,7 +525,8 @@ HWY_INLINE int shadeBlockMaterial(const TriangleSetup& t, const PlaneLanes& lane
   if (!passBits) return hidden;
   // Step 2: shade all 16 pixels at once, then write those that pass (and are not cut away).
   shade::Fragments f;
-  blockFragments(t, lanes, al, base, gx, gy, nullptr, nullptr, shade::attributesUsed(*a.material, env), f);
+  blockFragments(t, lanes, al, base, gx, gy, nullptr, nullptr,
+                 shade::attributesUsed(*a.material, env), f);
   alignas(64) float rgba[4][kBlockPixels];
   shade::shadeFragments(*a.material, env, f, rgba);
   const bool blend = a.material->alpha == shade::AlphaUse::blend;
@@ -578,9 +586,8 @@ HWY_INLINE bool samplesPassing(const TriangleSetup& t, const PlaneLanes& lanes,
     }
     const auto zPix = hn::Add(hn::Set(df, base[kDepth]), hn::LoadU(df, lanes.offset[kDepth] + i));
     auto p0 = hn::Zero(du32), p1 = p0;
-    const bool allPass =
-        uniform &&
-        hn::AllTrue(df, hn::Lt(hn::Add(zPix, hn::Set(df, uniform[1])), hn::Set(df, uniform[0])));
+    const bool allPass = uniform && hn::AllTrue(df, hn::Lt(hn::Add(zPix, hn::Set(df, uniform[1])),
+                                                           hn::Set(df, uniform[0])));
     if (allPass) {
       p0 = m0;
       p1 = m1;
@@ -628,10 +635,12 @@ HWY_INLINE void writeSamples(const TriangleSetup& t, const PlaneLanes& lanes,
   if (sums) {
     const hn::RebindToSigned<decltype(df)> di;
     for (size_t i = 0; i < size_t(kBlockPixels); i += hn::Lanes(df)) {
-      const auto count = hn::BitCast(di, hn::Add(hn::PopulationCount(hn::LoadU(du32, pass[0] + i)),
-                                                 hn::PopulationCount(hn::LoadU(du32, pass[1] + i))));
+      const auto count =
+          hn::BitCast(di, hn::Add(hn::PopulationCount(hn::LoadU(du32, pass[0] + i)),
+                                  hn::PopulationCount(hn::LoadU(du32, pass[1] + i))));
       hn::Vec<decltype(di)> c[kColorChannels];
-      for (int ch = 0; ch < kColorChannels; ++ch) c[ch] = unitToLanes(df, hn::LoadU(df, rgba[ch] + i));
+      for (int ch = 0; ch < kColorChannels; ++ch)
+        c[ch] = unitToLanes(df, hn::LoadU(df, rgba[ch] + i));
       addToSums(di, count, c, clearColor, sums, i);
     }
     return;
@@ -663,10 +672,9 @@ HWY_INLINE void writeSamples(const TriangleSetup& t, const PlaneLanes& lanes,
 // block whose top-left pixel is (bx[i], by[i]) from the planes' origin, at lane lane[i], moved by
 // (cx[i], cy[i]) — with exactly blockFragments' float operations, so that a pixel shades the same
 // in a batch as it would in its block.
-HWY_INLINE void batchFragments(const PlaneLanes& lanes,
-                               const AttributeLanes& al, const float* bx, const float* by,
-                               const int32_t* lane, const float* cx, const float* cy,
-                               unsigned used, shade::Fragments& f) {
+HWY_INLINE void batchFragments(const PlaneLanes& lanes, const AttributeLanes& al, const float* bx,
+                               const float* by, const int32_t* lane, const float* cx,
+                               const float* cy, unsigned used, shade::Fragments& f) {
   const hn::CappedTag<float, kBlockPixels> df;
   const hn::RebindToSigned<decltype(df)> di;
   const size_t n = hn::Lanes(df);
@@ -701,7 +709,7 @@ HWY_INLINE void batchFragments(const PlaneLanes& lanes,
 // in hardware: each pixel is shaded once, by its final winner, however many triangles covered it.
 // Returns the pixels hidden by the depth test.
 HWY_INLINE int visibleBlock(const TriangleSetup& t, const PlaneLanes& lanes, uint32_t mask, int gx,
-                             int gy, uint32_t id, float* depth, uint32_t* visible) {
+                            int gy, uint32_t id, float* depth, uint32_t* visible) {
   const hn::CappedTag<float, kBlockPixels> df;
   const hn::RebindToSigned<decltype(df)> di;
   const hn::RebindToUnsigned<decltype(df)> du;
@@ -778,7 +786,8 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
   const hn::RebindToSigned<decltype(df)> di;
   const hn::Rebind<uint16_t, decltype(df)> du16;
   const size_t n = hn::Lanes(df);
-  // A pixel is named by its index in the tile's block-major layout (framebuffer.h): block·16 + lane.
+  // A pixel is named by its index in the tile's block-major layout (framebuffer.h): block·16 +
+  // lane.
   struct Batch {
     uint32_t id = kNoTriangle;
     int count = 0;
@@ -925,8 +934,9 @@ HWY_NOINLINE void shadeVisible(const TileContext& ctx) {
                                     hn::Load(di, b.pixel + i), lastPixel);
       const auto block = hn::ShiftRight<2 * kBlockLog2>(p);
       const auto lane = hn::And(p, hn::Set(di, kBlockPixels - 1));
-      const auto x = hn::Or(hn::ShiftLeft<kBlockLog2>(hn::And(block, hn::Set(di, kBlocksPerTileSide - 1))),
-                            hn::And(lane, hn::Set(di, kBlockSize - 1)));
+      const auto x =
+          hn::Or(hn::ShiftLeft<kBlockLog2>(hn::And(block, hn::Set(di, kBlocksPerTileSide - 1))),
+                 hn::And(lane, hn::Set(di, kBlockSize - 1)));
       const auto y = hn::Or(hn::ShiftLeft<kBlockLog2>(hn::ShiftRight<4>(block)),
                             hn::ShiftRight<kBlockLog2>(lane));
       static_assert(kBlocksPerTileSide == 16, "block row = block >> 4");
@@ -1172,8 +1182,7 @@ HWY_INLINE float depthBound(const TriangleSetup& t, int gx0, int gy0, int gx1, i
   const double margin =
       1e-6 * (1.0 + std::fabs(c0) + std::fabs(dx) * (std::fabs(x0) + std::fabs(x1)) +
               std::fabs(dy) * (std::fabs(y0) + std::fabs(y1)));
-  if (upper)
-    return float(c0 + std::max(dx * x0, dx * x1) + std::max(dy * y0, dy * y1) + margin);
+  if (upper) return float(c0 + std::max(dx * x0, dx * x1) + std::max(dy * y0, dy * y1) + margin);
   return float(c0 + std::min(dx * x0, dx * x1) + std::min(dy * y0, dy * y1) - margin);
 }
 
@@ -1191,9 +1200,8 @@ class TriangleRaster {
     // what they cover; cut-outs (alpha mask) are dropped but mark nothing (their holes show what
     // lies behind); translucent ones blend over whatever the depth test lets through.
     if constexpr (kOp != PixelOp::overdraw) {
-      const shade::AlphaUse alpha = attributes && attributes->material
-                                        ? attributes->material->alpha
-                                        : shade::AlphaUse::opaque;
+      const shade::AlphaUse alpha = attributes && attributes->material ? attributes->material->alpha
+                                                                       : shade::AlphaUse::opaque;
       if (alpha != shade::AlphaUse::blend) occ_ = ctx.occupancy;
       mark_ = occ_ && alpha == shade::AlphaUse::opaque;
       computePlaneLanes(t, planeLanes_);
@@ -1211,8 +1219,8 @@ class TriangleRaster {
         const hn::CappedTag<T, kBlockPixels> d;
         for (size_t i = 0; i < size_t(kBlockPixels); i += hn::Lanes(d)) {
           const auto lx = hn::LoadU(d, kLaneX + i), ly = hn::LoadU(d, kLaneY + i);
-          hn::StoreU(hn::Add(hn::Mul(lx, hn::Set(d, sX_[k])), hn::Mul(ly, hn::Set(d, sY_[k]))),
-                     d, leafOffset_[k] + i);
+          hn::StoreU(hn::Add(hn::Mul(lx, hn::Set(d, sX_[k])), hn::Mul(ly, hn::Set(d, sY_[k]))), d,
+                     leafOffset_[k] + i);
         }
       } else {
         for (int i = 0; i < kBlockPixels; ++i)
@@ -1287,10 +1295,10 @@ class TriangleRaster {
         const int quadrant = int(a < 0 || (a == 0 && b < 0)) | int(b < 0 || (b == 0 && a < 0)) << 1;
         // ⌊32·|a| / S⌋ in double: the correctly rounded quotient of integers below 2^53 floors
         // exactly (as EdgeMaskTable::mask's), and costs a fraction of an int64 division.
-        const double slope = std::floor(double(EdgeMaskTable::kSlopeSteps) * double(std::abs(a)) /
-                                        double(S));
-        row = EdgeMaskTable::rowIndex(
-            quadrant, std::min(EdgeMaskTable::kSlopeSteps - 1, int(slope)));
+        const double slope =
+            std::floor(double(EdgeMaskTable::kSlopeSteps) * double(std::abs(a)) / double(S));
+        row =
+            EdgeMaskTable::rowIndex(quadrant, std::min(EdgeMaskTable::kSlopeSteps - 1, int(slope)));
       }
       rowOffset_[k] = row * EdgeMaskTable::kRowEntries;
       divisor_[k] = int32_t(std::max<int64_t>(S, 1));  // S < 2^25 (setup.h budget)
@@ -1299,8 +1307,8 @@ class TriangleRaster {
     const auto& offsets = cov.pattern->offsets;
     sampleDepthMax_ = -std::numeric_limits<float>::infinity();
     for (int s = 0; s < cov.samples; ++s) {
-      sampleDepth_[s] = t_.depth.dx * float(offsets[size_t(s)][0]) +
-                        t_.depth.dy * float(offsets[size_t(s)][1]);
+      sampleDepth_[s] =
+          t_.depth.dx * float(offsets[size_t(s)][0]) + t_.depth.dy * float(offsets[size_t(s)][1]);
       sampleDepthMax_ = std::max(sampleDepthMax_, sampleDepth_[s]);
     }
   }
@@ -1452,7 +1460,8 @@ class TriangleRaster {
     // Row entries are read by vector gathers: scalar loads of SIMD-computed entries measured 7 %
     // slower (AMD Zen 4, 100k triangles of 10 px at 4 samples: 28.1 vs 26.3 ms).
     alignas(64) uint32_t masks[2][kBlockPixels], coverage[2][kBlockPixels];
-    const uint32_t(*occupied)[kBlockPixels] = occ_ && !ctx_.hybrid ? occ_->samples(lx, ly) : nullptr;
+    const uint32_t(*occupied)[kBlockPixels] =
+        occ_ && !ctx_.hybrid ? occ_->samples(lx, ly) : nullptr;
     const auto zero = hn::Zero(di), minusOne = hn::Set(di, -1);
     const int32_t* word0 = reinterpret_cast<const int32_t*>(cov.word[0].data());
     const int32_t* word1 = reinterpret_cast<const int32_t*>(cov.word[1].data());
@@ -1486,10 +1495,10 @@ class TriangleRaster {
           // is within one of ⌊a / S⌋, then corrected exactly.
           const auto a = hn::Min(hn::ShiftRight<kShift>(hn::Abs(hn::Add(e, hn::Set(di, bias_[k])))),
                                  hn::Set(di, kHalf * divisor_[k]));
-          q = hn::Sub(hn::BitCast(di, hn::Add(hn::Mul(hn::ConvertTo(df, a),
-                                                      hn::Set(df, reciprocal_[k])),
-                                              hn::Set(df, 8388608.0f))),
-                      hn::Set(di, 0x4B000000));  // the bits of 2^23
+          q = hn::Sub(
+              hn::BitCast(di, hn::Add(hn::Mul(hn::ConvertTo(df, a), hn::Set(df, reciprocal_[k])),
+                                      hn::Set(df, 8388608.0f))),
+              hn::Set(di, 0x4B000000));  // the bits of 2^23
           const auto r = hn::Sub(a, hn::Mul(q, S));
           q = hn::Add(q, hn::VecFromMask(di, hn::Lt(r, zero)));                        // − 1
           q = hn::Sub(q, hn::VecFromMask(di, hn::Gt(r, hn::Sub(S, hn::Set(di, 1)))));  // + 1
@@ -1693,11 +1702,11 @@ class TriangleRaster {
           visibleBlock(t_, planeLanes_, mask, ctx_.originX + lx, ctx_.originY + ly, id_,
                        ctx_.depth + block * kBlockPixels, ctx_.visible + block * kBlockPixels);
     } else if constexpr (kOp == PixelOp::material) {
-      ctx_.stats->hiddenFragments += shadeBlockMaterial(
-          t_, planeLanes_, attributeLanes_, *attributes_, *ctx_.environment, mask,
-          ctx_.originX + lx, ctx_.originY + ly, ctx_.depth + block * kBlockPixels,
-          ctx_.color + block * kColorPerBlock,
-          ctx_.visible ? ctx_.visible + block * kBlockPixels : nullptr);
+      ctx_.stats->hiddenFragments +=
+          shadeBlockMaterial(t_, planeLanes_, attributeLanes_, *attributes_, *ctx_.environment,
+                             mask, ctx_.originX + lx, ctx_.originY + ly,
+                             ctx_.depth + block * kBlockPixels, ctx_.color + block * kColorPerBlock,
+                             ctx_.visible ? ctx_.visible + block * kBlockPixels : nullptr);
     } else {
       ctx_.stats->hiddenFragments +=
           shadeBlock(t_, planeLanes_, mask, ctx_.originX + lx, ctx_.originY + ly,
@@ -1719,7 +1728,8 @@ class TriangleRaster {
   }
 
   // Colour sums (TileWork::sums): block `block`'s, or nullptr; and the depth its samples are
-  // tested against — the tile's planes, or with sums the clear depth (all an unwritten sample holds).
+  // tested against — the tile's planes, or with sums the clear depth (all an unwritten sample
+  // holds).
   int32_t* blockSums(size_t block) const {
     return ctx_.sums ? ctx_.sums + block * kColorPerBlock : nullptr;
   }
@@ -1804,7 +1814,8 @@ class TriangleRaster {
       if (m.texture) shade::textureCoordinates(m, f[batch], coordinates[batch]);
     }
     for (int first = 0; first < pendingPixels_; first += kBlockPixels) {
-      const int count = std::min(kBlockPixels, pendingPixels_ - first), batch = first / kBlockPixels;
+      const int count = std::min(kBlockPixels, pendingPixels_ - first),
+                batch = first / kBlockPixels;
       alignas(64) float rgba[4][kBlockPixels];
       if (m.texture)
         shade::shadeFragments(m, *ctx_.environment, f[batch], coordinates[batch], rgba);
@@ -1840,7 +1851,8 @@ class TriangleRaster {
   // Only the AA material path uses these (left uninitialized otherwise: written before read).
   PendingBlock pending_[kAA && kOp == PixelOp::material ? kPendingBlocks : 1];
   int pendingBlocks_ = 0, pendingPixels_ = 0;
-  static constexpr int kPixelSlots = kAA && kOp == PixelOp::material ? kPendingPixels + kBlockPixels : 1;
+  static constexpr int kPixelSlots =
+      kAA && kOp == PixelOp::material ? kPendingPixels + kBlockPixels : 1;
   alignas(64) float pixelX_[kPixelSlots], pixelY_[kPixelSlots];
   alignas(64) int32_t pixelLane_[kPixelSlots];
   alignas(64) float pixelCx_[kPixelSlots], pixelCy_[kPixelSlots];
@@ -1848,12 +1860,12 @@ class TriangleRaster {
 
   const TriangleSetup& t_;
   const TileContext& ctx_;
-  const AttributeSetup* attributes_;  // PixelOp::material
-  const uint32_t id_;                 // PixelOp::visibility
-  Occupancy* occ_ = nullptr;          // masking: drop occupied windows
-  bool mark_ = false;                 // … and occupy what this triangle covers
+  const AttributeSetup* attributes_;                   // PixelOp::material
+  const uint32_t id_;                                  // PixelOp::visibility
+  Occupancy* occ_ = nullptr;                           // masking: drop occupied windows
+  bool mark_ = false;                                  // … and occupy what this triangle covers
   int boxX0_ = 0, boxY0_ = 0, boxX1_ = 0, boxY1_ = 0;  // the box inside the tile (draw)
-  int drawLevel_ = 1;  // PixelOp::levels: what shade() records
+  int drawLevel_ = 1;                                  // PixelOp::levels: what shade() records
   float boxZmin_ = 0;  // hybrid: the triangle's smallest depth in that box
   T sX_[E], sY_[E], pos_[E], neg_[E];
   alignas(64) T leafOffset_[E][kBlockPixels];
@@ -1898,12 +1910,11 @@ HWY_INLINE bool boxHidden(const TileContext& ctx, int minX, int minY, int maxX, 
   const int x1 = std::min(maxX - ctx.originX, kTileSize - 1);
   const int y1 = std::min(maxY - ctx.originY, kTileSize - 1);
   if (x0 > x1 || y0 > y1) return true;  // (the traversal would draw nothing)
-  const bool hidden =
-      ctx.hybrid ? ctx.occupancy->rectHidden(
-                       x0, y0, x1, y1,
-                       depthBound(*t, ctx.originX + x0, ctx.originY + y0, ctx.originX + x1,
-                                  ctx.originY + y1, kAA, false))
-                 : ctx.occupancy->rectFull(x0, y0, x1, y1);
+  const bool hidden = ctx.hybrid ? ctx.occupancy->rectHidden(
+                                       x0, y0, x1, y1,
+                                       depthBound(*t, ctx.originX + x0, ctx.originY + y0,
+                                                  ctx.originX + x1, ctx.originY + y1, kAA, false))
+                                 : ctx.occupancy->rectFull(x0, y0, x1, y1);
   ctx.stats->occludedTriangles += hidden;
   return hidden;
 }
@@ -1921,9 +1932,12 @@ HWY_INLINE void drawTriangle(const TriangleSetup& t, const TileContext& ctx,
     return;
   if (t.small) return TriangleRaster<3, kOp, int32_t, kAA>(t, ctx, attributes, id).draw();
   switch (t.edgeCount) {
-    case 3: return TriangleRaster<3, kOp, int64_t, kAA>(t, ctx, attributes, id).draw();
-    case 4: return TriangleRaster<4, kOp, int64_t, kAA>(t, ctx, attributes, id).draw();
-    default: return TriangleRaster<5, kOp, int64_t, kAA>(t, ctx, attributes, id).draw();
+    case 3:
+      return TriangleRaster<3, kOp, int64_t, kAA>(t, ctx, attributes, id).draw();
+    case 4:
+      return TriangleRaster<4, kOp, int64_t, kAA>(t, ctx, attributes, id).draw();
+    default:
+      return TriangleRaster<5, kOp, int64_t, kAA>(t, ctx, attributes, id).draw();
   }
 }
 
@@ -1980,12 +1994,20 @@ template <ShadeMode kShade, bool kAA>
 void drawLists(const TileWork& w, RasterStats& stats) {
   // Pixel shading at one sample is deferred: opaque triangles only record the winner per pixel.
   const bool deferred = kShade == ShadeMode::material && !kAA;
-  TileContext ctx{w.tileX * kTileSize, w.tileY * kTileSize, w.depth, w.color, &stats,
-                        w.coverage, w.coverage ? w.coverage->samples : 1, w.environment,
-                        deferred ? w.visible : nullptr, w.setups, w.attributes,
-                        kShade == ShadeMode::overdraw || w.masking == Masking::none ? nullptr
-                                                                                    : w.occupancy,
-                        w.masking == Masking::hybrid};
+  TileContext ctx{
+      w.tileX * kTileSize,
+      w.tileY * kTileSize,
+      w.depth,
+      w.color,
+      &stats,
+      w.coverage,
+      w.coverage ? w.coverage->samples : 1,
+      w.environment,
+      deferred ? w.visible : nullptr,
+      w.setups,
+      w.attributes,
+      kShade == ShadeMode::overdraw || w.masking == Masking::none ? nullptr : w.occupancy,
+      w.masking == Masking::hybrid};
   WinnerList winners;
   if (deferred) ctx.winners = &winners;
   alignas(64) float clearPlanes[64 * kBlockPixels];
@@ -2053,8 +2075,8 @@ void drawLists(const TileWork& w, RasterStats& stats) {
         const uint32_t object = objects[i];
         if (object != lastObject) {
           lastObject = object;
-          objectIsHidden = objectHidden(*ctx.occupancy, w.objects[object], w.tileX, w.tileY,
-                                        w.masking);
+          objectIsHidden =
+              objectHidden(*ctx.occupancy, w.objects[object], w.tileX, w.tileY, w.masking);
           stats.occludedObjects += objectIsHidden;
         }
         if (objectIsHidden) {  // the rest of its run, unread

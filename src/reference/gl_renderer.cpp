@@ -1,7 +1,5 @@
 #include "reference/gl_renderer.h"
 
-#include "texture/texture.h"
-
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -11,6 +9,8 @@
 #include <mutex>
 #include <string>
 #include <vector>
+
+#include "texture/texture.h"
 
 #if SV_HAVE_GL
 #define GL_GLEXT_PROTOTYPES 1
@@ -362,16 +362,28 @@ Status GlRenderer::load(const scene::Scene& scene) {
   GLint minFilter = GL_LINEAR_MIPMAP_LINEAR, magFilter = GL_LINEAR;
   float anisotropy = 1;
   switch (g.options.textureFilter) {
-    case scene::TextureFilter::point: minFilter = GL_NEAREST; magFilter = GL_NEAREST; break;
-    case scene::TextureFilter::nearest: minFilter = GL_NEAREST_MIPMAP_NEAREST; magFilter = GL_NEAREST; break;
+    case scene::TextureFilter::point:
+      minFilter = GL_NEAREST;
+      magFilter = GL_NEAREST;
+      break;
+    case scene::TextureFilter::nearest:
+      minFilter = GL_NEAREST_MIPMAP_NEAREST;
+      magFilter = GL_NEAREST;
+      break;
     case scene::TextureFilter::threePoint:
-    case scene::TextureFilter::bilinear: minFilter = GL_LINEAR_MIPMAP_NEAREST; break;
-    case scene::TextureFilter::anisotropic: anisotropy = 16; break;
-    default: break;
+    case scene::TextureFilter::bilinear:
+      minFilter = GL_LINEAR_MIPMAP_NEAREST;
+      break;
+    case scene::TextureFilter::anisotropic:
+      anisotropy = 16;
+      break;
+    default:
+      break;
   }
   auto wrapOf = [](texture::Wrap w) {
-    return w == texture::Wrap::clamp ? GL_CLAMP_TO_EDGE
-           : w == texture::Wrap::mirror ? GL_MIRRORED_REPEAT : GL_REPEAT;
+    return w == texture::Wrap::clamp    ? GL_CLAMP_TO_EDGE
+           : w == texture::Wrap::mirror ? GL_MIRRORED_REPEAT
+                                        : GL_REPEAT;
   };
   for (const scene::TextureMap& map : scene.textures) {
     const texture::Texture& t = *map.texture;
@@ -392,7 +404,8 @@ Status GlRenderer::load(const scene::Scene& scene) {
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, magFilter);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, wrapOf(t.wrapX()));
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, wrapOf(t.wrapY()));
-    if (anisotropy > 1) glTexParameterf(GL_TEXTURE_2D, 0x84FE /* GL_TEXTURE_MAX_ANISOTROPY */, anisotropy);
+    if (anisotropy > 1)
+      glTexParameterf(GL_TEXTURE_2D, 0x84FE /* GL_TEXTURE_MAX_ANISOTROPY */, anisotropy);
   }
   // GL puts the first row uploaded at t = 0 and ours is the image's top row, at v = 0 (glTF's
   // convention): (s, t) = (u, v).

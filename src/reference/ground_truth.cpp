@@ -1,10 +1,10 @@
 #include "reference/ground_truth.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <vector>
-
-#include <fmt/format.h>
 
 #include "core/thread_pool.h"
 #include "geometry/vertex_stage.h"
@@ -42,15 +42,16 @@ Result<Image> renderGroundTruth(const scene::Scene& scene, const GroundTruthOpti
   if (Status s = validate(o); !s) return s.error();
   if (Status s = scene::validate(scene, ""); !s) return s.error();
   if (g.samplesPerSide < 1 || g.samplesPerSide > 32)
-    return Error{"", "", fmt::format("{} samples per side is out of range (1…32)", g.samplesPerSide)};
+    return Error{"", "",
+                 fmt::format("{} samples per side is out of range (1…32)", g.samplesPerSide)};
   const Result<Mat4> camera = viewProjection(scene, o);
   if (!camera.ok()) return camera.error();
   const int W = o.width, H = o.height, n = g.samplesPerSide, S = n * n;
   // Stratified samples: one per cell of an n×n grid, jittered inside it by a hash of the pixel,
   // cell and axis (deterministic). A regular grid would favour the regular patterns it is used to
-  // judge — its own error is correlated with theirs: against a regular 16×16 truth, 4×4 supersampling
-  // looked 1.5× better than 16 n-rooks samples on mixed.json, against this one they are level
-  // (docs/quality.md). One sample per pixel stays at the centre (point sampling).
+  // judge — its own error is correlated with theirs: against a regular 16×16 truth, 4×4
+  // supersampling looked 1.5× better than 16 n-rooks samples on mixed.json, against this one they
+  // are level (docs/quality.md). One sample per pixel stays at the centre (point sampling).
   auto jitter = [n](int x, int y, int sx, int sy, int axis) {
     if (n == 1) return 0.5;
     uint64_t h = (uint64_t(uint32_t(x)) << 32 | uint32_t(y)) * 0x9E3779B97F4A7C15ull ^
@@ -169,9 +170,9 @@ Result<Image> renderGroundTruth(const scene::Scene& scene, const GroundTruthOpti
               depth[s] = zf;
               id[s] = int32_t(ti);
               for (int ch = 0; ch < 3; ++ch)
-                color[s * 3 + ch] = float(
-                    std::clamp((l[0] * t.color[0][ch] + l[1] * t.color[1][ch] +
-                                l[2] * t.color[2][ch]) / sum, 0.0, 1.0));
+                color[s * 3 + ch] = float(std::clamp(
+                    (l[0] * t.color[0][ch] + l[1] * t.color[1][ch] + l[2] * t.color[2][ch]) / sum,
+                    0.0, 1.0));
             }
     }
     // The 1×1 box filter, in linear light; and the edge mask.
@@ -208,11 +209,13 @@ Result<Image> renderGroundTruth(const scene::Scene& scene, const GroundTruthOpti
 
 Result<ImageDifference> compareImages(const Image& a, const Image& b, const Image* mask) {
   if (a.width != b.width || a.height != b.height || a.rgb.size() != b.rgb.size())
-    return Error{"", "", fmt::format("the images differ in size ({}x{} and {}x{})", a.width,
-                                     a.height, b.width, b.height)};
+    return Error{"", "",
+                 fmt::format("the images differ in size ({}x{} and {}x{})", a.width, a.height,
+                             b.width, b.height)};
   if (mask && (mask->width != a.width || mask->height != a.height))
-    return Error{"", "", fmt::format("the edge mask is {}x{}, the images {}x{}", mask->width,
-                                     mask->height, a.width, a.height)};
+    return Error{"", "",
+                 fmt::format("the edge mask is {}x{}, the images {}x{}", mask->width, mask->height,
+                             a.width, a.height)};
   if (a.rgb.empty()) return Error{"", "", "the images are empty"};
   double lut[256];
   for (int i = 0; i < 256; ++i) lut[i] = linearFromSrgb(uint8_t(i));
@@ -228,7 +231,8 @@ Result<ImageDifference> compareImages(const Image& a, const Image& b, const Imag
           const int nx = x + dx, ny = y + dy;
           if (nx < 0 || ny < 0 || nx >= W || ny >= H) continue;
           const size_t j = (size_t(ny) * W + nx) * 3;
-          for (int ch = 0; ch < 3; ++ch) edge |= std::abs(int(b.rgb[i + ch]) - int(b.rgb[j + ch])) > 1;
+          for (int ch = 0; ch < 3; ++ch)
+            edge |= std::abs(int(b.rgb[i + ch]) - int(b.rgb[j + ch])) > 1;
         }
       double e = 0;
       for (int ch = 0; ch < 3; ++ch) {

@@ -5,8 +5,8 @@
 // functions in double (Olano & Greer 1997), per sample an exact point-in-triangle test with the
 // near and far planes, a depth test "less" per sample, perspective-correct Gouraud colour; samples
 // stratified on an n×n grid inside each pixel, each jittered within its cell (n² per pixel, 256 by
-// default), box-filtered in linear light, then sRGB. Only the vertex stage (clip-space positions and lit vertex colours) is
-// synthvis's own, so both see the same triangles and colours.
+// default), box-filtered in linear light, then sRGB. Only the vertex stage (clip-space positions
+// and lit vertex colours) is synthvis's own, so both see the same triangles and colours.
 #pragma once
 
 #include "synthvis/image.h"

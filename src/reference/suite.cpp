@@ -195,11 +195,21 @@ Result<CaseResult> BenchRunner::run(const BenchCase& c) {
   if (s.sphereTrace) {
     ref = RendererRun{"sphere-trace",
                       fmt::format("synthvis, free forms marched in {} steps", s.options.marchSteps),
-                      {}, 0, 0, 0, {}, {}};
+                      {},
+                      0,
+                      0,
+                      0,
+                      {},
+                      {}};
   } else if (s.tessellated) {
     ref = RendererRun{"tessellated",
                       fmt::format("synthvis, free forms as {} triangles", polygons.triangleCount()),
-                      {}, 0, 0, 0, {}, {}};
+                      {},
+                      0,
+                      0,
+                      0,
+                      {},
+                      {}};
   } else if (impl_->gl) {
     if (Status st = impl_->gl->load(polygons); !st) return st.error();
     ref = RendererRun{"gl", impl_->glDescription, {}, 0, 0, 0, {}, {}};
@@ -270,28 +280,29 @@ nlohmann::json jsonRows(const CaseResult& r, const BenchSettings& s) {
   for (const RendererRun& run : r.runs) {
     nlohmann::json row = r.params;
     const double pixels = pixelsOf(r);
-    row.update({{"scene", r.name},
-                {"renderer", run.renderer},
-                {"renderer_description", run.description},
-                {"width", s.options.width},
-                {"height", s.options.height},
-                {"threads", s.options.threads},
-                {"frames", s.frames},
-                {"warmup", s.warmup},
-                {"shade", s.textured ? "textured" : "gouraud"},
-                {"fog", s.fog},
-                {"hsr", run.renderer == "synthvis" ? hsrName(s.options.hsr) : "zbuffer"},
-                {"texture_filter", scene::textureFilterName(s.options.textureFilter)},
-                {"aa", run.renderer == "synthvis" ? s.options.samples : std::max(1, s.referenceMsaa)},
-                {"filter", s.options.filter == RenderOptions::Filter::tent3 ? "tent3" : "box"},
-                {"readback_timed", run.renderer == "synthvis" || s.referenceReadback},
-                {"median_ms", run.medianMs},
-                {"min_ms", run.minMs},
-                {"max_ms", run.maxMs},
-                {"frame_ms", run.frameMs},
-                {"triangles", r.triangles},
-                {"mtri_per_s", run.medianMs > 0 ? double(r.triangles) / run.medianMs / 1e3 : 0},
-                {"mpix_per_s", run.medianMs > 0 ? pixels / run.medianMs / 1e3 : 0}});
+    row.update(
+        {{"scene", r.name},
+         {"renderer", run.renderer},
+         {"renderer_description", run.description},
+         {"width", s.options.width},
+         {"height", s.options.height},
+         {"threads", s.options.threads},
+         {"frames", s.frames},
+         {"warmup", s.warmup},
+         {"shade", s.textured ? "textured" : "gouraud"},
+         {"fog", s.fog},
+         {"hsr", run.renderer == "synthvis" ? hsrName(s.options.hsr) : "zbuffer"},
+         {"texture_filter", scene::textureFilterName(s.options.textureFilter)},
+         {"aa", run.renderer == "synthvis" ? s.options.samples : std::max(1, s.referenceMsaa)},
+         {"filter", s.options.filter == RenderOptions::Filter::tent3 ? "tent3" : "box"},
+         {"readback_timed", run.renderer == "synthvis" || s.referenceReadback},
+         {"median_ms", run.medianMs},
+         {"min_ms", run.minMs},
+         {"max_ms", run.maxMs},
+         {"frame_ms", run.frameMs},
+         {"triangles", r.triangles},
+         {"mtri_per_s", run.medianMs > 0 ? double(r.triangles) / run.medianMs / 1e3 : 0},
+         {"mpix_per_s", run.medianMs > 0 ? pixels / run.medianMs / 1e3 : 0}});
     if (run.renderer == "synthvis") row["triangles_drawn"] = run.stats.drawn;
     if (r.runs.size() > 1)
       row["psnr_db"] = std::isinf(r.psnrDb) ? nlohmann::json(999.0) : nlohmann::json(r.psnrDb);

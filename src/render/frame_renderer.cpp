@@ -65,7 +65,8 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
   const int samples = coverage ? coverage->samples : 1;
   const geometry::Viewport viewport{settings.width, settings.height, coverage != nullptr};
   const uint32_t triangleCount = static_cast<uint32_t>(packets.indices.size() / 3);
-  const uint32_t batchTriangles = std::clamp<uint32_t>(settings.batchTriangles, 1, kMaxBatchTriangles);
+  const uint32_t batchTriangles =
+      std::clamp<uint32_t>(settings.batchTriangles, 1, kMaxBatchTriangles);
   // One batch: each tile is cleared, drawn and handed on in a per-thread 64×64 buffer. Several: the
   // tiles persist in a whole-frame buffer from batch to batch.
   const bool wholeFrame = triangleCount > batchTriangles;
@@ -112,8 +113,7 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
     if (!wholeFrame) w.tile.resize(raster::kTileSize, raster::kTileSize, samples, sums);
     if (settings.shade == raster::ShadeMode::material && samples == 1)
       w.visible.assign(raster::kTilePixels, ~0u);
-    if (masking && !wholeFrame && !w.occupancy)
-      w.occupancy = std::make_unique<raster::Occupancy>();
+    if (masking && !wholeFrame && !w.occupancy) w.occupancy = std::make_unique<raster::Occupancy>();
     if (masking) w.objects.resize(chunkSize);
     if (pixelShading) w.attributes.resize(chunkSize);
   }
@@ -184,9 +184,10 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
         }
         n += uint32_t(geometry::setupTriangles(
             packets.vertices.data(), &packets.indices[size_t(tri) * 3], runEnd - tri, viewport,
-            call ? call->cull : geometry::CullMode::none, scratch.records.data() + n, outcomes,
-            tri, request.out ? &request : nullptr));
-        if (masking) std::fill(scratch.objects.begin() + first, scratch.objects.begin() + n, object);
+            call ? call->cull : geometry::CullMode::none, scratch.records.data() + n, outcomes, tri,
+            request.out ? &request : nullptr));
+        if (masking)
+          std::fill(scratch.objects.begin() + first, scratch.objects.begin() + n, object);
         if (pixelShading)
           for (uint32_t r = first; r < n; ++r) scratch.attributes[r].material = material;
         tri = runEnd;
@@ -275,7 +276,8 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
         w.opaqueDone = &opaqueDone_[tile];
       }
       raster::rasterizeTile(w, tileStats_[tile]);
-      if (lastBatch && settings.finishTile) settings.finishTile(int(tile), w.depth, w.color, w.sums);
+      if (lastBatch && settings.finishTile)
+        settings.finishTile(int(tile), w.depth, w.color, w.sums);
     });
     stats.rasterMs += msSince(t0);
   }

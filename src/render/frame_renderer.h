@@ -95,17 +95,18 @@ class FrameRenderer {
   struct WorkerScratch {
     std::vector<geometry::TriangleSetup> records;  // one chunk's, in submission order
     raster::Binner::Scratch bins;
-    raster::FrameBuffer tile;  // 64×64: the tile being drawn, in frames of one batch
+    raster::FrameBuffer tile;       // 64×64: the tile being drawn, in frames of one batch
     std::vector<uint32_t> visible;  // 64×64 deferred-shading records (TileWork::visible)
     std::unique_ptr<raster::Occupancy> occupancy;  // the tile's, in frames of one batch
     std::vector<uint32_t> objects;  // with masking: the chunk's records' objects (TileWork)
     std::vector<raster::AttributeSetup> attributes;  // pixel shading: the records', in their order
   };
-  std::vector<geometry::ObjectBound> objects_;   // with masking: every draw call's bound
+  std::vector<geometry::ObjectBound> objects_;     // with masking: every draw call's bound
   std::vector<raster::Occupancy> frameOccupancy_;  // every tile's, in frames of several batches
-  std::vector<geometry::TriangleSetup> setups_;  // the batch's, grouped by tile within each chunk
-  std::vector<raster::AttributeSetup> attributes_;  // ShadeMode::material: setups_[i]'s is attributes_[i]
-  std::vector<WorkerScratch> scratch_;           // one per pool worker
+  std::vector<geometry::TriangleSetup> setups_;    // the batch's, grouped by tile within each chunk
+  std::vector<raster::AttributeSetup>
+      attributes_;                      // ShadeMode::material: setups_[i]'s is attributes_[i]
+  std::vector<WorkerScratch> scratch_;  // one per pool worker
   std::vector<raster::RasterStats> tileStats_;
   std::vector<uint8_t> opaqueDone_;  // per tile: FrameSettings::afterOpaque has run
 };

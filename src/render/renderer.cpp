@@ -1,10 +1,11 @@
 // The one place that wires a frame together (STYLE.md habit 1): scene → vertex stage → setup and
 // binning → tiles → resolve.
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <fmt/format.h>
 #include <limits>
 #include <numeric>
 #include <thread>
@@ -68,8 +69,9 @@ Result<CameraMatrices> cameraMatrices(const scene::Scene& scene, const RenderOpt
   scene::Camera cam;
   if (!scene.cameras.empty()) {
     if (o.camera >= int(scene.cameras.size()))
-      return Error{"", "", fmt::format("camera {} does not exist (the scene has {})", o.camera,
-                                       scene.cameras.size())};
+      return Error{"", "",
+                   fmt::format("camera {} does not exist (the scene has {})", o.camera,
+                               scene.cameras.size())};
     cam = scene.cameras[size_t(o.camera)];
   } else {
     cam = defaultCamera(scene);
@@ -83,11 +85,16 @@ Result<CameraMatrices> cameraMatrices(const scene::Scene& scene, const RenderOpt
 texture::Filter samplerOf(scene::TextureFilter f) {
   switch (f) {
     case scene::TextureFilter::point:
-    case scene::TextureFilter::nearest: return texture::Filter::nearest;
-    case scene::TextureFilter::threePoint: return texture::Filter::threePoint;
-    case scene::TextureFilter::bilinear: return texture::Filter::bilinear;
-    case scene::TextureFilter::trilinearThreePoint: return texture::Filter::trilinearThreePoint;
-    default: return texture::Filter::trilinear;
+    case scene::TextureFilter::nearest:
+      return texture::Filter::nearest;
+    case scene::TextureFilter::threePoint:
+      return texture::Filter::threePoint;
+    case scene::TextureFilter::bilinear:
+      return texture::Filter::bilinear;
+    case scene::TextureFilter::trilinearThreePoint:
+      return texture::Filter::trilinearThreePoint;
+    default:
+      return texture::Filter::trilinear;
   }
 }
 
@@ -212,7 +219,8 @@ freeform::FreeForm toFreeForm(const scene::FreeFormNode& n) {
 // scene has lights and the material is lit: the normal is exact at every pixel), both sides lit.
 // A texture is projected along the object's y axis (tile_pass.h). Free forms are always opaque.
 std::vector<freeform::ShadedForm> shadedForms(const scene::Scene& scene, const Mat4& view,
-                                              const Mat4& projection, const ShadingTables& shading) {
+                                              const Mat4& projection,
+                                              const ShadingTables& shading) {
   std::vector<freeform::ShadedForm> out;
   const scene::Material defaultMaterial;
   const bool lights = shading.environment.lightOn || !shading.environment.points.empty();
@@ -225,7 +233,8 @@ std::vector<freeform::ShadedForm> shadedForms(const scene::Scene& scene, const M
     std::optional<freeform::ProjectedFreeForm> projected =
         freeform::ProjectedFreeForm::make(form, toDouble(projection) * toEye);
     if (!eyeInverse || !projected) continue;  // a singular placement shows nothing
-    freeform::ShadedForm s{form, std::move(*projected), toEye, eyeInverse->transposed(), {}, {}, {}};
+    freeform::ShadedForm s{form, std::move(*projected), toEye, eyeInverse->transposed(), {}, {},
+                           {}};
     s.material = *shading.of(object.material, true);
     s.material.phong = lights && !mat.unlit;
     s.material.twoSided = true;
@@ -256,26 +265,29 @@ Result<Mat4> viewMatrix(const scene::Scene& scene, const RenderOptions& o) {
 
 Status validate(const RenderOptions& o) {
   if (o.width < 1 || o.width > kMaxRasterSize || o.height < 1 || o.height > kMaxRasterSize)
-    return Error{"", "", fmt::format("image size {}x{} is out of range (1…{} each)", o.width,
-                                     o.height, kMaxRasterSize)};
+    return Error{"", "",
+                 fmt::format("image size {}x{} is out of range (1…{} each)", o.width, o.height,
+                             kMaxRasterSize)};
   if (o.threads < 0 || o.threads > kMaxThreads)
-    return Error{"", "", fmt::format("thread count {} is out of range (0…{})", o.threads,
-                                     kMaxThreads)};
+    return Error{"", "",
+                 fmt::format("thread count {} is out of range (0…{})", o.threads, kMaxThreads)};
   if (o.camera < 0) return Error{"", "", "camera index must not be negative"};
   if (o.supersample != 1 && o.supersample != 2 && o.supersample != 4 && o.supersample != 8 &&
       o.supersample != 16)
-    return Error{"", "", fmt::format("supersampling {} is not supported (1, 2, 4, 8 or 16)",
-                                     o.supersample)};
-  if (o.supersample > 1 && (o.width * o.supersample > kMaxRasterSize ||
-                            o.height * o.supersample > kMaxRasterSize))
-    return Error{"", "", fmt::format("supersampling {}x{} by {} exceeds the {}-pixel raster",
-                                     o.width, o.height, o.supersample, kMaxRasterSize)};
+    return Error{
+        "", "", fmt::format("supersampling {} is not supported (1, 2, 4, 8 or 16)", o.supersample)};
+  if (o.supersample > 1 &&
+      (o.width * o.supersample > kMaxRasterSize || o.height * o.supersample > kMaxRasterSize))
+    return Error{"", "",
+                 fmt::format("supersampling {}x{} by {} exceeds the {}-pixel raster", o.width,
+                             o.height, o.supersample, kMaxRasterSize)};
   const bool debug = o.debugView != RenderOptions::DebugView::none;
   if (o.supersample > 1 && debug)
     return Error{"", "", "a debug view shows one value per pixel; it cannot be supersampled"};
   if (o.samples != 1 && o.samples != 4 && o.samples != 8 && o.samples != 16 && o.samples != 64)
-    return Error{"", "", fmt::format("{} samples per pixel is not supported (1, 4, 8, 16 or 64)",
-                                     o.samples)};
+    return Error{
+        "", "",
+        fmt::format("{} samples per pixel is not supported (1, 4, 8, 16 or 64)", o.samples)};
   if (o.samples > 1 && o.supersample > 1)
     return Error{"", "", "anti-aliasing and supersampling are alternatives; choose one"};
   if (o.samples > 1 && debug)
@@ -319,7 +331,8 @@ std::string FrameStats::summary() const {
 Result<scene::Scene> tessellatedScene(const scene::Scene& scene, const RenderOptions& o) {
   const Result<CameraMatrices> camera = cameraMatrices(scene, o);
   if (!camera.ok()) return camera.error();
-  scene::Camera cam = scene.cameras.empty() ? defaultCamera(scene) : scene.cameras[size_t(o.camera)];
+  scene::Camera cam =
+      scene.cameras.empty() ? defaultCamera(scene) : scene.cameras[size_t(o.camera)];
   const double pixelPerDepth =
       2 * std::tan(cam.yfovDegrees * 3.14159265358979 / 360) / double(o.height * o.supersample);
   scene::Scene out = scene;
@@ -352,8 +365,9 @@ Result<scene::Scene> tessellatedScene(const scene::Scene& scene, const RenderOpt
     const double cell = std::sqrt(2 * radius * pixel / 3);
     freeform::TriangleSoup soup;
     if (!freeform::tessellate(form, *box, cell, kMaxTriangles, soup))
-      return Error{"", "", fmt::format("{} is unbounded or needs over {} triangles to tessellate",
-                                       label, kMaxTriangles)};
+      return Error{"", "",
+                   fmt::format("{} is unbounded or needs over {} triangles to tessellate", label,
+                               kMaxTriangles)};
     scene::Mesh mesh;
     mesh.name = object.name + " (tessellated)";
     mesh.material = object.material;
@@ -375,15 +389,19 @@ Result<RenderOptions::Hsr> parseHsr(const std::string& text) {
   if (text == "zbuffer") return RenderOptions::Hsr::zbuffer;
   if (text == "priority") return RenderOptions::Hsr::priority;
   if (text == "hybrid") return RenderOptions::Hsr::hybrid;
-  return Error{"", "", fmt::format("unknown hidden-surface method '{}' (zbuffer, priority or hybrid)",
-                                   text)};
+  return Error{
+      "", "",
+      fmt::format("unknown hidden-surface method '{}' (zbuffer, priority or hybrid)", text)};
 }
 
 const char* hsrName(RenderOptions::Hsr hsr) {
   switch (hsr) {
-    case RenderOptions::Hsr::priority: return "priority";
-    case RenderOptions::Hsr::hybrid: return "hybrid";
-    default: return "zbuffer";
+    case RenderOptions::Hsr::priority:
+      return "priority";
+    case RenderOptions::Hsr::hybrid:
+      return "hybrid";
+    default:
+      return "zbuffer";
   }
 }
 
@@ -496,8 +514,8 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
       render::DrawCall call;
       call.firstTriangle = static_cast<uint32_t>(indexCount / 3);
       call.triangleCount = static_cast<uint32_t>(mesh.triangleCount());
-      call.cull = o.cullBackFaces && !mat.doubleSided ? geometry::CullMode::back
-                                                        : geometry::CullMode::none;
+      call.cull =
+          o.cullBackFaces && !mat.doubleSided ? geometry::CullMode::back : geometry::CullMode::none;
       if (pixelShading && (mat.needsPixelShading() || shading.environment.fog))
         call.material = shading.of(mesh.material, !mesh.normals.empty());
       if (call.material) stored |= shade::attributesUsed(*call.material, shading.environment);
@@ -547,8 +565,8 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
   fs.clearColor[2] = scene.background.z;
   fs.shade = o.debugView == DebugView::overdraw ? raster::ShadeMode::overdraw
              : o.debugView == DebugView::levels ? raster::ShadeMode::levels
-             : pixelShading   ? raster::ShadeMode::material
-                              : raster::ShadeMode::gouraud;
+             : pixelShading                     ? raster::ShadeMode::material
+                                                : raster::ShadeMode::gouraud;
   fs.environment = &shading.environment;
   fs.samples = o.samples;
   fs.debugOccupancy = o.debugView == DebugView::occupancy;
@@ -597,8 +615,8 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
     };
   else if (o.samples > 1)
     fs.finishTile = [&](int tile, const float*, const uint16_t* color, const int32_t* sums) {
-      output::resolveSampleTile(color, sums, tile % tilesX, tile / tilesX, o.samples,
-                                impl_->gamma, image);
+      output::resolveSampleTile(color, sums, tile % tilesX, tile / tilesX, o.samples, impl_->gamma,
+                                image);
     };
   else
     fs.finishTile = [&](int tile, const float*, const uint16_t* color, const int32_t*) {

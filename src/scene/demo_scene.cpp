@@ -1,9 +1,9 @@
 // The built-in demo scene: scenes/demo.json, compiled into the library (demo_scene_text.cpp).
+#include <fmt/format.h>
+
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-
-#include <fmt/format.h>
 
 #include "synthvis/scene.h"
 
@@ -11,7 +11,8 @@ namespace sv::scene {
 
 Scene demoScene() {
   const char* text = demoSceneJson();
-  Result<Scene> scene = parseJsonScene(std::string(text, std::strlen(text)), "demo.json (built in)");
+  Result<Scene> scene =
+      parseJsonScene(std::string(text, std::strlen(text)), "demo.json (built in)");
   if (!scene) {
     // The text is part of the build and a test parses it, so this is a build defect, not an input
     // error: stop loudly rather than render an empty picture.

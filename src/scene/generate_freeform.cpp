@@ -35,7 +35,9 @@ void addBenchLight(Scene& s) {
 
 Scene generateFreeForms(const FreeFormParams& p) {
   std::mt19937_64 rng(p.seed);
-  auto uniform = [&](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
+  auto uniform = [&](double a, double b) {
+    return std::uniform_real_distribution<double>(a, b)(rng);
+  };
   Scene s;
   s.background = {0.55f, 0.62f, 0.72f};
   addBenchLight(s);
@@ -45,7 +47,8 @@ Scene generateFreeForms(const FreeFormParams& p) {
   for (int m = 0; m < 8; ++m) {
     Material mat;
     mat.name = "freeform" + std::to_string(m);
-    mat.baseColor = {float(uniform(0.2, 0.9)), float(uniform(0.2, 0.9)), float(uniform(0.2, 0.9)), 1};
+    mat.baseColor = {float(uniform(0.2, 0.9)), float(uniform(0.2, 0.9)), float(uniform(0.2, 0.9)),
+                     1};
     mat.phong = true;
     mat.specular = float(uniform(0.1, 0.5));
     mat.shininess = float(uniform(10, 60));
@@ -62,7 +65,8 @@ Scene generateFreeForms(const FreeFormParams& p) {
     const double r = 0.55 * std::sqrt(depth / 5) * uniform(0.7, 1.3);
     const Vec3 centre{float(uniform(-0.95, 0.95) * depth * tanHalf * aspect),
                       float(uniform(-0.95, 0.95) * depth * tanHalf), float(-depth)};
-    const Vec3 axis = normalize(Vec3{float(uniform(-1, 1)), float(uniform(-1, 1)), float(uniform(-1, 1))});
+    const Vec3 axis =
+        normalize(Vec3{float(uniform(-1, 1)), float(uniform(-1, 1)), float(uniform(-1, 1))});
     o.transform = Mat4::translation(centre) * Mat4::rotation(axis, float(uniform(0, 2 * kPi)));
     // The base: sphere, ellipsoid, capped cylinder or capped paraboloid, about the origin.
     const int kind = int(uniform(0, 4));
@@ -90,7 +94,8 @@ Scene generateFreeForms(const FreeFormParams& p) {
       const double l = std::sqrt(dot(d, d)) + 1e-9;
       const Vec3d at{d.x / l * radii.x, d.y / l * radii.y, d.z / l * radii.z};
       const double weight = uniform(0, 1) < 0.7 ? uniform(0.5, 3) : -uniform(0.5, 2);
-      o.form.perturbations.push_back(perturbation(at, r * uniform(0.25, 0.5), uniform(0, 1) < 0.5, weight));
+      o.form.perturbations.push_back(
+          perturbation(at, r * uniform(0.25, 0.5), uniform(0, 1) < 0.5, weight));
     }
     s.freeForms.push_back(std::move(o));
   }
@@ -117,7 +122,8 @@ Scene generateFreeFormOne() {
   o.form.quadric = Quadric::sphere({0, 0, 0}, 1).c;
   const Vec3d axes[6] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {-1, 0, 0}, {0, -1, 0}, {0, 0, -1}};
   for (int k = 0; k < 6; ++k)
-    o.form.perturbations.push_back(perturbation(axes[k], 0.45, k % 2 == 1, k % 2 == 0 ? 2.5 : -2.5));
+    o.form.perturbations.push_back(
+        perturbation(axes[k], 0.45, k % 2 == 1, k % 2 == 0 ? 2.5 : -2.5));
   s.freeForms.push_back(std::move(o));
   return s;
 }

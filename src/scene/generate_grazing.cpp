@@ -15,11 +15,13 @@ Scene generateGrazing(const GrazingParams& p) {
   auto addTexture = [&](const char* name, texture::Pattern pattern, int size, texture::Color4 a,
                         texture::Color4 b) {
     texture::Level level = texture::generateTexture(pattern, size, a, b, uint32_t(p.seed));
-    s.textures.push_back({name, std::make_shared<texture::Texture>(
-                                    std::move(level), texture::Wrap::repeat, texture::Wrap::repeat)});
+    s.textures.push_back(
+        {name, std::make_shared<texture::Texture>(std::move(level), texture::Wrap::repeat,
+                                                  texture::Wrap::repeat)});
   };
   // The ground: seed 001's random texture, 2.4 cm texels repeated every 12.5 m; the cubes: squares.
-  addTexture("random", texture::Pattern::noise, 512, {0.10f, 0.16f, 0.06f, 1}, {0.42f, 0.40f, 0.22f, 1});
+  addTexture("random", texture::Pattern::noise, 512, {0.10f, 0.16f, 0.06f, 1},
+             {0.42f, 0.40f, 0.22f, 1});
   addTexture("squares", texture::Pattern::squares, 256, {0.75f, 0.18f, 0.10f, 1},
              {0.92f, 0.90f, 0.82f, 1});
   Material ground;
@@ -42,8 +44,8 @@ Scene generateGrazing(const GrazingParams& p) {
   // Five cubes (thirty faces), 2 to 6 m, 9 to 90 m away, alternately left and right.
   const struct {
     float size, x, z, yawDegrees;
-  } cubes[] = {{2, -3, -9, 25}, {3, 4.5f, -16, -35}, {4, -9, -30, 10}, {5, 12, -55, 50},
-               {6, -4, -90, -15}};
+  } cubes[] = {
+      {2, -3, -9, 25}, {3, 4.5f, -16, -35}, {4, -9, -30, 10}, {5, 12, -55, 50}, {6, -4, -90, -15}};
   for (const auto& c : cubes) {
     Mesh box = detail::makeBox({c.size, c.size, c.size});
     box.name = "cube";
@@ -54,8 +56,12 @@ Scene generateGrazing(const GrazingParams& p) {
                                Mat4::rotation({0, 1, 0}, c.yawDegrees * 3.14159265f / 180)});
   }
 
-  s.cameras.push_back({.name = "grazing", .position = {0, 2, 0}, .target = {0, 1.55f, -40},
-                       .yfovDegrees = 45, .znear = 0.5f, .zfar = 2000});
+  s.cameras.push_back({.name = "grazing",
+                       .position = {0, 2, 0},
+                       .target = {0, 1.55f, -40},
+                       .yfovDegrees = 45,
+                       .znear = 0.5f,
+                       .zfar = 2000});
   s.light.direction = {-0.45f, -1.0f, -0.35f};
   s.light.color = {1.0f, 0.97f, 0.9f};
   s.light.ambient = 0.35f;

@@ -26,7 +26,9 @@ struct Dvec {
 Dvec operator+(Dvec a, Dvec b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
 Dvec operator*(Dvec a, double s) { return {a.x * s, a.y * s, a.z * s}; }
 double dotd(Dvec a, Dvec b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-Dvec crossd(Dvec a, Dvec b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+Dvec crossd(Dvec a, Dvec b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
 Dvec unit(Dvec a) { return a * (1.0 / std::sqrt(dotd(a, a))); }
 
 }  // namespace
@@ -40,20 +42,23 @@ Result<SubmitOrder> parseSubmitOrder(const std::string& text) {
 
 const char* submitOrderName(SubmitOrder order) {
   switch (order) {
-    case SubmitOrder::frontToBack: return "f2b";
-    case SubmitOrder::backToFront: return "b2f";
-    default: return "random";
+    case SubmitOrder::frontToBack:
+      return "f2b";
+    case SubmitOrder::backToFront:
+      return "b2f";
+    default:
+      return "random";
   }
 }
 
 void addBenchTexture(Scene& s) {
   // BENCH.md's textured scenes: a 1024 × 1024 texture (grey noise, so every texel differs),
   // repeated, modulating the vertex colours.
-  texture::Level level = texture::generateTexture(texture::Pattern::noise, 1024, {0.2f, 0.2f, 0.2f, 1},
-                                                  {1, 1, 1, 1}, 1);
-  s.textures.push_back({"bench-noise", std::make_shared<texture::Texture>(
-                                           std::move(level), texture::Wrap::repeat,
-                                           texture::Wrap::repeat)});
+  texture::Level level = texture::generateTexture(texture::Pattern::noise, 1024,
+                                                  {0.2f, 0.2f, 0.2f, 1}, {1, 1, 1, 1}, 1);
+  s.textures.push_back(
+      {"bench-noise", std::make_shared<texture::Texture>(std::move(level), texture::Wrap::repeat,
+                                                         texture::Wrap::repeat)});
   for (Material& m : s.materials) m.texture = 0;
 }
 
@@ -79,7 +84,9 @@ Scene benchCameraScene(const std::string& name) {
 
 Scene generateTris(const TrisParams& p, TrisStats* stats) {
   std::mt19937_64 rng(p.seed);
-  auto uniform = [&](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
+  auto uniform = [&](double a, double b) {
+    return std::uniform_real_distribution<double>(a, b)(rng);
+  };
 
   const double w = p.width, h = p.height, aspect = w / h;
   const double tanHalf = std::tan(kYFov / 2);
@@ -173,7 +180,8 @@ Scene generateTris(const TrisParams& p, TrisStats* stats) {
   }
   if (p.order != SubmitOrder::random) {
     std::stable_sort(tris.begin(), tris.end(), [&](const Tri& a, const Tri& b) {
-      return p.order == SubmitOrder::frontToBack ? a.distance < b.distance : a.distance > b.distance;
+      return p.order == SubmitOrder::frontToBack ? a.distance < b.distance
+                                                 : a.distance > b.distance;
     });
   }
 

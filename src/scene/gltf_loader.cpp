@@ -8,6 +8,9 @@
 // version 2.7.0 bounds the GLB BIN chunk without its 8-byte header. So this file checks the GLB
 // container itself before handing it over, and afterwards checks every index and byte range
 // before reading a single element.
+#include <fmt/format.h>
+#include <tiny_gltf.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -17,11 +20,8 @@
 #include <map>
 #include <new>
 #include <numbers>
-#include <utility>
 #include <tuple>
-
-#include <fmt/format.h>
-#include <tiny_gltf.h>
+#include <utility>
 
 #include "scene/loader_common.h"
 #include "texture/texture.h"
@@ -61,11 +61,13 @@ std::string glbProblem(const std::string& bytes) {
   if (readU32(bytes, 4) != 2) return fmt::format("unsupported GLB version {}", readU32(bytes, 4));
   uint64_t length = readU32(bytes, 8);
   if (length > bytes.size())
-    return fmt::format("truncated GLB: header says {} bytes, the file has {}", length, bytes.size());
+    return fmt::format("truncated GLB: header says {} bytes, the file has {}", length,
+                       bytes.size());
   uint64_t jsonLength = readU32(bytes, 12);
   if (readU32(bytes, 16) != kJson) return "the first GLB chunk is not JSON";
   uint64_t jsonEnd = 20 + jsonLength;
-  if (jsonLength == 0 || jsonEnd > length) return "the GLB JSON chunk runs past the end of the file";
+  if (jsonLength == 0 || jsonEnd > length)
+    return "the GLB JSON chunk runs past the end of the file";
   if (jsonEnd == length) return {};
   if (jsonEnd + 8 > length) return "truncated GLB chunk header";
   uint64_t binLength = readU32(bytes, size_t(jsonEnd));
@@ -139,12 +141,13 @@ struct DecodedImages {
 // tinygltf's image callback: PNG only (texture.h's decoder and limits), into DecodedImages.
 bool decodeImage(tinygltf::Image* image, const int index, std::string* err, std::string*, int, int,
                  const unsigned char* bytes, int size, void* user) {
-  const std::string name = fmt::format("images[{}]{}", index,
-                                       image->name.empty() ? "" : " ('" + image->name + "')");
+  const std::string name =
+      fmt::format("images[{}]{}", index, image->name.empty() ? "" : " ('" + image->name + "')");
   const bool png = size >= 8 && std::memcmp(bytes, "\x89PNG\r\n\x1a\n", 8) == 0;
   if (!png) {
-    if (err) *err += fmt::format("{}: only PNG textures are supported{}\n", name,
-                                 image->mimeType.empty() ? "" : " (this is " + image->mimeType + ")");
+    if (err)
+      *err += fmt::format("{}: only PNG textures are supported{}\n", name,
+                          image->mimeType.empty() ? "" : " (this is " + image->mimeType + ")");
     return false;
   }
   Result<texture::Level> level = texture::decodeTextureImage(bytes, size_t(size), name);
@@ -167,22 +170,31 @@ bool decodeImage(tinygltf::Image* image, const int index, std::string* err, std:
 int componentSize(int componentType) {
   switch (componentType) {
     case TINYGLTF_COMPONENT_TYPE_BYTE:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+      return 1;
     case TINYGLTF_COMPONENT_TYPE_SHORT:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
+      return 2;
     case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
-    case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
-    default: return 0;
+    case TINYGLTF_COMPONENT_TYPE_FLOAT:
+      return 4;
+    default:
+      return 0;
   }
 }
 
 int componentCount(int type) {
   switch (type) {
-    case TINYGLTF_TYPE_SCALAR: return 1;
-    case TINYGLTF_TYPE_VEC2: return 2;
-    case TINYGLTF_TYPE_VEC3: return 3;
-    case TINYGLTF_TYPE_VEC4: return 4;
-    default: return 0;
+    case TINYGLTF_TYPE_SCALAR:
+      return 1;
+    case TINYGLTF_TYPE_VEC2:
+      return 2;
+    case TINYGLTF_TYPE_VEC3:
+      return 3;
+    case TINYGLTF_TYPE_VEC4:
+      return 4;
+    default:
+      return 0;
   }
 }
 
@@ -210,7 +222,8 @@ struct AccessorView {
         std::memcpy(&x, p, 1);
         return normalized ? std::max(x / 127.0f, -1.0f) : float(x);
       }
-      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? *p / 255.0f : float(*p);
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+        return normalized ? *p / 255.0f : float(*p);
       case TINYGLTF_COMPONENT_TYPE_SHORT: {
         int16_t x;
         std::memcpy(&x, p, 2);
@@ -221,14 +234,16 @@ struct AccessorView {
         std::memcpy(&x, p, 2);
         return normalized ? x / 65535.0f : float(x);
       }
-      default: return 0;
+      default:
+        return 0;
     }
   }
   // Element i of a scalar unsigned integer accessor (indices).
   uint32_t index(size_t i) const {
     const unsigned char* p = data + i * stride;
     switch (componentType) {
-      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return *p;
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+        return *p;
       case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
         uint16_t x;
         std::memcpy(&x, p, 2);
@@ -258,7 +273,8 @@ class GltfConverter {
   const std::vector<int>& meshesOf(int gltfMesh);
   Mesh convertPrimitive(const tinygltf::Primitive& primitive, const std::string& where) const;
   Mat4 localMatrix(const tinygltf::Node& node, const std::string& where) const;
-  Camera convertCamera(const tinygltf::Node& node, const Mat4& world, const std::string& where) const;
+  Camera convertCamera(const tinygltf::Node& node, const Mat4& world,
+                       const std::string& where) const;
   void walkNodes();
 
   const tinygltf::Model& model_;
@@ -294,9 +310,9 @@ AccessorView GltfConverter::accessor(int index, const std::string& where,
 
   // Step 1: the buffer view inside its buffer.
   if (view.byteOffset > buffer.size() || view.byteLength > buffer.size() - view.byteOffset)
-    fail(fmt::format("{}: bufferViews[{}] (offset {}, length {}) lies outside buffers[{}] ({} bytes)",
-                     name, a.bufferView, view.byteOffset, view.byteLength, view.buffer,
-                     buffer.size()));
+    fail(fmt::format(
+        "{}: bufferViews[{}] (offset {}, length {}) lies outside buffers[{}] ({} bytes)", name,
+        a.bufferView, view.byteOffset, view.byteLength, view.buffer, buffer.size()));
 
   // Step 2: the elements inside the buffer view. Element i occupies
   // [byteOffset + i·stride, byteOffset + i·stride + elementSize).
@@ -314,10 +330,10 @@ AccessorView GltfConverter::accessor(int index, const std::string& where,
     const size_t room = a.byteOffset <= view.byteLength ? view.byteLength - a.byteOffset : 0;
     if (a.byteOffset > view.byteLength || room < elementSize ||
         (a.count - 1) > (room - elementSize) / out.stride)
-      fail(fmt::format("{}: {} elements of {} bytes (stride {}, offset {}) do not fit in "
-                       "bufferViews[{}] ({} bytes)",
-                       name, a.count, elementSize, out.stride, a.byteOffset, a.bufferView,
-                       view.byteLength));
+      fail(fmt::format(
+          "{}: {} elements of {} bytes (stride {}, offset {}) do not fit in "
+          "bufferViews[{}] ({} bytes)",
+          name, a.count, elementSize, out.stride, a.byteOffset, a.bufferView, view.byteLength));
     out.data = buffer.data() + view.byteOffset + a.byteOffset;
   }
   return out;
@@ -331,8 +347,7 @@ void GltfConverter::convertMaterials() {
     const std::vector<double>& f = gm.pbrMetallicRoughness.baseColorFactor;
     if (f.size() == 4) {
       for (double x : f)
-        if (!std::isfinite(x))
-          fail(fmt::format("materials[{}]: baseColorFactor is not finite", i));
+        if (!std::isfinite(x)) fail(fmt::format("materials[{}]: baseColorFactor is not finite", i));
       m.baseColor = {float(f[0]), float(f[1]), float(f[2]), float(f[3])};
     } else if (!f.empty()) {
       fail(fmt::format("materials[{}]: baseColorFactor must have 4 numbers, has {}", i, f.size()));
@@ -348,8 +363,10 @@ void GltfConverter::convertMaterials() {
       m.texture = textureFor(base.index, where + ".baseColorTexture");
     }
     // glTF 2.0 §3.9.4: OPAQUE ignores alpha, MASK cuts at alphaCutoff, BLEND composites.
-    if (gm.alphaMode == "BLEND") m.alphaMode = AlphaMode::blend;
-    else if (gm.alphaMode == "MASK") m.alphaMode = AlphaMode::mask;
+    if (gm.alphaMode == "BLEND")
+      m.alphaMode = AlphaMode::blend;
+    else if (gm.alphaMode == "MASK")
+      m.alphaMode = AlphaMode::mask;
     else if (gm.alphaMode != "OPAQUE" && !gm.alphaMode.empty())
       fail(fmt::format("{}: unknown alphaMode '{}'", where, gm.alphaMode));
     if (!std::isfinite(gm.alphaCutoff) || gm.alphaCutoff < 0)
@@ -361,9 +378,12 @@ void GltfConverter::convertMaterials() {
 
 texture::Wrap wrapOf(int mode, const std::string& where) {
   switch (mode) {  // glTF 2.0 §5.26 (sampler.wrapS / wrapT)
-    case 10497: return texture::Wrap::repeat;
-    case 33071: return texture::Wrap::clamp;
-    case 33648: return texture::Wrap::mirror;
+    case 10497:
+      return texture::Wrap::repeat;
+    case 33071:
+      return texture::Wrap::clamp;
+    case 33648:
+      return texture::Wrap::mirror;
   }
   fail(fmt::format("{}: unknown wrap mode {}", where, mode));
 }
@@ -395,11 +415,12 @@ int GltfConverter::textureFor(int gltfTexture, const std::string& where) {
                      image.uri.empty() ? "" : " ('" + image.uri + "')",
                      options_.followReferences ? "" : " (references to other files are disabled)"));
   TextureMap map;
-  map.name = !image.name.empty() ? image.name : !image.uri.empty() && image.uri.rfind("data:", 0) != 0
-                                                    ? image.uri
-                                                    : fmt::format("images[{}]", t.source);
-  map.texture = std::make_shared<texture::Texture>(level->second, wrapOf(wrapS, tw + ".sampler.wrapS"),
-                                                   wrapOf(wrapT, tw + ".sampler.wrapT"));
+  map.name = !image.name.empty() ? image.name
+             : !image.uri.empty() && image.uri.rfind("data:", 0) != 0
+                 ? image.uri
+                 : fmt::format("images[{}]", t.source);
+  map.texture = std::make_shared<texture::Texture>(
+      level->second, wrapOf(wrapS, tw + ".sampler.wrapS"), wrapOf(wrapT, tw + ".sampler.wrapT"));
   scene_.textures.push_back(std::move(map));
   const int index = int(scene_.textures.size()) - 1;
   textures_.emplace(key, index);
@@ -409,7 +430,8 @@ int GltfConverter::textureFor(int gltfTexture, const std::string& where) {
 Mesh GltfConverter::convertPrimitive(const tinygltf::Primitive& primitive,
                                      const std::string& where) const {
   constexpr int kFloat = TINYGLTF_COMPONENT_TYPE_FLOAT;
-  constexpr int kByte = TINYGLTF_COMPONENT_TYPE_BYTE, kUByte = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
+  constexpr int kByte = TINYGLTF_COMPONENT_TYPE_BYTE,
+                kUByte = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
   constexpr int kShort = TINYGLTF_COMPONENT_TYPE_SHORT;
   constexpr int kUShort = TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
   constexpr int kUInt = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
@@ -427,11 +449,13 @@ Mesh GltfConverter::convertPrimitive(const tinygltf::Primitive& primitive,
   const size_t n = positions.count;
   if (n > std::numeric_limits<uint32_t>::max()) fail(where + ": too many vertices");
   mesh.positions.resize(n);
-  for (size_t i = 0; i < n; ++i) mesh.positions[i] = {positions.get(i, 0), positions.get(i, 1), positions.get(i, 2)};
+  for (size_t i = 0; i < n; ++i)
+    mesh.positions[i] = {positions.get(i, 0), positions.get(i, 1), positions.get(i, 2)};
 
   auto sameCount = [&](const AccessorView& v, const char* name) {
     if (v.count != n)
-      fail(fmt::format("{}.attributes.{}: {} elements, but POSITION has {}", where, name, v.count, n));
+      fail(fmt::format("{}.attributes.{}: {} elements, but POSITION has {}", where, name, v.count,
+                       n));
   };
   if (const int* index = attribute("NORMAL")) {
     AccessorView v = accessor(*index, where + ".attributes.NORMAL", {TINYGLTF_TYPE_VEC3},
@@ -448,7 +472,8 @@ Mesh GltfConverter::convertPrimitive(const tinygltf::Primitive& primitive,
     v.normalized = true;
     mesh.colors.resize(n);
     for (size_t i = 0; i < n; ++i)
-      mesh.colors[i] = {v.get(i, 0), v.get(i, 1), v.get(i, 2), v.components == 4 ? v.get(i, 3) : 1.0f};
+      mesh.colors[i] = {v.get(i, 0), v.get(i, 1), v.get(i, 2),
+                        v.components == 4 ? v.get(i, 3) : 1.0f};
   }
   if (const int* index = attribute("TEXCOORD_0")) {
     AccessorView v = accessor(*index, where + ".attributes.TEXCOORD_0", {TINYGLTF_TYPE_VEC2},
@@ -485,7 +510,8 @@ Mesh GltfConverter::convertPrimitive(const tinygltf::Primitive& primitive,
   switch (primitive.mode) {
     case TINYGLTF_MODE_TRIANGLES:
       out.reserve(m - m % 3);
-      for (size_t i = 0; i + 2 < m; i += 3) out.insert(out.end(), {sequence[i], sequence[i + 1], sequence[i + 2]});
+      for (size_t i = 0; i + 2 < m; i += 3)
+        out.insert(out.end(), {sequence[i], sequence[i + 1], sequence[i + 2]});
       break;
     case TINYGLTF_MODE_TRIANGLE_STRIP:
       // Odd triangles swap their first two vertices to keep the winding.
@@ -498,7 +524,8 @@ Mesh GltfConverter::convertPrimitive(const tinygltf::Primitive& primitive,
     case TINYGLTF_MODE_TRIANGLE_FAN:
       for (size_t i = 1; i + 1 < m; ++i) emit(sequence[0], sequence[i], sequence[i + 1]);
       break;
-    default: break;  // points and lines have no triangles
+    default:
+      break;  // points and lines have no triangles
   }
 
   if (primitive.material >= 0 && size_t(primitive.material) >= scene_.materials.size())
@@ -519,12 +546,15 @@ const std::vector<int>& GltfConverter::meshesOf(int gltfMesh) {
     switch (primitive.mode) {
       case TINYGLTF_MODE_TRIANGLES:
       case TINYGLTF_MODE_TRIANGLE_STRIP:
-      case TINYGLTF_MODE_TRIANGLE_FAN: break;
+      case TINYGLTF_MODE_TRIANGLE_FAN:
+        break;
       case TINYGLTF_MODE_POINTS:
       case TINYGLTF_MODE_LINE:
       case TINYGLTF_MODE_LINE_LOOP:
-      case TINYGLTF_MODE_LINE_STRIP: continue;  // nothing to fill
-      default: fail(fmt::format("{}: unknown mode {}", where, primitive.mode));
+      case TINYGLTF_MODE_LINE_STRIP:
+        continue;  // nothing to fill
+      default:
+        fail(fmt::format("{}: unknown mode {}", where, primitive.mode));
     }
     Mesh mesh = convertPrimitive(primitive, where);
     mesh.name = gm.primitives.size() == 1 ? gm.name : fmt::format("{}[{}]", gm.name, k);
@@ -552,8 +582,8 @@ Mat4 GltfConverter::localMatrix(const tinygltf::Node& node, const std::string& w
   if (!node.translation.empty()) {
     if (node.translation.size() != 3) fail(where + ".translation: expected 3 numbers");
     finite(node.translation, "translation");
-    t = Mat4::translation({float(node.translation[0]), float(node.translation[1]),
-                           float(node.translation[2])});
+    t = Mat4::translation(
+        {float(node.translation[0]), float(node.translation[1]), float(node.translation[2])});
   }
   if (!node.rotation.empty()) {
     if (node.rotation.size() != 4) fail(where + ".rotation: expected 4 numbers");
@@ -564,9 +594,12 @@ Mat4 GltfConverter::localMatrix(const tinygltf::Node& node, const std::string& w
     double len = std::sqrt(x * x + y * y + z * z + w * w);
     if (!(len > 0)) fail(where + ".rotation: zero quaternion");
     x /= len, y /= len, z /= len, w /= len;
-    r.m[0] = {float(1 - 2 * (y * y + z * z)), float(2 * (x * y + z * w)), float(2 * (x * z - y * w)), 0};
-    r.m[1] = {float(2 * (x * y - z * w)), float(1 - 2 * (x * x + z * z)), float(2 * (y * z + x * w)), 0};
-    r.m[2] = {float(2 * (x * z + y * w)), float(2 * (y * z - x * w)), float(1 - 2 * (x * x + y * y)), 0};
+    r.m[0] = {float(1 - 2 * (y * y + z * z)), float(2 * (x * y + z * w)),
+              float(2 * (x * z - y * w)), 0};
+    r.m[1] = {float(2 * (x * y - z * w)), float(1 - 2 * (x * x + z * z)),
+              float(2 * (y * z + x * w)), 0};
+    r.m[2] = {float(2 * (x * z + y * w)), float(2 * (y * z - x * w)),
+              float(1 - 2 * (x * x + y * y)), 0};
   }
   if (!node.scale.empty()) {
     if (node.scale.size() != 3) fail(where + ".scale: expected 3 numbers");
@@ -698,27 +731,30 @@ Result<Scene> loadGltfFromMemory(const std::string& bytes, const std::string& pa
       jsonSize = readU32(bytes, 12);
     }
     if (!nestingWithin(json, jsonSize, kMaxGltfJsonDepth))
-      return Error{path, "",
-                   fmt::format("JSON values are nested more than {} levels deep", kMaxGltfJsonDepth)};
+      return Error{
+          path, "",
+          fmt::format("JSON values are nested more than {} levels deep", kMaxGltfJsonDepth)};
 
     // Step 2: tinygltf parses, with file access routed through readFile and images skipped.
     bool follow = options.followReferences;
     tinygltf::TinyGLTF loader;
-    loader.SetFsCallbacks({&fsFileExists, &fsExpandFilePath, &fsReadWholeFile, &fsWriteWholeFile,
-                           &follow});
+    loader.SetFsCallbacks(
+        {&fsFileExists, &fsExpandFilePath, &fsReadWholeFile, &fsWriteWholeFile, &follow});
     DecodedImages images;
     images.maxTexels = options.maxTexels;
     loader.SetImageLoader(&decodeImage, &images);
     tinygltf::Model model;
     std::string err, warn;
     const std::string baseDir = directoryOf(path);
-    bool ok = binary ? loader.LoadBinaryFromMemory(
-                           &model, &err, &warn, reinterpret_cast<const unsigned char*>(bytes.data()),
-                           static_cast<unsigned int>(bytes.size()), baseDir)
-                     : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(),
-                                                  static_cast<unsigned int>(bytes.size()), baseDir);
+    bool ok =
+        binary ? loader.LoadBinaryFromMemory(&model, &err, &warn,
+                                             reinterpret_cast<const unsigned char*>(bytes.data()),
+                                             static_cast<unsigned int>(bytes.size()), baseDir)
+               : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(),
+                                            static_cast<unsigned int>(bytes.size()), baseDir);
     if (!ok)
-      return Error{path, "", fmt::format("invalid glTF: {}", err.empty() ? "parse failed" : oneLine(err))};
+      return Error{path, "",
+                   fmt::format("invalid glTF: {}", err.empty() ? "parse failed" : oneLine(err))};
 
     // Step 3: the model, checked as it is converted.
     Scene scene = GltfConverter(model, options, images).convert();

@@ -10,22 +10,22 @@
 // Inside this file the walker reports a problem by throwing JsonProblem: it keeps each field
 // read to one line. parseJsonSceneIn catches it, and every other exception, and returns an
 // Error; nothing is thrown past this file.
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <initializer_list>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <numbers>
 #include <optional>
 #include <set>
 #include <string_view>
 #include <utility>
 
-#include <fmt/format.h>
-#include <nlohmann/json.hpp>
-
-#include "scene/loader_common.h"
 #include "freeform/quadric.h"
+#include "scene/loader_common.h"
 #include "scene/primitives.h"
 #include "texture/texture.h"
 
@@ -60,15 +60,23 @@ std::string element(const std::string& where, size_t i) { return fmt::format("{}
 
 const char* typeName(const Json& v) {
   switch (v.type()) {
-    case Json::value_t::object: return "an object";
-    case Json::value_t::array: return "an array";
-    case Json::value_t::string: return "a string";
-    case Json::value_t::boolean: return "a boolean";
-    case Json::value_t::null: return "null";
+    case Json::value_t::object:
+      return "an object";
+    case Json::value_t::array:
+      return "an array";
+    case Json::value_t::string:
+      return "a string";
+    case Json::value_t::boolean:
+      return "a boolean";
+    case Json::value_t::null:
+      return "null";
     case Json::value_t::number_integer:
-    case Json::value_t::number_unsigned: return "an integer";
-    case Json::value_t::number_float: return "a number";
-    default: return "an unsupported value";
+    case Json::value_t::number_unsigned:
+      return "an integer";
+    case Json::value_t::number_float:
+      return "a number";
+    default:
+      return "an unsupported value";
   }
 }
 
@@ -125,7 +133,9 @@ class ParseGuard {
         frames_.pop_back();
         finishValue();
         break;
-      case Json::parse_event_t::value: finishValue(); break;
+      case Json::parse_event_t::value:
+        finishValue();
+        break;
     }
     return true;
   }
@@ -133,7 +143,7 @@ class ParseGuard {
  private:
   struct Frame {
     bool array;
-    size_t index;  // arrays: elements completed so far
+    size_t index;     // arrays: elements completed so far
     std::string key;  // objects: the key being read
     std::set<std::string> keys;
   };
@@ -224,7 +234,8 @@ int64_t integer(const Json& v, const std::string& where, int64_t lo, int64_t hi)
   // Unsigned values beyond int64 are out of every range we accept.
   bool tooBig = v.is_number_unsigned() && v.get<uint64_t>() > uint64_t(hi);
   int64_t x = tooBig ? hi : v.get<int64_t>();
-  if (tooBig || x < lo || x > hi) fail(where, fmt::format("{} is out of range {}..{}", v.dump(), lo, hi));
+  if (tooBig || x < lo || x > hi)
+    fail(where, fmt::format("{} is out of range {}..{}", v.dump(), lo, hi));
   return x;
 }
 
@@ -296,8 +307,8 @@ std::array<float, N> sizes(const Json& v, const std::string& where) {
 std::array<int, 2> counts(const Json& v, const std::string& where, int lo, int hi) {
   if (v.is_array()) {
     if (v.size() != 2)
-      fail(where, fmt::format("expected an integer or an array of 2 integers, got {} elements",
-                              v.size()));
+      fail(where,
+           fmt::format("expected an integer or an array of 2 integers, got {} elements", v.size()));
     return {int(integer(v[0], element(where, 0), lo, hi)),
             int(integer(v[1], element(where, 1), lo, hi))};
   }
@@ -406,10 +417,12 @@ Scene SceneReader::read(const Json& root) {
                          "version {})",
                          kFormatVersion));
   if (!version->is_number_integer() || version->get<int64_t>() != kFormatVersion)
-    fail("synthvis", fmt::format("unsupported format version {} (this reader understands version {})",
-                                 version->dump(), kFormatVersion));
-  expectKeys(root, "", {"synthvis", "description", "background", "camera", "cameras", "light",
-                        "pointLights", "fog", "textures", "colorTable", "materials", "objects"});
+    fail("synthvis",
+         fmt::format("unsupported format version {} (this reader understands version {})",
+                     version->dump(), kFormatVersion));
+  expectKeys(root, "",
+             {"synthvis", "description", "background", "camera", "cameras", "light", "pointLights",
+              "fog", "textures", "colorTable", "materials", "objects"});
 
   if (const Json* description = find(root, "description")) string(*description, "description");
   if (const Json* background = find(root, "background")) {
@@ -456,7 +469,8 @@ Camera SceneReader::readCamera(const Json& v, const std::string& where) const {
     fail(where, fmt::format("far ({}) must be greater than near ({})", c.zfar, c.znear));
   Vec3 view = c.target - c.position;
   if (!(length(view) > 0)) fail(where, "position and target must differ");
-  if (!(length(cross(view, c.up)) > 0)) fail(where, "up must not be parallel to the view direction");
+  if (!(length(cross(view, c.up)) > 0))
+    fail(where, "up must not be parallel to the view direction");
   return c;
 }
 
@@ -473,7 +487,8 @@ void SceneReader::readLight(const Json& v, const std::string& where) {
   if (const Json* x = find(v, "direction"))
     light.direction = normalize(nonZeroVec3(*x, member(where, "direction")));
   if (const Json* x = find(v, "color")) light.color = lightColor(*x, member(where, "color"));
-  if (const Json* x = find(v, "ambient")) light.ambient = inRange(*x, member(where, "ambient"), 0, 1);
+  if (const Json* x = find(v, "ambient"))
+    light.ambient = inRange(*x, member(where, "ambient"), 0, 1);
   if (const Json* x = find(v, "enabled")) light.enabled = boolean(*x, member(where, "enabled"));
 }
 
@@ -481,13 +496,16 @@ void SceneReader::readPointLights(const Json& v, const std::string& where) {
   array(v, where);
   constexpr size_t kMaxPointLights = 64;  // each costs every Phong pixel a term
   if (v.size() > kMaxPointLights)
-    fail(where, fmt::format("{} point lights is more than the {} supported", v.size(), kMaxPointLights));
+    fail(where,
+         fmt::format("{} point lights is more than the {} supported", v.size(), kMaxPointLights));
   for (size_t i = 0; i < v.size(); ++i) {
     std::string w = element(where, i);
     expectKeys(v[i], w, {"position", "color"});
     PointLight light;
-    if (const Json* x = find(v[i], "position")) light.position = vec3(*x, member(w, "position"));
-    else fail(w, "missing key 'position'");
+    if (const Json* x = find(v[i], "position"))
+      light.position = vec3(*x, member(w, "position"));
+    else
+      fail(w, "missing key 'position'");
     if (const Json* x = find(v[i], "color")) light.color = lightColor(*x, member(w, "color"));
     scene_.pointLights.push_back(light);
   }
@@ -507,7 +525,8 @@ void SceneReader::readFog(const Json& v, const std::string& where) {
 
 void SceneReader::readColorTable(const Json& v, const std::string& where) {
   array(v, where);
-  if (v.size() > 256) fail(where, fmt::format("{} entries is more than 256 (an 8-bit code)", v.size()));
+  if (v.size() > 256)
+    fail(where, fmt::format("{} entries is more than 256 (an 8-bit code)", v.size()));
   for (size_t i = 0; i < v.size(); ++i) {
     Vec4 c = color(v[i], element(where, i), false);
     colorTable_.push_back({c.x, c.y, c.z});
@@ -554,7 +573,8 @@ void SceneReader::readTextures(const Json& v, const std::string& where) {
         if (find(v[i], key)) fail(member(w, key), "only for generated textures");
       const std::string ref = string(*file, member(w, "file"));
       if (!context_.options.followReferences)
-        fail(member(w, "file"), fmt::format("cannot open '{}' (references to other files are disabled)", ref));
+        fail(member(w, "file"),
+             fmt::format("cannot open '{}' (references to other files are disabled)", ref));
       Result<texture::Level> read = texture::readTextureImage(resolvePath(directoryOf(path_), ref));
       if (!read) fail(member(w, "file"), read.error().str());
       level = std::move(read.value());
@@ -564,10 +584,14 @@ void SceneReader::readTextures(const Json& v, const std::string& where) {
       const std::string gw = member(w, "generate");
       const std::string pattern = string(*generate, gw);
       texture::Pattern p;
-      if (pattern == "noise") p = texture::Pattern::noise;
-      else if (pattern == "squares") p = texture::Pattern::squares;
-      else if (pattern == "checker") p = texture::Pattern::checker;
-      else fail(gw, fmt::format("unknown pattern '{}' (noise, squares or checker)", pattern));
+      if (pattern == "noise")
+        p = texture::Pattern::noise;
+      else if (pattern == "squares")
+        p = texture::Pattern::squares;
+      else if (pattern == "checker")
+        p = texture::Pattern::checker;
+      else
+        fail(gw, fmt::format("unknown pattern '{}' (noise, squares or checker)", pattern));
       int size = 256;
       if (const Json* x = find(v[i], "size"))
         size = int(integer(*x, member(w, "size"), 1, texture::kMaxGeneratedSide));
@@ -582,7 +606,8 @@ void SceneReader::readTextures(const Json& v, const std::string& where) {
         }
       }
       uint32_t seed = 1;
-      if (const Json* x = find(v[i], "seed")) seed = uint32_t(integer(*x, member(w, "seed"), 0, 0xFFFFFFFF));
+      if (const Json* x = find(v[i], "seed"))
+        seed = uint32_t(integer(*x, member(w, "seed"), 0, 0xFFFFFFFF));
       level = texture::generateTexture(p, size, c[0], c[1], seed);
       if (map.name.empty()) map.name = pattern;
     }
@@ -598,9 +623,9 @@ void SceneReader::readMaterials(const Json& v, const std::string& where) {
   array(v, where);
   for (size_t i = 0; i < v.size(); ++i) {
     std::string w = element(where, i);
-    expectKeys(v[i], w, {"name", "color", "colorCode", "doubleSided", "unlit", "texture",
-                         "textureFilter", "textureScale", "phong", "specular", "shininess", "opacity",
-                         "alphaCutoff"});
+    expectKeys(v[i], w,
+               {"name", "color", "colorCode", "doubleSided", "unlit", "texture", "textureFilter",
+                "textureScale", "phong", "specular", "shininess", "opacity", "alphaCutoff"});
     Material m;
     if (const Json* x = find(v[i], "name")) {
       m.name = string(*x, member(w, "name"));
@@ -617,13 +642,15 @@ void SceneReader::readMaterials(const Json& v, const std::string& where) {
       const Vec3 c = colorTable_[size_t(integer(*x, cw, 0, int64_t(colorTable_.size()) - 1))];
       m.baseColor = {c.x, c.y, c.z, 1};
     }
-    if (const Json* x = find(v[i], "doubleSided")) m.doubleSided = boolean(*x, member(w, "doubleSided"));
+    if (const Json* x = find(v[i], "doubleSided"))
+      m.doubleSided = boolean(*x, member(w, "doubleSided"));
     if (const Json* x = find(v[i], "unlit")) m.unlit = boolean(*x, member(w, "unlit"));
     if (const Json* x = find(v[i], "texture")) {
       std::string tw = member(w, "texture");
       if (x->is_string()) {
         auto it = textureByName_.find(x->get<std::string>());
-        if (it == textureByName_.end()) fail(tw, fmt::format("no texture named '{}'", x->get<std::string>()));
+        if (it == textureByName_.end())
+          fail(tw, fmt::format("no texture named '{}'", x->get<std::string>()));
         m.texture = it->second;
       } else {
         if (scene_.textures.empty()) fail(tw, "there are no textures to refer to");
@@ -637,18 +664,22 @@ void SceneReader::readMaterials(const Json& v, const std::string& where) {
     }
     if (const Json* x = find(v[i], "textureScale")) {
       const std::string sw = member(w, "textureScale");
-      const auto k = x->is_number() ? std::array<float, 2>{number(*x, sw), number(*x, sw)} : numbers<2>(*x, sw);
+      const auto k = x->is_number() ? std::array<float, 2>{number(*x, sw), number(*x, sw)}
+                                    : numbers<2>(*x, sw);
       m.uvScale = {k[0], k[1]};
     }
     if (const Json* x = find(v[i], "phong")) m.phong = boolean(*x, member(w, "phong"));
-    if (const Json* x = find(v[i], "specular")) m.specular = inRange(*x, member(w, "specular"), 0, 1e6f);
-    if (const Json* x = find(v[i], "shininess")) m.shininess = inRange(*x, member(w, "shininess"), 0, 1e6f);
+    if (const Json* x = find(v[i], "specular"))
+      m.specular = inRange(*x, member(w, "specular"), 0, 1e6f);
+    if (const Json* x = find(v[i], "shininess"))
+      m.shininess = inRange(*x, member(w, "shininess"), 0, 1e6f);
     if (const Json* x = find(v[i], "opacity")) {
       m.baseColor.w = inRange(*x, member(w, "opacity"), 0, 1);
       m.alphaMode = AlphaMode::blend;
     }
     if (const Json* x = find(v[i], "alphaCutoff")) {
-      if (find(v[i], "opacity")) fail(member(w, "alphaCutoff"), "give either 'opacity' or 'alphaCutoff'");
+      if (find(v[i], "opacity"))
+        fail(member(w, "alphaCutoff"), "give either 'opacity' or 'alphaCutoff'");
       m.alphaCutoff = inRange(*x, member(w, "alphaCutoff"), 0, 1);
       m.alphaMode = AlphaMode::mask;
     }
@@ -696,8 +727,8 @@ int SceneReader::readObjectMaterial(const Json& object, const std::string& where
 
 void SceneReader::addTriangles(uint64_t triangles, const std::string& where) {
   if (triangles > context_.options.maxTriangles - triangles_)
-    fail(where, fmt::format("the scene would have more than {} triangles",
-                            context_.options.maxTriangles));
+    fail(where,
+         fmt::format("the scene would have more than {} triangles", context_.options.maxTriangles));
   triangles_ += triangles;
 }
 
@@ -719,7 +750,8 @@ void SceneReader::readObjectGeometry(const Json& v, const std::string& where) {
   const Json* freeform = find(v, "freeform");
   if (int(mesh != nullptr) + int(primitive != nullptr) + int(freeform != nullptr) > 1)
     fail(where, "an object has one of 'mesh', 'primitive' or 'freeform', not several");
-  if (!mesh && !primitive && !freeform) fail(where, "missing key 'mesh', 'primitive' or 'freeform'");
+  if (!mesh && !primitive && !freeform)
+    fail(where, "missing key 'mesh', 'primitive' or 'freeform'");
   if (freeform) return readFreeFormObject(v, where);
 
   if (primitive) {
@@ -754,7 +786,8 @@ void SceneReader::readFreeFormObject(const Json& v, const std::string& where) {
   expectKeys(v, where, {"name", "freeform", "material", "color", "transform", "priority"});
   FreeFormObject f;
   if (const Json* name = find(v, "name")) f.name = string(*name, member(where, "name"));
-  if (const Json* t = find(v, "transform")) f.transform = readTransform(*t, member(where, "transform"));
+  if (const Json* t = find(v, "transform"))
+    f.transform = readTransform(*t, member(where, "transform"));
   // Free forms are depth-tested, never masked: a priority is accepted (an object list may give
   // every object one) and has no effect on them.
   if (const Json* x = find(v, "priority"))
@@ -763,8 +796,8 @@ void SceneReader::readFreeFormObject(const Json& v, const std::string& where) {
   int quadrics = 0;
   f.form = readFreeForm(*find(v, "freeform"), member(where, "freeform"), 1, quadrics, true);
   if (scene_.freeForms.size() >= kMaxFreeFormObjects)
-    fail(where, fmt::format("the scene would have more than {} free-form objects",
-                            kMaxFreeFormObjects));
+    fail(where,
+         fmt::format("the scene would have more than {} free-form objects", kMaxFreeFormObjects));
   scene_.freeForms.push_back(std::move(f));
 }
 
@@ -815,7 +848,8 @@ FreeFormNode SceneReader::readFreeForm(const Json& v, const std::string& where, 
     if (const Json* x = find(v, "angle")) {
       angle = number(*x, member(where, "angle"));
       if (!(angle > 0 && angle < 90))
-        fail(member(where, "angle"), fmt::format("{} is out of range (0 < angle < 90 degrees)", x->dump()));
+        fail(member(where, "angle"),
+             fmt::format("{} is out of range (0 < angle < 90 degrees)", x->dump()));
     }
     q = Quadric::cone(vecOr("apex", {}, false), vecOr("axis", {0, 1, 0}, true),
                       angle * std::numbers::pi / 180);
@@ -842,7 +876,8 @@ FreeFormNode SceneReader::readFreeForm(const Json& v, const std::string& where, 
   node.quadric = q.c;
   // Step 2: its weight as a perturbation, and its own perturbations.
   if (const Json* w = find(v, "weight")) {
-    if (root) fail(member(where, "weight"), "'weight' belongs to perturbations, not the base quadric");
+    if (root)
+      fail(member(where, "weight"), "'weight' belongs to perturbations, not the base quadric");
     node.weight = number(*w, member(where, "weight"));
   }
   if (const Json* clips = find(v, "clip")) {
@@ -851,7 +886,8 @@ FreeFormNode SceneReader::readFreeForm(const Json& v, const std::string& where, 
     const Json& a = array(*clips, clipWhere);
     for (size_t i = 0; i < a.size(); ++i) {
       const std::string w = element(clipWhere, i);
-      if (a[i].is_object() && (find(a[i], "perturbations") || find(a[i], "weight") || find(a[i], "clip")))
+      if (a[i].is_object() &&
+          (find(a[i], "perturbations") || find(a[i], "weight") || find(a[i], "clip")))
         fail(w, "a clip is a plain quadric (no 'weight', 'perturbations' or 'clip')");
       node.clips.push_back(readFreeForm(a[i], w, depth + 1, quadrics, false).quadric);
     }
@@ -860,7 +896,8 @@ FreeFormNode SceneReader::readFreeForm(const Json& v, const std::string& where, 
     const std::string listWhere = member(where, "perturbations");
     const Json& a = array(*list, listWhere);
     for (size_t i = 0; i < a.size(); ++i)
-      node.perturbations.push_back(readFreeForm(a[i], element(listWhere, i), depth + 1, quadrics, false));
+      node.perturbations.push_back(
+          readFreeForm(a[i], element(listWhere, i), depth + 1, quadrics, false));
   }
   return node;
 }
@@ -872,36 +909,43 @@ void SceneReader::readPrimitive(const Json& v, const std::string& where) {
   // Step 1: the kind decides which keys are allowed.
   if (kind == "box") {
     p.kind = PrimitiveKind::kBox;
-    expectKeys(v, where, {"name", "primitive", "material", "color", "transform", "priority", "size"});
+    expectKeys(v, where,
+               {"name", "primitive", "material", "color", "transform", "priority", "size"});
   } else if (kind == "sphere") {
     p.kind = PrimitiveKind::kSphere;
-    expectKeys(v, where, {"name", "primitive", "material", "color", "transform", "priority", "radius",
-                          "segments", "rings"});
+    expectKeys(v, where,
+               {"name", "primitive", "material", "color", "transform", "priority", "radius",
+                "segments", "rings"});
   } else if (kind == "plane") {
     p.kind = PrimitiveKind::kPlane;
-    expectKeys(v, where, {"name", "primitive", "material", "color", "transform", "priority", "size",
-                          "subdivisions"});
+    expectKeys(v, where,
+               {"name", "primitive", "material", "color", "transform", "priority", "size",
+                "subdivisions"});
   } else if (kind == "checker") {
     p.kind = PrimitiveKind::kChecker;
     p.size = {8, 1, 8};
     p.divisionsX = p.divisionsZ = 8;
-    expectKeys(v, where, {"name", "primitive", "material", "color", "transform", "priority", "size",
-                          "squares", "colors"});
+    expectKeys(v, where,
+               {"name", "primitive", "material", "color", "transform", "priority", "size",
+                "squares", "colors"});
   } else if (kind == "cylinder") {
     p.kind = PrimitiveKind::kCylinder;
-    expectKeys(v, where, {"name", "primitive", "material", "color", "transform", "priority", "radius",
-                          "height", "segments", "caps"});
+    expectKeys(v, where,
+               {"name", "primitive", "material", "color", "transform", "priority", "radius",
+                "height", "segments", "caps"});
   } else if (kind == "cone") {
     p.kind = PrimitiveKind::kCone;
-    expectKeys(v, where, {"name", "primitive", "material", "color", "transform", "priority", "radius",
-                          "height", "segments", "caps"});
+    expectKeys(v, where,
+               {"name", "primitive", "material", "color", "transform", "priority", "radius",
+                "height", "segments", "caps"});
   } else if (kind == "torus") {
     p.kind = PrimitiveKind::kTorus;
     p.radius = 0.375f;
     p.segments = 48;
     p.sides = 24;
-    expectKeys(v, where, {"name", "primitive", "material", "color", "transform", "priority", "radius", "tube",
-                          "segments", "sides"});
+    expectKeys(v, where,
+               {"name", "primitive", "material", "color", "transform", "priority", "radius", "tube",
+                "segments", "sides"});
   } else {
     fail(kindWhere, fmt::format("unknown primitive '{}' (expected box, sphere, plane, checker, "
                                 "cylinder, cone or torus)",
@@ -1019,8 +1063,9 @@ void SceneReader::readInlineMesh(const Json& v, const std::string& where, Mesh& 
     for (size_t i = 0; i < x->size(); ++i) {
       const Json& index = (*x)[i];
       if (!index.is_number_integer() || index.get<int64_t>() < 0 || index.get<uint64_t>() >= n)
-        fail(element(iw, i), fmt::format("expected a vertex index 0..{}, got {}", n == 0 ? 0 : n - 1,
-                                         index.is_number() ? index.dump() : typeName(index)));
+        fail(element(iw, i),
+             fmt::format("expected a vertex index 0..{}, got {}", n == 0 ? 0 : n - 1,
+                         index.is_number() ? index.dump() : typeName(index)));
       mesh.indices.push_back(static_cast<uint32_t>(index.get<uint64_t>()));
     }
   } else {
@@ -1032,8 +1077,8 @@ void SceneReader::readInlineMesh(const Json& v, const std::string& where, Mesh& 
   }
 }
 
-void SceneReader::readMeshFile(const Json& v, const std::string& where,
-                               std::optional<int> material, const Mat4& m) {
+void SceneReader::readMeshFile(const Json& v, const std::string& where, std::optional<int> material,
+                               const Mat4& m) {
   const std::string ref = string(v, where);
   if (ref.empty()) fail(where, "expected a file path, got an empty string");
   // Untrusted text (fuzzing) must not make the loader touch the file system at all.
@@ -1041,7 +1086,8 @@ void SceneReader::readMeshFile(const Json& v, const std::string& where,
     fail(where, fmt::format("cannot open '{}' (references to other files are disabled)", ref));
   const std::string resolved = resolvePath(directoryOf(path_), ref);
   std::error_code ec;
-  if (!std::filesystem::exists(resolved, ec)) fail(where, fmt::format("cannot open '{}': no such file", ref));
+  if (!std::filesystem::exists(resolved, ec))
+    fail(where, fmt::format("cannot open '{}': no such file", ref));
 
   // Step 1: nesting and cycles. The current file is the last entry of openScenes.
   const std::string key = canonicalKey(resolved);
@@ -1123,7 +1169,8 @@ Result<Scene> parseJsonSceneIn(const std::string& text, const std::string& path,
     ParseGuard guard;
     try {
       root = Json::parse(
-          text, [&guard](int depth, Json::parse_event_t event, Json& parsed) {
+          text,
+          [&guard](int depth, Json::parse_event_t event, Json& parsed) {
             return guard(depth, event, parsed);
           },
           /*allow_exceptions=*/true, /*ignore_comments=*/true);

@@ -1,12 +1,12 @@
 // loadScene: choosing a loader by file extension, and the file and path helpers all loaders share.
+#include <fmt/format.h>
+
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <memory>
 #include <new>
-
-#include <fmt/format.h>
 
 #include "scene/loader_common.h"
 
@@ -34,7 +34,7 @@ Result<std::string> readFile(const std::string& path) {
   // Step 2: read it whole. The size was checked above; a file that grows meanwhile is read only
   // up to that size plus one byte, which is enough to notice.
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"),
-                                                      &std::fclose);
+                                                       &std::fclose);
   if (!file) return fail(std::strerror(errno));
   std::string bytes(static_cast<size_t>(size), '\0');
   size_t got = size ? std::fread(bytes.data(), 1, bytes.size(), file.get()) : 0;
@@ -42,9 +42,7 @@ Result<std::string> readFile(const std::string& path) {
   return bytes;
 }
 
-std::string directoryOf(const std::string& path) {
-  return fs::path(path).parent_path().string();
-}
+std::string directoryOf(const std::string& path) { return fs::path(path).parent_path().string(); }
 
 std::string resolvePath(const std::string& base, const std::string& ref) {
   fs::path r(ref);
@@ -90,9 +88,9 @@ std::string oneLine(const std::string& text) {
 Result<Scene> loadFile(const std::string& path, LoadContext& context) {
   std::string ext = lowerExtension(path);
   if (ext != ".json" && ext != ".gltf" && ext != ".glb" && ext != ".obj")
-    return Error{path, "",
-                 fmt::format("unknown scene file type '{}' (expected .json, .gltf, .glb or .obj)",
-                             ext)};
+    return Error{
+        path, "",
+        fmt::format("unknown scene file type '{}' (expected .json, .gltf, .glb or .obj)", ext)};
   Result<std::string> bytes = readFile(path);
   if (!bytes) return bytes.error();
   if (ext == ".json") return parseJsonSceneIn(bytes.value(), path, context);

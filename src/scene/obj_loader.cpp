@@ -6,15 +6,15 @@
 // vertex. So each distinct (v, vn, vt) triple becomes one vertex, found again through a hash map,
 // and faces are grouped into one Mesh per (shape, material). tinyobjloader does not check indices
 // against the attribute arrays; every index is checked here before it is used.
+#include <fmt/format.h>
+#include <tiny_obj_loader.h>
+
 #include <algorithm>
 #include <cmath>
 #include <map>
 #include <new>
 #include <sstream>
 #include <unordered_map>
-
-#include <fmt/format.h>
-#include <tiny_obj_loader.h>
 
 #include "scene/loader_common.h"
 #include "texture/texture.h"
@@ -124,19 +124,22 @@ Scene convertObj(const tinyobj::attrib_t& attrib, const std::vector<tinyobj::sha
     for (float c : channels)
       if (!std::isfinite(c)) fail(fmt::format("material '{}': colour is not finite", mtl.name));
     auto unit = [](float x) { return std::clamp(x, 0.0f, 1.0f); };
-    Material m{.name = mtl.name,
-               .baseColor = {unit(channels[0]), unit(channels[1]), unit(channels[2]), unit(channels[3])},
-               .doubleSided = false,
-               // Illumination model 0 is "colour on, ambient off": a constant colour.
-               .unlit = mtl.illum == 0};
+    Material m{
+        .name = mtl.name,
+        .baseColor = {unit(channels[0]), unit(channels[1]), unit(channels[2]), unit(channels[3])},
+        .doubleSided = false,
+        // Illumination model 0 is "colour on, ambient off": a constant colour.
+        .unlit = mtl.illum == 0};
     if (mtl.dissolve < 1) m.alphaMode = AlphaMode::blend;
     // map_Kd: the diffuse colour map, a PNG relative to the OBJ's directory.
     if (!mtl.diffuse_texname.empty()) {
       auto it = textureByFile.find(mtl.diffuse_texname);
       if (it == textureByFile.end()) {
         if (!options.followReferences)
-          fail(fmt::format("material '{}': cannot open '{}' (references to other files are "
-                           "disabled)", mtl.name, mtl.diffuse_texname));
+          fail(
+              fmt::format("material '{}': cannot open '{}' (references to other files are "
+                          "disabled)",
+                          mtl.name, mtl.diffuse_texname));
         Result<texture::Level> level =
             texture::readTextureImage(resolvePath(baseDir, mtl.diffuse_texname));
         if (!level) fail(fmt::format("material '{}': {}", mtl.name, level.error().str()));
@@ -145,9 +148,9 @@ Scene convertObj(const tinyobj::attrib_t& attrib, const std::vector<tinyobj::sha
           fail(fmt::format("material '{}': the textures exceed {} texels", mtl.name,
                            options.maxTexels));
         scene.textures.push_back(
-            {mtl.diffuse_texname, std::make_shared<texture::Texture>(std::move(level.value()),
-                                                                     texture::Wrap::repeat,
-                                                                     texture::Wrap::repeat)});
+            {mtl.diffuse_texname,
+             std::make_shared<texture::Texture>(std::move(level.value()), texture::Wrap::repeat,
+                                                texture::Wrap::repeat)});
         it = textureByFile.emplace(mtl.diffuse_texname, int(scene.textures.size()) - 1).first;
       }
       m.texture = it->second;
@@ -178,7 +181,8 @@ Scene convertObj(const tinyobj::attrib_t& attrib, const std::vector<tinyobj::sha
     size_t offset = 0;
     for (size_t f = 0; f < m.num_face_vertices.size(); ++f) {
       const size_t fv = m.num_face_vertices[f];
-      if (offset + fv > m.indices.size()) fail(fmt::format("shape '{}': inconsistent face data", shape.name));
+      if (offset + fv > m.indices.size())
+        fail(fmt::format("shape '{}': inconsistent face data", shape.name));
       if (fv == 3) {
         int material = m.material_ids[f];
         if (material < 0 || size_t(material) >= materials.size()) material = -1;
@@ -269,7 +273,8 @@ Result<Scene> parseObj(const std::string& text, const std::string& path,
                                /*triangulate=*/true, /*default_vcols_fallback=*/false);
     if (!ok) {
       std::string message = oneLine(err);
-      return Error{path, lineOf(message), fmt::format("invalid OBJ: {}", message.empty() ? "parse failed" : message)};
+      return Error{path, lineOf(message),
+                   fmt::format("invalid OBJ: {}", message.empty() ? "parse failed" : message)};
     }
     Scene scene = convertObj(attrib, shapes, materials, options, directoryOf(path));
     Status valid = validate(scene, path);

@@ -29,7 +29,9 @@ class MeshBuilder {
     mesh_.uvs.push_back(uv);
     return static_cast<uint32_t>(mesh_.positions.size() - 1);
   }
-  void triangle(uint32_t a, uint32_t b, uint32_t c) { mesh_.indices.insert(mesh_.indices.end(), {a, b, c}); }
+  void triangle(uint32_t a, uint32_t b, uint32_t c) {
+    mesh_.indices.insert(mesh_.indices.end(), {a, b, c});
+  }
   // a, b, c, d counter-clockwise seen from the front.
   void quad(uint32_t a, uint32_t b, uint32_t c, uint32_t d) {
     triangle(a, b, c);
@@ -55,27 +57,39 @@ Vec2 circle(int s, int n) {
 uint64_t primitiveTriangleCount(const PrimitiveParams& p) {
   const uint64_t s = uint64_t(p.segments);
   switch (p.kind) {
-    case PrimitiveKind::kBox: return 12;
-    case PrimitiveKind::kSphere: return 2 * s * uint64_t(p.rings - 1);
+    case PrimitiveKind::kBox:
+      return 12;
+    case PrimitiveKind::kSphere:
+      return 2 * s * uint64_t(p.rings - 1);
     case PrimitiveKind::kPlane:
-    case PrimitiveKind::kChecker: return 2 * uint64_t(p.divisionsX) * uint64_t(p.divisionsZ);
-    case PrimitiveKind::kCylinder: return p.caps ? 4 * s : 2 * s;
-    case PrimitiveKind::kCone: return p.caps ? 2 * s : s;
-    case PrimitiveKind::kTorus: return 2 * s * uint64_t(p.sides);
+    case PrimitiveKind::kChecker:
+      return 2 * uint64_t(p.divisionsX) * uint64_t(p.divisionsZ);
+    case PrimitiveKind::kCylinder:
+      return p.caps ? 4 * s : 2 * s;
+    case PrimitiveKind::kCone:
+      return p.caps ? 2 * s : s;
+    case PrimitiveKind::kTorus:
+      return 2 * s * uint64_t(p.sides);
   }
   return 0;
 }
 
 Mesh makePrimitive(const PrimitiveParams& p) {
   switch (p.kind) {
-    case PrimitiveKind::kBox: return makeBox(p.size);
-    case PrimitiveKind::kSphere: return makeSphere(p.radius, p.segments, p.rings);
-    case PrimitiveKind::kPlane: return makePlane(p.size.x, p.size.z, p.divisionsX, p.divisionsZ);
+    case PrimitiveKind::kBox:
+      return makeBox(p.size);
+    case PrimitiveKind::kSphere:
+      return makeSphere(p.radius, p.segments, p.rings);
+    case PrimitiveKind::kPlane:
+      return makePlane(p.size.x, p.size.z, p.divisionsX, p.divisionsZ);
     case PrimitiveKind::kChecker:
       return makeChecker(p.size.x, p.size.z, p.divisionsX, p.divisionsZ, p.colors[0], p.colors[1]);
-    case PrimitiveKind::kCylinder: return makeCylinder(p.radius, p.height, p.segments, p.caps);
-    case PrimitiveKind::kCone: return makeCone(p.radius, p.height, p.segments, p.caps);
-    case PrimitiveKind::kTorus: return makeTorus(p.radius, p.tube, p.segments, p.sides);
+    case PrimitiveKind::kCylinder:
+      return makeCylinder(p.radius, p.height, p.segments, p.caps);
+    case PrimitiveKind::kCone:
+      return makeCone(p.radius, p.height, p.segments, p.caps);
+    case PrimitiveKind::kTorus:
+      return makeTorus(p.radius, p.tube, p.segments, p.sides);
   }
   return {};
 }
@@ -87,9 +101,9 @@ Mesh makeBox(Vec3 size) {
     Vec3 n, u, v;
   };
   static constexpr Face kFaces[6] = {
-      {{1, 0, 0}, {0, 0, -1}, {0, 1, 0}},  {{-1, 0, 0}, {0, 0, 1}, {0, 1, 0}},
-      {{0, 1, 0}, {1, 0, 0}, {0, 0, -1}},  {{0, -1, 0}, {1, 0, 0}, {0, 0, 1}},
-      {{0, 0, 1}, {1, 0, 0}, {0, 1, 0}},   {{0, 0, -1}, {-1, 0, 0}, {0, 1, 0}},
+      {{1, 0, 0}, {0, 0, -1}, {0, 1, 0}}, {{-1, 0, 0}, {0, 0, 1}, {0, 1, 0}},
+      {{0, 1, 0}, {1, 0, 0}, {0, 0, -1}}, {{0, -1, 0}, {1, 0, 0}, {0, 0, 1}},
+      {{0, 0, 1}, {1, 0, 0}, {0, 1, 0}},  {{0, 0, -1}, {-1, 0, 0}, {0, 1, 0}},
   };
   const Vec3 half = size * 0.5f;
   MeshBuilder b(24, 12);
@@ -126,7 +140,7 @@ Mesh makeSphere(float radius, int segments, int rings) {
     for (int s = 0; s < segments; ++s) {
       uint32_t a = at(r, s), bl = at(r + 1, s), c = at(r + 1, s + 1), d = at(r, s + 1);
       if (r != rings - 1) b.triangle(a, bl, c);  // at the south pole bl and c coincide
-      if (r != 0) b.triangle(a, c, d);            // at the north pole a and d coincide
+      if (r != 0) b.triangle(a, c, d);           // at the north pole a and d coincide
     }
   return std::move(b.mesh());
 }
@@ -178,7 +192,8 @@ Mesh makeChecker(float sizeX, float sizeZ, int nx, int nz, Vec4 color0, Vec4 col
 Mesh makeCylinder(float radius, float height, int segments, bool caps) {
   const float top = height / 2, bottom = -height / 2;
   const size_t capVertices = caps ? 2 * size_t(segments + 1) : 0;
-  MeshBuilder b(2 * size_t(segments + 1) + capVertices, caps ? 4 * size_t(segments) : 2 * size_t(segments));
+  MeshBuilder b(2 * size_t(segments + 1) + capVertices,
+                caps ? 4 * size_t(segments) : 2 * size_t(segments));
   // Side: columns of (top, bottom) vertices with horizontal normals.
   for (int s = 0; s <= segments; ++s) {
     Vec2 c = circle(s, segments);
@@ -230,9 +245,9 @@ Mesh makeCone(float radius, float height, int segments, bool cap) {
   }
   const uint32_t apexBase = uint32_t(segments + 1);
   for (int s = 0; s < segments; ++s)
-    b.vertex({0, top, 0}, sideNormal(kTwoPi * (s + 0.5) / segments),
-             {f((s + 0.5) / segments), 0});
-  for (int s = 0; s < segments; ++s) b.triangle(apexBase + uint32_t(s), uint32_t(s), uint32_t(s + 1));
+    b.vertex({0, top, 0}, sideNormal(kTwoPi * (s + 0.5) / segments), {f((s + 0.5) / segments), 0});
+  for (int s = 0; s < segments; ++s)
+    b.triangle(apexBase + uint32_t(s), uint32_t(s), uint32_t(s + 1));
   if (cap) {
     uint32_t centre = b.vertex({0, bottom, 0}, {0, -1, 0}, {0.5f, 0.5f});
     for (int s = 0; s < segments; ++s) {

@@ -47,7 +47,7 @@ uint64_t primitiveTriangleCount(const PrimitiveParams& p);
 Mesh makePrimitive(const PrimitiveParams& p);
 
 // The generators behind makePrimitive.
-Mesh makeBox(Vec3 size);  // 24 vertices, flat normals per face
+Mesh makeBox(Vec3 size);                                 // 24 vertices, flat normals per face
 Mesh makeSphere(float radius, int segments, int rings);  // UV sphere, 2·segments·(rings − 1)
 // A grid in y = 0 facing +Y, vertices shared between cells: 2·nx·nz triangles.
 Mesh makePlane(float sizeX, float sizeZ, int nx, int nz);

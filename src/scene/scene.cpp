@@ -1,13 +1,13 @@
 // The scene database's own operations: counting, checking the invariants the loaders promise,
 // and merging one scene into another.
+#include "synthvis/scene.h"
+
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <utility>
-
-#include <fmt/format.h>
-
-#include "synthvis/scene.h"
 
 namespace sv::scene {
 
@@ -56,17 +56,22 @@ std::string meshLabel(const Mesh& mesh, size_t i) {
 
 namespace {
 constexpr std::pair<const char*, TextureFilter> kTextureFilterNames[] = {
-    {"point", TextureFilter::point},           {"nearest", TextureFilter::nearest},
+    {"point", TextureFilter::point},
+    {"nearest", TextureFilter::nearest},
     {"tri3", TextureFilter::threePoint},
-    {"bilinear", TextureFilter::bilinear},     {"trilinear3", TextureFilter::trilinearThreePoint},
-    {"trilinear", TextureFilter::trilinear},   {"aniso", TextureFilter::anisotropic}};
+    {"bilinear", TextureFilter::bilinear},
+    {"trilinear3", TextureFilter::trilinearThreePoint},
+    {"trilinear", TextureFilter::trilinear},
+    {"aniso", TextureFilter::anisotropic}};
 }  // namespace
 
 Result<TextureFilter> parseTextureFilter(const std::string& name) {
   for (const auto& [n, f] : kTextureFilterNames)
     if (name == n) return f;
-  return Error{"", "", fmt::format("unknown texture filter '{}' (point, nearest, tri3, bilinear, "
-                                   "trilinear3, trilinear or aniso)", name)};
+  return Error{"", "",
+               fmt::format("unknown texture filter '{}' (point, nearest, tri3, bilinear, "
+                           "trilinear3, trilinear or aniso)",
+                           name)};
 }
 
 const char* textureFilterName(TextureFilter filter) {
@@ -90,7 +95,8 @@ Status validate(const Scene& scene, const std::string& file, bool vertexData) {
           "{}: attribute arrays must be empty or match the {} positions (normals {}, colors {}, "
           "uvs {})",
           meshLabel(mesh, i), n, mesh.normals.size(), mesh.colors.size(), mesh.uvs.size()));
-    if (mesh.material < -1 || (mesh.material >= 0 && size_t(mesh.material) >= scene.materials.size()))
+    if (mesh.material < -1 ||
+        (mesh.material >= 0 && size_t(mesh.material) >= scene.materials.size()))
       return fail(fmt::format("{}: material {} does not exist ({} materials)", meshLabel(mesh, i),
                               mesh.material, scene.materials.size()));
     if (!vertexData) continue;
@@ -116,20 +122,19 @@ Status validate(const Scene& scene, const std::string& file, bool vertexData) {
   for (size_t i = 0; i < scene.instances.size(); ++i) {
     const Instance& instance = scene.instances[i];
     if (instance.mesh < 0 || size_t(instance.mesh) >= scene.meshes.size())
-      return fail(fmt::format("instances[{}]: mesh {} does not exist ({} meshes)", i,
-                              instance.mesh, scene.meshes.size()));
+      return fail(fmt::format("instances[{}]: mesh {} does not exist ({} meshes)", i, instance.mesh,
+                              scene.meshes.size()));
     if (!isFinite(instance.transform))
       return fail(fmt::format("instances[{}]: transform is not finite", i));
   }
   for (size_t i = 0; i < scene.freeForms.size(); ++i) {
     const FreeFormObject& f = scene.freeForms[i];
-    const std::string label = f.name.empty() ? fmt::format("freeForms[{}]", i)
-                                             : fmt::format("free form '{}'", f.name);
+    const std::string label =
+        f.name.empty() ? fmt::format("freeForms[{}]", i) : fmt::format("free form '{}'", f.name);
     if (f.material < -1 || (f.material >= 0 && size_t(f.material) >= scene.materials.size()))
       return fail(fmt::format("{}: material {} does not exist ({} materials)", label, f.material,
                               scene.materials.size()));
-    if (!isFinite(f.transform))
-      return fail(fmt::format("{}: transform is not finite", label));
+    if (!isFinite(f.transform)) return fail(fmt::format("{}: transform is not finite", label));
     const auto& m = f.transform.m;
     if (m[0][3] != 0 || m[1][3] != 0 || m[2][3] != 0 || m[3][3] != 1)
       return fail(fmt::format("{}: transform is not affine (last row must be 0, 0, 0, 1)", label));
@@ -152,7 +157,8 @@ Status validate(const Scene& scene, const std::string& file, bool vertexData) {
         return fail(fmt::format("{}: a quadric coefficient is not finite (or over 1e30)", label));
       if (n != &f.form && !n->clips.empty())
         return fail(fmt::format("{}: clips belong to the root of a free form", label));
-      if (!(std::fabs(n->weight) <= 1e30)) return fail(fmt::format("{}: a weight is not finite", label));
+      if (!(std::fabs(n->weight) <= 1e30))
+        return fail(fmt::format("{}: a weight is not finite", label));
       for (const FreeFormNode& p : n->perturbations) stack.push_back(&p);
     }
   }
@@ -161,10 +167,13 @@ Status validate(const Scene& scene, const std::string& file, bool vertexData) {
     if (m.texture < -1 || (m.texture >= 0 && size_t(m.texture) >= scene.textures.size()))
       return fail(fmt::format("materials[{}]: texture {} does not exist ({} textures)", i,
                               m.texture, scene.textures.size()));
-    if (!isFinite(m.baseColor) || !std::isfinite(m.uvScale.x) || !std::isfinite(m.uvScale.y) || !(m.specular >= 0 && m.specular <= 1e6f) ||
-        !(m.shininess >= 0 && m.shininess <= 1e6f) || !std::isfinite(m.alphaCutoff))
-      return fail(fmt::format("materials[{}]: colour, specular, shininess or alphaCutoff is not "
-                              "finite or out of range", i));
+    if (!isFinite(m.baseColor) || !std::isfinite(m.uvScale.x) || !std::isfinite(m.uvScale.y) ||
+        !(m.specular >= 0 && m.specular <= 1e6f) || !(m.shininess >= 0 && m.shininess <= 1e6f) ||
+        !std::isfinite(m.alphaCutoff))
+      return fail(
+          fmt::format("materials[{}]: colour, specular, shininess or alphaCutoff is not "
+                      "finite or out of range",
+                      i));
   }
   for (size_t i = 0; i < scene.textures.size(); ++i)
     if (!scene.textures[i].texture)

@@ -5,19 +5,18 @@
 //     ∂u/∂x = (U_x − u·q_x)·w·width   (and alike for y and v),
 // its larger singular value σ₁ from S = a² + b² + c² + d², D = ad − bc:
 //     σ₁² = (S + √(S² − 4D²)) / 2,   level of detail = max(0, ½·log2 σ₁²).
-// Phong (SPEC §8, seed 003): C = (Q_amb·C_surf + Q_diff·C_surf·Σ(n·l)⁺C_light + Q_spec·Σ((r·v)⁺)^p·C_light)
-// / (Q_amb + Q_diff + Q_spec). Fog (seed 002): C·f + C_F·(1 − f), f = 2^(−β·|eye position|).
-// Only multiplies, adds, divisions and square roots (all exactly rounded): the same bits on every
-// SIMD target (tests/shade/shade_test.cpp).
+// Phong (SPEC §8, seed 003): C = (Q_amb·C_surf + Q_diff·C_surf·Σ(n·l)⁺C_light +
+// Q_spec·Σ((r·v)⁺)^p·C_light) / (Q_amb + Q_diff + Q_spec). Fog (seed 002): C·f + C_F·(1 − f), f =
+// 2^(−β·|eye position|). Only multiplies, adds, divisions and square roots (all exactly rounded):
+// the same bits on every SIMD target (tests/shade/shade_test.cpp).
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "shade/shade_fragments.cpp"
-#include "hwy/foreach_target.h"  // IWYU pragma: keep
-#include "hwy/highway.h"
-
 #include <algorithm>
 #include <bit>
 #include <cmath>
 
+#include "hwy/foreach_target.h"  // IWYU pragma: keep
+#include "hwy/highway.h"
 #include "shade/shading.h"
 #include "texture/footprint.h"
 #include "texture/sample_block-inl.h"
@@ -43,7 +42,8 @@ HWY_INLINE VF log2(DF df, VF x) {
   const hn::RebindToSigned<DF> di;
   const auto bits = hn::BitCast(di, x);
   const VF e = hn::ConvertTo(df, hn::Sub(hn::ShiftRight<23>(bits), hn::Set(di, 127)));
-  const VF m = hn::BitCast(df, hn::Or(hn::And(bits, hn::Set(di, 0x7FFFFF)), hn::Set(di, 0x3F800000)));
+  const VF m =
+      hn::BitCast(df, hn::Or(hn::And(bits, hn::Set(di, 0x7FFFFF)), hn::Set(di, 0x3F800000)));
   const VF one = hn::Set(df, 1.0f);
   const VF t = hn::Div(hn::Sub(m, one), hn::Add(m, one));
   const VF t2 = hn::Mul(t, t);
@@ -141,7 +141,8 @@ void TextureCoordinates(const MaterialShading& m, const Fragments& f, TexCoords&
     const VF b = hn::Mul(hn::Sub(hn::Set(df, f.udy), hn::Mul(u, hn::Set(df, f.qdy))), ww);
     const VF c = hn::Mul(hn::Sub(hn::Set(df, f.vdx), hn::Mul(v, hn::Set(df, f.qdx))), wh);
     const VF d = hn::Mul(hn::Sub(hn::Set(df, f.vdy), hn::Mul(v, hn::Set(df, f.qdy))), wh);
-    const VF s = hn::Add(hn::Add(hn::Mul(a, a), hn::Mul(b, b)), hn::Add(hn::Mul(c, c), hn::Mul(d, d)));
+    const VF s =
+        hn::Add(hn::Add(hn::Mul(a, a), hn::Mul(b, b)), hn::Add(hn::Mul(c, c), hn::Mul(d, d)));
     const VF det = hn::Sub(hn::Mul(a, d), hn::Mul(b, c));
     const VF disc =
         hn::Max(hn::Sub(hn::Mul(s, s), hn::Mul(hn::Set(df, 4.0f), hn::Mul(det, det))), zero);
@@ -189,9 +190,9 @@ void ShadeFragments(const MaterialShading& m, const Environment& env, const Frag
     texture::Footprint fp[kMaxFragments];
     for (int i = 0; i < count; ++i) {
       const double q = std::max(double(f.q[i]), 1e-30);
-      fp[i] = texture::pixelFootprint(
-          {double(f.attribute[kU][i]), f.udx, f.udy}, {double(f.attribute[kV][i]), f.vdx, f.vdy},
-          {q, f.qdx, f.qdy}, width, m.texture->level(0).height);
+      fp[i] = texture::pixelFootprint({double(f.attribute[kU][i]), f.udx, f.udy},
+                                      {double(f.attribute[kV][i]), f.vdx, f.vdy}, {q, f.qdx, f.qdy},
+                                      width, m.texture->level(0).height);
     }
     texture::anisotropicBlock(*m.texture, fp, tc.x0, tc.y0, count, texel);
   }
@@ -206,14 +207,13 @@ void ShadeFragments(const MaterialShading& m, const Environment& env, const Frag
     if (m.texture) {
       // The block sampler runs here, in this target's lanes (sample_block-inl.h).
       const texture::HWY_NAMESPACE::Lanes4 t =
-          m.anisotropic
-              ? texture::HWY_NAMESPACE::Lanes4{hn::Load(df, texel[0] + i),
-                                               hn::Load(df, texel[1] + i),
-                                               hn::Load(df, texel[2] + i),
-                                               hn::Load(df, texel[3] + i)}
-              : texture::HWY_NAMESPACE::BlockSampler(*m.texture)
-                    .sample(m.filter, hn::Load(df, tc.lod + i), hn::Load(df, tc.x0 + i),
-                            hn::Load(df, tc.y0 + i));
+          m.anisotropic ? texture::HWY_NAMESPACE::Lanes4{hn::Load(df, texel[0] + i),
+                                                         hn::Load(df, texel[1] + i),
+                                                         hn::Load(df, texel[2] + i),
+                                                         hn::Load(df, texel[3] + i)}
+                        : texture::HWY_NAMESPACE::BlockSampler(*m.texture)
+                              .sample(m.filter, hn::Load(df, tc.lod + i), hn::Load(df, tc.x0 + i),
+                                      hn::Load(df, tc.y0 + i));
       if (opaqueTexture) {
         // Alpha exactly 1 (Texture::opaque): nothing to divide or multiply by.
         c.x = hn::Mul(c.x, t.r);
@@ -235,9 +235,9 @@ void ShadeFragments(const MaterialShading& m, const Environment& env, const Frag
              hn::Mul(hn::Load(df, f.attribute[kEyeZ] + i), w)};
     if (m.phong) {
       // n/w interpolated: its direction is n's, so it needs no division by q.
-      V3 n = normalized(df, {hn::Load(df, f.attribute[kNormalX] + i),
-                             hn::Load(df, f.attribute[kNormalY] + i),
-                             hn::Load(df, f.attribute[kNormalZ] + i)});
+      V3 n = normalized(
+          df, {hn::Load(df, f.attribute[kNormalX] + i), hn::Load(df, f.attribute[kNormalY] + i),
+               hn::Load(df, f.attribute[kNormalZ] + i)});
       const V3 view = normalized(df, {hn::Neg(eye.x), hn::Neg(eye.y), hn::Neg(eye.z)});
       if (m.twoSided) {
         const auto back = hn::Lt(dot3(n, view), zero);
@@ -246,7 +246,8 @@ void ShadeFragments(const MaterialShading& m, const Environment& env, const Frag
       }
       V3 diffuse{zero, zero, zero}, specular{zero, zero, zero};
       if (env.lightOn) {
-        const V3 l{hn::Set(df, env.toLight.x), hn::Set(df, env.toLight.y), hn::Set(df, env.toLight.z)};
+        const V3 l{hn::Set(df, env.toLight.x), hn::Set(df, env.toLight.y),
+                   hn::Set(df, env.toLight.z)};
         addLight(df, m, n, l, view, env.lightColor, diffuse, specular);
       }
       for (const PointLightEye& p : env.points) {
@@ -258,8 +259,9 @@ void ShadeFragments(const MaterialShading& m, const Environment& env, const Frag
       const float qAmb = env.ambient, qDiff = 1 - env.ambient, qSpec = m.specular;
       const VF norm = hn::Set(df, 1.0f / (qAmb + qDiff + qSpec));
       auto light = [&](VF surf, VF dif, VF spec) {
-        const VF sum = hn::Add(hn::Mul(hn::Set(df, qSpec), spec),
-                               hn::Mul(surf, hn::Add(hn::Mul(hn::Set(df, qDiff), dif), hn::Set(df, qAmb))));
+        const VF sum =
+            hn::Add(hn::Mul(hn::Set(df, qSpec), spec),
+                    hn::Mul(surf, hn::Add(hn::Mul(hn::Set(df, qDiff), dif), hn::Set(df, qAmb))));
         return hn::Mul(sum, norm);
       };
       c = {light(c.x, diffuse.x, specular.x), light(c.y, diffuse.y, specular.y),

@@ -18,7 +18,18 @@ namespace sv::shade {
 
 // Attributes interpolated for pixel shading, each carried as value/w (a §2 plane; the value is
 // the plane ÷ the 1/w plane): texture coordinates, the eye-space normal and position, and alpha.
-enum Attribute { kU, kV, kNormalX, kNormalY, kNormalZ, kEyeX, kEyeY, kEyeZ, kAlpha, kAttributeCount };
+enum Attribute {
+  kU,
+  kV,
+  kNormalX,
+  kNormalY,
+  kNormalZ,
+  kEyeX,
+  kEyeY,
+  kEyeZ,
+  kAlpha,
+  kAttributeCount
+};
 
 // Where a vertex's attributes sit in the vertex stage's output (render::DrawPackets): only those in
 // `stored` — the union of what the frame's materials read (attributesUsed) — packed in Attribute
@@ -76,8 +87,8 @@ inline constexpr int kMaxFragments = 16;
 // Up to 16 pixels of one triangle.
 struct Fragments {
   int count = 0;
-  alignas(64) float q[kMaxFragments];                          // 1/w
-  alignas(64) float color[3][kMaxFragments];                   // vertex colour, perspective-correct
+  alignas(64) float q[kMaxFragments];         // 1/w
+  alignas(64) float color[3][kMaxFragments];  // vertex colour, perspective-correct
   alignas(64) float attribute[kAttributeCount][kMaxFragments];  // attribute/w
   // Per-pixel gradients of q, U = u/w and V = v/w (constant over the triangle): the footprint.
   float qdx = 0, qdy = 0, udx = 0, udy = 0, vdx = 0, vdy = 0;

@@ -10,8 +10,8 @@
 // V = Σλ_k v_k, Q = Σλ_k = 1/w (geometry/setup.cpp). Their gradients give the Jacobian
 //     J = [∂u/∂x ∂u/∂y; ∂v/∂x ∂v/∂y],   ∂u/∂x = (U_x·Q − U·Q_x) / Q²  (and alike),
 // in texels when u, v are scaled by the texture's size. A pixel of diameter 1 maps, to first order,
-// onto the ellipse J·(unit-diameter circle), whose axes are J's singular values σ₁ ≥ σ₂. Every pixel
-// is computed on its own from the planes — no neighbour differences (the seed requires it).
+// onto the ellipse J·(unit-diameter circle), whose axes are J's singular values σ₁ ≥ σ₂. Every
+// pixel is computed on its own from the planes — no neighbour differences (the seed requires it).
 #pragma once
 
 namespace sv::texture {
@@ -22,9 +22,9 @@ struct LinearAt {
 };
 
 struct Footprint {
-  double major = 0, minor = 0;   // the ellipse's diameters, in texels (σ₁ ≥ σ₂ of J)
-  double axisX = 1, axisY = 0;   // unit direction of the major axis, in texel space
-  double lod = 0;                // log2(major), at least 0: the pyramid level whose texel ≈ major
+  double major = 0, minor = 0;  // the ellipse's diameters, in texels (σ₁ ≥ σ₂ of J)
+  double axisX = 1, axisY = 0;  // unit direction of the major axis, in texel space
+  double lod = 0;               // log2(major), at least 0: the pyramid level whose texel ≈ major
 };
 
 // The footprint of the pixel where U, V, Q have the given values and gradients (Q > 0), for a

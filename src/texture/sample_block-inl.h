@@ -267,9 +267,9 @@ class BlockSampler {
     x0 = sane(x0);
     y0 = sane(y0);
     const bool trilinear = filter == Filter::trilinear || filter == Filter::trilinearThreePoint;
-    const VI k = trilinear ? hn::Min(hn::ConvertTo(di, lod), hn::Set(di, last))
-                           : hn::Min(hn::ConvertTo(di, hn::Add(lod, hn::Set(df, 0.5f))),
-                                     hn::Set(di, last));
+    const VI k =
+        trilinear ? hn::Min(hn::ConvertTo(di, lod), hn::Set(di, last))
+                  : hn::Min(hn::ConvertTo(di, hn::Add(lod, hn::Set(df, 0.5f))), hn::Set(di, last));
     // 2^-k exactly: the float with exponent 127 − k.
     const VF scale = hn::BitCast(df, hn::ShiftLeft<23>(hn::Sub(hn::Set(di, 127), k)));
     const VF x = hn::Mul(x0, scale), y = hn::Mul(y0, scale);

@@ -2,12 +2,11 @@
 // dispatched call per block of up to 16 points.
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "texture/sample_block.cpp"
-#include "hwy/foreach_target.h"  // IWYU pragma: keep
-#include "hwy/highway.h"
-
 #include <algorithm>
 #include <cmath>
 
+#include "hwy/foreach_target.h"  // IWYU pragma: keep
+#include "hwy/highway.h"
 #include "texture/sample_block-inl.h"
 #include "texture/texture.h"
 

@@ -1,25 +1,27 @@
 #include "texture/texture.h"
 
+#include <fmt/format.h>
 #include <png.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <filesystem>
-#include <fmt/format.h>
 
 namespace sv::texture {
 
 int wrapIndex(int i, int size, Wrap wrap) {
   switch (wrap) {
-    case Wrap::clamp: return std::clamp(i, 0, size - 1);
+    case Wrap::clamp:
+      return std::clamp(i, 0, size - 1);
     case Wrap::mirror: {
       const int period = 2 * size;
       const int m = ((i % period) + period) % period;
       return m < size ? m : period - 1 - m;
     }
     case Wrap::repeat:
-    default: return ((i % size) + size) % size;
+    default:
+      return ((i % size) + size) % size;
   }
 }
 
@@ -80,7 +82,8 @@ Level nextLevel(const Level& src, Wrap wrapX, Wrap wrapY) {
         }
       }
       dst.texels[size_t(y) * size_t(dst.width) + size_t(x)] = {
-          uint16_t(sum[0] >> 4), uint16_t(sum[1] >> 4), uint16_t(sum[2] >> 4), uint16_t(sum[3] >> 4)};
+          uint16_t(sum[0] >> 4), uint16_t(sum[1] >> 4), uint16_t(sum[2] >> 4),
+          uint16_t(sum[3] >> 4)};
     }
   return dst;
 }
@@ -341,7 +344,8 @@ Level generateTexture(Pattern pattern, int size, const Color4& a, const Color4& 
   level.texels.resize(size_t(size) * size_t(size));
   auto texel = [&a, &b](float t) {
     auto q = [](float v) { return uint16_t(std::lround(std::clamp(v, 0.0f, 1.0f) * 65535.0f)); };
-    return Texel{q(a.r + (b.r - a.r) * t), q(a.g + (b.g - a.g) * t), q(a.b + (b.b - a.b) * t), 65535};
+    return Texel{q(a.r + (b.r - a.r) * t), q(a.g + (b.g - a.g) * t), q(a.b + (b.b - a.b) * t),
+                 65535};
   };
   // A 32-bit mix of (seed, index) (the finalizer of MurmurHash3): the texels do not depend on any
   // library's random number engine.
@@ -359,9 +363,15 @@ Level generateTexture(Pattern pattern, int size, const Color4& a, const Color4& 
     for (int x = 0; x < size; ++x) {
       float t = 0;
       switch (pattern) {
-        case Pattern::noise: t = float(hash(uint32_t(y * size + x)) >> 8) / float(1 << 24); break;
-        case Pattern::squares: t = (x % cell < line || y % cell < line) ? 1.0f : 0.0f; break;
-        case Pattern::checker: t = float((x / cell + y / cell) & 1); break;
+        case Pattern::noise:
+          t = float(hash(uint32_t(y * size + x)) >> 8) / float(1 << 24);
+          break;
+        case Pattern::squares:
+          t = (x % cell < line || y % cell < line) ? 1.0f : 0.0f;
+          break;
+        case Pattern::checker:
+          t = float((x / cell + y / cell) & 1);
+          break;
       }
       level.texels[size_t(y) * size_t(size) + size_t(x)] = texel(t);
     }

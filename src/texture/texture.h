@@ -7,8 +7,8 @@
 // three-point interpolation); pbrt-v4's src/pbrt/util/mipmap.cpp for the structure (not its code).
 //
 // Coordinates. A level is addressed in continuous texel coordinates (x, y): texel (i, j) is centred
-// at (i, j), so level 0's texel centres sit at integer positions and a texture coordinate u ∈ [0, 1]
-// maps to x = u·width − ½. Level k's texel i is the filtered level k − 1 at texel 2i, so it is
+// at (i, j), so level 0's texel centres sit at integer positions and a texture coordinate u ∈ [0,
+// 1] maps to x = u·width − ½. Level k's texel i is the filtered level k − 1 at texel 2i, so it is
 // centred where level 0's texel 2^k·i is: a position x₀ on level 0 is x₀ / 2^k on level k. (This
 // is the seed's "filter, then keep every other texel"; the usual box pyramid centres level k's
 // texels between level k − 1's instead.)
@@ -122,8 +122,8 @@ class Texture {
   Color4 sample(Filter filter, float lod, float x0, float y0) const;
   // Anisotropic filtering — the remedy for the grazing-angle blur the seed names as its open
   // problem (SPEC §7): n = min(kMaxProbes, ⌈major / minor⌉) trilinear probes spread evenly over
-  // the footprint's major axis (at offsets (i + ½)/n − ½ of its length), each at the level of detail
-  // of max(minor, major / n), averaged. (x0, y0) and the footprint are in level-0 texels.
+  // the footprint's major axis (at offsets (i + ½)/n − ½ of its length), each at the level of
+  // detail of max(minor, major / n), averaged. (x0, y0) and the footprint are in level-0 texels.
   static constexpr int kMaxProbes = 16;
   Color4 anisotropic(const Footprint& footprint, float x0, float y0) const;
 
@@ -139,7 +139,8 @@ class Texture {
     alignas(64) int32_t width[kMaxLevels] = {}, height[kMaxLevels] = {}, offset[kMaxLevels] = {};
   };
   const LevelTable& levelTable() const { return table_; }
-  // True when level 0's sides are powers of two (then so are every level's, and wrapping is a mask).
+  // True when level 0's sides are powers of two (then so are every level's, and wrapping is a
+  // mask).
   bool powerOfTwo() const { return powerOfTwo_; }
   // True when every texel's alpha code is 255. Every sampler, scalar and SIMD, then returns alpha
   // exactly 1 — the SIMD sampler without unpacking or blending it, the scalar ones by setting it

@@ -1,13 +1,13 @@
 // The command-line tool as a user meets it: malformed input gives one clear line naming the file
 // and the problem, and a non-zero exit — never a crash.
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
+#include <sys/wait.h>
 
 #include <array>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <sys/wait.h>
+#include <nlohmann/json.hpp>
 
 namespace {
 
@@ -62,7 +62,8 @@ TEST(Cli, RendersTheDemoSceneAndPrintsOneStatsLine) {
 }
 
 TEST(Cli, TruncatedJsonNamesFileAndPosition) {
-  const std::string f = write("trunc.json", "{\"synthvis\": 1, \"objects\": [ {\"primitive\": \"box\"");
+  const std::string f =
+      write("trunc.json", "{\"synthvis\": 1, \"objects\": [ {\"primitive\": \"box\"");
   expectOneLineError(run("render " + f + " -o " + (tempDir() / "x.png").string()), f, ":");
 }
 
@@ -72,8 +73,8 @@ TEST(Cli, TruncatedGlbIsAnError) {
 }
 
 TEST(Cli, MissingReferencedFileIsNamed) {
-  const std::string f = write("missing_ref.json",
-                              R"({"synthvis": 1, "objects": [{"mesh": "no_such_model.glb"}]})");
+  const std::string f =
+      write("missing_ref.json", R"({"synthvis": 1, "objects": [{"mesh": "no_such_model.glb"}]})");
   expectOneLineError(run("render " + f + " -o " + (tempDir() / "x.png").string()), f,
                      "no_such_model.glb");
 }
@@ -101,13 +102,16 @@ TEST(Cli, MissingSceneFileAndBadOptions) {
 
 TEST(Cli, BenchWritesTheJsonFieldsBenchMdNames) {
   const std::string json = (tempDir() / "bench.json").string();
-  const CliRun r = run("bench tris --count 2000 --area 20 --width 320 --height 240 --frames 2 "
-                    "--warmup 1 --json " + json);
+  const CliRun r =
+      run("bench tris --count 2000 --area 20 --width 320 --height 240 --frames 2 "
+          "--warmup 1 --json " +
+          json);
   ASSERT_EQ(r.status, 0) << r.out;
   std::ifstream f(json);
   std::string text((std::istreambuf_iterator<char>(f)), {});
-  for (const char* key : {"\"scene\"", "\"renderer\"", "\"width\"", "\"height\"", "\"threads\"",
-                          "\"frames\"", "\"median_ms\"", "\"min_ms\"", "\"max_ms\"", "\"triangles\""})
+  for (const char* key :
+       {"\"scene\"", "\"renderer\"", "\"width\"", "\"height\"", "\"threads\"", "\"frames\"",
+        "\"median_ms\"", "\"min_ms\"", "\"max_ms\"", "\"triangles\""})
     EXPECT_NE(text.find(key), std::string::npos) << key;
 }
 
@@ -140,9 +144,11 @@ TEST(Cli, BenchRepeatPrintsEachMeasurementAndTheirMedian) {
 TEST(Cli, BenchBothRenderersWritesARowEachWithPsnrAndAnHtmlPage) {
   const std::string json = (tempDir() / "both.json").string();
   const std::string html = (tempDir() / "both_html").string();
-  const CliRun r = run("bench tris --renderer both --count 800 --area 40 --width 320 --height 240 "
-                       "--frames 2 --warmup 1 --json " + json + " --html " + html,
-                       "ASAN_OPTIONS=detect_leaks=0 ");
+  const CliRun r =
+      run("bench tris --renderer both --count 800 --area 40 --width 320 --height 240 "
+          "--frames 2 --warmup 1 --json " +
+              json + " --html " + html,
+          "ASAN_OPTIONS=detect_leaks=0 ");
   ASSERT_EQ(r.status, 0) << r.out;
   std::ifstream f(json);
   const nlohmann::json rows = nlohmann::json::parse(f);

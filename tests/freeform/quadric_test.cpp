@@ -52,8 +52,8 @@ TEST(Quadric, ClipsIntersectInsides) {
   f.base = Quadric::cylinder({0, 0, 0}, {0, 1, 0}, 1);
   f.clips = {Quadric::halfSpace({0, 1, 0}, 1), Quadric::halfSpace({0, -1, 0}, 1)};
   EXPECT_GT(f.evaluate({0, 0, 0}), 0);
-  EXPECT_LT(f.evaluate({0, 1.5, 0}), 0);   // above the cap
-  EXPECT_LT(f.evaluate({1.5, 0, 0}), 0);   // outside the side
+  EXPECT_LT(f.evaluate({0, 1.5, 0}), 0);  // above the cap
+  EXPECT_LT(f.evaluate({1.5, 0, 0}), 0);  // outside the side
   EXPECT_NEAR(f.evaluate({0, 1, 0}), 0, 1e-12);
   const Vec3d top = f.gradient({0, 0.99, 0});  // nearest the top cap: −∇ points up
   EXPECT_NEAR(top.y, -1, 1e-12);
@@ -72,9 +72,17 @@ TEST(Quadric, FormsAreZeroOnTheirSurfacesAndPositiveInside) {
   const Case cases[] = {
       {"sphere", Quadric::sphere({1, 2, 3}, 2), {3, 2, 3}, {1, 2, 3}, {1, 4.5, 3}},
       {"ellipsoid", Quadric::ellipsoid({0, 0, 0}, {1, 2, 3}), {0, 0, 3}, {0.5, 0, 0}, {0, 2.1, 0}},
-      {"cylinder", Quadric::cylinder({0, 0, 0}, {0, 0, 5}, 1), {1 / s2, 1 / s2, 7}, {0.2, 0, -9}, {1, 1, 0}},
+      {"cylinder",
+       Quadric::cylinder({0, 0, 0}, {0, 0, 5}, 1),
+       {1 / s2, 1 / s2, 7},
+       {0.2, 0, -9},
+       {1, 1, 0}},
       {"cone", Quadric::cone({0, 0, 0}, {0, 1, 0}, M_PI / 4), {1, 1, 0}, {0, 2, 0.5}, {2, 1, 0}},
-      {"paraboloid", Quadric::paraboloid({0, -1, 0}, {0, 1, 0}, 2), {1, 1, 0}, {0, 0, 0}, {2, 0, 0}},
+      {"paraboloid",
+       Quadric::paraboloid({0, -1, 0}, {0, 1, 0}, 2),
+       {1, 1, 0},
+       {0, 0, 0},
+       {2, 0, 0}},
       {"half-space", Quadric::halfSpace({0, 0, 2}, 2), {5, -3, 1}, {0, 0, 0}, {0, 0, 1.5}},
   };
   for (const Case& c : cases) {
@@ -167,7 +175,8 @@ TEST(Projective, FivePointPairsFixTheMapWhichReproducesThemAndInvertsExactly) {
   }
   // The view frustum onto the cube: the map a perspective projection makes, recovered from five
   // of the frustum's corners.
-  std::array<Vec3d, 5> frustum = {Vec3d{-1, -1, -1}, {1, -1, -1}, {-1, 1, -1}, {-10, -10, -10}, {10, 10, -10}};
+  std::array<Vec3d, 5> frustum = {
+      Vec3d{-1, -1, -1}, {1, -1, -1}, {-1, 1, -1}, {-10, -10, -10}, {10, 10, -10}};
   std::array<Vec3d, 5> cube = {Vec3d{-1, -1, -1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}, {1, 1, 1}};
   const std::optional<Mat4d> p = projectiveFromFivePoints(frustum, cube);
   ASSERT_TRUE(p);

@@ -41,7 +41,10 @@ struct Buffers {
   std::vector<double> cubeZ;
   std::vector<uint32_t> object;
   Buffers(int w, int h)
-      : width(w), height(h), depth(size_t(w) * h, 1.0f), cubeZ(size_t(w) * h, 0),
+      : width(w),
+        height(h),
+        depth(size_t(w) * h, 1.0f),
+        cubeZ(size_t(w) * h, 0),
         object(size_t(w) * h, kNoHit) {}
 };
 
@@ -644,7 +647,8 @@ TEST(RayCast, MaskingChangesNothingAndTheMarcherAgrees) {
   FreeForm ground;
   ground.base = Quadric::halfSpace({0, 1, 0}, -0.7);
   const Mat4d toCube = cameraToCube(w, h);
-  const auto g = ProjectedFreeForm::make(f, toCube), floor = ProjectedFreeForm::make(ground, toCube);
+  const auto g = ProjectedFreeForm::make(f, toCube),
+             floor = ProjectedFreeForm::make(ground, toCube);
   ASSERT_TRUE(g && floor);
   Buffers masked(w, h), plain(w, h), marched(w, h);
   CastStats ms = cast(*g, 1, masked), ps = cast(*g, 1, plain, false);
@@ -702,7 +706,8 @@ TEST(Tessellate, SphereVerticesLieOnTheSurfaceWithOutwardFaces) {
   EXPECT_GT(soup.triangles(), 1000u);
   double area = 0;
   for (size_t t = 0; t < soup.triangles(); ++t) {
-    const Vec3d a = soup.positions[3 * t], b = soup.positions[3 * t + 1], c = soup.positions[3 * t + 2];
+    const Vec3d a = soup.positions[3 * t], b = soup.positions[3 * t + 1],
+                c = soup.positions[3 * t + 2];
     for (const Vec3d& p : {a, b, c}) {
       const Vec3d d = p - Vec3d{0.3, -0.2, 0.1};
       EXPECT_NEAR(std::sqrt(dot(d, d)), 1.5, 1e-5);

@@ -9,7 +9,6 @@
 #include <random>
 
 #include "hwy/targets.h"
-
 #include "support/raster_harness.h"
 #include "synthvis/math.h"
 
@@ -31,7 +30,8 @@ bool edgeInside(const TriangleSetup& t, int x, int y) {
 // (horizontal, inside towards +y, y down).
 bool exactInside(const int64_t vx[3], const int64_t vy[3], int px, int py) {
   const int64_t cx = int64_t(px) * 256 + 128, cy = int64_t(py) * 256 + 128;
-  const __int128 area = __int128(vx[1] - vx[0]) * (vy[2] - vy[0]) - __int128(vy[1] - vy[0]) * (vx[2] - vx[0]);
+  const __int128 area =
+      __int128(vx[1] - vx[0]) * (vy[2] - vy[0]) - __int128(vy[1] - vy[0]) * (vx[2] - vx[0]);
   if (area == 0) return false;
   for (int k = 0; k < 3; ++k) {
     const int i = (k + 1) % 3, j = (k + 2) % 3;
@@ -64,7 +64,8 @@ TEST(Setup, IntegerEdgesAgreeWithExactPointInTriangleIncludingTies) {
       v[k] = pixelVertex(gx / 8.0, gy / 8.0, w, h);
     }
     TriangleSetup t;
-    const auto outcome = geometry::setupTriangle(v[0], v[1], v[2], {w, h}, geometry::CullMode::none, t);
+    const auto outcome =
+        geometry::setupTriangle(v[0], v[1], v[2], {w, h}, geometry::CullMode::none, t);
     for (int y = 0; y < h; ++y)
       for (int x = 0; x < w; ++x) {
         const bool expected = exactInside(vx, vy, x, y);
@@ -79,9 +80,9 @@ TEST(Setup, IncrementalChildValuesEqualDirectEvaluation) {
   // The kernel carries e at a window's top-left pixel centre and steps it by sX·h, sY·h (seed 000
   // eq. 1); this must equal evaluating the edge directly at the child's corner.
   TriangleSetup t;
-  ASSERT_EQ(geometry::setupTriangle(pixelVertex(3.3, 2.1, 256, 256), pixelVertex(250.7, 40.2, 256, 256),
-                                    pixelVertex(30.9, 251.4, 256, 256), {256, 256},
-                                    geometry::CullMode::none, t),
+  ASSERT_EQ(geometry::setupTriangle(
+                pixelVertex(3.3, 2.1, 256, 256), pixelVertex(250.7, 40.2, 256, 256),
+                pixelVertex(30.9, 251.4, 256, 256), {256, 256}, geometry::CullMode::none, t),
             geometry::SetupOutcome::drawn);
   for (int k = 0; k < 3; ++k) {
     const auto& e = t.edges[k];
@@ -104,7 +105,8 @@ TEST(Setup, FacingFollowsCounterClockwiseFrontFaces) {
   const int w = 32, h = 32;
   // Counter-clockwise in NDC (y up) = clockwise on the raster (y down): (0,0) (10,0) (0,10) on the
   // raster is clockwise there, so counter-clockwise in NDC: a front face.
-  const ClipVertex a = pixelVertex(0, 10, w, h), b = pixelVertex(10, 10, w, h), c = pixelVertex(0, 0, w, h);
+  const ClipVertex a = pixelVertex(0, 10, w, h), b = pixelVertex(10, 10, w, h),
+                   c = pixelVertex(0, 0, w, h);
   TriangleSetup t;
   EXPECT_EQ(geometry::setupTriangle(a, b, c, {w, h}, geometry::CullMode::back, t),
             geometry::SetupOutcome::drawn);
@@ -236,8 +238,10 @@ TEST(Setup, ApertureBoxSpansEveryPixelSquareTheTriangleReaches) {
       v[k] = pixelVertex(x[k] / 256.0, y[k] / 256.0, w, h);
     }
     TriangleSetup point, aperture;
-    const auto o1 = geometry::setupTriangle(v[0], v[1], v[2], {w, h, false}, geometry::CullMode::none, point);
-    const auto o2 = geometry::setupTriangle(v[0], v[1], v[2], {w, h, true}, geometry::CullMode::none, aperture);
+    const auto o1 =
+        geometry::setupTriangle(v[0], v[1], v[2], {w, h, false}, geometry::CullMode::none, point);
+    const auto o2 =
+        geometry::setupTriangle(v[0], v[1], v[2], {w, h, true}, geometry::CullMode::none, aperture);
     if (o2 != geometry::SetupOutcome::drawn) {
       EXPECT_NE(o1, geometry::SetupOutcome::drawn) << t;  // the aperture only ever adds pixels
       continue;
@@ -328,14 +332,15 @@ TEST(Setup, BatchedSetupEqualsOneByOneOnEveryTarget) {
   auto add = [&](ClipVertex a) { v.push_back(a); };
   for (int t = 0; t < 4000; ++t) {
     const int regime = t % 10;
-    const double cx = u(rng) * w, cy = u(rng) * h, size = regime < 4 ? 1 + u(rng) * 20 : u(rng) * 900;
+    const double cx = u(rng) * w, cy = u(rng) * h,
+                 size = regime < 4 ? 1 + u(rng) * 20 : u(rng) * 900;
     for (int k = 0; k < 3; ++k) {
       ClipVertex c = pixelVertex(cx + (u(rng) - 0.5) * size, cy + (u(rng) - 0.5) * size, w, h,
                                  u(rng), 0.2f + 3 * u(rng), u(rng), u(rng), u(rng));
-      if (regime == 5 && k == 0) c.w = -c.w;                          // behind the eye
-      if (regime == 6 && k == 1) c.z = -2 * c.w;                      // before the near plane
-      if (regime == 7 && k == 2) c.z = 2 * c.w;                       // beyond the far plane
-      if (regime == 8 && k == 0) c.x = c.w * 200;                     // outside the guard band
+      if (regime == 5 && k == 0) c.w = -c.w;       // behind the eye
+      if (regime == 6 && k == 1) c.z = -2 * c.w;   // before the near plane
+      if (regime == 7 && k == 2) c.z = 2 * c.w;    // beyond the far plane
+      if (regime == 8 && k == 0) c.x = c.w * 200;  // outside the guard band
       if (regime == 9 && k == 1 && t % 20 == 9) c.y = std::numeric_limits<float>::quiet_NaN();
       if (regime == 9 && k == 1 && t % 20 == 19) c.w = std::numeric_limits<float>::infinity();
       add(c);
@@ -355,11 +360,13 @@ TEST(Setup, BatchedSetupEqualsOneByOneOnEveryTarget) {
     hwy::SetSupportedTargetsForTest(target);
     for (int mode = 0; mode < 4; ++mode) {
       // Every culling mode with point sampling, and back-face culling with the pixel aperture.
-      const geometry::CullMode cull = mode == 3 ? geometry::CullMode::back : geometry::CullMode(mode);
+      const geometry::CullMode cull =
+          mode == 3 ? geometry::CullMode::back : geometry::CullMode(mode);
       const geometry::Viewport vp{w, h, mode == 3};
       std::vector<TriangleSetup> one, batch(count);
       std::vector<geometry::Plane> onePlanes, batchPlanes(count * kValues, {7, 7, 7});
-      uint64_t oneOutcomes[geometry::kSetupOutcomes] = {}, batchOutcomes[geometry::kSetupOutcomes] = {};
+      uint64_t oneOutcomes[geometry::kSetupOutcomes] = {},
+               batchOutcomes[geometry::kSetupOutcomes] = {};
       for (size_t t = 0; t < count; ++t) {
         TriangleSetup s;
         const auto o = geometry::setupTriangle(v[3 * t], v[3 * t + 1], v[3 * t + 2], vp, cull, s);
@@ -373,8 +380,12 @@ TEST(Setup, BatchedSetupEqualsOneByOneOnEveryTarget) {
                                   planes, kUsed);
         onePlanes.insert(onePlanes.end(), planes, planes + kValues);
       }
-      geometry::AttributeRequest request{values.data(), kValues, kValues, kUsed,
-                                         batchPlanes.data(), sizeof(geometry::Plane) * kValues};
+      geometry::AttributeRequest request{values.data(),
+                                         kValues,
+                                         kValues,
+                                         kUsed,
+                                         batchPlanes.data(),
+                                         sizeof(geometry::Plane) * kValues};
       const size_t n = geometry::setupTriangles(v.data(), indices.data(), count, vp, cull,
                                                 batch.data(), batchOutcomes, 0, &request);
       ASSERT_EQ(n, one.size()) << hwy::TargetName(target);

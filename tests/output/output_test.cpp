@@ -76,7 +76,7 @@ TEST(Gamma, SrgbTablesMatchTheStandardAtKnownPoints) {
   const auto g = output::GammaTable::srgb();
   EXPECT_EQ(g.table[0], 0);
   EXPECT_EQ(g.table[65535], 255);
-  EXPECT_EQ(g.table[32768], 188);  // linear 0.5 → sRGB 0.7354 → 187.5 → 188
+  EXPECT_EQ(g.table[32768], 188);                // linear 0.5 → sRGB 0.7354 → 187.5 → 188
   EXPECT_EQ(g.table[int(0.2140 * 65535)], 127);  // linear 0.2140 → sRGB 0.49996 → 127.49
   EXPECT_EQ(g.table[int(0.2159 * 65535)], 128);  // sRGB 128/255 is linear 0.21586
   for (int i = 1; i < 65536; ++i) ASSERT_GE(g.table[i], g.table[i - 1]);  // monotonic

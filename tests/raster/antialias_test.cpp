@@ -57,7 +57,8 @@ TEST(AntiAlias, EqualsBruteForceSampleForSampleOnRandomScenes) {
       const DrawPackets p = randomScene(w, h, 100, seed, false);
       const test::Frame quad = test::renderQuadtree(p, aaSettings(w, h, n));
       const test::Frame ref = test::renderReference(p, aaSettings(w, h, n));
-      EXPECT_TRUE(quad == ref) << n << " samples, seed " << seed << ": " << firstDifference(quad, ref);
+      EXPECT_TRUE(quad == ref) << n << " samples, seed " << seed << ": "
+                               << firstDifference(quad, ref);
     }
 }
 
@@ -68,7 +69,8 @@ TEST(AntiAlias, EqualsBruteForceWithTrianglesBehindAndAcrossTheEye) {
       const DrawPackets p = randomScene(w, h, 150, seed, true);
       const test::Frame quad = test::renderQuadtree(p, aaSettings(w, h, n));
       const test::Frame ref = test::renderReference(p, aaSettings(w, h, n));
-      EXPECT_TRUE(quad == ref) << n << " samples, seed " << seed << ": " << firstDifference(quad, ref);
+      EXPECT_TRUE(quad == ref) << n << " samples, seed " << seed << ": "
+                               << firstDifference(quad, ref);
     }
 }
 
@@ -80,7 +82,8 @@ TEST(AntiAlias, EverySimdTargetThreadCountAndBatchingGivesTheSameFrame) {
   for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
     hwy::SetSupportedTargetsForTest(target);
     const test::Frame f = test::renderQuadtree(p, aaSettings(w, h, 16), 2);
-    EXPECT_TRUE(f == ref) << "target " << hwy::TargetName(target) << ": " << firstDifference(f, ref);
+    EXPECT_TRUE(f == ref) << "target " << hwy::TargetName(target) << ": "
+                          << firstDifference(f, ref);
     ++tested;
   }
   hwy::SetSupportedTargetsForTest(0);
@@ -99,8 +102,8 @@ TEST(AntiAlias, EverySimdTargetThreadCountAndBatchingGivesTheSameFrame) {
 // (interior only, since there the snapped outline vertices are not exactly collinear).
 // Near a vertex the table's masks are not exact: a sample within EdgeMaskTable::kMaxError of two of
 // the edges meeting there is decided for each edge from its own table cell, and may end in no
-// triangle or in two (docs/quality.md). Pixels within half a pixel of a grid vertex may so differ by
-// at most two samples.
+// triangle or in two (docs/quality.md). Pixels within half a pixel of a grid vertex may so differ
+// by at most two samples.
 void expectSeamless(int samples, double angle, unsigned seed) {
   const int w = 96, h = 96, cells = 24;
   const double size = 80, cell = size / cells, cx = 48, cy = 48;
@@ -148,7 +151,8 @@ void expectSeamless(int samples, double angle, unsigned seed) {
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const double dx = x + 0.5 - cx, dy = y + 0.5 - cy;
-      const double margin = size / 2 - std::max(std::fabs(ca * dx + sa * dy), std::fabs(-sa * dx + ca * dy));
+      const double margin =
+          size / 2 - std::max(std::fabs(ca * dx + sa * dy), std::fabs(-sa * dx + ca * dy));
       const bool interior = margin > 1.5;
       const uint16_t expected = one.resolved(x, y, 0);
       partial += expected > 0 && expected < 65535;
@@ -189,9 +193,11 @@ TEST(AntiAlias, IntersectingTrianglesResolvePerSample) {
   DrawPackets p;
   // Red tilts from near (left) to far (right), green the other way: they cross at x = 16.5.
   auto quad = [&](float zLeft, float zRight, float r, float g) {
-    addTriangle(p, pixelVertex(-4, -4, w, h, zLeft, 1, r, g, 0), pixelVertex(37, -4, w, h, zRight, 1, r, g, 0),
+    addTriangle(p, pixelVertex(-4, -4, w, h, zLeft, 1, r, g, 0),
+                pixelVertex(37, -4, w, h, zRight, 1, r, g, 0),
                 pixelVertex(-4, 40, w, h, zLeft, 1, r, g, 0));
-    addTriangle(p, pixelVertex(37, 40, w, h, zRight, 1, r, g, 0), pixelVertex(-4, 40, w, h, zLeft, 1, r, g, 0),
+    addTriangle(p, pixelVertex(37, 40, w, h, zRight, 1, r, g, 0),
+                pixelVertex(-4, 40, w, h, zLeft, 1, r, g, 0),
                 pixelVertex(37, -4, w, h, zRight, 1, r, g, 0));
   };
   quad(0.2f, 0.8f, 1, 0);

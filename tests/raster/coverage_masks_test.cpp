@@ -1,5 +1,7 @@
 // Sub-pixel coverage masks (SPEC §5; RASTER-NOTES pitfall 4): exact complements, agreement with
 // the exact edge test outside the stated precision, and coverage against the analytic area.
+#include "raster/coverage_masks.h"
+
 #include <gtest/gtest.h>
 
 #include <bit>
@@ -7,8 +9,6 @@
 #include <cstdio>
 #include <map>
 #include <random>
-
-#include "raster/coverage_masks.h"
 
 namespace sv::raster {
 namespace {
@@ -98,7 +98,8 @@ TEST(EdgeMasks, ChooseTheSamplesFarthestInsideTheEdge) {
         else
           highestOut = std::max(highestOut, v);
       }
-      ASSERT_LE(highestOut, lowestIn + 2 * cell) << n << " samples, edge " << a << " " << b << " " << c;
+      ASSERT_LE(highestOut, lowestIn + 2 * cell)
+          << n << " samples, edge " << a << " " << b << " " << c;
       // How far from the edge a sample's bit can disagree with the exact test at its position.
       for (int s = 0; s < n; ++s) {
         const double v = (a * p.offsets[size_t(s)][0] + b * p.offsets[size_t(s)][1] + c) / norm;
@@ -120,7 +121,8 @@ TEST(EdgeMasks, ChooseTheSamplesFarthestInsideTheEdge) {
 // The fraction of samples inside ≈ the area of the pixel inside the edge.
 double areaInside(double a, double b, double c) {
   // Clip the pixel square (−½, ½)² by a·x + b·y + c ≥ 0 (Sutherland–Hodgman), shoelace area.
-  std::vector<std::array<double, 2>> poly = {{-0.5, -0.5}, {0.5, -0.5}, {0.5, 0.5}, {-0.5, 0.5}}, out;
+  std::vector<std::array<double, 2>> poly = {{-0.5, -0.5}, {0.5, -0.5}, {0.5, 0.5}, {-0.5, 0.5}},
+                                     out;
   for (size_t i = 0; i < poly.size(); ++i) {
     const auto& p = poly[i];
     const auto& q = poly[(i + 1) % poly.size()];

@@ -101,7 +101,7 @@ TEST(Occupancy, DepthBoundsComeFromTheDepthBufferAndPropagate) {
   EXPECT_FLOAT_EQ(o.zmaxOver(3, 0, 0), 0.4f);
   EXPECT_TRUE(o.rectHidden(1, 1, 6, 6, 0.4f));
   EXPECT_FALSE(o.rectHidden(1, 1, 6, 6, 0.39f));
-  EXPECT_TRUE(o.rectHidden(0, 0, 3, 3, 0.3f));  // the first block alone: bound 0.25
+  EXPECT_TRUE(o.rectHidden(0, 0, 3, 3, 0.3f));   // the first block alone: bound 0.25
   EXPECT_FALSE(o.rectHidden(0, 0, 8, 3, 0.9f));  // reaches an empty block
 }
 
@@ -134,7 +134,8 @@ DrawPackets frontToBackScene(int w, int h, int count, unsigned seed) {
   DrawPackets p;
   for (const Tri& t : tris) {
     geometry::ClipVertex v[3];
-    for (int k = 0; k < 3; ++k) v[k] = test::pixelVertex(t.x[k], t.y[k], w, h, t.z, 1, t.r, t.g, t.b);
+    for (int k = 0; k < 3; ++k)
+      v[k] = test::pixelVertex(t.x[k], t.y[k], w, h, t.z, 1, t.r, t.g, t.b);
     test::addTriangle(p, v[0], v[1], v[2]);
   }
   return p;
@@ -157,8 +158,10 @@ TEST(PriorityMasking, EqualsTheZBufferOnFrontToBackSceneAtEverySampleCount) {
       const int w = 190, h = 140;
       const DrawPackets p = frontToBackScene(w, h, 900, seed);
       FrameStats zStats, pStats;
-      const test::Frame z = test::renderQuadtree(p, settings(w, h, samples, raster::Masking::none), 2, &zStats);
-      const test::Frame m = test::renderQuadtree(p, settings(w, h, samples, raster::Masking::priority), 2, &pStats);
+      const test::Frame z =
+          test::renderQuadtree(p, settings(w, h, samples, raster::Masking::none), 2, &zStats);
+      const test::Frame m =
+          test::renderQuadtree(p, settings(w, h, samples, raster::Masking::priority), 2, &pStats);
       EXPECT_TRUE(z == m) << samples << " samples, seed " << seed;
       // Masking did its work: windows and whole triangles dropped, fewer fragments shaded.
       EXPECT_GT(pStats.occludedWindows, 0u);
@@ -171,13 +174,17 @@ TEST(PriorityMasking, SameFrameForAnyThreadCountAndBatching) {
   const int w = 200, h = 150;
   const DrawPackets p = frontToBackScene(w, h, 700, 3);
   for (int samples : {1, 16}) {
-    const test::Frame ref = test::renderQuadtree(p, settings(w, h, samples, raster::Masking::priority), 1);
-    EXPECT_TRUE(test::renderQuadtree(p, settings(w, h, samples, raster::Masking::priority), 2) == ref);
-    EXPECT_TRUE(test::renderQuadtree(p, settings(w, h, samples, raster::Masking::priority), 8) == ref);
+    const test::Frame ref =
+        test::renderQuadtree(p, settings(w, h, samples, raster::Masking::priority), 1);
+    EXPECT_TRUE(test::renderQuadtree(p, settings(w, h, samples, raster::Masking::priority), 2) ==
+                ref);
+    EXPECT_TRUE(test::renderQuadtree(p, settings(w, h, samples, raster::Masking::priority), 8) ==
+                ref);
     FrameSettings batched = settings(w, h, samples, raster::Masking::priority);
     batched.batchTriangles = 97;  // occupancy kept per tile between batches
     EXPECT_TRUE(test::renderQuadtree(p, batched, 2) == ref) << samples;
-    EXPECT_TRUE(test::renderQuadtree(p, settings(w, h, samples, raster::Masking::none), 2) == ref) << samples;
+    EXPECT_TRUE(test::renderQuadtree(p, settings(w, h, samples, raster::Masking::none), 2) == ref)
+        << samples;
   }
 }
 
@@ -237,7 +244,8 @@ TEST(HybridMasking, EqualsTheZBufferInAnyOrder) {
     for (unsigned seed : {4u, 5u}) {
       const int w = 170, h = 120;
       const DrawPackets p = test::randomScene(w, h, 500, seed, seed == 5);
-      const test::Frame z = test::renderQuadtree(p, settings(w, h, samples, raster::Masking::none), 2);
+      const test::Frame z =
+          test::renderQuadtree(p, settings(w, h, samples, raster::Masking::none), 2);
       FrameStats stats;
       const test::Frame m =
           test::renderQuadtree(p, settings(w, h, samples, raster::Masking::hybrid), 2, &stats);
@@ -256,12 +264,16 @@ TEST(HybridMasking, DropsHiddenWorkInEveryOrderWithTheSameFrame) {
   // The same triangles back to front.
   for (size_t t = 0; t < b2f.indices.size() / 3; ++t)
     for (int k = 0; k < 3; ++k)
-      b2f.indices[t * 3 + size_t(k)] = f2b.indices[(f2b.indices.size() / 3 - 1 - t) * 3 + size_t(k)];
+      b2f.indices[t * 3 + size_t(k)] =
+          f2b.indices[(f2b.indices.size() / 3 - 1 - t) * 3 + size_t(k)];
   for (int samples : {1, 16}) {
     FrameStats zs, fs, bs;
-    const test::Frame z = test::renderQuadtree(f2b, settings(w, h, samples, raster::Masking::none), 2, &zs);
-    const test::Frame f = test::renderQuadtree(f2b, settings(w, h, samples, raster::Masking::hybrid), 2, &fs);
-    const test::Frame b = test::renderQuadtree(b2f, settings(w, h, samples, raster::Masking::hybrid), 2, &bs);
+    const test::Frame z =
+        test::renderQuadtree(f2b, settings(w, h, samples, raster::Masking::none), 2, &zs);
+    const test::Frame f =
+        test::renderQuadtree(f2b, settings(w, h, samples, raster::Masking::hybrid), 2, &fs);
+    const test::Frame b =
+        test::renderQuadtree(b2f, settings(w, h, samples, raster::Masking::hybrid), 2, &bs);
     EXPECT_TRUE(f == z) << samples;
     EXPECT_TRUE(b == test::renderQuadtree(b2f, settings(w, h, samples, raster::Masking::none), 2));
     EXPECT_GT(fs.occludedTriangles, 0u);
@@ -273,8 +285,10 @@ TEST(HybridMasking, DropsHiddenWorkInEveryOrderWithTheSameFrame) {
     EXPECT_EQ(bs.hybridWoken, 0u);
     EXPECT_EQ(bs.occludedWindows + bs.occludedTriangles, 0u);
     EXPECT_GT(zs.hiddenFragments, 0u);
-    EXPECT_TRUE(test::renderQuadtree(f2b, settings(w, h, samples, raster::Masking::hybrid), 1) == f);
-    EXPECT_TRUE(test::renderQuadtree(f2b, settings(w, h, samples, raster::Masking::hybrid), 8) == f);
+    EXPECT_TRUE(test::renderQuadtree(f2b, settings(w, h, samples, raster::Masking::hybrid), 1) ==
+                f);
+    EXPECT_TRUE(test::renderQuadtree(f2b, settings(w, h, samples, raster::Masking::hybrid), 8) ==
+                f);
     FrameSettings batched = settings(w, h, samples, raster::Masking::hybrid);
     batched.batchTriangles = 97;
     EXPECT_TRUE(test::renderQuadtree(f2b, batched, 2) == f) << samples;
@@ -289,7 +303,7 @@ TEST(HybridMasking, WakesOnlyWithEnoughOfTheTileToCome) {
   auto scene = [](int near, int far) {
     DrawPackets p;
     auto strip = [&](int count, float z) {  // `count` triangles over the tile, in vertical strips
-      const double width = 128.0 / count;  // of a strip: two triangles
+      const double width = 128.0 / count;   // of a strip: two triangles
       for (int i = 0; i < count; ++i) {
         const double x0 = (i / 2) * width, x1 = x0 + width;
         geometry::ClipVertex v[4] = {test::pixelVertex(x0, 0, 64, 64, z, 1, 1, 0, 0),
@@ -315,7 +329,8 @@ TEST(HybridMasking, WakesOnlyWithEnoughOfTheTileToCome) {
         test::renderQuadtree(a, settings(64, 64, samples, raster::Masking::hybrid), 1, &early);
     EXPECT_EQ(early.hybridWoken, 1u) << samples;
     EXPECT_GT(early.occludedTriangles + early.occludedWindows, 0u) << samples;
-    EXPECT_TRUE(wakes == test::renderQuadtree(a, settings(64, 64, samples, raster::Masking::none), 1));
+    EXPECT_TRUE(wakes ==
+                test::renderQuadtree(a, settings(64, 64, samples, raster::Masking::none), 1));
     // The same 32 far triangles after 128 near ones (of 32 px): the wake work is reached with 17
     // of 160 triangles to come (the one just drawn counted) — the tile stays the Z-buffer.
     FrameStats late;
@@ -324,7 +339,8 @@ TEST(HybridMasking, WakesOnlyWithEnoughOfTheTileToCome) {
         test::renderQuadtree(b, settings(64, 64, samples, raster::Masking::hybrid), 1, &late);
     EXPECT_EQ(late.hybridWoken, 0u) << samples;
     EXPECT_GT(late.hiddenFragments, 2048u) << samples;
-    EXPECT_TRUE(sleeps == test::renderQuadtree(b, settings(64, 64, samples, raster::Masking::none), 1));
+    EXPECT_TRUE(sleeps ==
+                test::renderQuadtree(b, settings(64, 64, samples, raster::Masking::none), 1));
   }
 }
 
@@ -346,8 +362,8 @@ DrawPackets objectScene(int w, int h, int objects, unsigned seed) {
       geometry::ClipVertex v[3];
       for (auto& vert : v) {
         vert = test::pixelVertex(cx + (u(rng) - 0.5) * size, cy + (u(rng) - 0.5) * size, w, h,
-                                 z + float(t * 0.05 / objects), 1, float(u(rng)),
-                                 float(u(rng)), float(u(rng)));
+                                 z + float(t * 0.05 / objects), 1, float(u(rng)), float(u(rng)),
+                                 float(u(rng)));
         lo = {std::min(lo.x, vert.x), std::min(lo.y, vert.y), std::min(lo.z, vert.z)};
         hi = {std::max(hi.x, vert.x), std::max(hi.y, vert.y), std::max(hi.z, vert.z)};
       }
@@ -370,7 +386,8 @@ TEST(ObjectCulling, DropsHiddenObjectsWholeWithTheZBufferFrame) {
   const DrawPackets p = objectScene(w, h, 400, 7);
   for (const raster::Masking masking : {raster::Masking::priority, raster::Masking::hybrid})
     for (int samples : {1, 16}) {
-      const test::Frame z = test::renderQuadtree(p, settings(w, h, samples, raster::Masking::none), 2);
+      const test::Frame z =
+          test::renderQuadtree(p, settings(w, h, samples, raster::Masking::none), 2);
       FrameStats stats, batchedStats;
       EXPECT_TRUE(test::renderQuadtree(p, settings(w, h, samples, masking), 2, &stats) == z)
           << samples;

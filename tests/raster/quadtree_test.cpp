@@ -70,7 +70,8 @@ TEST(FillRule, ReversedWindingDrawsTheSamePixels) {
   DrawPackets a, b;
   addTriangle(a, v(0.5, 0.5), v(9.5, 2.5), v(3.5, 8.5));
   addTriangle(b, v(0.5, 0.5), v(3.5, 8.5), v(9.5, 2.5));
-  EXPECT_EQ(test::renderQuadtree(a, countSettings(w, h)), test::renderQuadtree(b, countSettings(w, h)));
+  EXPECT_EQ(test::renderQuadtree(a, countSettings(w, h)),
+            test::renderQuadtree(b, countSettings(w, h)));
 }
 
 // A jittered N×N grid of quads (two triangles each), jitter ≤ 0.2 cell so nothing folds, boundary
@@ -121,7 +122,8 @@ void expectWatertightGrid(int width, int height, int cells, double angle, double
       inside += expected;
       if (f.channel(x, y, 0) != expected) {
         ++wrong;
-        ADD_FAILURE() << "pixel " << x << "," << y << " count " << f.channel(x, y, 0) << " margin " << margin;
+        ADD_FAILURE() << "pixel " << x << "," << y << " count " << f.channel(x, y, 0) << " margin "
+                      << margin;
       }
     }
   EXPECT_GT(inside, 0);
@@ -199,9 +201,10 @@ TEST(Quadtree, EveryLegLengthFromOneTo4096PixelsEqualsBruteForce) {
     std::uniform_real_distribution<double> u(0, 1);
     for (int i = 0; i < 20; ++i) {
       const double x = u(rng) * w, y = u(rng) * h, a = u(rng) * 6.28;
-      addTriangle(p, pixelVertex(x, y, w, h, 0.3f),
-                  pixelVertex(x + leg * std::cos(a), y + leg * std::sin(a), w, h, 0.6f),
-                  pixelVertex(x + leg * std::cos(a + 1.3), y + leg * std::sin(a + 1.3), w, h, 0.9f));
+      addTriangle(
+          p, pixelVertex(x, y, w, h, 0.3f),
+          pixelVertex(x + leg * std::cos(a), y + leg * std::sin(a), w, h, 0.6f),
+          pixelVertex(x + leg * std::cos(a + 1.3), y + leg * std::sin(a + 1.3), w, h, 0.9f));
     }
     EXPECT_TRUE(test::renderQuadtree(p, countSettings(w, h)) ==
                 test::renderReference(p, countSettings(w, h)))
@@ -223,7 +226,8 @@ TEST(Quadtree, SmallTrianglesAtTheInt32BudgetEqualBruteForce) {
     addTriangle(p, pixelVertex(x + e, y + e, w, h, 0.3f), pixelVertex(x, y + e * 0.5, w, h, 0.4f),
                 pixelVertex(x + e * 0.5, y + 0.1, w, h, 0.6f));  // a sliver across the box
   }
-  EXPECT_TRUE(test::renderQuadtree(p, countSettings(w, h)) == test::renderReference(p, countSettings(w, h)));
+  EXPECT_TRUE(test::renderQuadtree(p, countSettings(w, h)) ==
+              test::renderReference(p, countSettings(w, h)));
   FrameSettings aa = gouraudSettings(w, h);
   aa.samples = 16;
   EXPECT_TRUE(test::renderQuadtree(p, aa) == test::renderReference(p, aa));
@@ -234,10 +238,11 @@ TEST(BadVertices, NonFiniteAndHugeCoordinatesAreDroppedOrDrawnDeterministically)
   const float inf = std::numeric_limits<float>::infinity(), nan = std::nanf("");
   DrawPackets p;
   const ClipVertex good = pixelVertex(10, 10, w, h), good2 = pixelVertex(50, 12, w, h);
-  const ClipVertex bad[] = {{nan, 0, 0, 1, 1, 1, 1, 1},  {0, inf, 0, 1, 1, 1, 1, 1},
-                            {0, 0, -inf, 1, 1, 1, 1, 1}, {0, 0, 0, nan, 1, 1, 1, 1},
-                            {1e30f, 1e30f, 0, 1, 1, 1, 1, 1}, {-1e30f, 3e29f, 0, 1e-30f, 1, 1, 1, 1},
-                            {0, 0, 0, 0, 1, 1, 1, 1},     {0.5f, 0.5f, 0, -1e-30f, 1, 1, 1, 1}};
+  const ClipVertex bad[] = {
+      {nan, 0, 0, 1, 1, 1, 1, 1},       {0, inf, 0, 1, 1, 1, 1, 1},
+      {0, 0, -inf, 1, 1, 1, 1, 1},      {0, 0, 0, nan, 1, 1, 1, 1},
+      {1e30f, 1e30f, 0, 1, 1, 1, 1, 1}, {-1e30f, 3e29f, 0, 1e-30f, 1, 1, 1, 1},
+      {0, 0, 0, 0, 1, 1, 1, 1},         {0.5f, 0.5f, 0, -1e-30f, 1, 1, 1, 1}};
   for (const ClipVertex& b : bad) addTriangle(p, good, good2, b);
   // Degenerate: all three on a line, and all three equal.
   addTriangle(p, good, good2, pixelVertex(90, 14, w, h));

@@ -1,11 +1,12 @@
 // The ground-truth renderer and the image metrics (src/reference/ground_truth.h).
+#include "reference/ground_truth.h"
+
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
 
-#include <gtest/gtest.h>
-
-#include "reference/ground_truth.h"
 #include "synthvis/generators.h"
 
 namespace sv::reference {

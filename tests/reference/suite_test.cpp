@@ -1,12 +1,13 @@
 // The bench harness (src/reference): suites, PSNR, JSON rows, HTML, and the gl reference drawing
 // the same picture as synthvis.
 #include "reference/suite.h"
-#include "small_settings.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <filesystem>
+
+#include "small_settings.h"
 
 namespace sv::reference {
 namespace {

@@ -76,7 +76,8 @@ int analytic(double px, double py, int w, int h) {
   double r[3] = {-f[2], 0, f[0]};  // f × (0, 1, 0)
   const double rl = std::sqrt(r[0] * r[0] + r[2] * r[2]);
   r[0] /= rl, r[2] /= rl;
-  const double u[3] = {r[1] * f[2] - r[2] * f[1], r[2] * f[0] - r[0] * f[2], r[0] * f[1] - r[1] * f[0]};
+  const double u[3] = {r[1] * f[2] - r[2] * f[1], r[2] * f[0] - r[0] * f[2],
+                       r[0] * f[1] - r[1] * f[0]};
   double d[3];
   for (int i = 0; i < 3; ++i) d[i] = f[i] + nx * r[i] + ny * u[i];
   // Sphere |e + t·d − c|² = 1.
@@ -123,7 +124,8 @@ TEST(FreeFormRender, IntersectionWithPolygonsIsWhereAnalyticCastingPutsIt) {
       const uint8_t* p = &aa.rgb[(size_t(y) * w + size_t(x)) * 3];
       double sphere = 0;
       for (int j = 0; j < 16; ++j)
-        for (int i = 0; i < 16; ++i) sphere += analytic(x + (i + 0.5) / 16, y + (j + 0.5) / 16, w, h) == 1;
+        for (int i = 0; i < 16; ++i)
+          sphere += analytic(x + (i + 0.5) / 16, y + (j + 0.5) / 16, w, h) == 1;
       sphere /= 256;
       const double err = std::fabs(linear(p[0]) - sphere);
       worst = std::max(worst, err);
@@ -197,9 +199,9 @@ TEST(FreeFormRender, AbsurdFormsRenderInBoundedTime) {
     s.freeForms.push_back(o);
   };
   add({1e30, -1e30, 1e-30, 0, 0, 0, 1e30, 0, 0, -1e30}, 1e30);
-  add({0, 0, 0, 0, 0, 0, 0, 0, 0, 0});                  // zero everywhere: on the surface
-  add({0, 0, 0, 0, 0, 0, 0, 0, 0, 1});                  // inside everywhere: no surface
-  add({-1, -1, -1, 0, 0, 0, 0, 3, 10, -24}, -1e-30);    // a sphere about the eye
+  add({0, 0, 0, 0, 0, 0, 0, 0, 0, 0});                // zero everywhere: on the surface
+  add({0, 0, 0, 0, 0, 0, 0, 0, 0, 1});                // inside everywhere: no surface
+  add({-1, -1, -1, 0, 0, 0, 0, 3, 10, -24}, -1e-30);  // a sphere about the eye
   add({1e-300, 1e-300, 1e-300, 0, 0, 0, 0, 0, 0, -1e-300});
   scene::FreeFormNode* n = &s.freeForms.back().form;  // nested 12 deep
   for (int d = 0; d < 12; ++d) {
@@ -362,7 +364,8 @@ TEST(FreeFormRender, TessellatedSceneRendersNearlyTheSameImage) {
   ASSERT_TRUE(Renderer(o).render(s, a).ok());
   ASSERT_TRUE(Renderer(o).render(t.value(), b).ok());
   int differing = 0;
-  for (size_t i = 0; i < a.rgb.size(); ++i) differing += std::abs(int(a.rgb[i]) - int(b.rgb[i])) > 8;
+  for (size_t i = 0; i < a.rgb.size(); ++i)
+    differing += std::abs(int(a.rgb[i]) - int(b.rgb[i])) > 8;
   EXPECT_LT(differing, 40) << "channels differing by more than 8 (silhouette and curve pixels)";
   // An unbounded form cannot be tessellated.
   scene::FreeFormObject plane;

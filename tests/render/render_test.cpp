@@ -1,17 +1,17 @@
 // Whole frames through the public API: the demo scene's golden image, thread-count invariance,
 // option validation, and the benchmark generator's stated statistics.
+#include "synthvis/render.h"
+
 #include <gtest/gtest.h>
 
 #include <array>
 #include <cmath>
-
 #include <cstdlib>
 #include <filesystem>
 #include <set>
 
 #include "scene/primitives.h"
 #include "synthvis/generators.h"
-#include "synthvis/render.h"
 
 namespace sv {
 namespace {
@@ -109,7 +109,8 @@ TEST(Render, BadVertexDataIsRefusedWithTheOffenderNamed) {
   big.name = "big";
   for (int i = 0; i < 40000; ++i) {
     big.positions.push_back({float(i % 200) * 0.01f, float(i / 200) * 0.01f, 0});
-    if (i >= 2) big.indices.insert(big.indices.end(), {uint32_t(i - 2), uint32_t(i - 1), uint32_t(i)});
+    if (i >= 2)
+      big.indices.insert(big.indices.end(), {uint32_t(i - 2), uint32_t(i - 1), uint32_t(i)});
   }
   base.meshes.push_back(big);
   scene::Instance instance;
@@ -195,8 +196,8 @@ scene::Scene halfCoveredColumnScene(int w, int h) {
   scene::Scene s = scene::benchCameraScene("quad");
   const double tanHalf = std::tan(30.0 * 3.14159265358979 / 180), aspect = double(w) / h;
   auto at = [&](double px, double py) {
-    return Vec3{float((2 * px / w - 1) * 2 * tanHalf * aspect), float((1 - 2 * py / h) * 2 * tanHalf),
-                -2.0f};
+    return Vec3{float((2 * px / w - 1) * 2 * tanHalf * aspect),
+                float((1 - 2 * py / h) * 2 * tanHalf), -2.0f};
   };
   scene::Mesh m;
   m.positions = {at(-5, -5), at(10.5, -5), at(10.5, h + 5), at(-5, h + 5)};
@@ -356,7 +357,8 @@ TEST(LayersGenerator, TexturedAndFoggedLayersKeepTheirGeometry) {
     const Vec3 a = m.positions[t], b = m.positions[t + 1];
     const double pixelsPerUnit = p.height / (2 * tanHalf * -a.z);
     const double pixels = std::hypot(b.x - a.x, b.y - a.y) * pixelsPerUnit;
-    const double texels = std::hypot(m.uvs[t + 1].x - m.uvs[t].x, m.uvs[t + 1].y - m.uvs[t].y) * 1024;
+    const double texels =
+        std::hypot(m.uvs[t + 1].x - m.uvs[t].x, m.uvs[t + 1].y - m.uvs[t].y) * 1024;
     EXPECT_GE(texels / pixels, 0.5 - 1e-3) << t;
     EXPECT_LE(texels / pixels, 4 + 1e-3) << t;
   }
@@ -365,8 +367,8 @@ TEST(LayersGenerator, TexturedAndFoggedLayersKeepTheirGeometry) {
 // Priority masking on BENCH.md's layers given front to back, textured with fog: one sample draws
 // the Z-buffer's image byte for byte (deferred shading included); with 16 samples the images differ
 // only where two triangles of one layer claim the same sample near a shared vertex (area masks,
-// docs/quality.md) — the Z-buffer keeps the nearer by a rounding of equal depths, masking the first.
-// A translucent quad in front blends the same way over either.
+// docs/quality.md) — the Z-buffer keeps the nearer by a rounding of equal depths, masking the
+// first. A translucent quad in front blends the same way over either.
 TEST(LayersGenerator, PriorityMaskingDrawsTheZBufferImageOfOrderedLayers) {
   scene::LayersParams p;
   p.layers = 5;
@@ -413,7 +415,7 @@ TEST(LayersGenerator, PriorityMaskingDrawsTheZBufferImageOfOrderedLayers) {
       EXPECT_EQ(differing, 0u);
     } else {
       EXPECT_LT(differing, z.rgb.size() / 2000) << "channels differing";  // measured: 3 of 122 880
-      EXPECT_LE(worst, 8) << "a sample of 16";  // measured: 1
+      EXPECT_LE(worst, 8) << "a sample of 16";                            // measured: 1
     }
   }
 }
@@ -446,8 +448,8 @@ TEST(ObjectCulling, HiddenInstancesAreDroppedWholeWithTheZBufferImage) {
   s.instances.push_back({0, Mat4::translation({0, 0, -3})});
   for (int i = 0; i < 60; ++i)
     s.instances.push_back(
-        {1, Mat4::translation({float(i % 10) * 0.8f - 3.6f, float(i / 10) * 0.6f - 1.5f,
-                               -5.0f - float(i % 7)})});
+        {1, Mat4::translation(
+                {float(i % 10) * 0.8f - 3.6f, float(i / 10) * 0.6f - 1.5f, -5.0f - float(i % 7)})});
   s.instances.push_back({1, Mat4::translation({0.3f, -0.2f, -0.1f})});  // cut by the near plane
   s.instances.push_back({2, Mat4::translation({0.2f, 0.1f, -6})});      // translucent, hidden
   for (int samples : {1, 16}) {

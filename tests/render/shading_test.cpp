@@ -17,7 +17,8 @@ constexpr double kTanHalf = 0.57735026918962576;  // tan(30°): the cameras belo
 
 uint16_t srgbTo16(int byte) {
   const double v = byte / 255.0;
-  return uint16_t(std::lround((v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4)) * 65535));
+  return uint16_t(
+      std::lround((v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4)) * 65535));
 }
 double srgbToLinear(int byte) {
   const double v = byte / 255.0;
@@ -80,10 +81,11 @@ TEST(Shading, TextureCoordinatesArePerspectiveCorrectOnATiltedQuad) {
   texture::Level level;
   level.width = level.height = 16;
   for (int y = 0; y < 16; ++y)
-    for (int x = 0; x < 16; ++x) level.texels.push_back({srgbTo16(16 * x), srgbTo16(16 * y), 0, 65535});
+    for (int x = 0; x < 16; ++x)
+      level.texels.push_back({srgbTo16(16 * x), srgbTo16(16 * y), 0, 65535});
   scene::Scene s = emptyScene();
-  s.textures.push_back({"coords", std::make_shared<texture::Texture>(
-                                      level, texture::Wrap::clamp, texture::Wrap::clamp)});
+  s.textures.push_back({"coords", std::make_shared<texture::Texture>(level, texture::Wrap::clamp,
+                                                                     texture::Wrap::clamp)});
   scene::Material mat;
   mat.texture = 0;
   mat.unlit = true;
@@ -145,8 +147,8 @@ TEST(Shading, TranslucentSurfacesBlendOverWhatIsBehindInLinearLight) {
   const Image img = render(s, 32, 32);
   const uint8_t* p = pixel(img, 16, 16);
   auto encode = [](double linear) {
-    return int(std::lround(255 * (linear <= 0.0031308 ? 12.92 * linear
-                                                      : 1.055 * std::pow(linear, 1 / 2.4) - 0.055)));
+    return int(std::lround(
+        255 * (linear <= 0.0031308 ? 12.92 * linear : 1.055 * std::pow(linear, 1 / 2.4) - 0.055)));
   };
   EXPECT_NEAR(p[0], encode(0.25), 1);
   EXPECT_EQ(p[1], 0);
@@ -196,10 +198,12 @@ TEST(Shading, MaskingOrdersObjectsNearestFirstUnlessPrioritiesSay) {
                 render(s, 48, 32, 2, scene::TextureFilter::trilinear, samples).rgb);
   EXPECT_EQ(pixel(z, 24, 16)[0], 255);
   s.instances[0].priority = -1;  // the far quad declared nearest
-  const Image p = render(s, 48, 32, 2, scene::TextureFilter::trilinear, 1, RenderOptions::Hsr::priority);
+  const Image p =
+      render(s, 48, 32, 2, scene::TextureFilter::trilinear, 1, RenderOptions::Hsr::priority);
   EXPECT_EQ(pixel(p, 24, 16)[2], 255);  // blue hides red: the order was trusted
-  EXPECT_EQ(render(s, 48, 32, 2, scene::TextureFilter::trilinear, 1, RenderOptions::Hsr::hybrid).rgb,
-            z.rgb);  // hybrid stays exact
+  EXPECT_EQ(
+      render(s, 48, 32, 2, scene::TextureFilter::trilinear, 1, RenderOptions::Hsr::hybrid).rgb,
+      z.rgb);  // hybrid stays exact
 }
 
 TEST(Shading, AlphaCutOutsShowWhatIsBehindWhereAlphaIsBelowTheCutoff) {
@@ -207,8 +211,9 @@ TEST(Shading, AlphaCutOutsShowWhatIsBehindWhereAlphaIsBelowTheCutoff) {
   texture::Level level;
   level.width = level.height = 8;
   for (int y = 0; y < 8; ++y)
-    for (int x = 0; x < 8; ++x) level.texels.push_back(x < 4 ? texture::Texel{0, 0, 0, 0}
-                                                               : texture::Texel{65535, 65535, 65535, 65535});
+    for (int x = 0; x < 8; ++x)
+      level.texels.push_back(x < 4 ? texture::Texel{0, 0, 0, 0}
+                                   : texture::Texel{65535, 65535, 65535, 65535});
   scene::Scene s = emptyScene();
   s.textures.push_back({"half", std::make_shared<texture::Texture>(level, texture::Wrap::clamp,
                                                                    texture::Wrap::clamp)});
@@ -268,8 +273,8 @@ TEST(Shading, FogTakesTheFogColourWithDistance) {
   m.unlit = true;
   m.baseColor = {1, 1, 1, 1};
   s.materials.push_back(m);
-  s.fog = {true, {0, 0, 1}, 0.5f};  // halves every 2 units of range
-  addQuad(s, {-1, -1, -2}, {2, 0, 0}, {0, 2, 0}, 0);          // range ≈ 2 at the centre
+  s.fog = {true, {0, 0, 1}, 0.5f};                             // halves every 2 units of range
+  addQuad(s, {-1, -1, -2}, {2, 0, 0}, {0, 2, 0}, 0);           // range ≈ 2 at the centre
   addQuad(s, {-100, -100, -90}, {200, 0, 0}, {0, 200, 0}, 0);  // range ≥ 90
   const Image img = render(s, 33, 33);
   const uint8_t* near = pixel(img, 16, 16);
@@ -283,8 +288,8 @@ TEST(Shading, FogTakesTheFogColourWithDistance) {
 
 TEST(Shading, TexturedFramesAreIdenticalForAnyThreadCount) {
   scene::Scene s = emptyScene();
-  texture::Level level = texture::generateTexture(texture::Pattern::noise, 64, {0, 0, 0, 1},
-                                                  {1, 1, 1, 1}, 5);
+  texture::Level level =
+      texture::generateTexture(texture::Pattern::noise, 64, {0, 0, 0, 1}, {1, 1, 1, 1}, 5);
   s.textures.push_back({"noise", std::make_shared<texture::Texture>(level, texture::Wrap::repeat,
                                                                     texture::Wrap::mirror)});
   scene::Material m;
@@ -302,7 +307,8 @@ TEST(Shading, TexturedFramesAreIdenticalForAnyThreadCount) {
   for (int i = 0; i < 40; ++i) {
     const float a = float(i) * 0.7f;
     addQuad(s, {std::sin(a) * 3, std::cos(a * 1.3f) * 2, -4 - float(i % 7)},
-            {1.5f * std::cos(a), 0.4f, 0.3f}, {0.2f, 1.2f, -0.8f * std::sin(a)}, i % 5 == 0 ? 1 : 0);
+            {1.5f * std::cos(a), 0.4f, 0.3f}, {0.2f, 1.2f, -0.8f * std::sin(a)},
+            i % 5 == 0 ? 1 : 0);
   }
   for (int samples : {1, 4, 16})
     for (auto filter : {scene::TextureFilter::trilinear, scene::TextureFilter::anisotropic}) {
@@ -464,8 +470,8 @@ TEST(Shading, AntiAliasedTexturingAgreesWithPointSamplingInsideSurfaces) {
   // Pixel shading with sub-pixel masks (forward, colour once per pixel) against the deferred
   // shading of one sample: inside a textured, lit, fogged quad the two shade the same centres.
   scene::Scene s = emptyScene();
-  texture::Level level = texture::generateTexture(texture::Pattern::checker, 64, {0.1f, 0.2f, 0.3f, 1},
-                                                  {0.9f, 0.8f, 0.2f, 1}, 1);
+  texture::Level level = texture::generateTexture(texture::Pattern::checker, 64,
+                                                  {0.1f, 0.2f, 0.3f, 1}, {0.9f, 0.8f, 0.2f, 1}, 1);
   s.textures.push_back({"checker", std::make_shared<texture::Texture>(level, texture::Wrap::repeat,
                                                                       texture::Wrap::repeat)});
   scene::Material m;
@@ -485,7 +491,8 @@ TEST(Shading, AntiAliasedTexturingAgreesWithPointSamplingInsideSurfaces) {
     int differing = 0;
     for (size_t i = 0; i < one.rgb.size(); i += 3) {
       int d = 0;
-      for (int c = 0; c < 3; ++c) d = std::max(d, std::abs(int(one.rgb[i + c]) - int(aa.rgb[i + c])));
+      for (int c = 0; c < 3; ++c)
+        d = std::max(d, std::abs(int(one.rgb[i + c]) - int(aa.rgb[i + c])));
       differing += d > 1;
     }
     EXPECT_LE(differing, samples == 4 ? 0 : 96 * 72 / 40) << samples << " samples";

@@ -21,7 +21,8 @@ TEST(DemoScene, LoadsValidatesAndHasEnoughToLookAt) {
 }
 
 TEST(DemoScene, EmbeddedTextIsTheFileInTheSourceTree) {
-  EXPECT_EQ(std::string(demoSceneJson()), testing::readText(testing::sourcePath("scenes/demo.json")));
+  EXPECT_EQ(std::string(demoSceneJson()),
+            testing::readText(testing::sourcePath("scenes/demo.json")));
 }
 
 }  // namespace

@@ -1,11 +1,11 @@
 // The glTF 2.0 loader: the sample, node transforms, topology conversion, cameras and materials,
 // and the malformed inputs tinygltf lets through (accessors past their buffers, bad indices,
 // broken hierarchies, truncated GLB containers).
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <numbers>
 #include <string>
-
-#include <gtest/gtest.h>
 
 #include "scene/scene_test_util.h"
 #include "synthvis/scene.h"
@@ -90,14 +90,18 @@ TEST(Gltf, RejectsBufferViewOutsideItsBuffer) {
   const std::string path = dataPath("scene/short_buffer.gltf");
   Result<Scene> r = loadScene(path);
   ASSERT_FALSE(r.ok());
-  EXPECT_EQ(r.error().str(), path + ": meshes[0].primitives[0].attributes.POSITION: accessors[0]: "
-                                    "bufferViews[0] (offset 0, length 48) lies outside buffers[0] (36 bytes)");
+  EXPECT_EQ(r.error().str(),
+            path +
+                ": meshes[0].primitives[0].attributes.POSITION: accessors[0]: "
+                "bufferViews[0] (offset 0, length 48) lies outside buffers[0] (36 bytes)");
 }
 
 TEST(Gltf, RejectsAccessorPastTheEndOfItsBufferView) {
   GltfBuilder b = oneTriangle();
   b.doc["accessors"][0]["count"] = 4;  // the view holds 3 vertices
-  EXPECT_TRUE(contains(errorOf(b), "accessors[0]: 4 elements of 12 bytes (stride 12, offset 0) do not fit in bufferViews[0] (36 bytes)"));
+  EXPECT_TRUE(contains(errorOf(b),
+                       "accessors[0]: 4 elements of 12 bytes (stride 12, offset 0) do not fit in "
+                       "bufferViews[0] (36 bytes)"));
   b = oneTriangle();
   b.doc["accessors"][0]["byteOffset"] = 4;
   EXPECT_TRUE(contains(errorOf(b), "do not fit"));
@@ -113,8 +117,11 @@ TEST(Gltf, RejectsIndexOutOfRange) {
   GltfBuilder b;
   int positions = b.addPositions({0, 0, 0, 1, 0, 0, 0, 1, 0});
   int indices = b.addIndices({0, 1, 3});
-  b.addNode({{"mesh", b.addMesh({{"attributes", {{"POSITION", positions}}}, {"indices", indices}})}});
-  EXPECT_EQ(errorOf(b), "t.gltf: meshes[0].primitives[0].indices: index 3 at position 2 is out of range (3 vertices)");
+  b.addNode(
+      {{"mesh", b.addMesh({{"attributes", {{"POSITION", positions}}}, {"indices", indices}})}});
+  EXPECT_EQ(errorOf(b),
+            "t.gltf: meshes[0].primitives[0].indices: index 3 at position 2 is out of range (3 "
+            "vertices)");
 }
 
 TEST(Gltf, RejectsBrokenReferencesAndHierarchies) {
@@ -124,19 +131,55 @@ TEST(Gltf, RejectsBrokenReferencesAndHierarchies) {
     const char* expected;
   };
   const Row rows[] = {
-      {"accessor index", [](GltfBuilder& b) { b.doc["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = 9; }, "accessor 9 does not exist"},
-      {"no POSITION", [](GltfBuilder& b) { b.doc["meshes"][0]["primitives"][0]["attributes"] = json::object({{"NORMAL", 0}}); }, "has no POSITION attribute"},
-      {"wrong element type", [](GltfBuilder& b) { b.doc["accessors"][0]["type"] = "VEC2"; }, "unexpected element type"},
-      {"unknown mode", [](GltfBuilder& b) { b.doc["meshes"][0]["primitives"][0]["mode"] = 9; }, "meshes[0].primitives[0]: unknown mode 9"},
-      {"material index", [](GltfBuilder& b) { b.doc["meshes"][0]["primitives"][0]["material"] = 2; }, "material 2 does not exist"},
-      {"node mesh index", [](GltfBuilder& b) { b.doc["nodes"][0]["mesh"] = 7; }, "nodes[0]: mesh 7 does not exist"},
-      {"child index", [](GltfBuilder& b) { b.doc["nodes"][0]["children"] = {5}; }, "nodes[0]: child 5 does not exist"},
-      {"two parents", [](GltfBuilder& b) { b.addNode({{"children", {0}}}); b.addNode({{"children", {0}}}); }, "nodes[0]: has more than one parent"},
-      {"cycle", [](GltfBuilder& b) { b.doc["nodes"][0]["children"] = {0}; b.doc["scene"] = 0; b.doc["scenes"] = {{{"nodes", {0}}}}; }, "nodes[0]: reached twice"},
+      {"accessor index",
+       [](GltfBuilder& b) { b.doc["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = 9; },
+       "accessor 9 does not exist"},
+      {"no POSITION",
+       [](GltfBuilder& b) {
+         b.doc["meshes"][0]["primitives"][0]["attributes"] = json::object({{"NORMAL", 0}});
+       },
+       "has no POSITION attribute"},
+      {"wrong element type", [](GltfBuilder& b) { b.doc["accessors"][0]["type"] = "VEC2"; },
+       "unexpected element type"},
+      {"unknown mode", [](GltfBuilder& b) { b.doc["meshes"][0]["primitives"][0]["mode"] = 9; },
+       "meshes[0].primitives[0]: unknown mode 9"},
+      {"material index",
+       [](GltfBuilder& b) { b.doc["meshes"][0]["primitives"][0]["material"] = 2; },
+       "material 2 does not exist"},
+      {"node mesh index", [](GltfBuilder& b) { b.doc["nodes"][0]["mesh"] = 7; },
+       "nodes[0]: mesh 7 does not exist"},
+      {"child index", [](GltfBuilder& b) { b.doc["nodes"][0]["children"] = {5}; },
+       "nodes[0]: child 5 does not exist"},
+      {"two parents",
+       [](GltfBuilder& b) {
+         b.addNode({{"children", {0}}});
+         b.addNode({{"children", {0}}});
+       },
+       "nodes[0]: has more than one parent"},
+      {"cycle",
+       [](GltfBuilder& b) {
+         b.doc["nodes"][0]["children"] = {0};
+         b.doc["scene"] = 0;
+         b.doc["scenes"] = {{{"nodes", {0}}}};
+       },
+       "nodes[0]: reached twice"},
       {"scene index", [](GltfBuilder& b) { b.doc["scene"] = 3; }, "scene 3 does not exist"},
-      {"matrix size", [](GltfBuilder& b) { b.doc["nodes"][0]["matrix"] = {1, 0, 0}; }, "nodes[0].matrix: expected 16 numbers, got 3"},
-      {"required extension", [](GltfBuilder& b) { b.doc["extensionsRequired"] = {"KHR_draco_mesh_compression"}; }, "requires the unsupported extension 'KHR_draco_mesh_compression'"},
-      {"sparse accessor", [](GltfBuilder& b) { b.doc["accessors"][0]["sparse"] = {{"count", 1}, {"indices", {{"bufferView", 1}, {"componentType", 5123}}}, {"values", {{"bufferView", 0}}}}; }, "sparse accessors are not supported"},
+      {"matrix size",
+       [](GltfBuilder& b) {
+         b.doc["nodes"][0]["matrix"] = {1, 0, 0};
+       },
+       "nodes[0].matrix: expected 16 numbers, got 3"},
+      {"required extension",
+       [](GltfBuilder& b) { b.doc["extensionsRequired"] = {"KHR_draco_mesh_compression"}; },
+       "requires the unsupported extension 'KHR_draco_mesh_compression'"},
+      {"sparse accessor",
+       [](GltfBuilder& b) {
+         b.doc["accessors"][0]["sparse"] = {
+             {"count", 1},
+             {"indices", {{"bufferView", 1}, {"componentType", 5123}}},
+             {"values", {{"bufferView", 0}}}};
+       },
+       "sparse accessors are not supported"},
   };
   for (const Row& row : rows) {
     SCOPED_TRACE(row.why);
@@ -149,11 +192,13 @@ TEST(Gltf, RejectsBrokenReferencesAndHierarchies) {
 }
 
 TEST(Gltf, TinygltfErrorsBecomeOneLineNamingTheFile) {
-  Result<Scene> r = loadGltfFromMemory("{\"asset\": {\"version\": \"2.0\"}, \"buffers\": [{\"byteLength\": 4}]}", "t.gltf");
+  Result<Scene> r = loadGltfFromMemory(
+      "{\"asset\": {\"version\": \"2.0\"}, \"buffers\": [{\"byteLength\": 4}]}", "t.gltf");
   ASSERT_FALSE(r.ok());
   EXPECT_TRUE(contains(r.error().str(), "t.gltf: invalid glTF: "));
   EXPECT_EQ(r.error().str().find('\n'), std::string::npos);
-  EXPECT_TRUE(contains(loadGltfFromMemory("{\"asset\": ", "t.gltf").error().str(), "t.gltf: invalid glTF: "));
+  EXPECT_TRUE(contains(loadGltfFromMemory("{\"asset\": ", "t.gltf").error().str(),
+                       "t.gltf: invalid glTF: "));
 }
 
 TEST(Gltf, AppliesNodeTransformsDownTheHierarchy) {
@@ -204,7 +249,8 @@ TEST(Gltf, ConvertsStripsAndFansAndSkipsPointsAndLines) {
 
 TEST(Gltf, ReadsNormalizedIntegerColoursAndTexcoords) {
   GltfBuilder b = oneTriangle();
-  int colors = b.addAccessor(std::vector<uint8_t>{255, 0, 0, 255, 0, 255, 0, 128, 0, 0, 255, 0}, 5121, "VEC4", 3);
+  int colors = b.addAccessor(std::vector<uint8_t>{255, 0, 0, 255, 0, 255, 0, 128, 0, 0, 255, 0},
+                             5121, "VEC4", 3);
   b.doc["accessors"][size_t(colors)]["normalized"] = true;
   int uvs = b.addAccessor(std::vector<uint16_t>{0, 0, 65535, 0, 0, 65535}, 5123, "VEC2", 3);
   b.doc["accessors"][size_t(uvs)]["normalized"] = true;
@@ -237,10 +283,12 @@ TEST(Gltf, ReadsMaterialsWithUnlitAndDoubleSided) {
 
 TEST(Gltf, ReadsPerspectiveCamerasFromNodes) {
   GltfBuilder b = oneTriangle();
-  b.doc["cameras"] = {{{"type", "perspective"}, {"name", "eye"},
+  b.doc["cameras"] = {{{"type", "perspective"},
+                       {"name", "eye"},
                        {"perspective", {{"yfov", std::numbers::pi / 3}, {"znear", 0.5}}}}};
   // At (0, 2, 10), turned 90° about +Y: looks along −X.
-  b.addNode({{"camera", 0}, {"translation", {0, 2, 10}},
+  b.addNode({{"camera", 0},
+             {"translation", {0, 2, 10}},
              {"rotation", {0, std::sin(std::numbers::pi / 4), 0, std::cos(std::numbers::pi / 4)}}});
   Result<Scene> r = load(b);
   ASSERT_TRUE(r.ok()) << r.error().str();

@@ -1,8 +1,8 @@
 // saveGltf writes what loadGltf reads back: generated benchmark scenes survive the round trip.
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <filesystem>
-
-#include <gtest/gtest.h>
 
 #include "synthvis/generators.h"
 #include "synthvis/scene.h"
@@ -70,9 +70,8 @@ TEST(GltfWriter, TexturesWrapModesAndUvScaleRoundTrip) {
     const uint16_t a = uint16_t(i * 13000);
     level.texels.push_back({uint16_t(a / 2), uint16_t(a / 3), a, a});
   }
-  s.textures.push_back({"odd", std::make_shared<texture::Texture>(std::move(level),
-                                                                  texture::Wrap::clamp,
-                                                                  texture::Wrap::mirror)});
+  s.textures.push_back({"odd", std::make_shared<texture::Texture>(
+                                   std::move(level), texture::Wrap::clamp, texture::Wrap::mirror)});
   Material cutOut = s.materials[1];
   cutOut.texture = 2;
   cutOut.alphaMode = AlphaMode::mask;

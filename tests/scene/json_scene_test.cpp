@@ -1,9 +1,9 @@
 // The JSON scene format (docs/scene-format.md): values land where they should, and every class
 // of malformed input gives one error line naming the file, the place and the problem.
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <string>
-
-#include <gtest/gtest.h>
 
 #include "scene/scene_test_util.h"
 #include "synthvis/scene.h"
@@ -122,7 +122,8 @@ TEST(JsonScene, DefaultsMatchTheSceneTypes) {
 }
 
 TEST(JsonScene, ReadsACameraList) {
-  Result<Scene> r = parse(R"({"synthvis": 1, "cameras": [{"name": "a"}, {"name": "b", "yfov": 30}]})");
+  Result<Scene> r =
+      parse(R"({"synthvis": 1, "cameras": [{"name": "a"}, {"name": "b", "yfov": 30}]})");
   ASSERT_TRUE(r.ok()) << r.error().str();
   ASSERT_EQ(r->cameras.size(), 2u);
   EXPECT_EQ(r->cameras[1].name, "b");
@@ -138,7 +139,8 @@ TEST(JsonScene, ComposesTranslateRotateScaleAsTRS) {
 }
 
 TEST(JsonScene, EulerAnglesTurnAboutXThenYThenZ) {
-  Result<Scene> r = parse(withObjects(R"({"primitive": "box", "transform": {"rotate": [90, 90, 0]}})"));
+  Result<Scene> r =
+      parse(withObjects(R"({"primitive": "box", "transform": {"rotate": [90, 90, 0]}})"));
   ASSERT_TRUE(r.ok()) << r.error().str();
   // X by 90°: +Y → +Z; then Y by 90°: +Z → +X.
   expectNear(r->instances[0].transform.transformPoint({0, 1, 0}), {1, 0, 0});
@@ -184,7 +186,8 @@ TEST(JsonScene, ObjectColourMakesOneSharedDerivedMaterial) {
                   {"primitive": "box", "material": 0, "color": [1, 0, 0]},
                   {"primitive": "box", "color": [0, 1, 0]}]})");
   ASSERT_TRUE(r.ok()) << r.error().str();
-  ASSERT_EQ(r->materials.size(), 3u);  // shiny, shiny in red (shared by two boxes), default in green
+  ASSERT_EQ(r->materials.size(),
+            3u);  // shiny, shiny in red (shared by two boxes), default in green
   EXPECT_EQ(r->meshes[0].material, r->meshes[1].material);
   const Material& red = r->materials[size_t(r->meshes[0].material)];
   EXPECT_EQ(red.baseColor, (Vec4{1, 0, 0, 1}));
@@ -204,7 +207,8 @@ TEST(JsonScene, EveryPrimitiveKindLoadsWithItsParameters) {
   ASSERT_TRUE(r.ok()) << r.error().str();
   std::vector<size_t> triangles;
   for (const Mesh& m : r->meshes) triangles.push_back(m.triangleCount());
-  EXPECT_EQ(triangles, (std::vector<size_t>{12, 2 * 8 * 3, 2 * 2 * 3, 2 * 9, 2 * 5, 2 * 6, 2 * 7 * 4}));
+  EXPECT_EQ(triangles,
+            (std::vector<size_t>{12, 2 * 8 * 3, 2 * 2 * 3, 2 * 9, 2 * 5, 2 * 6, 2 * 7 * 4}));
   EXPECT_EQ(r->meshes[3].colors.size(), 4u * 9u);
 }
 
@@ -232,19 +236,23 @@ TEST(JsonScene, SyntaxErrorPointsAtTheOffendingCharacter) {
 }
 
 TEST(JsonScene, RejectsWrongTypeNamingThePath) {
-  expectLoadError("scene/wrong_type.json", "objects[2].transform.translate: expected an array of 3 numbers, got a string");
+  expectLoadError("scene/wrong_type.json",
+                  "objects[2].transform.translate: expected an array of 3 numbers, got a string");
 }
 
 TEST(JsonScene, RejectsUnknownKeyAndSuggestsTheIntendedOne) {
-  expectLoadError("scene/unknown_key.json", "camera: unknown key 'postion' (did you mean 'position'?)");
+  expectLoadError("scene/unknown_key.json",
+                  "camera: unknown key 'postion' (did you mean 'position'?)");
 }
 
 TEST(JsonScene, RejectsMissingReferencedFile) {
-  expectLoadError("scene/missing_mesh.json", "objects[0].mesh: cannot open 'no_such_model.glb': no such file");
+  expectLoadError("scene/missing_mesh.json",
+                  "objects[0].mesh: cannot open 'no_such_model.glb': no such file");
 }
 
 TEST(JsonScene, RejectsOtherFormatVersions) {
-  expectLoadError("scene/version2.json", "synthvis: unsupported format version 2 (this reader understands version 1)");
+  expectLoadError("scene/version2.json",
+                  "synthvis: unsupported format version 2 (this reader understands version 1)");
   EXPECT_TRUE(contains(errorOf(R"({"objects": []})"), "t.json: missing key 'synthvis'"));
   EXPECT_TRUE(contains(errorOf(R"({"synthvis": "1"})"), "unsupported format version \"1\""));
 }
@@ -260,7 +268,8 @@ TEST(JsonScene, RejectsNonFiniteNumberWithItsPosition) {
 }
 
 TEST(JsonScene, RejectsAbsurdSegments) {
-  expectLoadError("scene/absurd_segments.json", "objects[0].segments: 100000000 is out of range 3..4096");
+  expectLoadError("scene/absurd_segments.json",
+                  "objects[0].segments: 100000000 is out of range 3..4096");
   EXPECT_TRUE(contains(errorOf(withObjects(R"({"primitive": "torus", "sides": 2})")),
                        "objects[0].sides: 2 is out of range 3..4096"));
   EXPECT_TRUE(contains(errorOf(withObjects(R"({"primitive": "checker", "squares": [4, 0]})")),
@@ -294,25 +303,37 @@ TEST(JsonScene, RejectsEachMalformedClassWithAClearMessage) {
       // The top level must be an object.
       {"[1, 2]", "t.json: expected a JSON object at the top level, got an array"},
       // Two keys with one name: nlohmann would keep the last; a typo is likelier.
-      {R"({"synthvis": 1, "light": {"ambient": 0.1, "ambient": 0.2}})", "t.json: light: duplicate key 'ambient'"},
+      {R"({"synthvis": 1, "light": {"ambient": 0.1, "ambient": 0.2}})",
+       "t.json: light: duplicate key 'ambient'"},
       {R"({"synthvis": 1, "camera": {}, "cameras": []})", "use either 'camera' or 'cameras'"},
-      {R"({"synthvis": 1, "background": [1, 1]})", "background: expected a colour [r, g, b] with components 0..1, got 2 elements"},
+      {R"({"synthvis": 1, "background": [1, 1]})",
+       "background: expected a colour [r, g, b] with components 0..1, got 2 elements"},
       {R"({"synthvis": 1, "background": [1, 2, 1]})", "background[1]: 2 is out of range 0..1"},
-      {R"({"synthvis": 1, "camera": {"yfov": 180}})", "camera.yfov: 180 is out of range (0, 180) degrees"},
-      {R"({"synthvis": 1, "camera": {"near": 10, "far": 5}})", "camera: far (5) must be greater than near (10)"},
-      {R"({"synthvis": 1, "camera": {"position": [0, 0, 0]}})", "camera: position and target must differ"},
+      {R"({"synthvis": 1, "camera": {"yfov": 180}})",
+       "camera.yfov: 180 is out of range (0, 180) degrees"},
+      {R"({"synthvis": 1, "camera": {"near": 10, "far": 5}})",
+       "camera: far (5) must be greater than near (10)"},
+      {R"({"synthvis": 1, "camera": {"position": [0, 0, 0]}})",
+       "camera: position and target must differ"},
       {R"({"synthvis": 1, "camera": {"up": [0, 0, 1]}})", "camera: up must not be parallel"},
-      {R"({"synthvis": 1, "light": {"direction": [0, 0, 0]}})", "light.direction: expected a non-zero vector"},
-      {R"({"synthvis": 1, "light": {"enabled": 1}})", "light.enabled: expected true or false, got an integer"},
-      {R"({"synthvis": 1, "materials": [{"name": "a"}, {"name": "a"}]})", "materials[1].name: duplicate material name 'a'"},
+      {R"({"synthvis": 1, "light": {"direction": [0, 0, 0]}})",
+       "light.direction: expected a non-zero vector"},
+      {R"({"synthvis": 1, "light": {"enabled": 1}})",
+       "light.enabled: expected true or false, got an integer"},
+      {R"({"synthvis": 1, "materials": [{"name": "a"}, {"name": "a"}]})",
+       "materials[1].name: duplicate material name 'a'"},
       {R"({"synthvis": 1, "materials": [{"name": "red"}], "objects": [{"primitive": "box", "material": "rde"}]})",
        "objects[0].material: no material named 'rde' (did you mean 'red'?)"},
-      {R"({"synthvis": 1, "objects": [{"primitive": "box", "material": 0}]})", "objects[0].material: there are no materials"},
+      {R"({"synthvis": 1, "objects": [{"primitive": "box", "material": 0}]})",
+       "objects[0].material: there are no materials"},
       {R"({"synthvis": 1, "objects": {}})", "objects: expected an array, got an object"},
-      {R"({"synthvis": 1, "objects": [{}]})", "objects[0]: missing key 'mesh', 'primitive' or 'freeform'"},
-      {R"({"synthvis": 1, "objects": [{"mesh": "a.obj", "primitive": "box"}]})", "one of 'mesh', 'primitive' or 'freeform', not several"},
+      {R"({"synthvis": 1, "objects": [{}]})",
+       "objects[0]: missing key 'mesh', 'primitive' or 'freeform'"},
+      {R"({"synthvis": 1, "objects": [{"mesh": "a.obj", "primitive": "box"}]})",
+       "one of 'mesh', 'primitive' or 'freeform', not several"},
       // Free forms (SPEC §11).
-      {R"({"synthvis": 1, "objects": [{"freeform": {}}]})", "objects[0].freeform: missing key 'quadric'"},
+      {R"({"synthvis": 1, "objects": [{"freeform": {}}]})",
+       "objects[0].freeform: missing key 'quadric'"},
       {R"({"synthvis": 1, "objects": [{"freeform": {"quadric": "torus"}}]})",
        "objects[0].freeform.quadric: unknown quadric 'torus'"},
       {R"({"synthvis": 1, "objects": [{"freeform": {"quadric": "sphere", "radius": -1}}]})",
@@ -337,9 +358,12 @@ TEST(JsonScene, RejectsEachMalformedClassWithAClearMessage) {
        "not several"},
       {R"({"synthvis": 1, "objects": [{"freeform": {"quadric": "sphere"}, "transform": {"matrix": [1,0,0,0, 0,1,0,0, 0,0,0,0, 0,0,0,1]}}]})",
        "freeForms[0]: transform is singular"},
-      {R"({"synthvis": 1, "objects": [{"primitive": "teapot"}]})", "objects[0].primitive: unknown primitive 'teapot'"},
-      {R"({"synthvis": 1, "objects": [{"primitive": "box", "radius": 1}]})", "objects[0]: unknown key 'radius'"},
-      {R"({"synthvis": 1, "objects": [{"primitive": "sphere", "radius": -1}]})", "objects[0].radius: expected a number greater than 0, got -1"},
+      {R"({"synthvis": 1, "objects": [{"primitive": "teapot"}]})",
+       "objects[0].primitive: unknown primitive 'teapot'"},
+      {R"({"synthvis": 1, "objects": [{"primitive": "box", "radius": 1}]})",
+       "objects[0]: unknown key 'radius'"},
+      {R"({"synthvis": 1, "objects": [{"primitive": "sphere", "radius": -1}]})",
+       "objects[0].radius: expected a number greater than 0, got -1"},
       {R"({"synthvis": 1, "objects": [{"primitive": "box", "transform": {"matrix": [1], "scale": 2}}]})",
        "'matrix' cannot be combined"},
       {R"({"synthvis": 1, "objects": [{"primitive": "box", "transform": {"matrix": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,2]}}]})",
@@ -356,8 +380,10 @@ TEST(JsonScene, RejectsEachMalformedClassWithAClearMessage) {
        "objects[0].mesh.positions[8]: expected a number, got a string"},
       {R"({"synthvis": 1, "objects": [{"mesh": {"positions": [0, 0, 0, 1, 0, 0, 0, 1, 0], "colors": [0,0,0, 0,0,0, 0,0,2]}}]})",
        "objects[0].mesh.colors[6]: value out of range 0..1"},
-      {R"({"synthvis": 1, "objects": [{"mesh": ""}]})", "objects[0].mesh: expected a file path, got an empty string"},
-      {R"({"synthvis": 1, "objects": [{"mesh": "model.fbx"}]})", "objects[0].mesh: cannot open 'model.fbx'"},
+      {R"({"synthvis": 1, "objects": [{"mesh": ""}]})",
+       "objects[0].mesh: expected a file path, got an empty string"},
+      {R"({"synthvis": 1, "objects": [{"mesh": "model.fbx"}]})",
+       "objects[0].mesh: cannot open 'model.fbx'"},
   };
   for (const Row& row : rows) {
     SCOPED_TRACE(row.text);
@@ -366,7 +392,8 @@ TEST(JsonScene, RejectsEachMalformedClassWithAClearMessage) {
 }
 
 TEST(JsonScene, RejectsNestingDeeperThanSixtyFourLevels) {
-  std::string deep = R"({"synthvis": 1, "description": )" + std::string(100, '[') + std::string(100, ']') + "}";
+  std::string deep =
+      R"({"synthvis": 1, "description": )" + std::string(100, '[') + std::string(100, ']') + "}";
   EXPECT_TRUE(contains(errorOf(deep), "nested more than 64 levels"));
 }
 
@@ -374,7 +401,8 @@ TEST(JsonScene, RejectsScenesOverTheTriangleBudgetBeforeBuildingThem) {
   LoadOptions options;
   options.maxTriangles = 1000;
   Result<Scene> r = parseJsonScene(withObjects(R"({"primitive": "box"},
-      {"primitive": "sphere", "segments": 64})"), "t.json", options);
+      {"primitive": "sphere", "segments": 64})"),
+                                   "t.json", options);
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.error().str(), "t.json: objects[1]: the scene would have more than 1000 triangles");
 }
@@ -413,7 +441,8 @@ TEST(JsonScene, NestedErrorsAreChainedIntoOneLine) {
   Result<Scene> r = loadScene(path);
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.error().str(), path + ": objects[0].mesh: cannot load 'sub/inner.json': " +
-                                 dir.path("sub/inner.json") + ": objects: expected an array, got an integer");
+                                 dir.path("sub/inner.json") +
+                                 ": objects: expected an array, got an integer");
 }
 
 TEST(JsonScene, RejectsReferenceCycles) {
@@ -422,7 +451,9 @@ TEST(JsonScene, RejectsReferenceCycles) {
   dir.write("b.json", withObjects(R"({"mesh": "a.json"})"));
   Result<Scene> r = loadScene(dir.path("a.json"));
   ASSERT_FALSE(r.ok());
-  EXPECT_TRUE(contains(r.error().str(), "'a.json' refers back to a scene that is being loaded (a.json → b.json → a.json)"));
+  EXPECT_TRUE(
+      contains(r.error().str(),
+               "'a.json' refers back to a scene that is being loaded (a.json → b.json → a.json)"));
   // A file that includes itself.
   dir.write("self.json", withObjects(R"({"mesh": "./self.json"})"));
   EXPECT_TRUE(contains(loadScene(dir.path("self.json")).error().str(), "refers back"));
@@ -449,12 +480,15 @@ TEST(JsonScene, RefusesAllFilesWhenReferencesAreDisabled) {
   Result<Scene> r = parseJsonScene(withObjects(R"({"mesh": "pyramid.gltf"})"),
                                    sourcePath("scenes/x.json"), options);
   ASSERT_FALSE(r.ok());
-  EXPECT_TRUE(contains(r.error().str(), "objects[0].mesh: cannot open 'pyramid.gltf' (references to other files are disabled)"));
+  EXPECT_TRUE(contains(
+      r.error().str(),
+      "objects[0].mesh: cannot open 'pyramid.gltf' (references to other files are disabled)"));
 }
 
 TEST(JsonScene, MaterialOverrideAppliesToEveryMeshOfAReferencedFile) {
   Result<Scene> r = parseJsonScene(R"({"synthvis": 1, "materials": [{"name": "grey"}],
-      "objects": [{"mesh": "house.obj", "material": "grey"}]})", sourcePath("scenes/x.json"));
+      "objects": [{"mesh": "house.obj", "material": "grey"}]})",
+                                   sourcePath("scenes/x.json"));
   ASSERT_TRUE(r.ok()) << r.error().str();
   EXPECT_EQ(r->materials.size(), 1u);  // the house's own materials are not needed
   for (const Mesh& m : r->meshes) EXPECT_EQ(m.material, 0);

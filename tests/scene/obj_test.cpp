@@ -1,8 +1,8 @@
 // The Wavefront OBJ loader: the sample house with its .mtl colours, corner de-duplication, vertex
 // colours, and malformed faces.
-#include <string>
-
 #include <gtest/gtest.h>
+
+#include <string>
 
 #include "scene/scene_test_util.h"
 #include "synthvis/scene.h"
@@ -27,7 +27,7 @@ TEST(Obj, LoadsTheSampleHouseWithMaterialColours) {
   ASSERT_TRUE(r.ok()) << r.error().str();
   const Scene& s = r.value();
   EXPECT_EQ(s.triangleCount(), 16u);  // 7 quads and 2 triangles
-  ASSERT_EQ(s.meshes.size(), 2u);  // one per material
+  ASSERT_EQ(s.meshes.size(), 2u);     // one per material
   const Material* walls = findMaterial(s, "walls");
   const Material* roof = findMaterial(s, "roof");
   ASSERT_TRUE(walls && roof);
@@ -62,8 +62,10 @@ TEST(Obj, SharesVerticesOnlyBetweenIdenticalCorners) {
 }
 
 TEST(Obj, DropsAnAttributeThatNotEveryCornerHas) {
-  Result<Scene> r = parseObj("v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvt 0 0\n"
-                             "f 1/1/1 2//1 3/1/1\n", "t.obj");
+  Result<Scene> r = parseObj(
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvt 0 0\n"
+      "f 1/1/1 2//1 3/1/1\n",
+      "t.obj");
   ASSERT_TRUE(r.ok()) << r.error().str();
   EXPECT_EQ(r->meshes[0].normals.size(), 3u);
   EXPECT_TRUE(r->meshes[0].uvs.empty());  // corner 2 has no texture coordinate
@@ -77,7 +79,8 @@ TEST(Obj, ReadsVertexColours) {
 }
 
 TEST(Obj, RejectsAFaceIndexPastTheVertices) {
-  expectLoadError("scene/bad_index.obj", "shape '': face 1 uses vertex 4, but there are 3 vertices");
+  expectLoadError("scene/bad_index.obj",
+                  "shape '': face 1 uses vertex 4, but there are 3 vertices");
 }
 
 TEST(Obj, RejectsMalformedFacesWithTheLineNumber) {
@@ -99,7 +102,8 @@ TEST(Obj, RejectsFacesTooLargeToTriangulate) {
 
 TEST(Obj, MissingMaterialLibraryFallsBackToTheDefaultMaterial) {
   TempDir dir;
-  std::string path = dir.write("m.obj", "mtllib nowhere.mtl\nusemtl red\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  std::string path =
+      dir.write("m.obj", "mtllib nowhere.mtl\nusemtl red\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
   Result<Scene> r = loadObj(path);
   ASSERT_TRUE(r.ok()) << r.error().str();
   EXPECT_EQ(r->meshes[0].material, -1);

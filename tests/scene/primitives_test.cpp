@@ -1,16 +1,16 @@
 // The primitive generators: topology, normals, winding, closedness and size, each checked against
 // an independent evaluation (the divergence-theorem volume against the analytic one, the summed
 // triangle area against the analytic area).
+#include "scene/primitives.h"
+
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstring>
 #include <map>
 #include <numbers>
 #include <string>
 #include <tuple>
-
-#include <gtest/gtest.h>
-
-#include "scene/primitives.h"
 
 namespace sv::scene::detail {
 namespace {
@@ -32,7 +32,9 @@ PrimitiveParams params(PrimitiveKind kind) {
 // Every kind, in a few shapes: defaults, the fewest divisions allowed, and uneven sizes.
 std::vector<Case> allCases() {
   std::vector<Case> cases;
-  auto add = [&](const char* name, PrimitiveParams p, bool closed) { cases.push_back({name, p, closed}); };
+  auto add = [&](const char* name, PrimitiveParams p, bool closed) {
+    cases.push_back({name, p, closed});
+  };
   PrimitiveParams p = params(PrimitiveKind::kBox);
   add("box", p, true);
   p.size = {2, 0.5f, 3};
@@ -201,7 +203,8 @@ TEST(Primitives, OutputIsDeterministic) {
   for (const Case& c : allCases()) {
     Mesh a = makePrimitive(c.params), b = makePrimitive(c.params);
     ASSERT_EQ(a.positions.size(), b.positions.size());
-    EXPECT_EQ(0, std::memcmp(a.positions.data(), b.positions.data(), a.positions.size() * sizeof(Vec3)))
+    EXPECT_EQ(
+        0, std::memcmp(a.positions.data(), b.positions.data(), a.positions.size() * sizeof(Vec3)))
         << c.name;
     EXPECT_EQ(a.indices, b.indices) << c.name;
   }

@@ -1,11 +1,12 @@
 // The Scene database operations: triangle counting, validation, appending.
-#include <cmath>
-#include <limits>
+#include "synthvis/scene.h"
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+
 #include "scene/scene_test_util.h"
-#include "synthvis/scene.h"
 
 namespace sv::scene {
 namespace {
@@ -44,17 +45,30 @@ TEST(Scene, ValidateNamesTheFileAndTheBrokenInvariant) {
     const char* expected;
   };
   const Row rows[] = {
-      {"index past the vertices", [](Scene& s) { s.meshes[0].indices[2] = 3; }, "indices[2] = 3 is out of range (3 vertices)"},
-      {"incomplete triangle", [](Scene& s) { s.meshes[0].indices.push_back(0); }, "not a multiple of 3"},
-      {"normals for some vertices only", [](Scene& s) { s.meshes[0].normals = {{0, 0, 1}}; }, "attribute arrays"},
-      {"colours for too many vertices", [](Scene& s) { s.meshes[0].colors.resize(4); }, "attribute arrays"},
-      {"NaN position", [](Scene& s) { s.meshes[0].positions[1].y = std::numeric_limits<float>::quiet_NaN(); }, "positions[1] is not finite"},
-      {"infinite position", [](Scene& s) { s.meshes[0].positions[0].x = INFINITY; }, "positions[0] is not finite"},
+      {"index past the vertices", [](Scene& s) { s.meshes[0].indices[2] = 3; },
+       "indices[2] = 3 is out of range (3 vertices)"},
+      {"incomplete triangle", [](Scene& s) { s.meshes[0].indices.push_back(0); },
+       "not a multiple of 3"},
+      {"normals for some vertices only",
+       [](Scene& s) {
+         s.meshes[0].normals = {{0, 0, 1}};
+       },
+       "attribute arrays"},
+      {"colours for too many vertices", [](Scene& s) { s.meshes[0].colors.resize(4); },
+       "attribute arrays"},
+      {"NaN position",
+       [](Scene& s) { s.meshes[0].positions[1].y = std::numeric_limits<float>::quiet_NaN(); },
+       "positions[1] is not finite"},
+      {"infinite position", [](Scene& s) { s.meshes[0].positions[0].x = INFINITY; },
+       "positions[0] is not finite"},
       {"missing material", [](Scene& s) { s.meshes[0].material = 1; }, "material 1 does not exist"},
-      {"material below −1", [](Scene& s) { s.meshes[0].material = -2; }, "material -2 does not exist"},
-      {"instance of a missing mesh", [](Scene& s) { s.instances[0].mesh = 1; }, "instances[0]: mesh 1 does not exist"},
+      {"material below −1", [](Scene& s) { s.meshes[0].material = -2; },
+       "material -2 does not exist"},
+      {"instance of a missing mesh", [](Scene& s) { s.instances[0].mesh = 1; },
+       "instances[0]: mesh 1 does not exist"},
       {"negative mesh index", [](Scene& s) { s.instances[0].mesh = -1; }, "instances[0]: mesh -1"},
-      {"non-finite transform", [](Scene& s) { s.instances[0].transform.m[3][0] = NAN; }, "transform is not finite"},
+      {"non-finite transform", [](Scene& s) { s.instances[0].transform.m[3][0] = NAN; },
+       "transform is not finite"},
   };
   for (const Row& row : rows) {
     SCOPED_TRACE(row.why);

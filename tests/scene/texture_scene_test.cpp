@@ -1,10 +1,10 @@
 // Textures, fog, lights and the pixel-shading material keys in the scene loaders: glTF materials
 // (baseColorTexture with its sampler's wrap modes, embedded and external PNG images, alphaMode),
 // the JSON format's "textures", "fog", "pointLights", "colorTable" and material keys, OBJ's map_Kd.
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <string>
-
-#include <gtest/gtest.h>
 
 #include "scene/scene_test_util.h"
 #include "synthvis/image.h"
@@ -38,7 +38,8 @@ std::string pngBytes(const TempDir& dir) {
 
 uint16_t srgbTo16(int byte) {
   const double v = byte / 255.0;
-  return uint16_t(std::lround((v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4)) * 65535));
+  return uint16_t(
+      std::lround((v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4)) * 65535));
 }
 
 // One triangle whose material `material` uses texture 0; images and samplers as given.
@@ -62,13 +63,13 @@ GltfBuilder texturedTriangle(nlohmann::json material, nlohmann::json textures,
 TEST(GltfTextures, BaseColorTextureWithItsSamplerAndAlphaModeMapToTheMaterial) {
   TempDir dir;
   const std::string uri = "data:image/png;base64," + testing::base64(pngBytes(dir));
-  GltfBuilder b = texturedTriangle(
-      {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}},
-       {"alphaMode", "MASK"},
-       {"alphaCutoff", 0.3}},
-      nlohmann::json::array({{{"source", 0}, {"sampler", 0}}}),
-      nlohmann::json::array({{{"uri", uri}}}),
-      nlohmann::json::array({{{"wrapS", 33071}, {"wrapT", 33648}}}));
+  GltfBuilder b =
+      texturedTriangle({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}},
+                        {"alphaMode", "MASK"},
+                        {"alphaCutoff", 0.3}},
+                       nlohmann::json::array({{{"source", 0}, {"sampler", 0}}}),
+                       nlohmann::json::array({{{"uri", uri}}}),
+                       nlohmann::json::array({{{"wrapS", 33071}, {"wrapT", 33648}}}));
   Result<Scene> r = loadGltfFromMemory(b.gltf(), "t.gltf");
   ASSERT_TRUE(r.ok()) << r.error().str();
   const Scene& s = r.value();
@@ -96,13 +97,13 @@ TEST(GltfTextures, BaseColorTextureWithItsSamplerAndAlphaModeMapToTheMaterial) {
 TEST(GltfTextures, DefaultSamplerRepeatsAndOneImageServesTwoSamplersAsTwoTextures) {
   TempDir dir;
   const std::string uri = "data:image/png;base64," + testing::base64(pngBytes(dir));
-  GltfBuilder b = texturedTriangle(
-      {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 1}}}}}},
-      nlohmann::json::array({{{"source", 0}}, {{"source", 0}, {"sampler", 0}}}),
-      nlohmann::json::array({{{"uri", uri}}}),
-      nlohmann::json::array({{{"wrapS", 33071}, {"wrapT", 33071}}}));
-  b.doc["materials"].push_back({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}},
-                                {"alphaMode", "BLEND"}});
+  GltfBuilder b =
+      texturedTriangle({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 1}}}}}},
+                       nlohmann::json::array({{{"source", 0}}, {{"source", 0}, {"sampler", 0}}}),
+                       nlohmann::json::array({{{"uri", uri}}}),
+                       nlohmann::json::array({{{"wrapS", 33071}, {"wrapT", 33071}}}));
+  b.doc["materials"].push_back(
+      {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}, {"alphaMode", "BLEND"}});
   Result<Scene> r = loadGltfFromMemory(b.gltf(), "t.gltf");
   ASSERT_TRUE(r.ok()) << r.error().str();
   ASSERT_EQ(r->textures.size(), 2u);
@@ -114,9 +115,10 @@ TEST(GltfTextures, DefaultSamplerRepeatsAndOneImageServesTwoSamplersAsTwoTexture
 TEST(GltfTextures, ExternalImageIsReadRelativeToTheFile) {
   TempDir dir;
   dir.write("images/t.png", pngBytes(dir));
-  GltfBuilder b = texturedTriangle({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}},
-                                   nlohmann::json::array({{{"source", 0}}}),
-                                   nlohmann::json::array({{{"uri", "images/t.png"}}}), nullptr);
+  GltfBuilder b =
+      texturedTriangle({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}},
+                       nlohmann::json::array({{{"source", 0}}}),
+                       nlohmann::json::array({{{"uri", "images/t.png"}}}), nullptr);
   const std::string path = dir.write("m.gltf", b.gltf());
   Result<Scene> r = loadGltf(path);
   ASSERT_TRUE(r.ok()) << r.error().str();
@@ -138,10 +140,9 @@ TEST(GltfTextures, ProblemsAreNamed) {
   };
   const auto textures = nlohmann::json::array({{{"source", 0}}});
   EXPECT_TRUE(contains(
-      error(texturedTriangle({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}},
-                             textures,
-                             nlohmann::json::array({{{"uri", "data:image/jpeg;base64,/9j/4AAQSkZJRg=="}}}),
-                             nullptr)),
+      error(texturedTriangle(
+          {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}, textures,
+          nlohmann::json::array({{{"uri", "data:image/jpeg;base64,/9j/4AAQSkZJRg=="}}}), nullptr)),
       "only PNG textures are supported"));
   EXPECT_TRUE(contains(
       error(texturedTriangle(
@@ -220,7 +221,8 @@ TEST(JsonTextures, ProblemsAreNamed) {
                        "materials[0].textureFilter: unknown texture filter 'cubic'"));
   EXPECT_TRUE(contains(error(R"("materials": [{"colorCode": 0}])"), "no 'colorTable'"));
   EXPECT_TRUE(contains(error(R"("fog": {"beta": -1})"), "fog.beta"));
-  EXPECT_TRUE(contains(error(R"("pointLights": [{"color": [1, 1, 1]}])"), "missing key 'position'"));
+  EXPECT_TRUE(
+      contains(error(R"("pointLights": [{"color": [1, 1, 1]}])"), "missing key 'position'"));
   // The texel budget: checked before a texture is generated.
   LoadOptions small;
   small.maxTexels = 5000;
@@ -235,8 +237,9 @@ TEST(ObjTextures, MapKdIsReadAndVRunsDownTheImage) {
   TempDir dir;
   dir.write("t.png", pngBytes(dir));
   dir.write("m.mtl", "newmtl tex\nKd 1 1 1\nmap_Kd t.png\n");
-  const std::string path = dir.write(
-      "m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl tex\nf 1/1 2/2 3/3\n");
+  const std::string path = dir.write("m.obj",
+                                     "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt "
+                                     "0 1\nusemtl tex\nf 1/1 2/2 3/3\n");
   Result<Scene> r = loadObj(path);
   ASSERT_TRUE(r.ok()) << r.error().str();
   ASSERT_EQ(r->textures.size(), 1u);

@@ -7,7 +7,6 @@
 #include <random>
 
 #include "hwy/targets.h"
-
 #include "shade/shading.h"
 #include "texture/footprint.h"
 #include "texture/texture.h"
@@ -114,7 +113,8 @@ TEST(LevelOfDetail, NearestPicksTheLevelPixelFootprintNames) {
     const bool level0 = std::floor(fp.lod + 0.5) == 0;
     for (int i = 0; i < kMaxFragments; ++i) {
       if (level0)
-        EXPECT_TRUE(out[0][i] == 0 || out[0][i] == 1) << "s " << s << " lane " << i << ": " << out[0][i];
+        EXPECT_TRUE(out[0][i] == 0 || out[0][i] == 1)
+            << "s " << s << " lane " << i << ": " << out[0][i];
       else
         EXPECT_NEAR(out[0][i], 0.5, 0.01) << "s " << s << " lane " << i;
     }

@@ -41,7 +41,8 @@ render::DrawPackets randomScene(int width, int height, int count, unsigned seed,
     const double cx = u01(rng) * width, cy = u01(rng) * height;
     geometry::ClipVertex v[3];
     for (auto& vert : v) {
-      const float w = wild && u01(rng) < 0.15 ? float(u01(rng) * 2 - 0.5) : float(0.5 + u01(rng) * 3);
+      const float w =
+          wild && u01(rng) < 0.15 ? float(u01(rng) * 2 - 0.5) : float(0.5 + u01(rng) * 3);
       const float z = wild ? float(u01(rng) * 1.4 - 0.2) : float(u01(rng));
       vert = pixelVertex(cx + (u01(rng) - 0.5) * size, cy + (u01(rng) - 0.5) * size, width, height,
                          z, w, float(u01(rng)), float(u01(rng)), float(u01(rng)));
@@ -52,7 +53,8 @@ render::DrawPackets randomScene(int width, int height, int count, unsigned seed,
         vert.z = float(u01(rng) * 2 - 1);
       }
     }
-    addTriangle(p, v[0], v[1], v[2], t % 3 == 0 ? geometry::CullMode::back : geometry::CullMode::none);
+    addTriangle(p, v[0], v[1], v[2],
+                t % 3 == 0 ? geometry::CullMode::back : geometry::CullMode::none);
   }
   return p;
 }

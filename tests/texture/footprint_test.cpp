@@ -1,12 +1,12 @@
 // The pixel footprint (SPEC §7 level of detail): the Jacobian ellipse against the pixel circle
 // projected numerically onto a textured plane through exact ray–plane intersection, and the seed's
 // planar formula against the same projection (exact at the centre, ≈ 20 % at the corners).
+#include "texture/footprint.h"
+
 #include <gtest/gtest.h>
 
 #include <array>
 #include <cmath>
-
-#include "texture/footprint.h"
 
 namespace sv::texture {
 namespace {
@@ -87,7 +87,8 @@ TEST(Footprint, JacobianEllipseMatchesTheProjectedPixelCircle) {
       ASSERT_GT(Q.value, 0);
       const Footprint f = pixelFootprint(U, V, Q, v.texels, v.texels);
       const double numeric = v.projectedDiameter(px, py);
-      EXPECT_NEAR(f.major, numeric, 0.02 * numeric) << "tilt " << tilt << " pixel " << px << "," << py;
+      EXPECT_NEAR(f.major, numeric, 0.02 * numeric)
+          << "tilt " << tilt << " pixel " << px << "," << py;
       EXPECT_LE(f.minor, f.major);
       EXPECT_NEAR(f.lod, std::max(0.0, std::log2(f.major)), 1e-12);
       if (tilt >= 70) {
@@ -122,7 +123,8 @@ TEST(Footprint, SeedFormulaAgreesAtTheCentreAndWithinItsStatedErrorElsewhere) {
     EXPECT_NEAR(seed(320, 240), centre, 0.03 * centre) << tilt;
     for (auto [px, py] : {std::array<int, 2>{0, 0}, {639, 479}, {0, 479}, {639, 0}}) {
       const double numeric = v.projectedDiameter(px, py);
-      EXPECT_NEAR(seed(px, py), numeric, 0.25 * numeric) << "tilt " << tilt << " corner " << px << "," << py;
+      EXPECT_NEAR(seed(px, py), numeric, 0.25 * numeric)
+          << "tilt " << tilt << " corner " << px << "," << py;
     }
   }
 }

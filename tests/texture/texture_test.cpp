@@ -1,8 +1,9 @@
 // Texture maps (SPEC §7): wrap modes, the seed's pyramid against a direct evaluation of its 3×3
 // triangle filter, three-point interpolation against the seed's formulas at the corners, on the
 // diagonal and at the centre, bilinear and trilinear, and PNG decoding to linear light.
-#include <gtest/gtest.h>
+#include "texture/texture.h"
 
+#include <gtest/gtest.h>
 #include <png.h>
 
 #include <cmath>
@@ -11,7 +12,6 @@
 
 #include "hwy/targets.h"
 #include "texture/footprint.h"
-#include "texture/texture.h"
 
 namespace sv::texture {
 namespace {
@@ -71,8 +71,8 @@ TEST(Pyramid, LevelsAreTheTriangleFilterOfTheLevelAboveDecimatedByTwo) {
           const Texel& got = level.at(x, y);
           const uint16_t c[4] = {got.r, got.g, got.b, got.a};
           for (int ch = 0; ch < 4; ++ch)
-            ASSERT_EQ(c[ch], uint16_t(std::floor(sum[ch] + 0.5))) << "level " << k << " texel " << x
-                                                                   << "," << y << " channel " << ch;
+            ASSERT_EQ(c[ch], uint16_t(std::floor(sum[ch] + 0.5)))
+                << "level " << k << " texel " << x << "," << y << " channel " << ch;
         }
     }
     const Texture tex(chain[0], wrap, wrap);
@@ -137,11 +137,12 @@ TEST(PackedTexels, RoundTripWithinHalfACodeAndPremultipliedColourStaysBelowAlpha
 float channel(const Color4& c) { return c.r; }
 float value(const Texture& t, int x, int y) { return t.texel(0, x, y).r; }
 
-// SPEC §7, seed 001: Θ ≥ γ: R = γR3 + (Θ − γ)R4 + (1 − Θ)R1; Θ < γ: R = ΘR3 + (γ − Θ)R2 + (1 − γ)R1,
-// with R1…R4 at (0,0), (1,0), (1,1), (0,1).
+// SPEC §7, seed 001: Θ ≥ γ: R = γR3 + (Θ − γ)R4 + (1 − Θ)R1; Θ < γ: R = ΘR3 + (γ − Θ)R2 + (1 −
+// γ)R1, with R1…R4 at (0,0), (1,0), (1,1), (0,1).
 TEST(Samplers, ThreePointFollowsTheSeedAtCornersDiagonalAndCentre) {
   const Texture tex(randomLevel(4, 4, 9), Wrap::repeat, Wrap::repeat);
-  const float r1 = value(tex, 1, 1), r2 = value(tex, 2, 1), r3 = value(tex, 2, 2), r4 = value(tex, 1, 2);
+  const float r1 = value(tex, 1, 1), r2 = value(tex, 2, 1), r3 = value(tex, 2, 2),
+              r4 = value(tex, 1, 2);
   const float eps = 1e-6f;
   // Corners: the texels themselves.
   EXPECT_NEAR(channel(tex.threePoint(0, 1, 1)), r1, eps);
@@ -165,16 +166,17 @@ TEST(Samplers, NearestBilinearAndTrilinear) {
   EXPECT_NEAR(channel(tex.nearest(0, -0.6f, 0.2f)), value(tex, 7, 0), 1e-6f);  // wrapped
   // Bilinear is exact at texel centres and linear along an edge.
   EXPECT_NEAR(channel(tex.bilinear(0, 3, 4)), value(tex, 3, 4), 1e-6f);
-  EXPECT_NEAR(channel(tex.bilinear(0, 3.25f, 4)), 0.75f * value(tex, 3, 4) + 0.25f * value(tex, 4, 4),
-              1e-6f);
+  EXPECT_NEAR(channel(tex.bilinear(0, 3.25f, 4)),
+              0.75f * value(tex, 3, 4) + 0.25f * value(tex, 4, 4), 1e-6f);
   // Trilinear: an integer level of detail is that level's bilinear sample (level-0 coordinates
   // scaled by 2^-k); halfway between two levels is their mean.
   EXPECT_NEAR(channel(tex.trilinear(1, 4.0f, 6.0f)), channel(tex.bilinear(1, 2.0f, 3.0f)), 1e-6f);
   const float a = channel(tex.bilinear(1, 2.5f, 1.5f)), b = channel(tex.bilinear(2, 1.25f, 0.75f));
   EXPECT_NEAR(channel(tex.trilinear(1.5f, 5.0f, 3.0f)), 0.5f * (a + b), 1e-6f);
-  EXPECT_NEAR(channel(tex.trilinearThreePoint(1.5f, 5.0f, 3.0f)),
-              0.5f * (channel(tex.threePoint(1, 2.5f, 1.5f)) + channel(tex.threePoint(2, 1.25f, 0.75f))),
-              1e-6f);
+  EXPECT_NEAR(
+      channel(tex.trilinearThreePoint(1.5f, 5.0f, 3.0f)),
+      0.5f * (channel(tex.threePoint(1, 2.5f, 1.5f)) + channel(tex.threePoint(2, 1.25f, 0.75f))),
+      1e-6f);
   // Beyond the last level the 1×1 level is all there is.
   EXPECT_NEAR(channel(tex.trilinear(10, 3, 3)), tex.level(3).at(0, 0).r, 1e-6f);
 }
@@ -188,8 +190,8 @@ TEST(Samplers, AnisotropicKeepsDetailAcrossAThinFootprint) {
   l.texels.resize(64 * 64);
   for (int y = 0; y < 64; ++y)
     for (int x = 0; x < 64; ++x)
-      l.texels[size_t(y) * 64 + size_t(x)] = (y / 4) % 2 ? Texel{65535, 65535, 65535, 65535}
-                                                         : Texel{0, 0, 0, 65535};
+      l.texels[size_t(y) * 64 + size_t(x)] =
+          (y / 4) % 2 ? Texel{65535, 65535, 65535, 65535} : Texel{0, 0, 0, 65535};
   const Texture tex(l, Wrap::repeat, Wrap::repeat);
   Footprint f;
   f.major = 16;
