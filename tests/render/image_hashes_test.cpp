@@ -1,7 +1,8 @@
 // Every kind of image the project makes, held bit for bit: each scene in scenes/, the built-in demo
 // and every bench generator, at 1 and 16 samples, with the options that take other paths through
 // the frame (masking, filters, supersampling, debug views, the free-form methods) — rendered on
-// every compiled SIMD target and compared with the hashes recorded in tests/golden/image_hashes.txt.
+// every compiled SIMD target and compared with the hashes recorded in
+// tests/golden/image_hashes.txt.
 //
 // A refactor must leave every image the same; when a change means to alter images, look at them
 // (`synthvis render`), then record the new hashes:
@@ -17,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "reference/ground_truth.h"
 #include "reference/suite.h"
 #include "synthvis/render.h"
 
@@ -94,13 +96,15 @@ std::vector<HashCase> hashCases() {
   both("freeform", generatorCase("freeform"), none);
   both("freeform-one", generatorCase("freeform-one"), none);
   // Other paths through the frame.
-  both("demo-priority", fileCase(""), [](RenderOptions& o) { o.hsr = RenderOptions::Hsr::priority; });
+  both("demo-priority", fileCase(""),
+       [](RenderOptions& o) { o.hsr = RenderOptions::Hsr::priority; });
   both("demo-hybrid", fileCase(""), [](RenderOptions& o) { o.hsr = RenderOptions::Hsr::hybrid; });
   reference::BenchCase f2b = generatorCase("layers");
   f2b.layers.order = scene::SubmitOrder::frontToBack;
   both("layers-f2b-priority", f2b, [](RenderOptions& o) { o.hsr = RenderOptions::Hsr::priority; });
-  both("layers-textured-hybrid", generatorCase("layers"),
-       [](RenderOptions& o) { o.hsr = RenderOptions::Hsr::hybrid; }, true);
+  both(
+      "layers-textured-hybrid", generatorCase("layers"),
+      [](RenderOptions& o) { o.hsr = RenderOptions::Hsr::hybrid; }, true);
   both("mixed-tent3", fileCase("scenes/mixed.json"),
        [](RenderOptions& o) { o.filter = RenderOptions::Filter::tent3; });
   both("freeform-mixed-tent3", fileCase("scenes/freeform-mixed.json"),
@@ -195,8 +199,8 @@ TEST(ImageHashes, EveryImageOnEveryTargetIsTheRecordedOne) {
       const std::string h = hashText(imageHash(image));
       if (targets == 1) first[c.name] = h;
       if (update) {
-        EXPECT_EQ(h, first[c.name]) << c.name << " on " << hwy::TargetName(target)
-                                    << " differs from the first target";
+        EXPECT_EQ(h, first[c.name])
+            << c.name << " on " << hwy::TargetName(target) << " differs from the first target";
         continue;
       }
       const auto it = recorded.find(c.name);
@@ -207,12 +211,32 @@ TEST(ImageHashes, EveryImageOnEveryTargetIsTheRecordedOne) {
   }
   hwy::SetSupportedTargetsForTest(0);
   EXPECT_GE(targets, 1);
+  // The ground truth (`synthvis truth`) and its edge mask: scalar code, once.
+  for (const char* file : {"", "scenes/mixed.json", "scenes/aa-edges.json"}) {
+    auto loaded = *file ? scene::loadScene(std::string(SV_SOURCE_DIR) + "/" + file)
+                        : Result<scene::Scene>(scene::demoScene());
+    ASSERT_TRUE(loaded.ok()) << file;
+    reference::GroundTruthOptions g{baseOptions(1), 4};
+    Image edges;
+    auto truth = reference::renderGroundTruth(loaded.value(), g, &edges);
+    ASSERT_TRUE(truth.ok()) << file << ": " << truth.error().str();
+    const std::string name = std::string("truth:") + (*file ? file : "demo");
+    for (const auto& [suffix, image] :
+         {std::pair{"", &truth.value()}, std::pair{"-edges", &edges}}) {
+      const std::string h = hashText(imageHash(*image)), key = name + suffix;
+      first[key] = h;
+      if (update) continue;
+      const auto it = recorded.find(key);
+      ASSERT_NE(it, recorded.end()) << key << ": no hash recorded in " << kHashFile;
+      EXPECT_EQ(h, it->second) << key << " is not the recorded image";
+    }
+  }
   if (update) {
     std::ofstream out(kHashFile);
-    for (const HashCase& c : cases) out << c.name << " " << first[c.name] << "\n";
+    for (const auto& [name, hash] : first) out << name << " " << hash << "\n";
     ASSERT_TRUE(out.good()) << "cannot write " << kHashFile;
   } else {
-    EXPECT_EQ(recorded.size(), cases.size()) << kHashFile << " records cases no longer rendered";
+    EXPECT_EQ(recorded.size(), first.size()) << kHashFile << " records cases no longer rendered";
   }
 }
 
