@@ -62,7 +62,7 @@ struct CastSettings {
   // nearer than the cell are skipped at every level. Off: every cell is refined (the image is the
   // same; tests compare).
   bool masking = true;
-  // With several samples per pixel (FreeFormFrame): cast the pixel centres, and every sample only
+  // With several samples per pixel (FreeFormPass): cast the pixel centres, and every sample only
   // in pixels whose 3×3 neighbourhood of centres does not see one and the same form (silhouettes,
   // forms crossing) or whose polygon samples lie within the form's depth range over the pixel
   // (intersection curves); elsewhere the centre's hit stands for all samples. Off: every sample

@@ -1,6 +1,6 @@
 // Bounds of the free-form caster in SIMD lanes (Highway, per target). ProjectedFreeForm::
 // slabsHolding: one screen window's slabs in depth (the binary tree in depth of Caster::cell,
-// raycast.cpp, and of FreeFormFrame::markTiles), every slab a lane; the window's x and y are the
+// raycast.cpp, and of FreeFormPass::markTiles), every slab a lane; the window's x and y are the
 // same for all its slabs, so what depends on them alone — per quadric, its centre's quadratic in z
 // and the gradient's linear terms — is worked out once per window instead of once per slab.
 // ProjectedFreeForm::boundWindows: the bound with its slope of several windows over one depth

@@ -24,7 +24,7 @@ namespace {
 // What every vertex of one call shares, and the one-vertex transform.
 struct VertexRun {
   VertexRun(const scene::Mesh& mesh_, const scene::Material& material_, const Mat4& model_,
-            const VertexContext& context_, const shade::AttributeLayout* layout_)
+            const VertexContext& context_, const AttributeLayout* layout_)
       : mesh(mesh_),
         material(material_),
         model(model_),
@@ -78,28 +78,28 @@ struct VertexRun {
       auto put = [&](int k, float value) {
         if (layout->stored >> k & 1) a[layout->slot[k]] = value;
       };
-      if (layout->stored & (1u << shade::kU | 1u << shade::kV)) {
+      if (layout->stored & (1u << kU | 1u << kV)) {
         const Vec2 uv = mesh.uvs.empty() ? Vec2{0, 0} : mesh.uvs[i];
-        put(shade::kU, uv.x * material.uvScale.x);
-        put(shade::kV, uv.y * material.uvScale.y);
+        put(kU, uv.x * material.uvScale.x);
+        put(kV, uv.y * material.uvScale.y);
       }
       if (layout->stored &
-          (1u << shade::kNormalX | 1u << shade::kNormalY | 1u << shade::kNormalZ)) {
+          (1u << kNormalX | 1u << kNormalY | 1u << kNormalZ)) {
         // Phong's normal; a mesh without normals (or an unlit material) gets none and is not lit.
         const Vec3 n = lit && material.phong
                            ? normalize(normalToEye.transformDirection(mesh.normals[i]))
                            : Vec3{0, 0, 0};
-        put(shade::kNormalX, n.x);
-        put(shade::kNormalY, n.y);
-        put(shade::kNormalZ, n.z);
+        put(kNormalX, n.x);
+        put(kNormalY, n.y);
+        put(kNormalZ, n.z);
       }
-      if (layout->stored & (1u << shade::kEyeX | 1u << shade::kEyeY | 1u << shade::kEyeZ)) {
+      if (layout->stored & (1u << kEyeX | 1u << kEyeY | 1u << kEyeZ)) {
         const Vec3 e = modelView.transformPoint(p);
-        put(shade::kEyeX, e.x);
-        put(shade::kEyeY, e.y);
-        put(shade::kEyeZ, e.z);
+        put(kEyeX, e.x);
+        put(kEyeY, e.y);
+        put(kEyeZ, e.z);
       }
-      put(shade::kAlpha, alpha);
+      put(kAlpha, alpha);
     }
     return finite;
   }
@@ -108,7 +108,7 @@ struct VertexRun {
   const scene::Material& material;
   const Mat4& model;
   const VertexContext& context;
-  const shade::AttributeLayout* layout;
+  const AttributeLayout* layout;
   const Mat4 mvp, modelView, normalToWorld, normalToEye;
   const scene::Light& light;
   bool lit = false, vertexLit = false;
@@ -172,7 +172,7 @@ HWY_INLINE VF unitClamp(DF df, VF v) {  // std::clamp(v, 0.0f, 1.0f)
 
 bool TransformVertices(const scene::Mesh& mesh, const scene::Material& material, const Mat4& model,
                        const VertexContext& context, size_t begin, size_t end, ClipVertex* out,
-                       float* attributes, const shade::AttributeLayout* layout) {
+                       float* attributes, const AttributeLayout* layout) {
   const VertexRun run(mesh, material, model, context, layout);
   const DF df;
   const size_t N = hn::Lanes(df);
@@ -180,7 +180,7 @@ bool TransformVertices(const scene::Mesh& mesh, const scene::Material& material,
   const size_t stride = stored ? size_t(layout->stride) : 0;
   const VF big = hn::Set(df, std::numeric_limits<float>::max());
   auto finiteLanes = hn::Eq(big, big);
-  alignas(64) float position[4 * 16], color[4 * 16], attribute[shade::kAttributeCount][16];
+  alignas(64) float position[4 * 16], color[4 * 16], attribute[kAttributeCount][16];
   size_t i = begin;
   for (; i + N <= end; i += N) {
     V3 p;
@@ -241,31 +241,31 @@ bool TransformVertices(const scene::Mesh& mesh, const scene::Material& material,
     auto put = [&](int k, VF v) {
       if (stored >> k & 1) hn::Store(v, df, attribute[k]);
     };
-    if (stored & (1u << shade::kU | 1u << shade::kV)) {
+    if (stored & (1u << kU | 1u << kV)) {
       VF u = hn::Zero(df), v = hn::Zero(df);
       if (!mesh.uvs.empty()) hn::LoadInterleaved2(df, &mesh.uvs[i].x, u, v);
-      put(shade::kU, hn::Mul(u, hn::Set(df, material.uvScale.x)));
-      put(shade::kV, hn::Mul(v, hn::Set(df, material.uvScale.y)));
+      put(kU, hn::Mul(u, hn::Set(df, material.uvScale.x)));
+      put(kV, hn::Mul(v, hn::Set(df, material.uvScale.y)));
     }
-    if (stored & (1u << shade::kNormalX | 1u << shade::kNormalY | 1u << shade::kNormalZ)) {
+    if (stored & (1u << kNormalX | 1u << kNormalY | 1u << kNormalZ)) {
       V3 n{hn::Zero(df), hn::Zero(df), hn::Zero(df)};
       if (run.lit && material.phong) {
         hn::LoadInterleaved3(df, &mesh.normals[i].x, n.x, n.y, n.z);
         n = normalized(df, transform(df, run.normalToEye, n, 0.0f));
       }
-      put(shade::kNormalX, n.x);
-      put(shade::kNormalY, n.y);
-      put(shade::kNormalZ, n.z);
+      put(kNormalX, n.x);
+      put(kNormalY, n.y);
+      put(kNormalZ, n.z);
     }
-    if (stored & (1u << shade::kEyeX | 1u << shade::kEyeY | 1u << shade::kEyeZ)) {
+    if (stored & (1u << kEyeX | 1u << kEyeY | 1u << kEyeZ)) {
       const V3 e = transform(df, run.modelView, p, 1.0f);
-      put(shade::kEyeX, e.x);
-      put(shade::kEyeY, e.y);
-      put(shade::kEyeZ, e.z);
+      put(kEyeX, e.x);
+      put(kEyeY, e.y);
+      put(kEyeZ, e.z);
     }
-    put(shade::kAlpha, a);
+    put(kAlpha, a);
     float* dst = attributes + (i - begin) * stride;
-    for (int k = 0; k < shade::kAttributeCount; ++k)
+    for (int k = 0; k < kAttributeCount; ++k)
       if (stored >> k & 1)
         for (size_t j = 0; j < N; ++j) dst[j * stride + layout->slot[k]] = attribute[k][j];
   }
@@ -286,7 +286,7 @@ HWY_EXPORT(TransformVertices);
 
 bool transformVertices(const scene::Mesh& mesh, const scene::Material& material, const Mat4& model,
                        const VertexContext& context, size_t begin, size_t end, ClipVertex* out,
-                       float* attributes, const shade::AttributeLayout* layout) {
+                       float* attributes, const AttributeLayout* layout) {
   return HWY_DYNAMIC_DISPATCH(TransformVertices)(mesh, material, model, context, begin, end, out,
                                                  attributes, layout);
 }

@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "geometry/setup.h"
-#include "shade/shading.h"
+#include "geometry/attributes.h"
 #include "synthvis/scene.h"
 
 namespace sv::geometry {
@@ -19,7 +19,7 @@ struct VertexContext {
 };
 
 // Writes the clip-space vertices of mesh vertices [begin, end) to out[0 … end − begin), and, when
-// `attributes` is not null, their pixel-shading attributes (shade::Attribute: uv, eye-space normal
+// `attributes` is not null, their pixel-shading attributes (Attribute: uv, eye-space normal
 // and position, alpha) that `layout` stores, vertex i's at attributes[i·layout.stride + slot].
 // `model` places the mesh in the world. Colour = material colour × vertex colour × light intensity,
 // where intensity = ambient + (1 − ambient)·Σ max(0, n·l)·lightColour over the directional light
@@ -31,7 +31,7 @@ struct VertexContext {
 // positions are read anyway: the renderer skips it in validate).
 bool transformVertices(const scene::Mesh& mesh, const scene::Material& material, const Mat4& model,
                        const VertexContext& context, size_t begin, size_t end, ClipVertex* out,
-                       float* attributes = nullptr, const shade::AttributeLayout* layout = nullptr);
+                       float* attributes = nullptr, const AttributeLayout* layout = nullptr);
 
 // The bound of an object whose vertices lie in the box [lo, hi] placed by `mvp` (object → clip):
 // the projected corners' pixel box, widened by two pixels for vertex rounding and sample

@@ -6,12 +6,13 @@
 
 #include <algorithm>
 #include <cstdint>
-#include <functional>
+#include <span>
 
 #include "geometry/setup.h"
 #include "raster/binner.h"
 #include "raster/coverage_masks.h"
 #include "raster/occupancy.h"
+#include "raster/tile_pass.h"
 #include "shade/shading.h"
 
 namespace sv::raster {
@@ -140,11 +141,12 @@ struct TileWork {
   // (Binner::Box), or nullptr. A triangle whose box lies in occupied windows is dropped before
   // its records — setup and pixel shading's — are read (in a deep stack of layers, most are).
   const Binner::Box* const* listBoxes = nullptr;
-  // Called once per tile when its opaque triangles are all drawn (and shaded) — before its first
-  // translucent one, or after its last triangle in the frame's last batch — with the tile's
-  // buffers as they stand: free forms are drawn there (freeform/tile_pass.h). `opaqueDone` is set
-  // when it has been called (kept across batches by the caller).
-  const std::function<void()>* afterOpaque = nullptr;
+  // The passes that run once the tile's opaque triangles are all drawn (and shaded) — before its
+  // first translucent one, or after its last triangle in the frame's last batch — in order, into
+  // the tile's buffers as they stand (PassStage surfaces and volumes: free forms, tile_pass.h), on
+  // `worker`. `opaqueDone` is set when they have run (kept across batches by the caller).
+  std::span<TilePass* const> afterOpaque;
+  int worker = 0;
   uint8_t* opaqueDone = nullptr;
   bool lastBatch = true;
   // After the tile's triangles: its colour replaced by the occupancy view — the red channel 0

@@ -1983,11 +1983,12 @@ HWY_NOINLINE void occupyFromDepth(const TileContext& ctx, float clearDepth) {
     }
 }
 
-// The tile's opaque surfaces are all in: TileWork::afterOpaque, once.
+// The tile's opaque surfaces are all in: TileWork::afterOpaque's passes, once.
 void afterOpaque(const TileWork& w) {
-  if (!w.afterOpaque || !w.opaqueDone || *w.opaqueDone) return;
+  if (w.afterOpaque.empty() || !w.opaqueDone || *w.opaqueDone) return;
   *w.opaqueDone = true;
-  (*w.afterOpaque)();
+  const TileTarget target{w.tileX, w.tileY, w.depth, w.color, w.worker};
+  for (TilePass* pass : w.afterOpaque) pass->drawTile(target);
 }
 
 template <ShadeMode kShade, bool kAA>

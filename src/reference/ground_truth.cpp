@@ -4,10 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <vector>
 
 #include "core/thread_pool.h"
-#include "geometry/vertex_stage.h"
+#include "render/draw_packets.h"
 
 namespace sv::reference {
 namespace {
@@ -34,163 +35,173 @@ uint8_t srgbFromLinear(double l) {
   return uint8_t(std::lround(e * 255.0));
 }
 
+// Stratified samples: one per cell of an n×n grid, jittered inside it by a hash of the pixel,
+// cell and axis (deterministic). A regular grid would favour the regular patterns it is used to
+// judge — its own error is correlated with theirs: against a regular 16×16 truth, 4×4
+// supersampling looked 1.5× better than 16 n-rooks samples on mixed.json, against this one they
+// are level (docs/quality.md). One sample per pixel stays at the centre (point sampling).
+double jitter(int n, int x, int y, int sx, int sy, int axis) {
+  if (n == 1) return 0.5;
+  uint64_t h = (uint64_t(uint32_t(x)) << 32 | uint32_t(y)) * 0x9E3779B97F4A7C15ull ^
+               (uint64_t(sx) << 24 | uint64_t(sy) << 8 | uint64_t(axis));
+  h ^= h >> 31;  // splitmix64 finalizer
+  h *= 0xBF58476D1CE4E5B9ull;
+  h ^= h >> 27;
+  h *= 0x94D049BB133111EBull;
+  h ^= h >> 31;
+  return (double(h >> 11) + 0.5) / 9007199254740992.0;  // (0, 1)
+}
+
+// Triangle c's 2D homogeneous form and pixel box on a W × H raster, or nothing when it is not
+// finite, degenerate, culled as a back face, or off the raster.
+std::optional<Tri> homogeneousTriangle(const geometry::ClipVertex* const c[3], bool cullBack, int W,
+                                       int H) {
+  double V[3][3];
+  bool finite = true;
+  for (int k = 0; k < 3; ++k) {
+    V[k][0] = c[k]->x;
+    V[k][1] = c[k]->y;
+    V[k][2] = c[k]->w;
+    finite &= std::isfinite(c[k]->x) && std::isfinite(c[k]->y) && std::isfinite(c[k]->z) &&
+              std::isfinite(c[k]->w);
+  }
+  if (!finite) return std::nullopt;
+  Tri tri;
+  double adj[3][3];
+  for (int k = 0; k < 3; ++k) {
+    const double* a = V[(k + 1) % 3];
+    const double* b = V[(k + 2) % 3];
+    adj[k][0] = a[1] * b[2] - a[2] * b[1];
+    adj[k][1] = a[2] * b[0] - a[0] * b[2];
+    adj[k][2] = a[0] * b[1] - a[1] * b[0];
+  }
+  const double det = V[0][0] * adj[0][0] + V[0][1] * adj[0][1] + V[0][2] * adj[0][2];
+  if (!(std::fabs(det) > 0) || !std::isfinite(det)) return std::nullopt;
+  // Counter-clockwise in normalized device coordinates is the front (det > 0).
+  if (cullBack && det < 0) return std::nullopt;
+  for (int k = 0; k < 3; ++k) {
+    for (int q = 0; q < 3; ++q) tri.adj[k][q] = adj[k][q] / det;
+    tri.z[k] = c[k]->z;
+    tri.color[k][0] = c[k]->r;
+    tri.color[k][1] = c[k]->g;
+    tri.color[k][2] = c[k]->b;
+  }
+  // The box: from the projected vertices when all are in front of the eye, else everything.
+  tri.x0 = 0, tri.y0 = 0, tri.x1 = W - 1, tri.y1 = H - 1;
+  if (c[0]->w > 0 && c[1]->w > 0 && c[2]->w > 0) {
+    double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+    for (int k = 0; k < 3; ++k) {
+      const double px = (c[k]->x / double(c[k]->w) + 1) * 0.5 * W;
+      const double py = (1 - c[k]->y / double(c[k]->w)) * 0.5 * H;
+      lo[0] = std::min(lo[0], px), hi[0] = std::max(hi[0], px);
+      lo[1] = std::min(lo[1], py), hi[1] = std::max(hi[1], py);
+    }
+    tri.x0 = int(std::clamp(std::floor(lo[0]), 0.0, double(W - 1)));
+    tri.x1 = int(std::clamp(std::floor(hi[0]), 0.0, double(W - 1)));
+    tri.y0 = int(std::clamp(std::floor(lo[1]), 0.0, double(H - 1)));
+    tri.y1 = int(std::clamp(std::floor(hi[1]), 0.0, double(H - 1)));
+    if (hi[0] < 0 || lo[0] > W || hi[1] < 0 || lo[1] > H) return std::nullopt;
+  }
+  return tri;
+}
+
+// Every sample of rows [yb0, yb1) (`S` a pixel, n per side): depth test "less" against the
+// triangles in order, the winner's perspective-correct colour (`color`, 3 a sample, starting as
+// the background) and index (`id`, −1 for the background).
+void sampleBand(const std::vector<Tri>& tris, int W, int H, int n, int yb0, int yb1,
+                std::vector<float>& color, std::vector<int32_t>& id) {
+  const int S = n * n;
+  std::vector<float> depth(id.size(), std::numeric_limits<float>::infinity());
+  for (size_t ti = 0; ti < tris.size(); ++ti) {
+    const Tri& t = tris[ti];
+    const int ty0 = std::max(t.y0, yb0), ty1 = std::min(t.y1, yb1 - 1);
+    for (int y = ty0; y <= ty1; ++y)
+      for (int x = t.x0; x <= t.x1; ++x)
+        for (int sy = 0; sy < n; ++sy)
+          for (int sx = 0; sx < n; ++sx) {
+            const double X = 2 * (x + (sx + jitter(n, x, y, sx, sy, 0)) / n) / W - 1;
+            const double Y = 1 - 2 * (y + (sy + jitter(n, x, y, sx, sy, 1)) / n) / H;
+            double l[3], sum = 0;
+            bool inside = true;
+            for (int k = 0; k < 3; ++k) {
+              l[k] = t.adj[k][0] * X + t.adj[k][1] * Y + t.adj[k][2];
+              inside &= l[k] >= 0;
+              sum += l[k];
+            }
+            if (!inside || !(sum > 0)) continue;
+            const double z = l[0] * t.z[0] + l[1] * t.z[1] + l[2] * t.z[2];  // z / w
+            if (z < -1 || z > 1) continue;                                   // near, far
+            const size_t s = (size_t(y - yb0) * W + x) * S + size_t(sy * n + sx);
+            const float zf = float(0.5 * (z + 1));
+            if (!(zf < depth[s])) continue;
+            depth[s] = zf;
+            id[s] = int32_t(ti);
+            for (int ch = 0; ch < 3; ++ch)
+              color[s * 3 + ch] = float(std::clamp(
+                  (l[0] * t.color[0][ch] + l[1] * t.color[1][ch] + l[2] * t.color[2][ch]) / sum,
+                  0.0, 1.0));
+          }
+  }
+}
+
 }  // namespace
 
 Result<Image> renderGroundTruth(const scene::Scene& scene, const GroundTruthOptions& g,
                                 Image* edges) {
-  const RenderOptions& o = g.options;
+  RenderOptions o = g.options;
   if (Status s = validate(o); !s) return s.error();
   if (Status s = scene::validate(scene, ""); !s) return s.error();
   if (g.samplesPerSide < 1 || g.samplesPerSide > 32)
     return Error{"", "",
                  fmt::format("{} samples per side is out of range (1…32)", g.samplesPerSide)};
-  const Result<Mat4> camera = viewProjection(scene, o);
-  if (!camera.ok()) return camera.error();
   const int W = o.width, H = o.height, n = g.samplesPerSide, S = n * n;
-  // Stratified samples: one per cell of an n×n grid, jittered inside it by a hash of the pixel,
-  // cell and axis (deterministic). A regular grid would favour the regular patterns it is used to
-  // judge — its own error is correlated with theirs: against a regular 16×16 truth, 4×4
-  // supersampling looked 1.5× better than 16 n-rooks samples on mixed.json, against this one they
-  // are level (docs/quality.md). One sample per pixel stays at the centre (point sampling).
-  auto jitter = [n](int x, int y, int sx, int sy, int axis) {
-    if (n == 1) return 0.5;
-    uint64_t h = (uint64_t(uint32_t(x)) << 32 | uint32_t(y)) * 0x9E3779B97F4A7C15ull ^
-                 (uint64_t(sx) << 24 | uint64_t(sy) << 8 | uint64_t(axis));
-    h ^= h >> 31;  // splitmix64 finalizer
-    h *= 0xBF58476D1CE4E5B9ull;
-    h ^= h >> 27;
-    h *= 0x94D049BB133111EBull;
-    h ^= h >> 31;
-    return (double(h >> 11) + 0.5) / 9007199254740992.0;  // (0, 1)
-  };
+  core::ThreadPool pool(o.threads > 0 ? o.threads : 1);
 
-  // The same clip-space vertices and lit colours as synthvis's vertex stage.
+  // The same clip-space vertices and lit colours as synthvis's vertex stage: the render stage's
+  // draw packets, in submission order (the Z-buffer's), vertex colours only.
+  o.hsr = RenderOptions::Hsr::zbuffer;
+  const Result<render::FrameCamera> camera = render::frameCamera(scene, o);
+  if (!camera.ok()) return camera.error();
+  render::DrawPackets packets;
+  if (Status s = render::buildDrawPackets(scene, o, camera.value(), nullptr, pool, packets); !s)
+    return s.error();
   std::vector<Tri> tris;
-  const scene::Material defaultMaterial;
-  for (const scene::Instance& inst : scene.instances) {
-    const scene::Mesh& mesh = scene.meshes[size_t(inst.mesh)];
-    const scene::Material& mat =
-        mesh.material >= 0 ? scene.materials[size_t(mesh.material)] : defaultMaterial;
-    std::vector<geometry::ClipVertex> v(mesh.positions.size());
-    // (The eye-space `view` only places pixel-shading attributes, which are not asked for.)
-    geometry::transformVertices(mesh, mat, inst.transform,
-                                {Mat4{}, camera.value(), &scene.light, &scene.pointLights}, 0,
-                                v.size(), v.data());
-    const bool cullBack = o.cullBackFaces && !mat.doubleSided;
-    for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
-      const geometry::ClipVertex* c[3] = {&v[mesh.indices[t]], &v[mesh.indices[t + 1]],
-                                          &v[mesh.indices[t + 2]]};
-      double V[3][3];
-      bool finite = true;
-      for (int k = 0; k < 3; ++k) {
-        V[k][0] = c[k]->x;
-        V[k][1] = c[k]->y;
-        V[k][2] = c[k]->w;
-        finite &= std::isfinite(c[k]->x) && std::isfinite(c[k]->y) && std::isfinite(c[k]->z) &&
-                  std::isfinite(c[k]->w);
-      }
-      if (!finite) continue;
-      Tri tri;
-      double adj[3][3];
-      for (int k = 0; k < 3; ++k) {
-        const double* a = V[(k + 1) % 3];
-        const double* b = V[(k + 2) % 3];
-        adj[k][0] = a[1] * b[2] - a[2] * b[1];
-        adj[k][1] = a[2] * b[0] - a[0] * b[2];
-        adj[k][2] = a[0] * b[1] - a[1] * b[0];
-      }
-      const double det = V[0][0] * adj[0][0] + V[0][1] * adj[0][1] + V[0][2] * adj[0][2];
-      if (!(std::fabs(det) > 0) || !std::isfinite(det)) continue;
-      // Counter-clockwise in normalized device coordinates is the front (det > 0).
-      if (cullBack && det < 0) continue;
-      for (int k = 0; k < 3; ++k) {
-        for (int q = 0; q < 3; ++q) tri.adj[k][q] = adj[k][q] / det;
-        tri.z[k] = c[k]->z;
-        tri.color[k][0] = c[k]->r;
-        tri.color[k][1] = c[k]->g;
-        tri.color[k][2] = c[k]->b;
-      }
-      // The box: from the projected vertices when all are in front of the eye, else everything.
-      tri.x0 = 0, tri.y0 = 0, tri.x1 = W - 1, tri.y1 = H - 1;
-      if (c[0]->w > 0 && c[1]->w > 0 && c[2]->w > 0) {
-        double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
-        for (int k = 0; k < 3; ++k) {
-          const double px = (c[k]->x / double(c[k]->w) + 1) * 0.5 * W;
-          const double py = (1 - c[k]->y / double(c[k]->w)) * 0.5 * H;
-          lo[0] = std::min(lo[0], px), hi[0] = std::max(hi[0], px);
-          lo[1] = std::min(lo[1], py), hi[1] = std::max(hi[1], py);
-        }
-        tri.x0 = int(std::clamp(std::floor(lo[0]), 0.0, double(W - 1)));
-        tri.x1 = int(std::clamp(std::floor(hi[0]), 0.0, double(W - 1)));
-        tri.y0 = int(std::clamp(std::floor(lo[1]), 0.0, double(H - 1)));
-        tri.y1 = int(std::clamp(std::floor(hi[1]), 0.0, double(H - 1)));
-        if (hi[0] < 0 || lo[0] > W || hi[1] < 0 || lo[1] > H) continue;
-      }
-      tris.push_back(tri);
+  for (const render::DrawCall& call : packets.calls)
+    for (uint32_t t = call.firstTriangle; t < call.firstTriangle + call.triangleCount; ++t) {
+      const uint32_t* index = &packets.indices[size_t(t) * 3];
+      const geometry::ClipVertex* c[3] = {&packets.vertices[index[0]], &packets.vertices[index[1]],
+                                          &packets.vertices[index[2]]};
+      if (auto tri = homogeneousTriangle(c, call.cull == geometry::CullMode::back, W, H))
+        tris.push_back(*tri);
     }
-  }
 
-  // Bands of rows in parallel; each keeps its samples' depth and colour.
+  // Bands of rows in parallel; each keeps its samples' depth and colour, then box-filters its
+  // pixels in linear light and marks the edges.
   constexpr int kBand = 4;
   const int bands = (H + kBand - 1) / kBand;
   std::vector<double> linear(size_t(W) * H * 3);
   std::vector<uint8_t> edge(size_t(W) * H);
-  const double background[3] = {scene.background.x, scene.background.y, scene.background.z};
-  core::ThreadPool pool(o.threads > 0 ? o.threads : 1);
+  const float background[3] = {scene.background.x, scene.background.y, scene.background.z};
   pool.parallelFor(size_t(bands), [&](size_t band, int) {
     const int yb0 = int(band) * kBand, yb1 = std::min(H, yb0 + kBand);
     const size_t samples = size_t(yb1 - yb0) * W * S;
-    std::vector<float> depth(samples, std::numeric_limits<float>::infinity());
     std::vector<float> color(samples * 3);
     std::vector<int32_t> id(samples, -1);  // the triangle each sample shows; −1: background
     for (size_t i = 0; i < samples; ++i)
-      for (int ch = 0; ch < 3; ++ch) color[i * 3 + ch] = float(background[ch]);
-    for (size_t ti = 0; ti < tris.size(); ++ti) {
-      const Tri& t = tris[ti];
-      const int ty0 = std::max(t.y0, yb0), ty1 = std::min(t.y1, yb1 - 1);
-      for (int y = ty0; y <= ty1; ++y)
-        for (int x = t.x0; x <= t.x1; ++x)
-          for (int sy = 0; sy < n; ++sy)
-            for (int sx = 0; sx < n; ++sx) {
-              const double X = 2 * (x + (sx + jitter(x, y, sx, sy, 0)) / n) / W - 1;
-              const double Y = 1 - 2 * (y + (sy + jitter(x, y, sx, sy, 1)) / n) / H;
-              double l[3], sum = 0;
-              bool inside = true;
-              for (int k = 0; k < 3; ++k) {
-                l[k] = t.adj[k][0] * X + t.adj[k][1] * Y + t.adj[k][2];
-                inside &= l[k] >= 0;
-                sum += l[k];
-              }
-              if (!inside || !(sum > 0)) continue;
-              const double z = l[0] * t.z[0] + l[1] * t.z[1] + l[2] * t.z[2];  // z / w
-              if (z < -1 || z > 1) continue;                                   // near, far
-              const size_t s = (size_t(y - yb0) * W + x) * S + size_t(sy * n + sx);
-              const float zf = float(0.5 * (z + 1));
-              if (!(zf < depth[s])) continue;
-              depth[s] = zf;
-              id[s] = int32_t(ti);
-              for (int ch = 0; ch < 3; ++ch)
-                color[s * 3 + ch] = float(std::clamp(
-                    (l[0] * t.color[0][ch] + l[1] * t.color[1][ch] + l[2] * t.color[2][ch]) / sum,
-                    0.0, 1.0));
-            }
-    }
-    // The 1×1 box filter, in linear light; and the edge mask.
+      for (int ch = 0; ch < 3; ++ch) color[i * 3 + ch] = background[ch];
+    sampleBand(tris, W, H, n, yb0, yb1, color, id);
     for (int y = yb0; y < yb1; ++y)
       for (int x = 0; x < W; ++x) {
         const size_t base = (size_t(y - yb0) * W + x) * S;
         bool mixed = false;
         for (int s = 1; s < S; ++s) mixed |= id[base + size_t(s)] != id[base];
         edge[size_t(y) * W + x] = mixed;
-      }
-    for (int y = yb0; y < yb1; ++y)
-      for (int x = 0; x < W; ++x)
         for (int ch = 0; ch < 3; ++ch) {
           double acc = 0;
-          const size_t base = (size_t(y - yb0) * W + x) * S;
           for (int s = 0; s < S; ++s) acc += color[(base + size_t(s)) * 3 + ch];
           linear[(size_t(y) * W + x) * 3 + ch] = acc / S;
         }
+      }
   });
   Image image;
   image.width = W;

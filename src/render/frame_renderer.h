@@ -8,6 +8,7 @@
 
 #include "core/thread_pool.h"
 #include "geometry/setup.h"
+#include "render/draw_packets.h"
 #include "raster/binner.h"
 #include "raster/framebuffer.h"
 #include "raster/rasterizer.h"
@@ -15,34 +16,12 @@
 
 namespace sv::render {
 
-// A run of triangles that share a culling mode and a material.
-struct DrawCall {
-  uint32_t firstTriangle = 0;
-  uint32_t triangleCount = 0;
-  geometry::CullMode cull = geometry::CullMode::back;
-  // Shaded per pixel (FrameSettings::shade = material) with this material, reading `attributes`;
-  // nullptr: the interpolated vertex colour.
-  const shade::MaterialShading* material = nullptr;
-  // With masking: the object the run draws, bounded on screen (object-space culling, SPEC §4) —
-  // its triangles are dropped wherever the bound lies in occupied windows. Unbounded: no test.
-  bool bounded = false;
-  geometry::ObjectBound bound{};
-};
-
-// The plain input of a frame: vertices after the projective transform and triangles indexing them.
-struct DrawPackets {
-  std::vector<geometry::ClipVertex> vertices;
-  // For pixel shading, when some call has a material (else empty): per vertex, the attributes
-  // `attributeLayout` stores, attributeLayout.stride floats a vertex — the union of those the
-  // calls' materials read (shade::attributesUsed).
-  std::vector<float> attributes;
-  shade::AttributeLayout attributeLayout;
-  std::vector<uint32_t> indices;  // 3 per triangle, each < vertices.size()
-  std::vector<DrawCall> calls;    // in submission order
-};
-
 // The largest batch a frame uses (FrameSettings::batchTriangles is clamped to it).
 inline constexpr uint32_t kMaxBatchTriangles = 1u << 24;
+
+// Where a finished tile goes (FrameSettings::finishTile).
+using TileSink =
+    std::function<void(int tile, const float* depth, const uint16_t* color, const int32_t* sums)>;
 
 struct FrameSettings {
   int width = 0, height = 0;
@@ -57,12 +36,11 @@ struct FrameSettings {
   // or — when colour sums are used (`colorSums`) — its sums instead (then depth and colour hold
   // nothing; otherwise `sums` is nullptr). This is the only way out of the frame: the storage is
   // reused for the next tile as soon as the call returns.
-  std::function<void(int tile, const float* depth, const uint16_t* color, const int32_t* sums)>
-      finishTile;
+  TileSink finishTile;
   // finishTile can take colour sums (it needs no more than each pixel's mean: a box resolve).
   // They are used when the frame allows — anti-aliased priority masking, every triangle opaque,
-  // no afterOpaque pass, no occupancy view (raster::TileWork::sums) — and save writing, clearing
-  // and summing N sample planes per pixel.
+  // no pass besides the polygons, no occupancy view (raster::TileWork::sums) — and save writing,
+  // clearing and summing N sample planes per pixel.
   bool colorSums = false;
   // Triangles per batch (every batch sets up its triangles, then walks the tiles). Frames of one
   // batch draw each tile in a small per-thread buffer that never leaves the core's cache; frames of
@@ -73,10 +51,11 @@ struct FrameSettings {
   raster::Masking masking = raster::Masking::none;
   // The occupancy debug view (raster::TileWork::debugOccupancy).
   bool debugOccupancy = false;
-  // Called once per tile, on the thread drawing it, when its opaque triangles are drawn and before
-  // its translucent ones (raster::TileWork::afterOpaque), with the tile's depth and colour and the
-  // worker's number (0 … threads − 1): the free forms' pass. Empty: none.
-  std::function<void(int tile, int worker, float* depth, uint16_t* color)> afterOpaque;
+  // The frame's passes besides the polygons (raster/tile_pass.h), in the order render composed
+  // them: each prepared once, drawn into every tile where its stage says — surfaces and volumes
+  // once the tile's opaque triangles are in, lights after its last triangle, before finishTile —
+  // and its statistics added to the frame's.
+  std::vector<raster::TilePass*> passes;
 };
 
 class FrameRenderer {
@@ -89,6 +68,32 @@ class FrameRenderer {
   core::ThreadPool& pool() { return pool_; }
 
  private:
+  // What one frame's batches share (render works it out once).
+  struct Frame;
+  // One batch of triangles [begin, end).
+  struct Batch {
+    uint32_t begin = 0, end = 0;
+    int chunks = 0;
+    bool first = true, last = true;
+  };
+  struct SetupCounts {
+    uint64_t facing = 0, outside = 0, degenerate = 0, invalid = 0, occluded = 0, drawn = 0;
+  };
+
+  Frame frameOf(const DrawPackets& packets, const FrameSettings& settings) const;
+  void prepareBuffers(const DrawPackets& packets, const Frame& f);
+  void preparePasses(const FrameSettings& settings, const Frame& f);
+  // Stage 3: setup and binning of the batch, chunk by chunk in parallel.
+  void setUpBatch(const DrawPackets& packets, const FrameSettings& settings, const Frame& f,
+                  const Batch& batch, FrameStats& stats);
+  SetupCounts setUpChunk(const DrawPackets& packets, const FrameSettings& settings, const Frame& f,
+                         const Batch& batch, int chunk, int worker);
+  // Stage 4: the tiles in parallel, each drawing its lists in chunk order.
+  void drawTiles(const FrameSettings& settings, const Frame& f, const Batch& batch);
+  void drawTile(const FrameSettings& settings, const Frame& f, const Batch& batch, int tile,
+                int worker);
+  void addTileStats(FrameStats& stats) const;
+
   core::ThreadPool pool_;
   raster::FrameBuffer fb_;  // the whole frame, in frames of several batches
   raster::Binner binner_;
@@ -100,6 +105,11 @@ class FrameRenderer {
     std::unique_ptr<raster::Occupancy> occupancy;  // the tile's, in frames of one batch
     std::vector<uint32_t> objects;  // with masking: the chunk's records' objects (TileWork)
     std::vector<raster::AttributeSetup> attributes;  // pixel shading: the records', in their order
+    // The tile's lists, one per chunk: entries, sizes, objects and boxes (TileWork).
+    std::vector<const uint32_t*> lists;
+    std::vector<uint32_t> listSizes;
+    std::vector<const uint32_t*> listObjects;
+    std::vector<const raster::Binner::Box*> listBoxes;
   };
   std::vector<geometry::ObjectBound> objects_;     // with masking: every draw call's bound
   std::vector<raster::Occupancy> frameOccupancy_;  // every tile's, in frames of several batches
@@ -108,7 +118,11 @@ class FrameRenderer {
       attributes_;                      // ShadeMode::material: setups_[i]'s is attributes_[i]
   std::vector<WorkerScratch> scratch_;  // one per pool worker
   std::vector<raster::RasterStats> tileStats_;
-  std::vector<uint8_t> opaqueDone_;  // per tile: FrameSettings::afterOpaque has run
+  std::vector<SetupCounts> chunkCounts_;  // the batch's, per chunk
+  std::vector<uint8_t> opaqueDone_;       // per tile: the afterOpaque passes have run
+  // FrameSettings::passes by stage: those that run once a tile's opaque triangles are in, and
+  // those after its last triangle.
+  std::vector<raster::TilePass*> afterOpaque_, afterTranslucent_;
 };
 
 }  // namespace sv::render

@@ -16,7 +16,27 @@
 namespace sv {
 namespace {
 
+using geometry::AttributeLayout;
 using geometry::ClipVertex;
+using enum geometry::Attribute;
+
+// The vertex stage stores only the attributes some material reads, packed in Attribute order.
+TEST(AttributeLayout, PacksTheStoredAttributesInOrder) {
+  const AttributeLayout none = AttributeLayout::of(0);
+  EXPECT_EQ(none.stride, 0);
+  const AttributeLayout uv = AttributeLayout::of(1u << kU | 1u << kV);
+  EXPECT_EQ(uv.stride, 2);
+  EXPECT_EQ(uv.slot[kU], 0);
+  EXPECT_EQ(uv.slot[kV], 1);
+  const AttributeLayout fogged =
+      AttributeLayout::of(1u << kAlpha | 1u << kEyeX | 1u << kEyeY | 1u << kEyeZ | 1u << kV);
+  EXPECT_EQ(fogged.stride, 5);
+  EXPECT_EQ(fogged.slot[kV], 0);
+  EXPECT_EQ(fogged.slot[kEyeX], 1);
+  EXPECT_EQ(fogged.slot[kEyeZ], 3);
+  EXPECT_EQ(fogged.slot[kAlpha], 4);
+  EXPECT_EQ(AttributeLayout::of(~0u).stride, kAttributeCount);  // bits beyond the last ignored
+}
 
 scene::Mesh randomMesh(std::mt19937& rng, size_t n, bool colors, bool normals, bool uvs) {
   std::uniform_real_distribution<float> pos(-3, 3), unit(0, 1), dir(-1, 1);
@@ -59,8 +79,8 @@ TEST(VertexStage, LanesEqualTheOneVertexCodeOnEveryTarget) {
       const geometry::VertexContext context{view, proj * view, &light,
                                             withPoints ? &points : nullptr};
       for (unsigned stored :
-           {0u, (1u << shade::kU) | (1u << shade::kV), (1u << shade::kAttributeCount) - 1}) {
-        const shade::AttributeLayout layout = shade::AttributeLayout::of(stored);
+           {0u, (1u << kU) | (1u << kV), (1u << kAttributeCount) - 1}) {
+        const AttributeLayout layout = AttributeLayout::of(stored);
         const size_t stride = size_t(layout.stride);
         std::vector<ClipVertex> lanes(n), one(n);
         std::vector<float> lanesA(n * stride + 1, -1), oneA(n * stride + 1, -1);

@@ -27,24 +27,6 @@ Fragments flatFragments(float r, float g, float b) {
   return f;
 }
 
-// The vertex stage stores only the attributes some material reads, packed in Attribute order.
-TEST(AttributeLayout, PacksTheStoredAttributesInOrder) {
-  const AttributeLayout none = AttributeLayout::of(0);
-  EXPECT_EQ(none.stride, 0);
-  const AttributeLayout uv = AttributeLayout::of(1u << kU | 1u << kV);
-  EXPECT_EQ(uv.stride, 2);
-  EXPECT_EQ(uv.slot[kU], 0);
-  EXPECT_EQ(uv.slot[kV], 1);
-  const AttributeLayout fogged =
-      AttributeLayout::of(1u << kAlpha | 1u << kEyeX | 1u << kEyeY | 1u << kEyeZ | 1u << kV);
-  EXPECT_EQ(fogged.stride, 5);
-  EXPECT_EQ(fogged.slot[kV], 0);
-  EXPECT_EQ(fogged.slot[kEyeX], 1);
-  EXPECT_EQ(fogged.slot[kEyeZ], 3);
-  EXPECT_EQ(fogged.slot[kAlpha], 4);
-  EXPECT_EQ(AttributeLayout::of(~0u).stride, kAttributeCount);  // bits beyond the last ignored
-}
-
 TEST(Fog, RangeZeroKeepsTheSurfaceAndGreatRangeGivesTheFogColour) {
   MaterialShading m;
   Environment env;

@@ -1,6 +1,7 @@
-// Free forms in the frame: ray cast per 64×64 tile into the tile's own depth and colour buffers
-// (raster/framebuffer.h), after the tile's opaque polygons and before its translucent ones, so
-// that free forms and polygons meet at exact, anti-aliased intersection curves (issue 7 item 4).
+// Free forms in the frame: a tile pass (raster/tile_pass.h, stage `surfaces`) that ray casts them
+// per 64×64 tile into the tile's own depth and colour buffers (raster/framebuffer.h), after the
+// tile's opaque polygons and before its translucent ones, so that free forms and polygons meet at
+// exact, anti-aliased intersection curves (issue 7 item 4).
 //
 // Based on: SPEC §12 (multi-level ray casting; at a leaf the surface point, the normal from the
 // gradient, Phong shading, fog, depth), §5 (the same sample pattern as the polygons: one ray per
@@ -10,9 +11,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "core/thread_pool.h"
 #include "freeform/raycast.h"
 #include "freeform/surface_points.h"
+#include "raster/tile_pass.h"
 #include "shade/shading.h"
 
 namespace sv::freeform {
@@ -30,21 +31,31 @@ struct ShadedForm {
   float uvScale[2] = {1, 1};
 };
 
-// The frame's free forms, and which tiles each may show in (so a tile casts only those).
-class FreeFormFrame {
+// The frame's free forms, which tiles each may show in (so a tile casts only those), and their
+// cast into each tile.
+class FreeFormPass final : public raster::TilePass {
  public:
-  // Finds, for every form, the tiles of the width × height raster (64-pixel tiles) whose pixel
-  // squares its surface may cross, by the same bounds the caster uses, windows of the screen
-  // subdivided from the whole raster down to tiles — the forms shared among `pool`'s threads
-  // (nullptr: this one), the result the same.
-  void prepare(std::vector<ShadedForm> forms, int width, int height, int samples,
-               const int32_t* sampleOffsetX, const int32_t* sampleOffsetY,
-               const shade::Environment* environment, const CastSettings& settings, int marchSteps,
-               core::ThreadPool* pool = nullptr);
+  // The frame's forms and how to draw them; call before prepare. `environment` (lights, fog) must
+  // outlive the frame. marchSteps > 0: the fixed-step marcher instead of the caster (the
+  // baseline).
+  void setForms(std::vector<ShadedForm> forms, const shade::Environment* environment,
+                const CastSettings& settings, int marchSteps);
 
   bool empty() const { return forms_.empty(); }
   size_t size() const { return forms_.size(); }
 
+  raster::PassStage stage() const override { return raster::PassStage::surfaces; }
+  // Finds, for every form, the tiles of the raster whose pixel squares its surface may cross, by
+  // the same bounds the caster uses, windows of the screen subdivided from the whole raster down
+  // to tiles — the forms shared among the pool's threads, the result the same.
+  void prepare(const raster::PassFrame& frame) override;
+  // Casts the forms listed for the tile into its buffers, shading each pixel once per form that
+  // takes any of its samples.
+  void drawTile(const raster::TileTarget& tile) override;
+  // freeForms, and the cells, masked cells, bounds, rays and hits of every worker's casts.
+  void addStats(FrameStats& stats) const override;
+
+ private:
   // Per-thread buffers: the tile's samples row by row while it is cast.
   struct Scratch {
     std::vector<float> depth;
@@ -55,7 +66,7 @@ class FreeFormFrame {
     std::vector<double> centreZ;
     std::vector<uint32_t> ringObject;  // the centres with a one-pixel ring around the tile
     std::vector<float> ringDepth;
-    std::vector<uint8_t> pixelState;    // per pixel: what its samples take (drawTile)
+    std::vector<uint8_t> pixelState;    // per pixel: what its samples take (castAdaptive)
     std::vector<float> bandLo, bandHi;  // per pixel: its form's depth band
     RayFunction ray;
     struct Pending {  // a pixel to shade, and its first sample the form took
@@ -71,14 +82,14 @@ class FreeFormFrame {
     std::vector<uint64_t>
         pixelActive;  // per sample plane and pixel: its hit's (CastWindow::active)
   };
+  // Per worker, a cache line each: workers count into theirs while casting, and two workers'
+  // counters in one line would make each write wait for the other core (false sharing).
+  struct alignas(64) WorkerStats {
+    CastStats counts;
+  };
+  // One tile's cast, as drawTile hands it from step to step.
+  struct TileJob;
 
-  // Casts the forms listed for tile (tileX, tileY) into its buffers — `samples` depth and colour
-  // planes per 4×4 block (raster/framebuffer.h) — shading each pixel once per form that takes any
-  // of its samples. Adds to `stats`.
-  void drawTile(int tileX, int tileY, float* depth, uint16_t* color, Scratch& scratch,
-                CastStats& stats) const;
-
- private:
   // A tile form `form` may show in, with the nearest cube depth its bounds allow there.
   struct Mark {
     uint32_t tile;
@@ -86,6 +97,23 @@ class FreeFormFrame {
   };
   void markTiles(uint32_t form, int x0, int y0, int size, double zlo, double zhi,
                  std::vector<Mark>& marks) const;
+  void sortTileLists();
+
+  // drawTile's steps.
+  void readDepths(TileJob& job) const;
+  void castWindow(TileJob& job, float* depth, uint32_t* object, double* cubeZ, uint64_t* active,
+                  double dx, double dy) const;
+  void castEverySample(TileJob& job) const;
+  void castAdaptive(TileJob& job) const;
+  void castCentresWithRing(TileJob& job) const;
+  void classifyPixels(TileJob& job) const;
+  void castSampleRays(TileJob& job) const;
+  void listPixels(TileJob& job) const;
+  void shadeForm(TileJob& job, size_t place) const;
+  void shadeBatch(TileJob& job, size_t place, shade::Fragments& frag, const Scratch::Pending* batch,
+                  int count, int block) const;
+  void writeBack(TileJob& job, uint32_t form, const Scratch::Pending* batch, int first, int n,
+                 int block, const float (*out)[shade::kMaxFragments]) const;
 
   std::vector<ShadedForm> forms_;
   std::vector<SurfacePoints> surfaces_;  // per form: its hits' points and normals
@@ -100,6 +128,8 @@ class FreeFormFrame {
   // The nearest cube depth each listed form's bounds allow in the tile, in the same order.
   std::vector<std::vector<double>> tileNearest_;
   std::vector<std::vector<Mark>> marks_;  // per form (prepare's)
+  std::vector<Scratch> scratch_;          // per worker
+  std::vector<WorkerStats> stats_;        // per worker
 };
 
 }  // namespace sv::freeform

@@ -1,0 +1,46 @@
+// What one frame did: the counts every stage and pass adds to, and its timings. A plain record
+// (public API): the renderer fills it, each tile pass adds its own counts (raster/tile_pass.h).
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace sv {
+
+// What one frame did. Window counts are per quadtree level (64 … 4 pixels, then pixel tests).
+struct FrameStats {
+  uint64_t trianglesIn = 0;
+  uint64_t culledFacing = 0, culledOutside = 0, culledDegenerate = 0, culledInvalid = 0;
+  // With masking, in frames of several batches: triangles of objects whose bound lay in windows
+  // earlier batches occupied, dropped before setup (object-space culling, SPEC §4).
+  uint64_t culledOccluded = 0;
+  uint64_t drawn = 0;
+  uint64_t windows[6] = {};
+  uint64_t fullWindows = 0, partialBlocks = 0, fragments = 0;
+  uint64_t hiddenFragments = 0;  // fragments of which the depth test passed no sample
+  // Hybrid masking: tile passes (a tile per batch) in which it woke — a tile starts as the plain
+  // Z-buffer and masks once the depth test has hidden enough (docs/hidden-surfaces.md).
+  uint64_t hybridWoken = 0;
+  // Deferred pixel shading's passes (one a tile per batch, and one before each translucent
+  // triangle): those that found each triangle's pixels from a list of the triangles that won
+  // pixels, each with its box, and those that scanned the whole tile (many or large triangles,
+  // whose boxes hold more blocks than the scan reads; docs/performance.md).
+  uint64_t shadedByList = 0, shadedByScan = 0;
+  uint64_t occludedWindows = 0;    // windows triangles were dropped from as occupied (priority)
+  uint64_t occludedTriangles = 0;  // triangles dropped whole from a tile (their box occupied)
+  uint64_t occludedObjects = 0;    // objects dropped whole from a tile (their bound occupied)
+  // Free forms (SPEC §12): objects, screen cells bounded, cells skipped by masking, interval
+  // bounds evaluated, pixel (sample) rays solved, and those that took a surface.
+  uint64_t freeForms = 0, freeFormCells = 0, freeFormMaskedCells = 0, freeFormBounds = 0,
+           freeFormRays = 0, freeFormHits = 0;
+  // rasterMs: the tile pass, which includes resolving each finished tile into the image.
+  double vertexMs = 0, setupMs = 0, rasterMs = 0, totalMs = 0;
+
+  uint64_t culled() const {
+    return culledFacing + culledOutside + culledDegenerate + culledInvalid + culledOccluded;
+  }
+  // One line: triangles in / culled / drawn, windows per level, milliseconds.
+  std::string summary() const;
+};
+
+}  // namespace sv

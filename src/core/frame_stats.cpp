@@ -1,0 +1,33 @@
+// FrameStats' one-line summary (include/synthvis/frame_stats.h).
+#include "synthvis/frame_stats.h"
+
+#include <fmt/format.h>
+
+namespace sv {
+
+std::string FrameStats::summary() const {
+  return fmt::format(
+             "triangles in {} / culled {} (facing {}, outside {}, degenerate {}, invalid {}{}) / "
+             "drawn {} "
+             "| windows 64:{} 32:{} 16:{} 8:{} 4:{} px-tests:{} full:{} occluded:{} (triangles {}, "
+             "objects {}{}) | fragments {} (hidden {}{}) | {:.2f} ms (vertex {:.2f}, setup {:.2f}, "
+             "tiles "
+             "{:.2f} incl. resolve)",
+             trianglesIn, culled(), culledFacing, culledOutside, culledDegenerate, culledInvalid,
+             culledOccluded ? fmt::format(", occluded {}", culledOccluded) : std::string(), drawn,
+             windows[0], windows[1], windows[2], windows[3], windows[4], windows[5], fullWindows,
+             occludedWindows, occludedTriangles, occludedObjects,
+             hybridWoken ? fmt::format(", hybrid woke in {} tiles", hybridWoken) : std::string(),
+             fragments, hiddenFragments,
+             shadedByList + shadedByScan ? fmt::format("; shading passes by list {}, by scan {}",
+                                                       shadedByList, shadedByScan)
+                                         : std::string(),
+             totalMs, vertexMs, setupMs, rasterMs) +
+         (freeForms ? fmt::format(" | free forms {}: cells {} (masked {}), bounds {}, rays {}, "
+                                  "hits {}",
+                                  freeForms, freeFormCells, freeFormMaskedCells, freeFormBounds,
+                                  freeFormRays, freeFormHits)
+                    : std::string());
+}
+
+}  // namespace sv

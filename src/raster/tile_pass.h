@@ -1,0 +1,62 @@
+// A pass of the frame over each tile's shared buffers (docs/ARCHITECTURE.md, "Passes").
+//
+// A tile's work is an ordered list of passes over the same depth and colour samples: the opaque
+// polygons (the tile kernel's own), then the ray-cast surfaces (free forms, terrain), then
+// volumes, then the translucent polygons (the kernel again), then light points. Every primitive
+// besides polygons is one TilePass; render composes the frame's list, and the tile kernel and the
+// frame runner call each pass where its stage says, knowing nothing else of it.
+#pragma once
+
+#include <cstdint>
+
+#include "core/thread_pool.h"
+#include "raster/coverage_masks.h"
+#include "synthvis/frame_stats.h"
+
+namespace sv::raster {
+
+// Where a pass runs in a tile's order. Passes of one stage run in the order the list gives them.
+enum class PassStage : uint8_t {
+  surfaces,  // after the opaque polygons: opaque surfaces ray cast into the depth (free forms)
+  volumes,   // after the surfaces, before the translucent polygons: composited front to back
+  lights,    // after the translucent polygons, last: light points over everything
+};
+
+// What every pass learns of the frame before its tiles are drawn.
+struct PassFrame {
+  int width = 0, height = 0;  // the raster, pixels (64 × 64 tiles; the last row and column partial)
+  int samples = 1;            // per pixel
+  const CoverageTables* coverage = nullptr;  // with samples > 1: their positions (pattern)
+  core::ThreadPool* pool = nullptr;          // the frame's workers; prepare may use them
+};
+
+// One tile's shared buffers, as raster/framebuffer.h lays them out: `samples` depth and colour
+// planes per 4×4 block. `worker` (0 … pool threads − 1) names the calling thread, for scratch
+// memory; no two calls with the same worker run at once.
+struct TileTarget {
+  int tileX = 0, tileY = 0;  // the tile's pixel origin is (64·tileX, 64·tileY)
+  float* depth = nullptr;
+  uint16_t* color = nullptr;
+  int worker = 0;
+};
+
+// The contract (docs/ARCHITECTURE.md): a pass may read and write the tile's depth and colour
+// samples — and nothing else of the frame — through `drawTile`; it leaves depth as the nearest
+// surface drawn so far for every sample it writes (passes after it test against it), colour in
+// linear 16-bit light, and samples it does not touch as it found them. The tile's occupancy
+// (masking) is the polygons' alone: a pass does not read it. Output is the same for any thread
+// count: what a tile gets depends on the tile, never on the worker.
+class TilePass {
+ public:
+  virtual ~TilePass() = default;
+
+  virtual PassStage stage() const = 0;
+  // Once per frame, before any tile, on the frame's thread (may run work on frame.pool).
+  virtual void prepare(const PassFrame& frame) = 0;
+  // Draws the pass into one tile, once per tile and frame, on worker `tile.worker`.
+  virtual void drawTile(const TileTarget& tile) = 0;
+  // Once per frame, after every tile: adds what the pass did to the frame's statistics.
+  virtual void addStats(FrameStats& stats) const = 0;
+};
+
+}  // namespace sv::raster

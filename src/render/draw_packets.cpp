@@ -1,0 +1,195 @@
+// Based on: SPEC §1 (traversal → projective transform), §4 (the draw order masking needs: priority,
+// then nearest first; translucent surfaces last, farthest first).
+#include "render/draw_packets.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include "geometry/vertex_stage.h"
+
+namespace sv::render {
+namespace {
+
+// The vertex stage's work, in parallel chunks each writing its own range: a range of one
+// instance's vertices, or of its indices (copied offset to the frame's vertex numbering and
+// range-checked).
+struct VertexJob {
+  const scene::Instance* instance;
+  bool indices;  // else vertices
+  size_t begin, end, out;
+  uint32_t base;  // the instance's first vertex in the frame (indices)
+};
+constexpr size_t kVertexChunk = 1 << 14, kIndexChunk = 1 << 16;
+
+// Every vertex and index the frame draws is checked as the vertex stage reads it, not in a pass of
+// its own; the full check runs only to name an offender. (A mesh no instance draws is left to the
+// loaders' validation.)
+Status invalidVertexData(const scene::Scene& scene) {
+  if (Status s = scene::validate(scene, ""); !s) return s;
+  return Error{"", "", "invalid vertex data"};  // (validate finds what the stage found)
+}
+
+const scene::Material& materialOf(const scene::Scene& scene, const scene::Mesh& mesh) {
+  static const scene::Material defaultMaterial;
+  return mesh.material >= 0 ? scene.materials[size_t(mesh.material)] : defaultMaterial;
+}
+
+// The order instances are drawn in (indices into scene.instances). Opaque ones: in submission
+// order for the Z-buffer; for masking (SPEC §4) by priority, then nearest first — by the smallest
+// view depth of their bounding box's corners, which orders objects separated in depth correctly
+// (docs/hidden-surfaces.md). Translucent ones, always: farthest first by the view depth of their
+// box's centre, so that nearer ones blend over farther ones. Stable: ties keep submission order.
+// `boxes`: every mesh's bounds (Mesh::bounds), or empty when neither sort applies.
+std::vector<uint32_t> drawOrder(const scene::Scene& scene, const Mat4& view, RenderOptions::Hsr hsr,
+                                const std::vector<std::array<Vec3, 2>>& boxes) {
+  std::vector<uint32_t> order(scene.instances.size());
+  std::iota(order.begin(), order.end(), 0u);
+  if (boxes.empty()) return order;
+  const bool sortOpaque = hsr != RenderOptions::Hsr::zbuffer;
+  // Per instance the view depths of its mesh's box's corners.
+  std::vector<float> nearest(order.size()), centre(order.size());
+  for (size_t i = 0; i < order.size(); ++i) {
+    const scene::Instance& inst = scene.instances[i];
+    const auto& [lo, hi] = boxes[size_t(inst.mesh)];
+    const Mat4 toEye = view * inst.transform;
+    nearest[i] = nearestEyeDepth(toEye, lo, hi);
+    centre[i] = -toEye.transformPoint((lo + hi) * 0.5f).z;
+  }
+  auto translucent = [&](uint32_t i) {
+    const int m = scene.meshes[size_t(scene.instances[i].mesh)].material;
+    return m >= 0 && scene.materials[size_t(m)].alphaMode == scene::AlphaMode::blend;
+  };
+  std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+    const bool ta = translucent(a), tb = translucent(b);
+    if (ta != tb) return tb;  // opaque first (the passes pick them out again)
+    if (ta) return centre[a] > centre[b];
+    if (!sortOpaque) return false;
+    if (scene.instances[a].priority != scene.instances[b].priority)
+      return scene.instances[a].priority < scene.instances[b].priority;
+    return nearest[a] < nearest[b];
+  });
+  return order;
+}
+
+// Every mesh's bounds, for the draw order and the objects' screen bounds, when they are needed
+// (masking, or some translucent material); else nothing. False for a bound that is not finite (an
+// infinite position, not yet checked — the vertex stage checks them — would give the draw order
+// NaN depths to sort by).
+bool meshBounds(const scene::Scene& scene, const RenderOptions& o,
+                std::vector<std::array<Vec3, 2>>& boxes) {
+  bool anyTranslucent = false;
+  for (const scene::Material& m : scene.materials)
+    anyTranslucent |= m.alphaMode == scene::AlphaMode::blend;
+  if (o.hsr == RenderOptions::Hsr::zbuffer && !anyTranslucent) return true;
+  for (const scene::Mesh& m : scene.meshes) {
+    boxes.push_back(m.bounds());
+    for (const Vec3& corner : boxes.back())
+      if (!isFinite(corner)) return false;
+  }
+  return true;
+}
+
+// The frame's layout: one call per instance, opaque materials first, then translucent ones (SPEC
+// §4: blended over what is behind them), each with its vertex and index jobs; `stored` gathers the
+// attributes the calls' materials read. Sizes `p`'s vertices and indices.
+Status layOutCalls(const scene::Scene& scene, const RenderOptions& o, const FrameCamera& camera,
+                   const ShadingTables* shading, DrawPackets& p, std::vector<VertexJob>& jobs,
+                   unsigned& stored) {
+  std::vector<std::array<Vec3, 2>> boxes;
+  if (!meshBounds(scene, o, boxes)) return invalidVertexData(scene);
+  const bool masking =
+      o.hsr != RenderOptions::Hsr::zbuffer && o.debugView != RenderOptions::DebugView::overdraw;
+  const Mat4 viewProj = camera.projection * camera.view;
+  const geometry::Viewport boundViewport{o.width * o.supersample, o.height * o.supersample};
+  const std::vector<uint32_t> order = drawOrder(scene, camera.view, o.hsr, boxes);
+  size_t vertexCount = 0, indexCount = 0;
+  for (const bool translucentPass : {false, true})
+    for (const uint32_t instance : order) {
+      const scene::Instance& inst = scene.instances[instance];
+      const scene::Mesh& mesh = scene.meshes[inst.mesh];
+      const scene::Material& mat = materialOf(scene, mesh);
+      if ((mat.alphaMode == scene::AlphaMode::blend) != translucentPass) continue;
+      // Indices are 32-bit; a frame of more vertices or triangles than that cannot be expressed.
+      if (vertexCount + mesh.positions.size() > (size_t(1) << 31) ||
+          indexCount + mesh.indices.size() > (size_t(1) << 31))
+        return Error{"", "", "scene too large for one frame (over 2^31 vertices or indices)"};
+      const auto base = static_cast<uint32_t>(vertexCount);
+      for (size_t b = 0; b < mesh.positions.size(); b += kVertexChunk)
+        jobs.push_back({&inst, false, b, std::min(mesh.positions.size(), b + kVertexChunk),
+                        vertexCount + b, base});
+      for (size_t b = 0; b < mesh.indices.size(); b += kIndexChunk)
+        jobs.push_back(
+            {&inst, true, b, std::min(mesh.indices.size(), b + kIndexChunk), indexCount + b, base});
+      DrawCall call;
+      call.firstTriangle = static_cast<uint32_t>(indexCount / 3);
+      call.triangleCount = static_cast<uint32_t>(mesh.triangleCount());
+      call.cull =
+          o.cullBackFaces && !mat.doubleSided ? geometry::CullMode::back : geometry::CullMode::none;
+      if (shading && (mat.needsPixelShading() || shading->environment.fog))
+        call.material = shading->of(mesh.material, !mesh.normals.empty());
+      if (call.material) stored |= shade::attributesUsed(*call.material, shading->environment);
+      if (masking)
+        call.bounded =
+            geometry::boundObject(viewProj * inst.transform, boxes[size_t(inst.mesh)][0],
+                                  boxes[size_t(inst.mesh)][1], boundViewport, call.bound);
+      p.calls.push_back(call);
+      vertexCount += mesh.positions.size();
+      indexCount += mesh.indices.size();
+    }
+  p.vertices.resize(vertexCount);
+  p.indices.resize(indexCount);
+  return {};
+}
+
+}  // namespace
+
+float nearestEyeDepth(const Mat4& toEye, Vec3 lo, Vec3 hi) {
+  float near = std::numeric_limits<float>::infinity();
+  for (int c = 0; c < 8; ++c) {
+    const Vec3 corner{c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z};
+    near = std::min(near, -toEye.transformPoint(corner).z);
+  }
+  return near;
+}
+
+Status buildDrawPackets(const scene::Scene& scene, const RenderOptions& o,
+                        const FrameCamera& camera, const ShadingTables* shading,
+                        core::ThreadPool& pool, DrawPackets& p) {
+  // Vertices, attributes and indices are resized and every one is written by the vertex stage:
+  // not cleared first, so that a frame of the same size does not zero megabytes for nothing.
+  p.calls.clear();
+  std::vector<VertexJob> jobs;
+  unsigned stored = 0;  // the attributes some material reads (geometry::AttributeLayout)
+  if (Status s = layOutCalls(scene, o, camera, shading, p, jobs, stored); !s) return s;
+  // Only the attributes some material reads (geometry::AttributeLayout).
+  p.attributeLayout = geometry::AttributeLayout::of(stored);
+  const size_t stride = size_t(p.attributeLayout.stride);
+  p.attributes.resize(p.vertices.size() * stride);
+  const geometry::VertexContext context{camera.view, camera.projection * camera.view, &scene.light,
+                                        &scene.pointLights};
+  std::vector<uint8_t> finite(jobs.size());  // positions finite, indices in range
+  pool.parallelFor(jobs.size(), [&](size_t j, int) {
+    const VertexJob& job = jobs[j];
+    const scene::Mesh& mesh = scene.meshes[job.instance->mesh];
+    if (job.indices) {
+      uint32_t maxIndex = 0;
+      uint32_t* out = p.indices.data() + job.out;
+      for (size_t i = job.begin; i < job.end; ++i) {
+        maxIndex = std::max(maxIndex, mesh.indices[i]);
+        out[i - job.begin] = job.base + mesh.indices[i];
+      }
+      finite[j] = maxIndex < mesh.positions.size();
+      return;
+    }
+    finite[j] = geometry::transformVertices(
+        mesh, materialOf(scene, mesh), job.instance->transform, context, job.begin, job.end,
+        p.vertices.data() + job.out, stride ? p.attributes.data() + job.out * stride : nullptr,
+        &p.attributeLayout);
+  });
+  if (std::find(finite.begin(), finite.end(), 0) != finite.end()) return invalidVertexData(scene);
+  return {};
+}
+
+}  // namespace sv::render

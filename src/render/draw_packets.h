@@ -1,0 +1,56 @@
+// The frame's draw packets (SPEC §1 stages 2–3): every instance's triangles in draw order, their
+// vertices through the vertex stage — the plain input of setup and the tiles.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "core/thread_pool.h"
+#include "geometry/setup.h"
+#include "render/camera.h"
+#include "render/shading_tables.h"
+
+namespace sv::render {
+
+// A run of triangles that share a culling mode and a material.
+struct DrawCall {
+  uint32_t firstTriangle = 0;
+  uint32_t triangleCount = 0;
+  geometry::CullMode cull = geometry::CullMode::back;
+  // Shaded per pixel (FrameSettings::shade = material) with this material, reading `attributes`;
+  // nullptr: the interpolated vertex colour.
+  const shade::MaterialShading* material = nullptr;
+  // With masking: the object the run draws, bounded on screen (object-space culling, SPEC §4) —
+  // its triangles are dropped wherever the bound lies in occupied windows. Unbounded: no test.
+  bool bounded = false;
+  geometry::ObjectBound bound{};
+};
+
+// The plain input of a frame: vertices after the projective transform and triangles indexing them.
+struct DrawPackets {
+  std::vector<geometry::ClipVertex> vertices;
+  // For pixel shading, when some call has a material (else empty): per vertex, the attributes
+  // `attributeLayout` stores, attributeLayout.stride floats a vertex — the union of those the
+  // calls' materials read (shade::attributesUsed).
+  std::vector<float> attributes;
+  geometry::AttributeLayout attributeLayout;
+  std::vector<uint32_t> indices;  // 3 per triangle, each < vertices.size()
+  std::vector<DrawCall> calls;    // in submission order
+};
+
+// Builds `out` for the scene seen by `camera`: one call per instance in draw order (drawOrder:
+// opaque ones first — by priority and distance under masking — then translucent ones, farthest
+// first), each with its culling mode, its material when `shading` is given (pixel shading; else
+// nullptr: vertex colours only) and, under masking, its object bound; every vertex transformed and
+// every index range-checked in parallel chunks on `pool`. `out`'s storage is reused from frame to
+// frame. An error names invalid vertex data (non-finite positions, indices out of range) or a
+// frame of over 2^31 vertices or indices.
+Status buildDrawPackets(const scene::Scene& scene, const RenderOptions& options,
+                        const FrameCamera& camera, const ShadingTables* shading,
+                        core::ThreadPool& pool, DrawPackets& out);
+
+// The smallest view depth of the corners of the box [lo, hi] placed by `toEye`.
+float nearestEyeDepth(const Mat4& toEye, Vec3 lo, Vec3 hi);
+
+}  // namespace sv::render

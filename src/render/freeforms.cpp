@@ -1,0 +1,127 @@
+// The scene's free forms for the frame (SPEC §11–§12): as the free-form pass casts them, or — the
+// polygon baseline — tessellated.
+#include "render/freeforms.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "freeform/tessellate.h"
+#include "render/draw_packets.h"
+
+namespace sv::render {
+namespace {
+
+freeform::Mat4d toDouble(const Mat4& m) {  // column-major float → row-major double
+  freeform::Mat4d d;
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) d.m[r][c] = m.m[c][r];
+  return d;
+}
+
+}  // namespace
+
+freeform::FreeForm toFreeForm(const scene::FreeFormNode& n) {
+  freeform::FreeForm f;
+  f.base.c = n.quadric;
+  f.weight = n.weight;
+  for (const scene::FreeFormNode& p : n.perturbations) f.perturbations.push_back(toFreeForm(p));
+  for (const auto& c : n.clips) f.clips.push_back(freeform::Quadric{c});
+  return f;
+}
+
+std::vector<freeform::ShadedForm> shadedForms(const scene::Scene& scene, const Mat4& view,
+                                              const Mat4& projection,
+                                              const ShadingTables& shading) {
+  std::vector<freeform::ShadedForm> out;
+  const scene::Material defaultMaterial;
+  const bool lights = shading.environment.lightOn || !shading.environment.points.empty();
+  for (const scene::FreeFormObject& object : scene.freeForms) {
+    const scene::Material& mat =
+        object.material >= 0 ? scene.materials[size_t(object.material)] : defaultMaterial;
+    const freeform::Mat4d toEye = toDouble(view * object.transform);
+    const std::optional<freeform::Mat4d> eyeInverse = toEye.inverse();
+    const freeform::FreeForm form = toFreeForm(object.form);
+    std::optional<freeform::ProjectedFreeForm> projected =
+        freeform::ProjectedFreeForm::make(form, toDouble(projection) * toEye);
+    if (!eyeInverse || !projected) continue;  // a singular placement shows nothing
+    freeform::ShadedForm s{form, std::move(*projected), toEye, eyeInverse->transposed(), {}, {},
+                           {}};
+    s.material = *shading.of(object.material, true);
+    s.material.phong = lights && !mat.unlit;
+    s.material.twoSided = true;
+    s.material.alpha = shade::AlphaUse::opaque;
+    s.uvScale[0] = mat.uvScale.x;
+    s.uvScale[1] = mat.uvScale.y;
+    s.color[0] = mat.baseColor.x;
+    s.color[1] = mat.baseColor.y;
+    s.color[2] = mat.baseColor.z;
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
+}  // namespace sv::render
+
+namespace sv {
+
+Result<scene::Scene> tessellatedScene(const scene::Scene& scene, const RenderOptions& o) {
+  const Result<render::FrameCamera> camera = render::frameCamera(scene, o);
+  if (!camera.ok()) return camera.error();
+  const scene::Camera& cam = camera.value().camera;
+  const double pixelPerDepth =
+      2 * std::tan(cam.yfovDegrees * std::numbers::pi / 360) / double(o.height * o.supersample);
+  scene::Scene out = scene;
+  out.freeForms.clear();
+  constexpr size_t kMaxTriangles = size_t(1) << 22;
+  for (size_t i = 0; i < scene.freeForms.size(); ++i) {
+    const scene::FreeFormObject& object = scene.freeForms[i];
+    const std::string label = object.name.empty() ? fmt::format("freeForms[{}]", i)
+                                                  : fmt::format("free form '{}'", object.name);
+    const freeform::FreeForm form = render::toFreeForm(object.form);
+    bool unbounded = false;
+    const std::optional<freeform::Box> box = freeform::surfaceBounds(form, 1e4, 16, unbounded);
+    if (unbounded)
+      return Error{"", "", fmt::format("{} is unbounded or too large to tessellate", label)};
+    if (!box) continue;  // no surface
+    // The nearest eye depth of the box, and its smallest half extent as the curvature radius.
+    const Mat4 toEye = camera.value().view * object.transform;
+    const auto single = [](freeform::Vec3d v) { return Vec3{float(v.x), float(v.y), float(v.z)}; };
+    const double nearest =
+        std::max(double(render::nearestEyeDepth(toEye, single((*box)[0]), single((*box)[1]))),
+                 double(cam.znear));
+    const freeform::Vec3d extent = (*box)[1] - (*box)[0];
+    const double radius = 0.5 * std::min({extent.x, extent.y, extent.z});
+    // Object units per pixel at that depth (the transform's largest scale brings it to the world).
+    double scale = 0;
+    for (int c = 0; c < 3; ++c)
+      scale = std::max(scale, double(length(object.transform.transformDirection(
+                                  Vec3{float(c == 0), float(c == 1), float(c == 2)}))));
+    const double pixel = nearest * pixelPerDepth / std::max(scale, 1e-30);
+    // Sagitta c²/(8r) ≤ pixel/4 for chords c ≤ √3·cell (a leaf's diagonal).
+    const double cell = std::sqrt(2 * radius * pixel / 3);
+    freeform::TriangleSoup soup;
+    if (!freeform::tessellate(form, *box, cell, kMaxTriangles, soup))
+      return Error{"", "",
+                   fmt::format("{} is unbounded or needs over {} triangles to tessellate", label,
+                               kMaxTriangles)};
+    scene::Mesh mesh;
+    mesh.name = object.name + " (tessellated)";
+    mesh.material = object.material;
+    for (size_t v = 0; v < soup.positions.size(); ++v) {
+      const freeform::Vec3d& p = soup.positions[v];
+      const freeform::Vec3d& n = soup.normals[v];
+      mesh.positions.push_back({float(p.x), float(p.y), float(p.z)});
+      mesh.normals.push_back({float(n.x), float(n.y), float(n.z)});
+      mesh.uvs.push_back({float(p.x), float(p.z)});  // the free form's projection (tile_pass.h)
+      mesh.indices.push_back(uint32_t(v));
+    }
+    out.meshes.push_back(std::move(mesh));
+    out.instances.push_back({int(out.meshes.size()) - 1, object.transform});
+  }
+  return out;
+}
+
+}  // namespace sv

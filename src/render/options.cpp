@@ -1,0 +1,68 @@
+// The options' checks and names (synthvis/render.h).
+#include <fmt/format.h>
+
+#include "synthvis/render.h"
+
+namespace sv {
+
+Status validate(const RenderOptions& o) {
+  if (o.width < 1 || o.width > kMaxRasterSize || o.height < 1 || o.height > kMaxRasterSize)
+    return Error{"", "",
+                 fmt::format("image size {}x{} is out of range (1…{} each)", o.width, o.height,
+                             kMaxRasterSize)};
+  if (o.threads < 0 || o.threads > kMaxThreads)
+    return Error{"", "",
+                 fmt::format("thread count {} is out of range (0…{})", o.threads, kMaxThreads)};
+  if (o.camera < 0) return Error{"", "", "camera index must not be negative"};
+  if (o.supersample != 1 && o.supersample != 2 && o.supersample != 4 && o.supersample != 8 &&
+      o.supersample != 16)
+    return Error{
+        "", "", fmt::format("supersampling {} is not supported (1, 2, 4, 8 or 16)", o.supersample)};
+  if (o.supersample > 1 &&
+      (o.width * o.supersample > kMaxRasterSize || o.height * o.supersample > kMaxRasterSize))
+    return Error{"", "",
+                 fmt::format("supersampling {}x{} by {} exceeds the {}-pixel raster", o.width,
+                             o.height, o.supersample, kMaxRasterSize)};
+  const bool debug = o.debugView != RenderOptions::DebugView::none;
+  if (o.supersample > 1 && debug)
+    return Error{"", "", "a debug view shows one value per pixel; it cannot be supersampled"};
+  if (o.samples != 1 && o.samples != 4 && o.samples != 8 && o.samples != 16 && o.samples != 64)
+    return Error{
+        "", "",
+        fmt::format("{} samples per pixel is not supported (1, 4, 8, 16 or 64)", o.samples)};
+  if (o.samples > 1 && o.supersample > 1)
+    return Error{"", "", "anti-aliasing and supersampling are alternatives; choose one"};
+  if (o.samples > 1 && debug)
+    return Error{"", "", "a debug view shows one value per pixel; it cannot be anti-aliased"};
+  if (o.filter != RenderOptions::Filter::box && debug)
+    return Error{"", "", "a debug view cannot be filtered"};
+  if (o.debugView == RenderOptions::DebugView::occupancy && o.hsr == RenderOptions::Hsr::zbuffer)
+    return Error{"", "", "the occupancy view shows masking: use --hsr priority or hybrid"};
+  if (o.marchSteps < 1 || o.marchSteps > 1000000)
+    return Error{"", "", fmt::format("{} march steps is out of range (1…1000000)", o.marchSteps)};
+  if (o.gamma != 0 && !(o.gamma >= 0.5 && o.gamma <= 5))
+    return Error{"", "", fmt::format("gamma {} is out of range (0.5…5, or 0 for sRGB)", o.gamma)};
+  return {};
+}
+
+Result<RenderOptions::Hsr> parseHsr(const std::string& text) {
+  if (text == "zbuffer") return RenderOptions::Hsr::zbuffer;
+  if (text == "priority") return RenderOptions::Hsr::priority;
+  if (text == "hybrid") return RenderOptions::Hsr::hybrid;
+  return Error{
+      "", "",
+      fmt::format("unknown hidden-surface method '{}' (zbuffer, priority or hybrid)", text)};
+}
+
+const char* hsrName(RenderOptions::Hsr hsr) {
+  switch (hsr) {
+    case RenderOptions::Hsr::priority:
+      return "priority";
+    case RenderOptions::Hsr::hybrid:
+      return "hybrid";
+    default:
+      return "zbuffer";
+  }
+}
+
+}  // namespace sv

@@ -1,0 +1,24 @@
+#include "render/passes.h"
+
+#include "render/freeforms.h"
+
+namespace sv::render {
+
+std::vector<raster::TilePass*> FramePasses::compose(const scene::Scene& scene,
+                                                    const RenderOptions& o,
+                                                    const FrameCamera& camera,
+                                                    const ShadingTables& shading) {
+  std::vector<raster::TilePass*> passes;
+  if (o.debugView != RenderOptions::DebugView::none) return passes;
+  if (!scene.freeForms.empty()) {
+    freeForms_.setForms(shadedForms(scene, camera.view, camera.projection, shading),
+                        &shading.environment,
+                        freeform::CastSettings{.masking = true,
+                                               .adaptiveSamples = !o.freeFormEverySample},
+                        o.freeFormMethod == RenderOptions::FreeFormMethod::march ? o.marchSteps : 0);
+    passes.push_back(&freeForms_);
+  }
+  return passes;
+}
+
+}  // namespace sv::render

@@ -1,0 +1,25 @@
+// The frame's passes besides the polygons (raster/tile_pass.h), composed in tile order:
+// ray-cast surfaces (free forms; terrain next), volumes, light points.
+#pragma once
+
+#include <vector>
+
+#include "freeform/freeform_pass.h"
+#include "render/camera.h"
+#include "render/shading_tables.h"
+
+namespace sv::render {
+
+class FramePasses {
+ public:
+  // The passes `scene` needs under `options`, in the order they run (FrameSettings::passes): the
+  // free forms when it has any, except in the debug views, which show the polygon pipeline. The
+  // passes are this object's, valid until the next call.
+  std::vector<raster::TilePass*> compose(const scene::Scene& scene, const RenderOptions& options,
+                                         const FrameCamera& camera, const ShadingTables& shading);
+
+ private:
+  freeform::FreeFormPass freeForms_;
+};
+
+}  // namespace sv::render
