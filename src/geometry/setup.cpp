@@ -63,13 +63,6 @@ HomVertex canonicalCross(const HomVertex& a, const HomVertex& b) {
   return cross(a, b);
 }
 
-// The fill rule, owned here alone (STYLE.md habit 8). Raster y grows downward. A pixel centre
-// exactly on an edge belongs to the triangle that lies to the right of the edge (A > 0: a *left*
-// edge) or, for a horizontal edge, below it (A = 0, B > 0: a *top* edge) — the top-left rule.
-// It is antisymmetric: (A, B) and (−A, −B) never both own the centre, and one of them always
-// does, so two triangles sharing an edge neither both draw nor both miss a pixel on it.
-bool ownsBoundary(int64_t a, int64_t b) { return a > 0 || (a == 0 && b > 0); }
-
 // Turns e(x_f, y_f) = a·x_f + b·y_f + c in sub-pixel units (inside ≥ 0) into per-pixel form at
 // pixel centres, with the fill rule folded in: "e ≥ 0" becomes "e > 0" for edges that do not own
 // their boundary, i.e. c − 1 on integers.

@@ -12,6 +12,19 @@
 
 namespace sv::geometry {
 
+// The fill rule, owned here alone (STYLE.md habit 8): whether a pixel centre exactly on the edge
+// a·x + b·y + c = 0 (inside ≥ 0) belongs to the triangle. Raster y grows downward. It belongs to
+// the triangle that lies to the right of the edge (a > 0: a *left* edge) or, for a horizontal
+// edge, below it (a = 0, b > 0: a *top* edge) — the top-left rule. It is antisymmetric: (a, b) and
+// (−a, −b) never both own the centre, and one of them always does, so two triangles sharing an
+// edge neither both draw nor both miss a pixel on it. Setup folds it into each edge's constant
+// (setup.cpp; in SIMD lanes setup_batch.cpp, checked bit for bit against it), the anti-aliased
+// leaf takes it back out (raster/descent-inl.h), and the coverage tables decide their ties by it.
+template <class T>
+constexpr bool ownsBoundary(T a, T b) {
+  return a > T(0) || (a == T(0) && b > T(0));
+}
+
 // ---- Fixed-point budget (RASTER-NOTES.md pitfall 1) ------------------------------------------
 // Positions are snapped to 1/256 pixel (24.8). Exact integer edges are used for vertices in front
 // of the eye whose projection lies within the guard band |x|, |y| < 2^15 px; the raster itself is

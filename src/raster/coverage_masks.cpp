@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "geometry/setup.h"
+
 namespace sv::raster {
 namespace {
 
@@ -31,10 +33,6 @@ SamplePattern jittered8x8() {
   p.count = 64;
   return p;
 }
-
-// The side an edge through the pixel centre (d = 0) gives the centre cell to: antisymmetric in the
-// normal, like setup.cpp's fill rule.
-bool ownsTie(double nx, double ny) { return nx > 0 || (nx == 0 && ny > 0); }
 
 // The area of the pixel (−½, ½)² where nx·x + ny·y + d ≥ 0: the square clipped by the line
 // (Sutherland–Hodgman), then the shoelace formula.
@@ -146,9 +144,10 @@ uint64_t EdgeMaskTable::mask(double a, double b, double c) const {
   if (d <= -0.5) return 0;
   const int quadrant = int(a < 0 || (a == 0 && b < 0)) | int(b < 0 || (b == 0 && a < 0)) << 1;
   const int slope = std::min(kSlopeSteps - 1, int(std::fabs(a) / norm * kSlopeSteps));
-  // Distance cells mirror around 0 so that −d finds the mirrored cell; d = 0 goes by the tie rule.
+  // Distance cells mirror around 0 so that −d finds the mirrored cell; d = 0 (an edge through the
+  // centre) goes by the fill rule, antisymmetric in the normal.
   int distance;
-  if (d > 0 || (d == 0 && ownsTie(a, b)))
+  if (d > 0 || (d == 0 && geometry::ownsBoundary(a, b)))
     distance = std::min(kDistanceSteps - 1, kDistanceSteps / 2 + int(d * kDistanceSteps));
   else
     distance = std::max(0, kDistanceSteps / 2 - 1 - int(-d * kDistanceSteps));
