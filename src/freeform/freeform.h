@@ -9,7 +9,7 @@
 #include <optional>
 #include <vector>
 
-#include "freeform/quadric.h"
+#include "core/quadric.h"
 
 namespace sv::freeform {
 

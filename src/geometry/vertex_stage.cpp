@@ -23,7 +23,7 @@ namespace {
 
 // What every vertex of one call shares, and the one-vertex transform.
 struct VertexRun {
-  VertexRun(const scene::Mesh& mesh_, const scene::Material& material_, const Mat4& model_,
+  VertexRun(const VertexArrays& mesh_, const VertexMaterial& material_, const Mat4& model_,
             const VertexContext& context_, const AttributeLayout* layout_)
       : mesh(mesh_),
         material(material_),
@@ -34,9 +34,9 @@ struct VertexRun {
         modelView(context_.view * model_),
         normalToWorld(model_.normalMatrix()),
         normalToEye(modelView.normalMatrix()),
-        light(*context_.light) {
-    const bool hasLights = light.enabled || (context.pointLights && !context.pointLights->empty());
-    lit = hasLights && !material.unlit && !mesh.normals.empty();
+        light(context_.light) {
+    const bool hasLights = light.enabled || !context.pointLights.empty();
+    lit = hasLights && !material.unlit && mesh.normals != nullptr;
     vertexLit = lit && !material.phong;
     toLight = normalize(-light.direction);
     base = material.baseColor;
@@ -49,7 +49,7 @@ struct VertexRun {
     const bool finite = isFinite(p);
     const Vec4 c = mvp * Vec4{p.x, p.y, p.z, 1};
     Vec4 color = base;
-    if (!mesh.colors.empty()) {
+    if (mesh.colors) {
       const Vec4 vc = mesh.colors[i];
       color = {color.x * vc.x, color.y * vc.y, color.z * vc.z, color.w * vc.w};
     }
@@ -58,11 +58,10 @@ struct VertexRun {
       const Vec3 n = normalize(normalToWorld.transformDirection(mesh.normals[i]));
       Vec3 diffuse{0, 0, 0};
       if (light.enabled) diffuse = light.color * std::max(0.0f, dot(n, toLight));
-      if (context.pointLights)
-        for (const scene::PointLight& pl : *context.pointLights) {
-          const Vec3 l = normalize(pl.position - model.transformPoint(p));
-          diffuse = diffuse + pl.color * std::max(0.0f, dot(n, l));
-        }
+      for (const PointLight& pl : context.pointLights) {
+        const Vec3 l = normalize(pl.position - model.transformPoint(p));
+        diffuse = diffuse + pl.color * std::max(0.0f, dot(n, l));
+      }
       intensity = Vec3{light.ambient, light.ambient, light.ambient} + diffuse * (1 - light.ambient);
     }
     const float alpha = std::clamp(color.w, 0.0f, 1.0f);
@@ -79,12 +78,11 @@ struct VertexRun {
         if (layout->stored >> k & 1) a[layout->slot[k]] = value;
       };
       if (layout->stored & (1u << kU | 1u << kV)) {
-        const Vec2 uv = mesh.uvs.empty() ? Vec2{0, 0} : mesh.uvs[i];
+        const Vec2 uv = mesh.uvs ? mesh.uvs[i] : Vec2{0, 0};
         put(kU, uv.x * material.uvScale.x);
         put(kV, uv.y * material.uvScale.y);
       }
-      if (layout->stored &
-          (1u << kNormalX | 1u << kNormalY | 1u << kNormalZ)) {
+      if (layout->stored & (1u << kNormalX | 1u << kNormalY | 1u << kNormalZ)) {
         // Phong's normal; a mesh without normals (or an unlit material) gets none and is not lit.
         const Vec3 n = lit && material.phong
                            ? normalize(normalToEye.transformDirection(mesh.normals[i]))
@@ -104,13 +102,13 @@ struct VertexRun {
     return finite;
   }
 
-  const scene::Mesh& mesh;
-  const scene::Material& material;
+  const VertexArrays& mesh;
+  const VertexMaterial& material;
   const Mat4& model;
   const VertexContext& context;
   const AttributeLayout* layout;
   const Mat4 mvp, modelView, normalToWorld, normalToEye;
-  const scene::Light& light;
+  const DirectionalLight& light;
   bool lit = false, vertexLit = false;
   Vec3 toLight;
   Vec4 base;
@@ -170,7 +168,7 @@ HWY_INLINE VF unitClamp(DF df, VF v) {  // std::clamp(v, 0.0f, 1.0f)
                         hn::IfThenElse(hn::Lt(one, v), one, v));
 }
 
-bool TransformVertices(const scene::Mesh& mesh, const scene::Material& material, const Mat4& model,
+bool TransformVertices(const VertexArrays& mesh, const VertexMaterial& material, const Mat4& model,
                        const VertexContext& context, size_t begin, size_t end, ClipVertex* out,
                        float* attributes, const AttributeLayout* layout) {
   const VertexRun run(mesh, material, model, context, layout);
@@ -195,7 +193,7 @@ bool TransformVertices(const scene::Mesh& mesh, const scene::Material& material,
                       hn::Set(df, run.mvp.m[3][3]));
     VF r = hn::Set(df, run.base.x), g = hn::Set(df, run.base.y), b = hn::Set(df, run.base.z),
        a = hn::Set(df, run.base.w);
-    if (!mesh.colors.empty()) {
+    if (mesh.colors) {
       VF vr, vg, vb, va;
       hn::LoadInterleaved4(df, &mesh.colors[i].x, vr, vg, vb, va);
       r = hn::Mul(r, vr), g = hn::Mul(g, vg), b = hn::Mul(b, vb), a = hn::Mul(a, va);
@@ -204,16 +202,16 @@ bool TransformVertices(const scene::Mesh& mesh, const scene::Material& material,
       V3 n;
       hn::LoadInterleaved3(df, &mesh.normals[i].x, n.x, n.y, n.z);
       n = normalized(df, transform(df, run.normalToWorld, n, 0.0f));
-      const scene::Light& light = run.light;
+      const DirectionalLight& light = run.light;
       V3 diffuse{hn::Zero(df), hn::Zero(df), hn::Zero(df)};
       if (light.enabled) {
         const VF d = positivePart(df, dot3(df, n, run.toLight));
         diffuse = {hn::Mul(hn::Set(df, light.color.x), d), hn::Mul(hn::Set(df, light.color.y), d),
                    hn::Mul(hn::Set(df, light.color.z), d)};
       }
-      if (context.pointLights && !context.pointLights->empty()) {
+      if (!context.pointLights.empty()) {
         const V3 world = transform(df, model, p, 1.0f);
-        for (const scene::PointLight& pl : *context.pointLights) {
+        for (const PointLight& pl : context.pointLights) {
           const V3 l = normalized(df, V3{hn::Sub(hn::Set(df, pl.position.x), world.x),
                                          hn::Sub(hn::Set(df, pl.position.y), world.y),
                                          hn::Sub(hn::Set(df, pl.position.z), world.z)});
@@ -243,7 +241,7 @@ bool TransformVertices(const scene::Mesh& mesh, const scene::Material& material,
     };
     if (stored & (1u << kU | 1u << kV)) {
       VF u = hn::Zero(df), v = hn::Zero(df);
-      if (!mesh.uvs.empty()) hn::LoadInterleaved2(df, &mesh.uvs[i].x, u, v);
+      if (mesh.uvs) hn::LoadInterleaved2(df, &mesh.uvs[i].x, u, v);
       put(kU, hn::Mul(u, hn::Set(df, material.uvScale.x)));
       put(kV, hn::Mul(v, hn::Set(df, material.uvScale.y)));
     }
@@ -284,7 +282,7 @@ HWY_AFTER_NAMESPACE();
 namespace sv::geometry {
 HWY_EXPORT(TransformVertices);
 
-bool transformVertices(const scene::Mesh& mesh, const scene::Material& material, const Mat4& model,
+bool transformVertices(const VertexArrays& mesh, const VertexMaterial& material, const Mat4& model,
                        const VertexContext& context, size_t begin, size_t end, ClipVertex* out,
                        float* attributes, const AttributeLayout* layout) {
   return HWY_DYNAMIC_DISPATCH(TransformVertices)(mesh, material, model, context, begin, end, out,

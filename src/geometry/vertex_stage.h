@@ -2,20 +2,51 @@
 // per-vertex Gouraud lighting (SPEC §8) and the attributes pixel shading interpolates.
 #pragma once
 
-#include <vector>
+#include <span>
 
 #include "geometry/setup.h"
 #include "geometry/attributes.h"
-#include "synthvis/scene.h"
+#include "synthvis/math.h"
 
 namespace sv::geometry {
+
+// A mesh's vertex arrays as the vertex stage reads them (render passes a scene::Mesh's): `count`
+// positions and, per vertex, the optional normals, RGBA colours and texture coordinates (nullptr:
+// none).
+struct VertexArrays {
+  const Vec3* positions = nullptr;
+  size_t count = 0;
+  const Vec3* normals = nullptr;
+  const Vec4* colors = nullptr;
+  const Vec2* uvs = nullptr;
+};
+
+// What the vertex stage reads of a material.
+struct VertexMaterial {
+  Vec4 baseColor{1, 1, 1, 1};  // linear RGBA, multiplies vertex colours
+  Vec2 uvScale{1, 1};          // multiplies the texture coordinates
+  bool unlit = false;          // the lights are ignored
+  bool phong = false;          // lit per pixel: the vertex colour is left unlit
+};
+
+// The lights of the frame, in world space (SPEC §8).
+struct DirectionalLight {
+  Vec3 direction{0, -1, 0};  // the direction the light travels
+  Vec3 color{1, 1, 1};
+  float ambient = 0.25f;
+  bool enabled = true;
+};
+struct PointLight {
+  Vec3 position{0, 0, 0};
+  Vec3 color{1, 1, 1};
+};
 
 // What the vertex stage needs of the frame: camera and lights.
 struct VertexContext {
   Mat4 view;      // world → eye
   Mat4 viewProj;  // projection·view
-  const scene::Light* light = nullptr;
-  const std::vector<scene::PointLight>* pointLights = nullptr;  // world space
+  DirectionalLight light;
+  std::span<const PointLight> pointLights;
 };
 
 // Writes the clip-space vertices of mesh vertices [begin, end) to out[0 … end − begin), and, when
@@ -29,7 +60,7 @@ struct VertexContext {
 // which matches common viewers.
 // Returns whether every position read was finite (scene::validate's check, made here where the
 // positions are read anyway: the renderer skips it in validate).
-bool transformVertices(const scene::Mesh& mesh, const scene::Material& material, const Mat4& model,
+bool transformVertices(const VertexArrays& mesh, const VertexMaterial& material, const Mat4& model,
                        const VertexContext& context, size_t begin, size_t end, ClipVertex* out,
                        float* attributes = nullptr, const AttributeLayout* layout = nullptr);
 

@@ -36,6 +36,20 @@ const scene::Material& materialOf(const scene::Scene& scene, const scene::Mesh& 
   return mesh.material >= 0 ? scene.materials[size_t(mesh.material)] : defaultMaterial;
 }
 
+// The mesh's arrays and material as the vertex stage reads them.
+geometry::VertexArrays vertexArrays(const scene::Mesh& mesh) {
+  geometry::VertexArrays v;
+  v.positions = mesh.positions.data();
+  v.count = mesh.positions.size();
+  if (!mesh.normals.empty()) v.normals = mesh.normals.data();
+  if (!mesh.colors.empty()) v.colors = mesh.colors.data();
+  if (!mesh.uvs.empty()) v.uvs = mesh.uvs.data();
+  return v;
+}
+geometry::VertexMaterial vertexMaterial(const scene::Material& m) {
+  return {m.baseColor, m.uvScale, m.unlit, m.phong};
+}
+
 // The order instances are drawn in (indices into scene.instances). Opaque ones: in submission
 // order for the Z-buffer; for masking (SPEC §4) by priority, then nearest first — by the smallest
 // view depth of their bounding box's corners, which orders objects separated in depth correctly
@@ -167,8 +181,14 @@ Status buildDrawPackets(const scene::Scene& scene, const RenderOptions& o,
   p.attributeLayout = geometry::AttributeLayout::of(stored);
   const size_t stride = size_t(p.attributeLayout.stride);
   p.attributes.resize(p.vertices.size() * stride);
-  const geometry::VertexContext context{camera.view, camera.projection * camera.view, &scene.light,
-                                        &scene.pointLights};
+  geometry::VertexContext context{
+      camera.view,
+      camera.projection * camera.view,
+      {scene.light.direction, scene.light.color, scene.light.ambient, scene.light.enabled},
+      {}};
+  std::vector<geometry::PointLight> pointLights;
+  for (const scene::PointLight& l : scene.pointLights) pointLights.push_back({l.position, l.color});
+  context.pointLights = pointLights;
   std::vector<uint8_t> finite(jobs.size());  // positions finite, indices in range
   pool.parallelFor(jobs.size(), [&](size_t j, int) {
     const VertexJob& job = jobs[j];
@@ -184,9 +204,9 @@ Status buildDrawPackets(const scene::Scene& scene, const RenderOptions& o,
       return;
     }
     finite[j] = geometry::transformVertices(
-        mesh, materialOf(scene, mesh), job.instance->transform, context, job.begin, job.end,
-        p.vertices.data() + job.out, stride ? p.attributes.data() + job.out * stride : nullptr,
-        &p.attributeLayout);
+        vertexArrays(mesh), vertexMaterial(materialOf(scene, mesh)), job.instance->transform,
+        context, job.begin, job.end, p.vertices.data() + job.out,
+        stride ? p.attributes.data() + job.out * stride : nullptr, &p.attributeLayout);
   });
   if (std::find(finite.begin(), finite.end(), 0) != finite.end()) return invalidVertexData(scene);
   return {};

@@ -14,8 +14,8 @@
 namespace sv::render {
 namespace {
 
-freeform::Mat4d toDouble(const Mat4& m) {  // column-major float → row-major double
-  freeform::Mat4d d;
+Mat4d toDouble(const Mat4& m) {  // column-major float → row-major double
+  Mat4d d;
   for (int r = 0; r < 4; ++r)
     for (int c = 0; c < 4; ++c) d.m[r][c] = m.m[c][r];
   return d;
@@ -28,7 +28,7 @@ freeform::FreeForm toFreeForm(const scene::FreeFormNode& n) {
   f.base.c = n.quadric;
   f.weight = n.weight;
   for (const scene::FreeFormNode& p : n.perturbations) f.perturbations.push_back(toFreeForm(p));
-  for (const auto& c : n.clips) f.clips.push_back(freeform::Quadric{c});
+  for (const auto& c : n.clips) f.clips.push_back(Quadric{c});
   return f;
 }
 
@@ -41,8 +41,8 @@ std::vector<freeform::ShadedForm> shadedForms(const scene::Scene& scene, const M
   for (const scene::FreeFormObject& object : scene.freeForms) {
     const scene::Material& mat =
         object.material >= 0 ? scene.materials[size_t(object.material)] : defaultMaterial;
-    const freeform::Mat4d toEye = toDouble(view * object.transform);
-    const std::optional<freeform::Mat4d> eyeInverse = toEye.inverse();
+    const Mat4d toEye = toDouble(view * object.transform);
+    const std::optional<Mat4d> eyeInverse = toEye.inverse();
     const freeform::FreeForm form = toFreeForm(object.form);
     std::optional<freeform::ProjectedFreeForm> projected =
         freeform::ProjectedFreeForm::make(form, toDouble(projection) * toEye);
@@ -88,11 +88,11 @@ Result<scene::Scene> tessellatedScene(const scene::Scene& scene, const RenderOpt
     if (!box) continue;  // no surface
     // The nearest eye depth of the box, and its smallest half extent as the curvature radius.
     const Mat4 toEye = camera.value().view * object.transform;
-    const auto single = [](freeform::Vec3d v) { return Vec3{float(v.x), float(v.y), float(v.z)}; };
+    const auto single = [](Vec3d v) { return Vec3{float(v.x), float(v.y), float(v.z)}; };
     const double nearest =
         std::max(double(render::nearestEyeDepth(toEye, single((*box)[0]), single((*box)[1]))),
                  double(cam.znear));
-    const freeform::Vec3d extent = (*box)[1] - (*box)[0];
+    const Vec3d extent = (*box)[1] - (*box)[0];
     const double radius = 0.5 * std::min({extent.x, extent.y, extent.z});
     // Object units per pixel at that depth (the transform's largest scale brings it to the world).
     double scale = 0;
@@ -111,8 +111,8 @@ Result<scene::Scene> tessellatedScene(const scene::Scene& scene, const RenderOpt
     mesh.name = object.name + " (tessellated)";
     mesh.material = object.material;
     for (size_t v = 0; v < soup.positions.size(); ++v) {
-      const freeform::Vec3d& p = soup.positions[v];
-      const freeform::Vec3d& n = soup.normals[v];
+      const Vec3d& p = soup.positions[v];
+      const Vec3d& n = soup.normals[v];
       mesh.positions.push_back({float(p.x), float(p.y), float(p.z)});
       mesh.normals.push_back({float(n.x), float(n.y), float(n.z)});
       mesh.uvs.push_back({float(p.x), float(p.z)});  // the free form's projection (tile_pass.h)

@@ -3,15 +3,13 @@
 #include <cmath>
 #include <random>
 
-#include "freeform/quadric.h"
+#include "core/quadric.h"
 #include "scene/generator_common.h"
 #include "synthvis/generators.h"
 
 namespace sv::scene {
 namespace {
 
-using freeform::Quadric;
-using freeform::Vec3d;
 
 constexpr double kPi = 3.14159265358979323846;
 

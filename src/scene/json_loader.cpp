@@ -24,7 +24,7 @@
 #include <string_view>
 #include <utility>
 
-#include "freeform/quadric.h"
+#include "core/quadric.h"
 #include "scene/loader_common.h"
 #include "scene/primitives.h"
 #include "texture/texture.h"
@@ -803,8 +803,6 @@ void SceneReader::readFreeFormObject(const Json& v, const std::string& where) {
 
 FreeFormNode SceneReader::readFreeForm(const Json& v, const std::string& where, int depth,
                                        int& quadrics, bool root) const {
-  using freeform::Quadric;
-  using freeform::Vec3d;
   if (!v.is_object()) fail(where, fmt::format("expected a quadric object, got {}", typeName(v)));
   if (depth > kMaxFreeFormDepth)
     fail(where, fmt::format("perturbations nested deeper than {}", kMaxFreeFormDepth));

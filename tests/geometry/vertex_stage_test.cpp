@@ -38,9 +38,20 @@ TEST(AttributeLayout, PacksTheStoredAttributesInOrder) {
   EXPECT_EQ(AttributeLayout::of(~0u).stride, kAttributeCount);  // bits beyond the last ignored
 }
 
-scene::Mesh randomMesh(std::mt19937& rng, size_t n, bool colors, bool normals, bool uvs) {
+// A mesh's arrays, and the vertex stage's view of them.
+struct Mesh {
+  std::vector<Vec3> positions, normals;
+  std::vector<Vec4> colors;
+  std::vector<Vec2> uvs;
+  operator geometry::VertexArrays() const {
+    return {positions.data(), positions.size(), normals.empty() ? nullptr : normals.data(),
+            colors.empty() ? nullptr : colors.data(), uvs.empty() ? nullptr : uvs.data()};
+  }
+};
+
+Mesh randomMesh(std::mt19937& rng, size_t n, bool colors, bool normals, bool uvs) {
   std::uniform_real_distribution<float> pos(-3, 3), unit(0, 1), dir(-1, 1);
-  scene::Mesh m;
+  Mesh m;
   for (size_t i = 0; i < n; ++i) {
     m.positions.push_back({pos(rng), pos(rng), pos(rng) - 8});
     if (colors) m.colors.push_back({unit(rng), unit(rng), unit(rng), 1.5f * unit(rng) - 0.25f});
@@ -61,25 +72,27 @@ TEST(VertexStage, LanesEqualTheOneVertexCodeOnEveryTarget) {
   const Mat4 proj = Mat4::perspective(1.0f, 1.5f, 0.1f, 100.0f);
   const Mat4 model = Mat4::translation({0.5f, -0.25f, 1}) * Mat4::rotation({1, 2, 0.5f}, 0.7f) *
                      Mat4::scaling({1.5f, 0.75f, 1.25f});
-  const std::vector<scene::PointLight> points = {{{2, 3, -5}, {0.8f, 0.5f, 0.3f}},
-                                                 {{-4, 1, -9}, {0.2f, 0.9f, 0.6f}}};
+  const std::vector<geometry::PointLight> points = {{{2, 3, -5}, {0.8f, 0.5f, 0.3f}},
+                                                    {{-4, 1, -9}, {0.2f, 0.9f, 0.6f}}};
   int cases = 0;
   for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
     hwy::SetSupportedTargetsForTest(target);
     for (int variant = 0; variant < 32; ++variant) {
       const bool colors = variant & 1, normals = variant & 2, phong = variant & 4,
                  lightOn = variant & 8, withPoints = variant & 16;
-      const scene::Mesh mesh = randomMesh(rng, n, colors, normals, variant % 3 != 0);
-      scene::Material material;
+      const Mesh mesh = randomMesh(rng, n, colors, normals, variant % 3 != 0);
+      geometry::VertexMaterial material;
       material.baseColor = {0.9f, 0.7f, 0.5f, 0.8f};
       material.phong = phong;
       material.uvScale = {2.5f, 0.75f};
-      scene::Light light;
+      geometry::DirectionalLight light;
+      light.direction = {-0.4f, -1.0f, -0.6f};
       light.enabled = lightOn;
-      const geometry::VertexContext context{view, proj * view, &light,
-                                            withPoints ? &points : nullptr};
-      for (unsigned stored :
-           {0u, (1u << kU) | (1u << kV), (1u << kAttributeCount) - 1}) {
+      const geometry::VertexContext context{view, proj * view, light,
+                                            withPoints
+                                                ? std::span<const geometry::PointLight>(points)
+                                                : std::span<const geometry::PointLight>()};
+      for (unsigned stored : {0u, (1u << kU) | (1u << kV), (1u << kAttributeCount) - 1}) {
         const AttributeLayout layout = AttributeLayout::of(stored);
         const size_t stride = size_t(layout.stride);
         std::vector<ClipVertex> lanes(n), one(n);
@@ -105,19 +118,17 @@ TEST(VertexStage, LanesEqualTheOneVertexCodeOnEveryTarget) {
 TEST(VertexStage, ANonFinitePositionIsReportedFromTheLanesAndTheTail) {
   std::mt19937 rng(3);
   const Mat4 view = Mat4::lookAt({0, 0, 0}, {0, 0, -1}, {0, 1, 0});
-  const geometry::VertexContext context{view, Mat4::perspective(1.0f, 1.0f, 0.1f, 100.0f) * view,
-                                        nullptr, nullptr};
-  scene::Light light;
-  const geometry::VertexContext lit{context.view, context.viewProj, &light, nullptr};
+  const geometry::VertexContext lit{
+      view, Mat4::perspective(1.0f, 1.0f, 0.1f, 100.0f) * view, {}, {}};
   for (size_t bad : {size_t(2), size_t(40), size_t(63)}) {
-    scene::Mesh mesh = randomMesh(rng, 64, true, false, false);
+    Mesh mesh = randomMesh(rng, 64, true, false, false);
     mesh.positions[bad].y = bad == 40 ? std::nanf("") : INFINITY;
     std::vector<ClipVertex> out(64);
-    EXPECT_FALSE(geometry::transformVertices(mesh, scene::Material{}, Mat4::identity(), lit, 0, 64,
-                                             out.data()))
+    EXPECT_FALSE(geometry::transformVertices(mesh, geometry::VertexMaterial{}, Mat4::identity(),
+                                             lit, 0, 64, out.data()))
         << bad;
-    EXPECT_TRUE(geometry::transformVertices(mesh, scene::Material{}, Mat4::identity(), lit, 0, bad,
-                                            out.data()))
+    EXPECT_TRUE(geometry::transformVertices(mesh, geometry::VertexMaterial{}, Mat4::identity(), lit,
+                                            0, bad, out.data()))
         << bad;
   }
 }

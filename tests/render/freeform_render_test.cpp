@@ -10,7 +10,7 @@
 #include <memory>
 #include <vector>
 
-#include "freeform/quadric.h"
+#include "core/quadric.h"
 #include "freeform/raycast.h"
 #include "synthvis/generators.h"
 #include "synthvis/render.h"
@@ -44,7 +44,7 @@ scene::Scene sphereOnGround() {
   s.meshes.push_back(ground);
   s.instances.push_back({0, Mat4{}});
   scene::FreeFormObject ball;
-  ball.form.quadric = freeform::Quadric::sphere({0, 0.6, 0}, 1).c;
+  ball.form.quadric = Quadric::sphere({0, 0.6, 0}, 1).c;
   ball.material = 0;
   s.freeForms.push_back(ball);
   return s;
@@ -239,9 +239,9 @@ TEST(FreeFormRender, ProjectedTextureMatchesTheSameTextureOnPolygons) {
     s.materials[1].uvScale = {0.25f, 0.25f};
     if (freeForm) {
       scene::FreeFormObject f;
-      f.form.quadric = freeform::Quadric::halfSpace({0, 1, 0}, 0).c;
-      for (const freeform::Vec3d n : {freeform::Vec3d{1, 0, 0}, {-1, 0, 0}, {0, 0, 1}, {0, 0, -1}})
-        f.form.clips.push_back(freeform::Quadric::halfSpace(n, 10).c);
+      f.form.quadric = Quadric::halfSpace({0, 1, 0}, 0).c;
+      for (const Vec3d n : {Vec3d{1, 0, 0}, {-1, 0, 0}, {0, 0, 1}, {0, 0, -1}})
+        f.form.clips.push_back(Quadric::halfSpace(n, 10).c);
       f.material = 1;
       s.freeForms.push_back(f);
     } else {
@@ -271,8 +271,8 @@ TEST(FreeFormRender, MarchedFormsAreShadedAsCastOnes) {
   s.materials[0].unlit = false;
   scene::FreeFormNode& ball = s.freeForms[0].form;
   ball.perturbations.resize(2);
-  ball.perturbations[0].quadric = freeform::Quadric::sphere({0.5, 1.2, 0.6}, 0.45).c;
-  ball.perturbations[1].quadric = freeform::Quadric::sphere({-0.6, 0.5, 0.7}, 0.4).c;
+  ball.perturbations[0].quadric = Quadric::sphere({0.5, 1.2, 0.6}, 0.45).c;
+  ball.perturbations[1].quadric = Quadric::sphere({-0.6, 0.5, 0.7}, 0.4).c;
   ball.perturbations[1].weight = -1;
   RenderOptions o;
   o.width = 160;
@@ -299,13 +299,13 @@ TEST(FreeFormRender, RaysGrazingACreaseFindTheFirstCrossing) {
   const scene::Camera& cam = s.cameras[0];
   const Mat4 m = Mat4::perspective(cam.yfovDegrees * float(M_PI) / 180, 1, cam.znear, cam.zfar) *
                  Mat4::lookAt(cam.position, cam.target, cam.up);
-  freeform::Mat4d toCube;
+  Mat4d toCube;
   for (int r = 0; r < 4; ++r)
     for (int c = 0; c < 4; ++c) toCube.m[r][c] = m.m[c][r];
   const std::function<freeform::FreeForm(const scene::FreeFormNode&)> convert =
       [&](const scene::FreeFormNode& n) {
         freeform::FreeForm f;
-        f.base = freeform::Quadric{n.quadric};
+        f.base = Quadric{n.quadric};
         f.weight = n.weight;
         for (const scene::FreeFormNode& p : n.perturbations) f.perturbations.push_back(convert(p));
         return f;
@@ -369,7 +369,7 @@ TEST(FreeFormRender, TessellatedSceneRendersNearlyTheSameImage) {
   EXPECT_LT(differing, 40) << "channels differing by more than 8 (silhouette and curve pixels)";
   // An unbounded form cannot be tessellated.
   scene::FreeFormObject plane;
-  plane.form.quadric = freeform::Quadric::halfSpace({0, 1, 0}, -1).c;
+  plane.form.quadric = Quadric::halfSpace({0, 1, 0}, -1).c;
   s.freeForms.push_back(plane);
   const Result<scene::Scene> bad = tessellatedScene(s, o);
   ASSERT_FALSE(bad.ok());

@@ -1,12 +1,12 @@
 // Based on: SPEC §11–§12 (seed 003). Quadric forms as sums of squared linear forms, the projective
 // transform of a quadric's matrix, the five-point projective map, interval bounds.
-#include "freeform/quadric.h"
+#include "core/quadric.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-namespace sv::freeform {
+namespace sv {
 
 Vec3d normalize(Vec3d v) {
   const double l = std::sqrt(dot(v, v));
@@ -273,4 +273,4 @@ Quadric Quadric::transformedByInverse(const Mat4d& inverse) const {
   return fromMatrix(inverse.transposed() * matrix() * inverse);
 }
 
-}  // namespace sv::freeform
+}  // namespace sv

@@ -1,4 +1,5 @@
-// Quadrics, the base primitives of free-form surfaces, with interval bounds and projective maps.
+// Quadrics, the base primitives of free-form surfaces, with interval bounds and projective maps —
+// core maths, because the scene's loaders build quadrics and the free-form stage casts them.
 //
 // Based on: SPEC §11 (seed 003: quadrics F = Ax² + By² + Cz² + Dxy + Exz + Fyz + Gx + Hy + Iz + K),
 // §12 (a quadric stays a quadric under a projective map, S' = M^{-T} S M^{-1}; a projective map of
@@ -16,8 +17,13 @@
 #include <limits>
 #include <optional>
 
-namespace sv::freeform {
+namespace sv {
 
+// Vec3d, Vec4d and Mat4d are synthvis/math.h's Vec3, Vec4 and Mat4 in double, for the free forms'
+// arithmetic: a quadric carried into the cube by a projective map and its interval bounds lose
+// the surface in float (the map's entries span many orders of magnitude near the far plane).
+// Mat4d is row-major (m[r][c]), as SPEC §12 writes S' = M^{-T} S M^{-1} and a quadric's matrix;
+// render turns the camera's column-major Mat4 into it (render/freeforms.cpp).
 struct Vec3d {
   double x = 0, y = 0, z = 0;
   friend Vec3d operator+(Vec3d a, Vec3d b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
@@ -133,4 +139,4 @@ struct Quadric {
   Quadric transformedByInverse(const Mat4d& inverse) const;
 };
 
-}  // namespace sv::freeform
+}  // namespace sv
