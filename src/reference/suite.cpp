@@ -4,23 +4,20 @@
 
 #include <algorithm>
 #include <cctype>
-#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <optional>
 
+#include "core/timing.h"
 #include "reference/gl_renderer.h"
 
 namespace sv::reference {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double msSince(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
+using core::Clock;
+using core::msSince;
 
 double median(std::vector<double> v) {
   if (v.empty()) return 0;

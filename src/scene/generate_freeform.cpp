@@ -1,6 +1,7 @@
 // BENCH.md `freeform` and `freeform-one`: perturbed quadrics (SPEC §11) for multi-level ray casting
 // (SPEC §12) and its baselines.
 #include <cmath>
+#include <numbers>
 #include <random>
 
 #include "core/quadric.h"
@@ -9,9 +10,6 @@
 
 namespace sv::scene {
 namespace {
-
-
-constexpr double kPi = 3.14159265358979323846;
 
 // A perturbation: a small sphere or ellipsoid centred on `at`, a bump (w > 0) or a dent (w < 0).
 FreeFormNode perturbation(Vec3d at, double radius, bool ellipsoid, double weight) {
@@ -52,7 +50,7 @@ Scene generateFreeForms(const FreeFormParams& p) {
     mat.shininess = float(uniform(10, 60));
     s.materials.push_back(mat);
   }
-  const double tanHalf = std::tan(kPi / 6), aspect = double(p.width) / p.height;
+  const double tanHalf = std::tan(std::numbers::pi / 6), aspect = double(p.width) / p.height;
   for (int i = 0; i < p.count; ++i) {
     FreeFormObject o;
     o.name = "freeform" + std::to_string(i);
@@ -65,7 +63,8 @@ Scene generateFreeForms(const FreeFormParams& p) {
                       float(uniform(-0.95, 0.95) * depth * tanHalf), float(-depth)};
     const Vec3 axis =
         normalize(Vec3{float(uniform(-1, 1)), float(uniform(-1, 1)), float(uniform(-1, 1))});
-    o.transform = Mat4::translation(centre) * Mat4::rotation(axis, float(uniform(0, 2 * kPi)));
+    o.transform =
+        Mat4::translation(centre) * Mat4::rotation(axis, float(uniform(0, 2 * std::numbers::pi)));
     // The base: sphere, ellipsoid, capped cylinder or capped paraboloid, about the origin.
     const int kind = int(uniform(0, 4));
     Vec3d radii{r, r, r};

@@ -2,6 +2,7 @@
 // textured cubes — for the texture samplers' cost where their level of detail varies most.
 #include <cmath>
 #include <memory>
+#include <numbers>
 #include <utility>
 
 #include "scene/primitives.h"
@@ -51,9 +52,10 @@ Scene generateGrazing(const GrazingParams& p) {
     box.name = "cube";
     box.material = 1;
     s.meshes.push_back(std::move(box));
-    s.instances.push_back({int(s.meshes.size() - 1),
-                           Mat4::translation({c.x, c.size / 2, c.z}) *
-                               Mat4::rotation({0, 1, 0}, c.yawDegrees * 3.14159265f / 180)});
+    s.instances.push_back(
+        {int(s.meshes.size() - 1),
+         Mat4::translation({c.x, c.size / 2, c.z}) *
+             Mat4::rotation({0, 1, 0}, c.yawDegrees * std::numbers::pi_v<float> / 180)});
   }
 
   s.cameras.push_back({.name = "grazing",

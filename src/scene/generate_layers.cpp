@@ -8,17 +8,14 @@
 // Texture and fog (BENCH.md) come with their issues; the geometry is final.
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <random>
 
 #include "scene/generator_common.h"
 #include "synthvis/generators.h"
 
 namespace sv::scene {
-namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
-}  // namespace
+namespace {}  // namespace
 
 Scene generateLayers(const LayersParams& p, TrisStats* stats) {
   std::mt19937_64 rng(p.seed);
@@ -26,7 +23,7 @@ Scene generateLayers(const LayersParams& p, TrisStats* stats) {
     return std::uniform_real_distribution<double>(a, b)(rng);
   };
   const double w = p.width, h = p.height, aspect = w / h;
-  const double tanHalf = std::tan(30.0 * kPi / 180.0);
+  const double tanHalf = std::tan(30.0 * std::numbers::pi / 180.0);
   const int cols = std::max(1, int(std::lround(w / 20))),
             rows = std::max(1, int(std::lround(h / 20)));
   const double cellW = w / cols, cellH = h / rows;

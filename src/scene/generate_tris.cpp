@@ -7,6 +7,7 @@
 // values, stored linear); UVs giving 0.5–4 texels per pixel on a 1024² texture.
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <numeric>
 #include <random>
 
@@ -17,8 +18,7 @@
 namespace sv::scene {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kYFov = 60.0 * kPi / 180.0;
+constexpr double kYFov = 60.0 * std::numbers::pi / 180.0;
 
 struct Dvec {
   double x, y, z;
@@ -132,17 +132,18 @@ Scene generateTris(const TrisParams& p, TrisStats* stats) {
     const Dvec back = dir * -1.0;
     Dvec helper = std::fabs(back.x) < 0.9 ? Dvec{1, 0, 0} : Dvec{0, 1, 0};
     const Dvec a1 = unit(crossd(back, helper)), a2 = crossd(back, a1);
-    const double tilt = uniform(0, 60) * kPi / 180, azimuth = uniform(0, 2 * kPi);
+    const double tilt = uniform(0, 60) * std::numbers::pi / 180,
+                 azimuth = uniform(0, 2 * std::numbers::pi);
     const Dvec axis = a1 * std::cos(azimuth) + a2 * std::sin(azimuth);
     const Dvec n = back * std::cos(tilt) + crossd(axis, back) * std::sin(tilt);
     const Dvec e1 = unit(crossd(n, helper)), e2 = crossd(n, e1);
     // A roughly equilateral triangle of unit scale in that plane.
-    double angle = uniform(0, 2 * kPi);
+    double angle = uniform(0, 2 * std::numbers::pi);
     Dvec local[3];
     for (int k = 0; k < 3; ++k) {
       const double r = uniform(0.75, 1.25);
       local[k] = e1 * (r * std::cos(angle)) + e2 * (r * std::sin(angle));
-      angle += (120 + uniform(-20, 20)) * kPi / 180;
+      angle += (120 + uniform(-20, 20)) * std::numbers::pi / 180;
     }
     // Scale to the target projected area (projection is nearly linear at this size: two passes).
     double scale = distance * 0.01;

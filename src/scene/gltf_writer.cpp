@@ -15,6 +15,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <numbers>
 
 #include "synthvis/scene.h"
 #include "texture/texture.h"
@@ -171,7 +172,7 @@ Status saveGltf(const Scene& scene, const std::string& path) {
     tinygltf::Camera cam;
     cam.type = "perspective";
     cam.name = c.name;
-    cam.perspective.yfov = c.yfovDegrees * 3.14159265358979 / 180.0;
+    cam.perspective.yfov = c.yfovDegrees * std::numbers::pi / 180.0;
     cam.perspective.znear = c.znear;
     cam.perspective.zfar = c.zfar;
     model.cameras.push_back(cam);

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <random>
 
 #include "hwy/targets.h"
@@ -154,7 +155,8 @@ TEST(NearPlane, CameraInsideClosedSphereHitsEveryPixelOnce) {
   DrawPackets p;
   for (int i = 0; i <= stacks; ++i)
     for (int j = 0; j <= slices; ++j) {
-      const float th = 3.14159265f * i / stacks, ph = 2 * 3.14159265f * j / slices;
+      const float th = std::numbers::pi_v<float> * i / stacks,
+                  ph = 2 * std::numbers::pi_v<float> * j / slices;
       const Vec4 c = vp * Vec4{2 * std::sin(th) * std::cos(ph), 2 * std::cos(th),
                                2 * std::sin(th) * std::sin(ph), 1};
       p.vertices.push_back({c.x, c.y, c.z, c.w, 1, 1, 1, 1});

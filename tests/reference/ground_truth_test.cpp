@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <numbers>
 
 #include "synthvis/generators.h"
 
@@ -15,7 +16,7 @@ namespace {
 // A white, unlit quad over pixels x ∈ [0, right), all rows, on the BENCH.md camera at depth 2.
 scene::Scene quadScene(int width, int height, double right) {
   scene::Scene s = scene::benchCameraScene("quad");
-  const double tanHalf = std::tan(30.0 * 3.14159265358979 / 180), aspect = double(width) / height;
+  const double tanHalf = std::tan(30.0 * std::numbers::pi / 180), aspect = double(width) / height;
   auto at = [&](double px, double py) {
     const double z = 2;
     return Vec3{float((2 * px / width - 1) * z * tanHalf * aspect),

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <numbers>
 #include <set>
 
 #include "scene/primitives.h"
@@ -194,7 +195,7 @@ TEST(TrisGenerator, RenderedAreaMatchesTheRequestedArea) {
 // (x = 10.5) of a w × h image: column 9 fully covered, column 10 half, column 11 not at all.
 scene::Scene halfCoveredColumnScene(int w, int h) {
   scene::Scene s = scene::benchCameraScene("quad");
-  const double tanHalf = std::tan(30.0 * 3.14159265358979 / 180), aspect = double(w) / h;
+  const double tanHalf = std::tan(30.0 * std::numbers::pi / 180), aspect = double(w) / h;
   auto at = [&](double px, double py) {
     return Vec3{float((2 * px / w - 1) * 2 * tanHalf * aspect),
                 float((1 - 2 * py / h) * 2 * tanHalf), -2.0f};
@@ -352,7 +353,7 @@ TEST(LayersGenerator, TexturedAndFoggedLayersKeepTheirGeometry) {
   // Texels per pixel from a triangle's UVs and its (parallel-to-screen) pixel positions.
   const scene::Mesh& m = shaded.meshes[0];
   ASSERT_EQ(m.uvs.size(), m.positions.size());
-  const double tanHalf = std::tan(30.0 * 3.14159265358979 / 180.0);
+  const double tanHalf = std::tan(30.0 * std::numbers::pi / 180.0);
   for (size_t t = 0; t < m.positions.size(); t += 3 * 97) {
     const Vec3 a = m.positions[t], b = m.positions[t + 1];
     const double pixelsPerUnit = p.height / (2 * tanHalf * -a.z);

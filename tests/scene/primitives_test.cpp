@@ -15,8 +15,6 @@
 namespace sv::scene::detail {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-
 struct Case {
   const char* name;
   PrimitiveParams params;
@@ -158,12 +156,13 @@ TEST(Primitives, EnclosedVolumesMatchTheAnalyticSolids) {
   EXPECT_NEAR(enclosedVolume(makeBox({2, 3, 4})), 24.0, 1e-4);
   const int n = 128;
   const double r = 1.5, h = 2.0;
-  const double polygonArea = n / 2.0 * r * r * std::sin(2 * kPi / n);  // regular n-gon
+  const double polygonArea = n / 2.0 * r * r * std::sin(2 * std::numbers::pi / n);  // regular n-gon
   EXPECT_NEAR(enclosedVolume(makeCylinder(float(r), float(h), n, true)), polygonArea * h, 1e-4);
   EXPECT_NEAR(enclosedVolume(makeCone(float(r), float(h), n, true)), polygonArea * h / 3, 1e-4);
-  EXPECT_NEAR(enclosedVolume(makeSphere(float(r), n, n / 2)), 4.0 / 3.0 * kPi * r * r * r,
-              0.005 * 4.0 / 3.0 * kPi * r * r * r);
-  const double torus = 2 * kPi * kPi * 1.0 * 0.25 * 0.25;  // 2π²·R·t²
+  EXPECT_NEAR(enclosedVolume(makeSphere(float(r), n, n / 2)),
+              4.0 / 3.0 * std::numbers::pi * r * r * r,
+              0.005 * 4.0 / 3.0 * std::numbers::pi * r * r * r);
+  const double torus = 2 * std::numbers::pi * std::numbers::pi * 1.0 * 0.25 * 0.25;  // 2π²·R·t²
   EXPECT_NEAR(enclosedVolume(makeTorus(1.0f, 0.25f, n, n)), torus, 0.005 * torus);
 }
 
