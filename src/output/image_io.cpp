@@ -1,18 +1,16 @@
-// PNG through libpng's simplified API (no setjmp across C++ frames); PPM by hand.
+// Image files: PNG through the one PNG codec (texture/png.h); PPM by hand.
 #include <fmt/format.h>
-#include <png.h>
 
 #include <cstdio>
 #include <memory>
 
 #include "synthvis/image.h"
+#include "texture/png.h"
 
 namespace sv {
 namespace {
 
-// The raster limit (8192², 192 MiB of RGB): a PNG header claiming more is refused before any
-// allocation, so a tiny malicious file cannot ask for gigabytes.
-constexpr int kMaxImageSide = 1 << 13;
+constexpr int kMaxImageSide = 1 << 13;  // as the raster's
 
 bool endsWith(const std::string& s, const char* suffix) {
   const std::string x(suffix);
@@ -39,19 +37,7 @@ Status writeImage(const Image& image, const std::string& path) {
 
 Status writePng(const Image& image, const std::string& path) {
   if (Status s = checkImage(image, path); !s) return s;
-  png_image png{};
-  png.version = PNG_IMAGE_VERSION;
-  png.width = static_cast<png_uint_32>(image.width);
-  png.height = static_cast<png_uint_32>(image.height);
-  png.format = PNG_FORMAT_RGB;
-  // Declare the pixels sRGB-encoded so viewers show them as rendered.
-  png.flags = 0;
-  if (!png_image_write_to_file(&png, path.c_str(), 0, image.rgb.data(), image.width * 3, nullptr)) {
-    std::string msg = png.message;
-    png_image_free(&png);
-    return Error{path, "", "cannot write PNG: " + msg};
-  }
-  return {};
+  return texture::writePng(path, image.width, image.height, 3, image.rgb.data());
 }
 
 Status writePpm(const Image& image, const std::string& path) {
@@ -67,48 +53,27 @@ Status writePpm(const Image& image, const std::string& path) {
 
 namespace {
 
-// Both readers: `png` has begun reading (from a file or from memory); `name` is for messages.
-Result<Image> finishPngRead(png_image& png, const std::string& name) {
-  if (png.width == 0 || png.height == 0 || png.width > kMaxImageSide ||
-      png.height > kMaxImageSide) {
-    png_image_free(&png);
-    return Error{name, "", fmt::format("PNG size {}x{} is out of range", png.width, png.height)};
-  }
-  png.format = PNG_FORMAT_RGB;
+// The raster limit (8192², 192 MiB of RGB): a PNG header claiming more is refused before any
+// allocation, so a tiny malicious file cannot ask for gigabytes.
+constexpr texture::PngLimits kImageLimits{kMaxImageSide, int64_t(kMaxImageSide) * kMaxImageSide};
+
+Result<Image> imageOf(Result<texture::PngPixels> png) {
+  if (!png.ok()) return png.error();
   Image image;
-  image.width = static_cast<int>(png.width);
-  image.height = static_cast<int>(png.height);
-  image.rgb.resize(PNG_IMAGE_SIZE(png));
-  if (!png_image_finish_read(&png, nullptr, image.rgb.data(), 0, nullptr)) {
-    std::string msg = png.message;
-    png_image_free(&png);
-    return Error{name, "", "cannot decode PNG: " + msg};
-  }
+  image.width = png.value().width;
+  image.height = png.value().height;
+  image.rgb = std::move(png.value().data);
   return image;
 }
 
 }  // namespace
 
 Result<Image> readPng(const std::string& path) {
-  png_image png{};
-  png.version = PNG_IMAGE_VERSION;
-  if (!png_image_begin_read_from_file(&png, path.c_str())) {
-    std::string msg = png.message;
-    png_image_free(&png);
-    return Error{path, "", "cannot read PNG: " + msg};
-  }
-  return finishPngRead(png, path);
+  return imageOf(texture::readPng(path, texture::PngLayout::rgb8, kImageLimits));
 }
 
 Result<Image> decodePng(const void* data, size_t size, const std::string& name) {
-  png_image png{};
-  png.version = PNG_IMAGE_VERSION;
-  if (!png_image_begin_read_from_memory(&png, data, size)) {
-    std::string msg = png.message;
-    png_image_free(&png);
-    return Error{name, "", "cannot read PNG: " + msg};
-  }
-  return finishPngRead(png, name);
+  return imageOf(texture::decodePng(data, size, name, texture::PngLayout::rgb8, kImageLimits));
 }
 
 }  // namespace sv

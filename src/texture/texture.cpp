@@ -1,12 +1,11 @@
 #include "texture/texture.h"
 
-#include <fmt/format.h>
-#include <png.h>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <filesystem>
+#include <cstring>
+
+#include "texture/png.h"
 
 namespace sv::texture {
 
@@ -247,48 +246,21 @@ Color4 Texture::anisotropic(const Footprint& f, float x0, float y0) const {
 
 namespace {
 
-// libpng's simplified API has begun reading `png` (`bytes` long); finish into a linear,
-// premultiplied level.
-Result<Level> finishRead(png_image& png, uint64_t bytes, const std::string& name) {
-  if (png.width == 0 || png.height == 0 || png.width > uint32_t(kMaxTextureSide) ||
-      png.height > uint32_t(kMaxTextureSide) ||
-      int64_t(png.width) * int64_t(png.height) > kMaxTextureTexels) {
-    png_image_free(&png);
-    return Error{name, "",
-                 fmt::format("texture size {}x{} is out of range (sides 1…{}, at most {} texels)",
-                             png.width, png.height, kMaxTextureSide, kMaxTextureTexels)};
-  }
-  // Deflate expands at most about 1032:1, so a file too short for the size its header states is
-  // refused before the image is allocated (a 60-byte file must not cost half a gigabyte).
-  if (uint64_t(PNG_IMAGE_SIZE(png)) > bytes * 1032 + 65536) {
-    png_image_free(&png);
-    return Error{name, "",
-                 fmt::format("{} bytes of PNG cannot hold the {}x{} image its header states", bytes,
-                             png.width, png.height)};
-  }
+// A texture map's pixels as linear, premultiplied texels: 16-bit files are libpng's linear RGBA
+// with premultiplied alpha already (their samples are linear unless a gAMA chunk says otherwise,
+// which libpng then undoes); 8-bit ones are sRGB-encoded RGBA (libpng re-encodes another stated
+// gamma as sRGB), decoded here by the exact IEC 61966-2-1 curve — libpng's own linear output uses
+// a 2.2 power law — and premultiplied by alpha.
+Level levelOf(const PngPixels& png) {
   Level level;
-  level.width = int(png.width);
-  level.height = int(png.height);
-  level.texels.resize(size_t(png.width) * png.height);
-  static_assert(sizeof(Texel) == 4 * sizeof(png_uint_16));
-  auto fail = [&] {
-    const std::string message = png.message;
-    png_image_free(&png);
-    return Error{name, "", "cannot decode PNG: " + message};
-  };
-  if (png.format & PNG_FORMAT_FLAG_LINEAR) {
-    // A 16-bit file: libpng's linear RGBA with premultiplied alpha (its samples are linear unless
-    // a gAMA chunk says otherwise, which libpng then undoes).
-    png.format = PNG_FORMAT_LINEAR_RGB_ALPHA;
-    if (!png_image_finish_read(&png, nullptr, level.texels.data(), 0, nullptr)) return fail();
+  level.width = png.width;
+  level.height = png.height;
+  level.texels.resize(size_t(png.width) * size_t(png.height));
+  static_assert(sizeof(Texel) == 4 * sizeof(uint16_t));
+  if (png.linear16) {
+    std::memcpy(level.texels.data(), png.data.data(), level.texels.size() * sizeof(Texel));
     return level;
   }
-  // An 8-bit file: sRGB-encoded RGBA (libpng re-encodes another stated gamma as sRGB), decoded here
-  // by the exact IEC 61966-2-1 curve — libpng's own linear output uses a 2.2 power law — and
-  // premultiplied by alpha.
-  png.format = PNG_FORMAT_RGBA;
-  std::vector<uint8_t> encoded(PNG_IMAGE_SIZE(png));
-  if (!png_image_finish_read(&png, nullptr, encoded.data(), 0, nullptr)) return fail();
   static const auto decode = [] {
     std::array<double, 256> t{};
     for (int i = 0; i < 256; ++i) {
@@ -298,7 +270,7 @@ Result<Level> finishRead(png_image& png, uint64_t bytes, const std::string& name
     return t;
   }();
   for (size_t i = 0; i < level.texels.size(); ++i) {
-    const uint8_t* p = &encoded[4 * i];
+    const uint8_t* p = &png.data[4 * i];
     const double alpha = p[3] / 255.0;
     auto channel = [&](uint8_t c) { return uint16_t(std::lround(decode[c] * alpha * 65535.0)); };
     level.texels[i] = {channel(p[0]), channel(p[1]), channel(p[2]),
@@ -307,30 +279,20 @@ Result<Level> finishRead(png_image& png, uint64_t bytes, const std::string& name
   return level;
 }
 
+constexpr PngLimits kTextureLimits{kMaxTextureSide, kMaxTextureTexels};
+
 }  // namespace
 
 Result<Level> readTextureImage(const std::string& path) {
-  png_image png{};
-  png.version = PNG_IMAGE_VERSION;
-  if (!png_image_begin_read_from_file(&png, path.c_str())) {
-    const std::string message = png.message;
-    png_image_free(&png);
-    return Error{path, "", "cannot read PNG: " + message};
-  }
-  std::error_code error;
-  const uintmax_t bytes = std::filesystem::file_size(path, error);
-  return finishRead(png, error ? 0 : uint64_t(bytes), path);
+  auto png = readPng(path, PngLayout::rgba8OrLinear16, kTextureLimits);
+  if (!png.ok()) return png.error();
+  return levelOf(png.value());
 }
 
 Result<Level> decodeTextureImage(const void* data, size_t size, const std::string& name) {
-  png_image png{};
-  png.version = PNG_IMAGE_VERSION;
-  if (!png_image_begin_read_from_memory(&png, data, size)) {
-    const std::string message = png.message;
-    png_image_free(&png);
-    return Error{name, "", "cannot read PNG: " + message};
-  }
-  return finishRead(png, size, name);
+  auto png = decodePng(data, size, name, PngLayout::rgba8OrLinear16, kTextureLimits);
+  if (!png.ok()) return png.error();
+  return levelOf(png.value());
 }
 
 }  // namespace sv::texture
@@ -400,26 +362,7 @@ std::vector<uint8_t> toSrgb8(const LevelView& level) {
 
 Result<std::vector<uint8_t>> encodeTexturePng(const LevelView& level, const std::string& name) {
   const std::vector<uint8_t> rgba = toSrgb8(level);
-  png_image png{};
-  png.version = PNG_IMAGE_VERSION;
-  png.width = png_uint_32(level.width);
-  png.height = png_uint_32(level.height);
-  png.format = PNG_FORMAT_RGBA;
-  // First the size, then the bytes (libpng's two-call protocol for memory output).
-  png_alloc_size_t bytes = 0;
-  if (!png_image_write_to_memory(&png, nullptr, &bytes, 0, rgba.data(), 0, nullptr)) {
-    const std::string message = png.message;
-    png_image_free(&png);
-    return Error{name, "", "cannot encode PNG: " + message};
-  }
-  std::vector<uint8_t> out(bytes);
-  if (!png_image_write_to_memory(&png, out.data(), &bytes, 0, rgba.data(), 0, nullptr)) {
-    const std::string message = png.message;
-    png_image_free(&png);
-    return Error{name, "", "cannot encode PNG: " + message};
-  }
-  out.resize(bytes);
-  return out;
+  return encodePng(name, level.width, level.height, 4, rgba.data());
 }
 
 }  // namespace sv::texture

@@ -62,6 +62,30 @@ TEST(ImageIo, ErrorsNameTheFile) {
   EXPECT_FALSE(writeImage(gradient(2, 2), tempPath("sv_img.bmp")).ok());
 }
 
+// The image reader is the texture maps' (texture/png.h): the same size limit and the same refusal
+// of a header that claims more than the file can hold, before anything is allocated.
+TEST(ImageIo, ReadsThroughTheOnePngCodecWithItsLimits) {
+  std::vector<uint8_t> black(size_t(4096) * 4096 * 3, 0);
+  Image big{4096, 4096, black};
+  const std::string path = tempPath("sv_big.png");
+  ASSERT_TRUE(writePng(big, path).ok());
+  std::ifstream in(path, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), {});
+  bytes.resize(300);  // a few hundred bytes cannot hold 16 M pixels
+  auto shortFile = decodePng(bytes.data(), bytes.size(), "short.png");
+  ASSERT_FALSE(shortFile.ok());
+  EXPECT_NE(shortFile.error().str().find("short.png: 300 bytes of PNG cannot hold"),
+            std::string::npos)
+      << shortFile.error().str();
+  std::vector<uint8_t> row(size_t(8193) * 3, 0);
+  const std::string wide = tempPath("sv_wide.png");
+  ASSERT_TRUE(writePng(Image{8193, 1, row}, wide).ok());
+  auto tooWide = readPng(wide);
+  ASSERT_FALSE(tooWide.ok());
+  EXPECT_NE(tooWide.error().str().find("PNG size 8193x1 is out of range"), std::string::npos)
+      << tooWide.error().str();
+}
+
 TEST(Gamma, DisplayGammaTable) {
   const auto g = output::GammaTable::power(2.2);
   EXPECT_EQ(g.table[0], 0);

@@ -1,0 +1,46 @@
+// PNG files (libpng's simplified API, no setjmp across C++ frames): the one reader and writer of
+// synthvis — texture maps (texture.h) and the images the display stage writes and `compare` reads
+// (synthvis/image.h) both go through here.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "synthvis/result.h"
+
+namespace sv::texture {
+
+// How a PNG's samples are read: 8-bit RGB (alpha dropped); or as the file holds them — 8-bit
+// sRGB-encoded RGBA for 8-bit files, 16-bit linear RGBA with alpha premultiplied (libpng's linear
+// form) for 16-bit ones.
+enum class PngLayout : uint8_t { rgb8, rgba8OrLinear16 };
+
+// What a header may claim before anything is allocated: at most maxSide a side and maxPixels in
+// all. A file is also refused when it is too short for the size its header states (deflate
+// expands at most about 1032:1), so a 60-byte file cannot cost half a gigabyte.
+struct PngLimits {
+  int maxSide = 1 << 13;
+  int64_t maxPixels = int64_t(1) << 26;
+};
+
+struct PngPixels {
+  int width = 0, height = 0;
+  bool linear16 = false;      // rgba8OrLinear16 of a 16-bit file: `data` holds uint16 samples
+  std::vector<uint8_t> data;  // rows, top first: 3 or 4 bytes a pixel, or 4 uint16
+};
+
+// The PNG at `path`, or `size` bytes at `data` (`name` names them in errors). Errors name the file
+// and the problem.
+Result<PngPixels> readPng(const std::string& path, PngLayout layout, const PngLimits& limits);
+Result<PngPixels> decodePng(const void* data, size_t size, const std::string& name,
+                            PngLayout layout, const PngLimits& limits);
+
+// `width` × `height` pixels of 8-bit RGB (channels 3) or RGBA (4), rows top first, as a PNG file
+// at `path`, or as PNG bytes in memory.
+Status writePng(const std::string& path, int width, int height, int channels, const uint8_t* rows);
+Result<std::vector<uint8_t>> encodePng(const std::string& name, int width, int height,
+                                       int channels, const uint8_t* rows);
+
+}  // namespace sv::texture
