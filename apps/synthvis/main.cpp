@@ -159,31 +159,19 @@ struct BenchArgs {
   sv::RenderOptions options{.width = 1920, .height = 1080, .threads = 2};
 };
 
-// BENCH.md's generators that need features of later issues.
-const char* missingGenerator(const std::string& name) {
-  if (name == "terrain") return "height fields";
-  if (name == "volume") return "voxel volumes";
-  if (name == "lights") return "light points";
-  return nullptr;
-}
-
-// The case for generator `kind` (tris, layers or grazing) with the given parameters; an error names
-// a generator that needs a later feature, or an unknown one.
+// The case for generator `kind` with the given parameters; an error names a generator that needs
+// a later feature, or an unknown one.
 sv::Result<sv::reference::BenchCase> generatorCase(const std::string& kind,
                                                    const GeneratorArgs& g) {
-  if (const char* needs = missingGenerator(kind))
+  auto generator = sv::scene::parseGenerator(kind);
+  if (!generator) return generator.error();
+  if (const char* needs = sv::scene::generatorNeeds(generator.value()))
     return sv::Error{"", "", fmt::format("generator '{}' needs {}, not built yet", kind, needs)};
-  if (kind != "tris" && kind != "layers" && kind != "grazing" && kind != "freeform" &&
-      kind != "freeform-one")
-    return sv::Error{"", "",
-                     fmt::format("unknown generator '{}' (tris, layers, grazing, freeform, "
-                                 "freeform-one)",
-                                 kind)};
   auto order = sv::scene::parseSubmitOrder(g.order);
   if (!order) return order.error();
   sv::reference::BenchCase c;
   c.name = kind;
-  c.generator = kind;
+  c.generator = generator.value();
   c.tris = g.tris;
   c.tris.order = order.value();
   c.layers.layers = g.layers;
@@ -240,8 +228,7 @@ int runBench(BenchArgs a) {
     cases = std::move(c).value();
   } else {
     ref::BenchCase c;
-    if (a.scene == "tris" || a.scene == "layers" || a.scene == "grazing" || a.scene == "freeform" ||
-        a.scene == "freeform-one" || missingGenerator(a.scene)) {
+    if (sv::scene::parseGenerator(a.scene).ok()) {
       auto g = generatorCase(a.scene, a.generator);
       if (!g) return fail(g.error());
       c = g.value();
@@ -569,7 +556,8 @@ int main(int argc, char** argv) {
   if (*render) return runRender(r);
   if (*bench) {
     // BENCH.md's freeform-one is 1024 × 1024 unless the size is given.
-    if (b.scene == "freeform-one" && bench->count("--width") == 0 && bench->count("--height") == 0)
+    if (b.scene == sv::scene::generatorName(sv::scene::Generator::freeformOne) &&
+        bench->count("--width") == 0 && bench->count("--height") == 0)
       b.options.width = b.options.height = 1024;
     return runBench(b);
   }

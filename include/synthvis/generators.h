@@ -8,6 +8,26 @@
 
 namespace sv::scene {
 
+// BENCH.md's generators, one per kind of benchmark scene. `none`: a scene from a file. The last
+// three need features of later issues (generatorNeeds).
+enum class Generator : uint8_t {
+  none,
+  tris,
+  layers,
+  grazing,
+  freeform,
+  freeformOne,
+  terrain,
+  volume,
+  lights,
+};
+// By name, as BENCH.md and the CLI write them: "tris", "layers", "grazing", "freeform",
+// "freeform-one", "terrain", "volume", "lights"; an error lists them.
+Result<Generator> parseGenerator(const std::string& name);
+const char* generatorName(Generator generator);  // "" for none
+// What a generator needs that is not built yet ("height fields", …), or nullptr.
+const char* generatorNeeds(Generator generator);
+
 enum class SubmitOrder { random, frontToBack, backToFront };
 
 // Parses "random", "f2b", "b2f".

@@ -34,7 +34,7 @@ void finish(RendererRun& r) {
 
 BenchCase trisCase(int count, double area) {
   BenchCase c;
-  c.generator = "tris";
+  c.generator = scene::Generator::tris;
   c.tris.count = count;
   c.tris.area = area;
   const std::string n =
@@ -45,7 +45,7 @@ BenchCase trisCase(int count, double area) {
 
 BenchCase layersCase(int layers, scene::SubmitOrder order) {
   BenchCase c;
-  c.generator = "layers";
+  c.generator = scene::Generator::layers;
   c.layers.layers = layers;
   c.layers.order = order;
   c.name = fmt::format("layers-d{}-{}", layers, scene::submitOrderName(order));
@@ -70,9 +70,10 @@ Result<std::vector<BenchCase>> suiteCases(const std::string& suite) {
            {SubmitOrder::random, SubmitOrder::frontToBack, SubmitOrder::backToFront})
         cases.push_back(layersCase(d, o));
     // Free forms (issue 7), at the suite's raster; the gl reference draws them tessellated.
-    for (const char* name : {"freeform", "freeform-one"}) {
+    for (const scene::Generator g : {scene::Generator::freeform, scene::Generator::freeformOne}) {
       BenchCase c;
-      c.name = c.generator = name;
+      c.generator = g;
+      c.name = scene::generatorName(g);
       cases.push_back(c);
     }
   } else {
@@ -84,7 +85,7 @@ Result<std::vector<BenchCase>> suiteCases(const std::string& suite) {
 Result<CaseScene> makeScene(const BenchCase& c, const RenderOptions& options) {
   CaseScene out;
   scene::TrisStats realized;
-  if (c.generator == "tris") {
+  if (c.generator == scene::Generator::tris) {
     scene::TrisParams t = c.tris;
     if (t.count < 0 || t.count > 20'000'000 || !(t.area > 0 && t.area <= 1e7) || !(t.depth >= 0))
       return Error{"", "", "tris: count must be 0…2e7, area in (0, 1e7] px, depth ≥ 0"};
@@ -96,7 +97,7 @@ Result<CaseScene> makeScene(const BenchCase& c, const RenderOptions& options) {
                   {"depth", t.depth},
                   {"order", scene::submitOrderName(t.order)},
                   {"seed", t.seed}};
-  } else if (c.generator == "layers") {
+  } else if (c.generator == scene::Generator::layers) {
     scene::LayersParams l = c.layers;
     if (l.layers < 1 || l.layers > 64) return Error{"", "", "layers: D must be 1…64"};
     l.width = options.width;
@@ -104,11 +105,11 @@ Result<CaseScene> makeScene(const BenchCase& c, const RenderOptions& options) {
     out.scene = scene::generateLayers(l, &realized);
     out.params = {
         {"layers", l.layers}, {"order", scene::submitOrderName(l.order)}, {"seed", l.seed}};
-  } else if (c.generator == "grazing") {
+  } else if (c.generator == scene::Generator::grazing) {
     out.scene = scene::generateGrazing(c.grazing);
     out.params = {{"seed", c.grazing.seed}};
     return out;  // no target area or depth complexity to report
-  } else if (c.generator == "freeform") {
+  } else if (c.generator == scene::Generator::freeform) {
     scene::FreeFormParams f = c.freeform;
     if (f.count < 0 || f.count > 100000) return Error{"", "", "freeform: objects must be 0…100000"};
     f.width = options.width;
@@ -116,18 +117,20 @@ Result<CaseScene> makeScene(const BenchCase& c, const RenderOptions& options) {
     out.scene = scene::generateFreeForms(f);
     out.params = {{"objects", f.count}, {"seed", f.seed}};
     return out;
-  } else if (c.generator == "freeform-one") {
+  } else if (c.generator == scene::Generator::freeformOne) {
     out.scene = scene::generateFreeFormOne();
     out.params = {{"objects", 1}, {"perturbations", 6}};
     return out;
-  } else if (c.generator.empty()) {
+  } else if (c.generator == scene::Generator::none) {
     auto loaded = scene::loadScene(c.file);
     if (!loaded) return loaded.error();
     out.scene = std::move(loaded).value();
     out.params = {{"file", c.file}};
     return out;
   } else {
-    return Error{"", "", fmt::format("no generator '{}'", c.generator)};
+    return Error{"", "",
+                 fmt::format("generator '{}' needs {}, not built yet", scene::generatorName(c.generator),
+                             scene::generatorNeeds(c.generator))};
   }
   out.meanArea = realized.meanArea;
   out.depthComplexity = realized.depthComplexity;

@@ -19,7 +19,7 @@ namespace sv::reference {
 // A scene to time: a generator with its parameters, or a scene file.
 struct BenchCase {
   std::string name;       // e.g. "tris-100k-a10", or the file's path
-  std::string generator;  // "tris", "layers", "grazing", "freeform", "freeform-one", or empty
+  scene::Generator generator = scene::Generator::none;  // none: `file`
   scene::TrisParams tris;
   scene::LayersParams layers;
   scene::GrazingParams grazing;

@@ -26,12 +26,12 @@ TEST(GlReference, DrawsWhatSynthvisDraws) {
     GTEST_SKIP() << "the gl reference cannot start here: " << st.error().str();
   BenchCase tris;
   tris.name = "tris";
-  tris.generator = "tris";
+  tris.generator = scene::Generator::tris;
   tris.tris.count = 2000;
   tris.tris.area = 60;
   BenchCase layers;
   layers.name = "layers";
-  layers.generator = "layers";
+  layers.generator = scene::Generator::layers;
   layers.layers.layers = 3;
   for (const BenchCase& c : {tris, layers}) {
     auto r = runner.run(c);

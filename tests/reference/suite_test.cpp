@@ -39,7 +39,7 @@ TEST(Suites, QuickAndFullNameBenchMdScenes) {
   bool hasLayers16 = false, hasFreeForm = false;
   for (const auto& c : full.value()) {
     hasLayers16 |= c.name == "layers-d16-b2f";
-    hasFreeForm |= c.generator == "freeform";
+    hasFreeForm |= c.generator == scene::Generator::freeform;
   }
   EXPECT_TRUE(hasLayers16);
   EXPECT_TRUE(hasFreeForm);
@@ -51,7 +51,7 @@ TEST(BenchRunner, JsonRowsCarryBenchMdFields) {
   BenchRunner runner(s);
   BenchCase c;
   c.name = "tris-small";
-  c.generator = "tris";
+  c.generator = scene::Generator::tris;
   c.tris.count = 300;
   c.tris.area = 40;
   auto r = runner.run(c);
@@ -73,7 +73,7 @@ TEST(Html, WritesPageImagesAndPlots) {
   BenchRunner runner(s);
   BenchCase c;
   c.name = "tris-html";
-  c.generator = "tris";
+  c.generator = scene::Generator::tris;
   c.tris.count = 100;
   auto r = runner.run(c);
   ASSERT_TRUE(r.ok());
@@ -96,7 +96,8 @@ TEST(BenchRunner, FreeFormsRunAgainstTheMarcherAndTheirTessellation) {
     s.options.marchSteps = 64;
     BenchRunner runner(s);
     BenchCase c;
-    c.name = c.generator = "freeform-one";
+    c.name = "freeform-one";
+    c.generator = scene::Generator::freeformOne;
     auto r = runner.run(c);
     ASSERT_TRUE(r.ok()) << r.error().str();
     ASSERT_EQ(r->runs.size(), 2u);

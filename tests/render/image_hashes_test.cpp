@@ -54,7 +54,7 @@ reference::BenchCase fileCase(const std::string& file) {
 reference::BenchCase generatorCase(const std::string& generator) {
   reference::BenchCase c;
   c.name = generator;
-  c.generator = generator;
+  c.generator = scene::parseGenerator(generator).value();
   c.tris.count = 3000;
   c.tris.area = 12;
   c.freeform.count = 12;
@@ -172,7 +172,7 @@ TEST(ImageHashes, EveryImageOnEveryTargetIsTheRecordedOne) {
     reference::BenchCase shaded = c.scene;
     shaded.tris.textured = shaded.layers.textured = c.textured;
     shaded.tris.fog = shaded.layers.fog = shaded.grazing.fog = c.fog;
-    if (shaded.generator.empty() && shaded.file.empty()) {
+    if (shaded.generator == scene::Generator::none && shaded.file.empty()) {
       scenes.push_back(scene::demoScene());
       continue;
     }

@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "scene/scene_test_util.h"
+#include "synthvis/generators.h"
 
 namespace sv::scene {
 namespace {
@@ -101,6 +102,27 @@ TEST(Scene, AppendSceneOffsetsIndicesAndComposesTransforms) {
   EXPECT_EQ(s.cameras[0].target, (Vec3{10, 0, 0}));
   EXPECT_EQ(s.light.ambient, Light{}.ambient);  // the outer scene keeps its light
   EXPECT_TRUE(validate(s, "merged").ok());
+}
+
+// BENCH.md's generators are named in one place: every name parses back to its generator, an
+// unknown one is refused with the list, and those of later issues say what they need.
+TEST(Generators, NamesParseBackAndLaterOnesSayWhatTheyNeed) {
+  for (Generator g : {Generator::tris, Generator::layers, Generator::grazing, Generator::freeform,
+                      Generator::freeformOne, Generator::terrain, Generator::volume,
+                      Generator::lights}) {
+    const Result<Generator> parsed = parseGenerator(generatorName(g));
+    ASSERT_TRUE(parsed.ok()) << generatorName(g);
+    EXPECT_EQ(parsed.value(), g);
+    const bool later = g == Generator::terrain || g == Generator::volume || g == Generator::lights;
+    EXPECT_EQ(generatorNeeds(g) != nullptr, later) << generatorName(g);
+  }
+  EXPECT_STREQ(generatorName(Generator::freeformOne), "freeform-one");
+  EXPECT_STREQ(generatorNeeds(Generator::terrain), "height fields");
+  const Result<Generator> bad = parseGenerator("trees");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_EQ(bad.error().message,
+            "unknown generator 'trees' (tris, layers, grazing, freeform, freeform-one, terrain, "
+            "volume, lights)");
 }
 
 }  // namespace

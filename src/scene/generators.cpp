@@ -1,0 +1,53 @@
+// BENCH.md's generators by name (synthvis/generators.h).
+#include <fmt/format.h>
+
+#include <array>
+#include <utility>
+
+#include "synthvis/generators.h"
+
+namespace sv::scene {
+namespace {
+
+constexpr std::array<std::pair<Generator, const char*>, 8> kGenerators = {{
+    {Generator::tris, "tris"},
+    {Generator::layers, "layers"},
+    {Generator::grazing, "grazing"},
+    {Generator::freeform, "freeform"},
+    {Generator::freeformOne, "freeform-one"},
+    {Generator::terrain, "terrain"},
+    {Generator::volume, "volume"},
+    {Generator::lights, "lights"},
+}};
+
+}  // namespace
+
+Result<Generator> parseGenerator(const std::string& name) {
+  std::string names;
+  for (const auto& [generator, n] : kGenerators) {
+    if (name == n) return generator;
+    names += names.empty() ? n : fmt::format(", {}", n);
+  }
+  return Error{"", "", fmt::format("unknown generator '{}' ({})", name, names)};
+}
+
+const char* generatorName(Generator generator) {
+  for (const auto& [g, n] : kGenerators)
+    if (g == generator) return n;
+  return "";
+}
+
+const char* generatorNeeds(Generator generator) {
+  switch (generator) {
+    case Generator::terrain:
+      return "height fields";
+    case Generator::volume:
+      return "voxel volumes";
+    case Generator::lights:
+      return "light points";
+    default:
+      return nullptr;
+  }
+}
+
+}  // namespace sv::scene
