@@ -1,5 +1,7 @@
 #include "core/thread_pool.h"
 
+#include "core/check.h"
+
 namespace sv::core {
 namespace {
 
@@ -14,6 +16,7 @@ void pause() {
 }  // namespace
 
 ThreadPool::ThreadPool(int threads) {
+  SV_CHECK_GE(threads, 1);
   for (int i = 1; i < threads; ++i) workers_.emplace_back([this, i] { workerLoop(i); });
 }
 
@@ -40,6 +43,7 @@ void ThreadPool::parallelFor(size_t count, const std::function<void(size_t, int)
   }
   {
     std::lock_guard lock(mutex_);
+    SV_CHECK(job_ == nullptr);  // not reentrant: fn must not call parallelFor
     job_ = &fn;
     count_ = count;
     next_.store(0, std::memory_order_relaxed);

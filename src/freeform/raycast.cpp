@@ -7,6 +7,8 @@
 #include <limits>
 #include <vector>
 
+#include "core/check.h"
+
 namespace sv::freeform {
 namespace {
 
@@ -527,6 +529,7 @@ void MaskingPyramid::refreshAbove(int level, int lx, int ly) {
 void castWindow(const ProjectedFreeForm& form, uint32_t id, const CastWindow& window,
                 const CastSettings& settings, CastStats& stats, MaskingPyramid* pyramid,
                 uint64_t* active) {
+  SV_CHECK(window.size >= 1 && window.size <= 64 && std::has_single_bit(unsigned(window.size)));
   // Counted locally: the callers' per-thread totals may share a cache line, and counting into
   // them directly made one line bounce between the cores on every bound (2/3 of a frame).
   CastStats local;

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+
+#include "core/check.h"
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
@@ -224,6 +226,7 @@ void tentFilterRows(const LinearImage& linear, const GammaTable& gamma, int rowB
 
 void resolveTile(const uint16_t* color, int tileX, int tileY, int factor, const GammaTable& gamma,
                  Image& image) {
+  SV_CHECK(factor == 1 || factor == 2 || factor == 4 || factor == 8 || factor == 16);
   if (factor == 1) return resolveTile(color, tileX, tileY, gamma, image);
   forEachBlockMean(color, tileX, tileY, factor, image.width, image.height,
                    [&](int x, int y, const uint16_t* mean) {

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <bit>
 
+#include "core/check.h"
 #include "hwy/foreach_target.h"  // IWYU pragma: keep
 #include "hwy/highway.h"
 #include "output/resolve.h"
@@ -86,6 +87,7 @@ HWY_EXPORT(ResolveSampleTile);
 
 void resolveSampleTile(const uint16_t* color, const int32_t* sums, int tileX, int tileY,
                        int samples, const GammaTable& gamma, Image& image) {
+  SV_CHECK(samples == 4 || samples == 8 || samples == 16 || samples == 64);
   HWY_DYNAMIC_DISPATCH(ResolveSampleTile)(color, sums, tileX, tileY, samples, gamma, image);
 }
 }  // namespace sv::output

@@ -26,7 +26,6 @@ HWY_INLINE void countBlock(uint32_t mask, uint16_t* color) {
   for (; mask; mask &= mask - 1) ++color[std::countr_zero(mask)];
 }
 
-
 // Depth test ("less") and Gouraud colour for the pixels of one 4×4 block set in `mask`.
 // (gx, gy) is the block's top-left pixel; `depth` and `color` point at the block's storage.
 // Returns how many of the pixels failed the depth test (hidden fragments, as every depth-testing
@@ -185,7 +184,6 @@ HWY_INLINE int shadeBlockSamples(const TriangleSetup& t, const PlaneLanes& lanes
   }
   return hidden;
 }
-
 
 // Visibility (PixelOp::visibility): the depth test alone, recording triangle `id` in the pixels it
 // wins — the SPEC §1 split of visibility from shading that the image generators of the seeds made

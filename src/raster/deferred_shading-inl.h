@@ -14,6 +14,7 @@
 
 #include <algorithm>
 
+#include "core/check.h"
 #include "raster/kernel_common-inl.h"
 #include "shade/shading.h"
 
@@ -38,6 +39,7 @@ struct WinnerList {
 
   // Triangle `id`, which won pixels in the tile-local pixel box [x0, x1] × [y0, y1].
   void add(uint32_t id, int x0, int y0, int x1, int y1) {
+    SV_DCHECK(0 <= x0 && x0 <= x1 && x1 < kTileSize && 0 <= y0 && y0 <= y1 && y1 < kTileSize);
     if (blocks > kBudget) return;  // the scan's, for the rest of the pass
     const int bx0 = x0 >> kBlockLog2, by0 = y0 >> kBlockLog2;
     const int bx1 = x1 >> kBlockLog2, by1 = y1 >> kBlockLog2;
@@ -221,6 +223,7 @@ class DeferredShader {
   // start its next).
   template <class VI, class M>
   void take(Batch& b, uint32_t t, VI pixels, M mine) {
+    SV_DCHECK_LT(b.count, kBlockPixels);  // room for a whole vector past it
     hn::StoreU(hn::Compress(pixels, hn::RebindMask(di, mine)), di, b.pixel + b.count);
     b.count += int(hn::CountTrue(du, mine));
     if (b.count >= kBlockPixels) {
@@ -467,8 +470,8 @@ class DeferredShader {
     bool block = count == kBlockPixels && (pixel[0] & (kBlockPixels - 1)) == 0 &&
                  pixel[kBlockPixels - 1] == pixel[0] + kBlockPixels - 1;
     for (size_t i = 0; block && i < size_t(kBlockPixels); i += lanes())
-      block = hn::AllTrue(
-          di, hn::Eq(hn::Load(di, pixel + i), hn::Add(laneIndex(), hn::Set(di, pixel[0] + int(i)))));
+      block = hn::AllTrue(di, hn::Eq(hn::Load(di, pixel + i),
+                                     hn::Add(laneIndex(), hn::Set(di, pixel[0] + int(i)))));
     if (block) {
       uint16_t* dst = ctx_.color + size_t(pixel[0] >> (2 * kBlockLog2)) * kColorPerBlock;
       for (int ch = 0; ch < kColorChannels; ++ch)

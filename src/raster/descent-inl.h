@@ -743,7 +743,6 @@ class TriangleRaster {
   float sampleDepthMax_ = 0;  // the largest of them
 };
 
-
 // Priority masking: whether the triangle with box (minX, minY)–(maxX, maxY) lies in occupied
 // windows of the tile, so that it is dropped before its traversal is set up (in a deep stack of
 // layers, most are); counted as occluded. Hybrid masking (`t`): in full windows whose depth bounds

@@ -1,8 +1,12 @@
 #include "raster/framebuffer.h"
 
+#include "core/check.h"
+
 namespace sv::raster {
 
 void FrameBuffer::resize(int width, int height, int samples, bool sums) {
+  SV_CHECK(width >= 1 && width <= 8192 && height >= 1 && height <= 8192);
+  SV_CHECK(samples >= 1 && samples <= 64);
   const int tx = (width + kTileSize - 1) >> kTileLog2, ty = (height + kTileSize - 1) >> kTileLog2;
   const size_t needed = size_t(tx) * ty * kTilePixels * size_t(samples);
   if (needed > capacity_ || !depth_) {

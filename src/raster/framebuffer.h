@@ -46,7 +46,7 @@ constexpr uint32_t fullSampleWord(int samples, int w) {
 
 class FrameBuffer {
  public:
-  // Allocates for a width × height raster (1 … 8192 each; checked by the caller) of `samples`
+  // Allocates for a width × height raster (1 … 8192 each; checked) of `samples`
   // samples per pixel (1 … 64); with `sums`, colour sums besides (kSumsPerTile per tile).
   void resize(int width, int height, int samples = 1, bool sums = false);
 

@@ -154,7 +154,6 @@ HWY_INLINE void computePlaneLanes(const TriangleSetup& t, PlaneLanes& out) {
   }
 }
 
-
 // The five plane values (c0 + dx·X) + dy·Y at a block's top-left pixel (gx, gy), one lane per
 // plane.
 HWY_INLINE void blockBases(const TriangleSetup& t, const PlaneLanes& lanes, int gx, int gy,
@@ -186,7 +185,6 @@ HWY_INLINE auto colorLanes(DF df, const PlaneLanes& lanes, const float* base, in
   const auto cw = hn::Add(hn::Set(df, base[kRed + ch]), hn::LoadU(df, lanes.offset[kRed + ch] + i));
   return colorToLanes(df, cw, w);
 }
-
 
 // 0…1 → 16-bit lanes (colorToLanes' rounding, for a value already in range).
 template <class DF, class V>

@@ -97,7 +97,6 @@ HWY_INLINE void blockFragments(const TriangleSetup& t, const PlaneLanes& lanes,
   setGradients(lanes, al, f);
 }
 
-
 // Writes shaded colour `rgba` to the lanes of one sample plane set in `pass`: the colour itself, or
 // for translucent materials rgb + (1 − a)·(what the pixel holds) (premultiplied "over").
 template <class DF, class M>

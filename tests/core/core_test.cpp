@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/check.h"
 #include "core/streaming.h"
 #include "core/thread_pool.h"
 #include "synthvis/math.h"
@@ -82,6 +83,25 @@ TEST(Mat4, LookAtPutsTheTargetOnTheNegativeZAxis) {
   EXPECT_NEAR(t.x, 0, 1e-5f);
   EXPECT_NEAR(t.y, 0, 1e-5f);
   EXPECT_NEAR(t.z, -std::sqrt(16.0f + 4 + 25), 1e-4f);
+}
+
+// A failed check names the place, the condition and both operands, and stops the program; a check
+// that holds does nothing.
+TEST(Check, AFailedCheckPrintsTheConditionAndBothOperandsAndAborts) {
+  SV_CHECK_EQ(2 + 2, 4);
+  SV_CHECK(true);
+  const int samples = 3;
+  EXPECT_DEATH(SV_CHECK_LE(samples, 2),
+               "core_test.cpp:[0-9]+: check failed: samples <= 2 \\(3 vs 2\\)");
+  EXPECT_DEATH(SV_CHECK(samples == 4), "check failed: samples == 4");
+}
+
+// The pool is not reentrant: a job that starts another is stopped at once instead of deadlocking.
+TEST(Check, AParallelForInsideAParallelForIsRefused) {
+  GTEST_FLAG_SET(death_test_style, "threadsafe");  // the pool's threads exist
+  core::ThreadPool pool(2);
+  EXPECT_DEATH(pool.parallelFor(8, [&](size_t, int) { pool.parallelFor(8, [](size_t, int) {}); }),
+               "check failed: job_ == nullptr");
 }
 
 }  // namespace
