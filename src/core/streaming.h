@@ -2,7 +2,7 @@
 // (non-temporal) stores: they write whole lines to memory without first reading them into the
 // cache (the read a normal store of a line not in cache costs) and without evicting the pass's own
 // working set. Binning's record copies (raster/binner.cpp, render/frame_renderer.cpp): 16 MB a
-// frame at tris 100k × 10 px, ×0.919 for that frame (docs/performance.md).
+// frame at tris 100k × 10 px (docs/performance.md, "Setup and binning").
 #pragma once
 
 #include <cstddef>

@@ -112,13 +112,11 @@ bool firstCrossing(const ProjectedFreeForm& form, double x, double y, uint64_t a
 // Windows of 2^kRayLevel pixels and less are cast ray by ray.
 constexpr int kRayLevel = 2;
 // Cells of 2^kQuadricLevel pixels and less that no perturbation reaches are solved ray by ray in
-// closed form, without their children's bounds (Caster::cell). Measured on BENCH.md's freeform /
-// freeform-one against the 4×4 ray windows alone: 8×8 cells ×0.942 / ×0.943; 16×16 ×1.029 /
-// ×0.997 against 8×8 (their empty parts cost more rays than the bounds save).
+// closed form, without their children's bounds (Caster::cell): 8×8 cells, not 4×4 or 16×16,
+// whose empty parts cost more rays than the bounds save (docs/performance.md, "Free forms").
 constexpr int kQuadricLevel = 3;
-// Rays whose H may turn (Caster::rayWindow) take their spans in this many pieces (measured on
-// BENCH.md's freeform / freeform-one against 8: 2 pieces ×1.13 / ×1.10 slower, 4 ×1.01 / ×1.03,
-// 16 ×1.10 / ×1.03).
+// Rays whose H may turn (Caster::rayWindow) take their spans in this many pieces, the fastest of
+// 2, 4, 8 and 16 (docs/performance.md, "Free forms").
 constexpr int kPieces = 8;
 
 class Caster {
@@ -209,8 +207,8 @@ class Caster {
     // them empty), and the solution needs no depth range tighter than [zlo, zhi].
     if (level <= kQuadricLevel && form_.quadricsAlone(active))
       return quadricCell(level, lx, ly, box, zlo, zhi, active);
-    // Step 2: the binary tree in depth, four levels deep: of sixteen slabs, those whose bound may
-    // hold the surface (measured on BENCH.md's freeform: 4 slabs 395 ms, 8 264, 16 250, 32 272).
+    // Step 2: the binary tree in depth, four levels deep: of sixteen slabs (the fastest of 4, 8,
+    // 16 and 32, docs/performance.md "Free forms"), those whose bound may hold the surface.
     // Runs of such slabs are separate depth ranges — a solid's front and back surfaces, with its
     // inside (H > 0 throughout) between them — taken front to back, so that once the front one
     // has filled the window, masking drops the back one whole.
@@ -404,8 +402,8 @@ class Caster {
       const int i = place[j];
       z[i] = pz[j];
       if (std::isnan(from[j])) continue;
-      // The ray's own subdivision, eight pieces at a time (measured on BENCH.md's freeform /
-      // freeform-one against halves one at a time: ×0.959 / ×0.934).
+      // The ray's own subdivision, eight pieces at a time rather than halves one at a time
+      // (docs/performance.md, "Free forms").
       if (!firstCrossing(form_, x[i], y[i], active, from[j], end[i], kNaN, ray_, z[i], stats_))
         z[i] = kNaN;
     }

@@ -51,7 +51,7 @@ struct Rays {
 // Newton's method along a ray is a chain of dependent steps — each waits on its evaluation and
 // on two divisions — so kGroup vectors of rays are solved together, their chains interleaved
 // operation by operation (each lane still does exactly the single-vector operations: same bits;
-// measured 1–2 % faster than one vector at a time).
+// faster than one vector at a time, docs/performance.md "Free forms").
 constexpr int kGroup = 2;
 
 // RayFunction::evaluateNode with the slope, for K vectors' rays r[k] at z[k].

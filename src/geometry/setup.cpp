@@ -126,7 +126,8 @@ struct ScreenVertex {
 };
 
 // Always inlined into setup: called out of line, its 12-byte result went back through the stack
-// with mismatched store and load sizes (store-forwarding stalls), 12 % of a 100k × 10 px frame.
+// with mismatched store and load sizes — store-forwarding stalls (docs/performance.md, "Setup
+// and binning").
 [[gnu::always_inline]] inline ScreenVertex snapVertex(const ClipVertex& c,
                                                       const Viewport& viewport) {
   ScreenVertex s;

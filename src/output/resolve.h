@@ -30,9 +30,9 @@ void prepareImage(int width, int height, Image& image);
 // The resolves' way into the image: n bytes of a row put together in a buffer (`row`) written to
 // `dst` with non-temporal stores where dst allows (16-byte aligned; the rest plainly). The image's
 // lines are not in cache when a tile is resolved, and byte stores into them made the core read
-// each line before overwriting it (BENCH.md's freeform-one 2.6 % faster, tris 10k × 1000 px
-// textured 1.3 %; docs/performance.md). finishImageRows orders them before whatever the thread
-// does next (another thread reads the image once the frame's tiles are joined): once per tile.
+// each line before overwriting it (docs/performance.md, "Resolve"). finishImageRows orders them
+// before whatever the thread does next (another thread reads the image once the frame's tiles are
+// joined): once per tile.
 void writeImageRow(const uint8_t* row, int n, uint8_t* dst);
 void finishImageRows();
 

@@ -34,10 +34,9 @@ void Binner::binChunk(int chunk, const geometry::TriangleSetup* records, uint32_
     scratch.order[p] = i;
   }
   // Copied in storage order: sequential writes to memory that is not in cache (the storage is the
-  // size of a batch) and scattered reads from the chunk's records, which are in L2. (Copying in
-  // record order, with scattered writes, was 62 % of binning; this order makes the whole 100k ×
-  // 10 px frame 4 % faster.) Streaming stores: the tiles read the records only after all chunks
-  // are binned (core/streaming.h).
+  // size of a batch) and scattered reads from the chunk's records, which are in L2 — not in record
+  // order with scattered writes (docs/performance.md, "Setup and binning"). Streaming stores: the
+  // tiles read the records only after all chunks are binned (core/streaming.h).
   core::gatherStreaming(storage, records, scratch.order.data(), n);
   // The lists: count the entries per tile, then place them in submission order.
   ChunkLists& out = chunkLists_[size_t(chunk)];

@@ -56,7 +56,7 @@ const SamplePattern* samplePattern(int count);
 class EdgeMaskTable {
  public:
   // 32 × 128 cells: 67 KB of 32-bit masks per table. 64 × 256 cut 64 samples' edge error by 4 %
-  // more and cost the same time on tris 100k × 10 px (docs/quality.md).
+  // more at no gain in speed (docs/quality.md, docs/performance.md).
   static constexpr int kSlopeSteps = 32;
   static constexpr int kDistanceSteps = 128;
   static constexpr double kAreaError = 2 * (0.5 / kSlopeSteps + 0.5 / kDistanceSteps);
@@ -103,8 +103,8 @@ struct CoverageTables {
   int32_t offsetX[64] = {}, offsetY[64] = {};  // the pattern's offsets in 1/256 pixel
   // Shade a partly covered pixel at the centroid of its covered samples rather than at its centre
   // (tile_kernel.cpp): with 16 and 64 samples, where it cuts the edge error of small Gouraud
-  // triangles by 4 %; with 4 and 8 it changes it by under 1 % and costs 6 % of the frame
-  // (docs/quality.md).
+  // triangles by 4 %; with 4 and 8 it changes it by under 1 % and costs more than it gives
+  // (docs/quality.md, docs/performance.md "Anti-aliasing").
   bool centroid = false;
   EdgeMaskTable table;
   std::vector<uint32_t> word[2];  // kRows × kRowEntries each

@@ -112,9 +112,8 @@ class TriangleRaster {
     // §3 allows any initial window): half the extent rounded up to a power of two, so the box
     // spans at most 3×3 cells — instead of descending from the whole screen (RASTER-NOTES: 3–7×
     // slower for small triangles). Up to kScanExtent pixels the cells are the 4×4 leaves
-    // themselves: a scan of the box's blocks, each tested in SIMD, beats any descent there.
-    // Measured, 1 thread, 1920×1080 (docs/performance.md): tris of 100 px² 24.2 → 20.4 ms and of
-    // 300 px² 16.0 → 14.5 ms with the scan up to 32 px; of 3000 px² 18.0 → 19.4 ms up to 48 px.
+    // themselves: a scan of the box's blocks, each tested in SIMD, beats any descent there, up to
+    // 32 px and not beyond (docs/performance.md, "The descent").
     constexpr int kScanExtent = 32;
     const int extent = std::max(x1 - x0, y1 - y0) + 1;
     const int log2n = extent <= kScanExtent
@@ -321,8 +320,8 @@ class TriangleRaster {
         }
       }
     }
-    // Row entries are read by vector gathers: scalar loads of SIMD-computed entries measured 7 %
-    // slower (AMD Zen 4, 100k triangles of 10 px at 4 samples: 28.1 vs 26.3 ms).
+    // Row entries are read by vector gathers, which measured faster than scalar loads of
+    // SIMD-computed entries (docs/performance.md, "Anti-aliasing").
     alignas(64) uint32_t masks[2][kBlockPixels], coverage[2][kBlockPixels];
     const uint32_t(*occupied)[kBlockPixels] =
         occ_ && !ctx_.hybrid ? occ_->samples(lx, ly) : nullptr;

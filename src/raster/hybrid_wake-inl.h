@@ -68,11 +68,12 @@ HWY_NOINLINE void occupyFromDepth(const TileContext& ctx, float clearDepth) {
 // whole is what masking does best): the occupancy is rebuilt from the depth buffer and masking
 // runs from there on — if at least a quarter of the tile's triangles are still to come: the
 // rebuild reads the whole depth buffer, which a few remaining triangles do not repay (random
-// order at D = 2 reaches kWakeWork near the end of a tile's list: waking there made the frame 2 %
-// slower than the Z-buffer's). The image is the Z-buffer's either way; only the work differs. The
-// first batch's pass over a tile starts so; one that ends asleep wakes before the next batch,
-// whose object culling before setup reads the occupancy (finish). Not priority masking: its order
-// may overrule depth — stated priorities — which the Z-buffer would not honour.
+// order at D = 2 reaches kWakeWork near the end of a tile's list, and waking there made the frame
+// slower than the Z-buffer's; docs/hidden-surfaces.md). The image is the Z-buffer's either way;
+// only the work differs. The first batch's pass over a tile starts so; one that ends asleep wakes
+// before the next batch, whose object culling before setup reads the occupancy (finish). Not
+// priority masking: its order may overrule depth — stated priorities — which the Z-buffer would
+// not honour.
 class HybridWake {
  public:
   // `ctx`: the tile's context with its occupancy; `asleep`: whether the tile starts as the plain

@@ -58,8 +58,8 @@ void clearTile(const TileWork& w) {
   }
   const int planes = kTilePixels / kBlockPixels * samples;
   std::fill(w.depth, w.depth + size_t(planes) * kBlockPixels, w.clearDepth);
-  // One plane's worth, copied whole (two or three vector stores): 3 fills of 16 values per plane
-  // were 5 % of a 4-sample frame.
+  // One plane's worth, copied whole (two or three vector stores), not three fills of 16 values
+  // per plane (docs/performance.md, "Anti-aliasing").
   alignas(64) uint16_t plane[kColorPerBlock];
   for (int ch = 0; ch < kColorChannels; ++ch)
     std::fill_n(plane + ch * kBlockPixels, kBlockPixels, w.clearColor[ch]);

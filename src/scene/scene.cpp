@@ -101,8 +101,8 @@ Status validate(const Scene& scene, const std::string& file, bool vertexData) {
                               mesh.material, scene.materials.size()));
     if (!vertexData) continue;
     // Two branch-free reductions (they vectorize) in the common case, the offender searched for
-    // only when one fails. (perf: the early-exit loops were 2.5 % of a tris 100k × 10 px frame
-    // when the renderer ran them every frame, on one thread while the others waited.)
+    // only when one fails: early-exit loops cost the renderer, which ran them every frame on one
+    // thread while the others waited (docs/performance.md, "Vertex stage").
     uint32_t maxIndex = 0;
     for (uint32_t index : mesh.indices) maxIndex = std::max(maxIndex, index);
     if (!mesh.indices.empty() && maxIndex >= n) {
