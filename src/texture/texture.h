@@ -53,7 +53,7 @@ struct Level {
 // near sRGB's 2.2, so that 8 bits keep the dark tones the precision of an sRGB8 texture — and alpha
 // holds alpha:  r = code_r² / 255², … ,  a = code_a / 255.  Half the bytes of a Texel: twice the
 // texels per cache line, and a texel with its right-hand neighbour is one 64-bit word, which the
-// SIMD samplers gather as a pair (docs/performance.md, "Texel storage").
+// SIMD samplers gather as a pair (docs/performance.md, "Pixel shading and texture").
 using PackedTexel = uint32_t;
 // The nearest code of each channel (colour rounded in the square-root domain, never above alpha).
 PackedTexel packTexel(const Texel& t);
