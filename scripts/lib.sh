@@ -2,9 +2,13 @@
 # shellcheck shell=bash
 
 SV_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+# What a minimal Debian 12 (debootstrap --variant=minbase) lacks for scripts/demo and scripts/test;
+# scripts/fresh-check proves the list there. The reference renderer links libOpenGL and libEGL
+# (libopengl-dev, libegl-dev; libgl-dev for the headers) and runs on llvmpipe (libegl-mesa0,
+# libgl1-mesa-dri); python3 is for scripts/quality and scripts/bench-masking.
 SV_PACKAGES=(cmake g++ ninja-build pkg-config libgtest-dev libgmock-dev libbenchmark-dev
   libhwy-dev libtinygltf-dev libtinyobjloader-dev libstb-dev libpng-dev nlohmann-json3-dev
-  libcli11-dev libfmt-dev libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri python3)
+  libcli11-dev libfmt-dev libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri python3)
 
 sv_install_packages() {
   local missing=()
