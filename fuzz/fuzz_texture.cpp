@@ -1,17 +1,21 @@
-// Fuzz target: texture images (decodeTextureImage, libpng's simplified API) on arbitrary bytes,
-// and the MIP pyramid and samplers on what decodes. Beyond "no crash, no sanitizer report": a
+// Fuzz target: texture images (decodeTextureImage, libpng's simplified API) on arbitrary bytes
+// with the chunks' CRCs made to match (png_crc.h), and the MIP pyramid and samplers (trilinear,
+// and each single-level filter) on what decodes. Beyond "no crash, no sanitizer report": a
 // decoded level has its stated size, the pyramid ends at 1×1 with each level half the one above
 // (rounded up), and samples stay within [0, 1]; a failure carries a message.
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <vector>
 
+#include "png_crc.h"
 #include "texture/texture.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   namespace tx = sv::texture;
-  sv::Result<tx::Level> r = tx::decodeTextureImage(data, size, "fuzz.png");
+  const std::vector<uint8_t> bytes = sv::fuzz::withPngCrcs(data, size);
+  sv::Result<tx::Level> r = tx::decodeTextureImage(bytes.data(), bytes.size(), "fuzz.png");
   if (!r.ok()) {
     if (r.error().message.empty()) std::abort();
     return 0;
@@ -35,6 +39,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const tx::Color4 d = t.trilinear(lod, 7.9f, 0.4f);
     for (float v : {c.r, c.g, c.b, c.a, d.r, d.g, d.b, d.a})
       if (!(v >= 0 && v <= 1.0001f)) std::abort();
+    for (tx::Filter f : {tx::Filter::nearest, tx::Filter::threePoint, tx::Filter::bilinear}) {
+      const tx::Color4 e = t.sample(f, lod, -0.3f, 5.6f);
+      for (float v : {e.r, e.g, e.b, e.a})
+        if (!(v >= 0 && v <= 1.0001f)) std::abort();
+    }
   }
   return 0;
 }

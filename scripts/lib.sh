@@ -1,14 +1,16 @@
-# Shared by scripts/demo and scripts/test: install what is missing, configure, build.
+# Shared by scripts/demo, scripts/test and scripts/fuzz: install what is missing, configure, build.
 # shellcheck shell=bash
 
 SV_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 # What a minimal Debian 12 (debootstrap --variant=minbase) lacks for scripts/demo and scripts/test;
 # scripts/fresh-check proves the list there. The reference renderer links libOpenGL and libEGL
 # (libopengl-dev, libegl-dev; libgl-dev for the headers) and runs on llvmpipe (libegl-mesa0,
-# libgl1-mesa-dri); python3 is for scripts/quality and scripts/bench-masking.
+# libgl1-mesa-dri); python3 is for scripts/quality and scripts/bench-masking; clang and its runtime
+# (libclang-rt-14-dev) build the libFuzzer targets (scripts/fuzz, and scripts/test builds them).
 SV_PACKAGES=(cmake g++ ninja-build pkg-config libgtest-dev libgmock-dev libbenchmark-dev
   libhwy-dev libtinygltf-dev libtinyobjloader-dev libstb-dev libpng-dev nlohmann-json3-dev
-  libcli11-dev libfmt-dev libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri python3)
+  libcli11-dev libfmt-dev libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri python3
+  clang libclang-rt-14-dev)
 
 sv_install_packages() {
   local missing=()
@@ -29,4 +31,26 @@ sv_build() {
   shift
   cmake -S "$SV_ROOT" -B "$dir" -G Ninja "$@" >/dev/null
   cmake --build "$dir" --parallel "$(nproc)"
+}
+
+# The libFuzzer build (fuzz/README.md): clang, every synthvis library instrumented, no tests or
+# benchmarks. SV_FUZZ_DIR is its build directory; sv_fuzz_targets prints the targets' names
+# (json_scene, gltf, ...), one per fuzz/fuzz_<name>.cpp.
+SV_FUZZ_DIR="$SV_ROOT/build-fuzz"
+
+sv_fuzz_targets() {
+  local f
+  for f in "$SV_ROOT"/fuzz/fuzz_*.cpp; do
+    f="${f##*/fuzz_}"
+    echo "${f%.cpp}"
+  done
+}
+
+# sv_build_fuzz: configure (once) SV_FUZZ_DIR and build the fuzz_<name> executables only.
+sv_build_fuzz() {
+  local targets=()
+  mapfile -t targets < <(sv_fuzz_targets)
+  cmake -S "$SV_ROOT" -B "$SV_FUZZ_DIR" -G Ninja -DCMAKE_CXX_COMPILER=clang++ \
+    -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSV_BUILD_FUZZ=ON -DSV_BUILD_TESTS=OFF -DSV_BUILD_BENCH=OFF >/dev/null
+  cmake --build "$SV_FUZZ_DIR" --parallel "$(nproc)" --target "${targets[@]/#/fuzz_}"
 }

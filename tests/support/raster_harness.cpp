@@ -213,7 +213,9 @@ Frame renderReference(const render::DrawPackets& p, const render::FrameSettings&
         const geometry::Plane* planes[3] = {&t.red, &t.green, &t.blue};
         for (int ch = 0; ch < 3; ++ch) {
           const float v = n > 1 ? at(*planes[ch]) : evalPlane(*planes[ch], x, y, t.minX, t.minY);
-          const float c = std::min(std::max(v * w, 0.0f), 1.0f);
+          // NaN → 0, as the kernels' Max(v·w, 0) gives on every SIMD target (it returns the
+          // other operand); std::max returns its first operand when the two are unordered.
+          const float c = std::min(std::max(0.0f, v * w), 1.0f);
           c16[ch] = uint16_t(std::nearbyint(c * 65535.0f));  // ties to even
         }
         for (int k = 0; k < n; ++k) {
