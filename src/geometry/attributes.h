@@ -22,10 +22,10 @@ enum Attribute {
 };
 
 // Where a vertex's attributes sit in the vertex stage's output (render::DrawPackets): only those in
-// `stored` — the union of what the frame's materials read (shade::attributesUsed) — packed in Attribute
-// order, `stride` floats a vertex, attribute a at slot[a] (0 for those not stored, never read). A
-// textured, unlit frame stores 2 floats a vertex instead of 9, and the vertex stage and setup
-// move that much less memory (docs/performance.md).
+// `stored` — the union of what the frame's materials read (shade::attributesUsed) — packed in
+// Attribute order, `stride` floats a vertex, attribute a at slot[a] (0 for those not stored, never
+// read). A textured, unlit frame stores 2 floats a vertex instead of 9, and the vertex stage and
+// setup move that much less memory (docs/performance.md).
 struct AttributeLayout {
   unsigned stored = 0;
   int stride = 0;

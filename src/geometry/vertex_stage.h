@@ -4,8 +4,8 @@
 
 #include <span>
 
-#include "geometry/setup.h"
 #include "geometry/attributes.h"
+#include "geometry/setup.h"
 #include "synthvis/math.h"
 
 namespace sv::geometry {

@@ -128,9 +128,10 @@ Result<CaseScene> makeScene(const BenchCase& c, const RenderOptions& options) {
     out.params = {{"file", c.file}};
     return out;
   } else {
-    return Error{"", "",
-                 fmt::format("generator '{}' needs {}, not built yet", scene::generatorName(c.generator),
-                             scene::generatorNeeds(c.generator))};
+    return Error{
+        "", "",
+        fmt::format("generator '{}' needs {}, not built yet", scene::generatorName(c.generator),
+                    scene::generatorNeeds(c.generator))};
   }
   out.meanArea = realized.meanArea;
   out.depthComplexity = realized.depthComplexity;

@@ -267,8 +267,9 @@ FrameRenderer::SetupCounts FrameRenderer::setUpChunk(const DrawPackets& packets,
 }
 
 void FrameRenderer::drawTiles(const FrameSettings& settings, const Frame& f, const Batch& batch) {
-  pool_.parallelFor(size_t(f.tiles),
-                    [&](size_t tile, int worker) { drawTile(settings, f, batch, int(tile), worker); });
+  pool_.parallelFor(size_t(f.tiles), [&](size_t tile, int worker) {
+    drawTile(settings, f, batch, int(tile), worker);
+  });
 }
 
 // One tile's lists, in chunk order; after the frame's last batch its lights passes and its sink.

@@ -8,10 +8,10 @@
 
 #include "core/thread_pool.h"
 #include "geometry/setup.h"
-#include "render/draw_packets.h"
 #include "raster/binner.h"
 #include "raster/framebuffer.h"
 #include "raster/rasterizer.h"
+#include "render/draw_packets.h"
 #include "synthvis/render.h"
 
 namespace sv::render {

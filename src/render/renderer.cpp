@@ -60,9 +60,8 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
 
   // Stage 3: every instance's vertices to clip space, in draw order.
   const auto t0 = core::Clock::now();
-  if (Status s = render::buildDrawPackets(scene, o, camera.value(),
-                                          pixelShading ? &m.shading : nullptr, m.frame.pool(),
-                                          m.packets);
+  if (Status s = render::buildDrawPackets(
+          scene, o, camera.value(), pixelShading ? &m.shading : nullptr, m.frame.pool(), m.packets);
       !s)
     return s;
   stats.vertexMs = core::msSince(t0);

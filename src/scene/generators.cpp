@@ -1,10 +1,10 @@
 // BENCH.md's generators by name (synthvis/generators.h).
+#include "synthvis/generators.h"
+
 #include <fmt/format.h>
 
 #include <array>
 #include <utility>
-
-#include "synthvis/generators.h"
 
 namespace sv::scene {
 namespace {

@@ -82,16 +82,15 @@ Result<PngPixels> decodePng(const void* data, size_t size, const std::string& na
   return finishRead(png, size, name, layout, limits);
 }
 
-Status writePng(const std::string& path, int width, int height, int channels,
-                const uint8_t* rows) {
+Status writePng(const std::string& path, int width, int height, int channels, const uint8_t* rows) {
   png_image png = header(width, height, channels);
   if (!png_image_write_to_file(&png, path.c_str(), 0, rows, width * channels, nullptr))
     return writeFailed(png, path, "cannot write PNG");
   return {};
 }
 
-Result<std::vector<uint8_t>> encodePng(const std::string& name, int width, int height,
-                                       int channels, const uint8_t* rows) {
+Result<std::vector<uint8_t>> encodePng(const std::string& name, int width, int height, int channels,
+                                       const uint8_t* rows) {
   png_image png = header(width, height, channels);
   // First the size, then the bytes (libpng's two-call protocol for memory output).
   png_alloc_size_t bytes = 0;

@@ -40,7 +40,7 @@ Result<PngPixels> decodePng(const void* data, size_t size, const std::string& na
 // `width` × `height` pixels of 8-bit RGB (channels 3) or RGBA (4), rows top first, as a PNG file
 // at `path`, or as PNG bytes in memory.
 Status writePng(const std::string& path, int width, int height, int channels, const uint8_t* rows);
-Result<std::vector<uint8_t>> encodePng(const std::string& name, int width, int height,
-                                       int channels, const uint8_t* rows);
+Result<std::vector<uint8_t>> encodePng(const std::string& name, int width, int height, int channels,
+                                       const uint8_t* rows);
 
 }  // namespace sv::texture

@@ -59,7 +59,8 @@ class BlockSampler {
     if constexpr (!HWY_HAVE_SCALABLE && hn::MaxLanes(DI()) >= size_t(Texture::kMaxLevels)) {
       // A whole table is one vector: three permutes by k, whether the lanes share a level or
       // not. Lanes of a batch that mixes triangles often differ in level, and the three 16-lane
-      // gathers below took a sixth of the sampler's time (docs/performance.md, "Pixel shading and texture").
+      // gathers below took a sixth of the sampler's time (docs/performance.md, "Pixel shading and
+      // texture").
       const auto index = hn::IndicesFromVec(di, k);
       return {hn::TableLookupLanes(hn::Load(di, table_.width), index),
               hn::TableLookupLanes(hn::Load(di, table_.height), index),

@@ -107,9 +107,9 @@ TEST(Scene, AppendSceneOffsetsIndicesAndComposesTransforms) {
 // BENCH.md's generators are named in one place: every name parses back to its generator, an
 // unknown one is refused with the list, and those of later issues say what they need.
 TEST(Generators, NamesParseBackAndLaterOnesSayWhatTheyNeed) {
-  for (Generator g : {Generator::tris, Generator::layers, Generator::grazing, Generator::freeform,
-                      Generator::freeformOne, Generator::terrain, Generator::volume,
-                      Generator::lights}) {
+  for (Generator g :
+       {Generator::tris, Generator::layers, Generator::grazing, Generator::freeform,
+        Generator::freeformOne, Generator::terrain, Generator::volume, Generator::lights}) {
     const Result<Generator> parsed = parseGenerator(generatorName(g));
     ASSERT_TRUE(parsed.ok()) << generatorName(g);
     EXPECT_EQ(parsed.value(), g);
