@@ -1,6 +1,8 @@
 # `cmake --install`: the public headers (include/synthvis, installed by sv_publish_headers), the
 # stage libraries (static) with a CMake package — find_package(synthvis CONFIG) gives
-# synthvis::synthvis and synthvis::<stage> — and a pkg-config file, synthvis.pc. The CLI installs
+# synthvis::synthvis, what a program links — and a pkg-config file, synthvis.pc. The stage targets
+# (synthvis::<stage>) are exported because synthvis::synthvis links them; their own headers are
+# internal and not installed, so they carry libraries, not an API. The CLI installs
 # itself (apps/synthvis). tests/install builds a small program against an installed copy.
 include(CMakePackageConfigHelpers)
 

@@ -22,11 +22,10 @@ namespace sv::scene {
 
 // How a texture map is sampled (SPEC §7; docs/quality.md compares them): nearest texel; the seed's
 // three-point interpolation ("tri3"); bilinear; the trilinear blends of those between pyramid
-// levels
-// ("trilinear3", "trilinear"); anisotropic (trilinear probes along the pixel footprint's major
-// axis); `point`, the nearest texel of the full-resolution image, no pyramid (aliases: the
-// reference that, supersampled, gives docs/quality.md's ground truth). `inherit` (materials
-// only): the frame's choice, RenderOptions::textureFilter.
+// levels ("trilinear3", "trilinear"); anisotropic (trilinear probes along the pixel footprint's
+// major axis); `point`, the nearest texel of the full-resolution image, no pyramid (aliases: the
+// reference that, supersampled, gives docs/quality.md's ground truth). `inherit` (materials only):
+// the frame's choice, RenderOptions::textureFilter.
 enum class TextureFilter : uint8_t {
   inherit,
   point,
@@ -181,6 +180,8 @@ struct Scene {
   Vec3 background{0.05f, 0.06f, 0.09f};
 
   size_t triangleCount() const;  // over all instances
+  // Material `index` (a Mesh's or a FreeFormObject's), or the default Material for −1 (none).
+  const Material& materialAt(int index) const;
 };
 
 // Checks the invariants stated on Mesh and Instance; the error names `file`. `vertexData = false`

@@ -1,6 +1,6 @@
 // Checks of preconditions and invariants (STYLE.md habit 9): SV_CHECK is always on, for what a
-// caller must guarantee and a comment used to ask for; SV_DCHECK is on in debug builds only, for
-// hot loops. A failed check prints file and line, the condition and — for the comparisons — both
+// caller must guarantee and a comment used to ask for; SV_DCHECK is on in debug builds and in the
+// sanitizer builds scripts/test runs (SV_ENABLE_DCHECK, set by SV_SANITIZE), for hot loops. A failed check prints file and line, the condition and — for the comparisons — both
 // operands, then aborts. Input errors are not checks: they are values (synthvis/result.h).
 #pragma once
 
@@ -37,7 +37,7 @@ namespace sv::core {
 #define SV_CHECK_GE(a, b) SV_CHECK_OP(a, >=, b)
 #define SV_CHECK_GT(a, b) SV_CHECK_OP(a, >, b)
 
-#ifdef NDEBUG
+#if defined(NDEBUG) && !defined(SV_ENABLE_DCHECK)
 #define SV_DCHECK(condition) \
   do {                       \
   } while (false && (condition))
@@ -48,5 +48,9 @@ namespace sv::core {
 #define SV_DCHECK(condition) SV_CHECK(condition)
 #define SV_DCHECK_OP(a, op, b) SV_CHECK_OP(a, op, b)
 #endif
+#define SV_DCHECK_EQ(a, b) SV_DCHECK_OP(a, ==, b)
+#define SV_DCHECK_NE(a, b) SV_DCHECK_OP(a, !=, b)
 #define SV_DCHECK_LT(a, b) SV_DCHECK_OP(a, <, b)
 #define SV_DCHECK_LE(a, b) SV_DCHECK_OP(a, <=, b)
+#define SV_DCHECK_GE(a, b) SV_DCHECK_OP(a, >=, b)
+#define SV_DCHECK_GT(a, b) SV_DCHECK_OP(a, >, b)

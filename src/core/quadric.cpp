@@ -225,8 +225,8 @@ Vec3d Quadric::gradient(Vec3d p) const {
 
 Interval Quadric::bound(Interval x, Interval y, Interval z) const {
   // Exact in z, centred in x and y. With (x, y) = (x_c + h_x, y_c + h_y), |h| ≤ r:
-  //   F = F(x_c, y_c, z) + F_x(x_c, y_c, z)·h_x + F_y(x_c, y_c, z)·h_y + A·h_x² + B·h_y² +
-  //   D·h_x·h_y
+  //   F = F(x_c, y_c, z) + F_x(x_c, y_c, z)·h_x + F_y(x_c, y_c, z)·h_y
+  //       + A·h_x² + B·h_y² + D·h_x·h_y
   // exactly. The first term is a quadratic in z alone, bounded exactly (quadraticRange); the
   // gradient terms are linear in z, so their largest magnitudes over z are at its ends; the
   // remainder is second order in the window's size. Term-by-term interval arithmetic loses the
@@ -235,8 +235,8 @@ Interval Quadric::bound(Interval x, Interval y, Interval z) const {
   // BENCH.md's freeform: 4-pixel windows three object radii away from a surface kept).
   const double xc = 0.5 * (x.lo + x.hi), yc = 0.5 * (y.lo + y.hi);
   const double rx = 0.5 * (x.hi - x.lo), ry = 0.5 * (y.hi - y.lo);
-  // F(x_c, y_c, z) = C·z² + (E·x_c + F·y_c + I)·z + [A·x_c² + B·y_c² + D·x_c·y_c + G·x_c + H·y_c +
-  // K]
+  // F(x_c, y_c, z) = C·z² + (E·x_c + F·y_c + I)·z
+  //                  + [A·x_c² + B·y_c² + D·x_c·y_c + G·x_c + H·y_c + K]
   const double b = c[4] * xc + c[5] * yc + c[8];
   const double k = (c[0] * xc + c[3] * yc + c[6]) * xc + (c[1] * yc + c[7]) * yc + c[9];
   const Interval centre = quadraticRange(c[2], b, k, z);

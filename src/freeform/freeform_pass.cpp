@@ -214,10 +214,10 @@ void FreeFormPass::readDepths(TileJob& job) const {
   }
 }
 
-// The whole tile as one window of buffers `depth`, `object`, `cubeZ` and (if given) `active`
+// The whole tile as one window (freeform::castWindow) of buffers `depth`, `object`, `cubeZ` and (if given) `active`
 // (row-major, kTileSize wide), its rays at sample offset (dx, dy); every listed form cast into it.
-void FreeFormPass::castWindow(TileJob& job, float* depth, uint32_t* object, double* cubeZ,
-                              uint64_t* active, double dx, double dy) const {
+void FreeFormPass::castTile(TileJob& job, float* depth, uint32_t* object, double* cubeZ,
+                            uint64_t* active, double dx, double dy) const {
   CastWindow w;
   w.width = width_;
   w.height = height_;
@@ -238,17 +238,17 @@ void FreeFormPass::castWindow(TileJob& job, float* depth, uint32_t* object, doub
   MaskingPyramid pyramid(w);  // one for all the forms
   for (size_t i = 0; i < job.listed.size(); ++i) {
     uint64_t formActive;
-    freeform::castWindow(forms_[job.listed[i]].projected, job.listed[i], w, settings_, job.stats,
-                         &pyramid, &formActive);
+    castWindow(forms_[job.listed[i]].projected, job.listed[i], w, settings_, job.stats, &pyramid,
+               &formActive);
     job.scratch.active[i] |= formActive;
   }
 }
 
 void FreeFormPass::castEverySample(TileJob& job) const {
   for (int k = 0; k < job.samples; ++k)
-    castWindow(job, job.depthPlane(k), job.objectPlane(k), job.cubeZPlane(k),
-               job.pixelMasks ? job.scratch.pixelActive.data() + kPlane * size_t(k) : nullptr,
-               offsetX_[k], offsetY_[k]);
+    castTile(job, job.depthPlane(k), job.objectPlane(k), job.cubeZPlane(k),
+             job.pixelMasks ? job.scratch.pixelActive.data() + kPlane * size_t(k) : nullptr,
+             offsetX_[k], offsetY_[k]);
 }
 
 // CastSettings::adaptiveSamples: the pixel centres, then every sample only where the centres do
@@ -289,14 +289,14 @@ void FreeFormPass::castCentresWithRing(TileJob& job) const {
   scratch.centreObject.assign(kPlane, kNoHit);
   scratch.centreZ.resize(kPlane);
   // Plane by plane: the planes lie 16 KB apart, and a pixel's samples read one after another
-  // fall in one cache set (measured: a fifth of a 16-sample frame went to such reads).
+  // fall in one cache set (docs/performance.md, "Free forms").
   std::copy_n(scratch.depth.data(), kPlane, scratch.centreDepth.data());
   for (int k = 1; k < job.samples; ++k)
     for (size_t p = 0; p < kPlane; ++p)
       scratch.centreDepth[p] =
           std::max(scratch.centreDepth[p], scratch.depth[kPlane * size_t(k) + p]);
-  castWindow(job, scratch.centreDepth.data(), scratch.centreObject.data(), scratch.centreZ.data(),
-             nullptr, 0, 0);
+  castTile(job, scratch.centreDepth.data(), scratch.centreObject.data(), scratch.centreZ.data(),
+           nullptr, 0, 0);
   scratch.ringObject.assign(size_t(kRing) * kRing, kNoHit);
   scratch.ringDepth.assign(size_t(kRing) * kRing, 1.0f);
   uint32_t* co = scratch.ringObject.data();

@@ -101,8 +101,8 @@ class FreeFormPass final : public raster::TilePass {
 
   // drawTile's steps.
   void readDepths(TileJob& job) const;
-  void castWindow(TileJob& job, float* depth, uint32_t* object, double* cubeZ, uint64_t* active,
-                  double dx, double dy) const;
+  void castTile(TileJob& job, float* depth, uint32_t* object, double* cubeZ, uint64_t* active,
+                double dx, double dy) const;
   void castEverySample(TileJob& job) const;
   void castAdaptive(TileJob& job) const;
   void castCentresWithRing(TileJob& job) const;

@@ -35,7 +35,7 @@ HWY_INLINE V3 TransformPoint(DD d, const Mat4d& m, const V3& p) {
   return {hn::Div(r[0], r[3]), hn::Div(r[1], r[3]), hn::Div(r[2], r[3])};
 }
 
-// The 3×3 part of m times v (tile_pass.cpp's apply3).
+// The 3×3 part of m times v (Mat4d acting on a direction).
 HWY_INLINE V3 Apply3(DD d, const Mat4d& m, const V3& v) {
   VD r[3];
   for (int i = 0; i < 3; ++i)

@@ -275,8 +275,8 @@ VD Refine(DD d, const Rays& rays, VD a, VD b, VD fa, VD fb, MD crossing, VD gues
 }
 
 // Values v[s0 … s0 + m) into the lanes, `fill` past them. A whole vector is loaded as it is: a
-// vector load of lanes just written one by one waits for the stores (measured: a sixth of
-// quadricCrossings).
+// vector load of lanes just written one by one waits for the stores (docs/performance.md,
+// "Pitfalls").
 HWY_INLINE VD LoadPadded(DD d, const double* v, size_t s0, size_t m, double fill) {
   if (m == hn::Lanes(d)) return hn::LoadU(d, v + s0);
   alignas(64) double lanes[16];

@@ -147,7 +147,8 @@ HWY_INLINE void setupLanes(D d, const ClipVertex* vertices, const uint32_t* indi
   const auto by1 = hn::Min(maxY, hn::Floor(hn::Mul(hn::Sub(y1, insetHigh), inv256)));
   const auto empty = hn::Or(hn::Gt(bx0, bx1), hn::Gt(by0, by1));
   const auto isSmall = hn::Le(hn::Max(hn::Sub(x1, x0), hn::Sub(y1, y0)), small);
-  // Step 7: oriented edges with the fill rule folded in (setup.cpp, toPixelEdge).
+  // Step 7: oriented edges with the fill rule folded in (setup.cpp, toPixelEdge): `owns` is
+  // geometry::ownsBoundary in lanes (the setup tests compare every record with the scalar one).
   int r = 0;
   for (int k = 0; k < 3; ++k) {
     const auto a = hn::Mul(orient, A[k]), b = hn::Mul(orient, B[k]), c = hn::Mul(orient, C[k]);

@@ -31,7 +31,7 @@ struct VertexMaterial {
 
 // The lights of the frame, in world space (SPEC §8).
 struct DirectionalLight {
-  Vec3 direction{0, -1, 0};  // the direction the light travels
+  Vec3 direction{-0.4f, -1.0f, -0.6f};  // the direction the light travels (scene::Light's default)
   Vec3 color{1, 1, 1};
   float ambient = 0.25f;
   bool enabled = true;

@@ -57,7 +57,7 @@ namespace {
 // allocation, so a tiny malicious file cannot ask for gigabytes.
 constexpr texture::PngLimits kImageLimits{kMaxImageSide, int64_t(kMaxImageSide) * kMaxImageSide};
 
-Result<Image> imageOf(Result<texture::PngPixels> png) {
+Result<Image> toImage(Result<texture::PngPixels> png) {
   if (!png.ok()) return png.error();
   Image image;
   image.width = png.value().width;
@@ -69,11 +69,11 @@ Result<Image> imageOf(Result<texture::PngPixels> png) {
 }  // namespace
 
 Result<Image> readPng(const std::string& path) {
-  return imageOf(texture::readPng(path, texture::PngLayout::rgb8, kImageLimits));
+  return toImage(texture::readPng(path, texture::PngLayout::rgb8, kImageLimits));
 }
 
 Result<Image> decodePng(const void* data, size_t size, const std::string& name) {
-  return imageOf(texture::decodePng(data, size, name, texture::PngLayout::rgb8, kImageLimits));
+  return toImage(texture::decodePng(data, size, name, texture::PngLayout::rgb8, kImageLimits));
 }
 
 }  // namespace sv

@@ -67,8 +67,8 @@ HWY_INLINE int shadeBlock(const TriangleSetup& t, const PlaneLanes& lanes, uint3
 }
 
 // The centroid of each lane's covered samples relative to its pixel centre, in pixels (zero for a
-// lane whose samples are all covered): (Σ offsets in 1/256 px, an exact integer) · (1 / (count ·
-// 256)).
+// lane whose samples are all covered):
+//     (Σ offsets in 1/256 px, an exact integer) · (1 / (count · 256)).
 template <class DF, class VU, class V>
 HWY_INLINE void centroidOffsets(DF df, const CoverageTables& cov, VU m0, VU m1, V& cx, V& cy) {
   const hn::RebindToSigned<DF> di;

@@ -102,7 +102,7 @@ struct CoverageTables {
   const SamplePattern* pattern = nullptr;
   int32_t offsetX[64] = {}, offsetY[64] = {};  // the pattern's offsets in 1/256 pixel
   // Shade a partly covered pixel at the centroid of its covered samples rather than at its centre
-  // (tile_kernel.cpp): with 16 and 64 samples, where it cuts the edge error of small Gouraud
+  // (shadeBlockSamples, samplesPassing in raster/*-inl.h): with 16 and 64 samples, where it cuts the edge error of small Gouraud
   // triangles by 4 %; with 4 and 8 it changes it by under 1 % and costs more than it gives
   // (docs/quality.md, docs/performance.md "Anti-aliasing").
   bool centroid = false;

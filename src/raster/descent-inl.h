@@ -8,8 +8,8 @@
 // Symbols. For an edge e(px, py) = c + sX·px + sY·py (setup.h), a window of n×n pixels is kept by
 // the value tl of e at the centre of its top-left pixel. Seed 000's coverage function is
 //     d = e(x_c, y_c) + ε,   ε = (|A|·a + |B|·b)/2,   a = b = n − 1 (α = β = 0: point sampling)
-// — the largest value of e over the window's pixel centres. With sX⁺ = max(sX, 0), sX⁻ = min(sX,
-// 0):
+// — the largest value of e over the window's pixel centres. With sX⁺ = max(sX, 0) and
+// sX⁻ = min(sX, 0):
 //     d      = tl + (sX⁺ + sY⁺)·(n − 1)        d < 0   → the window is outside: reject
 //     d − 2ε = tl + (sX⁻ + sY⁻)·(n − 1)        d ≥ 2ε  → inside this edge: drop the edge below here
 // A child of size h = n/2 at (cx, cy) ∈ {0,1}² has tl' = tl + cx·sX·h + cy·sY·h (seed 000 eq. 1),

@@ -12,8 +12,8 @@
 // colour one plane — 16 pixels — per vector, and the resolve sums the planes. Memory per pixel: N ×
 // (4 bytes of depth + 6 of colour). Colour sums (TileWork::sums): where every sample is written at
 // most once (priority masking, opaque), a pixel's colour is kept instead as the sum of its N
-// samples' 16-bit values, 3 int32 per pixel laid out as one plane (block by block, 16 R, 16 G, 16
-// B) — what the resolve would have summed, so the image is the same bit for bit.
+// samples' 16-bit values, 3 int32 per pixel laid out as one plane (block by block: 16 R, 16 G,
+// 16 B) — what the resolve would have summed, so the image is the same bit for bit.
 #pragma once
 
 #include <cstddef>

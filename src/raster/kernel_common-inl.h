@@ -166,16 +166,21 @@ HWY_INLINE void blockBases(const TriangleSetup& t, const PlaneLanes& lanes, int 
               d8, base + p);
 }
 
-// Perspective-correct colour (colour/w)·w, clamped to [0, 1], as 16-bit linear light in int32
-// lanes. Float → 16-bit by the magic-number trick: for 0 ≤ v < 2^23, the float v + 2^23 holds
-// round-to-nearest-even(v) in its low mantissa bits (no range fix-ups, unlike ConvertTo).
+// 0…1 → 16-bit linear light in int32 lanes. Float → 16-bit by the magic-number trick: for
+// 0 ≤ v < 2^23, the float v + 2^23 holds round-to-nearest-even(v) in its low mantissa bits (no
+// range fix-ups, unlike ConvertTo).
 template <class DF, class V>
-HWY_INLINE auto colorToLanes(DF df, V cw, V w) {
+HWY_INLINE auto unitToLanes(DF df, V c) {
   const hn::RebindToSigned<DF> di;
-  const auto c = hn::Min(hn::Max(hn::Mul(cw, w), hn::Zero(df)), hn::Set(df, 1.0f));
   return hn::And(
       hn::BitCast(di, hn::Add(hn::Mul(c, hn::Set(df, 65535.0f)), hn::Set(df, 8388608.0f))),
       hn::Set(di, 0xFFFF));
+}
+
+// Perspective-correct colour (colour/w)·w, clamped to [0, 1], as unitToLanes' 16-bit lanes.
+template <class DF, class V>
+HWY_INLINE auto colorToLanes(DF df, V cw, V w) {
+  return unitToLanes(df, hn::Min(hn::Max(hn::Mul(cw, w), hn::Zero(df)), hn::Set(df, 1.0f)));
 }
 
 // Channel ch at the pixel centres of lanes i… .
@@ -184,15 +189,6 @@ HWY_INLINE auto colorLanes(DF df, const PlaneLanes& lanes, const float* base, in
                            V w) {
   const auto cw = hn::Add(hn::Set(df, base[kRed + ch]), hn::LoadU(df, lanes.offset[kRed + ch] + i));
   return colorToLanes(df, cw, w);
-}
-
-// 0…1 → 16-bit lanes (colorToLanes' rounding, for a value already in range).
-template <class DF, class V>
-HWY_INLINE auto unitToLanes(DF df, V c) {
-  const hn::RebindToSigned<DF> di;
-  return hn::And(
-      hn::BitCast(di, hn::Add(hn::Mul(c, hn::Set(df, 65535.0f)), hn::Set(df, 8388608.0f))),
-      hn::Set(di, 0xFFFF));
 }
 
 // A bound of the triangle's depth over the pixels [gx0, gx1] × [gy0, gy1] (frame coordinates, with

@@ -121,7 +121,7 @@ HWY_INLINE void prefetchRecords(const TileWork& w, uint32_t ahead, bool wideReco
 }
 
 // The tile's context for the kernel's steps.
-TileContext tileContext(const TileWork& w, RasterStats& stats, bool deferred) {
+TileContext makeTileContext(const TileWork& w, RasterStats& stats, bool deferred) {
   return TileContext{
       w.tileX * kTileSize,
       w.tileY * kTileSize,
@@ -176,7 +176,7 @@ template <ShadeMode kShade, bool kAA>
 void drawLists(const TileWork& w, RasterStats& stats) {
   // Pixel shading at one sample is deferred: opaque triangles only record the winner per pixel.
   constexpr bool kDeferred = kShade == ShadeMode::material && !kAA;
-  TileContext ctx = tileContext(w, stats, kDeferred);
+  TileContext ctx = makeTileContext(w, stats, kDeferred);
   WinnerList winners;
   if (kDeferred) ctx.winners = &winners;
   alignas(64) float clearPlanes[64 * kBlockPixels];

@@ -410,11 +410,9 @@ Status GlRenderer::load(const scene::Scene& scene) {
   // GL puts the first row uploaded at t = 0 and ours is the image's top row, at v = 0 (glTF's
   // convention): (s, t) = (u, v).
 
-  const scene::Material defaultMaterial;
   for (const scene::Instance& inst : scene.instances) {
     const scene::Mesh& mesh = scene.meshes[size_t(inst.mesh)];
-    const scene::Material& mat =
-        mesh.material >= 0 ? scene.materials[size_t(mesh.material)] : defaultMaterial;
+    const scene::Material& mat = scene.materialAt(mesh.material);
     Draw d;
     d.mesh = size_t(inst.mesh);
     const Mat4 mvp = camera.value() * inst.transform;

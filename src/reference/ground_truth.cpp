@@ -158,13 +158,17 @@ Result<Image> renderGroundTruth(const scene::Scene& scene, const GroundTruthOpti
   core::ThreadPool pool(o.threads > 0 ? o.threads : 1);
 
   // The same clip-space vertices and lit colours as synthvis's vertex stage: the render stage's
-  // draw packets, in submission order (the Z-buffer's), vertex colours only.
+  // draw packets (vertex colours only), their calls taken in the scene's order of instances — the
+  // truth has no translucency, and drawn in that order a depth tie goes to the earlier instance.
   o.hsr = RenderOptions::Hsr::zbuffer;
-  const Result<render::FrameCamera> camera = render::frameCamera(scene, o);
+  const Result<render::FrameCamera> camera = render::chooseCamera(scene, o);
   if (!camera.ok()) return camera.error();
   render::DrawPackets packets;
   if (Status s = render::buildDrawPackets(scene, o, camera.value(), nullptr, pool, packets); !s)
     return s.error();
+  std::stable_sort(
+      packets.calls.begin(), packets.calls.end(),
+      [](const render::DrawCall& a, const render::DrawCall& b) { return a.instance < b.instance; });
   std::vector<Tri> tris;
   for (const render::DrawCall& call : packets.calls)
     for (uint32_t t = call.firstTriangle; t < call.firstTriangle + call.triangleCount; ++t) {

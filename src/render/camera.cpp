@@ -40,7 +40,7 @@ scene::Camera defaultCamera(const scene::Scene& s) {
 
 }  // namespace
 
-Result<FrameCamera> frameCamera(const scene::Scene& scene, const RenderOptions& o) {
+Result<FrameCamera> chooseCamera(const scene::Scene& scene, const RenderOptions& o) {
   FrameCamera f;
   if (!scene.cameras.empty()) {
     if (o.camera >= int(scene.cameras.size()))
@@ -64,13 +64,13 @@ Result<FrameCamera> frameCamera(const scene::Scene& scene, const RenderOptions& 
 namespace sv {
 
 Result<Mat4> viewProjection(const scene::Scene& scene, const RenderOptions& o) {
-  const Result<render::FrameCamera> c = render::frameCamera(scene, o);
+  const Result<render::FrameCamera> c = render::chooseCamera(scene, o);
   if (!c.ok()) return c.error();
   return c.value().projection * c.value().view;
 }
 
 Result<Mat4> viewMatrix(const scene::Scene& scene, const RenderOptions& o) {
-  const Result<render::FrameCamera> c = render::frameCamera(scene, o);
+  const Result<render::FrameCamera> c = render::chooseCamera(scene, o);
   if (!c.ok()) return c.error();
   return c.value().view;
 }

@@ -13,6 +13,6 @@ struct FrameCamera {
 
 // The camera `options.camera` of the scene (an error names one that does not exist), or for a
 // scene without cameras one that frames its bounds.
-Result<FrameCamera> frameCamera(const scene::Scene& scene, const RenderOptions& options);
+Result<FrameCamera> chooseCamera(const scene::Scene& scene, const RenderOptions& options);
 
 }  // namespace sv::render

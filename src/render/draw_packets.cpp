@@ -31,13 +31,8 @@ Status invalidVertexData(const scene::Scene& scene) {
   return Error{"", "", "invalid vertex data"};  // (validate finds what the stage found)
 }
 
-const scene::Material& materialOf(const scene::Scene& scene, const scene::Mesh& mesh) {
-  static const scene::Material defaultMaterial;
-  return mesh.material >= 0 ? scene.materials[size_t(mesh.material)] : defaultMaterial;
-}
-
 // The mesh's arrays and material as the vertex stage reads them.
-geometry::VertexArrays vertexArrays(const scene::Mesh& mesh) {
+geometry::VertexArrays toVertexArrays(const scene::Mesh& mesh) {
   geometry::VertexArrays v;
   v.positions = mesh.positions.data();
   v.count = mesh.positions.size();
@@ -46,7 +41,7 @@ geometry::VertexArrays vertexArrays(const scene::Mesh& mesh) {
   if (!mesh.uvs.empty()) v.uvs = mesh.uvs.data();
   return v;
 }
-geometry::VertexMaterial vertexMaterial(const scene::Material& m) {
+geometry::VertexMaterial toVertexMaterial(const scene::Material& m) {
   return {m.baseColor, m.uvScale, m.unlit, m.phong};
 }
 
@@ -123,7 +118,7 @@ Status layOutCalls(const scene::Scene& scene, const RenderOptions& o, const Fram
     for (const uint32_t instance : order) {
       const scene::Instance& inst = scene.instances[instance];
       const scene::Mesh& mesh = scene.meshes[inst.mesh];
-      const scene::Material& mat = materialOf(scene, mesh);
+      const scene::Material& mat = scene.materialAt(mesh.material);
       if ((mat.alphaMode == scene::AlphaMode::blend) != translucentPass) continue;
       // Indices are 32-bit; a frame of more vertices or triangles than that cannot be expressed.
       if (vertexCount + mesh.positions.size() > (size_t(1) << 31) ||
@@ -137,6 +132,7 @@ Status layOutCalls(const scene::Scene& scene, const RenderOptions& o, const Fram
         jobs.push_back(
             {&inst, true, b, std::min(mesh.indices.size(), b + kIndexChunk), indexCount + b, base});
       DrawCall call;
+      call.instance = instance;
       call.firstTriangle = static_cast<uint32_t>(indexCount / 3);
       call.triangleCount = static_cast<uint32_t>(mesh.triangleCount());
       call.cull =
@@ -204,8 +200,8 @@ Status buildDrawPackets(const scene::Scene& scene, const RenderOptions& o,
       return;
     }
     finite[j] = geometry::transformVertices(
-        vertexArrays(mesh), vertexMaterial(materialOf(scene, mesh)), job.instance->transform,
-        context, job.begin, job.end, p.vertices.data() + job.out,
+        toVertexArrays(mesh), toVertexMaterial(scene.materialAt(mesh.material)),
+        job.instance->transform, context, job.begin, job.end, p.vertices.data() + job.out,
         stride ? p.attributes.data() + job.out * stride : nullptr, &p.attributeLayout);
   });
   if (std::find(finite.begin(), finite.end(), 0) != finite.end()) return invalidVertexData(scene);

@@ -25,6 +25,7 @@ struct DrawCall {
   // its triangles are dropped wherever the bound lies in occupied windows. Unbounded: no test.
   bool bounded = false;
   geometry::ObjectBound bound{};
+  uint32_t instance = 0;  // the scene instance drawn (an index into Scene::instances)
 };
 
 // The plain input of a frame: vertices after the projective transform and triangles indexing them.
@@ -36,7 +37,7 @@ struct DrawPackets {
   std::vector<float> attributes;
   geometry::AttributeLayout attributeLayout;
   std::vector<uint32_t> indices;  // 3 per triangle, each < vertices.size()
-  std::vector<DrawCall> calls;    // in submission order
+  std::vector<DrawCall> calls;    // in draw order (buildDrawPackets)
 };
 
 // Builds `out` for the scene seen by `camera`: one call per instance in draw order (drawOrder:

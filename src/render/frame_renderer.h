@@ -29,7 +29,7 @@ struct FrameSettings {
   raster::ShadeMode shade = raster::ShadeMode::gouraud;
   const shade::Environment* environment = nullptr;  // lights and fog, for ShadeMode::material
   // Samples per pixel: 1 (point sampling at centres) or 4, 8, 16, 64 (anti-aliasing with sub-pixel
-  // masks, SPEC §5; Gouraud only). finishTile then receives `samples` sample planes per block.
+  // masks, SPEC §5). finishTile then receives `samples` sample planes per block.
   int samples = 1;
   // Called once per tile, on the thread that drew it, right after the tile's last triangle, with
   // the tile's depth and colour (laid out as raster/framebuffer.h describes, `samples` per pixel),

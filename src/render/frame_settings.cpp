@@ -29,9 +29,9 @@ Status sizeBatches(const RenderOptions& o, size_t triangles, FrameSettings& fs) 
 
 }  // namespace
 
-Result<FrameSettings> frameSettings(const RenderOptions& o, Vec3 background,
-                                    const shade::Environment& environment, bool pixelShading,
-                                    size_t triangles) {
+Result<FrameSettings> makeFrameSettings(const RenderOptions& o, Vec3 background,
+                                        const shade::Environment& environment, bool pixelShading,
+                                        size_t triangles) {
   using DebugView = RenderOptions::DebugView;
   FrameSettings fs;
   fs.width = o.width * o.supersample;

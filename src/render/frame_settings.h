@@ -9,8 +9,8 @@ namespace sv::render {
 // (the debug views, pixel shading when `pixelShading`, else Gouraud), samples, masking, and with
 // anti-aliasing the batch size that keeps the sample buffer within memory for `triangles` — an
 // error when even that needs over 4 GB. No tile sink and no passes yet.
-Result<FrameSettings> frameSettings(const RenderOptions& options, Vec3 background,
-                                    const shade::Environment& environment, bool pixelShading,
-                                    size_t triangles);
+Result<FrameSettings> makeFrameSettings(const RenderOptions& options, Vec3 background,
+                                        const shade::Environment& environment, bool pixelShading,
+                                        size_t triangles);
 
 }  // namespace sv::render

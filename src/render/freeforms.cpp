@@ -32,15 +32,13 @@ freeform::FreeForm toFreeForm(const scene::FreeFormNode& n) {
   return f;
 }
 
-std::vector<freeform::ShadedForm> shadedForms(const scene::Scene& scene, const Mat4& view,
-                                              const Mat4& projection,
-                                              const ShadingTables& shading) {
+std::vector<freeform::ShadedForm> makeShadedForms(const scene::Scene& scene, const Mat4& view,
+                                                  const Mat4& projection,
+                                                  const ShadingTables& shading) {
   std::vector<freeform::ShadedForm> out;
-  const scene::Material defaultMaterial;
   const bool lights = shading.environment.lightOn || !shading.environment.points.empty();
   for (const scene::FreeFormObject& object : scene.freeForms) {
-    const scene::Material& mat =
-        object.material >= 0 ? scene.materials[size_t(object.material)] : defaultMaterial;
+    const scene::Material& mat = scene.materialAt(object.material);
     const Mat4d toEye = toDouble(view * object.transform);
     const std::optional<Mat4d> eyeInverse = toEye.inverse();
     const freeform::FreeForm form = toFreeForm(object.form);
@@ -68,7 +66,7 @@ std::vector<freeform::ShadedForm> shadedForms(const scene::Scene& scene, const M
 namespace sv {
 
 Result<scene::Scene> tessellatedScene(const scene::Scene& scene, const RenderOptions& o) {
-  const Result<render::FrameCamera> camera = render::frameCamera(scene, o);
+  const Result<render::FrameCamera> camera = render::chooseCamera(scene, o);
   if (!camera.ok()) return camera.error();
   const scene::Camera& cam = camera.value().camera;
   const double pixelPerDepth =
@@ -115,7 +113,8 @@ Result<scene::Scene> tessellatedScene(const scene::Scene& scene, const RenderOpt
       const Vec3d& n = soup.normals[v];
       mesh.positions.push_back({float(p.x), float(p.y), float(p.z)});
       mesh.normals.push_back({float(n.x), float(n.y), float(n.z)});
-      mesh.uvs.push_back({float(p.x), float(p.z)});  // the free form's projection (tile_pass.h)
+      mesh.uvs.push_back(
+          {float(p.x), float(p.z)});  // the free form's projection (ShadedForm::uvScale)
       mesh.indices.push_back(uint32_t(v));
     }
     out.meshes.push_back(std::move(mesh));

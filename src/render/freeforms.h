@@ -18,7 +18,8 @@ freeform::FreeForm toFreeForm(const scene::FreeFormNode& node);
 // has lights and the material is lit: the normal is exact at every pixel), both sides lit. A
 // texture is projected along the object's y axis (freeform/freeform_pass.h). Free forms are always
 // opaque. A form with a singular placement shows nothing and is left out.
-std::vector<freeform::ShadedForm> shadedForms(const scene::Scene& scene, const Mat4& view,
-                                              const Mat4& projection, const ShadingTables& shading);
+std::vector<freeform::ShadedForm> makeShadedForms(const scene::Scene& scene, const Mat4& view,
+                                                  const Mat4& projection,
+                                                  const ShadingTables& shading);
 
 }  // namespace sv::render

@@ -12,7 +12,7 @@ std::vector<raster::TilePass*> FramePasses::compose(const scene::Scene& scene,
   if (o.debugView != RenderOptions::DebugView::none) return passes;
   if (!scene.freeForms.empty()) {
     freeForms_.setForms(
-        shadedForms(scene, camera.view, camera.projection, shading), &shading.environment,
+        makeShadedForms(scene, camera.view, camera.projection, shading), &shading.environment,
         freeform::CastSettings{.masking = true, .adaptiveSamples = !o.freeFormEverySample},
         o.freeFormMethod == RenderOptions::FreeFormMethod::march ? o.marchSteps : 0);
     passes.push_back(&freeForms_);

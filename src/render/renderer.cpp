@@ -53,7 +53,7 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
   const auto start = core::Clock::now();
 
   // Stage 2: the camera, and the shading stage's tables in its eye space.
-  const Result<render::FrameCamera> camera = render::frameCamera(scene, o);
+  const Result<render::FrameCamera> camera = render::chooseCamera(scene, o);
   if (!camera.ok()) return camera.error();
   render::buildShading(scene, o, camera.value().view, m.shading);
   const bool pixelShading = m.shading.any && o.debugView == RenderOptions::DebugView::none;
@@ -67,7 +67,7 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
   stats.vertexMs = core::msSince(t0);
 
   // Stages 3–5: setup and the tiles, with the frame's passes, each tile resolved when finished.
-  Result<render::FrameSettings> settings = render::frameSettings(
+  Result<render::FrameSettings> settings = render::makeFrameSettings(
       o, scene.background, m.shading.environment, pixelShading, m.packets.indices.size() / 3);
   if (!settings.ok()) return settings.error();
   render::FrameSettings& fs = settings.value();

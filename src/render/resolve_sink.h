@@ -17,6 +17,9 @@ class ResolveSink {
   // must be sized by output::prepareImage before the first tile.
   ResolveSink(const RenderOptions& options, const output::GammaTable& gamma,
               output::LinearImage& linear, Image& image);
+  // The sinks finishTile hands out refer to this object: it stays where it is.
+  ResolveSink(const ResolveSink&) = delete;
+  ResolveSink& operator=(const ResolveSink&) = delete;
 
   // FrameSettings::finishTile for a raster `tilesX` tiles wide.
   TileSink finishTile(int tilesX);

@@ -24,10 +24,9 @@ texture::Filter samplerOf(scene::TextureFilter f) {
 void buildShading(const scene::Scene& scene, const RenderOptions& o, const Mat4& view,
                   ShadingTables& out) {
   out.materials.clear();
-  const scene::Material defaultMaterial;
   const bool hasLights = scene.light.enabled || !scene.pointLights.empty();
   for (int m = -1; m < int(scene.materials.size()); ++m) {
-    const scene::Material& mat = m >= 0 ? scene.materials[size_t(m)] : defaultMaterial;
+    const scene::Material& mat = scene.materialAt(m);
     for (int normals = 0; normals < 2; ++normals) {
       shade::MaterialShading s;
       if (mat.texture >= 0) s.texture = scene.textures[size_t(mat.texture)].texture.get();

@@ -15,7 +15,6 @@
 #include "synthvis/generators.h"
 
 namespace sv::scene {
-namespace {}  // namespace
 
 Scene generateLayers(const LayersParams& p, TrisStats* stats) {
   std::mt19937_64 rng(p.seed);

@@ -27,6 +27,11 @@ int FreeFormNode::quadricCount() const {
   return n;
 }
 
+const Material& Scene::materialAt(int index) const {
+  static const Material defaultMaterial;
+  return index >= 0 ? materials[size_t(index)] : defaultMaterial;
+}
+
 size_t Scene::triangleCount() const {
   size_t n = 0;
   for (const Instance& instance : instances)

@@ -1,6 +1,6 @@
 // Pixel shading (SPEC §8, with §7's texture): what a covered pixel of a textured, Phong-lit,
-// fogged or translucent material looks like. The tile kernel (raster/tile_kernel.cpp) interpolates
-// the attributes below for up to 16 pixels of one triangle and hands them here; the result is the
+// fogged or translucent material looks like. The tile kernel (raster/material_blocks-inl.h,
+// deferred_shading-inl.h) interpolates the attributes below for up to 16 pixels of one triangle and hands them here; the result is the
 // pixel's premultiplied linear colour, which the kernel depth-tests, blends and stores.
 //
 // Based on: SPEC §8 (seed 003's Phong weighting, seed 002's fog 2^(−βz) and colour table), §7

@@ -8,6 +8,8 @@
 namespace sv::texture {
 namespace {
 
+constexpr uint64_t kUnknownSize = ~uint64_t(0);
+
 // libpng has begun reading `png` (`bytes` long); finish as `layout` says, within `limits`.
 Result<PngPixels> finishRead(png_image& png, uint64_t bytes, const std::string& name,
                              PngLayout layout, const PngLimits& limits) {
@@ -19,8 +21,9 @@ Result<PngPixels> finishRead(png_image& png, uint64_t bytes, const std::string& 
                  fmt::format("PNG size {}x{} is out of range (sides 1…{}, at most {} pixels)",
                              png.width, png.height, limits.maxSide, limits.maxPixels)};
   }
-  // The file's own samples (the format begin_read found) against what its bytes can hold.
-  if (uint64_t(PNG_IMAGE_SIZE(png)) > bytes * 1032 + 65536) {
+  // The file's own samples (the format begin_read found) against what its bytes can hold; a size
+  // that cannot be known (a pipe) bounds nothing.
+  if (bytes != kUnknownSize && uint64_t(PNG_IMAGE_SIZE(png)) > bytes * 1032 + 65536) {
     png_image_free(&png);
     return Error{name, "",
                  fmt::format("{} bytes of PNG cannot hold the {}x{} image its header states", bytes,
@@ -71,7 +74,7 @@ Result<PngPixels> readPng(const std::string& path, PngLayout layout, const PngLi
   if (!png_image_begin_read_from_file(&png, path.c_str())) return beginFailed(png, path);
   std::error_code error;
   const uintmax_t bytes = std::filesystem::file_size(path, error);
-  return finishRead(png, error ? 0 : uint64_t(bytes), path, layout, limits);
+  return finishRead(png, error ? kUnknownSize : uint64_t(bytes), path, layout, limits);
 }
 
 Result<PngPixels> decodePng(const void* data, size_t size, const std::string& name,

@@ -19,7 +19,8 @@ enum class PngLayout : uint8_t { rgb8, rgba8OrLinear16 };
 
 // What a header may claim before anything is allocated: at most maxSide a side and maxPixels in
 // all. A file is also refused when it is too short for the size its header states (deflate
-// expands at most about 1032:1), so a 60-byte file cannot cost half a gigabyte.
+// expands at most about 1032:1), so a 60-byte file cannot cost half a gigabyte — when its size can
+// be known (a pipe's cannot).
 struct PngLimits {
   int maxSide = 1 << 13;
   int64_t maxPixels = int64_t(1) << 26;

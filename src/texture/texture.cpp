@@ -251,7 +251,7 @@ namespace {
 // which libpng then undoes); 8-bit ones are sRGB-encoded RGBA (libpng re-encodes another stated
 // gamma as sRGB), decoded here by the exact IEC 61966-2-1 curve — libpng's own linear output uses
 // a 2.2 power law — and premultiplied by alpha.
-Level levelOf(const PngPixels& png) {
+Level toLevel(const PngPixels& png) {
   Level level;
   level.width = png.width;
   level.height = png.height;
@@ -286,13 +286,13 @@ constexpr PngLimits kTextureLimits{kMaxTextureSide, kMaxTextureTexels};
 Result<Level> readTextureImage(const std::string& path) {
   auto png = readPng(path, PngLayout::rgba8OrLinear16, kTextureLimits);
   if (!png.ok()) return png.error();
-  return levelOf(png.value());
+  return toLevel(png.value());
 }
 
 Result<Level> decodeTextureImage(const void* data, size_t size, const std::string& name) {
   auto png = decodePng(data, size, name, PngLayout::rgba8OrLinear16, kTextureLimits);
   if (!png.ok()) return png.error();
-  return levelOf(png.value());
+  return toLevel(png.value());
 }
 
 }  // namespace sv::texture

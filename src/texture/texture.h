@@ -7,8 +7,8 @@
 // three-point interpolation); pbrt-v4's src/pbrt/util/mipmap.cpp for the structure (not its code).
 //
 // Coordinates. A level is addressed in continuous texel coordinates (x, y): texel (i, j) is centred
-// at (i, j), so level 0's texel centres sit at integer positions and a texture coordinate u ∈ [0,
-// 1] maps to x = u·width − ½. Level k's texel i is the filtered level k − 1 at texel 2i, so it is
+// at (i, j), so level 0's texel centres sit at integer positions and a texture coordinate
+// u ∈ [0, 1] maps to x = u·width − ½. Level k's texel i is the filtered level k − 1 at texel 2i, so it is
 // centred where level 0's texel 2^k·i is: a position x₀ on level 0 is x₀ / 2^k on level k. (This
 // is the seed's "filter, then keep every other texel"; the usual box pyramid centres level k's
 // texels between level k − 1's instead.)

@@ -1,8 +1,10 @@
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <thread>
 
 #include "output/resolve.h"
 #include "raster/framebuffer.h"
@@ -80,6 +82,22 @@ TEST(ImageIo, ReadsThroughTheOnePngCodecWithItsLimits) {
   std::vector<uint8_t> row(size_t(8193) * 3, 0);
   const std::string wide = tempPath("sv_wide.png");
   ASSERT_TRUE(writePng(Image{8193, 1, row}, wide).ok());
+  // A pipe's size cannot be known, which bounds nothing: its image reads.
+  const std::string fifo = tempPath("sv_fifo.png");
+  std::remove(fifo.c_str());
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  const Image picture = gradient(300, 200);
+  const std::string picturePath = tempPath("sv_picture.png");
+  ASSERT_TRUE(writePng(picture, picturePath).ok());
+  std::thread writer([&] {
+    std::ifstream from(picturePath, std::ios::binary);
+    std::ofstream to(fifo, std::ios::binary);
+    to << from.rdbuf();
+  });
+  auto piped = readPng(fifo);
+  writer.join();
+  ASSERT_TRUE(piped.ok()) << piped.error().str();
+  EXPECT_EQ(piped->rgb, picture.rgb);
   auto tooWide = readPng(wide);
   ASSERT_FALSE(tooWide.ok());
   EXPECT_NE(tooWide.error().str().find("PNG size 8193x1 is out of range"), std::string::npos)

@@ -212,7 +212,8 @@ TEST(ImageHashes, EveryImageOnEveryTargetIsTheRecordedOne) {
   hwy::SetSupportedTargetsForTest(0);
   EXPECT_GE(targets, 1);
   // The ground truth (`synthvis truth`) and its edge mask: scalar code, once.
-  for (const char* file : {"", "scenes/mixed.json", "scenes/aa-edges.json"}) {
+  for (const char* file :
+       {"", "scenes/mixed.json", "scenes/aa-edges.json", "scenes/freeform-mixed.json"}) {
     auto loaded = *file ? scene::loadScene(std::string(SV_SOURCE_DIR) + "/" + file)
                         : Result<scene::Scene>(scene::demoScene());
     ASSERT_TRUE(loaded.ok()) << file;

@@ -118,7 +118,7 @@ std::vector<uint16_t> renderResolved(const render::DrawPackets& p, const render:
 }
 
 namespace {
-// The kernel's evaluation order (tile_kernel.cpp): per 4×4 block a base at its top-left pixel,
+// The kernel's evaluation order (blockBases, raster/kernel_common-inl.h): per 4×4 block a base at its top-left pixel,
 // plus a per-lane offset.
 float evalPlane(const geometry::Plane& p, int x, int y, int minX, int minY) {
   const float bx = float((x & ~3) - minX), by = float((y & ~3) - minY);
