@@ -532,7 +532,7 @@ void FreeFormPass::shadeBatch(TileJob& job, size_t place, shade::Fragments& frag
     }
   }
   SurfaceLanes& hit = scratch.surface;
-  float out[4][shade::kMaxFragments];
+  alignas(64) float out[4][shade::kMaxFragments];  // shadeFragments stores whole vectors
   if (form.material.texture == nullptr) {
     surfaces_[f].at(qx, qy, qz, count, hit, active, frag.attribute + shade::kU);
     frag.count = count;

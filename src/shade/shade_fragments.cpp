@@ -14,7 +14,9 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstdint>
 
+#include "core/check.h"
 #include "hwy/foreach_target.h"  // IWYU pragma: keep
 #include "hwy/highway.h"
 #include "shade/shading.h"
@@ -298,6 +300,7 @@ HWY_EXPORT(TextureCoordinates);
 
 void shadeFragments(const MaterialShading& m, const Environment& env, const Fragments& f,
                     float out[4][kMaxFragments]) {
+  SV_DCHECK(reinterpret_cast<uintptr_t>(out) % 64 == 0);
   HWY_DYNAMIC_DISPATCH(ShadeFragments)(m, env, f, nullptr, out);
 }
 
@@ -308,6 +311,7 @@ void textureCoordinates(const MaterialShading& m, const Fragments& f, TexCoords&
 
 void shadeFragments(const MaterialShading& m, const Environment& env, const Fragments& f,
                     const TexCoords& coordinates, float out[4][kMaxFragments]) {
+  SV_DCHECK(reinterpret_cast<uintptr_t>(out) % 64 == 0);
   HWY_DYNAMIC_DISPATCH(ShadeFragments)(m, env, f, &coordinates, out);
 }
 }  // namespace sv::shade

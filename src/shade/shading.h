@@ -78,7 +78,8 @@ inline unsigned attributesUsed(const MaterialShading& m, const Environment& env)
 
 // Shades `f` with material `m` under `env`: out[0…3][i] = premultiplied linear r, g, b, a of
 // fragment i, each 0…1 (alpha 1 for opaque materials; for alpha-masked ones 0 where the pixel is
-// cut away, else 1). Runs the best SIMD target (Highway), bit-identical from run to run.
+// cut away, else 1). `out` is 64-byte aligned (whole vectors are stored to it; SV_DCHECK). Runs the
+// best SIMD target (Highway), bit-identical from run to run.
 void shadeFragments(const MaterialShading& m, const Environment& env, const Fragments& f,
                     float out[4][kMaxFragments]);
 
