@@ -506,10 +506,11 @@ void FreeFormPass::shadeBatch(TileJob& job, size_t place, shade::Fragments& frag
   Scratch& scratch = job.scratch;
   const uint32_t f = job.listed[place];
   const ShadedForm& form = forms_[f];
-  // Per fragment: its sample's cube point; the perturbations that may be positive at any. (Zeroed:
-  // lanes past `count` are read, not used.)
-  double qx[shade::kMaxFragments] = {}, qy[shade::kMaxFragments] = {},
-         qz[shade::kMaxFragments] = {};
+  // Per fragment: its sample's cube point (the worker's arrays: lanes past `count` are read, not
+  // used); the perturbations that may be positive at any.
+  double* qx = scratch.cubeX;
+  double* qy = scratch.cubeY;
+  double* qz = scratch.cubeZPoint;
   uint64_t active = job.pixelMasks ? 0 : scratch.active[place];
   if (block >= 0) {  // a whole block: its first samples, row by row
     const int bx = blockX(block), by = blockY(block);

@@ -77,6 +77,9 @@ class FreeFormPass final : public raster::TilePass {
     std::vector<uint32_t> place;                // per form: its place in the tile's list
     std::vector<int> lastPixel;                 // per listed form: the last pixel pending
     SurfaceLanes surface;
+    // shadeBatch's fragments' cube points.
+    alignas(64) double cubeX[shade::kMaxFragments] = {}, cubeY[shade::kMaxFragments] = {},
+                       cubeZPoint[shade::kMaxFragments] = {};
     std::vector<double> columnX, rowY;  // per sample: the tile's columns' cube x, rows' cube y
     std::vector<uint64_t> active;       // per listed form: its perturbations that may be positive
     std::vector<uint64_t>
