@@ -41,9 +41,6 @@ class FreeFormPass final : public raster::TilePass {
   void setForms(std::vector<ShadedForm> forms, const shade::Environment* environment,
                 const CastSettings& settings, int marchSteps);
 
-  bool empty() const { return forms_.empty(); }
-  size_t size() const { return forms_.size(); }
-
   raster::PassStage stage() const override { return raster::PassStage::surfaces; }
   // Finds, for every form, the tiles of the raster whose pixel squares its surface may cross, by
   // the same bounds the caster uses, windows of the screen subdivided from the whole raster down

@@ -95,7 +95,7 @@ class DeferredShader {
   static size_t lanes() { return hn::Lanes(df); }
   // Lane i holds i: the pixel numbers of a vector of a block (Highway's Iota builds its vector in
   // memory, lane by lane; a constant table is one load).
-  static hn::Vec<DI> laneIndex() { return hn::LoadU(di, kLaneIndex); }
+  static hn::Vec<DI> laneIndex() { return hn::Load(di, kLaneIndex); }
 
   // A pixel is named by its index in the tile's block-major layout (framebuffer.h): block·16 +
   // lane.

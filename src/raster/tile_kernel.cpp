@@ -144,9 +144,9 @@ TileContext makeTileContext(const TileWork& w, RasterStats& stats, bool deferred
 // the opaque surfaces run: blending reads the colour behind. `pending`: some pixel records a
 // triangle not yet shaded.
 template <bool kAA>
-HWY_INLINE void drawShadedTriangle(const TileWork& w, TileContext& ctx, const TileContext& use,
-                                   uint32_t id, bool boxTested, WinnerList& winners,
-                                   bool& pending) {
+HWY_INLINE void drawShadedTriangle(const TileWork& w, const TileContext& ctx,
+                                   const TileContext& use, uint32_t id, bool boxTested,
+                                   WinnerList& winners, bool& pending) {
   const TriangleSetup& t = w.setups[id];
   const AttributeSetup& a = w.attributes[id];
   const shade::AlphaUse alpha = a.material ? a.material->alpha : shade::AlphaUse::opaque;
