@@ -1,0 +1,94 @@
+// Height fields (SPEC §11, seed 003's scalar perturbations): a 2D table of heights over a base
+// surface, displaced along the base's normal, defined in the infinite prism over the table's
+// footprint — the ground of a flight or driving simulator.
+//
+// Map coordinates. A table is a grid of `width` × `height` samples, row 0 the northern edge (the
+// order GDAL and image files keep). Sample (i, j) sits at map position
+//   u = originU + i·spacingU  (east),   v = originV − j·spacingV  (north),
+// in metres. Heights are metres up along the base's normal, held at 16 bits:
+//   h = offset + scale·q,  q ∈ [0, 65535]  (SPEC §11 does not fix a precision; 16 bits with the
+// table's own scale keep 1/65535 of its range — 0.15 m over a 10 km range — at a quarter of the
+// memory of double, and a 16384² table fits in 512 MB).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "synthvis/result.h"
+
+namespace sv::terrain {
+
+// The largest table accepted, a side and in all (issue 29: maps up to 16384² in memory). Loaders
+// refuse anything larger — or a header declaring it — before allocating.
+inline constexpr int kMaxSide = 16384;
+inline constexpr int64_t kMaxSamples = int64_t(kMaxSide) * kMaxSide;
+
+// How heights between the samples are interpolated (SPEC §11): bilinearly, or bicubically by the
+// Catmull–Rom spline, which passes through the samples (and so may overshoot them: the pyramid's
+// bounds include the overshoot, pyramid.h).
+enum class Interpolation : uint8_t { bilinear, bicubic };
+Result<Interpolation> parseInterpolation(const std::string& name);  // "bilinear" | "bicubic"
+const char* interpolationName(Interpolation i);
+
+struct HeightField {
+  int width = 0, height = 0;  // samples
+  double originU = 0, originV = 0;      // map position of sample (0, 0), metres
+  double spacingU = 1, spacingV = 1;    // metres between samples, east and south (> 0)
+  double offset = 0, scale = 1;         // h = offset + scale·q
+  std::vector<uint16_t> q;              // width × height, row-major, row 0 north
+  std::string source;                   // the file (or generator) it came from, for messages
+
+  double at(int i, int j) const {
+    return offset + scale * q[size_t(j) * size_t(width) + size_t(i)];
+  }
+  uint16_t code(int i, int j) const { return q[size_t(j) * size_t(width) + size_t(i)]; }
+  // Map extent: u from originU to eastU(), v from southV() to originV.
+  double eastU() const { return originU + (width - 1) * spacingU; }
+  double southV() const { return originV - (height - 1) * spacingV; }
+  size_t bytes() const { return q.size() * sizeof(uint16_t); }
+};
+
+// Heights given in any unit as doubles (NaN: no data), to a HeightField: scale and offset chosen
+// so that the smallest and largest valid heights map to codes 0 and 65535; no-data samples take
+// the smallest valid height (documented in docs/terrain.md; a table without one valid sample is
+// an error). `values` is row-major, width × height.
+Result<HeightField> quantize(const std::vector<double>& values, int width, int height,
+                             const std::string& source);
+
+// The interpolated height at grid position (x, y) (x = (u − originU)/spacingU, y = (originV −
+// v)/spacingV; samples at integers), and its derivatives ∂h/∂x, ∂h/∂y per grid step, positions
+// clamped to the table. Bicubic reads the 4×4 samples around the cell, edge samples repeated
+// beyond the border. Both reproduce the table exactly at grid points.
+double interpolate(const HeightField& f, Interpolation interp, double x, double y,
+                   double* dx = nullptr, double* dy = nullptr);
+
+// A seeded fractal table (midpoint displacement with roughness 0.5 — fractal dimension 2.5, the
+// statistics of natural terrain — plus a ridge and valley overlay), `size` × `size` samples
+// `spacing` metres apart, heights spanning [0, relief] metres, centred on map origin (0, 0). The
+// same seed gives the same table on every machine.
+Result<HeightField> generateFractal(int size, double spacing, double relief, uint32_t seed);
+
+// Loaders (load_heights.cpp), each with one-line errors naming the file and the problem:
+// - loadGdal: any raster GDAL reads (GeoTIFF, SRTM .hgt, …), band 1, with its georeferencing
+//   (origin, pixel size; a geographic raster's degrees converted to metres at its centre latitude
+//   on a sphere of radius kEarthRadius), no-data value, and the band's scale and offset;
+// - loadPng16: a 16-bit greyscale PNG (8-bit accepted), codes as heights offset + scale·code with
+//   the caller's spacing and origin (a PNG holds no georeferencing).
+inline constexpr double kEarthRadius = 6371008.8;  // metres, the mean radius (IUGG)
+Result<HeightField> loadGdal(const std::string& path);
+struct PngPlacement {
+  double originU = 0, originV = 0, spacingU = 1, spacingV = 1, offset = 0, scale = 1;
+};
+Result<HeightField> loadPng16(const std::string& path, const PngPlacement& placement);
+// By extension: .png → loadPng16, anything else → loadGdal.
+Result<HeightField> loadHeights(const std::string& path, const PngPlacement& pngPlacement);
+
+// Several tables side by side as one ground (a DEM mosaic): placed by their map positions on one
+// grid — all the same spacing, aligned to it (to 1/1000 of a step), samples shared where tiles
+// overlap (SRTM tiles repeat their edge rows) required to agree to the coarser of their
+// quantizations — and merged into one table, so the ground has no seams to crack at. Samples no
+// tile covers take the lowest height. The result is requantized over the union's range.
+Result<HeightField> mosaic(const std::vector<HeightField>& tiles);
+
+}  // namespace sv::terrain
