@@ -1,0 +1,107 @@
+// Multi-level ray casting of a height field (SPEC §12): bundles of rays — a screen window's, down
+// to one sample's — marched in depth through the min/max pyramid (pyramid.h), the level of each
+// step chosen from the window's projected size, a step skipped whenever the bundle's bounding box
+// lies above the largest height its footprint allows; at the finest level one ray solves against
+// the interpolated surface. The same cast answers the host's height and line-of-sight queries, so
+// they agree with the picture exactly.
+//
+// Placement in the world (y up, the scene's convention): map east is +x, north is −z, height is
+// +y. The map position (refU, refV) lies at the world origin. The base surface is the plane y = 0,
+// or (radius > 0) a sphere of that radius through the origin, centre (0, −radius, 0): a table on
+// a sphere is laid out on the tangent plane at the origin and carried onto the sphere by central
+// (gnomonic) projection from its centre, heights along the sphere's radius. Gnomonic coordinates
+// stretch distances by 1 + (ρ/R)² at ρ from the origin: 0.1 % at 200 km, where the Earth's
+// curvature has dropped the ground by 3 km.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+
+#include "core/quadric.h"
+#include "terrain/height_field.h"
+#include "terrain/pyramid.h"
+
+namespace sv::terrain {
+
+struct Placement {
+  double refU = 0, refV = 0;  // the map position at the world origin
+  double radius = 0;          // 0: the plane base; else the sphere's radius
+};
+
+// What the casts did, for the frame statistics.
+struct CastCounters {
+  uint64_t windows = 0;  // screen windows marched
+  uint64_t steps = 0;    // depth steps tested against the pyramid
+  uint64_t rays = 0;     // single rays cast to the surface
+  uint64_t solves = 0;   // finest-level steps solved against the interpolated surface
+  uint64_t hits = 0;
+  void add(const CastCounters& o) {
+    windows += o.windows, steps += o.steps, rays += o.rays, solves += o.solves, hits += o.hits;
+  }
+};
+
+// A bundle of rays from `origin` through the convex hull of up to four directions (a screen
+// window's corner rays; a single ray repeats its one direction), a point of it at parameter s
+// being origin + s·direction.
+struct Bundle {
+  Vec3d origin;
+  Vec3d corner[4];
+};
+
+class Caster {
+ public:
+  Caster(const HeightField& field, const Pyramid& pyramid, Interpolation interp,
+         const Placement& placement);
+
+  // Grid coordinates (samples at integers, x east, y south) and height above the base of a world
+  // point, and back.
+  struct MapPoint {
+    double gx, gy, h;
+  };
+  MapPoint toMap(Vec3d world) const;
+  Vec3d toWorld(double gx, double gy, double h) const;
+  // The map position (metres) of grid coordinates.
+  double mapU(double gx) const { return field_.originU + gx * field_.spacingU; }
+  double mapV(double gy) const { return field_.originV - gy * field_.spacingV; }
+
+  // The interpolated surface's height at grid (gx, gy); NaN beyond the table's footprint.
+  double surface(double gx, double gy) const;
+  // The unit outward normal of the surface (world) at grid (gx, gy), and the world directions of
+  // map east and north there (unit, tangent to the base).
+  Vec3d normal(double gx, double gy, Vec3d* east = nullptr, Vec3d* north = nullptr) const;
+
+  // The bundle marched from s0 toward s1: the smallest s at which it may meet the surface at the
+  // resolution of its own footprint (the pyramid level whose nodes are as wide as the bundle is
+  // there), or s1 when it meets nothing before s1. `footprint`: the bundle's width per unit s in
+  // grid steps (0 for one ray).
+  double march(const Bundle& b, double s0, double s1, double footprint, CastCounters& c) const;
+  // The first s in [s0, s1] at which origin + s·dir meets the surface — or enters the solid below
+  // it through the prism's side — or NaN. Exact to 10⁻⁶ of a grid step along the ray.
+  double cast(Vec3d origin, Vec3d dir, double s0, double s1, CastCounters& c) const;
+
+  const HeightField& field() const { return field_; }
+  const Pyramid& pyramid() const { return pyramid_; }
+  const Placement& placement() const { return placement_; }
+
+ private:
+  struct Box {
+    double gx0, gx1, gy0, gy1, h0, h1;  // grid rectangle and heights above the base
+  };
+  Box bounds(const Bundle& b, double sa, double sb) const;
+  // f(s) = height above the surface of origin + s·dir (+∞ beyond the footprint).
+  double above(Vec3d origin, Vec3d dir, double s) const;
+  // The first root of `above` in [sa, sb], sampled finer than a quarter cell, or NaN.
+  double solve(Vec3d origin, Vec3d dir, double sa, double sb, double fa) const;
+  // Grid steps per unit s of the fastest of the bundle's directions, horizontally.
+  double gridSpeed(const Bundle& b) const;
+
+  const HeightField& field_;
+  const Pyramid& pyramid_;
+  Interpolation interp_;
+  Placement placement_;
+  // The world → grid map of the plane base: gx = ax·x + bx, gy = ay·z + by.
+  double ax_ = 1, bx_ = 0, ay_ = 1, by_ = 0;
+  double margin_ = 0;  // added to the pyramid's bounds against rounding: 10⁻⁹ of the relief
+};
+
+}  // namespace sv::terrain

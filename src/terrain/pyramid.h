@@ -1,0 +1,60 @@
+// The min/max pyramids of a height table (SPEC §11's max-LOD maps, with the minimum map beside
+// them, for tight bounds from both sides).
+//
+// Level n is the grid itself: its cells (i, j) … (i + 1, j + 1). Level n − 1 holds, for each 2×2
+// cells, the smallest and largest height the *interpolated* surface takes over them; level k − 1
+// the minimum of the minima and the maximum of the maxima of each 2×2 nodes of level k; level 0 one
+// node, the whole map. Level n is not stored: the stored levels n − 1 … 0 cost a third of the
+// table's memory at 16 bits a bound, and a ray at the finest stored level solves against the
+// surface of at most two cells along its path anyway (caster.h).
+//
+// The bounds hold for the interpolated surface (issue 29): bilinear interpolation stays within its
+// cell's four samples; Catmull–Rom does not. Its 1D weights at t are w₀ = (−t³ + 2t² − t)/2 and
+// w₃ = (t³ − t²)/2, both ≤ 0, with w₀ + w₃ = −(t − t²)/2 ≥ −1/8; in 2D the negative weights of the
+// tensor product sum to at most 2·(1 + 1/8)·(1/8) = 9/32. So over a cell the surface lies within
+// [lo − 9/32·(hi − lo), hi + 9/32·(hi − lo)] for lo, hi the extremes of the 4×4 samples around it
+// — the overshoot included, tests/terrain/pyramid_test.cpp checks it by sampling.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "terrain/height_field.h"
+
+namespace sv::terrain {
+
+class Pyramid {
+ public:
+  Pyramid() = default;
+  Pyramid(const HeightField& field, Interpolation interp);
+
+  // n: the grid's level (cells padded to 2^n a side); levels n − 1 … 0 are stored.
+  int gridLevel() const { return n_; }
+  int cellsX() const { return cellsX_; }
+  int cellsY() const { return cellsY_; }
+  // Cells per node side at `level` (0 … n).
+  int nodeCells(int level) const { return 1 << (n_ - level); }
+
+  struct Range {
+    double lo, hi;  // hi < lo: no surface there (beyond the table's footprint)
+  };
+  // The bounds over nodes [i0, i1] × [j0, j1] of `level` (0 … n − 1), clamped to the footprint.
+  Range range(int level, int i0, int i1, int j0, int j1) const;
+  // The bounds of node (i, j) of `level`; cell (i, j) itself at level n.
+  Range node(int level, int i, int j) const;
+  size_t bytes() const;
+
+ private:
+  struct Bound {
+    uint16_t lo, hi;  // codes of boundOffset_ + boundScale_·code, rounded outward
+  };
+  int n_ = 0, cellsX_ = 0, cellsY_ = 0;
+  double boundOffset_ = 0, boundScale_ = 1;
+  std::vector<std::vector<Bound>> levels_;  // levels_[k]: 2^k × 2^k nodes, k = 0 … n − 1
+  std::vector<int> sideX_, sideY_;           // per level: the nodes over the footprint
+  const HeightField* field_ = nullptr;
+  Interpolation interp_ = Interpolation::bilinear;
+  Range cell(int i, int j) const;  // level n, computed from the table
+};
+
+}  // namespace sv::terrain

@@ -1,0 +1,143 @@
+// The pyramid's bounds and the caster's hits against brute force (issue 29's acceptance).
+#include "terrain/caster.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+namespace sv::terrain {
+namespace {
+
+const Interpolation kFilters[] = {Interpolation::bilinear, Interpolation::bicubic};
+
+TEST(Pyramid, EveryBoundHoldsEveryInterpolatedSampleOfItsNodes) {
+  const HeightField f = generateFractal(77, 10, 800, 5).value();  // odd size: padded nodes
+  for (Interpolation interp : kFilters) {
+    const Pyramid p(f, interp);
+    const int n = p.gridLevel();
+    ASSERT_EQ(p.cellsX(), 76);
+    ASSERT_EQ(n, 7);
+    // Level n (cells, computed) and every stored level: 6×6 samples a cell, edges included.
+    for (int level = 0; level <= n; ++level) {
+      const int cells = p.nodeCells(level);
+      for (int j = 0; j * cells < p.cellsY(); ++j)
+        for (int i = 0; i * cells < p.cellsX(); ++i) {
+          const Pyramid::Range r = p.node(level, i, j);
+          ASSERT_LE(r.lo, r.hi);
+          const int step = std::max(1, cells / 4);  // coarse levels: every fourth cell
+          for (int cy = j * cells; cy < std::min((j + 1) * cells, p.cellsY()); cy += step)
+            for (int cx = i * cells; cx < std::min((i + 1) * cells, p.cellsX()); cx += step)
+              for (int sy = 0; sy <= 5; ++sy)
+                for (int sx = 0; sx <= 5; ++sx) {
+                  const double h = interpolate(f, interp, cx + sx / 5.0, cy + sy / 5.0);
+                  ASSERT_GE(h, r.lo - 1e-9) << interpolationName(interp) << " level " << level;
+                  ASSERT_LE(h, r.hi + 1e-9) << interpolationName(interp) << " level " << level;
+                }
+        }
+    }
+  }
+}
+
+TEST(Pyramid, BicubicBoundsIncludeTheOvershoot) {
+  // A step: Catmull–Rom rings below 0 and above 1 next to it.
+  std::vector<double> v(8 * 8);
+  for (int j = 0; j < 8; ++j)
+    for (int i = 0; i < 8; ++i) v[size_t(j * 8 + i)] = i < 4 ? 0.0 : 100.0;
+  const HeightField f = quantize(v, 8, 8, "step").value();
+  const double low = interpolate(f, Interpolation::bicubic, 2.5, 3);
+  EXPECT_LT(low, 0.0);  // the overshoot is real
+  const Pyramid p(f, Interpolation::bicubic);
+  EXPECT_LE(p.node(p.gridLevel(), 2, 3).lo, low);
+  EXPECT_LE(p.node(0, 0, 0).lo, low);
+}
+
+// The first crossing by a march of 1/256 cell, refined by bisection: the reference.
+double denseMarch(const Caster& c, Vec3d o, Vec3d d, double s0, double s1) {
+  const Caster::MapPoint a = c.toMap(o), b = c.toMap(o + d);
+  const double speed = std::max(std::hypot(b.gx - a.gx, b.gy - a.gy), 1e-9);
+  const double step = 1.0 / 256 / speed;
+  auto f = [&](double s) {
+    const Caster::MapPoint m = c.toMap(o + d * s);
+    const double h = c.surface(m.gx, m.gy);
+    return std::isnan(h) ? 1e300 : m.h - h;
+  };
+  double prev = s0;
+  for (double s = s0; s <= s1; s += step) {
+    if (f(s) <= 0) {
+      double lo = prev, hi = s;
+      for (int i = 0; i < 60; ++i) {
+        const double m = 0.5 * (lo + hi);
+        (f(m) <= 0 ? hi : lo) = m;
+      }
+      return hi;
+    }
+    prev = s;
+  }
+  return NAN;
+}
+
+void castAgainstDenseMarch(double radius) {
+  const HeightField f = generateFractal(129, 20, 600, 9).value();
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<double> u(0, 1);
+  for (Interpolation interp : kFilters) {
+    const Pyramid p(f, interp);
+    const Caster c(f, p, interp, Placement{0, 0, radius});
+    int hits = 0, grazing = 0;
+    for (int k = 0; k < 300; ++k) {
+      // From 5 … 700 m above the base somewhere over (or beside) the map, looking down 0.2° …
+      // 40°: grazing rays included.
+      const double half = 64 * 20.0 * 1.2;
+      const Vec3d o{(2 * u(rng) - 1) * half, 5 + 700 * u(rng), (2 * u(rng) - 1) * half};
+      const double yaw = 2 * M_PI * u(rng), pitch = -(0.2 + 40 * u(rng) * u(rng)) * M_PI / 180;
+      const Vec3d d{std::cos(pitch) * std::cos(yaw), std::sin(pitch),
+                    std::cos(pitch) * std::sin(yaw)};
+      CastCounters counters;
+      const double s1 = 4000;
+      const double got = c.cast(o, d, 0, s1, counters);
+      const double want = denseMarch(c, o, d, 0, s1);
+      if (std::fabs(pitch) < 2 * M_PI / 180) ++grazing;
+      ASSERT_EQ(std::isnan(got), std::isnan(want))
+          << interpolationName(interp) << " ray " << k << " got " << got << " want " << want;
+      if (std::isnan(got)) continue;
+      ++hits;
+      // Tolerance: 10⁻³ of a grid step along the ray (the march finds the same crossing).
+      ASSERT_NEAR(got, want, 1e-3 * 20) << interpolationName(interp) << " ray " << k;
+    }
+    EXPECT_GT(hits, 100);
+    EXPECT_GT(grazing, 10);
+  }
+}
+
+TEST(Caster, HitsAgreeWithADenseMarchOnThePlane) { castAgainstDenseMarch(0); }
+TEST(Caster, HitsAgreeWithADenseMarchOnASphere) { castAgainstDenseMarch(50000); }
+
+TEST(Caster, MapAndWorldAreInverse) {
+  const HeightField f = generateFractal(33, 100, 600, 9).value();
+  const Pyramid p(f, Interpolation::bilinear);
+  for (double radius : {0.0, 6371000.0}) {
+    const Caster c(f, p, Interpolation::bilinear, Placement{150, -320, radius});
+    for (double gx : {0.0, 7.5, 32.0})
+      for (double gy : {0.0, 13.25, 32.0}) {
+        const Caster::MapPoint m = c.toMap(c.toWorld(gx, gy, 123.0));
+        EXPECT_NEAR(m.gx, gx, 1e-6);
+        EXPECT_NEAR(m.gy, gy, 1e-6);
+        EXPECT_NEAR(m.h, 123.0, 1e-6);
+      }
+  }
+}
+
+TEST(Caster, TheSideOfThePrismIsAWall) {
+  // A flat table 100 m high: a level ray at 50 m from outside meets its western edge.
+  const HeightField f = quantize(std::vector<double>(16 * 16, 100.0), 16, 16, "flat").value();
+  const Pyramid p(f, Interpolation::bilinear);
+  const Caster c(f, p, Interpolation::bilinear, Placement{7.5, -7.5, 0});
+  CastCounters counters;
+  const double s = c.cast({-20, 50, 0}, {1, 0, 0}, 0, 100, counters);
+  EXPECT_NEAR(s, 20 - 7.5, 1e-5);
+  EXPECT_TRUE(std::isnan(c.cast({-20, 150, 0}, {1, 0, 0}, 0, 100, counters)));
+}
+
+}  // namespace
+}  // namespace sv::terrain
