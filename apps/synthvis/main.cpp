@@ -35,6 +35,8 @@
 #include "synthvis/image.h"
 #include "synthvis/render.h"
 #include "synthvis/scene.h"
+#include "synthvis/terrain.h"
+#include "terrain/height_field.h"
 
 namespace {
 
@@ -64,6 +66,7 @@ struct RenderArgs {
   std::string textureFilter = "trilinear";
   std::string hsr = "zbuffer";
   std::string freeform = "raycast";
+  std::string terrainFilter = "scene";
   bool noCull = false;
   sv::RenderOptions options;
 };
@@ -85,6 +88,14 @@ int runRender(const RenderArgs& a) {
         {"", "", fmt::format("unknown free-form method '{}' (raycast or march)", a.freeform)});
   o.freeFormMethod = a.freeform == "march" ? sv::RenderOptions::FreeFormMethod::march
                                            : sv::RenderOptions::FreeFormMethod::raycast;
+  if (a.terrainFilter == "bilinear")
+    o.terrainFilter = sv::RenderOptions::TerrainFilter::bilinear;
+  else if (a.terrainFilter == "bicubic")
+    o.terrainFilter = sv::RenderOptions::TerrainFilter::bicubic;
+  else if (a.terrainFilter != "scene")
+    return fail({"", "",
+                 fmt::format("unknown terrain filter '{}' (scene, bilinear or bicubic)",
+                             a.terrainFilter)});
   if (!a.debugView.empty()) {
     using DebugView = sv::RenderOptions::DebugView;
     if (a.debugView == "overdraw")
@@ -122,6 +133,8 @@ struct GeneratorArgs {
   int layers = 4;
   std::string order = "random";
   int objects = 100;
+  int size = 4096;  // terrain: heights a side
+  std::string terrainFilter = "bilinear";
 };
 
 void addGeneratorOptions(CLI::App* app, GeneratorArgs& g) {
@@ -134,6 +147,11 @@ void addGeneratorOptions(CLI::App* app, GeneratorArgs& g) {
   app->add_option("--objects", g.objects, "freeform: number of perturbed quadrics")
       ->capture_default_str();
   app->add_option("--order", g.order, "tris, layers: random, f2b or b2f")->capture_default_str();
+  app->add_option("--size", g.size, "terrain: heights a side (the map is 40.96 km square)")
+      ->capture_default_str();
+  app->add_option("--terrain-filter", g.terrainFilter,
+                  "terrain: interpolation below the finest level, bilinear or bicubic")
+      ->capture_default_str();
   app->add_option("--seed", g.tris.seed, "generator seed")->capture_default_str();
 }
 
@@ -180,6 +198,11 @@ sv::Result<sv::reference::BenchCase> generatorCase(const std::string& kind,
   c.grazing.seed = g.tris.seed;
   c.freeform.count = g.objects;
   c.freeform.seed = g.tris.seed;
+  c.terrain.size = g.size;
+  c.terrain.seed = g.tris.seed;
+  auto interp = sv::terrain::parseInterpolation(g.terrainFilter);
+  if (!interp) return interp.error();
+  c.terrain.bicubic = interp.value() == sv::terrain::Interpolation::bicubic;
   return c;
 }
 
@@ -402,6 +425,44 @@ int runCompare(const std::string& imagePath, const std::string& referencePath,
   return 0;
 }
 
+// `synthvis terrain SCENE --height X,Y,Z | --los X,Y,Z,X,Y,Z`: the host's queries (synthvis/terrain.h).
+int runTerrainQuery(const std::string& scenePath, const std::vector<double>& at,
+                    const std::vector<double>& los, const std::string& filterName) {
+  using Filter = sv::RenderOptions::TerrainFilter;
+  Filter filter = Filter::scene;
+  if (filterName == "bilinear")
+    filter = Filter::bilinear;
+  else if (filterName == "bicubic")
+    filter = Filter::bicubic;
+  else if (filterName != "scene")
+    return fail({"", "", fmt::format("unknown terrain filter '{}' (scene, bilinear or bicubic)",
+                                     filterName)});
+  if (at.empty() == los.empty())
+    return fail({"", "", "give one query: --height X,Y,Z or --los X,Y,Z,X,Y,Z"});
+  auto loaded = sv::scene::loadScene(scenePath);
+  if (!loaded) return fail(loaded.error());
+  const sv::scene::Scene& scene = loaded.value();
+  if (scene.terrains.empty()) return fail({scenePath, "", "the scene has no terrain"});
+  if (!at.empty()) {
+    const auto h = sv::terrainHeight(scene, at[0], at[1], at[2], filter);
+    if (!h) {
+      fmt::print("no terrain under ({}, {}, {})\n", at[0], at[1], at[2]);
+      return 1;
+    }
+    fmt::print("terrain {}: ground at {:.4f} m, the point {:.4f} m above it\n", h->terrain,
+               h->elevation, h->above);
+    return 0;
+  }
+  const auto hit = sv::lineOfSight(scene, los.data(), los.data() + 3, filter);
+  if (!hit) {
+    fmt::print("clear: the line of sight does not meet the ground\n");
+    return 0;
+  }
+  fmt::print("blocked by terrain {} at ({:.4f}, {:.4f}, {:.4f}), {:.6f} of the way\n", hit->terrain,
+             hit->x, hit->y, hit->z, hit->fraction);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -449,6 +510,10 @@ int main(int argc, char** argv) {
                    "baseline, --march-steps steps of eye depth per ray)")
       ->capture_default_str();
   render->add_option("--march-steps", r.options.marchSteps, "--freeform march: steps per ray")
+      ->capture_default_str();
+  render
+      ->add_option("--terrain-filter", r.terrainFilter,
+                   "terrain interpolation: scene (each terrain's own), bilinear or bicubic")
       ->capture_default_str();
   render
       ->add_option("--gamma", r.options.gamma,
@@ -548,6 +613,20 @@ int main(int argc, char** argv) {
                       "edge mask from `truth --edges` (default: pixels "
                       "whose neighbours differ in the reference)");
 
+  std::string queryScene, queryFilter = "scene";
+  std::vector<double> queryAt, queryLos;
+  CLI::App* query = app.add_subcommand(
+      "terrain", "ask a scene's terrain: the ground's height at a point, or a line of sight");
+  query->add_option("scene", queryScene, "scene file with terrain")->required();
+  query->add_option("--height", queryAt, "X,Y,Z: the ground under this world point")
+      ->delimiter(',')
+      ->expected(3);
+  query->add_option("--los", queryLos, "X,Y,Z,X,Y,Z: where the segment first meets the ground")
+      ->delimiter(',')
+      ->expected(6);
+  query->add_option("--terrain-filter", queryFilter, "scene, bilinear or bicubic")
+      ->capture_default_str();
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -564,5 +643,6 @@ int main(int argc, char** argv) {
   if (*gen) return runGen(g);
   if (*truth) return runTruth(tr);
   if (*compare) return runCompare(compareImage, compareReference, compareEdges);
+  if (*query) return runTerrainQuery(queryScene, queryAt, queryLos, queryFilter);
   return 0;
 }

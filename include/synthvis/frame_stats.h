@@ -33,6 +33,12 @@ struct FrameStats {
   // bounds evaluated, pixel (sample) rays solved, and those that took a surface.
   uint64_t freeForms = 0, freeFormCells = 0, freeFormMaskedCells = 0, freeFormBounds = 0,
            freeFormRays = 0, freeFormHits = 0;
+  // Terrain (SPEC §11–§12): height fields drawn, screen windows marched in depth, depth steps
+  // bounded by the pyramids, sample rays cast and those that met the ground; the grounds' memory
+  // (heights and pyramids) and the time their loading took (once, when the scene was read).
+  uint64_t terrains = 0, terrainWindows = 0, terrainSteps = 0, terrainRays = 0, terrainHits = 0;
+  uint64_t terrainBytes = 0;
+  double terrainLoadMs = 0;
   // rasterMs: the tile pass, which includes resolving each finished tile into the image.
   double vertexMs = 0, setupMs = 0, rasterMs = 0, totalMs = 0;
 

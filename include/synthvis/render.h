@@ -61,6 +61,9 @@ struct RenderOptions {
   // sample is a ray, exact also for features thinner than a pixel, at up to `samples` times the
   // cost.
   bool freeFormEverySample = false;
+  // Terrain (Scene::terrains) interpolation below the finest level: each terrain's own, or all
+  // bilinear or all bicubic (SPEC §11; the CLI's --terrain-filter).
+  enum class TerrainFilter { scene, bilinear, bicubic } terrainFilter = TerrainFilter::scene;
 };
 
 // The scene with every free form replaced by triangles (issue 7's polygon baseline): marching

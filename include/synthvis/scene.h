@@ -18,6 +18,10 @@ namespace sv::texture {
 class Texture;  // src/texture/texture.h: a decoded image, its MIP pyramid and wrap modes
 }
 
+namespace sv::terrain {
+struct Ground;  // src/terrain/ground.h: a height table and its min/max pyramids
+}
+
 namespace sv::scene {
 
 // How a texture map is sampled (SPEC §7; docs/quality.md compares them): nearest texel; the seed's
@@ -133,6 +137,33 @@ struct FreeFormObject {
   int material = -1;  // index into Scene::materials, or −1 for the default material
 };
 
+// A height-field ground (SPEC §11–§12; docs/terrain.md; the scene format's "terrain"): drawn by
+// multi-level ray casting, never tessellated, in the same depth and samples as everything else.
+// World placement: map east is +x, north is −z, height +y; the map position `origin` (metres)
+// lies at the world origin. Base: the plane y = 0, or a sphere of radius `baseRadius` through
+// the origin (centre (0, −baseRadius, 0)), heights along its radius.
+struct TerrainColorStop {
+  double height = 0;  // metres
+  Vec3 color;         // linear
+};
+struct Terrain {
+  std::string name;
+  std::shared_ptr<const terrain::Ground> ground;
+  double origin[2] = {0, 0};  // map (east, north), metres, at the world origin
+  double baseRadius = 0;      // 0: a plane
+  bool bicubic = false;       // interpolation below the finest level (else bilinear)
+  int material = -1;          // colour (multiplies the image or ramp), light, texture filter
+  // The draped image (seed 001's planar texture, SPEC §7): Scene::textures index, or −1; its
+  // corners in map metres: west, south, east, north. Without one, `ramp` colours by height.
+  int image = -1;
+  double imageBounds[4] = {0, 0, 1, 1};
+  // An optional detail texture repeated every detailSize metres, multiplying the colour by
+  // 2·texel (a mid-grey detail leaves it unchanged on average).
+  int detail = -1;
+  double detailSize = 10;
+  std::vector<TerrainColorStop> ramp;  // by height, ascending; empty: the default (terrain.md)
+};
+
 struct Camera {
   std::string name;
   Vec3 position{0, 0, 5};
@@ -172,6 +203,7 @@ struct Scene {
   std::vector<Material> materials;
   std::vector<Instance> instances;
   std::vector<FreeFormObject> freeForms;
+  std::vector<Terrain> terrains;
   std::vector<Camera> cameras;  // the first one is used unless another is chosen
   Light light;
   std::vector<PointLight> pointLights;

@@ -27,7 +27,12 @@ std::string FrameStats::summary() const {
                                   "hits {}",
                                   freeForms, freeFormCells, freeFormMaskedCells, freeFormBounds,
                                   freeFormRays, freeFormHits)
-                    : std::string());
+                    : std::string()) +
+         (terrains ? fmt::format(" | terrain {}: windows {}, steps {}, rays {}, hits {}, "
+                                 "{:.1f} MB, loaded in {:.1f} ms",
+                                 terrains, terrainWindows, terrainSteps, terrainRays, terrainHits,
+                                 terrainBytes / 1e6, terrainLoadMs)
+                   : std::string());
 }
 
 }  // namespace sv

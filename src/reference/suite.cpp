@@ -121,6 +121,14 @@ Result<CaseScene> makeScene(const BenchCase& c, const RenderOptions& options) {
     out.scene = scene::generateFreeFormOne();
     out.params = {{"objects", 1}, {"perturbations", 6}};
     return out;
+  } else if (c.generator == scene::Generator::terrain) {
+    Result<scene::Scene> t = scene::generateTerrain(c.terrain);
+    if (!t) return t.error();
+    out.scene = std::move(t).value();
+    out.params = {{"size", c.terrain.size},
+                  {"seed", c.terrain.seed},
+                  {"interpolation", c.terrain.bicubic ? "bicubic" : "bilinear"}};
+    return out;
   } else if (c.generator == scene::Generator::none) {
     auto loaded = scene::loadScene(c.file);
     if (!loaded) return loaded.error();
@@ -186,7 +194,7 @@ Result<CaseResult> BenchRunner::run(const BenchCase& c) {
   if (s.sphereTrace || s.tessellated) marcher.emplace(s.sphereTrace ? marchOptions : s.options);
   // Free forms as triangles, for the polygon baseline and for the gl reference.
   std::optional<scene::Scene> tessellated;
-  if (!sc.freeForms.empty() && (s.tessellated || impl_->gl)) {
+  if ((!sc.freeForms.empty() || !sc.terrains.empty()) && (s.tessellated || impl_->gl)) {
     auto t = tessellatedScene(sc, s.options);
     if (!t.ok()) return t.error();
     tessellated = std::move(t).value();

@@ -24,6 +24,7 @@ struct BenchCase {
   scene::LayersParams layers;
   scene::GrazingParams grazing;
   scene::FreeFormParams freeform;
+  scene::TerrainParams terrain;
   std::string file;
 };
 

@@ -17,6 +17,10 @@ std::vector<raster::TilePass*> FramePasses::compose(const scene::Scene& scene,
         o.freeFormMethod == RenderOptions::FreeFormMethod::march ? o.marchSteps : 0);
     passes.push_back(&freeForms_);
   }
+  if (!scene.terrains.empty()) {
+    terrains_.setTerrains(scene, camera, shading, o);
+    passes.push_back(&terrains_);
+  }
   return passes;
 }
 

@@ -1,5 +1,5 @@
 // The frame's passes besides the polygons (raster/tile_pass.h), composed in tile order:
-// ray-cast surfaces (free forms; terrain next), volumes, light points.
+// ray-cast surfaces (free forms, then terrain), volumes, light points.
 #pragma once
 
 #include <vector>
@@ -7,6 +7,7 @@
 #include "freeform/freeform_pass.h"
 #include "render/camera.h"
 #include "render/shading_tables.h"
+#include "render/terrain_pass.h"
 
 namespace sv::render {
 
@@ -20,6 +21,7 @@ class FramePasses {
 
  private:
   freeform::FreeFormPass freeForms_;
+  TerrainPass terrains_;
 };
 
 }  // namespace sv::render

@@ -39,8 +39,6 @@ const char* generatorName(Generator generator) {
 
 const char* generatorNeeds(Generator generator) {
   switch (generator) {
-    case Generator::terrain:
-      return "height fields";
     case Generator::volume:
       return "voxel volumes";
     case Generator::lights:

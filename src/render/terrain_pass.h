@@ -1,0 +1,73 @@
+// Terrain in the frame: a tile pass (raster/tile_pass.h, stage `surfaces`) that ray casts the
+// scene's height fields (terrain/caster.h) into each tile's depth and samples, after the opaque
+// polygons and the free forms, shading each pixel once where its samples meet the ground.
+//
+// Based on: SPEC §12 (multi-level ray casting: the screen quadtree from the tile down to pixels,
+// each window marched in depth from where its parent stopped — front to back, bounded by the
+// farthest depth already in the window, so what polygons hide is never cast), §5 (one ray per
+// sample, the frame's sample pattern: silhouettes and ridges anti-aliased with the polygons'),
+// §7 (seed 001's planar texture: the draped image by the map plane's anchor and axes), §8.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "raster/tile_pass.h"
+#include "render/camera.h"
+#include "render/shading_tables.h"
+#include "terrain/ground.h"
+
+namespace sv::render {
+
+class TerrainPass final : public raster::TilePass {
+ public:
+  TerrainPass();
+  ~TerrainPass() override;
+  // The scene's terrains as `camera` sees them; `environment` must outlive the frame.
+  // `interpolation` overrides each terrain's own when set (the CLI's --terrain-filter).
+  void setTerrains(const scene::Scene& scene, const FrameCamera& camera,
+                   const ShadingTables& shading, const RenderOptions& options);
+
+  raster::PassStage stage() const override { return raster::PassStage::surfaces; }
+  void prepare(const raster::PassFrame& frame) override;
+  void drawTile(const raster::TileTarget& tile) override;
+  void addStats(FrameStats& stats) const override;
+
+ private:
+  struct Drawn {  // one terrain as the frame draws it
+    const terrain::Ground* ground;
+    std::unique_ptr<terrain::Caster> caster;
+    shade::MaterialShading material;
+    float color[3];
+    const texture::Texture* detail = nullptr;
+    double detailSize = 10;
+    double imageBounds[4];
+    std::vector<scene::TerrainColorStop> ramp;
+  };
+  struct Scratch;
+  struct alignas(64) WorkerStats {
+    terrain::CastCounters counts;
+  };
+
+  void castWindow(Scratch& w, const Drawn& t, int x0, int y0, int size, double start) const;
+  void shadeHits(Scratch& w, const Drawn& t, const raster::TileTarget& tile) const;
+  Vec3d direction(double px, double py) const;  // the ray through raster point (px, py)
+  double depthToS(float windowDepth) const;
+  float sToDepth(double s) const;
+
+  std::vector<Drawn> terrains_;
+  const shade::Environment* environment_ = nullptr;
+  // The camera in the world: eye, and the ray direction's parts (a point at eye depth s is
+  // eye + s·(forward + px·right + py·up)), and the eye-space rotation.
+  Vec3d eye_, forward_, right_, up_;
+  double tanX_ = 1, tanY_ = 1, znear_ = 0.1, zfar_ = 1000;
+  double p22_ = 0, p23_ = 0;  // the projection's depth row: ndc z = −p22 + p23/s
+  int width_ = 0, height_ = 0, samples_ = 1;
+  double offsetX_[64] = {}, offsetY_[64] = {};
+  std::vector<std::unique_ptr<Scratch>> scratch_;
+  std::vector<WorkerStats> stats_;
+  size_t groundBytes_ = 0;
+  double loadMs_ = 0;
+};
+
+}  // namespace sv::render
