@@ -6,11 +6,12 @@ SV_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 # scripts/fresh-check proves the list there. The reference renderer links libOpenGL and libEGL
 # (libopengl-dev, libegl-dev; libgl-dev for the headers) and runs on llvmpipe (libegl-mesa0,
 # libgl1-mesa-dri); python3 is for scripts/quality and scripts/bench-masking; clang and its runtime
-# (libclang-rt-14-dev) build the libFuzzer targets (scripts/fuzz, and scripts/test builds them).
+# (libclang-rt-14-dev) build the libFuzzer targets (scripts/fuzz, and scripts/test builds them);
+# libgdal-dev is the terrain loaders' reader of DEM rasters (GeoTIFF, SRTM .hgt, …).
 SV_PACKAGES=(cmake g++ ninja-build pkg-config libgtest-dev libgmock-dev libbenchmark-dev
   libhwy-dev libtinygltf-dev libtinyobjloader-dev libstb-dev libpng-dev nlohmann-json3-dev
   libcli11-dev libfmt-dev libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri python3
-  clang libclang-rt-14-dev)
+  clang libclang-rt-14-dev libgdal-dev)
 
 sv_install_packages() {
   local missing=()
@@ -23,6 +24,45 @@ sv_install_packages() {
   [ "$(id -u)" -ne 0 ] && sudo="sudo"
   $sudo apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+}
+
+# sv_terrain_data: the real DEMs the terrain tests read, unpacked (never committed) from two Debian
+# packages of R's example data: r-cran-stars (tif/olinda_dem_utm25s.tif, a 111×111 float32 DEM in
+# UTM 25S, and tif/L7_ETMs.tif, Landsat bands of the same ground) and r-cran-terra (ex/elev.tif,
+# 95×90 int16 heights in longitude/latitude with no-data cells). The .debs are cached in
+# build-data/debs and unpacked (dpkg -x, not installed) into build-data/root; the tests find them
+# under build-data/root/usr/lib/R/site-library (SV_TERRAIN_DATA_DIR).
+SV_TERRAIN_DEBS=(r-cran-stars r-cran-terra)
+
+sv_terrain_data() {
+  local debs="$SV_ROOT/build-data/debs" root="$SV_ROOT/build-data/root"
+  local lib="$root/usr/lib/R/site-library"
+  if [ -f "$lib/stars/tif/olinda_dem_utm25s.tif" ] && [ -f "$lib/terra/ex/elev.tif" ]; then
+    return 0
+  fi
+  mkdir -p "$debs" "$root"
+  local missing=() p
+  for p in "${SV_TERRAIN_DEBS[@]}"; do
+    compgen -G "$debs/${p}_*.deb" >/dev/null || missing+=("$p")
+  done
+  if [ ${#missing[@]} -gt 0 ]; then
+    echo "synthvis: downloading ${missing[*]} (terrain test data) into $debs"
+    # As root, apt drops privileges to _apt for downloads, which cannot write to most directories:
+    # download as root instead (nothing is installed, the files are only unpacked).
+    local apt=(apt-get download -qq -o APT::Sandbox::User=root)
+    if ! (cd "$debs" && "${apt[@]}" "${missing[@]}"); then
+      # A fresh system has no package lists yet.
+      local sudo=""
+      [ "$(id -u)" -ne 0 ] && sudo="sudo"
+      $sudo apt-get update -qq
+      (cd "$debs" && "${apt[@]}" "${missing[@]}")
+    fi
+  fi
+  for p in "${SV_TERRAIN_DEBS[@]}"; do
+    local f
+    for f in "$debs/${p}"_*.deb; do dpkg -x "$f" "$root"; done
+  done
+  echo "synthvis: terrain test data in $lib"
 }
 
 # sv_build DIR [cmake args...]: configure (once) and build everything in DIR.

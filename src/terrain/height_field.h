@@ -11,6 +11,7 @@
 // memory of double, and a 16384² table fits in 512 MB).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -69,19 +70,37 @@ double interpolate(const HeightField& f, Interpolation interp, double x, double 
 // same seed gives the same table on every machine.
 Result<HeightField> generateFractal(int size, double spacing, double relief, uint32_t seed);
 
-// Loaders (load_heights.cpp), each with one-line errors naming the file and the problem:
-// - loadGdal: any raster GDAL reads (GeoTIFF, SRTM .hgt, …), band 1, with its georeferencing
-//   (origin, pixel size; a geographic raster's degrees converted to metres at its centre latitude
-//   on a sphere of radius kEarthRadius), no-data value, and the band's scale and offset;
+// Loaders (load_heights.cpp), each with one-line errors naming the file and the problem, and
+// each refusing a size beyond kMaxSide / kMaxSamples (or the `maxSamples` budget of the in-memory
+// forms) before reading a sample:
+// - loadGdal: any raster GDAL reads (GeoTIFF, SRTM .hgt, …), band 1 (samples equal to its no-data
+//   value are no data, quantize's rule; its scale and offset applied), placed by its geotransform
+//   with (originU, originV) the centre of pixel (0, 0). Only north-up rasters (no rotation or
+//   shear, rows running south). A projected raster's units are taken as metres; a geographic
+//   one's degrees become metres by the equirectangular projection with standard parallel at the
+//   raster's centre latitude lat0 on a sphere of radius kEarthRadius: u = R·cos(lat0)·λ,
+//   v = R·φ (λ, φ longitude and latitude in radians), so the raster's centre (λ0, φ0) lands at
+//   (R·cos(lat0)·λ0, R·φ0) — true to scale along lat0 and along meridians, east–west scale off by
+//   cos(φ)/cos(lat0) away from it (1.7 % at 1° from lat0 = 45°). A raster without a geotransform
+//   gets spacing 1 and origin (0, 0).
+// - loadGdalFromMemory: the same from `bytes` (through GDAL's /vsimem/), `name` naming them in
+//   errors and giving drivers that read it (SRTM .hgt) the file name. For untrusted input: only
+//   drivers that read one self-contained file (GTiff, SRTMHGT, AAIGrid, USGSDEM, the Surfer grids,
+//   BT) — no VRT or service descriptions, which would open other files or the network.
 // - loadPng16: a 16-bit greyscale PNG (8-bit accepted), codes as heights offset + scale·code with
-//   the caller's spacing and origin (a PNG holds no georeferencing).
+//   the caller's spacing and origin (a PNG holds no georeferencing): the table holds the file's
+//   codes unchanged. decodePng16 reads PNG bytes in memory.
 inline constexpr double kEarthRadius = 6371008.8;  // metres, the mean radius (IUGG)
 Result<HeightField> loadGdal(const std::string& path);
+Result<HeightField> loadGdalFromMemory(const std::string& bytes, const std::string& name,
+                                       int64_t maxSamples = kMaxSamples);
 struct PngPlacement {
   double originU = 0, originV = 0, spacingU = 1, spacingV = 1, offset = 0, scale = 1;
 };
 Result<HeightField> loadPng16(const std::string& path, const PngPlacement& placement);
-// By extension: .png → loadPng16, anything else → loadGdal.
+Result<HeightField> decodePng16(const void* data, size_t size, const std::string& name,
+                                const PngPlacement& placement, int64_t maxSamples = kMaxSamples);
+// By extension: .png (any case) → loadPng16, anything else → loadGdal.
 Result<HeightField> loadHeights(const std::string& path, const PngPlacement& pngPlacement);
 
 // Several tables side by side as one ground (a DEM mosaic): placed by their map positions on one

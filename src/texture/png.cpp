@@ -3,16 +3,22 @@
 #include <fmt/format.h>
 #include <png.h>
 
+#include <algorithm>
+#include <array>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <optional>
 
 namespace sv::texture {
 namespace {
 
 constexpr uint64_t kUnknownSize = ~uint64_t(0);
 
-// libpng has begun reading `png` (`bytes` long); finish as `layout` says, within `limits`.
-Result<PngPixels> finishRead(png_image& png, uint64_t bytes, const std::string& name,
-                             PngLayout layout, const PngLimits& limits) {
+// The size `png`'s header states (begin_read has run), against `limits` and against what `bytes`
+// of file can hold; on failure `png` is freed.
+std::optional<Error> checkSize(png_image& png, uint64_t bytes, const std::string& name,
+                               const PngLimits& limits) {
   if (png.width == 0 || png.height == 0 || png.width > uint32_t(limits.maxSide) ||
       png.height > uint32_t(limits.maxSide) ||
       int64_t(png.width) * int64_t(png.height) > limits.maxPixels) {
@@ -29,6 +35,13 @@ Result<PngPixels> finishRead(png_image& png, uint64_t bytes, const std::string& 
                  fmt::format("{} bytes of PNG cannot hold the {}x{} image its header states", bytes,
                              png.width, png.height)};
   }
+  return std::nullopt;
+}
+
+// libpng has begun reading `png` (`bytes` long); finish as `layout` says, within `limits`.
+Result<PngPixels> finishRead(png_image& png, uint64_t bytes, const std::string& name,
+                             PngLayout layout, const PngLimits& limits) {
+  if (std::optional<Error> e = checkSize(png, bytes, name, limits)) return *e;
   PngPixels out;
   out.width = int(png.width);
   out.height = int(png.height);
@@ -49,6 +62,43 @@ Error beginFailed(png_image& png, const std::string& name) {
   const std::string message = png.message;
   png_image_free(&png);
   return Error{name, "", "cannot read PNG: " + message};
+}
+
+uint32_t bigEndian32(const uint8_t* p) {
+  return uint32_t(p[0]) << 24 | uint32_t(p[1]) << 16 | uint32_t(p[2]) << 8 | uint32_t(p[3]);
+}
+
+// The PNG `bytes` without the chunks that make libpng's simplified API change samples (it applies
+// gAMA, sRGB, iCCP and cHRM to reach its output gamma, and composes tRNS's transparent grey onto a
+// background); without them a 16-bit file is taken as linear and an 8-bit one as sRGB, and each
+// is read unchanged into the output of its own kind. Also the IHDR's bit depth and colour type
+// (0, 0 when there is no readable IHDR). Anything malformed is copied as it is, for libpng to
+// report.
+std::vector<uint8_t> withoutColourChunks(const uint8_t* bytes, size_t size, int* bitDepth,
+                                         int* colourType) {
+  *bitDepth = *colourType = 0;
+  constexpr size_t kSignature = 8;
+  if (size < kSignature) return std::vector<uint8_t>(bytes, bytes + size);
+  std::vector<uint8_t> out(bytes, bytes + kSignature);
+  out.reserve(size);
+  size_t at = kSignature;
+  while (size - at >= 12) {  // length, type, CRC
+    const uint64_t length = bigEndian32(bytes + at);
+    if (length > size - at - 12) break;
+    const size_t chunk = size_t(length) + 12;
+    const uint8_t* type = bytes + at + 4;
+    if (std::memcmp(type, "IHDR", 4) == 0 && length >= 13 && at == kSignature) {
+      *bitDepth = bytes[at + 8 + 8];
+      *colourType = bytes[at + 8 + 9];
+    }
+    constexpr std::array<const char*, 5> kDropped = {"gAMA", "sRGB", "iCCP", "cHRM", "tRNS"};
+    bool dropped = false;
+    for (const char* d : kDropped) dropped = dropped || std::memcmp(type, d, 4) == 0;
+    if (!dropped) out.insert(out.end(), bytes + at, bytes + at + chunk);
+    at += chunk;
+  }
+  out.insert(out.end(), bytes + at, bytes + size);
+  return out;
 }
 
 png_image header(int width, int height, int channels) {
@@ -101,6 +151,86 @@ Result<std::vector<uint8_t>> encodePng(const std::string& name, int width, int h
     return writeFailed(png, name, "cannot encode PNG");
   std::vector<uint8_t> out(bytes);
   if (!png_image_write_to_memory(&png, out.data(), &bytes, 0, rows, 0, nullptr))
+    return writeFailed(png, name, "cannot encode PNG");
+  out.resize(bytes);
+  return out;
+}
+
+Result<PngGrey> decodePngGrey(const void* data, size_t size, const std::string& name,
+                              const PngLimits& limits) {
+  int bitDepth = 0, colourType = 0;
+  const std::vector<uint8_t> bytes =
+      withoutColourChunks(static_cast<const uint8_t*>(data), size, &bitDepth, &colourType);
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  if (!png_image_begin_read_from_memory(&png, bytes.data(), bytes.size()))
+    return beginFailed(png, name);
+  // Colour type 0 is grey without alpha (PNG spec §11.2.2).
+  if (colourType != 0 || (bitDepth != 8 && bitDepth != 16)) {
+    png_image_free(&png);
+    return Error{name, "",
+                 fmt::format("PNG of colour type {} and bit depth {} is not 8- or 16-bit greyscale",
+                             colourType, bitDepth)};
+  }
+  if (std::optional<Error> e = checkSize(png, size, name, limits)) return *e;
+  PngGrey out;
+  out.width = int(png.width);
+  out.height = int(png.height);
+  out.bitDepth = bitDepth;
+  out.samples.resize(size_t(png.width) * png.height);
+  std::vector<uint8_t> narrow;
+  void* buffer = out.samples.data();
+  if (bitDepth == 16) {
+    png.format = PNG_FORMAT_LINEAR_Y;
+  } else {
+    png.format = PNG_FORMAT_GRAY;
+    narrow.resize(out.samples.size());
+    buffer = narrow.data();
+  }
+  if (!png_image_finish_read(&png, nullptr, buffer, 0, nullptr)) {
+    const std::string message = png.message;
+    png_image_free(&png);
+    return Error{name, "", "cannot decode PNG: " + message};
+  }
+  if (bitDepth == 8) std::copy(narrow.begin(), narrow.end(), out.samples.begin());
+  return out;
+}
+
+Result<PngGrey> readPngGrey(const std::string& path, const PngLimits& limits) {
+  // The whole file first (its colour chunks are dropped before libpng sees it), no larger than
+  // the largest image the limits allow could take at no compression.
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error))
+    return Error{path, "", error ? "cannot open PNG file: " + error.message() : "not a file"};
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Error{path, "", "cannot open PNG file"};
+  const uintmax_t bytes = std::filesystem::file_size(path, error);
+  const uint64_t largest = uint64_t(limits.maxPixels) * 2 * 1001 / 1000 + (uint64_t(1) << 20);
+  if (error || bytes > largest)
+    return Error{path, "", error ? "cannot tell the PNG file's size" : "PNG file is too large"};
+  std::vector<char> data(bytes);
+  if (!in.read(data.data(), std::streamsize(bytes)))
+    return Error{path, "", "cannot read PNG file"};
+  return decodePngGrey(data.data(), data.size(), path, limits);
+}
+
+Status writePngGrey16(const std::string& path, int width, int height, const uint16_t* samples) {
+  png_image png = header(width, height, 1);
+  png.format = PNG_FORMAT_LINEAR_Y;
+  if (!png_image_write_to_file(&png, path.c_str(), 0, samples, 0, nullptr))
+    return writeFailed(png, path, "cannot write PNG");
+  return {};
+}
+
+Result<std::vector<uint8_t>> encodePngGrey16(const std::string& name, int width, int height,
+                                             const uint16_t* samples) {
+  png_image png = header(width, height, 1);
+  png.format = PNG_FORMAT_LINEAR_Y;
+  png_alloc_size_t bytes = 0;
+  if (!png_image_write_to_memory(&png, nullptr, &bytes, 0, samples, 0, nullptr))
+    return writeFailed(png, name, "cannot encode PNG");
+  std::vector<uint8_t> out(bytes);
+  if (!png_image_write_to_memory(&png, out.data(), &bytes, 0, samples, 0, nullptr))
     return writeFailed(png, name, "cannot encode PNG");
   out.resize(bytes);
   return out;

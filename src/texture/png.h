@@ -38,10 +38,28 @@ Result<PngPixels> readPng(const std::string& path, PngLayout layout, const PngLi
 Result<PngPixels> decodePng(const void* data, size_t size, const std::string& name,
                             PngLayout layout, const PngLimits& limits);
 
+// A greyscale PNG's samples exactly as the file stores them, for data that is not light (height
+// maps, terrain/load_heights.cpp): 8- or 16-bit grey only (colour, alpha, palettes and 1/2/4-bit
+// grey are refused), and no gamma or colour space applied — the gAMA, sRGB, iCCP, cHRM and tRNS
+// chunks are ignored, so a code comes out as the number the file holds whatever tool wrote it.
+struct PngGrey {
+  int width = 0, height = 0;
+  int bitDepth = 0;               // 8 or 16: codes 0…255 or 0…65535
+  std::vector<uint16_t> samples;  // width × height, rows top first
+};
+Result<PngGrey> readPngGrey(const std::string& path, const PngLimits& limits);
+Result<PngGrey> decodePngGrey(const void* data, size_t size, const std::string& name,
+                              const PngLimits& limits);
+
 // `width` × `height` pixels of 8-bit RGB (channels 3) or RGBA (4), rows top first, as a PNG file
 // at `path`, or as PNG bytes in memory.
 Status writePng(const std::string& path, int width, int height, int channels, const uint8_t* rows);
 Result<std::vector<uint8_t>> encodePng(const std::string& name, int width, int height, int channels,
                                        const uint8_t* rows);
+// `width` × `height` 16-bit grey samples, rows top first, as a 16-bit greyscale PNG (tagged gamma
+// 1.0; readPngGrey gives the same codes back).
+Status writePngGrey16(const std::string& path, int width, int height, const uint16_t* samples);
+Result<std::vector<uint8_t>> encodePngGrey16(const std::string& name, int width, int height,
+                                             const uint16_t* samples);
 
 }  // namespace sv::texture
