@@ -102,7 +102,7 @@ Scene generateFreeFormOne();
 // BENCH.md `terrain`: a seeded fractal height field of `size` × `size` samples over a fixed
 // 40.96 km square (so a larger table is finer ground, the same view: the cost of more heights
 // alone), 1 200 m of relief, draped with a 2048² image coloured by height and seed 001's noise,
-// lit by a low sun, with haze (half the colour every 8 km); the camera 300 m above the ground at
+// lit by a low sun, with haze (half the colour every 12 km); the camera 300 m above the ground at
 // the map's centre looking toward the horizon (8° down, 60° vertical field of view, near 1 m,
 // far 60 km). `bicubic`: Catmull–Rom below the finest level (else bilinear).
 struct TerrainParams {

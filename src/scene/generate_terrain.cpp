@@ -72,12 +72,12 @@ Result<Scene> generateTerrain(const TerrainParams& p) {
   c.znear = 1;
   c.zfar = 60000;
   s.cameras.push_back(c);
-  s.light.direction = {-0.5f, -0.35f, -0.8f};  // a low sun from the south-east, behind
+  s.light.direction = {0.7f, -0.3f, 0.45f};  // a low sun ahead, from the north-west
   s.light.ambient = 0.3f;
   s.background = {0.55f, 0.63f, 0.75f};
   s.fog.enabled = true;
   s.fog.color = s.background;
-  s.fog.beta = float(1.0 / 8000);
+  s.fog.beta = float(1.0 / 12000);
   return s;
 }
 

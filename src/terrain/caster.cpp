@@ -185,7 +185,7 @@ double Caster::solve(Vec3d o, Vec3d d, double sa, double sb, double fa) const {
       // finite, bisection across the footprint's edge (f0 = +∞).
       double a = s0, fa2 = f0, b = s1, fb = f1;
       int side = 0;
-      const double tolerance = 1e-6 / std::max(gridSpeed(Bundle{o, {d, d, d, d}}), 1e-300);
+      const double tolerance = 1e-4 / std::max(gridSpeed(Bundle{o, {d, d, d, d}}), 1e-300);
       for (int it = 0; it < 60 && b - a > tolerance; ++it) {
         const double m =
             std::isfinite(fa2) && fa2 - fb > 0 ? b - fb * (b - a) / (fb - fa2) : 0.5 * (a + b);

@@ -76,7 +76,7 @@ class Caster {
   // grid steps (0 for one ray).
   double march(const Bundle& b, double s0, double s1, double footprint, CastCounters& c) const;
   // The first s in [s0, s1] at which origin + s·dir meets the surface — or enters the solid below
-  // it through the prism's side — or NaN. Exact to 10⁻⁶ of a grid step along the ray.
+  // it through the prism's side — or NaN. Exact to 10⁻⁴ of a grid step along the ray.
   double cast(Vec3d origin, Vec3d dir, double s0, double s1, CastCounters& c) const;
 
   const HeightField& field() const { return field_; }

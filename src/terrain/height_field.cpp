@@ -129,14 +129,14 @@ Result<HeightField> generateFractal(int size, double spacing, double relief, uin
   if (!(spacing > 0) || !(relief > 0) || !std::isfinite(spacing) || !std::isfinite(relief))
     return Error{"", "", "terrain spacing and relief must be positive"};
   // Midpoint displacement (diamond–square) on the smallest 2^k + 1 grid holding the table, the
-  // displacement halving with each level (roughness 0.5), then cropped.
+  // displacement × 0.6 with each level (height_field.h), then cropped.
   int n = 1;
   while (n + 1 < size) n *= 2;
   const int m = n + 1;
   std::vector<float> g(size_t(m) * size_t(m), 0.0f);
   auto at = [&](int x, int y) -> float& { return g[size_t(y) * size_t(m) + size_t(x)]; };
   double amplitude = 1.0;
-  for (int step = n; step > 1; step /= 2, amplitude *= 0.5) {
+  for (int step = n; step > 1; step /= 2, amplitude *= 0.6) {
     const int h = step / 2;
     for (int y = h; y < m; y += step)  // diamond: the squares' centres
       for (int x = h; x < m; x += step)
@@ -159,7 +159,7 @@ Result<HeightField> generateFractal(int size, double spacing, double relief, uin
   for (int y = 0; y < size; ++y)
     for (int x = 0; x < size; ++x) {
       const double v = at(x, y);
-      values[size_t(y) * size_t(size) + size_t(x)] = v + 0.6 * (0.5 - std::fabs(v));
+      values[size_t(y) * size_t(size) + size_t(x)] = v + 1.5 * (0.5 - std::fabs(v));
     }
   Result<HeightField> f = quantize(values, size, size, source);
   if (!f.ok()) return f;

@@ -64,8 +64,8 @@ Result<HeightField> quantize(const std::vector<double>& values, int width, int h
 double interpolate(const HeightField& f, Interpolation interp, double x, double y,
                    double* dx = nullptr, double* dy = nullptr);
 
-// A seeded fractal table (midpoint displacement with roughness 0.5 — fractal dimension 2.5, the
-// statistics of natural terrain — plus a ridge and valley overlay), `size` × `size` samples
+// A seeded fractal table (midpoint displacement, the displacement × 0.6 per halving — fractal
+// dimension ≈ 2.3, as mountains measure — plus a ridge and valley overlay), `size` × `size` samples
 // `spacing` metres apart, heights spanning [0, relief] metres, centred on map origin (0, 0). The
 // same seed gives the same table on every machine.
 Result<HeightField> generateFractal(int size, double spacing, double relief, uint32_t seed);
