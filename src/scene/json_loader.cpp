@@ -484,7 +484,7 @@ Scene SceneReader::read(const Json& root) {
 void SceneReader::readTerrain(const Json& v, const std::string& where) {
   expectKeys(v, where,
              {"name", "heights", "generate", "png", "origin", "base", "interpolation", "material",
-              "color", "image", "detail", "ramp"});
+              "color", "image", "detail", "ramp", "verticalScale"});
   Terrain t;
   if (const Json* x = find(v, "name")) t.name = string(*x, member(where, "name"));
   t.ground = readHeights(v, where);
@@ -656,6 +656,12 @@ std::shared_ptr<const terrain::Ground> SceneReader::readHeights(const Json& v,
     field = tiles.size() == 1 ? Result<terrain::HeightField>(std::move(tiles[0]))
                               : terrain::mosaic(tiles);
     if (!field) fail(w, field.error().str());
+  }
+  // Vertical exaggeration, for low ground (a coastal plain's 90 m over 10 km shows little relief).
+  if (const Json* x = find(v, "verticalScale")) {
+    const double k = inRange(*x, member(where, "verticalScale"), 1e-3f, 1e3f);
+    field->scale *= k;
+    field->offset *= k;
   }
   auto ground = std::make_shared<terrain::Ground>(std::move(field.value()));
   ground->loadMs =
