@@ -113,11 +113,11 @@ TEST(Generators, NamesParseBackAndLaterOnesSayWhatTheyNeed) {
     const Result<Generator> parsed = parseGenerator(generatorName(g));
     ASSERT_TRUE(parsed.ok()) << generatorName(g);
     EXPECT_EQ(parsed.value(), g);
-    const bool later = g == Generator::terrain || g == Generator::volume || g == Generator::lights;
+    const bool later = g == Generator::volume || g == Generator::lights;
     EXPECT_EQ(generatorNeeds(g) != nullptr, later) << generatorName(g);
   }
   EXPECT_STREQ(generatorName(Generator::freeformOne), "freeform-one");
-  EXPECT_STREQ(generatorNeeds(Generator::terrain), "height fields");
+  EXPECT_STREQ(generatorNeeds(Generator::volume), "voxel volumes");
   const Result<Generator> bad = parseGenerator("trees");
   ASSERT_FALSE(bad.ok());
   EXPECT_EQ(bad.error().message,
