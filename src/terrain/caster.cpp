@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <tuple>
 
 namespace sv::terrain {
 namespace {
@@ -209,6 +210,70 @@ double Caster::solve(Vec3d o, Vec3d d, double sa, double sb, double fa) const {
   return std::numeric_limits<double>::quiet_NaN();
 }
 
+double Caster::solveBilinear(Vec3d o, Vec3d d, double sa, double sb) const {
+  // Grid space: x = x0 + s·ex, y = y0 + s·ey, height z = z0 + s·ez.
+  const double x0 = ax_ * o.x + bx_, ex = ax_ * d.x, y0 = ay_ * o.z + by_, ey = ay_ * d.z;
+  const double z0 = o.y, ez = d.y;
+  const HeightField& f = field_;
+  const int cellsX = f.width - 1, cellsY = f.height - 1;
+  // Clipped to the footprint [0, cellsX] × [0, cellsY] (slabs): beyond it there is no surface, and
+  // where the ray enters it below the heights it meets the prism's wall.
+  for (const auto& [p0, e, hi] : {std::tuple{x0, ex, double(cellsX)}, std::tuple{y0, ey, double(cellsY)}}) {
+    if (e == 0) {
+      if (p0 < 0 || p0 > hi) return std::numeric_limits<double>::quiet_NaN();
+      continue;
+    }
+    const double t0 = (0 - p0) / e, t1 = (hi - p0) / e;
+    sa = std::max(sa, std::min(t0, t1));
+    sb = std::min(sb, std::max(t0, t1));
+  }
+  if (!(sa <= sb)) return std::numeric_limits<double>::quiet_NaN();
+  double s = sa;
+  // The cell holding the point at s (the last row and column belong to the cells before them).
+  double x = x0 + s * ex, y = y0 + s * ey;
+  int i = std::clamp(int(std::floor(x)), 0, cellsX - 1), j = std::clamp(int(std::floor(y)), 0, cellsY - 1);
+  const int stepI = ex > 0 ? 1 : -1, stepJ = ey > 0 ? 1 : -1;
+  for (int guard = 0; guard < 4 * (cellsX + cellsY) + 8 && s <= sb; ++guard) {
+    // Where the ray leaves this cell (or sb).
+    const double tx = ex != 0 ? ((ex > 0 ? i + 1 : i) - x0) / ex : kInf;
+    const double ty = ey != 0 ? ((ey > 0 ? j + 1 : j) - y0) / ey : kInf;
+    const double out = std::min({tx, ty, sb});
+    {
+      // h = a + b·u + c·v + g·u·v over the cell, u = x − i, v = y − j; along the ray from s:
+      // u = u0 + t·ex, v = v0 + t·ey, so z − h = A·t² + B·t + C.
+      const double h00 = f.at(i, j), h10 = f.at(i + 1, j), h01 = f.at(i, j + 1),
+                   h11 = f.at(i + 1, j + 1);
+      const double b = h10 - h00, c = h01 - h00, g = h11 - h10 - h01 + h00;
+      const double u0 = x0 + s * ex - i, v0 = y0 + s * ey - j;
+      const double A = -g * ex * ey;
+      const double B = ez - b * ex - c * ey - g * (u0 * ey + v0 * ex);
+      const double C = z0 + s * ez - (h00 + b * u0 + c * v0 + g * u0 * v0);
+      const double span = out - s;
+      if (C <= 0) return s;  // under the surface already (the prism's wall, or the start)
+      double root = kInf;
+      if (std::fabs(A) * span < 1e-12 * (std::fabs(B) + std::fabs(C) / std::max(span, 1e-300))) {
+        if (B < 0) root = -C / B;
+      } else {
+        const double disc = B * B - 4 * A * C;
+        if (disc >= 0) {
+          // The stable pair: q = −(B + sign(B)·√disc)/2, roots q/A and C/q.
+          const double q = -0.5 * (B + std::copysign(std::sqrt(disc), B));
+          const double r1 = q / A, r2 = q != 0 ? C / q : kInf;
+          for (double r : {r1, r2})
+            if (r >= 0 && r < root) root = r;
+        }
+      }
+      if (root <= span) return s + root;
+    }
+    if (out >= sb) break;
+    s = out;
+    if (tx <= ty) i += stepI;
+    if (ty <= tx) j += stepJ;
+    if (i < 0 || j < 0 || i >= cellsX || j >= cellsY) break;
+  }
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
 double Caster::cast(Vec3d o, Vec3d d, double s, double s1, CastCounters& c) const {
   ++c.rays;
   const Bundle ray{o, {d, d, d, d}};
@@ -222,7 +287,9 @@ double Caster::cast(Vec3d o, Vec3d d, double s, double s1, CastCounters& c) cons
     if (s >= s1) break;
     const double sb = std::min(s + pyramid_.nodeCells(pyramid_.gridLevel() - 1) / gridSpeed(ray), s1);
     ++c.solves;
-    const double hit = solve(o, d, s, sb, above(o, d, s));
+    const double hit = placement_.radius <= 0 && interp_ == Interpolation::bilinear
+                           ? solveBilinear(o, d, s, sb)
+                           : solve(o, d, s, sb, above(o, d, s));
     if (!std::isnan(hit)) {
       ++c.hits;
       return hit;

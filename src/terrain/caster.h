@@ -92,6 +92,9 @@ class Caster {
   double above(Vec3d origin, Vec3d dir, double s) const;
   // The first root of `above` in [sa, sb], sampled finer than a quarter cell, or NaN.
   double solve(Vec3d origin, Vec3d dir, double sa, double sb, double fa) const;
+  // The same for the plane base and bilinear interpolation, exactly: the ray walked cell by cell
+  // (a 2D DDA), in each cell the height above the surface a quadratic in s, its first root.
+  double solveBilinear(Vec3d origin, Vec3d dir, double sa, double sb) const;
   // Grid steps per unit s of the fastest of the bundle's directions, horizontally.
   double gridSpeed(const Bundle& b) const;
 
