@@ -223,22 +223,30 @@ void TerrainPass::castWindow(Scratch& w, const Drawn& t, int x0, int y0, int siz
                            std::min(f.spacingU, f.spacingV);
   const double s = t.caster->march(b, start, limit, footprint, *w.counts);
   if (!(s < limit)) return;
-  if (size > 1) {
-    const int h = size / 2;
-    castWindow(w, t, x0, y0, h, s);
-    castWindow(w, t, x0 + h, y0, h, s);
-    castWindow(w, t, x0, y0 + h, h, s);
-    castWindow(w, t, x0 + h, y0 + h, h, s);
-    return;
+  const int h = size / 2;
+  for (int c = 0; c < 4; ++c) {
+    const int cx = x0 + (c & 1) * h, cy = y0 + (c >> 1) * h;
+    // Pixels are cast from their 2×2 window's start: a march of the pixel's own footprint first
+    // would find little its samples' rays do not.
+    if (h == 1)
+      castPixel(w, t, cx, cy, s);
+    else
+      castWindow(w, t, cx, cy, h, s);
   }
-  const size_t p = size_t(y0 * kTileSize + x0);
+}
+
+// Pixel (x, y) of the tile: its samples' rays cast from `start` to the depth each holds.
+void TerrainPass::castPixel(Scratch& w, const Drawn& t, int x, int y, double start) const {
+  const int gx = w.ox + x, gy = w.oy + y;
+  if (gx >= width_ || gy >= height_) return;
+  const size_t p = size_t(y * kTileSize + x);
   bool any = false;
   for (int k = 0; k < samples_; ++k) {
     const size_t at = kPlane * size_t(k) + p;
     const double lim = w.limit[at];
-    if (!(s < lim)) continue;
+    if (!(start < lim)) continue;
     const Vec3d d = direction(gx + 0.5 + offsetX_[k], gy + 0.5 + offsetY_[k]);
-    const double hs = t.caster->cast(eye_, d, s, lim, *w.counts);
+    const double hs = t.caster->cast(eye_, d, start, lim, *w.counts);
     if (std::isnan(hs) || !(sToDepth(hs) < w.depth[at])) continue;
     w.hit[at] = hs;
     any = true;

@@ -50,6 +50,7 @@ class TerrainPass final : public raster::TilePass {
   };
 
   void castWindow(Scratch& w, const Drawn& t, int x0, int y0, int size, double start) const;
+  void castPixel(Scratch& w, const Drawn& t, int x, int y, double start) const;
   void shadeHits(Scratch& w, const Drawn& t, const raster::TileTarget& tile) const;
   Vec3d direction(double px, double py) const;  // the ray through raster point (px, py)
   double depthToS(float windowDepth) const;

@@ -243,6 +243,16 @@ double Caster::solveBilinear(Vec3d o, Vec3d d, double sa, double sb) const {
       // u = u0 + t·ex, v = v0 + t·ey, so z − h = A·t² + B·t + C.
       const double h00 = f.at(i, j), h10 = f.at(i + 1, j), h01 = f.at(i, j + 1),
                    h11 = f.at(i + 1, j + 1);
+      // Above the cell's highest corner all the way through it: nothing to solve.
+      if (z0 + std::min(s, out) * ez > std::max({h00, h10, h01, h11}) &&
+          z0 + out * ez > std::max({h00, h10, h01, h11})) {
+        if (out >= sb) break;
+        s = out;
+        if (tx <= ty) i += stepI;
+        if (ty <= tx) j += stepJ;
+        if (i < 0 || j < 0 || i >= cellsX || j >= cellsY) break;
+        continue;
+      }
       const double b = h10 - h00, c = h01 - h00, g = h11 - h10 - h01 + h00;
       const double u0 = x0 + s * ex - i, v0 = y0 + s * ey - j;
       const double A = -g * ex * ey;
