@@ -70,7 +70,11 @@ struct RenderOptions {
 // tetrahedra on an interval octree in object space, cells small enough that a chord strays at most
 // a quarter of a pixel from the surface at the object's nearest distance in this camera and raster
 // (`options`: camera, height) — equal silhouette error with ray casting, within the resolution of
-// the image. Errors name a form that is unbounded or needs over 4 million triangles.
+// the image. Errors name a form that is unbounded or needs over 4 million triangles. Every terrain
+// becomes its full-resolution grid, two triangles a cell (issue 29's polygon baseline: the same
+// heights at the same resolution, the surface linear across each triangle), with the
+// interpolated surface's normals and the draped image's texture coordinates (or the colour ramp
+// as vertex colours).
 Result<scene::Scene> tessellatedScene(const scene::Scene& scene, const RenderOptions& options);
 
 // By name, as the CLI's --hsr writes them: "zbuffer", "priority", "hybrid".

@@ -10,6 +10,7 @@
 
 #include "freeform/tessellate.h"
 #include "render/draw_packets.h"
+#include "render/terrain_pass.h"
 
 namespace sv::render {
 namespace {
@@ -120,6 +121,9 @@ Result<scene::Scene> tessellatedScene(const scene::Scene& scene, const RenderOpt
     out.meshes.push_back(std::move(mesh));
     out.instances.push_back({int(out.meshes.size()) - 1, object.transform});
   }
+  out.terrains.clear();
+  for (const scene::Terrain& t : scene.terrains)
+    if (t.ground) render::appendTerrainGrid(t, o, out);
   return out;
 }
 

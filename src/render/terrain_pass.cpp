@@ -67,6 +67,63 @@ struct TerrainPass::Scratch {
   int ox = 0, oy = 0;
 };
 
+namespace {
+
+terrain::Interpolation interpolationFor(const scene::Terrain& t, const RenderOptions& o) {
+  return o.terrainFilter == RenderOptions::TerrainFilter::bicubic ||
+                 (o.terrainFilter == RenderOptions::TerrainFilter::scene && t.bicubic)
+             ? terrain::Interpolation::bicubic
+             : terrain::Interpolation::bilinear;
+}
+
+}  // namespace
+
+void appendTerrainGrid(const scene::Terrain& t, const RenderOptions& o, scene::Scene& out) {
+  const terrain::HeightField& f = t.ground->field;
+  const terrain::Interpolation interp = interpolationFor(t, o);
+  const terrain::Caster c(f, t.ground->pyramid(interp), interp,
+                          terrain::Placement{t.origin[0], t.origin[1], t.baseRadius});
+  const std::vector<scene::TerrainColorStop> ramp =
+      t.ramp.empty() ? defaultRamp(f.offset, f.offset + 65535 * f.scale) : t.ramp;
+  scene::Material m = out.materialAt(t.material);
+  m.name = (t.name.empty() ? std::string("terrain") : t.name) + " (grid)";
+  m.texture = t.image;
+  m.doubleSided = true;
+  m.uvScale = {1, 1};
+  if (!m.unlit) m.phong = true;
+  out.materials.push_back(m);
+  scene::Mesh mesh;
+  mesh.name = m.name;
+  mesh.material = int(out.materials.size()) - 1;
+  const size_t n = size_t(f.width) * size_t(f.height);
+  mesh.positions.reserve(n);
+  mesh.normals.reserve(n);
+  for (int j = 0; j < f.height; ++j)
+    for (int i = 0; i < f.width; ++i) {
+      const double h = f.at(i, j);
+      const Vec3d p = c.toWorld(i, j, h);
+      const Vec3d nn = c.normal(i, j);
+      mesh.positions.push_back({float(p.x), float(p.y), float(p.z)});
+      mesh.normals.push_back({float(nn.x), float(nn.y), float(nn.z)});
+      if (t.image >= 0) {
+        const double* b = t.imageBounds;
+        mesh.uvs.push_back({float((c.mapU(i) - b[0]) / (b[2] - b[0])),
+                            float((b[3] - c.mapV(j)) / (b[3] - b[1]))});
+      } else {
+        const Vec3 col = rampAt(ramp, h);
+        mesh.colors.push_back({col.x, col.y, col.z, 1});
+      }
+    }
+  mesh.indices.reserve(size_t(f.width - 1) * size_t(f.height - 1) * 6);
+  for (int j = 0; j + 1 < f.height; ++j)
+    for (int i = 0; i + 1 < f.width; ++i) {
+      const uint32_t a = uint32_t(j * f.width + i), b = a + 1, d = a + uint32_t(f.width), e = d + 1;
+      for (uint32_t k : {a, d, b, b, d, e}) mesh.indices.push_back(k);
+    }
+  out.meshes.push_back(std::move(mesh));
+  out.instances.push_back({int(out.meshes.size()) - 1, Mat4{}});
+}
+
 TerrainPass::TerrainPass() = default;
 TerrainPass::~TerrainPass() = default;
 
@@ -92,11 +149,7 @@ void TerrainPass::setTerrains(const scene::Scene& scene, const FrameCamera& came
     if (!t.ground) continue;
     Drawn d;
     d.ground = t.ground.get();
-    const terrain::Interpolation interp =
-        options.terrainFilter == RenderOptions::TerrainFilter::bicubic ||
-                (options.terrainFilter == RenderOptions::TerrainFilter::scene && t.bicubic)
-            ? terrain::Interpolation::bicubic
-            : terrain::Interpolation::bilinear;
+    const terrain::Interpolation interp = interpolationFor(t, options);
     d.caster = std::make_unique<terrain::Caster>(
         t.ground->field, t.ground->pyramid(interp), interp,
         terrain::Placement{t.origin[0], t.origin[1], t.baseRadius});

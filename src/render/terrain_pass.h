@@ -19,6 +19,12 @@
 
 namespace sv::render {
 
+// Terrain `t` as its full-resolution triangle grid, appended to `out` (tessellatedScene: the
+// polygon and llvmpipe baselines): vertices on the table's samples, normals of the surface
+// `options` interpolates, the image's texture coordinates or the ramp's colours, a material of
+// its own (the terrain's, with the image as its texture, double-sided).
+void appendTerrainGrid(const scene::Terrain& t, const RenderOptions& options, scene::Scene& out);
+
 class TerrainPass final : public raster::TilePass {
  public:
   TerrainPass();
