@@ -11,6 +11,8 @@ namespace sv::terrain {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// Cells a ray walks directly from its start before marching (Caster::cast).
+constexpr double kDirectCells = 8;
 
 double length(Vec3d v) { return std::sqrt(dot(v, v)); }
 Vec3d cross(Vec3d a, Vec3d b) {
@@ -287,19 +289,29 @@ double Caster::solveBilinear(Vec3d o, Vec3d d, double sa, double sb) const {
 double Caster::cast(Vec3d o, Vec3d d, double s, double s1, CastCounters& c) const {
   ++c.rays;
   const Bundle ray{o, {d, d, d, d}};
-  double f = above(o, d, s);
-  if (f <= 0) {
+  const bool exact = placement_.radius <= 0 && interp_ == Interpolation::bilinear;
+  const double speed = gridSpeed(ray);
+  if (exact) {
+    // A bundle's start lies close to where its rays meet the ground: the first few cells walked
+    // directly, before any march (whose steps cost more than a cell's quadratic).
+    const double near = std::min(s + kDirectCells / speed, s1);
+    ++c.solves;
+    const double hit = solveBilinear(o, d, s, near);
+    if (!std::isnan(hit)) {
+      ++c.hits;
+      return hit;
+    }
+    s = near;
+  } else if (above(o, d, s) <= 0) {
     ++c.hits;
     return s;
   }
   while (s < s1) {
     s = march(ray, s, s1, 0, c);
     if (s >= s1) break;
-    const double sb = std::min(s + pyramid_.nodeCells(pyramid_.gridLevel() - 1) / gridSpeed(ray), s1);
+    const double sb = std::min(s + pyramid_.nodeCells(pyramid_.gridLevel() - 1) / speed, s1);
     ++c.solves;
-    const double hit = placement_.radius <= 0 && interp_ == Interpolation::bilinear
-                           ? solveBilinear(o, d, s, sb)
-                           : solve(o, d, s, sb, above(o, d, s));
+    const double hit = exact ? solveBilinear(o, d, s, sb) : solve(o, d, s, sb, above(o, d, s));
     if (!std::isnan(hit)) {
       ++c.hits;
       return hit;
