@@ -326,7 +326,8 @@ TEST(GdalLoader, RefusesRotatedAndSouthUpRasters) {
 TEST(GdalLoader, RefusesBrokenFilesNamingThem) {
   const fs::path dir = tempDir();
   const fs::path garbage = dir / "garbage.tif";
-  writeBytes(garbage, std::string("II*\0garbage bytes, not a TIFF at all \x01\x02\x03", 45));
+  static constexpr char kGarbage[] = "II*\0garbage bytes, not a TIFF at all \x01\x02\x03";
+  writeBytes(garbage, std::string(kGarbage, sizeof kGarbage - 1));
   expectOneLineErrorNaming(loadGdal(garbage.string()), garbage.string());
   const fs::path huge = dir / "huge.vrt";
   writeBytes(huge,
