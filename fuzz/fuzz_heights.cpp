@@ -61,8 +61,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   check(f.width >= 2 && f.height >= 2 && int64_t(f.width) * f.height <= kBudget,
         "the size is within the budget");
   check(f.q.size() == size_t(f.width) * size_t(f.height), "the table holds width × height codes");
-  check(std::isfinite(f.originU) && std::isfinite(f.originV) && f.spacingU > 0 &&
-            f.spacingV > 0 && std::isfinite(f.spacingU) && std::isfinite(f.spacingV),
+  check(std::isfinite(f.originU) && std::isfinite(f.originV) && f.spacingU > 0 && f.spacingV > 0 &&
+            std::isfinite(f.spacingU) && std::isfinite(f.spacingV),
         "the placement is finite with positive spacing");
   check(std::isfinite(f.offset) && f.scale > 0 && std::isfinite(f.scale),
         "heights have a finite offset and positive scale");

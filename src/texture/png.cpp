@@ -209,8 +209,7 @@ Result<PngGrey> readPngGrey(const std::string& path, const PngLimits& limits) {
   if (error || bytes > largest)
     return Error{path, "", error ? "cannot tell the PNG file's size" : "PNG file is too large"};
   std::vector<char> data(bytes);
-  if (!in.read(data.data(), std::streamsize(bytes)))
-    return Error{path, "", "cannot read PNG file"};
+  if (!in.read(data.data(), std::streamsize(bytes))) return Error{path, "", "cannot read PNG file"};
   return decodePngGrey(data.data(), data.size(), path, limits);
 }
 

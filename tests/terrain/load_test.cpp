@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <numeric>
 #include <string>
 #include <vector>
@@ -29,9 +30,9 @@ namespace fs = std::filesystem;
 // A fresh directory for the running test's files (ctest runs tests in parallel processes).
 fs::path tempDir() {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  const fs::path dir = fs::temp_directory_path() /
-                       (std::string("synthvis-load-test-") + info->test_suite_name() + "-" +
-                        info->name() + "-" + std::to_string(getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / (std::string("synthvis-load-test-") + info->test_suite_name() +
+                                   "-" + info->name() + "-" + std::to_string(getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
@@ -149,7 +150,8 @@ TEST_F(TerrainData, GeographicElevBecomesMetresAtItsCentreLatitudeAndKeepsNoData
   EXPECT_EQ(h, 90);
   // The equirectangular projection at the centre latitude (height_field.h), evaluated here
   // directly: the raster's centre (lon0, lat0) lands at (R·cos(lat0)·lon0, R·lat0) in radians.
-  const double deg = M_PI / 180, lat0 = gt[3] + 0.5 * h * gt[5], lon0 = gt[0] + 0.5 * w * gt[1];
+  const double deg = std::numbers::pi / 180, lat0 = gt[3] + 0.5 * h * gt[5],
+               lon0 = gt[0] + 0.5 * w * gt[1];
   const double kx = kEarthRadius * std::cos(lat0 * deg) * deg, k = kEarthRadius * deg;
   EXPECT_NEAR(f->spacingU, gt[1] * kx, 1e-9 * f->spacingU);
   EXPECT_NEAR(f->spacingV, -gt[5] * k, 1e-9 * f->spacingV);
@@ -200,7 +202,8 @@ TEST_F(TerrainData, TruncatedGeoTiffIsRefusedNamingTheFile) {
 
 TEST_F(TerrainData, InMemoryLoadEqualsTheFileLoad) {
   const std::string file = path("stars/tif/olinda_dem_utm25s.tif");
-  const Result<HeightField> a = loadGdal(file), b = loadGdalFromMemory(readBytes(file), "olinda.tif");
+  const Result<HeightField> a = loadGdal(file),
+                            b = loadGdalFromMemory(readBytes(file), "olinda.tif");
   ASSERT_TRUE(a.ok()) << a.error().str();
   ASSERT_TRUE(b.ok()) << b.error().str();
   EXPECT_EQ(a->q, b->q);
@@ -234,9 +237,8 @@ void writeRaster(const char* driver, const std::string& path, int w, int h, GDAL
   ASSERT_EQ(GDALRasterIO(band, GF_Write, 0, 0, w, h, const_cast<double*>(values.data()), w, h,
                          GDT_Float64, 0, 0),
             CE_None);
-  GDALDatasetH out =
-      GDALCreateCopy(GDALGetDriverByName(driver), path.c_str(), mem, FALSE, nullptr, nullptr,
-                     nullptr);
+  GDALDatasetH out = GDALCreateCopy(GDALGetDriverByName(driver), path.c_str(), mem, FALSE, nullptr,
+                                    nullptr, nullptr);
   ASSERT_NE(out, nullptr) << CPLGetLastErrorMsg();
   GDALClose(out);
   GDALClose(mem);
@@ -258,7 +260,7 @@ TEST(GdalLoader, ReadsAnSrtmTileWrittenByGdal) {
   ASSERT_TRUE(f.ok()) << f.error().str();
   EXPECT_EQ(f->width, n);
   EXPECT_EQ(f->height, n);
-  const double deg = M_PI / 180, kx = kEarthRadius * std::cos(45.5 * deg) * deg;
+  const double deg = std::numbers::pi / 180, kx = kEarthRadius * std::cos(45.5 * deg) * deg;
   EXPECT_NEAR(f->originU, 6 * kx, 1e-6);  // pixel (0, 0)'s centre: 6° E, 46° N
   EXPECT_NEAR(f->originV, 46 * kEarthRadius * deg, 1e-6);
   EXPECT_NEAR(f->spacingU, d * kx, 1e-9);
@@ -367,7 +369,8 @@ TEST(PngLoader, SixteenBitRoundTripKeepsEveryCode) {
   EXPECT_EQ(f->at(0, 0), -100);
   EXPECT_EQ(f->at(255, 255), -100 + 0.25 * 65535);
   EXPECT_EQ(f->source, file);
-  const Result<std::vector<uint8_t>> bytes = texture::encodePngGrey16("m.png", 256, 256, codes.data());
+  const Result<std::vector<uint8_t>> bytes =
+      texture::encodePngGrey16("m.png", 256, 256, codes.data());
   ASSERT_TRUE(bytes.ok());
   const Result<HeightField> m = decodePng16(bytes->data(), bytes->size(), "m.png", placement);
   ASSERT_TRUE(m.ok()) << m.error().str();
@@ -449,10 +452,9 @@ TEST(Mosaic, TwoByTwoTilesSharingAnEdgeRowMergeBackToTheTable) {
   const Result<HeightField> whole = generateFractal(65, 30, 1200, 29);
   ASSERT_TRUE(whole.ok());
   // SRTM's layout: neighbours repeat the shared row and column (sample 32 is in both halves).
-  std::vector<HeightField> tiles = {tileOf(whole.value(), 32, 32, 33, 33, "se"),
-                                    tileOf(whole.value(), 0, 0, 33, 33, "nw"),
-                                    tileOf(whole.value(), 32, 0, 33, 33, "ne"),
-                                    tileOf(whole.value(), 0, 32, 33, 33, "sw")};
+  std::vector<HeightField> tiles = {
+      tileOf(whole.value(), 32, 32, 33, 33, "se"), tileOf(whole.value(), 0, 0, 33, 33, "nw"),
+      tileOf(whole.value(), 32, 0, 33, 33, "ne"), tileOf(whole.value(), 0, 32, 33, 33, "sw")};
   const Result<HeightField> m = mosaic(tiles);
   ASSERT_TRUE(m.ok()) << m.error().str();
   EXPECT_EQ(m->width, 65);
@@ -499,8 +501,8 @@ TEST(Mosaic, UncoveredSamplesTakeTheLowestHeight) {
   const Result<HeightField> whole = generateFractal(33, 10, 300, 3);
   ASSERT_TRUE(whole.ok());
   // Two diagonal corners: the other two quarters are covered by no tile.
-  const Result<HeightField> m =
-      mosaic({tileOf(whole.value(), 0, 0, 10, 10, "a"), tileOf(whole.value(), 23, 23, 10, 10, "b")});
+  const Result<HeightField> m = mosaic(
+      {tileOf(whole.value(), 0, 0, 10, 10, "a"), tileOf(whole.value(), 23, 23, 10, 10, "b")});
   ASSERT_TRUE(m.ok()) << m.error().str();
   EXPECT_EQ(m->width, 33);
   EXPECT_EQ(m->code(32, 0), 0);
