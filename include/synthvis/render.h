@@ -64,6 +64,10 @@ struct RenderOptions {
   // Terrain (Scene::terrains) interpolation below the finest level: each terrain's own, or all
   // bilinear or all bicubic (SPEC §11; the CLI's --terrain-filter).
   enum class TerrainFilter { scene, bilinear, bicubic } terrainFilter = TerrainFilter::scene;
+  // Terrain levels of detail (terrain/caster.h): where a pixel spans more than a grid step the
+  // ground is drawn from the mean pyramid's level of its size, as a texture's MIP levels are;
+  // false: the table's own surface everywhere (exact, and aliased in the distance).
+  bool terrainLod = true;
 };
 
 // The scene with every free form replaced by triangles (issue 7's polygon baseline): marching

@@ -166,6 +166,11 @@ void TerrainPass::setTerrains(const scene::Scene& scene, const FrameCamera& came
     std::copy_n(t.imageBounds, 4, d.imageBounds);
     const terrain::HeightField& f = t.ground->field;
     d.ramp = t.ramp.empty() ? defaultRamp(f.offset, f.offset + 65535 * f.scale) : t.ramp;
+    // A pixel's width per unit eye depth, in grid steps (at the view's centre: the level of
+    // detail needs no more), or 0 for the exact surface everywhere.
+    d.pixel = options.terrainLod ? 2 * tanY_ / (options.height * options.supersample) /
+                                       std::min(f.spacingU, f.spacingV)
+                                 : 0.0;
     groundBytes_ += t.ground->bytes();
     loadMs_ += t.ground->loadMs;
     terrains_.push_back(std::move(d));
@@ -274,7 +279,7 @@ void TerrainPass::castWindow(Scratch& w, const Drawn& t, int x0, int y0, int siz
   const Vec3d d1 = b.corner[3] - b.corner[0], d2 = b.corner[2] - b.corner[1];
   const double footprint = std::max(std::hypot(d1.x, d1.z), std::hypot(d2.x, d2.z)) /
                            std::min(f.spacingU, f.spacingV);
-  const double s = t.caster->march(b, start, limit, footprint, *w.counts);
+  const double s = t.caster->march(b, start, limit, footprint, t.pixel, *w.counts);
   if (!(s < limit)) return;
   const int h = size / 2;
   for (int c = 0; c < 4; ++c) {
@@ -299,7 +304,7 @@ void TerrainPass::castPixel(Scratch& w, const Drawn& t, int x, int y, double sta
     const double lim = w.limit[at];
     if (!(start < lim)) continue;
     const Vec3d d = direction(gx + 0.5 + offsetX_[k], gy + 0.5 + offsetY_[k]);
-    const double hs = t.caster->cast(eye_, d, start, lim, *w.counts);
+    const double hs = t.caster->cast(eye_, d, start, lim, *w.counts, t.pixel);
     if (std::isnan(hs) || !(sToDepth(hs) < w.depth[at])) continue;
     w.hit[at] = hs;
     any = true;
@@ -341,7 +346,9 @@ void TerrainPass::shadeHits(Scratch& w, const Drawn& t, const raster::TileTarget
       const double gxc = std::clamp(m.gx, 0.0, double(f.width - 1));
       const double gyc = std::clamp(m.gy, 0.0, double(f.height - 1));
       Vec3d eastDir, northDir;
-      const Vec3d normal = c.normal(gxc, gyc, &eastDir, &northDir);
+      // The normal of the surface the ray met: its level of detail's.
+      const Vec3d normal =
+          c.normal(gxc, gyc, &eastDir, &northDir, c.lodLevel(hs, t.pixel, c.stretch(d)));
       const Vec3d rel = point - eye_;
       frag.attribute[shade::kEyeX][i] = float(dot(rel, right_));
       frag.attribute[shade::kEyeY][i] = float(dot(rel, up_));

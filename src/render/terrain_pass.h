@@ -49,6 +49,7 @@ class TerrainPass final : public raster::TilePass {
     double detailSize = 10;
     double imageBounds[4];
     std::vector<scene::TerrainColorStop> ramp;
+    double pixel = 0;  // a pixel's width per unit s in grid steps (terrain::Caster's levels of detail)
   };
   struct Scratch;
   struct alignas(64) WorkerStats {

@@ -51,15 +51,53 @@ Vec3d Caster::toWorld(double gx, double gy, double h) const {
   return Vec3d{0, -R, 0} + d * (R + h);
 }
 
-double Caster::surface(double gx, double gy) const {
-  if (!(gx >= 0 && gy >= 0 && gx <= field_.width - 1 && gy <= field_.height - 1))
-    return std::numeric_limits<double>::quiet_NaN();
-  return interpolate(field_, interp_, gx, gy);
+namespace {
+
+// Level k's bilinear surface at grid (gx, gy), in codes, and its derivatives per grid step.
+double meanSurface(const Pyramid::MeanLevel& m, double gx, double gy, double* dx, double* dy) {
+  const double x = std::clamp(gx / m.step, 0.0, double(m.width - 1));
+  const double y = std::clamp(gy / m.step, 0.0, double(m.height - 1));
+  const int i = std::min(int(x), m.width - 2), j = std::min(int(y), m.height - 2);
+  const double u = x - i, v = y - j;
+  const double h00 = m.code(i, j), h10 = m.code(i + 1, j), h01 = m.code(i, j + 1),
+               h11 = m.code(i + 1, j + 1);
+  const double top = h00 + (h10 - h00) * u, bottom = h01 + (h11 - h01) * u;
+  if (dx) *dx = ((h10 - h00) * (1 - v) + (h11 - h01) * v) / m.step;
+  if (dy) *dy = (bottom - top) / m.step;
+  return top + (bottom - top) * v;
 }
 
-Vec3d Caster::normal(double gx, double gy, Vec3d* eastOut, Vec3d* northOut) const {
+}  // namespace
+
+int Caster::lodLevel(double s, double pixel, double stretch) const {
+  const double w = pixel * s * stretch;
+  const int n = pyramid_.gridLevel();
+  if (!(w > 1)) return n;
+  return std::max(n - int(std::ceil(std::log2(w))), 0);
+}
+
+double Caster::stretch(Vec3d d) const {
+  const double r = std::sqrt(dot(d, d));
+  // On a sphere the base's normal varies; the view's vertical is near enough for a level choice.
+  return std::min(kMaxStretch, r / std::max(std::fabs(d.y), 1e-300));
+}
+
+double Caster::surface(double gx, double gy, int level) const {
+  if (!(gx >= 0 && gy >= 0 && gx <= field_.width - 1 && gy <= field_.height - 1))
+    return std::numeric_limits<double>::quiet_NaN();
+  if (level >= pyramid_.gridLevel()) return interpolate(field_, interp_, gx, gy);
+  return field_.offset +
+         field_.scale * meanSurface(pyramid_.mean(level), gx, gy, nullptr, nullptr);
+}
+
+Vec3d Caster::normal(double gx, double gy, Vec3d* eastOut, Vec3d* northOut, int level) const {
   double dx = 0, dy = 0;
-  interpolate(field_, interp_, gx, gy, &dx, &dy);
+  if (level >= pyramid_.gridLevel()) {
+    interpolate(field_, interp_, gx, gy, &dx, &dy);
+  } else {
+    meanSurface(pyramid_.mean(level), gx, gy, &dx, &dy);
+    dx *= field_.scale, dy *= field_.scale;
+  }
   // Slopes per metre east and north (gy grows southward).
   const double se = dx / field_.spacingU, sn = -dy / field_.spacingV;
   Vec3d up{0, 1, 0}, east{1, 0, 0}, north{0, 0, -1};
@@ -123,7 +161,7 @@ Caster::Box Caster::bounds(const Bundle& b, double sa, double sb) const {
   return box;
 }
 
-double Caster::march(const Bundle& b, double s, double s1, double footprint,
+double Caster::march(const Bundle& b, double s, double s1, double footprint, double pixel,
                      CastCounters& c) const {
   ++c.windows;
   const int finest = pyramid_.gridLevel() - 1;
@@ -135,21 +173,30 @@ double Caster::march(const Bundle& b, double s, double s1, double footprint,
     if (!(w > 1)) return finest;
     return std::clamp(pyramid_.gridLevel() - int(std::ceil(std::log2(w))), 0, finest);
   };
-  int level = levelFor(s);
+  // The bundle's longest stretch on the ground: its coarsest level of detail.
+  double stretchMax = 1;
+  for (const Vec3d& d : b.corner) stretchMax = std::max(stretchMax, stretch(d));
+  auto stopAt = [&](double at) {
+    return std::min(levelFor(at), lodLevel(at, pixel, stretchMax));
+  };
+  int level = stopAt(s);
   int empties = 0;
   while (s < s1) {
-    const int stop = levelFor(s);
+    const int stop = stopAt(s);
     level = std::min(level, stop);
     const double nodeSize = pyramid_.nodeCells(level);
     const double sb = std::min(s + nodeSize / speed, s1);
     ++c.steps;
     const Box box = bounds(b, s, sb);
     const double inv = 1 / nodeSize;
+    // Where a mean level is drawn, one node more on every side: its surface over a node reads its
+    // neighbours' samples (pyramid.h), and stops at `level` or finer never read further.
+    const int grow = lodLevel(s, pixel, stretchMax) < pyramid_.gridLevel() ? 1 : 0;
     const Pyramid::Range r = pyramid_.range(
-        level, int(std::floor(std::max(box.gx0, -1.0) * inv)),
-        int(std::floor(std::min(box.gx1, 1e9) * inv)),
-        int(std::floor(std::max(box.gy0, -1.0) * inv)),
-        int(std::floor(std::min(box.gy1, 1e9) * inv)));
+        level, int(std::floor(std::max(box.gx0, -1.0) * inv)) - grow,
+        int(std::floor(std::min(box.gx1, 1e9) * inv)) + grow,
+        int(std::floor(std::max(box.gy0, -1.0) * inv)) - grow,
+        int(std::floor(std::min(box.gy1, 1e9) * inv)) + grow);
     if (r.hi < r.lo || box.h0 > r.hi + margin_) {
       // Wholly above the surface (or beyond the table): on, and after two such steps coarser.
       s = sb;
@@ -166,24 +213,25 @@ double Caster::march(const Bundle& b, double s, double s1, double footprint,
   return s1;
 }
 
-double Caster::above(Vec3d origin, Vec3d dir, double s) const {
+double Caster::above(Vec3d origin, Vec3d dir, double s, int level) const {
   const MapPoint m = toMap(origin + dir * s);
-  const double h = surface(m.gx, m.gy);
+  const double h = surface(m.gx, m.gy, level);
   return std::isnan(h) ? kInf : m.h - h;
 }
 
-double Caster::solve(Vec3d o, Vec3d d, double sa, double sb, double fa) const {
+double Caster::solve(Vec3d o, Vec3d d, double sa, double sb, double fa, int level) const {
   if (fa <= 0) return sa;
   // Samples an eighth of a cell apart (on the plane a cell's bilinear surface along a line is a
   // parabola, its bicubic one of degree 6, and on a sphere neither: eight samples a cell find every
   // crossing but a ridge the ray grazes by less than the surface's rise over an eighth of a cell —
   // four missed one on the sphere test's grazing rays, tests/terrain/caster_test.cpp).
-  const double along = (sb - sa) * gridSpeed(Bundle{o, {d, d, d, d}});
+  const double along = (sb - sa) * gridSpeed(Bundle{o, {d, d, d, d}}) /
+                       pyramid_.nodeCells(std::min(level, pyramid_.gridLevel()));
   const int n = std::clamp(int(std::ceil(8 * along)), 1, 64);
   double s0 = sa, f0 = fa;
   for (int k = 1; k <= n; ++k) {
     const double s1 = k == n ? sb : sa + (sb - sa) * k / n;
-    const double f1 = above(o, d, s1);
+    const double f1 = above(o, d, s1, level);
     if (f1 <= 0) {
       // A bracket [s0, s1], f0 > 0 ≥ f1: regula falsi with the Illinois step while both ends are
       // finite, bisection across the footprint's edge (f0 = +∞).
@@ -194,7 +242,7 @@ double Caster::solve(Vec3d o, Vec3d d, double sa, double sb, double fa) const {
         const double m =
             std::isfinite(fa2) && fa2 - fb > 0 ? b - fb * (b - a) / (fb - fa2) : 0.5 * (a + b);
         const double mm = (m > a && m < b) ? m : 0.5 * (a + b);
-        const double fm = above(o, d, mm);
+        const double fm = above(o, d, mm, level);
         if (fm <= 0) {
           b = mm, fb = fm;
           if (side == -1) fa2 *= 0.5;
@@ -212,15 +260,21 @@ double Caster::solve(Vec3d o, Vec3d d, double sa, double sb, double fa) const {
   return std::numeric_limits<double>::quiet_NaN();
 }
 
-double Caster::solveBilinear(Vec3d o, Vec3d d, double sa, double sb) const {
-  // Grid space: x = x0 + s·ex, y = y0 + s·ey, height z = z0 + s·ez.
-  const double x0 = ax_ * o.x + bx_, ex = ax_ * d.x, y0 = ay_ * o.z + by_, ey = ay_ * d.z;
-  const double z0 = o.y, ez = d.y;
-  const HeightField& f = field_;
-  const int cellsX = f.width - 1, cellsY = f.height - 1;
+double Caster::solveBilinear(Vec3d o, Vec3d d, double sa, double sb, int level) const {
+  // The level's grid: x = x0 + s·ex, y = y0 + s·ey in its sample steps; heights z = z0 + s·ez
+  // in codes of the table (h = offset + scale·code).
+  const Pyramid::MeanLevel m = pyramid_.mean(level);
+  const double k = 1 / m.step;
+  const double x0 = (ax_ * o.x + bx_) * k, ex = ax_ * d.x * k, y0 = (ay_ * o.z + by_) * k,
+               ey = ay_ * d.z * k;
+  const double toCode = 1 / field_.scale;
+  const double z0 = (o.y - field_.offset) * toCode, ez = d.y * toCode;
+  const int cellsX = m.width - 1, cellsY = m.height - 1;
+  // The table's footprint, in the level's steps (its last samples may lie beyond it).
+  const double footX = (field_.width - 1) * k, footY = (field_.height - 1) * k;
   // Clipped to the footprint [0, cellsX] × [0, cellsY] (slabs): beyond it there is no surface, and
   // where the ray enters it below the heights it meets the prism's wall.
-  for (const auto& [p0, e, hi] : {std::tuple{x0, ex, double(cellsX)}, std::tuple{y0, ey, double(cellsY)}}) {
+  for (const auto& [p0, e, hi] : {std::tuple{x0, ex, footX}, std::tuple{y0, ey, footY}}) {
     if (e == 0) {
       if (p0 < 0 || p0 > hi) return std::numeric_limits<double>::quiet_NaN();
       continue;
@@ -234,27 +288,20 @@ double Caster::solveBilinear(Vec3d o, Vec3d d, double sa, double sb) const {
   // The cell holding the point at s (the last row and column belong to the cells before them).
   double x = x0 + s * ex, y = y0 + s * ey;
   int i = std::clamp(int(std::floor(x)), 0, cellsX - 1), j = std::clamp(int(std::floor(y)), 0, cellsY - 1);
+  // Amanatides–Woo: the parameters where the ray crosses the next column and row boundary,
+  // advanced by a cell's worth each step.
   const int stepI = ex > 0 ? 1 : -1, stepJ = ey > 0 ? 1 : -1;
-  for (int guard = 0; guard < 4 * (cellsX + cellsY) + 8 && s <= sb; ++guard) {
-    // Where the ray leaves this cell (or sb).
-    const double tx = ex != 0 ? ((ex > 0 ? i + 1 : i) - x0) / ex : kInf;
-    const double ty = ey != 0 ? ((ey > 0 ? j + 1 : j) - y0) / ey : kInf;
-    const double out = std::min({tx, ty, sb});
-    {
+  const double dtx = ex != 0 ? std::fabs(1 / ex) : kInf, dty = ey != 0 ? std::fabs(1 / ey) : kInf;
+  double tx = ex != 0 ? ((ex > 0 ? i + 1 : i) - x0) / ex : kInf;
+  double ty = ey != 0 ? ((ey > 0 ? j + 1 : j) - y0) / ey : kInf;
+  for (;;) {
+    const double out = std::min(std::min(tx, ty), sb);  // where the ray leaves the cell
+    const double h00 = m.code(i, j), h10 = m.code(i + 1, j), h01 = m.code(i, j + 1),
+                 h11 = m.code(i + 1, j + 1);
+    // Solved only where the ray's lowest point in the cell is not above its highest corner.
+    if (z0 + (ez < 0 ? out : s) * ez <= std::max(std::max(h00, h10), std::max(h01, h11))) {
       // h = a + b·u + c·v + g·u·v over the cell, u = x − i, v = y − j; along the ray from s:
       // u = u0 + t·ex, v = v0 + t·ey, so z − h = A·t² + B·t + C.
-      const double h00 = f.at(i, j), h10 = f.at(i + 1, j), h01 = f.at(i, j + 1),
-                   h11 = f.at(i + 1, j + 1);
-      // Above the cell's highest corner all the way through it: nothing to solve.
-      if (z0 + std::min(s, out) * ez > std::max({h00, h10, h01, h11}) &&
-          z0 + out * ez > std::max({h00, h10, h01, h11})) {
-        if (out >= sb) break;
-        s = out;
-        if (tx <= ty) i += stepI;
-        if (ty <= tx) j += stepJ;
-        if (i < 0 || j < 0 || i >= cellsX || j >= cellsY) break;
-        continue;
-      }
       const double b = h10 - h00, c = h01 - h00, g = h11 - h10 - h01 + h00;
       const double u0 = x0 + s * ex - i, v0 = y0 + s * ey - j;
       const double A = -g * ex * ey;
@@ -279,39 +326,49 @@ double Caster::solveBilinear(Vec3d o, Vec3d d, double sa, double sb) const {
     }
     if (out >= sb) break;
     s = out;
-    if (tx <= ty) i += stepI;
-    if (ty <= tx) j += stepJ;
+    if (tx <= ty)
+      i += stepI, tx += dtx;
+    else
+      j += stepJ, ty += dty;
     if (i < 0 || j < 0 || i >= cellsX || j >= cellsY) break;
   }
   return std::numeric_limits<double>::quiet_NaN();
 }
 
-double Caster::cast(Vec3d o, Vec3d d, double s, double s1, CastCounters& c) const {
+double Caster::solveAt(Vec3d o, Vec3d d, double sa, double sb, int level) const {
+  const bool bilinear = level < pyramid_.gridLevel() || interp_ == Interpolation::bilinear;
+  if (placement_.radius <= 0 && bilinear) return solveBilinear(o, d, sa, sb, level);
+  return solve(o, d, sa, sb, above(o, d, sa, level), level);
+}
+
+double Caster::cast(Vec3d o, Vec3d d, double s, double s1, CastCounters& c, double pixel) const {
   ++c.rays;
   const Bundle ray{o, {d, d, d, d}};
-  const bool exact = placement_.radius <= 0 && interp_ == Interpolation::bilinear;
-  const double speed = gridSpeed(ray);
-  if (exact) {
-    // A bundle's start lies close to where its rays meet the ground: the first few cells walked
-    // directly, before any march (whose steps cost more than a cell's quadratic).
-    const double near = std::min(s + kDirectCells / speed, s1);
+  const double speed = gridSpeed(ray), rayStretch = stretch(d);
+  // A bundle's start lies close to where its rays meet the ground: the first few cells of its
+  // level walked directly, before any march (whose steps cost more than a cell's solve).
+  {
+    const int level = lodLevel(s, pixel, rayStretch);
+    const double near =
+        std::min(s + kDirectCells * pyramid_.nodeCells(std::min(level, pyramid_.gridLevel())) / speed, s1);
     ++c.solves;
-    const double hit = solveBilinear(o, d, s, near);
+    const double hit = solveAt(o, d, s, near, level);
     if (!std::isnan(hit)) {
       ++c.hits;
       return hit;
     }
     s = near;
-  } else if (above(o, d, s) <= 0) {
-    ++c.hits;
-    return s;
   }
   while (s < s1) {
-    s = march(ray, s, s1, 0, c);
+    s = march(ray, s, s1, 0, pixel, c);
     if (s >= s1) break;
-    const double sb = std::min(s + pyramid_.nodeCells(pyramid_.gridLevel() - 1) / speed, s1);
+    // Two cells of the finest stored level, or of the level of detail if coarser.
+    const int level = lodLevel(s, pixel, rayStretch);
+    const int cells = std::max(pyramid_.nodeCells(pyramid_.gridLevel() - 1),
+                               pyramid_.nodeCells(std::min(level, pyramid_.gridLevel())) * 2);
+    const double sb = std::min(s + cells / speed, s1);
     ++c.solves;
-    const double hit = exact ? solveBilinear(o, d, s, sb) : solve(o, d, s, sb, above(o, d, s));
+    const double hit = solveAt(o, d, s, sb, level);
     if (!std::isnan(hit)) {
       ++c.hits;
       return hit;

@@ -64,20 +64,37 @@ class Caster {
   double mapU(double gx) const { return field_.originU + gx * field_.spacingU; }
   double mapV(double gy) const { return field_.originV - gy * field_.spacingV; }
 
-  // The interpolated surface's height at grid (gx, gy); NaN beyond the table's footprint.
-  double surface(double gx, double gy) const;
-  // The unit outward normal of the surface (world) at grid (gx, gy), and the world directions of
+  // Levels of detail (SPEC §11: the level from the projected size). A frame casts each ray against
+  // the surface of the mean pyramid's level whose samples are as far apart as the ray's pixel is
+  // long on the ground there (pyramid.h, Pyramid::mean) — the table's own interpolated surface
+  // (level n) wherever a pixel covers at most a grid step, a filtered one beyond, as a texture's
+  // MIP levels are: a far ridge is drawn from its mean heights instead of aliasing from samples
+  // the pixel skips. `pixel`: the pixel's width per unit s in grid steps; the length on the ground
+  // is that width stretched by 1/sin of the ray's angle with the base (at most kMaxStretch).
+  // pixel = 0: level n everywhere (the host's queries).
+  static constexpr double kMaxStretch = 4;
+  int lodLevel(double s, double pixel, double stretch) const;
+  double stretch(Vec3d dir) const;
+
+  // The surface's height at grid (gx, gy) — level `level` of detail, the table's interpolated
+  // surface at level n (and by default); NaN beyond the table's footprint.
+  double surface(double gx, double gy, int level = 1 << 30) const;
+  // The unit outward normal of that surface (world) at grid (gx, gy), and the world directions of
   // map east and north there (unit, tangent to the base).
-  Vec3d normal(double gx, double gy, Vec3d* east = nullptr, Vec3d* north = nullptr) const;
+  Vec3d normal(double gx, double gy, Vec3d* east = nullptr, Vec3d* north = nullptr,
+               int level = 1 << 30) const;
 
   // The bundle marched from s0 toward s1: the smallest s at which it may meet the surface at the
   // resolution of its own footprint (the pyramid level whose nodes are as wide as the bundle is
-  // there), or s1 when it meets nothing before s1. `footprint`: the bundle's width per unit s in
-  // grid steps (0 for one ray).
-  double march(const Bundle& b, double s0, double s1, double footprint, CastCounters& c) const;
-  // The first s in [s0, s1] at which origin + s·dir meets the surface — or enters the solid below
-  // it through the prism's side — or NaN. Exact to 10⁻⁴ of a grid step along the ray.
-  double cast(Vec3d origin, Vec3d dir, double s0, double s1, CastCounters& c) const;
+  // there, or as its level of detail if coarser), or s1 when it meets nothing before s1.
+  // `footprint`: the bundle's width per unit s in grid steps (0 for one ray); `pixel`: as above.
+  double march(const Bundle& b, double s0, double s1, double footprint, double pixel,
+               CastCounters& c) const;
+  // The first s in [s0, s1] at which origin + s·dir meets the surface (at the level of detail
+  // `pixel` gives, as above) — or enters the solid below it through the prism's side — or NaN.
+  // Exact to 10⁻⁴ of a grid step along the ray.
+  double cast(Vec3d origin, Vec3d dir, double s0, double s1, CastCounters& c,
+              double pixel = 0) const;
 
   const HeightField& field() const { return field_; }
   const Pyramid& pyramid() const { return pyramid_; }
@@ -88,13 +105,16 @@ class Caster {
     double gx0, gx1, gy0, gy1, h0, h1;  // grid rectangle and heights above the base
   };
   Box bounds(const Bundle& b, double sa, double sb) const;
-  // f(s) = height above the surface of origin + s·dir (+∞ beyond the footprint).
-  double above(Vec3d origin, Vec3d dir, double s) const;
-  // The first root of `above` in [sa, sb], sampled finer than a quarter cell, or NaN.
-  double solve(Vec3d origin, Vec3d dir, double sa, double sb, double fa) const;
-  // The same for the plane base and bilinear interpolation, exactly: the ray walked cell by cell
-  // (a 2D DDA), in each cell the height above the surface a quadratic in s, its first root.
-  double solveBilinear(Vec3d origin, Vec3d dir, double sa, double sb) const;
+  // f(s) = height above level `level`'s surface of origin + s·dir (+∞ beyond the footprint).
+  double above(Vec3d origin, Vec3d dir, double s, int level) const;
+  // The first root of `above` in [sa, sb], sampled at eighths of the level's cells, or NaN.
+  double solve(Vec3d origin, Vec3d dir, double sa, double sb, double fa, int level) const;
+  // The same for the plane base and a bilinear surface (the table's, bilinear; any mean level),
+  // exactly: the ray walked cell by cell (a 2D DDA), in each cell the height above the surface a
+  // quadratic in s, its first root.
+  double solveBilinear(Vec3d origin, Vec3d dir, double sa, double sb, int level) const;
+  // The first root in [sa, sb] at `level`, by whichever of the two applies.
+  double solveAt(Vec3d origin, Vec3d dir, double sa, double sb, int level) const;
   // Grid steps per unit s of the fastest of the bundle's directions, horizontally.
   double gridSpeed(const Bundle& b) const;
 

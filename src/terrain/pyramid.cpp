@@ -85,6 +85,40 @@ Pyramid::Pyramid(const HeightField& field, Interpolation interp)
         coarse[size_t(J) * size_t(cx) + size_t(I)] = b;
       }
   }
+  // The mean levels, each from the one above it: [1 2 1]/4 along x, then along y, rounded.
+  means_.resize(size_t(n_));
+  meanW_.resize(size_t(n_));
+  meanH_.resize(size_t(n_));
+  for (int k = n_ - 1; k >= 0; --k) {
+    const MeanLevel fine = mean(k + 1);
+    const int w = (fine.width - 1 + 1) / 2 + 1, h = (fine.height - 1 + 1) / 2 + 1;
+    std::vector<uint32_t> rows(size_t(w) * size_t(fine.height));
+    for (int j = 0; j < fine.height; ++j)
+      for (int i = 0; i < w; ++i) {
+        const int c = std::min(2 * i, fine.width - 1);
+        rows[size_t(j) * size_t(w) + size_t(i)] = uint32_t(fine.code(std::max(c - 1, 0), j)) +
+                                                  2u * fine.code(c, j) +
+                                                  fine.code(std::min(c + 1, fine.width - 1), j);
+      }
+    std::vector<uint16_t>& out = means_[size_t(k)];
+    out.resize(size_t(w) * size_t(h));
+    for (int j = 0; j < h; ++j) {
+      const int c = std::min(2 * j, fine.height - 1);
+      const uint32_t* up = rows.data() + size_t(std::max(c - 1, 0)) * size_t(w);
+      const uint32_t* mid = rows.data() + size_t(c) * size_t(w);
+      const uint32_t* down = rows.data() + size_t(std::min(c + 1, fine.height - 1)) * size_t(w);
+      for (int i = 0; i < w; ++i)
+        out[size_t(j) * size_t(w) + size_t(i)] = uint16_t((up[i] + 2 * mid[i] + down[i] + 8) / 16);
+    }
+    meanW_[size_t(k)] = w;
+    meanH_[size_t(k)] = h;
+  }
+}
+
+Pyramid::MeanLevel Pyramid::mean(int level) const {
+  if (level >= n_) return {field_->width, field_->height, 1.0, field_->q.data()};
+  return {meanW_[size_t(level)], meanH_[size_t(level)], double(nodeCells(level)),
+          means_[size_t(level)].data()};
 }
 
 Pyramid::Range Pyramid::cell(int i, int j) const {
@@ -123,6 +157,7 @@ Pyramid::Range Pyramid::range(int level, int i0, int i1, int j0, int j1) const {
 size_t Pyramid::bytes() const {
   size_t b = 0;
   for (const auto& l : levels_) b += l.size() * sizeof(Bound);
+  for (const auto& l : means_) b += l.size() * sizeof(uint16_t);
   return b;
 }
 

@@ -44,6 +44,20 @@ class Pyramid {
   Range node(int level, int i, int j) const;
   size_t bytes() const;
 
+  // The mean pyramid beside the bounds (the levels of detail a frame draws at a distance, SPEC
+  // §11: "the level from the projected size"): level k < n holds the table's samples every
+  // 2^(n − k) steps, each the [1 2 1]/4 filter of level k + 1 around it (along both axes, edges
+  // repeated), in the table's 16-bit codes; level n is the table. The surface of level k < n is
+  // bilinear over its samples, and over a node of level k it stays within the bounds of that node
+  // and its eight neighbours (its samples average the table within one node of them).
+  struct MeanLevel {
+    int width = 0, height = 0;  // samples
+    double step = 1;            // grid steps between samples: 2^(n − k)
+    const uint16_t* q = nullptr;
+    uint16_t code(int i, int j) const { return q[size_t(j) * size_t(width) + size_t(i)]; }
+  };
+  MeanLevel mean(int level) const;
+
  private:
   struct Bound {
     uint16_t lo, hi;  // codes of boundOffset_ + boundScale_·code, rounded outward
@@ -52,6 +66,8 @@ class Pyramid {
   double boundOffset_ = 0, boundScale_ = 1;
   std::vector<std::vector<Bound>> levels_;  // levels_[k]: 2^k × 2^k nodes, k = 0 … n − 1
   std::vector<int> sideX_, sideY_;           // per level: the nodes over the footprint
+  std::vector<std::vector<uint16_t>> means_;  // means_[k], k = 0 … n − 1 (MeanLevel)
+  std::vector<int> meanW_, meanH_;
   const HeightField* field_ = nullptr;
   Interpolation interp_ = Interpolation::bilinear;
   Range cell(int i, int j) const;  // level n, computed from the table
