@@ -171,6 +171,7 @@ struct BenchArgs {
   int warmup = 2;
   int repeat = 1;  // measurements of each scene (each with its warm-up and timed frames)
   int aa = 1;
+  std::string terrainLod = "on";
   int glAa = -1;  // -1: as --aa, capped at llvmpipe's 4
   std::string filter = "box";
   bool glReadback = false;
@@ -209,6 +210,9 @@ sv::Result<sv::reference::BenchCase> generatorCase(const std::string& kind,
 int runBench(BenchArgs a) {
   namespace ref = sv::reference;
   a.options.samples = a.aa == 0 ? 1 : a.aa;
+  if (a.terrainLod != "on" && a.terrainLod != "off")
+    return fail({"", "", fmt::format("--terrain-lod is on or off, not '{}'", a.terrainLod)});
+  a.options.terrainLod = a.terrainLod == "on";
   if (auto f = parseFilter(a.filter); !f)
     return fail(f.error());
   else
@@ -319,9 +323,20 @@ int runBench(BenchArgs a) {
     results.push_back(std::move(repeats[median]));
   }
 
-  if (!a.image.empty())
-    if (sv::Status s = sv::writeImage(results.back().runs[0].image, a.image); !s)
-      return fail(s.error());
+  if (!a.image.empty()) {
+    // The first renderer's frame to FILE; a second renderer's beside it, FILE's stem + "-" + its
+    // name (out.png → out-gl.png), for `synthvis compare`.
+    const std::vector<ref::RendererRun>& runs = results.back().runs;
+    if (sv::Status s = sv::writeImage(runs[0].image, a.image); !s) return fail(s.error());
+    if (runs.size() > 1) {
+      const size_t dot = a.image.find_last_of('.');
+      const std::string second = dot == std::string::npos
+                                     ? a.image + "-" + runs[1].renderer
+                                     : a.image.substr(0, dot) + "-" + runs[1].renderer +
+                                           a.image.substr(dot);
+      if (sv::Status s = sv::writeImage(runs[1].image, second); !s) return fail(s.error());
+    }
+  }
   if (!a.json.empty()) {
     std::ofstream out(a.json);
     // One scene on one renderer: an object (BENCH.md); otherwise a list of rows.
@@ -573,6 +588,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   bench->add_option("--json", b.json, "write the results as JSON to this file");
   bench->add_option("--html", b.html, "write an HTML page with plots and images to this directory");
+  bench->add_option("--terrain-lod", b.terrainLod,
+                    "terrain: on (levels of detail where a pixel spans more than a grid step) or "
+                    "off (the table's own surface everywhere)")
+      ->capture_default_str();
   bench->add_option("--image", b.image,
                     "write the last frame of the last scene to this image file");
 

@@ -404,7 +404,7 @@ class SceneReader {
   void readPrimitive(const Json& object, const std::string& where);
   void readFreeFormObject(const Json& object, const std::string& where);
   void readTerrain(const Json& v, const std::string& where);
-  std::shared_ptr<const terrain::Ground> readHeights(const Json& v, const std::string& where);
+  std::shared_ptr<terrain::Ground> readHeights(const Json& v, const std::string& where);
   int textureRef(const Json& v, const std::string& where) const;
   FreeFormNode readFreeForm(const Json& v, const std::string& where, int depth, int& quadrics,
                             bool root) const;
@@ -487,7 +487,8 @@ void SceneReader::readTerrain(const Json& v, const std::string& where) {
               "color", "image", "detail", "ramp", "verticalScale"});
   Terrain t;
   if (const Json* x = find(v, "name")) t.name = string(*x, member(where, "name"));
-  t.ground = readHeights(v, where);
+  std::shared_ptr<terrain::Ground> ground = readHeights(v, where);
+  t.ground = ground;
   const terrain::HeightField& f = t.ground->field;
   t.origin[0] = 0.5 * (f.originU + f.eastU());
   t.origin[1] = 0.5 * (f.originV + f.southV());
@@ -516,6 +517,11 @@ void SceneReader::readTerrain(const Json& v, const std::string& where) {
     if (!i) fail(member(where, "interpolation"), i.error().message);
     t.bicubic = i.value() == terrain::Interpolation::bicubic;
   }
+  // The pyramid the scene asks for, built now: part of loading, not of the first frame.
+  const auto start = std::chrono::steady_clock::now();
+  ground->pyramid(t.bicubic ? terrain::Interpolation::bicubic : terrain::Interpolation::bilinear);
+  ground->loadMs +=
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   t.material = readObjectMaterial(v, where);
   if (const Json* x = find(v, "image")) {
     const std::string w = member(where, "image");
@@ -591,8 +597,8 @@ void SceneReader::readTerrain(const Json& v, const std::string& where) {
 }
 
 // The table: "heights" (a file, or an array of files: a mosaic) or "generate" (a fractal).
-std::shared_ptr<const terrain::Ground> SceneReader::readHeights(const Json& v,
-                                                                const std::string& where) {
+std::shared_ptr<terrain::Ground> SceneReader::readHeights(const Json& v,
+                                                          const std::string& where) {
   const Json* heights = find(v, "heights");
   const Json* generate = find(v, "generate");
   if (!heights == !generate)

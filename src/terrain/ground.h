@@ -12,7 +12,9 @@ namespace sv::terrain {
 struct Ground {
   explicit Ground(HeightField f) : field(std::move(f)) {}
   HeightField field;
-  double loadMs = 0;  // reading (or generating) the table, and its first pyramid
+  // Reading (or generating) the table and building the pyramid the scene asks for (loaders build
+  // it; another interpolation's is built by the first frame that asks, in that frame's time).
+  double loadMs = 0;
 
   // The pyramid over `interp`'s surface (thread-safe; built once).
   const Pyramid& pyramid(Interpolation interp) const {
