@@ -81,7 +81,8 @@ std::vector<HashCase> hashCases() {
   for (const char* file :
        {"", "scenes/demo.json", "scenes/aa-edges.json", "scenes/mixed.json", "scenes/grazing.json",
         "scenes/grazing-plane.json", "scenes/freeform-mixed.json", "scenes/freeform-sculpture.json",
-        "scenes/crate.gltf", "scenes/pyramid.gltf", "scenes/house.obj"})
+        "scenes/crate.gltf", "scenes/pyramid.gltf", "scenes/house.obj",
+        "scenes/terrain-olinda.json"})
     both(*file ? file : "demo", fileCase(file), none);
   both("tris", generatorCase("tris"), none);
   both("tris-textured", generatorCase("tris"), none, true);
@@ -95,6 +96,12 @@ std::vector<HashCase> hashCases() {
   both("grazing-fog", generatorCase("grazing"), none, true, true);
   both("freeform", generatorCase("freeform"), none);
   both("freeform-one", generatorCase("freeform-one"), none);
+  reference::BenchCase terrain = generatorCase("terrain");
+  terrain.terrain.size = 257;
+  both("terrain", terrain, none);
+  both("terrain-exact", terrain, [](RenderOptions& o) { o.terrainLod = false; });
+  terrain.terrain.bicubic = true;
+  both("terrain-bicubic", terrain, none);
   // Other paths through the frame.
   both("demo-priority", fileCase(""),
        [](RenderOptions& o) { o.hsr = RenderOptions::Hsr::priority; });
