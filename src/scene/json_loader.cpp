@@ -549,6 +549,8 @@ void SceneReader::readTerrain(const Json& v, const std::string& where) {
           bands[k] = int(integer((*b)[b->size() == 1 ? 0 : k], element(bw, k), 1, 65535));
       }
       const std::string ref = string(*file, member(w, "file"));
+      if (!context_.options.followReferences)
+        fail(member(w, "file"), "referenced files are not read here");
       Result<terrain::OrthoImage> img =
           terrain::loadOrthoImage(resolvePath(directoryOf(path_), ref), bands);
       if (!img) fail(member(w, "file"), img.error().str());
