@@ -345,35 +345,27 @@ double Caster::cast(Vec3d o, Vec3d d, double s, double s1, CastCounters& c, doub
   ++c.rays;
   const Bundle ray{o, {d, d, d, d}};
   const double speed = gridSpeed(ray), rayStretch = stretch(d);
-  // A bundle's start lies close to where its rays meet the ground: the first few cells of its
-  // level walked directly, before any march (whose steps cost more than a cell's solve).
-  {
+  const int n = pyramid_.gridLevel();
+  // Solves [s, s + cells of the level of detail at s): the hit, or NaN and s moved past them.
+  auto solveAhead = [&](double cells) {
     const int level = lodLevel(s, pixel, rayStretch);
-    const double near =
-        std::min(s + kDirectCells * pyramid_.nodeCells(std::min(level, pyramid_.gridLevel())) / speed, s1);
+    const double sb = std::min(s + cells * pyramid_.nodeCells(std::min(level, n)) / speed, s1);
     ++c.solves;
-    const double hit = solveAt(o, d, s, near, level);
-    if (!std::isnan(hit)) {
+    const double hit = solveAt(o, d, s, sb, level);
+    if (!std::isnan(hit))
       ++c.hits;
-      return hit;
-    }
-    s = near;
-  }
+    else
+      s = sb;
+    return hit;
+  };
+  // A bundle's start lies close to where its rays meet the ground: the first few cells walked
+  // directly, before any march (whose steps cost more than a cell's solve).
+  if (const double hit = solveAhead(kDirectCells); !std::isnan(hit)) return hit;
   while (s < s1) {
     s = march(ray, s, s1, 0, pixel, c);
     if (s >= s1) break;
-    // Two cells of the finest stored level, or of the level of detail if coarser.
-    const int level = lodLevel(s, pixel, rayStretch);
-    const int cells = std::max(pyramid_.nodeCells(pyramid_.gridLevel() - 1),
-                               pyramid_.nodeCells(std::min(level, pyramid_.gridLevel())) * 2);
-    const double sb = std::min(s + cells / speed, s1);
-    ++c.solves;
-    const double hit = solveAt(o, d, s, sb, level);
-    if (!std::isnan(hit)) {
-      ++c.hits;
-      return hit;
-    }
-    s = sb;
+    // Two cells of the level of detail (the finest stored level's node, at level n).
+    if (const double hit = solveAhead(2); !std::isnan(hit)) return hit;
   }
   return std::numeric_limits<double>::quiet_NaN();
 }
