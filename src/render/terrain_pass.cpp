@@ -18,6 +18,8 @@ using raster::kTileSize;
 
 constexpr size_t kPlane = size_t(kTileSize) * kTileSize;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+// The window size whose pixels are cast from its start (TerrainPass::castWindow).
+constexpr int kPixelWindow = 2;
 
 
 // The colour ramp of a terrain without an image or a ramp of its own: sea-level greens through
@@ -281,16 +283,15 @@ void TerrainPass::castWindow(Scratch& w, const Drawn& t, int x0, int y0, int siz
                            std::min(f.spacingU, f.spacingV);
   const double s = t.caster->march(b, start, limit, footprint, t.pixel, *w.counts);
   if (!(s < limit)) return;
-  const int h = size / 2;
-  for (int c = 0; c < 4; ++c) {
-    const int cx = x0 + (c & 1) * h, cy = y0 + (c >> 1) * h;
-    // Pixels are cast from their 2×2 window's start: a march of the pixel's own footprint first
-    // would find little its samples' rays do not.
-    if (h == 1)
-      castPixel(w, t, cx, cy, s);
-    else
-      castWindow(w, t, cx, cy, h, s);
+  // The smallest windows cast their pixels from their own start: a march of a smaller footprint
+  // first would find little the pixels' rays do not.
+  if (size <= kPixelWindow) {
+    for (int y = y0; y < y0 + size; ++y)
+      for (int x = x0; x < x0 + size; ++x) castPixel(w, t, x, y, s);
+    return;
   }
+  const int h = size / 2;
+  for (int c = 0; c < 4; ++c) castWindow(w, t, x0 + (c & 1) * h, y0 + (c >> 1) * h, h, s);
 }
 
 // Pixel (x, y) of the tile: its samples' rays cast from `start` to the depth each holds.
