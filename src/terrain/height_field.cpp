@@ -154,23 +154,31 @@ Result<HeightField> generateFractal(int size, double spacing, double relief, uin
         at(x, y) = float(sum / count + amplitude * noise(seed, uint32_t(x), uint32_t(y)));
       }
   }
-  // Ridges: |·| folds the low-frequency relief into valleys and crests, as mountains look.
-  std::vector<double> values(size_t(size) * size_t(size));
+  // Ridges: |·| folds the low-frequency relief into valleys and crests, as mountains look. Folded
+  // in place and quantized straight from the grid over [0, relief] (no table of doubles: at
+  // 16384² that would be 2 GB more).
+  float lo = std::numeric_limits<float>::infinity(), hi = -lo;
   for (int y = 0; y < size; ++y)
     for (int x = 0; x < size; ++x) {
-      const double v = at(x, y);
-      values[size_t(y) * size_t(size) + size_t(x)] = v + 1.5 * (0.5 - std::fabs(v));
+      float& v = at(x, y);
+      v = float(v + 1.5 * (0.5 - std::fabs(double(v))));
+      lo = std::min(lo, v), hi = std::max(hi, v);
     }
-  Result<HeightField> f = quantize(values, size, size, source);
-  if (!f.ok()) return f;
-  HeightField& hf = f.value();
-  // Stretch to [0, relief].
+  HeightField hf;
+  hf.width = hf.height = size;
+  hf.source = source;
   hf.scale = relief / 65535.0;
   hf.offset = 0;
   hf.spacingU = hf.spacingV = spacing;
   hf.originU = -0.5 * (size - 1) * spacing;
   hf.originV = 0.5 * (size - 1) * spacing;
-  return f;
+  hf.q.resize(size_t(size) * size_t(size));
+  const double toCode = hi > lo ? 65535.0 / (double(hi) - lo) : 0.0;
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x)
+      hf.q[size_t(y) * size_t(size) + size_t(x)] =
+          uint16_t(std::clamp(std::lround((double(at(x, y)) - lo) * toCode), 0L, 65535L));
+  return hf;
 }
 
 }  // namespace sv::terrain
