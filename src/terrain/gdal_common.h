@@ -12,6 +12,7 @@
 #include <string>
 
 #include "synthvis/result.h"
+#include "terrain/height_field.h"
 
 namespace sv::terrain::gdal {
 
@@ -64,6 +65,7 @@ struct DatasetCloser {
 struct GridPlacement {
   double originU = 0, originV = 0, spacingU = 1, spacingV = 1;
   bool georeferenced = false;
+  HeightField::Geographic geographic;  // a geographic raster's own grid (height_field.h)
 };
 Result<GridPlacement> gridPlacement(GDALDatasetH ds, int width, int height,
                                     const std::string& source);

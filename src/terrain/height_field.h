@@ -39,6 +39,14 @@ struct HeightField {
   double offset = 0, scale = 1;         // h = offset + scale·q
   std::vector<uint16_t> q;              // width × height, row-major, row 0 north
   std::string source;                   // the file (or generator) it came from, for messages
+  // A geographic raster's own grid (loadGdal): sample (0, 0) at (lon0, lat0), steps dLon east
+  // and dLat south, in the SRS's angular unit (radiansPerUnit); the placement above is its
+  // conversion to metres at the table's centre latitude. A mosaic of such tiles converts them all
+  // at the union's centre latitude, so tiles in different rows share one grid.
+  struct Geographic {
+    bool on = false;
+    double lon0 = 0, lat0 = 0, dLon = 0, dLat = 0, radiansPerUnit = 0;
+  } geographic;
 
   double at(int i, int j) const {
     return offset + scale * q[size_t(j) * size_t(width) + size_t(i)];

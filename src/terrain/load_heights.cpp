@@ -91,6 +91,7 @@ Result<GridPlacement> gridPlacement(GDALDatasetH ds, int width, int height,
   // linear, u = kx·λ, v = k·φ, so origin and spacing scale alike and the centre (λ0, φ0) lands at
   // (kx·λ0, k·φ0). The geotransform is in longitude, latitude order whatever the SRS's axis order
   // (GDAL's "traditional GIS order" for rasters).
+  HeightField::Geographic geographic;
   if (georeferenced) {
     if (OGRSpatialReferenceH srs = GDALGetSpatialRef(ds); srs && OSRIsGeographic(srs)) {
       const double radiansPerUnit = OSRGetAngularUnits(srs, nullptr);
@@ -101,6 +102,8 @@ Result<GridPlacement> gridPlacement(GDALDatasetH ds, int width, int height,
                      fmt::format("geographic raster centred at latitude {} (unit {} rad) is not "
                                  "on the sphere",
                                  lat0, radiansPerUnit)};
+      geographic = {true, placed.originU, placed.originV, placed.spacingU, placed.spacingV,
+                    radiansPerUnit};
       const double k = kEarthRadius * radiansPerUnit, kx = k * std::cos(lat0Radians);
       placed.originU *= kx;
       placed.spacingU *= kx;
@@ -110,7 +113,7 @@ Result<GridPlacement> gridPlacement(GDALDatasetH ds, int width, int height,
   }
   if (std::optional<Error> e = checkPlacement(placed, source)) return *e;
   return GridPlacement{placed.originU, placed.originV, placed.spacingU, placed.spacingV,
-                       georeferenced};
+                       georeferenced, geographic};
 }
 
 }  // namespace gdal
@@ -181,6 +184,7 @@ Result<HeightField> readDataset(GDALDatasetH ds, const std::string& gdalPath,
   f->originV = placed.originV;
   f->spacingU = placed.spacingU;
   f->spacingV = placed.spacingV;
+  f->geographic = grid->geographic;
   return f;
 }
 
@@ -297,8 +301,45 @@ Result<HeightField> loadHeights(const std::string& path, const PngPlacement& png
   return endsWithPng(path) ? loadPng16(path, pngPlacement) : loadGdal(path);
 }
 
-Result<HeightField> mosaic(const std::vector<HeightField>& tiles) {
-  if (tiles.empty()) return Error{"", "", "a mosaic needs at least one tile"};
+namespace {
+
+// Geographic tiles converted to metres at one latitude, the union's centre (each loaded alone was
+// converted at its own, which gives tiles in different rows different east–west spacings).
+Result<std::vector<HeightField>> onOneLatitude(const std::vector<HeightField>& tiles) {
+  double top = -1e300, bottom = 1e300;
+  for (const HeightField& t : tiles) {
+    if (t.geographic.on != tiles.front().geographic.on)
+      return Error{t.source, "",
+                   fmt::format("is {} but {} is not: a mosaic's tiles share one kind of grid",
+                               t.geographic.on ? "geographic" : "projected", tiles.front().source)};
+    top = std::max(top, t.geographic.lat0 * t.geographic.radiansPerUnit);
+    bottom = std::min(bottom, (t.geographic.lat0 - (t.height - 1) * t.geographic.dLat) *
+                                  t.geographic.radiansPerUnit);
+  }
+  const double cosLat = std::cos(0.5 * (top + bottom));
+  std::vector<HeightField> out = tiles;
+  for (HeightField& t : out) {
+    const double k = kEarthRadius * t.geographic.radiansPerUnit, kx = k * cosLat;
+    t.originU = t.geographic.lon0 * kx;
+    t.spacingU = t.geographic.dLon * kx;
+    t.originV = t.geographic.lat0 * k;
+    t.spacingV = t.geographic.dLat * k;
+  }
+  return out;
+}
+
+}  // namespace
+
+Result<HeightField> mosaic(const std::vector<HeightField>& given) {
+  if (given.empty()) return Error{"", "", "a mosaic needs at least one tile"};
+  std::vector<HeightField> replaced;
+  if (std::any_of(given.begin(), given.end(),
+                  [](const HeightField& t) { return t.geographic.on; })) {
+    Result<std::vector<HeightField>> r = onOneLatitude(given);
+    if (!r) return r.error();
+    replaced = std::move(r.value());
+  }
+  const std::vector<HeightField>& tiles = replaced.empty() ? given : replaced;
   for (const HeightField& t : tiles) {
     if (t.width < 1 || t.height < 1 || t.q.size() != size_t(t.width) * size_t(t.height))
       return Error{t.source, "", "the tile's table does not match its size"};
@@ -378,6 +419,11 @@ Result<HeightField> mosaic(const std::vector<HeightField>& tiles) {
   f->originV = first.originV - double(minJ) * sv;
   f->spacingU = su;
   f->spacingV = sv;
+  if (first.geographic.on) {
+    f->geographic = first.geographic;
+    f->geographic.lon0 += double(minI) * first.geographic.dLon;
+    f->geographic.lat0 -= double(minJ) * first.geographic.dLat;
+  }
   return f;
 }
 

@@ -275,6 +275,41 @@ TEST(GdalLoader, ReadsAnSrtmTileWrittenByGdal) {
   fs::remove_all(dir);
 }
 
+TEST(GdalLoader, GeographicTilesInTwoRowsMosaicOnOneLatitude) {
+  // Two 1°-high geographic tiles, one above the other, sharing their edge row (as SRTM's do):
+  // alone each converts at its own centre latitude (different east–west spacings); together they
+  // are placed on one grid at the union's centre latitude, 45°.
+  const int n = 11;
+  const double d = 0.1;
+  const fs::path dir = tempDir();
+  std::vector<std::string> files;
+  for (int row = 0; row < 2; ++row) {
+    std::vector<double> v(size_t(n) * n);
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) v[size_t(j) * n + size_t(i)] = 100 + i + 10 * (j + row * (n - 1));
+    const double top = 46 - row;  // the tile's northern sample row, degrees
+    const double gt[6] = {6 - 0.5 * d, d, 0, top + 0.5 * d, 0, -d};
+    files.push_back((dir / ("row" + std::to_string(row) + ".tif")).string());
+    writeRaster("GTiff", files.back(), n, n, GDT_Float64, v, gt, 4326);
+  }
+  std::vector<HeightField> tiles;
+  for (const std::string& f : files) tiles.push_back(loadGdal(f).value());
+  ASSERT_NE(tiles[0].spacingU, tiles[1].spacingU);  // alone: each at its own latitude
+  const Result<HeightField> m = mosaic(tiles);
+  ASSERT_TRUE(m.ok()) << m.error().str();
+  EXPECT_EQ(m->width, n);
+  EXPECT_EQ(m->height, 2 * n - 1);
+  const double k = kEarthRadius * std::numbers::pi / 180;
+  EXPECT_NEAR(m->spacingU, d * k * std::cos(45 * std::numbers::pi / 180), 1e-6);
+  EXPECT_NEAR(m->spacingV, d * k, 1e-6);
+  for (int j = 0; j < m->height; ++j)
+    for (int i = 0; i < m->width; ++i)
+      // Quantized twice: each tile's step, then the mosaic's.
+      ASSERT_NEAR(m->at(i, j), 100 + i + 10 * j,
+                  0.5 * (m->scale + std::max(tiles[0].scale, tiles[1].scale)) + 1e-9)
+          << i << ", " << j;
+}
+
 TEST(GdalLoader, AppliesTheBandsScaleOffsetAndNoData) {
   const int w = 4, h = 3;
   const std::vector<double> raw = {0, 10, 20, 30, 40, -9999, 60, 70, 80, 90, 100, 110};
