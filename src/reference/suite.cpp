@@ -76,6 +76,13 @@ Result<std::vector<BenchCase>> suiteCases(const std::string& suite) {
       c.name = scene::generatorName(g);
       cases.push_back(c);
     }
+    // Terrain (issue 29) at 1024² heights, the size whose full-resolution grid the gl reference
+    // draws (2.1 M triangles).
+    BenchCase t;
+    t.generator = scene::Generator::terrain;
+    t.terrain.size = 1024;
+    t.name = "terrain-1024";
+    cases.push_back(t);
   } else {
     return Error{"", "", fmt::format("unknown suite '{}' (quick or full)", suite)};
   }
