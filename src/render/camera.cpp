@@ -7,11 +7,13 @@
 #include <limits>
 #include <numbers>
 
+#include "terrain/ground.h"
+
 namespace sv::render {
 namespace {
 
-// A camera for scenes that have none: looks at the centre of the scene's bounds from the front
-// and a little above, far enough to see all of it.
+// A camera for scenes that have none: looks at the centre of the scene's bounds (its instances'
+// and terrains') from the front and a little above, far enough to see all of it.
 scene::Camera defaultCamera(const scene::Scene& s) {
   Vec3 lo{std::numeric_limits<float>::max(), std::numeric_limits<float>::max(),
           std::numeric_limits<float>::max()};
@@ -25,6 +27,18 @@ scene::Camera defaultCamera(const scene::Scene& s) {
       hi = {std::max(hi.x, w.x), std::max(hi.y, w.y), std::max(hi.z, w.z)};
       any = true;
     }
+  // Terrain: its footprint between its lowest and highest heights (on the plane; a sphere's
+  // ground drops below it, which a default view need not mind).
+  for (const scene::Terrain& t : s.terrains) {
+    if (!t.ground) continue;
+    const terrain::HeightField& f = t.ground->field;
+    const float x0 = float(f.originU - t.origin[0]), x1 = float(f.eastU() - t.origin[0]);
+    const float z0 = float(t.origin[1] - f.originV), z1 = float(t.origin[1] - f.southV());
+    const float y0 = float(f.offset), y1 = float(f.offset + 65535 * f.scale);
+    lo = {std::min(lo.x, x0), std::min(lo.y, y0), std::min(lo.z, z0)};
+    hi = {std::max(hi.x, x1), std::max(hi.y, y1), std::max(hi.z, z1)};
+    any = true;
+  }
   scene::Camera cam;
   if (!any) return cam;
   const Vec3 centre = (lo + hi) * 0.5f;
