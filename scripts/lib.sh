@@ -26,27 +26,30 @@ sv_install_packages() {
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 }
 
-# sv_terrain_data: the real DEMs the terrain tests read, unpacked (never committed) from two Debian
-# packages of R's example data: r-cran-stars (tif/olinda_dem_utm25s.tif, a 111×111 float32 DEM in
-# UTM 25S, and tif/L7_ETMs.tif, Landsat bands of the same ground) and r-cran-terra (ex/elev.tif,
-# 95×90 int16 heights in longitude/latitude with no-data cells). The .debs are cached in
-# build-data/debs and unpacked (dpkg -x, not installed) into build-data/root; the tests find them
-# under build-data/root/usr/lib/R/site-library (SV_TERRAIN_DATA_DIR).
-SV_TERRAIN_DEBS=(r-cran-stars r-cran-terra)
+# sv_data: the real data the tests and demos read, unpacked (never committed) from Debian packages
+# — with `dpkg -x`, not installed, so without their runtimes: r-cran-stars (tif/olinda_dem_utm25s.tif,
+# a 111×111 float32 DEM in UTM 25S, and tif/L7_ETMs.tif, Landsat bands of the same ground),
+# r-cran-terra (ex/elev.tif, 95×90 int16 heights in longitude/latitude with no-data cells) and
+# xplanet (stars/BSC, the Yale Bright Star Catalogue: the light points' star field). The .debs are
+# cached in build-data/debs and unpacked into build-data/root; the tests find the DEMs under
+# build-data/root/usr/lib/R/site-library (SV_TERRAIN_DATA_DIR) and the stars under
+# build-data/root/usr/share/xplanet (SV_STAR_CATALOG).
+SV_DATA_DEBS=(r-cran-stars r-cran-terra xplanet)
 
-sv_terrain_data() {
+sv_data() {
   local debs="$SV_ROOT/build-data/debs" root="$SV_ROOT/build-data/root"
   local lib="$root/usr/lib/R/site-library"
-  if [ -f "$lib/stars/tif/olinda_dem_utm25s.tif" ] && [ -f "$lib/terra/ex/elev.tif" ]; then
+  if [ -f "$lib/stars/tif/olinda_dem_utm25s.tif" ] && [ -f "$lib/terra/ex/elev.tif" ] &&
+    [ -f "$root/usr/share/xplanet/stars/BSC" ]; then
     return 0
   fi
   mkdir -p "$debs" "$root"
   local missing=() p
-  for p in "${SV_TERRAIN_DEBS[@]}"; do
+  for p in "${SV_DATA_DEBS[@]}"; do
     compgen -G "$debs/${p}_*.deb" >/dev/null || missing+=("$p")
   done
   if [ ${#missing[@]} -gt 0 ]; then
-    echo "synthvis: downloading ${missing[*]} (terrain test data) into $debs"
+    echo "synthvis: downloading ${missing[*]} (test and demo data) into $debs"
     # As root, apt drops privileges to _apt for downloads, which cannot write to most directories:
     # download as root instead (nothing is installed, the files are only unpacked).
     local apt=(apt-get download -qq -o APT::Sandbox::User=root)
@@ -58,11 +61,11 @@ sv_terrain_data() {
       (cd "$debs" && "${apt[@]}" "${missing[@]}")
     fi
   fi
-  for p in "${SV_TERRAIN_DEBS[@]}"; do
+  for p in "${SV_DATA_DEBS[@]}"; do
     local f
     for f in "$debs/${p}"_*.deb; do dpkg -x "$f" "$root"; done
   done
-  echo "synthvis: terrain test data in $lib"
+  echo "synthvis: test and demo data in $root"
 }
 
 # sv_build DIR [cmake args...]: configure (once) and build everything in DIR.

@@ -39,6 +39,11 @@ struct FrameStats {
   uint64_t terrains = 0, terrainWindows = 0, terrainSteps = 0, terrainRays = 0, terrainHits = 0;
   uint64_t terrainBytes = 0;
   double terrainLoadMs = 0;
+  // Light points (SPEC §13): lights and stars considered, those drawn (lit, in front of the eye,
+  // on screen, bright enough), and the light pass's time (its per-frame preparation plus the
+  // busiest worker's tile work).
+  uint64_t lightPoints = 0, lightsDrawn = 0;
+  double lightsMs = 0;
   // rasterMs: the tile pass, which includes resolving each finished tile into the image.
   double vertexMs = 0, setupMs = 0, rasterMs = 0, totalMs = 0;
 

@@ -9,8 +9,10 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
+#include "synthvis/light_points.h"
 #include "synthvis/math.h"
 #include "synthvis/result.h"
 
@@ -210,6 +212,14 @@ struct Scene {
   Fog fog;
   std::vector<TextureMap> textures;
   Vec3 background{0.05f, 0.06f, 0.09f};
+  // Light points (SPEC §13; synthvis/light_points.h): drawn last, over everything, depth-tested.
+  std::vector<LightAppearance> lightAppearances;
+  std::vector<LightPoint> lightPoints;
+  std::vector<LightGroup> lightGroups;  // the host switches and dims them between frames
+  LightSettings lightSettings;
+  StarField stars;
+  // Simulation time, seconds: what blinking, sequences and the stars' rotation are functions of.
+  double time = 0;
 
   size_t triangleCount() const;  // over all instances
   // Material `index` (a Mesh's or a FreeFormObject's), or the default Material for −1 (none).
@@ -235,6 +245,14 @@ Result<Scene> loadJsonScene(const std::string& path);
 Result<Scene> parseJsonScene(const std::string& text, const std::string& path);
 Result<Scene> loadGltf(const std::string& path);
 Result<Scene> loadObj(const std::string& path);
+// The star catalogue (docs/lights.md#stars): xplanet's Bright Star Catalogue format — per line
+// declination (degrees), right ascension (hours), magnitude, an optional B−V colour index, then
+// anything (a quoted name, numbers); '#' comments. Errors name the file and line.
+Result<std::vector<Star>> loadStarCatalog(const std::string& path);
+Result<std::vector<Star>> parseStarCatalog(std::string_view text, const std::string& path);
+// A star's linear colour (maximum component 1) from its B−V index: the black-body temperature
+// by Ballesteros' formula, its chromaticity by a fit of the Planckian locus.
+Vec3 starColor(float bv);
 
 // Limits and switches shared by all loaders. The defaults suit files from disk.
 struct LoadOptions {

@@ -32,7 +32,10 @@ std::string FrameStats::summary() const {
                                  "{:.1f} MB, loaded in {:.1f} ms",
                                  terrains, terrainWindows, terrainSteps, terrainRays, terrainHits,
                                  terrainBytes / 1e6, terrainLoadMs)
-                   : std::string());
+                   : std::string()) +
+         (lightPoints ? fmt::format(" | lights {}: drawn {}, {:.2f} ms", lightPoints, lightsDrawn,
+                                    lightsMs)
+                      : std::string());
 }
 
 }  // namespace sv

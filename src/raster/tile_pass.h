@@ -19,7 +19,7 @@ namespace sv::raster {
 enum class PassStage : uint8_t {
   surfaces,  // after the opaque polygons: opaque surfaces ray cast into the depth (free forms)
   volumes,   // after the surfaces, before the translucent polygons: composited front to back
-  lights,    // after the translucent polygons, last: light points over everything
+  lights,    // last, once every tile's other passes are done: light points over everything
 };
 
 // What every pass learns of the frame before its tiles are drawn.
@@ -28,6 +28,10 @@ struct PassFrame {
   int samples = 1;            // per pixel
   const CoverageTables* coverage = nullptr;  // with samples > 1: their positions (pattern)
   core::ThreadPool* pool = nullptr;          // the frame's workers; prepare may use them
+  // For passes of stage `lights`: the whole frame's buffer. They run once every tile's other
+  // passes are done, so its depth is final when drawTile is called, and a pass may read any
+  // tile's depth (a light's centre may lie in the next tile); it still writes only its own tile.
+  const class FrameBuffer* frame = nullptr;
 };
 
 // One tile's shared buffers, as raster/framebuffer.h lays them out: `samples` depth and colour

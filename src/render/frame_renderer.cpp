@@ -57,6 +57,7 @@ struct FrameRenderer::Frame {
   // One batch: each tile is cleared, drawn and handed on in a per-thread 64×64 buffer. Several:
   // the tiles persist in a whole-frame buffer from batch to batch.
   bool wholeFrame;
+  bool lights;  // some pass is of stage lights: they run after all tiles, before the sink
   int tilesX, tilesY, tiles;
   // Colour sums (raster::TileWork::sums): each sample written at most once and read by nothing but
   // the resolve — priority masking (every written sample occupied), opaque triangles only (a
@@ -82,7 +83,12 @@ FrameRenderer::Frame FrameRenderer::frameOf(const DrawPackets& packets,
   f.triangles = static_cast<uint32_t>(packets.indices.size() / 3);
   f.batchTriangles = std::clamp<uint32_t>(settings.batchTriangles, 1, kMaxBatchTriangles);
   f.chunkSize = chunkTriangles(std::min(f.triangles, f.batchTriangles));
-  f.wholeFrame = f.triangles > f.batchTriangles;
+  // Light points read the whole frame's final depth (raster::PassFrame::frame): the tiles are
+  // kept until every one is drawn, then the lights are added and the tiles handed on.
+  f.lights = std::any_of(settings.passes.begin(), settings.passes.end(), [](auto* p) {
+    return p->stage() == raster::PassStage::lights;
+  });
+  f.wholeFrame = f.triangles > f.batchTriangles || f.lights;
   f.tilesX = (settings.width + raster::kTileSize - 1) >> raster::kTileLog2;
   f.tilesY = (settings.height + raster::kTileSize - 1) >> raster::kTileLog2;
   f.tiles = f.tilesX * f.tilesY;
@@ -147,7 +153,8 @@ void FrameRenderer::prepareBuffers(const DrawPackets& packets, const Frame& f) {
 void FrameRenderer::preparePasses(const FrameSettings& settings, const Frame& f) {
   afterOpaque_.clear();
   afterTranslucent_.clear();
-  const raster::PassFrame frame{settings.width, settings.height, f.samples, f.coverage, &pool_};
+  const raster::PassFrame frame{settings.width, settings.height, f.samples, f.coverage, &pool_,
+                                f.wholeFrame ? &fb_ : nullptr};
   for (raster::PassStage stage :
        {raster::PassStage::surfaces, raster::PassStage::volumes, raster::PassStage::lights})
     for (raster::TilePass* pass : settings.passes) {
@@ -176,6 +183,14 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
     stats.setupMs += core::msSince(t0);
     t0 = core::Clock::now();
     drawTiles(settings, f, batch);
+    stats.rasterMs += core::msSince(t0);
+  }
+  if (f.lights) {
+    const auto t0 = core::Clock::now();
+    pool_.parallelFor(size_t(f.tiles), [&](size_t tile, int worker) {
+      finishTile(settings, int(tile), fb_.tileDepth(int(tile)), fb_.tileColor(int(tile)), nullptr,
+                 worker);
+    });
     stats.rasterMs += core::msSince(t0);
   }
   addTileStats(stats);
@@ -272,7 +287,8 @@ void FrameRenderer::drawTiles(const FrameSettings& settings, const Frame& f, con
   });
 }
 
-// One tile's lists, in chunk order; after the frame's last batch its lights passes and its sink.
+// One tile's lists, in chunk order; after the frame's last batch its lights passes and its sink
+// (with light points, once every tile is drawn: FrameRenderer::render).
 void FrameRenderer::drawTile(const FrameSettings& settings, const Frame& f, const Batch& batch,
                              int tile, int worker) {
   WorkerScratch& scratch = scratch_[size_t(worker)];
@@ -318,10 +334,16 @@ void FrameRenderer::drawTile(const FrameSettings& settings, const Frame& f, cons
   w.worker = worker;
   w.opaqueDone = &opaqueDone_[size_t(tile)];
   raster::rasterizeTile(w, tileStats_[size_t(tile)]);
-  if (!batch.last) return;
-  const raster::TileTarget target{w.tileX, w.tileY, w.depth, w.color, worker};
+  if (batch.last && !f.lights) finishTile(settings, tile, w.depth, w.color, w.sums, worker);
+}
+
+// A drawn tile's last passes (stage lights) and its sink.
+void FrameRenderer::finishTile(const FrameSettings& settings, int tile, float* depth,
+                               uint16_t* color, int32_t* sums, int worker) {
+  const int tilesX = (settings.width + raster::kTileSize - 1) >> raster::kTileLog2;
+  const raster::TileTarget target{tile % tilesX, tile / tilesX, depth, color, worker};
   for (raster::TilePass* pass : afterTranslucent_) pass->drawTile(target);
-  if (settings.finishTile) settings.finishTile(tile, w.depth, w.color, w.sums);
+  if (settings.finishTile) settings.finishTile(tile, depth, color, sums);
 }
 
 void FrameRenderer::addTileStats(FrameStats& stats) const {

@@ -53,8 +53,8 @@ struct FrameSettings {
   bool debugOccupancy = false;
   // The frame's passes besides the polygons (raster/tile_pass.h), in the order render composed
   // them: each prepared once, drawn into every tile where its stage says — surfaces and volumes
-  // once the tile's opaque triangles are in, lights after its last triangle, before finishTile —
-  // and its statistics added to the frame's.
+  // once the tile's opaque triangles are in, lights once every tile is drawn (the frame then
+  // kept whole), before finishTile — and its statistics added to the frame's.
   std::vector<raster::TilePass*> passes;
 };
 
@@ -92,6 +92,8 @@ class FrameRenderer {
   void drawTiles(const FrameSettings& settings, const Frame& f, const Batch& batch);
   void drawTile(const FrameSettings& settings, const Frame& f, const Batch& batch, int tile,
                 int worker);
+  void finishTile(const FrameSettings& settings, int tile, float* depth, uint16_t* color,
+                  int32_t* sums, int worker);
   void addTileStats(FrameStats& stats) const;
 
   core::ThreadPool pool_;

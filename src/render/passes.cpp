@@ -21,6 +21,20 @@ std::vector<raster::TilePass*> FramePasses::compose(const scene::Scene& scene,
     terrains_.setTerrains(scene, camera, shading, o);
     passes.push_back(&terrains_);
   }
+  if (!scene.lightPoints.empty() || !scene.stars.stars.empty()) {
+    lights::LightInput in;
+    in.appearances = scene.lightAppearances;
+    in.points = scene.lightPoints;
+    in.groups = scene.lightGroups;
+    in.settings = scene.lightSettings;
+    in.stars = scene.stars.stars.empty() ? nullptr : &scene.stars;
+    in.time = scene.time;
+    in.view = camera.view;
+    in.projection = camera.projection;
+    in.fogBeta = scene.fog.enabled ? scene.fog.beta : 0.0f;
+    lights_.setLights(in);
+    passes.push_back(&lights_);
+  }
   return passes;
 }
 

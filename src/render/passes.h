@@ -1,10 +1,11 @@
 // The frame's passes besides the polygons (raster/tile_pass.h), composed in tile order:
-// ray-cast surfaces (free forms, then terrain), volumes, light points.
+// ray-cast surfaces (free forms, then terrain), volumes, light points (and stars).
 #pragma once
 
 #include <vector>
 
 #include "freeform/freeform_pass.h"
+#include "lights/light_pass.h"
 #include "render/camera.h"
 #include "render/shading_tables.h"
 #include "render/terrain_pass.h"
@@ -22,6 +23,7 @@ class FramePasses {
  private:
   freeform::FreeFormPass freeForms_;
   TerrainPass terrains_;
+  lights::LightPass lights_;
 };
 
 }  // namespace sv::render

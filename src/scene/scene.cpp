@@ -85,6 +85,69 @@ const char* textureFilterName(TextureFilter filter) {
   return "inherit";
 }
 
+namespace {
+
+bool inRange(float v, float lo, float hi) { return v >= lo && v <= hi; }
+
+// The light points' invariants (synthvis/light_points.h): every number finite and in its range,
+// every index in range. The per-light checks are branch-free reductions (they run every frame).
+Status validateLights(const Scene& scene) {
+  auto fail = [](std::string message) { return Status(Error{"", "", std::move(message)}); };
+  for (size_t i = 0; i < scene.lightAppearances.size(); ++i) {
+    const LightAppearance& a = scene.lightAppearances[i];
+    const bool ok = isFinite(a.color) && isFinite(a.backColor) && isFinite(a.lowColor) &&
+                    isFinite(a.direction) && length(a.direction) > 0 &&
+                    inRange(a.intensity, 0, 1e9f) && inRange(a.horizontalLobe, 1e-3f, 179.9f) &&
+                    inRange(a.verticalLobe, 1e-3f, 179.9f) && inRange(a.falloff, 0, 64) &&
+                    inRange(a.splitAngle, -90, 90) && inRange(a.splitWidth, 0, 90) &&
+                    inRange(a.blink.period, 0, 1e6f) && inRange(a.blink.phase, -1e6f, 1e6f) &&
+                    inRange(a.blink.onFraction, 0, 1) && inRange(a.rotationPeriod, 0, 1e6f) &&
+                    a.color.x >= 0 && a.color.y >= 0 && a.color.z >= 0;
+    if (!ok) return fail(fmt::format("lightAppearances[{}] ('{}'): a value is not finite or out "
+                                     "of range", i, a.name));
+  }
+  bool ok = true;
+  const auto appearances = uint32_t(scene.lightAppearances.size());
+  const auto groups = int32_t(scene.lightGroups.size());
+  for (const LightPoint& p : scene.lightPoints)
+    ok &= isFinite(p.position) & (p.appearance < appearances) & (p.group >= -1) &
+          (p.group < groups) & std::isfinite(p.phase);
+  if (!ok)
+    for (size_t i = 0; i < scene.lightPoints.size(); ++i) {
+      const LightPoint& p = scene.lightPoints[i];
+      if (!isFinite(p.position) || !std::isfinite(p.phase))
+        return fail(fmt::format("lightPoints[{}]: not finite", i));
+      if (p.appearance >= appearances)
+        return fail(fmt::format("lightPoints[{}]: appearance {} does not exist ({} appearances)",
+                                i, p.appearance, appearances));
+      if (p.group < -1 || p.group >= groups)
+        return fail(fmt::format("lightPoints[{}]: group {} does not exist ({} groups)", i,
+                                p.group, groups));
+    }
+  for (size_t i = 0; i < scene.lightGroups.size(); ++i)
+    if (!inRange(scene.lightGroups[i].dim, 0, 1))
+      return fail(fmt::format("lightGroups[{}] ('{}'): dim {} is not in [0, 1]", i,
+                              scene.lightGroups[i].name, scene.lightGroups[i].dim));
+  const LightSettings& l = scene.lightSettings;
+  if (!inRange(l.exposure, 0, 1e12f) || !inRange(l.minSize, 0.5f, 64) ||
+      !inRange(l.maxSize, l.minSize, 64) || !inRange(l.punchThrough, 0, 1) ||
+      !inRange(l.depthBias, 0, 1e6f))
+    return fail("lightSettings: a value is not finite or out of range (sizes 0.5 … 64 pixels, "
+                "min ≤ max; punchThrough 0 … 1)");
+  const StarField& f = scene.stars;
+  if (!inRange(f.latitude, -90, 90) || !std::isfinite(f.siderealTime) ||
+      !inRange(f.brightness, 0, 1e6f) || !std::isfinite(f.limit))
+    return fail("stars: latitude, siderealTime, brightness or limit not finite or out of range");
+  ok = true;
+  for (const Star& star : f.stars)
+    ok &= isFinite(star.direction) & isFinite(star.color) & std::isfinite(star.magnitude);
+  if (!ok) return fail("stars: a star's direction, colour or magnitude is not finite");
+  if (!std::isfinite(scene.time)) return fail("time is not finite");
+  return {};
+}
+
+}  // namespace
+
 Status validate(const Scene& scene, const std::string& file, bool vertexData) {
   auto fail = [&](std::string message) { return Status(Error{file, "", std::move(message)}); };
 
@@ -188,6 +251,7 @@ Status validate(const Scene& scene, const std::string& file, bool vertexData) {
   for (size_t i = 0; i < scene.pointLights.size(); ++i)
     if (!isFinite(scene.pointLights[i].position) || !isFinite(scene.pointLights[i].color))
       return fail(fmt::format("pointLights[{}]: not finite", i));
+  if (Status s = validateLights(scene); !s) return Status(Error{file, "", s.error().message});
   for (size_t i = 0; i < scene.cameras.size(); ++i) {
     const Camera& c = scene.cameras[i];
     if (!isFinite(c.position) || !isFinite(c.target) || !isFinite(c.up) ||

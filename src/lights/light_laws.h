@@ -1,0 +1,137 @@
+// The laws a light point obeys (SPEC §13, docs/lights.md): blinking, lobes, fog, on-screen size
+// and energy, the splat's weights, the stars' sky. Pure functions, each tested against its
+// formula (tests/lights/light_laws_test.cpp); the pass (light_pass.h) applies them per frame.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "synthvis/light_points.h"
+
+namespace sv::lights {
+
+// Whether a blinking light is lit at time `t` (seconds): frac(t / period + phase) < onFraction,
+// phase the appearance's plus the light's own (turns). Steady lights (period 0) always are.
+inline bool blinkOn(const scene::LightBlink& b, float lightPhase, double t) {
+  if (!(b.period > 0)) return true;
+  const double u = t / double(b.period) + double(b.phase) + double(lightPhase);
+  return u - std::floor(u) < double(b.onFraction);
+}
+
+// The lobe's axis at time t: `direction`, or for a rotating beacon `direction` turned about
+// world up by 2π·(t / rotationPeriod + lightPhase), from +x (east) toward +z (south): clockwise
+// seen from above, as beacons turn.
+inline Vec3 lobeAxis(const scene::LightAppearance& a, float lightPhase, double t) {
+  if (!(a.rotationPeriod > 0)) return a.direction;
+  const double turns = t / double(a.rotationPeriod) + double(lightPhase);
+  const double angle = 2 * std::numbers::pi * (turns - std::floor(turns));
+  const double c = std::cos(angle), s = std::sin(angle);
+  const Vec3 d = a.direction;
+  return {float(c * d.x - s * d.z), d.y, float(s * d.x + c * d.z)};
+}
+
+// A directional light's factor toward a viewer in unit direction `toViewer` (from the light),
+// for a lobe about unit `axis`: (1 − t)^falloff with t = (x / tan(H/2))² + (y / tan(V/2))², where
+// x, y, z are `toViewer` in the lobe's frame (z along the axis, x horizontal — perpendicular to
+// the axis and world up — y the rest) and x, y are taken over z; 0 where z ≤ 0 or t ≥ 1.
+inline float lobeFactor(Vec3 axis, Vec3 toViewer, float horizontalLobe, float verticalLobe,
+                        float falloff) {
+  const float z = dot(axis, toViewer);
+  if (!(z > 0)) return 0;
+  Vec3 right = cross(axis, Vec3{0, 1, 0});
+  const float r2 = dot(right, right);
+  right = r2 > 1e-12f ? right * (1 / std::sqrt(r2)) : Vec3{1, 0, 0};  // a vertical axis: +x
+  const Vec3 up = cross(right, axis);
+  const float th = std::tan(horizontalLobe * (std::numbers::pi_v<float> / 360));
+  const float tv = std::tan(verticalLobe * (std::numbers::pi_v<float> / 360));
+  const float x = dot(right, toViewer) / (z * th), y = dot(up, toViewer) / (z * tv);
+  const float t = x * x + y * y;
+  if (!(t < 1)) return 0;
+  return falloff == 1 ? 1 - t : std::pow(1 - t, falloff);
+}
+
+// The colour a light shows a viewer in unit direction `toViewer` (from the light), times its
+// lobe factor: the front lobe in `color` (or, split, blended toward `lowColor` below the split
+// elevation), the back lobe in `backColor`; an omnidirectional light is `color` everywhere.
+inline Vec3 appearanceColor(const scene::LightAppearance& a, Vec3 axis, Vec3 toViewer) {
+  Vec3 front = a.color;
+  if (a.split) {
+    // Elevation of the viewer above the light's horizontal plane, degrees.
+    const float elevation =
+        std::asin(std::clamp(toViewer.y, -1.0f, 1.0f)) * (180 / std::numbers::pi_v<float>);
+    const float w = std::max(a.splitWidth, 1e-6f);
+    const float high = std::clamp((elevation - a.splitAngle) / w + 0.5f, 0.0f, 1.0f);
+    front = a.lowColor * (1 - high) + a.color * high;
+  }
+  if (!a.directional) return front;
+  const float f = lobeFactor(axis, toViewer, a.horizontalLobe, a.verticalLobe, a.falloff);
+  if (f > 0) return front * f;
+  if (!a.backLobe) return {};
+  return a.backColor * lobeFactor(-axis, toViewer, a.horizontalLobe, a.verticalLobe, a.falloff);
+}
+
+// The fog's transmission for a light at distance d: 2^(−β · punchThrough · d) (SPEC §8's law
+// with the light's punch-through, docs/lights.md).
+inline float fogTransmission(float beta, float punchThrough, float d) {
+  return beta > 0 ? std::exp2(-beta * punchThrough * d) : 1.0f;
+}
+
+// The on-screen energy of a light of intensity I candela at d metres, transmission T:
+// Φ = exposure · I · T / d² (pixels of full white).
+inline float screenEnergy(float exposure, float intensity, float transmission, float d) {
+  return exposure * intensity * transmission / (d * d);
+}
+
+// The diameter a light of energy Φ is drawn at: its natural size, the disc of area Φ
+// (D = 2·√(Φ/π): full white at unit brightness), clamped to [minSize, maxSize]. Below the minimum
+// the light keeps the minimum size and its energy (it fades); above the maximum it brightens.
+inline float splatDiameter(float energy, float minSize, float maxSize) {
+  return std::clamp(2 * std::sqrt(energy / std::numbers::pi_v<float>), minSize, maxSize);
+}
+
+// The splat's kernel radius for a diameter D: the disc widened by half a pixel, so that a 1-px
+// light still reaches the pixel centres around it (the aperture of SPEC §3.2).
+inline float splatRadius(float diameter) { return 0.5f * diameter + 0.5f; }
+
+// The kernel's weight at squared distance r² from the light's centre, radius R (1/R² given):
+// (1 − r²/R²)², smooth to its edge; a pixel's share of the energy is its weight over the sum
+// of the weights of every pixel centre within R (so the total is Φ wherever the light falls).
+inline float splatWeight(float r2, float invR2) {
+  const float u = 1 - r2 * invR2;
+  return u > 0 ? u * u : 0;
+}
+
+// The sum of the weights over pixel centres (i + ½, j + ½) within radius R of (x, y).
+inline float splatWeightSum(float x, float y, float radius) {
+  const float invR2 = 1 / (radius * radius);
+  const int x0 = int(std::floor(x - radius)), x1 = int(std::floor(x + radius));
+  const int y0 = int(std::floor(y - radius)), y1 = int(std::floor(y + radius));
+  float sum = 0;
+  for (int j = y0; j <= y1; ++j) {
+    const float dy = float(j) + 0.5f - y;
+    for (int i = x0; i <= x1; ++i) {
+      const float dx = float(i) + 0.5f - x;
+      sum += splatWeight(dx * dx + dy * dy, invR2);
+    }
+  }
+  return sum;
+}
+
+// A star's world direction at time t (seconds): equatorial `e` (x toward RA 0h, z toward the
+// celestial pole) turned by the local sidereal time into the observer's horizon frame, then to
+// world axes (+y up, −z north, +x east).
+inline Vec3 starDirection(Vec3 e, float latitudeDegrees, double siderealHours, double t) {
+  const double lst = siderealHours + t * (1.0027379 / 3600);  // hours
+  const double theta = lst * (std::numbers::pi / 12);          // the hour angle of RA 0h
+  // Hour-angle frame: x toward the meridian (hour angle 0), y toward the west (hour angle 6h).
+  const double c = std::cos(theta), s = std::sin(theta);
+  const double hx = c * e.x + s * e.y, hy = s * e.x - c * e.y, hz = e.z;
+  // To the horizon: south, west, zenith components.
+  const double phi = double(latitudeDegrees) * (std::numbers::pi / 180);
+  const double sp = std::sin(phi), cp = std::cos(phi);
+  const double south = sp * hx - cp * hz, west = hy, zenith = cp * hx + sp * hz;
+  return {float(-west), float(zenith), float(south)};
+}
+
+}  // namespace sv::lights

@@ -1,0 +1,241 @@
+// Based on: SPEC §13 (light points: tiny, bright, anti-aliased, attenuated by distance and fog,
+// directional and blinking, depth-tested), §5 (the frame's samples), §8 (fog, linear light).
+#include "lights/light_pass.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/timing.h"
+#include "lights/light_laws.h"
+#include "raster/framebuffer.h"
+
+namespace sv::lights {
+namespace {
+
+using raster::FrameBuffer;
+using raster::kTileLog2;
+using raster::kTileSize;
+
+// Lights are projected in chunks of this many (fixed: the splats' order never depends on the
+// thread count).
+constexpr size_t kChunk = 4096;
+// A light adds less than half a 16-bit step to every pixel below this: not drawn.
+constexpr float kDarkest = 0.5f;
+
+}  // namespace
+
+void LightPass::setLights(const LightInput& input) { in_ = input; }
+
+float LightPass::eyeDepthOf(float windowDepth) const {
+  if (!(windowDepth < 1.0f)) return zfar_;
+  return m32_ / (2 * windowDepth - 1 + m22_);
+}
+
+// Clamp a splat's size, weigh its kernel, and scale its colour so that the weights carry Φ.
+bool LightPass::finishSplat(float energy, Vec3 color, Splat& s) const {
+  const float peak = energy * std::max({color.x, color.y, color.z}) * 65535;
+  if (!(peak >= kDarkest)) return false;
+  const scene::LightSettings& ls = in_.settings;
+  s.radius = splatRadius(splatDiameter(energy, ls.minSize, ls.maxSize));
+  s.invR2 = 1 / (s.radius * s.radius);
+  if (s.x + s.radius < 0 || s.y + s.radius < 0 || s.x - s.radius > float(frame_.width) ||
+      s.y - s.radius > float(frame_.height))
+    return false;
+  const float scale = energy * 65535 / splatWeightSum(s.x, s.y, s.radius);
+  s.rgb[0] = color.x * scale;
+  s.rgb[1] = color.y * scale;
+  s.rgb[2] = color.z * scale;
+  return true;
+}
+
+bool LightPass::projectPoint(const scene::LightPoint& p, Splat& s) const {
+  float dim = 1;
+  if (p.group >= 0) {
+    const scene::LightGroup& g = in_.groups[size_t(p.group)];
+    if (!g.on) return false;
+    dim = g.dim;
+  }
+  const scene::LightAppearance& a = in_.appearances[p.appearance];
+  if (!blinkOn(a.blink, p.phase, in_.time)) return false;
+  const Vec4 eye = in_.view * Vec4{p.position.x, p.position.y, p.position.z, 1};
+  const Vec4 c = in_.projection * eye;
+  if (!(c.w > 0) || !(c.z >= -c.w) || !(c.z <= c.w)) return false;  // behind, near, beyond far
+  const float invW = 1 / c.w;
+  s.x = (c.x * invW + 1) * 0.5f * float(frame_.width);
+  s.y = (1 - c.y * invW) * 0.5f * float(frame_.height);
+  s.eyeDepth = -eye.z;
+  const Vec3 toEye = eye_ - p.position;
+  const float d = length(toEye);
+  if (!(d > 0)) return false;
+  const Vec3 color = appearanceColor(a, lobeAxis(a, p.phase, in_.time), toEye * (1 / d));
+  const float transmission = fogTransmission(in_.fogBeta, in_.settings.punchThrough, d);
+  const float energy =
+      screenEnergy(in_.settings.exposure, a.intensity * dim, transmission, d);
+  return finishSplat(energy, color, s);
+}
+
+bool LightPass::projectStar(const scene::Star& star, Splat& s) const {
+  const scene::StarField& f = *in_.stars;
+  if (star.magnitude > f.limit) return false;
+  const Vec3 e = star.direction;
+  const Vec3 w = starAxes_[0] * e.x + starAxes_[1] * e.y + starAxes_[2] * e.z;
+  const Vec4 eye = in_.view * Vec4{w.x, w.y, w.z, 0};  // a direction: at infinity
+  const Vec4 c = in_.projection * eye;
+  if (!(c.w > 0)) return false;
+  const float invW = 1 / c.w;
+  s.x = (c.x * invW + 1) * 0.5f * float(frame_.width);
+  s.y = (1 - c.y * invW) * 0.5f * float(frame_.height);
+  s.eyeDepth = 0;
+  return finishSplat(f.brightness * std::exp2(-0.4f * std::log2(10.0f) * star.magnitude),
+                     star.color, s);
+}
+
+void LightPass::projectRange(size_t begin, size_t end, std::vector<Splat>& out) const {
+  out.clear();
+  const size_t points = in_.points.size();
+  for (size_t i = begin; i < end; ++i) {
+    Splat s;
+    const bool drawn = i < points ? projectPoint(in_.points[i], s)
+                                  : projectStar(in_.stars->stars[i - points], s);
+    if (drawn) out.push_back(s);
+  }
+}
+
+void LightPass::prepare(const raster::PassFrame& frame) {
+  const auto t0 = core::Clock::now();
+  frame_ = frame;
+  const Mat4& v = in_.view;
+  // The eye: view = [R t], eye = −Rᵀ t.
+  for (int j = 0; j < 3; ++j) {
+    float e = 0;
+    for (int i = 0; i < 3; ++i) e -= v.m[j][i] * v.m[3][i];
+    (j == 0 ? eye_.x : j == 1 ? eye_.y : eye_.z) = e;
+  }
+  m22_ = in_.projection.m[2][2];
+  m32_ = in_.projection.m[3][2];
+  zfar_ = m32_ / (1 + m22_);
+  const size_t stars = in_.stars ? in_.stars->stars.size() : 0;
+  if (stars) {
+    const scene::StarField& f = *in_.stars;
+    starAxes_[0] = starDirection({1, 0, 0}, f.latitude, f.siderealTime, in_.time);
+    starAxes_[1] = starDirection({0, 1, 0}, f.latitude, f.siderealTime, in_.time);
+    starAxes_[2] = starDirection({0, 0, 1}, f.latitude, f.siderealTime, in_.time);
+  }
+  const size_t total = in_.points.size() + stars;
+  candidates_ = total;
+  const size_t chunks = (total + kChunk - 1) / kChunk;
+  chunks_.resize(chunks);
+  frame.pool->parallelFor(chunks, [&](size_t c, int) {
+    projectRange(c * kChunk, std::min(total, (c + 1) * kChunk), chunks_[c]);
+  });
+  splats_.clear();
+  for (const std::vector<Splat>& c : chunks_) splats_.insert(splats_.end(), c.begin(), c.end());
+  bin();
+  workerMs_.assign(size_t(frame.pool->threadCount()), 0.0);
+  prepareMs_ = core::msSince(t0);
+}
+
+// Each splat listed for every tile its kernel's box reaches, in splat order (a counting sort).
+void LightPass::bin() {
+  const int tilesX = (frame_.width + kTileSize - 1) >> kTileLog2;
+  const int tilesY = (frame_.height + kTileSize - 1) >> kTileLog2;
+  tileStart_.assign(size_t(tilesX) * size_t(tilesY) + 1, 0);
+  auto range = [&](const Splat& s, int& tx0, int& tx1, int& ty0, int& ty1) {
+    tx0 = std::max(0, int(std::floor(s.x - s.radius)) >> kTileLog2);
+    tx1 = std::min(tilesX - 1, int(std::floor(s.x + s.radius)) >> kTileLog2);
+    ty0 = std::max(0, int(std::floor(s.y - s.radius)) >> kTileLog2);
+    ty1 = std::min(tilesY - 1, int(std::floor(s.y + s.radius)) >> kTileLog2);
+  };
+  for (const Splat& s : splats_) {
+    int tx0, tx1, ty0, ty1;
+    range(s, tx0, tx1, ty0, ty1);
+    for (int ty = ty0; ty <= ty1; ++ty)
+      for (int tx = tx0; tx <= tx1; ++tx) ++tileStart_[size_t(ty * tilesX + tx) + 1];
+  }
+  for (size_t t = 1; t < tileStart_.size(); ++t) tileStart_[t] += tileStart_[t - 1];
+  tileSplats_.resize(tileStart_.back());
+  std::vector<uint32_t> fill(tileStart_.begin(), tileStart_.end() - 1);
+  for (size_t i = 0; i < splats_.size(); ++i) {
+    int tx0, tx1, ty0, ty1;
+    range(splats_[i], tx0, tx1, ty0, ty1);
+    for (int ty = ty0; ty <= ty1; ++ty)
+      for (int tx = tx0; tx <= tx1; ++tx)
+        tileSplats_[fill[size_t(ty * tilesX + tx)]++] = uint32_t(i);
+  }
+}
+
+// Visibility (docs/lights.md): the fraction of the centre pixel's samples that do not hide the
+// light. A sample hides a light when its surface is nearer than the light by more than the
+// depth bias plus the surface's own spread — how much nearer the surface is in the pixels around
+// (ground seen at a grazing angle falls away steeply from pixel to pixel; a wall does not). A
+// star is seen only where nothing was drawn.
+float LightPass::visibility(const Splat& s) const {
+  const int cx = std::clamp(int(std::floor(s.x)), 0, frame_.width - 1);
+  const int cy = std::clamp(int(std::floor(s.y)), 0, frame_.height - 1);
+  const int n = frame_.samples;
+  auto depthAt = [&](int x, int y, int k) {
+    const int tile = (y >> kTileLog2) * ((frame_.width + kTileSize - 1) >> kTileLog2) +
+                     (x >> kTileLog2);
+    return frame_.frame->tileDepth(tile)[FrameBuffer::depthOffset(x, y, n, k)];
+  };
+  int visible = 0;
+  if (s.eyeDepth == 0) {
+    for (int k = 0; k < n; ++k) visible += !(depthAt(cx, cy, k) < 1.0f);
+    return float(visible) / float(n);
+  }
+  const float centre = eyeDepthOf(depthAt(cx, cy, 0));
+  float nearest = centre;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int x = cx + dx, y = cy + dy;
+      if (x < 0 || y < 0 || x >= frame_.width || y >= frame_.height) continue;
+      nearest = std::min(nearest, eyeDepthOf(depthAt(x, y, 0)));
+    }
+  const float limit = s.eyeDepth - in_.settings.depthBias - (centre - nearest);
+  for (int k = 0; k < n; ++k) visible += !(eyeDepthOf(depthAt(cx, cy, k)) < limit);
+  return float(visible) / float(n);
+}
+
+void LightPass::drawTile(const raster::TileTarget& tile) {
+  const auto t0 = core::Clock::now();
+  const int tilesX = (frame_.width + kTileSize - 1) >> kTileLog2;
+  const size_t t = size_t(tile.tileY * tilesX + tile.tileX);
+  const int ox = tile.tileX * kTileSize, oy = tile.tileY * kTileSize;
+  const int xEnd = std::min(ox + kTileSize, frame_.width);
+  const int yEnd = std::min(oy + kTileSize, frame_.height);
+  const int n = frame_.samples;
+  for (uint32_t e = tileStart_[t]; e < tileStart_[t + 1]; ++e) {
+    const Splat& s = splats_[tileSplats_[e]];
+    const float v = visibility(s);
+    if (!(v > 0)) continue;
+    const int x0 = std::max(ox, int(std::floor(s.x - s.radius)));
+    const int x1 = std::min(xEnd - 1, int(std::floor(s.x + s.radius)));
+    const int y0 = std::max(oy, int(std::floor(s.y - s.radius)));
+    const int y1 = std::min(yEnd - 1, int(std::floor(s.y + s.radius)));
+    for (int y = y0; y <= y1; ++y) {
+      const float dy = float(y) + 0.5f - s.y;
+      for (int x = x0; x <= x1; ++x) {
+        const float dx = float(x) + 0.5f - s.x;
+        const float w = splatWeight(dx * dx + dy * dy, s.invR2) * v;
+        if (!(w > 0)) continue;
+        int add[3];
+        for (int ch = 0; ch < 3; ++ch) add[ch] = int(std::lround(std::min(s.rgb[ch] * w, 65535.f)));
+        if ((add[0] | add[1] | add[2]) == 0) continue;
+        for (int k = 0; k < n; ++k)
+          for (int ch = 0; ch < 3; ++ch) {
+            uint16_t& c = tile.color[FrameBuffer::colorOffset(x, y, ch, n, k)];
+            c = uint16_t(std::min(65535, int(c) + add[ch]));
+          }
+      }
+    }
+  }
+  workerMs_[size_t(tile.worker)] += core::msSince(t0);
+}
+
+void LightPass::addStats(FrameStats& stats) const {
+  stats.lightPoints += candidates_;
+  stats.lightsDrawn += splats_.size();
+  stats.lightsMs += prepareMs_ + *std::max_element(workerMs_.begin(), workerMs_.end());
+}
+
+}  // namespace sv::lights

@@ -1,0 +1,82 @@
+// Light points in the frame (SPEC §13): the last pass of a tile (raster/tile_pass.h, stage
+// `lights`), after the translucent polygons. Each light becomes an anti-aliased splat added in
+// linear light to the samples of the pixels it reaches, its energy conserved whatever its size
+// and sub-pixel position; hidden where the frame's surface at its centre is nearer.
+//
+// Per frame (prepare, in parallel over chunks of lights): every light projected, culled (behind
+// the eye, off screen, off, dark, beyond the far plane), its blink, lobe, fog, energy, size and
+// weight sum worked out (lights/light_laws.h), then listed for every tile its splat reaches, in
+// light order. Per tile (drawTile): each listed light's visibility from the depth around its
+// centre pixel — which may lie in another tile: the lights stage runs once every tile's other
+// passes are done (FrameRenderer), so the whole frame's depth is final and read-only — then its
+// weights added into the tile's colour samples. Depth is left as it was.
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "raster/tile_pass.h"
+#include "synthvis/light_points.h"
+
+namespace sv::lights {
+
+// What the pass needs of the scene and the frame's camera (render fills it; the spans and the
+// star field must outlive the frame).
+struct LightInput {
+  std::span<const scene::LightAppearance> appearances;
+  std::span<const scene::LightPoint> points;
+  std::span<const scene::LightGroup> groups;
+  scene::LightSettings settings;
+  const scene::StarField* stars = nullptr;
+  double time = 0;   // seconds
+  Mat4 view;         // world → eye
+  Mat4 projection;   // eye → clip (OpenGL conventions: depth row −m22 + m32 / s)
+  float fogBeta = 0;  // the scene's fog β, 0 without fog
+};
+
+// One light as the frame draws it.
+struct Splat {
+  float x = 0, y = 0;     // raster position, pixels (pixel centres at i + ½)
+  float eyeDepth = 0;     // the light's depth along the view axis (s > 0); 0 for a star
+  float radius = 1;       // the kernel's, pixels (light_laws.h: splatRadius)
+  float invR2 = 1;
+  float rgb[3] = {};      // Φ · colour · 65535 / Σw: a weight-1 pixel's 16-bit addition
+};
+
+class LightPass final : public raster::TilePass {
+ public:
+  void setLights(const LightInput& input);
+
+  raster::PassStage stage() const override { return raster::PassStage::lights; }
+  void prepare(const raster::PassFrame& frame) override;
+  void drawTile(const raster::TileTarget& tile) override;
+  void addStats(FrameStats& stats) const override;
+
+  // The frame's splats in drawing order (after prepare): tests read them.
+  std::span<const Splat> splats() const { return splats_; }
+
+ private:
+  // Lights [begin, end) of the input (stars after the points) into `out`.
+  void projectRange(size_t begin, size_t end, std::vector<Splat>& out) const;
+  bool projectPoint(const scene::LightPoint& p, Splat& s) const;
+  bool projectStar(const scene::Star& star, Splat& s) const;
+  bool finishSplat(float energy, Vec3 color, Splat& s) const;
+  void bin();
+  // The fraction of the centre pixel's samples that do not hide splat `s`.
+  float visibility(const Splat& s) const;
+  float eyeDepthOf(float windowDepth) const;
+
+  LightInput in_;
+  raster::PassFrame frame_;
+  float m22_ = 0, m32_ = 1, zfar_ = 1;  // the projection's depth row, its far plane
+  Vec3 eye_;
+  Vec3 starAxes_[3];  // equatorial x, y, z in world at this frame's time
+  std::vector<std::vector<Splat>> chunks_;
+  std::vector<Splat> splats_;
+  std::vector<uint32_t> tileStart_, tileSplats_;  // per tile: its splats' indices, in order
+  std::vector<double> workerMs_;
+  double prepareMs_ = 0;
+  uint64_t candidates_ = 0;
+};
+
+}  // namespace sv::lights
