@@ -83,11 +83,12 @@ inline float screenEnergy(float exposure, float intensity, float transmission, f
   return exposure * intensity * transmission / (d * d);
 }
 
-// The diameter a light of energy Φ is drawn at: its natural size, the disc of area Φ
-// (D = 2·√(Φ/π): full white at unit brightness), clamped to [minSize, maxSize]. Below the minimum
-// the light keeps the minimum size and its energy (it fades); above the maximum it brightens.
+// The diameter a light of energy Φ is drawn at: its natural size — the kernel (splatWeight) of
+// radius R = √(3Φ/π) carries Φ at a peak of full white (the kernel integrates to πR²/3), and the
+// diameter is 2R − 1 (splatRadius's inverse) — clamped to [minSize, maxSize]. Below the minimum
+// the light keeps the minimum size and its energy, and fades; above the maximum it brightens.
 inline float splatDiameter(float energy, float minSize, float maxSize) {
-  return std::clamp(2 * std::sqrt(energy / std::numbers::pi_v<float>), minSize, maxSize);
+  return std::clamp(2 * std::sqrt(3 * energy / std::numbers::pi_v<float>) - 1, minSize, maxSize);
 }
 
 // The splat's kernel radius for a diameter D: the disc widened by half a pixel, so that a 1-px

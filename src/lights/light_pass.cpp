@@ -166,9 +166,11 @@ void LightPass::bin() {
 
 // Visibility (docs/lights.md): the fraction of the centre pixel's samples that do not hide the
 // light. A sample hides a light when its surface is nearer than the light by more than the
-// depth bias plus the surface's own spread — how much nearer the surface is in the pixels around
-// (ground seen at a grazing angle falls away steeply from pixel to pixel; a wall does not). A
-// star is seen only where nothing was drawn.
+// depth bias plus the surface's own spread — the largest depth difference between the centre
+// pixel and the eight around it: ground seen at a grazing angle changes depth steeply from pixel
+// to pixel, so a light standing on it stays lit; a wall facing the eye does not, and hides what
+// is behind it (but within a pixel of a silhouette a light behind shows). A star is seen only
+// where nothing was drawn.
 float LightPass::visibility(const Splat& s) const {
   const int cx = std::clamp(int(std::floor(s.x)), 0, frame_.width - 1);
   const int cy = std::clamp(int(std::floor(s.y)), 0, frame_.height - 1);
@@ -184,14 +186,14 @@ float LightPass::visibility(const Splat& s) const {
     return float(visible) / float(n);
   }
   const float centre = eyeDepthOf(depthAt(cx, cy, 0));
-  float nearest = centre;
+  float spread = 0;
   for (int dy = -1; dy <= 1; ++dy)
     for (int dx = -1; dx <= 1; ++dx) {
       const int x = cx + dx, y = cy + dy;
       if (x < 0 || y < 0 || x >= frame_.width || y >= frame_.height) continue;
-      nearest = std::min(nearest, eyeDepthOf(depthAt(x, y, 0)));
+      spread = std::max(spread, std::fabs(eyeDepthOf(depthAt(x, y, 0)) - centre));
     }
-  const float limit = s.eyeDepth - in_.settings.depthBias - (centre - nearest);
+  const float limit = s.eyeDepth - in_.settings.depthBias - spread;
   for (int k = 0; k < n; ++k) visible += !(eyeDepthOf(depthAt(cx, cy, k)) < limit);
   return float(visible) / float(n);
 }
