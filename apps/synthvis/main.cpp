@@ -135,10 +135,32 @@ struct GeneratorArgs {
   int objects = 100;
   int size = 4096;  // terrain: heights a side
   std::string terrainFilter = "bilinear";
+  std::string stars = "auto";  // lights: the star catalogue, "auto" or "none"
+  int lights = 100000;         // lights: light points per channel, stars included
 };
+
+// lights --stars auto: xplanet's catalogue where Debian installs it, or where scripts/lib.sh
+// (sv_data) unpacks it in a checkout (the current directory); none if neither is there.
+std::string starCatalog(const std::string& option) {
+  if (option == "none") return "";
+  if (option != "auto") return option;
+  for (const char* path :
+       {"/usr/share/xplanet/stars/BSC", "build-data/root/usr/share/xplanet/stars/BSC"})
+    if (std::FILE* f = std::fopen(path, "rb")) {
+      std::fclose(f);
+      return path;
+    }
+  return "";
+}
 
 void addGeneratorOptions(CLI::App* app, GeneratorArgs& g) {
   app->add_option("--count", g.tris.count, "tris: number of triangles")->capture_default_str();
+  app->add_option("--lights", g.lights, "lights: light points, stars included")
+      ->capture_default_str();
+  app->add_option("--stars", g.stars,
+                  "lights: the star catalogue (xplanet's BSC), auto (found where Debian or "
+                  "scripts/lib.sh puts it) or none")
+      ->capture_default_str();
   app->add_option("--area", g.tris.area, "tris: mean projected area, pixels")
       ->capture_default_str();
   app->add_option("--depth", g.tris.depth, "tris: depth complexity (0 = whole screen)")
@@ -204,6 +226,9 @@ sv::Result<sv::reference::BenchCase> generatorCase(const std::string& kind,
   auto interp = sv::terrain::parseInterpolation(g.terrainFilter);
   if (!interp) return interp.error();
   c.terrain.bicubic = interp.value() == sv::terrain::Interpolation::bicubic;
+  c.lights.count = g.lights;
+  c.lights.seed = g.tris.seed;
+  c.lights.starCatalog = starCatalog(g.stars);
   return c;
 }
 

@@ -112,6 +112,22 @@ struct TerrainParams {
 };
 Result<Scene> generateTerrain(const TerrainParams& params);
 
+// BENCH.md `lights`: `count` light points over the `layers` D = 1 scene (its screen-filling grid at
+// view distance 2, its camera: 60°, looking down −Z): the Bright Star Catalogue when `starCatalog`
+// names it (behind the grid: every star projected and tested, none seen), then runway-like
+// strings (a quarter: pairs of edge rows and a centreline running away from the eye, directional,
+// some blinking in sequence) and a city grid (the rest: omnidirectional, warm), all in front of
+// the grid at view distances 0.15 … 1.9, sized 1.5 … 4 px. Lights are in scene units: intensity
+// and exposure are set for that scale.
+struct LightsParams {
+  int count = 100000;
+  uint64_t seed = 1;
+  int width = 1920;
+  int height = 1080;
+  std::string starCatalog;  // xplanet's BSC; empty: no stars
+};
+Result<Scene> generateLights(const LightsParams& params);
+
 // The frame every generated scene shares: one instance of mesh 0 with material 0 (unlit,
 // double-sided, named `name`), the BENCH.md camera, no light, black background. No meshes yet.
 Scene benchCameraScene(const std::string& name);

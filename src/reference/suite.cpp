@@ -136,6 +136,18 @@ Result<CaseScene> makeScene(const BenchCase& c, const RenderOptions& options) {
                   {"seed", c.terrain.seed},
                   {"interpolation", c.terrain.bicubic ? "bicubic" : "bilinear"}};
     return out;
+  } else if (c.generator == scene::Generator::lights) {
+    scene::LightsParams l = c.lights;
+    l.width = options.width;
+    l.height = options.height;
+    Result<scene::Scene> made = scene::generateLights(l);
+    if (!made) return made.error();
+    out.scene = std::move(made).value();
+    out.params = {{"lights", out.scene.lightPoints.size()},
+                  {"stars", out.scene.stars.stars.size()},
+                  {"seed", l.seed},
+                  {"layers", 1}};
+    return out;
   } else if (c.generator == scene::Generator::none) {
     auto loaded = scene::loadScene(c.file);
     if (!loaded) return loaded.error();

@@ -25,6 +25,7 @@ struct BenchCase {
   scene::GrazingParams grazing;
   scene::FreeFormParams freeform;
   scene::TerrainParams terrain;
+  scene::LightsParams lights;
   std::string file;
 };
 

@@ -41,8 +41,6 @@ const char* generatorNeeds(Generator generator) {
   switch (generator) {
     case Generator::volume:
       return "voxel volumes";
-    case Generator::lights:
-      return "light points";
     default:
       return nullptr;
   }
