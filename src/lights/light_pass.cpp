@@ -153,14 +153,14 @@ void LightPass::bin() {
       for (int tx = tx0; tx <= tx1; ++tx) ++tileStart_[size_t(ty * tilesX + tx) + 1];
   }
   for (size_t t = 1; t < tileStart_.size(); ++t) tileStart_[t] += tileStart_[t - 1];
-  tileSplats_.resize(tileStart_.back());
+  tileSplats_.resize(tileStart_.back());  // copies, in tile order: a tile reads its lights in a run
   std::vector<uint32_t> fill(tileStart_.begin(), tileStart_.end() - 1);
   for (size_t i = 0; i < splats_.size(); ++i) {
     int tx0, tx1, ty0, ty1;
     range(splats_[i], tx0, tx1, ty0, ty1);
     for (int ty = ty0; ty <= ty1; ++ty)
       for (int tx = tx0; tx <= tx1; ++tx)
-        tileSplats_[fill[size_t(ty * tilesX + tx)]++] = uint32_t(i);
+        tileSplats_[fill[size_t(ty * tilesX + tx)]++] = splats_[i];
   }
 }
 
@@ -185,6 +185,11 @@ float LightPass::visibility(const Splat& s) const {
     for (int k = 0; k < n; ++k) visible += !(depthAt(cx, cy, k) < 1.0f);
     return float(visible) / float(n);
   }
+  // Every sample at least as far as the light (the common case: a light in front of what is
+  // behind it): visible, without the spread.
+  float nearestSample = 1.0f;
+  for (int k = 0; k < n; ++k) nearestSample = std::min(nearestSample, depthAt(cx, cy, k));
+  if (!(eyeDepthOf(nearestSample) < s.eyeDepth - in_.settings.depthBias)) return 1.0f;
   const float centre = eyeDepthOf(depthAt(cx, cy, 0));
   float spread = 0;
   for (int dy = -1; dy <= 1; ++dy)
@@ -206,27 +211,38 @@ void LightPass::drawTile(const raster::TileTarget& tile) {
   const int xEnd = std::min(ox + kTileSize, frame_.width);
   const int yEnd = std::min(oy + kTileSize, frame_.height);
   const int n = frame_.samples;
+  if (tileStart_[t] == tileStart_[t + 1]) return;
+  // The tile's depth and colour left the caches while the rest of the frame was drawn: stream
+  // them back in order (the lights then touch them at random).
+  const char* depth = reinterpret_cast<const char*>(tile.depth);
+  const char* color = reinterpret_cast<const char*>(tile.color);
+  for (size_t b = 0; b < size_t(raster::kTilePixels) * size_t(n) * sizeof(float); b += 64)
+    __builtin_prefetch(depth + b);
+  for (size_t b = 0; b < size_t(raster::kTilePixels) * size_t(n) * 6; b += 64)
+    __builtin_prefetch(color + b, 1);
   for (uint32_t e = tileStart_[t]; e < tileStart_[t + 1]; ++e) {
-    const Splat& s = splats_[tileSplats_[e]];
+    const Splat& s = tileSplats_[e];
     const float v = visibility(s);
     if (!(v > 0)) continue;
     const int x0 = std::max(ox, int(std::floor(s.x - s.radius)));
     const int x1 = std::min(xEnd - 1, int(std::floor(s.x + s.radius)));
     const int y0 = std::max(oy, int(std::floor(s.y - s.radius)));
     const int y1 = std::min(yEnd - 1, int(std::floor(s.y + s.radius)));
+    const float r = s.rgb[0] * v, g = s.rgb[1] * v, b = s.rgb[2] * v;
     for (int y = y0; y <= y1; ++y) {
       const float dy = float(y) + 0.5f - s.y;
       for (int x = x0; x <= x1; ++x) {
         const float dx = float(x) + 0.5f - s.x;
-        const float w = splatWeight(dx * dx + dy * dy, s.invR2) * v;
-        if (!(w > 0)) continue;
-        int add[3];
-        for (int ch = 0; ch < 3; ++ch) add[ch] = int(std::lround(std::min(s.rgb[ch] * w, 65535.f)));
+        const float w = splatWeight(dx * dx + dy * dy, s.invR2);
+        // Rounded to the nearest 16-bit step (non-negative: + ½ and truncate).
+        const int add[3] = {int(std::min(r * w, 65535.f) + 0.5f), int(std::min(g * w, 65535.f) + 0.5f),
+                            int(std::min(b * w, 65535.f) + 0.5f)};
         if ((add[0] | add[1] | add[2]) == 0) continue;
-        for (int k = 0; k < n; ++k)
+        uint16_t* c = tile.color + FrameBuffer::colorOffset(x, y, 0, n, 0);
+        for (int k = 0; k < n; ++k, c += raster::kColorPerBlock)
           for (int ch = 0; ch < 3; ++ch) {
-            uint16_t& c = tile.color[FrameBuffer::colorOffset(x, y, ch, n, k)];
-            c = uint16_t(std::min(65535, int(c) + add[ch]));
+            uint16_t& cc = c[ch * raster::kBlockPixels];
+            cc = uint16_t(std::min(65535, int(cc) + add[ch]));
           }
       }
     }

@@ -73,7 +73,8 @@ class LightPass final : public raster::TilePass {
   Vec3 starAxes_[3];  // equatorial x, y, z in world at this frame's time
   std::vector<std::vector<Splat>> chunks_;
   std::vector<Splat> splats_;
-  std::vector<uint32_t> tileStart_, tileSplats_;  // per tile: its splats' indices, in order
+  std::vector<uint32_t> tileStart_;  // per tile: where its splats start in tileSplats_
+  std::vector<Splat> tileSplats_;    // every tile's splats, in light order within a tile
   std::vector<double> workerMs_;
   double prepareMs_ = 0;
   uint64_t candidates_ = 0;
