@@ -10,6 +10,9 @@
 #include <string>
 #include <vector>
 
+#include "core/thread_pool.h"
+#include "lights/light_pass.h"
+#include "render/camera.h"
 #include "texture/texture.h"
 
 #if SV_HAVE_GL
@@ -78,6 +81,31 @@ void main() {
 }
 )";
 
+// Light points as point sprites (BENCH.md `lights`): each light's splat from synthvis's own laws
+// (lights::LightPass, once when the scene is loaded: the sprites are static, which favours GL),
+// drawn as a GL point of the kernel's diameter whose fragments add the kernel's weight times the
+// light's colour — blended additively in linear light, depth-tested, not writing depth.
+constexpr const char* kPointVertexShader = R"(#version 330 core
+layout(location = 0) in vec4 ndcSize;  // clip position (w = 1) and the point's diameter
+layout(location = 1) in vec3 color;    // a weight-1 fragment's addition, linear
+out vec3 vColor;
+void main() {
+  gl_Position = vec4(ndcSize.xyz, 1.0);
+  gl_PointSize = ndcSize.w;
+  vColor = color;
+}
+)";
+
+constexpr const char* kPointFragmentShader = R"(#version 330 core
+in vec3 vColor;
+out vec4 fragColor;
+void main() {
+  vec2 d = gl_PointCoord * 2.0 - 1.0;
+  float u = max(1.0 - dot(d, d), 0.0);
+  fragColor = vec4(vColor * (u * u), 1.0);
+}
+)";
+
 std::string glError(const char* what) {
   const GLenum e = glGetError();
   return e == GL_NO_ERROR ? std::string() : fmt::format("{}: OpenGL error 0x{:x}", what, e);
@@ -108,6 +136,8 @@ struct GlRenderer::Impl {
   EGLDisplay display = EGL_NO_DISPLAY;
   EGLContext context = EGL_NO_CONTEXT;
   GLuint program = 0;
+  GLuint pointProgram = 0, pointVao = 0, pointBuffer = 0;
+  GLsizei pointCount = 0;
   GLuint fbo = 0, colorRb = 0, depthRb = 0;  // the render target (multisampled if msaa)
   GLuint resolveFbo = 0, resolveRb = 0;      // single-sampled copy for readback (msaa)
   GLint uMvp = -1, uNormal = -1, uBase = -1, uToLight = -1, uLightColor = -1, uAmbient = -1,
@@ -129,6 +159,9 @@ struct GlRenderer::Impl {
       eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, context);
       freeMeshes();
       glDeleteProgram(program);
+      glDeleteProgram(pointProgram);
+      glDeleteVertexArrays(1, &pointVao);
+      glDeleteBuffers(1, &pointBuffer);
       glDeleteFramebuffers(1, &fbo);
       glDeleteFramebuffers(1, &resolveFbo);
       const GLuint rbs[3] = {colorRb, depthRb, resolveRb};
@@ -273,6 +306,23 @@ Result<std::unique_ptr<GlRenderer>> GlRenderer::create(const RenderOptions& opti
   g.uFog = glGetUniformLocation(g.program, "fog");
   g.uFogColor = glGetUniformLocation(g.program, "fogColor");
   g.uFogBeta = glGetUniformLocation(g.program, "fogBeta");
+  {
+    auto pvs = compile(GL_VERTEX_SHADER, kPointVertexShader);
+    if (!pvs) return pvs.error();
+    auto pfs = compile(GL_FRAGMENT_SHADER, kPointFragmentShader);
+    if (!pfs) return pfs.error();
+    g.pointProgram = glCreateProgram();
+    glAttachShader(g.pointProgram, pvs.value());
+    glAttachShader(g.pointProgram, pfs.value());
+    glLinkProgram(g.pointProgram);
+    glDeleteShader(pvs.value());
+    glDeleteShader(pfs.value());
+    GLint pointLinked = 0;
+    glGetProgramiv(g.pointProgram, GL_LINK_STATUS, &pointLinked);
+    if (!pointLinked) return Error{"", "", "gl: point-sprite program does not link"};
+    glGenVertexArrays(1, &g.pointVao);
+    glGenBuffers(1, &g.pointBuffer);
+  }
 
   // Render target: sRGB colour and 24-bit depth, multisampled when asked.
   const int w = options.width, h = options.height;
@@ -452,7 +502,55 @@ Status GlRenderer::load(const scene::Scene& scene) {
   g.background[0] = scene.background.x;
   g.background[1] = scene.background.y;
   g.background[2] = scene.background.z;
+  if (Status s = loadLights(scene); !s) return s;
   if (std::string e = glError("gl: upload"); !e.empty()) return Error{"", "", e};
+  return {};
+}
+
+// The scene's light points as sprites (kPointVertexShader): position, size and colour of every
+// splat synthvis would draw this frame.
+Status GlRenderer::loadLights(const scene::Scene& scene) {
+  Impl& g = *impl_;
+  g.pointCount = 0;
+  if (scene.lightPoints.empty() && scene.stars.stars.empty()) return {};
+  const Result<render::FrameCamera> cam = render::chooseCamera(scene, g.options);
+  if (!cam.ok()) return cam.error();
+  lights::LightInput in;
+  in.appearances = scene.lightAppearances;
+  in.points = scene.lightPoints;
+  in.groups = scene.lightGroups;
+  in.settings = scene.lightSettings;
+  in.stars = scene.stars.stars.empty() ? nullptr : &scene.stars;
+  in.time = scene.time;
+  in.view = cam.value().view;
+  in.projection = cam.value().projection;
+  in.fogBeta = scene.fog.enabled ? scene.fog.beta : 0.0f;
+  lights::LightPass pass;
+  pass.setLights(in);
+  core::ThreadPool pool(1);
+  const int w = g.options.width, h = g.options.height;
+  pass.prepare(raster::PassFrame{w, h, 1, nullptr, &pool, nullptr});
+  const float m22 = in.projection.m[2][2], m32 = in.projection.m[3][2];
+  std::vector<float> data;
+  data.reserve(pass.splats().size() * 7);
+  for (const lights::Splat& s : pass.splats()) {
+    // A star lies on the far plane: drawn where nothing else is.
+    const float z = s.eyeDepth > 0 ? -m22 + m32 / s.eyeDepth : 1.0f - 1e-6f;
+    const float v[7] = {2 * s.x / float(w) - 1, 1 - 2 * s.y / float(h), z, 2 * s.radius,
+                        s.rgb[0] / 65535, s.rgb[1] / 65535, s.rgb[2] / 65535};
+    data.insert(data.end(), v, v + 7);
+  }
+  glBindVertexArray(g.pointVao);
+  glBindBuffer(GL_ARRAY_BUFFER, g.pointBuffer);
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(data.size() * sizeof(float)), data.data(),
+               GL_STATIC_DRAW);
+  glEnableVertexAttribArray(0);
+  glVertexAttribPointer(0, 4, GL_FLOAT, GL_FALSE, 7 * sizeof(float), nullptr);
+  glEnableVertexAttribArray(1);
+  glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 7 * sizeof(float),
+                        reinterpret_cast<const void*>(4 * sizeof(float)));
+  glBindVertexArray(0);
+  g.pointCount = GLsizei(pass.splats().size());
   return {};
 }
 
@@ -491,6 +589,18 @@ Status GlRenderer::render() {
     if (!m.hasColors) glVertexAttrib4f(2, 1, 1, 1, 1);
     if (!m.hasUvs) glVertexAttrib2f(3, 0, 0);
     glDrawElements(GL_TRIANGLES, m.indexCount, GL_UNSIGNED_INT, nullptr);
+  }
+  if (g.pointCount) {
+    glUseProgram(g.pointProgram);
+    glEnable(GL_PROGRAM_POINT_SIZE);
+    glDisable(GL_CULL_FACE);
+    glDepthMask(GL_FALSE);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE);
+    glBindVertexArray(g.pointVao);
+    glDrawArrays(GL_POINTS, 0, g.pointCount);
+    glDisable(GL_BLEND);
+    glDepthMask(GL_TRUE);
   }
   glBindVertexArray(0);
   glFinish();
@@ -543,6 +653,7 @@ Result<std::unique_ptr<GlRenderer>> GlRenderer::create(const RenderOptions&, int
                "(scripts/demo does) and configure again"};
 }
 Status GlRenderer::load(const scene::Scene&) { return Error{"", "", "gl: not built"}; }
+Status GlRenderer::loadLights(const scene::Scene&) { return Error{"", "", "gl: not built"}; }
 Status GlRenderer::render() { return Error{"", "", "gl: not built"}; }
 Status GlRenderer::readImage(Image&) { return Error{"", "", "gl: not built"}; }
 

@@ -11,7 +11,7 @@
 // texture's wrap modes, --texture-filter mapped to the GL min/mag filters (aniso: 16×
 // GL_TEXTURE_MAX_ANISOTROPY), UVs scaled by the material's uvScale, modulating the lit colour.
 // The geometry is uploaded once to static buffers; a frame is clear, one draw per instance,
-// glFinish.
+// the light points as one draw of blended, depth-tested point sprites, glFinish.
 #pragma once
 
 #include <memory>
@@ -49,6 +49,7 @@ class GlRenderer {
 
  private:
   GlRenderer();
+  Status loadLights(const scene::Scene& scene);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
