@@ -285,6 +285,17 @@ sv::Result<sv::reference::BenchCase> generatorCase(const std::string& kind,
   return c;
 }
 
+// bench --channels N --arc DEG: 0 (the classic view) … 16 channels, each under 180°.
+sv::Status checkBenchChannels(int channels, float arc) {
+  if (channels < 0 || channels > int(sv::scene::kMaxChannels))
+    return sv::Error{"", "",
+                     fmt::format("--channels {}: must be 0…{}", channels, sv::scene::kMaxChannels)};
+  if (!(arc > 0 && arc < 180.0f * float(std::max(channels, 1))))
+    return sv::Error{"", "",
+                     fmt::format("--arc {}: must be more than 0 and less than 180 a channel", arc)};
+  return {};
+}
+
 int runBench(BenchArgs a) {
   namespace ref = sv::reference;
   a.options.samples = a.aa == 0 ? 1 : a.aa;
@@ -306,12 +317,7 @@ int runBench(BenchArgs a) {
   else
     a.options.hsr = h.value();
   if (sv::Status s = sv::validate(a.options); !s) return fail(s.error());
-  if (a.channels < 0 || a.channels > int(sv::scene::kMaxChannels))
-    return fail({"", "", fmt::format("--channels {}: must be 0…{}", a.channels,
-                                     sv::scene::kMaxChannels)});
-  if (!(a.arc > 0 && a.arc < 180.0f * float(std::max(a.channels, 1))))
-    return fail({"", "", fmt::format("--arc {}: must be more than 0 and less than 180 a channel",
-                                     a.arc)});
+  if (sv::Status s = checkBenchChannels(a.channels, a.arc); !s) return fail(s.error());
   if (a.scene.empty() == a.suite.empty())
     return fail({"", "", "give either a scene (a generator name or a file) or --suite quick|full"});
   if (a.renderer.empty()) a.renderer = a.suite.empty() ? "synthvis" : "both";
@@ -563,14 +569,8 @@ int runTerrainQuery(const std::string& scenePath, const std::vector<double>& at,
   return 0;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  CLI::App app{"synthvis — a real-time software image generator (recursive 2x2 subdivision)"};
-  app.require_subcommand(1);
-
-  RenderArgs r;
-  CLI::App* render = app.add_subcommand("render", "render a scene to an image");
+// The `render` subcommand's options, into `r`.
+void addRenderOptions(CLI::App* render, RenderArgs& r) {
   render->add_option("scene", r.scene,
                      "scene file (.json, .gltf, .glb, .obj); default: built-in demo");
   render->add_option("-o,--output", r.output, "output image (.png or .ppm)")->capture_default_str();
@@ -627,6 +627,17 @@ int main(int argc, char** argv) {
                      "horizontal field of view)");
   render->add_option("--mosaic", r.mosaic,
                      "a scene with channels: also write them side by side into this image");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"synthvis — a real-time software image generator (recursive 2x2 subdivision)"};
+  app.require_subcommand(1);
+
+  RenderArgs r;
+  CLI::App* render = app.add_subcommand("render", "render a scene to an image");
+  addRenderOptions(render, r);
 
   BenchArgs b;
   CLI::App* bench =
