@@ -28,8 +28,8 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
-#include <numbers>
 #include <nlohmann/json.hpp>
+#include <numbers>
 
 #include "reference/ground_truth.h"
 #include "reference/suite.h"
@@ -94,11 +94,12 @@ sv::Status addArcChannels(sv::scene::Scene& scene, const sv::RenderOptions& o, i
   if (arc != 0 && n == 0) return sv::Error{"", "", "--arc needs --channels"};
   if (n == 0) return {};
   if (!scene.channels.empty())
-    return sv::Error{"", "",
-                     fmt::format("--channels: the scene has {} channels of its own",
-                                 scene.channels.size())};
+    return sv::Error{
+        "", "",
+        fmt::format("--channels: the scene has {} channels of its own", scene.channels.size())};
   if (n < 1 || n > int(sv::scene::kMaxChannels))
-    return sv::Error{"", "", fmt::format("--channels {}: must be 1…{}", n, sv::scene::kMaxChannels)};
+    return sv::Error{"", "",
+                     fmt::format("--channels {}: must be 1…{}", n, sv::scene::kMaxChannels)};
   if (arc == 0) {
     const sv::scene::Camera camera = o.camera < int(scene.cameras.size())
                                          ? scene.cameras[size_t(o.camera)]
@@ -251,8 +252,8 @@ struct BenchArgs {
   int glAa = -1;  // -1: as --aa, capped at llvmpipe's 4
   std::string filter = "box";
   bool glReadback = false;
-  int channels = 0;   // BENCH.md --channels N (SPEC §9)
-  float arc = 150;    // … abutting in this arc, degrees
+  int channels = 0;  // BENCH.md --channels N (SPEC §9)
+  float arc = 150;   // … abutting in this arc, degrees
   sv::RenderOptions options{.width = 1920, .height = 1080, .threads = 2};
 };
 

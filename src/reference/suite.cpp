@@ -188,11 +188,12 @@ Result<CaseResult> BenchRunner::run(const BenchCase& c) {
     made.value().scene.channels =
         scene::arcChannels(s.channels, s.arcDegrees, s.options.width, s.options.height);
     if (made.value().scene.channels.empty())
-      return Error{"", "", fmt::format("--channels {}: must be 1…{}", s.channels,
-                                       scene::kMaxChannels)};
+      return Error{"", "",
+                   fmt::format("--channels {}: must be 1…{}", s.channels, scene::kMaxChannels)};
   }
   if (!made.value().scene.channels.empty() && impl_->gl)
-    return Error{"", "", "channels: the gl reference draws one view only (use --renderer synthvis)"};
+    return Error{"", "",
+                 "channels: the gl reference draws one view only (use --renderer synthvis)"};
   const scene::Scene& sc = made.value().scene;
 
   CaseResult r;

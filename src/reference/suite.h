@@ -45,8 +45,8 @@ struct RendererRun {
   std::string description;  // e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
   std::vector<double> frameMs;
   double medianMs = 0, minMs = 0, maxMs = 0;
-  FrameStats stats;  // synthvis only (with channels: the first channel's)
-  Image image;       // the last frame (with channels: their mosaic, SPEC §9)
+  FrameStats stats;                      // synthvis only (with channels: the first channel's)
+  Image image;                           // the last frame (with channels: their mosaic, SPEC §9)
   std::vector<FrameStats> channelStats;  // synthvis with channels: each channel's, last frame
 };
 

@@ -6,7 +6,7 @@
 namespace sv::render {
 
 struct FrameCamera {
-  scene::Camera camera;  // the scene's camera as placed in the world (a channel's is turned from it)
+  scene::Camera camera;  // the scene's camera in the world (a channel's view is turned from it)
   Mat4 view;             // world → eye (the camera at the origin looking down −z)
   Mat4 projection;       // eye → clip: the view window below onto the raster
   // The view window at unit eye depth: the ray through raster point (px, py) of a W × H raster is

@@ -48,8 +48,7 @@ std::string channelsProblem(const std::vector<Channel>& channels) {
       const ChannelFrustum& f = *c.frustum;
       for (float a : {f.leftDegrees, f.rightDegrees, f.downDegrees, f.upDegrees})
         if (!(a > -90 && a < 90)) return at + ".frustum: angles must be in (−90, 90) degrees";
-      if (!(f.leftDegrees < f.rightDegrees))
-        return at + ".frustum: left must be less than right";
+      if (!(f.leftDegrees < f.rightDegrees)) return at + ".frustum: left must be less than right";
       if (!(f.downDegrees < f.upDegrees)) return at + ".frustum: down must be less than up";
     }
   }

@@ -447,8 +447,7 @@ Scene SceneReader::read(const Json& root) {
                      version->dump(), kFormatVersion));
   expectKeys(root, "",
              {"synthvis", "description", "background", "camera", "cameras", "light", "pointLights",
-              "fog", "textures", "colorTable", "materials", "objects", "terrain",
-              "channels"});
+              "fog", "textures", "colorTable", "materials", "objects", "terrain", "channels"});
 
   if (const Json* description = find(root, "description")) string(*description, "description");
   if (const Json* background = find(root, "background")) {
@@ -725,8 +724,9 @@ std::vector<Channel> SceneReader::readChannels(const Json& v, const std::string&
     const int n = int(integer(*find(v, "count"), member(where, "count"), 1, kMaxChannels));
     const float arc = number(*find(v, "arc"), member(where, "arc"));
     if (!(arc > 0 && arc < 180.0f * float(n)))
-      fail(member(where, "arc"),
-           fmt::format("{} is out of range (0, {}) degrees (each channel under 180)", arc, 180 * n));
+      fail(
+          member(where, "arc"),
+          fmt::format("{} is out of range (0, {}) degrees (each channel under 180)", arc, 180 * n));
     const int w = int(integer(*find(v, "width"), member(where, "width"), 1, 8192));
     const int h = int(integer(*find(v, "height"), member(where, "height"), 1, 8192));
     float vfov = 0;
@@ -771,7 +771,8 @@ std::vector<Channel> SceneReader::readChannels(const Json& v, const std::string&
         if (!(a[k] > -90 && a[k] < 90))
           fail(member(fw, keys[k]), fmt::format("{} is out of range (-90, 90) degrees", y->dump()));
       }
-      if (!(a[0] < a[1])) fail(fw, fmt::format("left ({}) must be less than right ({})", a[0], a[1]));
+      if (!(a[0] < a[1]))
+        fail(fw, fmt::format("left ({}) must be less than right ({})", a[0], a[1]));
       if (!(a[2] < a[3])) fail(fw, fmt::format("down ({}) must be less than up ({})", a[2], a[3]));
       c.frustum = ChannelFrustum{a[0], a[1], a[2], a[3]};
     }

@@ -122,8 +122,9 @@ TEST(Cli, RenderWritesAnImageAndAStatisticsLinePerChannelAndTheMosaic) {
   fs::remove_all(dir);
   fs::create_directories(dir);
   const std::string out = (dir / "view.png").string(), mosaic = (dir / "all.png").string();
-  CliRun r = run("render -o " + out + " --width 64 --height 48 --threads 2 --channels 3 --arc 150 " +
-                 "--mosaic " + mosaic);
+  CliRun r =
+      run("render -o " + out + " --width 64 --height 48 --threads 2 --channels 3 --arc 150 " +
+          "--mosaic " + mosaic);
   ASSERT_EQ(r.status, 0) << r.out;
   for (const char* name : {"view-0.png", "view-1.png", "view-2.png", "all.png"})
     EXPECT_TRUE(fs::exists(dir / name)) << name;
@@ -151,8 +152,10 @@ TEST(Cli, RenderWritesAnImageAndAStatisticsLinePerChannelAndTheMosaic) {
 
 TEST(Cli, BenchChannelsTimesTheWholeFrameAndWritesTheChannelsField) {
   const std::string json = (tempDir() / "bench_channels.json").string();
-  const CliRun r = run("bench tris --count 2000 --area 20 --width 160 --height 120 --frames 2 "
-                       "--warmup 1 --channels 3 --json " + json);
+  const CliRun r =
+      run("bench tris --count 2000 --area 20 --width 160 --height 120 --frames 2 "
+          "--warmup 1 --channels 3 --json " +
+          json);
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_NE(r.out.find("channel 2:"), std::string::npos) << r.out;
   std::ifstream f(json);

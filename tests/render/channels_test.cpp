@@ -252,8 +252,8 @@ TEST(Channels, TerrainOnAnAsymmetricChannelMeetsTheGroundWhereTheProjectionSays)
       const float z = depth[raster::FrameBuffer::depthOffset(lx, ly)];
       if (!(z < 1.0f)) continue;
       const double px = tx * 64 + lx + 0.5, py = ty * 64 + ly + 0.5;
-      const Vec3d w = clipToWorld.transformPoint(
-          {2 * px / o.width - 1, 1 - 2 * py / o.height, 2.0 * z - 1});
+      const Vec3d w =
+          clipToWorld.transformPoint({2 * px / o.width - 1, 1 - 2 * py / o.height, 2.0 * z - 1});
       const std::optional<TerrainHeight> h = terrainHeight(s, w.x, w.y, w.z);
       ASSERT_TRUE(h.has_value());
       EXPECT_NEAR(h->above, 0.0, 0.5) << "pixel " << px << ", " << py;

@@ -36,6 +36,12 @@ TEST(ArcChannels, NeighboursShareAnEdgeAndTheArcIsCentred) {
   EXPECT_TRUE(arcChannels(int(kMaxChannels) + 1, 90, 64, 64).empty());
 }
 
+Channel named(const std::string& name) {
+  Channel c;
+  c.name = name;
+  return c;
+}
+
 TEST(ArcChannels, ValidateRejectsEachBadChannel) {
   struct Row {
     void (*spoil)(Channel&);
@@ -47,25 +53,40 @@ TEST(ArcChannels, ValidateRejectsEachBadChannel) {
       {[](Channel& c) { c.pitchDegrees = 91; }, "pitch −90 … 90"},
       {[](Channel& c) { c.width = 0; }, "channels[1]: 0x480 pixels, each must be 1 … 8192"},
       {[](Channel& c) { c.height = 8193; }, "each must be 1 … 8192"},
-      {[](Channel& c) { c.frustum = ChannelFrustum{10, -10, -5, 5}; },
+      {[](Channel& c) {
+         c.frustum = ChannelFrustum{10, -10, -5, 5};
+       },
        "channels[1].frustum: left must be less than right"},
-      {[](Channel& c) { c.frustum = ChannelFrustum{-10, 10, 5, 5}; }, "down must be less than up"},
-      {[](Channel& c) { c.frustum = ChannelFrustum{-90, 10, -5, 5}; }, "in (−90, 90) degrees"},
-      {[](Channel& c) { c.name = "../x"; }, "channels[1].name: use 1 … 64 letters"},
-      {[](Channel& c) { c.name = "a"; }, "channels[1].name: duplicate channel name 'a'"},
+      {[](Channel& c) {
+         c.frustum = ChannelFrustum{-10, 10, 5, 5};
+       },
+       "down must be less than up"},
+      {[](Channel& c) {
+         c.frustum = ChannelFrustum{-90, 10, -5, 5};
+       },
+       "in (−90, 90) degrees"},
       {[](Channel& c) { c.offset.y = std::numeric_limits<float>::infinity(); },
        "channels[1].offset: not finite"},
   };
   for (const Row& row : rows) {
     Scene s;
-    s.channels.resize(2);
-    s.channels[0].name = "a";
+    s.channels = {named("a"), Channel{}};
     EXPECT_TRUE(validate(s, "s.json").ok());
     row.spoil(s.channels[1]);
     const Status st = validate(s, "s.json");
     ASSERT_FALSE(st.ok()) << row.expected;
     EXPECT_TRUE(contains(st.error().str(), row.expected)) << st.error().str();
     EXPECT_TRUE(contains(st.error().str(), "s.json")) << st.error().str();
+  }
+  // Names: they become parts of file names, so one file per channel.
+  const std::string badNames[][2] = {{"../x", "channels[1].name: use 1 … 64 letters"},
+                                     {"a", "channels[1].name: duplicate channel name 'a'"}};
+  for (const auto& [name, expected] : badNames) {
+    Scene s;
+    s.channels = {named("a"), named(name)};
+    const Status st = validate(s, "s.json");
+    ASSERT_FALSE(st.ok()) << expected;
+    EXPECT_TRUE(contains(st.error().str(), expected)) << st.error().str();
   }
   Scene s;
   s.channels.resize(kMaxChannels + 1);
