@@ -1,6 +1,7 @@
 // synthvis — command-line front end.
 //
 //   synthvis render [SCENE] -o out.png [--width W] [--height H] [--threads T] [--camera I]
+//                   [--channels N [--arc DEG]] [--mosaic FILE]
 //                   [--no-cull] [--debug-view overdraw|levels|occupancy] [--gamma G]
 //                   [--supersample K] [--aa 1|4|8|16|64] [--filter box|tent3]
 //                   [--texture-filter point|nearest|tri3|bilinear|trilinear3|trilinear|aniso]
@@ -9,7 +10,7 @@
 //                  [--order random|f2b|b2f] [--shade gouraud|textured] [--fog]
 //                  [--texture-filter F] [--hsr zbuffer|priority|hybrid] [--width W] [--height H]
 //                  [--threads T] [--frames F] [--warmup W] [--seed S] [--aa S] [--gl-aa S]
-//                  [--filter box|tent3] [--repeat N]
+//                  [--filter box|tent3] [--repeat N] [--channels N [--arc DEG]]
 //                  [--renderer synthvis|gl|both] [--gl-readback] [--json FILE] [--html DIR]
 //                  [--image FILE]
 //   synthvis gen tris|layers|grazing -o scene.glb [--count N] [--area A] [--depth D] [--layers D]
@@ -28,6 +29,7 @@
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <numbers>
 
 #include "reference/ground_truth.h"
 #include "reference/suite.h"
@@ -68,8 +70,75 @@ struct RenderArgs {
   std::string freeform = "raycast";
   std::string terrainFilter = "scene";
   bool noCull = false;
+  // Display channels (SPEC §9): N abutting channels in an arc of `arc` degrees (0: N times the
+  // camera's horizontal field of view) for a scene without channels of its own; the mosaic file.
+  int channels = 0;
+  float arc = 0;
+  std::string mosaic;
   sv::RenderOptions options;
 };
+
+// `path` with "-" + `suffix` before its extension: out.png → out-left.png.
+std::string withSuffix(const std::string& path, const std::string& suffix) {
+  const size_t slash = path.find_last_of('/');
+  const size_t dot = path.find_last_of('.');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash))
+    return path + "-" + suffix;
+  return path.substr(0, dot) + "-" + suffix + path.substr(dot);
+}
+
+// --channels N [--arc DEG]: N channels abutting in an arc around the scene camera's view, each
+// --width × --height with square pixels; without --arc, N times the camera's horizontal field of
+// view (so each channel sees what the camera alone would, side by side).
+sv::Status addArcChannels(sv::scene::Scene& scene, const sv::RenderOptions& o, int n, float arc) {
+  if (arc != 0 && n == 0) return sv::Error{"", "", "--arc needs --channels"};
+  if (n == 0) return {};
+  if (!scene.channels.empty())
+    return sv::Error{
+        "", "",
+        fmt::format("--channels: the scene has {} channels of its own", scene.channels.size())};
+  if (n < 1 || n > int(sv::scene::kMaxChannels))
+    return sv::Error{"", "",
+                     fmt::format("--channels {}: must be 1…{}", n, sv::scene::kMaxChannels)};
+  if (arc == 0) {
+    const sv::scene::Camera camera = o.camera < int(scene.cameras.size())
+                                         ? scene.cameras[size_t(o.camera)]
+                                         : sv::scene::Camera{};
+    const double halfY = camera.yfovDegrees * std::numbers::pi / 360;
+    arc = float(n * 360 / std::numbers::pi * std::atan(std::tan(halfY) * o.width / o.height));
+  }
+  if (!(arc > 0 && arc < 180.0f * float(n)))
+    return sv::Error{"", "",
+                     fmt::format("--arc {}: must be more than 0 and less than 180 a channel", arc)};
+  scene.channels = sv::scene::arcChannels(n, arc, o.width, o.height);
+  return {};
+}
+
+// A scene with display channels (SPEC §9): all of them in one call; OUT-<name>.png each (the
+// channel's index for an unnamed one), a statistics line each, and the mosaic if asked for.
+int renderChannels(const RenderArgs& a, const sv::scene::Scene& scene, sv::Renderer& renderer) {
+  std::vector<sv::Image> images;
+  std::vector<sv::FrameStats> stats;
+  if (sv::Status s = renderer.renderChannels(scene, images, &stats); !s) {
+    sv::Error e = s.error();
+    if (e.file.empty()) e.file = a.scene.empty() ? "<demo scene>" : a.scene;
+    return fail(e);
+  }
+  double totalMs = 0;
+  for (size_t i = 0; i < images.size(); ++i) {
+    const sv::scene::Channel& c = scene.channels[i];
+    const std::string path = withSuffix(a.output, c.name.empty() ? std::to_string(i) : c.name);
+    if (sv::Status s = sv::writeImage(images[i], path); !s) return fail(s.error());
+    fmt::print("{}: {}x{} | {}\n", path, images[i].width, images[i].height, stats[i].summary());
+    totalMs += stats[i].totalMs;
+  }
+  fmt::print("frame: {} channels, {:.2f} ms\n", images.size(), totalMs);
+  if (!a.mosaic.empty()) {
+    if (sv::Status s = sv::writeImage(sv::mosaic(images), a.mosaic); !s) return fail(s.error());
+    fmt::print("{}: the {} channels side by side\n", a.mosaic, images.size());
+  }
+  return 0;
+}
 
 int runRender(const RenderArgs& a) {
   sv::RenderOptions o = a.options;
@@ -113,8 +182,16 @@ int runRender(const RenderArgs& a) {
 
   auto loaded = loadSceneOrDemo(a.scene);
   if (!loaded) return fail(loaded.error());
-  const sv::scene::Scene scene = std::move(loaded).value();
+  sv::scene::Scene scene = std::move(loaded).value();
+  if (sv::Status s = addArcChannels(scene, o, a.channels, a.arc); !s) {
+    sv::Error e = s.error();
+    if (!scene.channels.empty() && !a.scene.empty()) e.file = a.scene;  // its channels conflict
+    return fail(e);
+  }
   sv::Renderer renderer(o);
+  if (!scene.channels.empty()) return renderChannels(a, scene, renderer);
+  if (!a.mosaic.empty())
+    return fail({"", "", "--mosaic: the scene has no channels (add --channels N)"});
   sv::Image image;
   sv::FrameStats stats;
   if (sv::Status s = renderer.render(scene, image, &stats); !s) {
@@ -197,6 +274,8 @@ struct BenchArgs {
   int glAa = -1;  // -1: as --aa, capped at llvmpipe's 4
   std::string filter = "box";
   bool glReadback = false;
+  int channels = 0;  // BENCH.md --channels N (SPEC §9)
+  float arc = 150;   // … abutting in this arc, degrees
   sv::RenderOptions options{.width = 1920, .height = 1080, .threads = 2};
 };
 
@@ -232,6 +311,17 @@ sv::Result<sv::reference::BenchCase> generatorCase(const std::string& kind,
   return c;
 }
 
+// bench --channels N --arc DEG: 0 (the classic view) … 16 channels, each under 180°.
+sv::Status checkBenchChannels(int channels, float arc) {
+  if (channels < 0 || channels > int(sv::scene::kMaxChannels))
+    return sv::Error{"", "",
+                     fmt::format("--channels {}: must be 0…{}", channels, sv::scene::kMaxChannels)};
+  if (!(arc > 0 && arc < 180.0f * float(std::max(channels, 1))))
+    return sv::Error{"", "",
+                     fmt::format("--arc {}: must be more than 0 and less than 180 a channel", arc)};
+  return {};
+}
+
 int runBench(BenchArgs a) {
   namespace ref = sv::reference;
   a.options.samples = a.aa == 0 ? 1 : a.aa;
@@ -253,6 +343,7 @@ int runBench(BenchArgs a) {
   else
     a.options.hsr = h.value();
   if (sv::Status s = sv::validate(a.options); !s) return fail(s.error());
+  if (sv::Status s = checkBenchChannels(a.channels, a.arc); !s) return fail(s.error());
   if (a.scene.empty() == a.suite.empty())
     return fail({"", "", "give either a scene (a generator name or a file) or --suite quick|full"});
   if (a.renderer.empty()) a.renderer = a.suite.empty() ? "synthvis" : "both";
@@ -299,6 +390,8 @@ int runBench(BenchArgs a) {
   settings.referenceReadback = a.glReadback;
   settings.textured = a.shade == "textured";
   settings.fog = a.fog;
+  settings.channels = a.channels;
+  settings.arcDegrees = a.arc;
   settings.synthvis = a.renderer != "gl";
   settings.sphereTrace = a.renderer == "sphere-trace";
   settings.tessellated = a.renderer == "tessellated";
@@ -335,7 +428,11 @@ int runBench(BenchArgs a) {
         fmt::print("{}: {} triangles, mean area {:.1f} px, depth complexity {:.2f}\n", cr.name,
                    cr.triangles, cr.meanArea, cr.depthComplexity);
       fmt::print("{}\n", ref::summaryLine(cr));
-      if (settings.synthvis) fmt::print("  synthvis last frame: {}\n", cr.runs[0].stats.summary());
+      if (settings.synthvis && cr.runs[0].channelStats.empty())
+        fmt::print("  synthvis last frame: {}\n", cr.runs[0].stats.summary());
+      for (size_t c = 0; c < cr.runs[0].channelStats.size(); ++c)
+        fmt::print("  synthvis last frame, channel {}: {}\n", c,
+                   cr.runs[0].channelStats[c].summary());
       for (auto& row : ref::jsonRows(cr, settings)) {
         if (a.repeat > 1) row["repeat"] = k + 1;
         rows.push_back(row);
@@ -353,14 +450,9 @@ int runBench(BenchArgs a) {
     // name (out.png → out-gl.png), for `synthvis compare`.
     const std::vector<ref::RendererRun>& runs = results.back().runs;
     if (sv::Status s = sv::writeImage(runs[0].image, a.image); !s) return fail(s.error());
-    if (runs.size() > 1) {
-      const size_t dot = a.image.find_last_of('.');
-      const std::string second = dot == std::string::npos
-                                     ? a.image + "-" + runs[1].renderer
-                                     : a.image.substr(0, dot) + "-" + runs[1].renderer +
-                                           a.image.substr(dot);
-      if (sv::Status s = sv::writeImage(runs[1].image, second); !s) return fail(s.error());
-    }
+    if (runs.size() > 1)
+      if (sv::Status s = sv::writeImage(runs[1].image, withSuffix(a.image, runs[1].renderer)); !s)
+        return fail(s.error());
   }
   if (!a.json.empty()) {
     std::ofstream out(a.json);
@@ -503,14 +595,8 @@ int runTerrainQuery(const std::string& scenePath, const std::vector<double>& at,
   return 0;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  CLI::App app{"synthvis — a real-time software image generator (recursive 2x2 subdivision)"};
-  app.require_subcommand(1);
-
-  RenderArgs r;
-  CLI::App* render = app.add_subcommand("render", "render a scene to an image");
+// The `render` subcommand's options, into `r`.
+void addRenderOptions(CLI::App* render, RenderArgs& r) {
   render->add_option("scene", r.scene,
                      "scene file (.json, .gltf, .glb, .obj); default: built-in demo");
   render->add_option("-o,--output", r.output, "output image (.png or .ppm)")->capture_default_str();
@@ -559,6 +645,25 @@ int main(int argc, char** argv) {
       ->add_option("--gamma", r.options.gamma,
                    "display gamma G (encoded = linear^(1/G)); default 0 = sRGB")
       ->capture_default_str();
+  render->add_option("--channels", r.channels,
+                     "display channels: N abutting views from the scene camera, each --width x "
+                     "--height, written as OUT-0.png, OUT-1.png, … (for a scene without channels)");
+  render->add_option("--arc", r.arc,
+                     "--channels: the arc they span, degrees (default: N times the camera's "
+                     "horizontal field of view)");
+  render->add_option("--mosaic", r.mosaic,
+                     "a scene with channels: also write them side by side into this image");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"synthvis — a real-time software image generator (recursive 2x2 subdivision)"};
+  app.require_subcommand(1);
+
+  RenderArgs r;
+  CLI::App* render = app.add_subcommand("render", "render a scene to an image");
+  addRenderOptions(render, r);
 
   BenchArgs b;
   CLI::App* bench =
@@ -616,6 +721,13 @@ int main(int argc, char** argv) {
   bench->add_option("--terrain-lod", b.terrainLod,
                     "terrain: on (levels of detail where a pixel spans more than a grid step) or "
                     "off (the table's own surface everywhere)")
+      ->capture_default_str();
+  bench
+      ->add_option("--channels", b.channels,
+                   "display channels: N abutting views (each --width x --height) in one frame; the "
+                   "time is the whole frame's (synthvis only)")
+      ->capture_default_str();
+  bench->add_option("--arc", b.arc, "--channels: the arc they span, degrees")
       ->capture_default_str();
   bench->add_option("--image", b.image,
                     "write the last frame of the last scene to this image file");

@@ -19,6 +19,11 @@ struct Image {
   uint8_t* pixel(int x, int y) { return &rgb[(size_t(y) * width + x) * 3]; }
 };
 
+// The display channels of one frame side by side (SPEC §9), left to right in the given order, in
+// one image as wide as their widths summed and as high as the highest; a shorter image sits at the
+// top, the rows below it black. No images: an empty image.
+Image mosaic(const std::vector<Image>& images);
+
 // Writes by extension: .png (8-bit RGB) or .ppm (binary P6). Errors name the file.
 Status writeImage(const Image& image, const std::string& path);
 Status writePng(const Image& image, const std::string& path);

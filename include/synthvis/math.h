@@ -59,6 +59,10 @@ struct Mat4 {
   static Mat4 rotation(Vec3 axis, float radians);
   // OpenGL-style perspective projection: vertical field of view in radians, clip z ∈ [−w, w].
   static Mat4 perspective(float yfov, float aspect, float znear, float zfar);
+  // OpenGL-style (glFrustum) off-axis projection: the view window's left, right, bottom and top
+  // edges on the near plane z = −znear (left < right, bottom < top; asymmetric allowed), clip
+  // z ∈ [−w, w] with the same depth row as `perspective`. SPEC §9: a display channel's frustum.
+  static Mat4 frustum(float left, float right, float bottom, float top, float znear, float zfar);
   // View matrix of a camera at `eye` looking at `target`.
   static Mat4 lookAt(Vec3 eye, Vec3 target, Vec3 up);
   // Column-major 16 floats, as glTF and the JSON scene format store them.

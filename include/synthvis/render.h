@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "synthvis/frame_stats.h"
 #include "synthvis/image.h"
@@ -105,6 +106,14 @@ class Renderer {
 
   // Renders `scene` into `image`. Identical bytes for any thread count.
   Status render(const scene::Scene& scene, Image& image, FrameStats* stats = nullptr);
+  // Renders every display channel of `scene` (SPEC §9: one scene at one instant, N views): channel
+  // i into images[i] at its own width × height, its statistics into (*stats)[i] — the options'
+  // width and height are not used. The channels are drawn one after another, each frame's tiles
+  // shared among all the renderer's threads. A scene without channels gives the one classic image.
+  // Identical bytes for any thread count; a channel with no turn, offset or frustum of its own at
+  // the options' size gives render()'s image.
+  Status renderChannels(const scene::Scene& scene, std::vector<Image>& images,
+                        std::vector<FrameStats>* stats = nullptr);
 
   const RenderOptions& options() const;
 

@@ -8,6 +8,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -176,6 +177,39 @@ struct Camera {
   float zfar = 1000.0f;
 };
 
+// A display channel (SPEC §9; docs/scene-format.md "Channels"): one of the N views that make a
+// frame, all of one scene at one instant, each from the scene camera's eyepoint turned and moved by
+// the channel's own orientation and offset, through its own (possibly asymmetric) frustum, at its
+// own resolution. Renderer::renderChannels draws them all in one call.
+struct ChannelFrustum {
+  // Half-angles of the view window from the channel's axis, degrees in (−90, 90), signed: left and
+  // down negative for a window around the axis; left < right, down < up.
+  float leftDegrees = -30, rightDegrees = 30, downDegrees = -20, upDegrees = 20;
+};
+struct Channel {
+  std::string name;  // letters, digits, '-' and '_' (it names the channel's image file)
+  // Orientation relative to the scene camera's view, degrees, applied in this order about the
+  // channel's own axes (heading, then pitch, then bank): yaw positive turns the view to the right
+  // (−180…180), pitch positive up (−90…90), roll positive leans the image's up to the right
+  // (−180…180).
+  float yawDegrees = 0, pitchDegrees = 0, rollDegrees = 0;
+  // The channel's eye in the camera's eye space (x right, y up, z toward the viewer), metres.
+  Vec3 offset{0, 0, 0};
+  // Empty: symmetric, from the camera's yfovDegrees and this channel's width / height.
+  std::optional<ChannelFrustum> frustum;
+  int width = 640, height = 480;  // pixels, 1 … 8192 each
+};
+inline constexpr size_t kMaxChannels = 16;  // per scene (seed 002's video channel had up to 8)
+
+// `n` channels (1 … kMaxChannels) abutting in an arc of `totalHorizontalDegrees` (0 < total <
+// 180·n, each channel < 180) centred on the camera's view: channel i spans
+// [−total/2 + i·total/n, −total/2 + (i+1)·total/n], as a yaw to its centre and a symmetric window
+// of ±total/(2n). Each is width × height pixels; its vertical window is ±verticalFovDegrees/2, or
+// for verticalFovDegrees = 0 the one that makes pixels square (tan v/2 = tan(h/2)·height/width).
+// Named "0", "1", … from the left.
+std::vector<Channel> arcChannels(int n, float totalHorizontalDegrees, int width, int height,
+                                 float verticalFovDegrees = 0);
+
 // One directional light for Gouraud shading (SPEC §8): per-vertex intensity
 // ambient + diffuse·max(0, n·l), interpolated across the triangle.
 struct Light {
@@ -207,6 +241,8 @@ struct Scene {
   std::vector<FreeFormObject> freeForms;
   std::vector<Terrain> terrains;
   std::vector<Camera> cameras;  // the first one is used unless another is chosen
+  // The display channels (SPEC §9), at most kMaxChannels; empty: the classic single view.
+  std::vector<Channel> channels;
   Light light;
   std::vector<PointLight> pointLights;
   Fog fog;

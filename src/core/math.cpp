@@ -37,6 +37,19 @@ Mat4 Mat4::perspective(float yfov, float aspect, float znear, float zfar) {
   return r;
 }
 
+// glFrustum's matrix: x_ndc = (2n·x/(r−l) + (r+l)/(r−l)·z)/(−z), so that x/(−z) = l/n maps to −1
+// and r/n to +1 (likewise y with b, t). The depth row is `perspective`'s, written the same way so
+// that a symmetric frustum gives the same depth bits.
+Mat4 Mat4::frustum(float left, float right, float bottom, float top, float znear, float zfar) {
+  Mat4 r;
+  r.m[0] = {2 * znear / (right - left), 0, 0, 0};
+  r.m[1] = {0, 2 * znear / (top - bottom), 0, 0};
+  r.m[2] = {(right + left) / (right - left), (top + bottom) / (top - bottom),
+            (zfar + znear) / (znear - zfar), -1};
+  r.m[3] = {0, 0, 2 * zfar * znear / (znear - zfar), 0};
+  return r;
+}
+
 Mat4 Mat4::lookAt(Vec3 eye, Vec3 target, Vec3 up) {
   Vec3 f = normalize(target - eye);
   Vec3 s = normalize(cross(f, up));

@@ -196,6 +196,16 @@ Result<CaseResult> BenchRunner::run(const BenchCase& c) {
   shaded.tris.fog = shaded.layers.fog = shaded.grazing.fog = s.fog;
   auto made = makeScene(shaded, s.options);
   if (!made.ok()) return made.error();
+  if (s.channels > 0 && made.value().scene.channels.empty()) {
+    made.value().scene.channels =
+        scene::arcChannels(s.channels, s.arcDegrees, s.options.width, s.options.height);
+    if (made.value().scene.channels.empty())
+      return Error{"", "",
+                   fmt::format("--channels {}: must be 1…{}", s.channels, scene::kMaxChannels)};
+  }
+  if (!made.value().scene.channels.empty() && impl_->gl)
+    return Error{"", "",
+                 "channels: the gl reference draws one view only (use --renderer synthvis)"};
   const scene::Scene& sc = made.value().scene;
 
   CaseResult r;
@@ -205,7 +215,7 @@ Result<CaseResult> BenchRunner::run(const BenchCase& c) {
   r.meanArea = made.value().meanArea;
   r.depthComplexity = made.value().depthComplexity;
   std::optional<RendererRun> ours, ref;
-  if (s.synthvis) ours = RendererRun{"synthvis", "synthvis", {}, 0, 0, 0, {}, {}};
+  if (s.synthvis) ours = RendererRun{"synthvis", "synthvis", {}, 0, 0, 0, {}, {}, {}};
   Renderer renderer(s.options);
   RenderOptions marchOptions = s.options;
   marchOptions.freeFormMethod = RenderOptions::FreeFormMethod::march;
@@ -220,6 +230,15 @@ Result<CaseResult> BenchRunner::run(const BenchCase& c) {
     r.params["tessellated_triangles"] = tessellated->triangleCount();
   }
   const scene::Scene& polygons = tessellated ? *tessellated : sc;
+  // One frame: the classic view, or every channel (SPEC §9), timed as one.
+  std::vector<Image> oursImages, refImages;
+  auto renderFrame = [&](Renderer& with, const scene::Scene& scene, RendererRun& run,
+                         std::vector<Image>& images) -> Status {
+    if (scene.channels.empty()) return with.render(scene, run.image, &run.stats);
+    if (Status st = with.renderChannels(scene, images, &run.channelStats); !st) return st;
+    run.stats = run.channelStats[0];
+    return {};
+  };
   if (s.sphereTrace) {
     ref = RendererRun{"sphere-trace",
                       fmt::format("synthvis, free forms marched in {} steps", s.options.marchSteps),
@@ -227,6 +246,7 @@ Result<CaseResult> BenchRunner::run(const BenchCase& c) {
                       0,
                       0,
                       0,
+                      {},
                       {},
                       {}};
   } else if (s.tessellated) {
@@ -237,22 +257,23 @@ Result<CaseResult> BenchRunner::run(const BenchCase& c) {
                       0,
                       0,
                       {},
+                      {},
                       {}};
   } else if (impl_->gl) {
     if (Status st = impl_->gl->load(polygons); !st) return st.error();
-    ref = RendererRun{"gl", impl_->glDescription, {}, 0, 0, 0, {}, {}};
+    ref = RendererRun{"gl", impl_->glDescription, {}, 0, 0, 0, {}, {}, {}};
   }
   // A/B, frame by frame.
   for (int i = 0; i < s.warmup + s.frames; ++i) {
     if (ours) {
       const auto t0 = Clock::now();
-      if (Status st = renderer.render(sc, ours->image, &ours->stats); !st) return st.error();
+      if (Status st = renderFrame(renderer, sc, *ours, oursImages); !st) return st.error();
       const double ms = msSince(t0);
       if (i >= s.warmup) ours->frameMs.push_back(ms);
     }
     if (ref && (s.sphereTrace || s.tessellated)) {
       const auto t0 = Clock::now();
-      if (Status st = marcher->render(s.sphereTrace ? sc : polygons, ref->image, &ref->stats); !st)
+      if (Status st = renderFrame(*marcher, s.sphereTrace ? sc : polygons, *ref, refImages); !st)
         return st.error();
       const double ms = msSince(t0);
       if (i >= s.warmup) ref->frameMs.push_back(ms);
@@ -267,10 +288,12 @@ Result<CaseResult> BenchRunner::run(const BenchCase& c) {
   }
   if (ours) {
     finish(*ours);
+    if (!ours->channelStats.empty()) ours->image = mosaic(oursImages);
     r.runs.push_back(std::move(*ours));
   }
   if (ref) {
     finish(*ref);
+    if (!ref->channelStats.empty()) ref->image = mosaic(refImages);
     if (!s.sphereTrace && !s.tessellated)
       if (Status st = impl_->gl->readImage(ref->image); !st) return st.error();
     if (!r.runs.empty()) r.psnrDb = psnr(r.runs[0].image, ref->image);
@@ -285,7 +308,12 @@ namespace {
 double pixelsOf(const CaseResult& r) {
   if (r.meanArea > 0) return r.meanArea * double(r.triangles);
   for (const RendererRun& run : r.runs)
-    if (run.renderer == "synthvis") return double(run.stats.fragments);
+    if (run.renderer == "synthvis") {
+      if (run.channelStats.empty()) return double(run.stats.fragments);
+      double sum = 0;
+      for (const FrameStats& c : run.channelStats) sum += double(c.fragments);
+      return sum;
+    }
   return 0;
 }
 }  // namespace
@@ -331,7 +359,16 @@ nlohmann::json jsonRows(const CaseResult& r, const BenchSettings& s) {
          {"triangles", r.triangles},
          {"mtri_per_s", run.medianMs > 0 ? double(r.triangles) / run.medianMs / 1e3 : 0},
          {"mpix_per_s", run.medianMs > 0 ? pixels / run.medianMs / 1e3 : 0}});
-    if (run.renderer == "synthvis") row["triangles_drawn"] = run.stats.drawn;
+    if (run.renderer == "synthvis") {
+      uint64_t drawn = run.stats.drawn;
+      if (!run.channelStats.empty()) {
+        drawn = 0;
+        for (const FrameStats& c : run.channelStats) drawn += c.drawn;
+      }
+      row["triangles_drawn"] = drawn;  // over all channels
+    }
+    // Views in one frame (SPEC §9): 1 for the classic view; width and height are each channel's.
+    row["channels"] = run.channelStats.empty() ? size_t(1) : run.channelStats.size();
     if (r.runs.size() > 1)
       row["psnr_db"] = std::isinf(r.psnrDb) ? nlohmann::json(999.0) : nlohmann::json(r.psnrDb);
     rows.push_back(row);

@@ -46,8 +46,9 @@ struct RendererRun {
   std::string description;  // e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
   std::vector<double> frameMs;
   double medianMs = 0, minMs = 0, maxMs = 0;
-  FrameStats stats;  // synthvis only
-  Image image;       // the last frame
+  FrameStats stats;                      // synthvis only (with channels: the first channel's)
+  Image image;                           // the last frame (with channels: their mosaic, SPEC §9)
+  std::vector<FrameStats> channelStats;  // synthvis with channels: each channel's, last frame
 };
 
 struct CaseResult {
@@ -82,6 +83,11 @@ struct BenchSettings {
   bool textured = false;
   // BENCH.md --fog: generated scenes get the bench fog (scene::addBenchFog), in both renderers.
   bool fog = false;
+  // BENCH.md --channels N (SPEC §9): a scene without channels of its own gets N abutting ones in
+  // an arc of `arcDegrees` around its camera, each options.width × options.height; one frame is
+  // all channels (Renderer::renderChannels). 0: the classic single view. synthvis only.
+  int channels = 0;
+  float arcDegrees = 150;
 };
 
 // Renders, per case, warm-up frames then timed frames, alternating synthvis and the reference

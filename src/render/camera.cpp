@@ -52,6 +52,35 @@ scene::Camera defaultCamera(const scene::Scene& s) {
   return cam;
 }
 
+float radians(float degrees) { return degrees * std::numbers::pi_v<float> / 180.0f; }
+
+// The inverse of a rotation followed by a translation: the rotation transposed, and the
+// translation brought back through it.
+Mat4 rigidInverse(const Mat4& m) {
+  Mat4 r;
+  for (int c = 0; c < 3; ++c)
+    for (int row = 0; row < 3; ++row) r.m[c][row] = m.m[row][c];
+  const Vec3 t{m.m[3][0], m.m[3][1], m.m[3][2]};
+  r.m[3] = {-r.m[0][0] * t.x - r.m[1][0] * t.y - r.m[2][0] * t.z,
+            -r.m[0][1] * t.x - r.m[1][1] * t.y - r.m[2][1] * t.z,
+            -r.m[0][2] * t.x - r.m[1][2] * t.y - r.m[2][2] * t.z, 1};
+  return r;
+}
+
+// The camera's own window: yfov high, width / height wide, symmetric about the view axis. The
+// tangents are computed as the terrain pass and free-form tessellation always did (in double from
+// the degrees), so that their images stay bit for bit what they were.
+void setSymmetricWindow(FrameCamera& f, int width, int height) {
+  const scene::Camera& cam = f.camera;
+  const float aspect = float(width) / float(height);
+  f.projection = Mat4::perspective(cam.yfovDegrees * std::numbers::pi_v<float> / 180.0f, aspect,
+                                   cam.znear, cam.zfar);
+  f.tanTop = std::tan(cam.yfovDegrees * std::numbers::pi / 360);
+  f.tanBottom = -f.tanTop;
+  f.tanRight = f.tanTop * double(width) / double(height);
+  f.tanLeft = -f.tanRight;
+}
+
 }  // namespace
 
 Result<FrameCamera> chooseCamera(const scene::Scene& scene, const RenderOptions& o) {
@@ -65,11 +94,45 @@ Result<FrameCamera> chooseCamera(const scene::Scene& scene, const RenderOptions&
   } else {
     f.camera = defaultCamera(scene);
   }
-  const scene::Camera& cam = f.camera;
-  const float aspect = float(o.width) / float(o.height);
-  f.view = Mat4::lookAt(cam.position, cam.target, cam.up);
-  f.projection = Mat4::perspective(cam.yfovDegrees * std::numbers::pi_v<float> / 180.0f, aspect,
-                                   cam.znear, cam.zfar);
+  f.view = Mat4::lookAt(f.camera.position, f.camera.target, f.camera.up);
+  setSymmetricWindow(f, o.width, o.height);
+  return f;
+}
+
+Result<FrameCamera> channelCamera(const scene::Scene& scene, const RenderOptions& o,
+                                  const scene::Channel& channel) {
+  Result<FrameCamera> base = chooseCamera(scene, o);
+  if (!base.ok()) return base.error();
+  FrameCamera f = std::move(base).value();
+  // Channel → camera eye space: the offset, then heading, pitch and bank about the channel's own
+  // axes. Yaw right is a turn about −y (a right-handed turn about +y swings −z to −x, the left);
+  // pitch up a turn about +x; roll right (up leaning to +x) a turn about −z. The view is that
+  // placement's inverse before the camera's. Skipped when it is the identity, so that a centred
+  // channel keeps the camera's view bit for bit.
+  const scene::Channel& c = channel;
+  if (c.yawDegrees != 0 || c.pitchDegrees != 0 || c.rollDegrees != 0 ||
+      !(c.offset == Vec3{0, 0, 0})) {
+    const Mat4 toCamera = Mat4::translation(c.offset) *
+                          Mat4::rotation({0, 1, 0}, -radians(c.yawDegrees)) *
+                          Mat4::rotation({1, 0, 0}, radians(c.pitchDegrees)) *
+                          Mat4::rotation({0, 0, -1}, radians(c.rollDegrees));
+    f.view = rigidInverse(toCamera) * f.view;
+  }
+  if (!c.frustum) {
+    setSymmetricWindow(f, c.width, c.height);
+    return f;
+  }
+  // The channel's own window: tangents of its half-angles, and glFrustum's matrix on the near
+  // plane (SPEC §9: abutting channels share an edge direction, so they meet without gap or
+  // overlap).
+  const double toRadians = std::numbers::pi / 180;
+  f.tanLeft = std::tan(c.frustum->leftDegrees * toRadians);
+  f.tanRight = std::tan(c.frustum->rightDegrees * toRadians);
+  f.tanBottom = std::tan(c.frustum->downDegrees * toRadians);
+  f.tanTop = std::tan(c.frustum->upDegrees * toRadians);
+  const double n = f.camera.znear;
+  f.projection = Mat4::frustum(float(n * f.tanLeft), float(n * f.tanRight), float(n * f.tanBottom),
+                               float(n * f.tanTop), f.camera.znear, f.camera.zfar);
   return f;
 }
 

@@ -6,13 +6,27 @@
 namespace sv::render {
 
 struct FrameCamera {
-  scene::Camera camera;  // as placed in the world
+  scene::Camera camera;  // the scene's camera in the world (a channel's view is turned from it)
   Mat4 view;             // world → eye (the camera at the origin looking down −z)
-  Mat4 projection;       // eye → clip, aspect width / height
+  Mat4 projection;       // eye → clip: the view window below onto the raster
+  // The view window at unit eye depth: the ray through raster point (px, py) of a W × H raster is
+  // (tanLeft + (tanRight − tanLeft)·px/W, tanTop − (tanTop − tanBottom)·py/H, −1) in eye space.
+  // Symmetric for the classic view; a channel's may be asymmetric (SPEC §9). Whatever needs rays
+  // or pixel sizes (terrain, free-form tessellation) reads these, never the camera's yfov.
+  double tanLeft = -1, tanRight = 1, tanBottom = -1, tanTop = 1;
 };
 
 // The camera `options.camera` of the scene (an error names one that does not exist), or for a
-// scene without cameras one that frames its bounds.
+// scene without cameras one that frames its bounds; its window is yfov high, aspect
+// options.width / options.height.
 Result<FrameCamera> chooseCamera(const scene::Scene& scene, const RenderOptions& options);
+
+// Display channel `channel` (SPEC §9) of the camera chooseCamera picks: its view is the camera's
+// turned by the channel's yaw, pitch and roll and moved by its offset (scene.h, Channel); its
+// projection is the channel's frustum (Mat4::frustum), or without one the camera's yfov at the
+// channel's aspect. A channel with no turn, no offset and no frustum at the options' size is the
+// classic view exactly (the same matrices, bit for bit).
+Result<FrameCamera> channelCamera(const scene::Scene& scene, const RenderOptions& options,
+                                  const scene::Channel& channel);
 
 }  // namespace sv::render

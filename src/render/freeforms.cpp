@@ -6,7 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
+#include <limits>
 
 #include "freeform/tessellate.h"
 #include "render/draw_packets.h"
@@ -67,11 +67,22 @@ std::vector<freeform::ShadedForm> makeShadedForms(const scene::Scene& scene, con
 namespace sv {
 
 Result<scene::Scene> tessellatedScene(const scene::Scene& scene, const RenderOptions& o) {
-  const Result<render::FrameCamera> camera = render::chooseCamera(scene, o);
-  if (!camera.ok()) return camera.error();
-  const scene::Camera& cam = camera.value().camera;
-  const double pixelPerDepth =
-      2 * std::tan(cam.yfovDegrees * std::numbers::pi / 360) / double(o.height * o.supersample);
+  // The views the frame has: the camera's, or every display channel's (SPEC §9); each object is
+  // cut finely enough for the view that sees it largest.
+  std::vector<render::FrameCamera> cameras;
+  std::vector<int> heights;
+  if (scene.channels.empty()) {
+    const Result<render::FrameCamera> camera = render::chooseCamera(scene, o);
+    if (!camera.ok()) return camera.error();
+    cameras.push_back(camera.value());
+    heights.push_back(o.height);
+  }
+  for (const scene::Channel& channel : scene.channels) {
+    const Result<render::FrameCamera> camera = render::channelCamera(scene, o, channel);
+    if (!camera.ok()) return camera.error();
+    cameras.push_back(camera.value());
+    heights.push_back(channel.height);
+  }
   scene::Scene out = scene;
   out.freeForms.clear();
   constexpr size_t kMaxTriangles = size_t(1) << 22;
@@ -85,12 +96,20 @@ Result<scene::Scene> tessellatedScene(const scene::Scene& scene, const RenderOpt
     if (unbounded)
       return Error{"", "", fmt::format("{} is unbounded or too large to tessellate", label)};
     if (!box) continue;  // no surface
-    // The nearest eye depth of the box, and its smallest half extent as the curvature radius.
-    const Mat4 toEye = camera.value().view * object.transform;
-    const auto single = [](Vec3d v) { return Vec3{float(v.x), float(v.y), float(v.z)}; };
-    const double nearest =
-        std::max(double(render::nearestEyeDepth(toEye, single((*box)[0]), single((*box)[1]))),
-                 double(cam.znear));
+    // Per view: the nearest eye depth of the box, and a pixel's height per unit eye depth (from
+    // the view window, FrameCamera's tangents) — the smallest pixel there, in world units.
+    double worldPixel = std::numeric_limits<double>::infinity();
+    for (size_t k = 0; k < cameras.size(); ++k) {
+      const Mat4 toEye = cameras[k].view * object.transform;
+      const auto single = [](Vec3d v) { return Vec3{float(v.x), float(v.y), float(v.z)}; };
+      const double nearest =
+          std::max(double(render::nearestEyeDepth(toEye, single((*box)[0]), single((*box)[1]))),
+                   double(cameras[k].camera.znear));
+      const double pixelPerDepth =
+          (cameras[k].tanTop - cameras[k].tanBottom) / double(heights[k] * o.supersample);
+      worldPixel = std::min(worldPixel, nearest * pixelPerDepth);
+    }
+    // Its smallest half extent as the curvature radius.
     const Vec3d extent = (*box)[1] - (*box)[0];
     const double radius = 0.5 * std::min({extent.x, extent.y, extent.z});
     // Object units per pixel at that depth (the transform's largest scale brings it to the world).
@@ -98,7 +117,7 @@ Result<scene::Scene> tessellatedScene(const scene::Scene& scene, const RenderOpt
     for (int c = 0; c < 3; ++c)
       scale = std::max(scale, double(length(object.transform.transformDirection(
                                   Vec3{float(c == 0), float(c == 1), float(c == 2)}))));
-    const double pixel = nearest * pixelPerDepth / std::max(scale, 1e-30);
+    const double pixel = worldPixel / std::max(scale, 1e-30);
     // Sagitta c²/(8r) ≤ pixel/4 for chords c ≤ √3·cell (a leaf's diagonal).
     const double cell = std::sqrt(2 * radius * pixel / 3);
     freeform::TriangleSoup soup;

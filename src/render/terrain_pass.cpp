@@ -141,7 +141,15 @@ void TerrainPass::setTerrains(const scene::Scene& scene, const FrameCamera& came
   const Vec3d back{v.m[0][2], v.m[1][2], v.m[2][2]};
   forward_ = back * -1.0;
   eye_ = (right_ * v.m[3][0] + up_ * v.m[3][1] + back * v.m[3][2]) * -1.0;
-  tanY_ = std::tan(camera.camera.yfovDegrees * std::numbers::pi / 360);
+  // The view window (SPEC §9: a channel's may be asymmetric) as its centre and half-size at unit
+  // depth. A centre of 0 is stored as −0, which adds to any value without changing a bit, so the
+  // classic symmetric view casts exactly the rays it always did.
+  halfX_ = 0.5 * (camera.tanRight - camera.tanLeft);
+  halfY_ = 0.5 * (camera.tanTop - camera.tanBottom);
+  centreX_ = 0.5 * (camera.tanRight + camera.tanLeft);
+  centreY_ = 0.5 * (camera.tanTop + camera.tanBottom);
+  if (centreX_ == 0) centreX_ = -0.0;
+  if (centreY_ == 0) centreY_ = -0.0;
   znear_ = camera.camera.znear;
   zfar_ = camera.camera.zfar;
   p22_ = camera.projection.m[2][2];
@@ -170,7 +178,7 @@ void TerrainPass::setTerrains(const scene::Scene& scene, const FrameCamera& came
     d.ramp = t.ramp.empty() ? defaultRamp(f.offset, f.offset + 65535 * f.scale) : t.ramp;
     // A pixel's width per unit eye depth, in grid steps (at the view's centre: the level of
     // detail needs no more), or 0 for the exact surface everywhere.
-    d.pixel = options.terrainLod ? 2 * tanY_ / (options.height * options.supersample) /
+    d.pixel = options.terrainLod ? 2 * halfY_ / (options.height * options.supersample) /
                                        std::min(f.spacingU, f.spacingV)
                                  : 0.0;
     groundBytes_ += t.ground->bytes();
@@ -183,7 +191,6 @@ void TerrainPass::prepare(const raster::PassFrame& frame) {
   width_ = frame.width;
   height_ = frame.height;
   samples_ = frame.samples;
-  tanX_ = tanY_ * double(width_) / double(height_);
   for (int s = 0; s < samples_; ++s) {
     offsetX_[s] = frame.coverage ? frame.coverage->offsetX[s] / 256.0 : 0.0;
     offsetY_[s] = frame.coverage ? frame.coverage->offsetY[s] / 256.0 : 0.0;
@@ -206,8 +213,8 @@ void TerrainPass::addStats(FrameStats& stats) const {
 }
 
 Vec3d TerrainPass::direction(double px, double py) const {
-  return forward_ + right_ * ((2 * px / width_ - 1) * tanX_) +
-         up_ * ((1 - 2 * py / height_) * tanY_);
+  return forward_ + right_ * ((2 * px / width_ - 1) * halfX_ + centreX_) +
+         up_ * ((1 - 2 * py / height_) * halfY_ + centreY_);
 }
 
 // Window depth (z + 1)/2 ↔ eye depth s: ndc z = −p22 + p23/s (the GL projection's depth row).

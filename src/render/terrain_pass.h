@@ -66,9 +66,10 @@ class TerrainPass final : public raster::TilePass {
   std::vector<Drawn> terrains_;
   const shade::Environment* environment_ = nullptr;
   // The camera in the world: eye, and the ray direction's parts (a point at eye depth s is
-  // eye + s·(forward + px·right + py·up)), and the eye-space rotation.
+  // eye + s·(forward + px·right + py·up)), and the eye-space rotation; the view window at unit
+  // depth, its centre and half-size (FrameCamera's tangents).
   Vec3d eye_, forward_, right_, up_;
-  double tanX_ = 1, tanY_ = 1, znear_ = 0.1, zfar_ = 1000;
+  double halfX_ = 1, halfY_ = 1, centreX_ = -0.0, centreY_ = -0.0, znear_ = 0.1, zfar_ = 1000;
   double p22_ = 0, p23_ = 0;  // the projection's depth row: ndc z = −p22 + p23/s
   int width_ = 0, height_ = 0, samples_ = 1;
   double offsetX_[64] = {}, offsetY_[64] = {};

@@ -26,6 +26,7 @@
 #include <utility>
 
 #include "core/quadric.h"
+#include "scene/channels.h"
 #include "scene/loader_common.h"
 #include "scene/primitives.h"
 #include "terrain/ground.h"
@@ -391,6 +392,7 @@ class SceneReader {
 
  private:
   Camera readCamera(const Json& v, const std::string& where) const;
+  std::vector<Channel> readChannels(const Json& v, const std::string& where) const;
   void readLight(const Json& v, const std::string& where);
   void readMaterials(const Json& v, const std::string& where);
   void readTextures(const Json& v, const std::string& where);
@@ -458,7 +460,7 @@ Scene SceneReader::read(const Json& root) {
   expectKeys(root, "",
              {"synthvis", "description", "background", "camera", "cameras", "light", "pointLights",
               "fog", "textures", "colorTable", "materials", "objects", "terrain", "lights",
-              "time"});
+              "time", "channels"});
 
   if (const Json* description = find(root, "description")) string(*description, "description");
   if (const Json* background = find(root, "background")) {
@@ -474,6 +476,7 @@ Scene SceneReader::read(const Json& root) {
     for (size_t i = 0; i < cameras->size(); ++i)
       scene_.cameras.push_back(readCamera((*cameras)[i], element("cameras", i)));
   }
+  if (const Json* x = find(root, "channels")) scene_.channels = readChannels(*x, "channels");
   if (const Json* light = find(root, "light")) readLight(*light, "light");
   if (const Json* x = find(root, "pointLights")) readPointLights(*x, "pointLights");
   if (const Json* x = find(root, "fog")) readFog(*x, "fog");
@@ -724,6 +727,77 @@ Camera SceneReader::readCamera(const Json& v, const std::string& where) const {
   if (!(length(cross(view, c.up)) > 0))
     fail(where, "up must not be parallel to the view direction");
   return c;
+}
+
+// "channels" (docs/scene-format.md, "Channels"; SPEC §9): a list of channels, or an arc of
+// abutting ones (scene::arcChannels).
+std::vector<Channel> SceneReader::readChannels(const Json& v, const std::string& where) const {
+  if (v.is_object()) {
+    expectKeys(v, where, {"arc", "count", "width", "height", "vfov"});
+    for (const char* key : {"arc", "count", "width", "height"})
+      if (!find(v, key)) fail(where, fmt::format("missing key '{}'", key));
+    const int n = int(integer(*find(v, "count"), member(where, "count"), 1, kMaxChannels));
+    const float arc = number(*find(v, "arc"), member(where, "arc"));
+    if (!(arc > 0 && arc < 180.0f * float(n)))
+      fail(
+          member(where, "arc"),
+          fmt::format("{} is out of range (0, {}) degrees (each channel under 180)", arc, 180 * n));
+    const int w = int(integer(*find(v, "width"), member(where, "width"), 1, 8192));
+    const int h = int(integer(*find(v, "height"), member(where, "height"), 1, 8192));
+    float vfov = 0;
+    if (const Json* x = find(v, "vfov")) {
+      vfov = number(*x, member(where, "vfov"));
+      if (!(vfov > 0 && vfov < 180))
+        fail(member(where, "vfov"), fmt::format("{} is out of range (0, 180) degrees", x->dump()));
+    }
+    return arcChannels(n, arc, w, h, vfov);
+  }
+  array(v, where);
+  if (v.size() > kMaxChannels)
+    fail(where, fmt::format("{} channels is more than the {} supported", v.size(), kMaxChannels));
+  std::vector<Channel> out;
+  for (size_t i = 0; i < v.size(); ++i) {
+    const std::string w = element(where, i);
+    expectKeys(v[i], w, {"name", "yaw", "pitch", "roll", "offset", "frustum", "width", "height"});
+    Channel c;
+    if (const Json* x = find(v[i], "name")) {
+      c.name = string(*x, member(w, "name"));
+      if (!detail::isChannelName(c.name))
+        fail(member(w, "name"), "use 1 … 64 letters, digits, '-' or '_' (it names an image file)");
+      for (const Channel& other : out)
+        if (other.name == c.name)
+          fail(member(w, "name"), fmt::format("duplicate channel name '{}'", c.name));
+    }
+    if (const Json* x = find(v[i], "yaw")) c.yawDegrees = inRange(*x, member(w, "yaw"), -180, 180);
+    if (const Json* x = find(v[i], "pitch"))
+      c.pitchDegrees = inRange(*x, member(w, "pitch"), -90, 90);
+    if (const Json* x = find(v[i], "roll"))
+      c.rollDegrees = inRange(*x, member(w, "roll"), -180, 180);
+    if (const Json* x = find(v[i], "offset")) c.offset = vec3(*x, member(w, "offset"));
+    if (const Json* x = find(v[i], "frustum")) {
+      const std::string fw = member(w, "frustum");
+      expectKeys(*x, fw, {"left", "right", "down", "up"});
+      float a[4];
+      const char* keys[4] = {"left", "right", "down", "up"};
+      for (int k = 0; k < 4; ++k) {
+        const Json* y = find(*x, keys[k]);
+        if (!y) fail(fw, fmt::format("missing key '{}'", keys[k]));
+        a[k] = number(*y, member(fw, keys[k]));
+        if (!(a[k] > -90 && a[k] < 90))
+          fail(member(fw, keys[k]), fmt::format("{} is out of range (-90, 90) degrees", y->dump()));
+      }
+      if (!(a[0] < a[1]))
+        fail(fw, fmt::format("left ({}) must be less than right ({})", a[0], a[1]));
+      if (!(a[2] < a[3])) fail(fw, fmt::format("down ({}) must be less than up ({})", a[2], a[3]));
+      c.frustum = ChannelFrustum{a[0], a[1], a[2], a[3]};
+    }
+    for (const char* key : {"width", "height"})
+      if (!find(v[i], key)) fail(w, fmt::format("missing key '{}'", key));
+    c.width = int(integer(*find(v[i], "width"), member(w, "width"), 1, 8192));
+    c.height = int(integer(*find(v[i], "height"), member(w, "height"), 1, 8192));
+    out.push_back(c);
+  }
+  return out;
 }
 
 // Light colours may exceed 1 (a brighter light); they may not be negative.

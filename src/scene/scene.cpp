@@ -9,6 +9,8 @@
 #include <limits>
 #include <utility>
 
+#include "scene/channels.h"
+
 namespace sv::scene {
 
 std::array<Vec3, 2> Mesh::bounds() const {
@@ -258,6 +260,8 @@ Status validate(const Scene& scene, const std::string& file, bool vertexData) {
         !std::isfinite(c.yfovDegrees) || !std::isfinite(c.znear) || !std::isfinite(c.zfar))
       return fail(fmt::format("cameras[{}]: not finite", i));
   }
+  if (std::string problem = detail::channelsProblem(scene.channels); !problem.empty())
+    return fail(std::move(problem));
   return {};
 }
 

@@ -115,6 +115,56 @@ TEST(Cli, BenchWritesTheJsonFieldsBenchMdNames) {
     EXPECT_NE(text.find(key), std::string::npos) << key;
 }
 
+// SPEC §9: --channels N writes OUT-<i>.png per channel with a statistics line each, and the
+// mosaic; a scene's own channels are written by name; misuse is a one-line error.
+TEST(Cli, RenderWritesAnImageAndAStatisticsLinePerChannelAndTheMosaic) {
+  const fs::path dir = tempDir() / "channels";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string out = (dir / "view.png").string(), mosaic = (dir / "all.png").string();
+  CliRun r =
+      run("render -o " + out + " --width 64 --height 48 --threads 2 --channels 3 --arc 150 " +
+          "--mosaic " + mosaic);
+  ASSERT_EQ(r.status, 0) << r.out;
+  for (const char* name : {"view-0.png", "view-1.png", "view-2.png", "all.png"})
+    EXPECT_TRUE(fs::exists(dir / name)) << name;
+  EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 5) << r.out;  // 3 channels, frame, mosaic
+  EXPECT_NE(r.out.find("view-2.png: 64x48 | triangles in"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("frame: 3 channels"), std::string::npos) << r.out;
+
+  const std::string scene = write("channels.json", R"({"synthvis": 1,
+      "objects": [{"primitive": "box"}],
+      "channels": [{"name": "left", "yaw": -30, "width": 32, "height": 24},
+                   {"name": "right", "yaw": 30, "width": 40, "height": 24,
+                    "frustum": {"left": -10, "right": 20, "down": -10, "up": 10}}]})");
+  r = run("render " + scene + " -o " + out);
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_TRUE(fs::exists(dir / "view-left.png"));
+  EXPECT_TRUE(fs::exists(dir / "view-right.png"));
+  expectOneLineError(run("render " + scene + " -o " + out + " --channels 2"), "channels.json",
+                     "--channels: the scene has 2 channels of its own");
+  expectOneLineError(run("render -o " + out + " --channels 17"), "", "--channels 17: must be 1…16");
+  const std::string bad = write("bad_channels.json", R"({"synthvis": 1,
+      "channels": [{"width": 32, "height": 24, "frustum": {"left": 5, "right": -5, "down": -5, "up": 5}}]})");
+  expectOneLineError(run("render " + bad + " -o " + out), "bad_channels.json",
+                     "channels[0].frustum: left (5) must be less than right (-5)");
+}
+
+TEST(Cli, BenchChannelsTimesTheWholeFrameAndWritesTheChannelsField) {
+  const std::string json = (tempDir() / "bench_channels.json").string();
+  const CliRun r =
+      run("bench tris --count 2000 --area 20 --width 160 --height 120 --frames 2 "
+          "--warmup 1 --channels 3 --json " +
+          json);
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("channel 2:"), std::string::npos) << r.out;
+  std::ifstream f(json);
+  const nlohmann::json row = nlohmann::json::parse(f);
+  EXPECT_EQ(row["channels"], 3);
+  EXPECT_EQ(row["width"], 160);
+  EXPECT_GT(row["median_ms"].get<double>(), 0);
+}
+
 // --repeat N: each measurement printed and written as a JSON row numbered by its repeat, then the
 // medians over them; an impossible count is a one-line error.
 TEST(Cli, BenchRepeatPrintsEachMeasurementAndTheirMedian) {

@@ -77,6 +77,31 @@ TEST(Mat4, PerspectiveMapsNearAndFarToMinusOneAndOne) {
   EXPECT_NEAR(farPt.z / farPt.w, 1.0f, 1e-5f);
 }
 
+// glFrustum by hand for l = −1, r = 3, b = −2, t = 1, n = 2, f = 10: x' = (2n·x + (r+l)·z)/(r−l)
+// = (4x + 2z)/4, y' = (4y − z)/3, w = −z. The window's corners on the near plane land on ±1, and a
+// point halfway through depth keeps the symmetric projection's depth.
+TEST(Mat4, FrustumMatchesTheHandComputationForAnAsymmetricWindow) {
+  const Mat4 p = Mat4::frustum(-1, 3, -2, 1, 2, 10);
+  const Vec4 q = p * Vec4{0.5f, -0.25f, -4, 1};
+  EXPECT_FLOAT_EQ(q.x, (4 * 0.5f + 2 * -4.0f) / 4);
+  EXPECT_FLOAT_EQ(q.y, (4 * -0.25f - -4.0f) / 3);
+  EXPECT_FLOAT_EQ(q.w, 4);
+  const Vec4 lowLeft = p * Vec4{-1, -2, -2, 1}, upRight = p * Vec4{3, 1, -2, 1};
+  EXPECT_FLOAT_EQ(lowLeft.x / lowLeft.w, -1);
+  EXPECT_FLOAT_EQ(lowLeft.y / lowLeft.w, -1);
+  EXPECT_FLOAT_EQ(lowLeft.z / lowLeft.w, -1);
+  EXPECT_FLOAT_EQ(upRight.x / upRight.w, 1);
+  EXPECT_FLOAT_EQ(upRight.y / upRight.w, 1);
+  // Symmetric, it is the perspective projection with the same depth row.
+  const float t = std::tan(0.5f);
+  const Mat4 s = Mat4::frustum(-2 * t * 1.5f, 2 * t * 1.5f, -2 * t, 2 * t, 2, 10);
+  const Mat4 g = Mat4::perspective(1.0f, 1.5f, 2, 10);
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r) EXPECT_NEAR(s.m[c][r], g.m[c][r], 1e-6f) << c << ", " << r;
+  EXPECT_EQ(s.m[2][2], g.m[2][2]);
+  EXPECT_EQ(s.m[3][2], g.m[3][2]);
+}
+
 TEST(Mat4, LookAtPutsTheTargetOnTheNegativeZAxis) {
   const Mat4 v = Mat4::lookAt({3, 4, 5}, {-1, 2, 0}, {0, 1, 0});
   const Vec3 t = v.transformPoint({-1, 2, 0});

@@ -40,6 +40,21 @@ TEST(ImageIo, PngRoundTripIsLossless) {
   EXPECT_EQ(back->rgb, img.rgb);
 }
 
+// SPEC §9: channels side by side, in order; the shorter one padded below with black.
+TEST(Mosaic, PutsChannelsSideBySideAndPadsShorterOnesWithBlack) {
+  const Image a = gradient(5, 4), b = gradient(3, 7);
+  const Image m = mosaic({a, b});
+  ASSERT_EQ(m.width, 8);
+  ASSERT_EQ(m.height, 7);
+  for (int y = 0; y < 7; ++y)
+    for (int x = 0; x < 8; ++x)
+      for (int c = 0; c < 3; ++c) {
+        const int expected = x < 5 ? (y < 4 ? a.pixel(x, y)[c] : 0) : b.pixel(x - 5, y)[c];
+        ASSERT_EQ(m.pixel(x, y)[c], expected) << x << ", " << y;
+      }
+  EXPECT_EQ(mosaic({}).rgb.size(), 0u);
+}
+
 TEST(ImageIo, PpmHasBinaryP6HeaderAndPixels) {
   const Image img = gradient(5, 3);
   const std::string path = tempPath("sv_img.ppm");

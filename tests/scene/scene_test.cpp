@@ -113,7 +113,7 @@ TEST(Generators, NamesParseBackAndLaterOnesSayWhatTheyNeed) {
     const Result<Generator> parsed = parseGenerator(generatorName(g));
     ASSERT_TRUE(parsed.ok()) << generatorName(g);
     EXPECT_EQ(parsed.value(), g);
-    const bool later = g == Generator::volume || g == Generator::lights;
+    const bool later = g == Generator::volume;
     EXPECT_EQ(generatorNeeds(g) != nullptr, later) << generatorName(g);
   }
   EXPECT_STREQ(generatorName(Generator::freeformOne), "freeform-one");
