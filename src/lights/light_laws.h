@@ -83,40 +83,57 @@ inline float screenEnergy(float exposure, float intensity, float transmission, f
   return exposure * intensity * transmission / (d * d);
 }
 
-// The diameter a light of energy Φ is drawn at: its natural size — the kernel (splatWeight) of
-// radius R = √(3Φ/π) carries Φ at a peak of full white (the kernel integrates to πR²/3), and the
-// diameter is 2R − 1 (splatRadius's inverse) — clamped to [minSize, maxSize]. Below the minimum
-// the light keeps the minimum size and its energy, and fades; above the maximum it brightens.
+// The splat's kernel is separable (its weights, and their sum, come from two short rows): the
+// product k(dx)·k(dy) of k(t) = (1 − t²/R²)² for |t| < R — round enough at the sizes lights are
+// drawn, and smooth to its edge. A pixel's share of the energy is its weight over the sum of the
+// weights of every pixel centre in the kernel's square (so the total is Φ wherever the light
+// falls). ∫k = 16R/15, so the kernel's integral is (16R/15)².
+
+// The diameter a light of energy Φ is drawn at: its natural size — the kernel whose peak is full
+// white carries Φ when (16R/15)² = Φ, R = (15/16)·√Φ, and the diameter is 2R − 1 (splatRadius's
+// inverse) — clamped to [minSize, maxSize]. Below the minimum the light keeps the minimum size
+// and its energy, and fades; above the maximum it brightens.
 inline float splatDiameter(float energy, float minSize, float maxSize) {
-  return std::clamp(2 * std::sqrt(3 * energy / std::numbers::pi_v<float>) - 1, minSize, maxSize);
+  return std::clamp(2 * (15.0f / 16) * std::sqrt(energy) - 1, minSize, maxSize);
 }
 
 // The splat's kernel radius for a diameter D: the disc widened by half a pixel, so that a 1-px
 // light still reaches the pixel centres around it (the aperture of SPEC §3.2).
 inline float splatRadius(float diameter) { return 0.5f * diameter + 0.5f; }
 
-// The kernel's weight at squared distance r² from the light's centre, radius R (1/R² given):
-// (1 − r²/R²)², smooth to its edge; a pixel's share of the energy is its weight over the sum
-// of the weights of every pixel centre within R (so the total is Φ wherever the light falls).
-inline float splatWeight(float r2, float invR2) {
-  const float u = 1 - r2 * invR2;
+// The kernel along one axis at squared distance t² (1/R² given): (1 − t²/R²)², 0 from R on.
+inline float splatWeight(float t2, float invR2) {
+  const float u = 1 - t2 * invR2;
   return u > 0 ? u * u : 0;
 }
 
-// The sum of the weights over pixel centres (i + ½, j + ½) within radius R of (x, y).
-inline float splatWeightSum(float x, float y, float radius) {
+// The largest number of pixel centres a kernel spans along an axis (radius ≤ 32.5: sizes ≤ 64).
+inline constexpr int kMaxSplatSpan = 66;
+
+// The kernel's weights along one axis for a light at coordinate c with radius R: out[k] for the
+// pixel centres first + k + ½, k < the returned count (those in [c − R, c + R]).
+inline int splatAxis(float c, float radius, float* out, int& first) {
   const float invR2 = 1 / (radius * radius);
-  const int x0 = int(std::floor(x - radius)), x1 = int(std::floor(x + radius));
-  const int y0 = int(std::floor(y - radius)), y1 = int(std::floor(y + radius));
-  float sum = 0;
-  for (int j = y0; j <= y1; ++j) {
-    const float dy = float(j) + 0.5f - y;
-    for (int i = x0; i <= x1; ++i) {
-      const float dx = float(i) + 0.5f - x;
-      sum += splatWeight(dx * dx + dy * dy, invR2);
-    }
+  first = int(std::floor(c - radius));
+  const int last = int(std::floor(c + radius));
+  int n = 0;
+  for (int i = first; i <= last && n < kMaxSplatSpan; ++i) {
+    const float d = float(i) + 0.5f - c;
+    out[n++] = splatWeight(d * d, invR2);
   }
-  return sum;
+  return n;
+}
+
+// The sum of the kernel's weights over the pixel centres around (x, y): a product of two sums.
+inline float splatWeightSum(float x, float y, float radius) {
+  float w[kMaxSplatSpan];
+  int first;
+  float sx = 0, sy = 0;
+  const int nx = splatAxis(x, radius, w, first);
+  for (int k = 0; k < nx; ++k) sx += w[k];
+  const int ny = splatAxis(y, radius, w, first);
+  for (int k = 0; k < ny; ++k) sy += w[k];
+  return sx * sy;
 }
 
 // A star's world direction at time t (seconds): equatorial `e` (x toward RA 0h, z toward the

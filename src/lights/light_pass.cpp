@@ -37,7 +37,6 @@ bool LightPass::finishSplat(float energy, Vec3 color, Splat& s) const {
   if (!(peak >= kDarkest)) return false;
   const scene::LightSettings& ls = in_.settings;
   s.radius = splatRadius(splatDiameter(energy, ls.minSize, ls.maxSize));
-  s.invR2 = 1 / (s.radius * s.radius);
   if (s.x + s.radius < 0 || s.y + s.radius < 0 || s.x - s.radius > float(frame_.width) ||
       s.y - s.radius > float(frame_.height))
     return false;
@@ -224,18 +223,20 @@ void LightPass::drawTile(const raster::TileTarget& tile) {
     const Splat& s = tileSplats_[e];
     const float v = visibility(s);
     if (!(v > 0)) continue;
-    const int x0 = std::max(ox, int(std::floor(s.x - s.radius)));
-    const int x1 = std::min(xEnd - 1, int(std::floor(s.x + s.radius)));
-    const int y0 = std::max(oy, int(std::floor(s.y - s.radius)));
-    const int y1 = std::min(yEnd - 1, int(std::floor(s.y + s.radius)));
+    float kx[kMaxSplatSpan], ky[kMaxSplatSpan];
+    int fx, fy;
+    const int nx = splatAxis(s.x, s.radius, kx, fx), ny = splatAxis(s.y, s.radius, ky, fy);
+    const int x0 = std::max(ox, fx), x1 = std::min(xEnd - 1, fx + nx - 1);
+    const int y0 = std::max(oy, fy), y1 = std::min(yEnd - 1, fy + ny - 1);
     const float r = s.rgb[0] * v, g = s.rgb[1] * v, b = s.rgb[2] * v;
     for (int y = y0; y <= y1; ++y) {
-      const float dy = float(y) + 0.5f - s.y;
+      const float wy = ky[y - fy];
+      if (!(wy > 0)) continue;
       for (int x = x0; x <= x1; ++x) {
-        const float dx = float(x) + 0.5f - s.x;
-        const float w = splatWeight(dx * dx + dy * dy, s.invR2);
+        const float w = kx[x - fx] * wy;
         // Rounded to the nearest 16-bit step (non-negative: + ½ and truncate).
-        const int add[3] = {int(std::min(r * w, 65535.f) + 0.5f), int(std::min(g * w, 65535.f) + 0.5f),
+        const int add[3] = {int(std::min(r * w, 65535.f) + 0.5f),
+                            int(std::min(g * w, 65535.f) + 0.5f),
                             int(std::min(b * w, 65535.f) + 0.5f)};
         if ((add[0] | add[1] | add[2]) == 0) continue;
         uint16_t* c = tile.color + FrameBuffer::colorOffset(x, y, 0, n, 0);

@@ -107,15 +107,18 @@ TEST(LightLaws, FogSizeAndEnergyFollowTheirFormulas) {
   EXPECT_FLOAT_EQ(fogTransmission(0, 0.5f, 1e6f), 1);
   // Φ = exposure · I · T / d².
   EXPECT_FLOAT_EQ(screenEnergy(5000, 200, 0.5f, 1000), 5000 * 200 * 0.5f / 1e6f);
-  // D = 2√(3Φ/π) − 1 clamped: Φ = 3π/3 gives R = 3, D = 5.
-  EXPECT_FLOAT_EQ(splatDiameter(kPi * 3, 1, 8), 5);
+  // D = 2·(15/16)·√Φ − 1 clamped: Φ = (16/15 · 3)² gives R = 3, D = 5.
+  EXPECT_FLOAT_EQ(splatDiameter(std::pow(16.0f / 15 * 3, 2.0f), 1, 8), 5);
   EXPECT_FLOAT_EQ(splatDiameter(0.01f, 1.5f, 8), 1.5f);
   EXPECT_FLOAT_EQ(splatDiameter(1e6f, 1.5f, 8), 8);
   EXPECT_FLOAT_EQ(splatRadius(2), 1.5f);
-  // The kernel: (1 − r²/R²)², 1 at the centre, 0 at and beyond R.
+  // The kernel along an axis: (1 − t²/R²)², 1 at the centre, 0 at and beyond R.
   EXPECT_FLOAT_EQ(splatWeight(0, 0.25f), 1);
   EXPECT_FLOAT_EQ(splatWeight(1, 0.25f), 0.5625f);
   EXPECT_EQ(splatWeight(4, 0.25f), 0);
+  // The sum over the square is the product of the axes' sums: at (10.5, 20.5), R = 2, each axis
+  // has centres at distances 0, ±1 (and ±2, weight 0): 1 + 2·0.5625.
+  EXPECT_FLOAT_EQ(splatWeightSum(10.5f, 20.5f, 2), 2.125f * 2.125f);
   EXPECT_EQ(splatWeight(5, 0.25f), 0);
 }
 

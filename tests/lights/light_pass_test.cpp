@@ -113,8 +113,8 @@ TEST(LightPass, SizeAndEnergyFollowDistanceAndFog) {
       f.draw(pass);
       ASSERT_EQ(pass.splats().size(), 1u);
       const double phi = 4.0 * 50 * std::exp2(-beta * 0.5 * d) / (d * d);
-      // The kernel's radius: half the natural diameter 2√(3Φ/π) − 1, clamped, plus half a pixel.
-      const double diameter = std::clamp(2 * std::sqrt(3 * phi / std::numbers::pi) - 1, 1.5, 3.0);
+      // The kernel's radius: half the natural diameter 2·(15/16)·√Φ − 1, clamped, plus ½ pixel.
+      const double diameter = std::clamp(2 * (15.0 / 16) * std::sqrt(phi) - 1, 1.5, 3.0);
       EXPECT_NEAR(pass.splats()[0].radius, diameter / 2 + 0.5, 1e-4) << d << " " << beta;
       // Full white saturates a pixel at 65535: compare the energy where no pixel can.
       if (pass.splats()[0].rgb[1] < 65535) {
