@@ -29,6 +29,7 @@
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <numbers>
 
 #include "reference/ground_truth.h"
@@ -75,6 +76,7 @@ struct RenderArgs {
   int channels = 0;
   float arc = 0;
   std::string mosaic;
+  std::optional<double> time;  // the scene's simulation time, seconds (light points' blinking)
   sv::RenderOptions options;
 };
 
@@ -183,6 +185,10 @@ int runRender(const RenderArgs& a) {
   auto loaded = loadSceneOrDemo(a.scene);
   if (!loaded) return fail(loaded.error());
   sv::scene::Scene scene = std::move(loaded).value();
+  if (a.time) {
+    if (!std::isfinite(*a.time)) return fail({"", "", "--time: not a finite number of seconds"});
+    scene.time = *a.time;
+  }
   if (sv::Status s = addArcChannels(scene, o, a.channels, a.arc); !s) {
     sv::Error e = s.error();
     if (!scene.channels.empty() && !a.scene.empty()) e.file = a.scene;  // its channels conflict
@@ -606,6 +612,9 @@ void addRenderOptions(CLI::App* render, RenderArgs& r) {
       ->capture_default_str();
   render->add_option("--camera", r.options.camera, "index of the scene camera to use")
       ->capture_default_str();
+  render->add_option("--time", r.time,
+                     "simulation time in seconds (blinking and sequenced light points, the "
+                     "stars' rotation); default: the scene's own");
   render->add_flag("--no-cull", r.noCull, "draw back faces of single-sided materials too");
   render->add_option("--debug-view", r.debugView,
                      "false-colour diagnostic image: overdraw, levels or occupancy (with --hsr "
