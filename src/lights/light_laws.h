@@ -107,6 +107,12 @@ inline float splatWeight(float t2, float invR2) {
   return u > 0 ? u * u : 0;
 }
 
+// ⌊x⌋ for |x| < 2³¹, without a call (the baseline target has no rounding instruction).
+inline int floorToInt(float x) {
+  const int i = int(x);
+  return i - (float(i) > x);
+}
+
 // The largest number of pixel centres a kernel spans along an axis (radius ≤ 32.5: sizes ≤ 64).
 inline constexpr int kMaxSplatSpan = 66;
 
@@ -114,8 +120,8 @@ inline constexpr int kMaxSplatSpan = 66;
 // pixel centres first + k + ½, k < the returned count (those in [c − R, c + R]).
 inline int splatAxis(float c, float radius, float* out, int& first) {
   const float invR2 = 1 / (radius * radius);
-  first = int(std::floor(c - radius));
-  const int last = int(std::floor(c + radius));
+  first = floorToInt(c - radius);
+  const int last = floorToInt(c + radius);
   int n = 0;
   for (int i = first; i <= last && n < kMaxSplatSpan; ++i) {
     const float d = float(i) + 0.5f - c;

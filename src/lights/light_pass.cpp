@@ -41,9 +41,15 @@ bool LightPass::finishSplat(float energy, Vec3 color, Splat& s) const {
       s.y - s.radius > float(frame_.height))
     return false;
   const float scale = energy * 65535 / splatWeightSum(s.x, s.y, s.radius);
-  s.rgb[0] = color.x * scale;
-  s.rgb[1] = color.y * scale;
-  s.rgb[2] = color.z * scale;
+  // A weight-1 pixel's addition, capped where it saturates anyway (so that it converts to int).
+  s.rgb[0] = std::min(color.x * scale, 1e6f);
+  s.rgb[1] = std::min(color.y * scale, 1e6f);
+  s.rgb[2] = std::min(color.z * scale, 1e6f);
+  // The window depth at depthBias in front of the light: a sample no nearer cannot hide it.
+  const float front = s.eyeDepth - in_.settings.depthBias;
+  s.frontDepth = s.eyeDepth == 0   ? 1.0f
+                 : front > 0       ? 0.5f * (-m22_ + m32_ / front) + 0.5f
+                                   : -1.0f;
   return true;
 }
 
@@ -140,10 +146,10 @@ void LightPass::bin() {
   const int tilesY = (frame_.height + kTileSize - 1) >> kTileLog2;
   tileStart_.assign(size_t(tilesX) * size_t(tilesY) + 1, 0);
   auto range = [&](const Splat& s, int& tx0, int& tx1, int& ty0, int& ty1) {
-    tx0 = std::max(0, int(std::floor(s.x - s.radius)) >> kTileLog2);
-    tx1 = std::min(tilesX - 1, int(std::floor(s.x + s.radius)) >> kTileLog2);
-    ty0 = std::max(0, int(std::floor(s.y - s.radius)) >> kTileLog2);
-    ty1 = std::min(tilesY - 1, int(std::floor(s.y + s.radius)) >> kTileLog2);
+    tx0 = std::max(0, floorToInt(s.x - s.radius) >> kTileLog2);
+    tx1 = std::min(tilesX - 1, floorToInt(s.x + s.radius) >> kTileLog2);
+    ty0 = std::max(0, floorToInt(s.y - s.radius) >> kTileLog2);
+    ty1 = std::min(tilesY - 1, floorToInt(s.y + s.radius) >> kTileLog2);
   };
   for (const Splat& s : splats_) {
     int tx0, tx1, ty0, ty1;
@@ -171,8 +177,8 @@ void LightPass::bin() {
 // is behind it (but within a pixel of a silhouette a light behind shows). A star is seen only
 // where nothing was drawn.
 float LightPass::visibility(const Splat& s) const {
-  const int cx = std::clamp(int(std::floor(s.x)), 0, frame_.width - 1);
-  const int cy = std::clamp(int(std::floor(s.y)), 0, frame_.height - 1);
+  const int cx = std::clamp(floorToInt(s.x), 0, frame_.width - 1);
+  const int cy = std::clamp(floorToInt(s.y), 0, frame_.height - 1);
   const int n = frame_.samples;
   auto depthAt = [&](int x, int y, int k) {
     const int tile = (y >> kTileLog2) * ((frame_.width + kTileSize - 1) >> kTileLog2) +
@@ -184,11 +190,11 @@ float LightPass::visibility(const Splat& s) const {
     for (int k = 0; k < n; ++k) visible += !(depthAt(cx, cy, k) < 1.0f);
     return float(visible) / float(n);
   }
-  // Every sample at least as far as the light (the common case: a light in front of what is
-  // behind it): visible, without the spread.
+  // Every sample at least as far as the light less the bias (the common case: a light in front
+  // of what is behind it): visible, without the spread.
   float nearestSample = 1.0f;
   for (int k = 0; k < n; ++k) nearestSample = std::min(nearestSample, depthAt(cx, cy, k));
-  if (!(eyeDepthOf(nearestSample) < s.eyeDepth - in_.settings.depthBias)) return 1.0f;
+  if (!(nearestSample < s.frontDepth)) return 1.0f;
   const float centre = eyeDepthOf(depthAt(cx, cy, 0));
   float spread = 0;
   for (int dy = -1; dy <= 1; ++dy)
@@ -235,9 +241,7 @@ void LightPass::drawTile(const raster::TileTarget& tile) {
       for (int x = x0; x <= x1; ++x) {
         const float w = kx[x - fx] * wy;
         // Rounded to the nearest 16-bit step (non-negative: + ½ and truncate).
-        const int add[3] = {int(std::min(r * w, 65535.f) + 0.5f),
-                            int(std::min(g * w, 65535.f) + 0.5f),
-                            int(std::min(b * w, 65535.f) + 0.5f)};
+        const int add[3] = {int(r * w + 0.5f), int(g * w + 0.5f), int(b * w + 0.5f)};
         if ((add[0] | add[1] | add[2]) == 0) continue;
         uint16_t* c = tile.color + FrameBuffer::colorOffset(x, y, 0, n, 0);
         for (int k = 0; k < n; ++k, c += raster::kColorPerBlock)

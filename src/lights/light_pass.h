@@ -40,6 +40,7 @@ struct Splat {
   float eyeDepth = 0;     // the light's depth along the view axis (s > 0); 0 for a star
   float radius = 1;       // the kernel's, pixels (light_laws.h: splatRadius)
   float rgb[3] = {};      // Φ · colour · 65535 / Σw: a weight-1 pixel's 16-bit addition
+  float frontDepth = 1;   // the window depth depthBias in front of the light (a star: 1)
 };
 
 class LightPass final : public raster::TilePass {
