@@ -106,6 +106,17 @@ void LightPass::projectRange(size_t begin, size_t end, std::vector<Splat>& out) 
   }
 }
 
+template <class F>
+void LightPass::forTiles(const Splat& s, F&& f) const {
+  const int tilesY = int(tiles_ / size_t(tilesX_));
+  const int tx0 = std::max(0, floorToInt(s.x - s.radius) >> kTileLog2);
+  const int tx1 = std::min(tilesX_ - 1, floorToInt(s.x + s.radius) >> kTileLog2);
+  const int ty0 = std::max(0, floorToInt(s.y - s.radius) >> kTileLog2);
+  const int ty1 = std::min(tilesY - 1, floorToInt(s.y + s.radius) >> kTileLog2);
+  for (int ty = ty0; ty <= ty1; ++ty)
+    for (int tx = tx0; tx <= tx1; ++tx) f(size_t(ty) * size_t(tilesX_) + size_t(tx));
+}
+
 void LightPass::prepare(const raster::PassFrame& frame) {
   const auto t0 = core::Clock::now();
   frame_ = frame;
@@ -128,45 +139,45 @@ void LightPass::prepare(const raster::PassFrame& frame) {
   }
   const size_t total = in_.points.size() + stars;
   candidates_ = total;
-  const size_t chunks = (total + kChunk - 1) / kChunk;
+  // Chunks of a size fixed by the light count alone (never the thread count), at most 64 of them,
+  // so that the per-chunk tile counts stay small.
+  const size_t chunk = std::max(kChunk, (total + 63) / 64);
+  const size_t chunks = (total + chunk - 1) / chunk;
   chunks_.resize(chunks);
+  tilesX_ = (frame_.width + kTileSize - 1) >> kTileLog2;
+  tiles_ = size_t(tilesX_) * size_t((frame_.height + kTileSize - 1) >> kTileLog2);
+  chunkTileCounts_.assign(chunks * tiles_, 0);
   frame.pool->parallelFor(chunks, [&](size_t c, int) {
-    projectRange(c * kChunk, std::min(total, (c + 1) * kChunk), chunks_[c]);
+    projectRange(c * chunk, std::min(total, (c + 1) * chunk), chunks_[c]);
+    for (const Splat& sp : chunks_[c])
+      forTiles(sp, [&](size_t t) { ++chunkTileCounts_[c * tiles_ + t]; });
   });
-  splats_.clear();
-  for (const std::vector<Splat>& c : chunks_) splats_.insert(splats_.end(), c.begin(), c.end());
-  bin();
+  // Each tile's list is its chunks' splats in chunk order, each chunk's in light order (a counting
+  // sort): where chunk c's splats for tile t start.
+  tileStart_.assign(tiles_ + 1, 0);
+  uint32_t at = 0;
+  for (size_t t = 0; t < tiles_; ++t) {
+    tileStart_[t] = at;
+    for (size_t c = 0; c < chunks; ++c) {
+      const uint32_t n = chunkTileCounts_[c * tiles_ + t];
+      chunkTileCounts_[c * tiles_ + t] = at;
+      at += n;
+    }
+  }
+  tileStart_[tiles_] = at;
+  tileSplats_.resize(at);  // copies, in tile order: a tile reads its lights in a run
+  frame.pool->parallelFor(chunks, [&](size_t c, int) {
+    for (const Splat& sp : chunks_[c])
+      forTiles(sp, [&](size_t t) { tileSplats_[chunkTileCounts_[c * tiles_ + t]++] = sp; });
+  });
   workerMs_.assign(size_t(frame.pool->threadCount()), 0.0);
   prepareMs_ = core::msSince(t0);
 }
 
-// Each splat listed for every tile its kernel's box reaches, in splat order (a counting sort).
-void LightPass::bin() {
-  const int tilesX = (frame_.width + kTileSize - 1) >> kTileLog2;
-  const int tilesY = (frame_.height + kTileSize - 1) >> kTileLog2;
-  tileStart_.assign(size_t(tilesX) * size_t(tilesY) + 1, 0);
-  auto range = [&](const Splat& s, int& tx0, int& tx1, int& ty0, int& ty1) {
-    tx0 = std::max(0, floorToInt(s.x - s.radius) >> kTileLog2);
-    tx1 = std::min(tilesX - 1, floorToInt(s.x + s.radius) >> kTileLog2);
-    ty0 = std::max(0, floorToInt(s.y - s.radius) >> kTileLog2);
-    ty1 = std::min(tilesY - 1, floorToInt(s.y + s.radius) >> kTileLog2);
-  };
-  for (const Splat& s : splats_) {
-    int tx0, tx1, ty0, ty1;
-    range(s, tx0, tx1, ty0, ty1);
-    for (int ty = ty0; ty <= ty1; ++ty)
-      for (int tx = tx0; tx <= tx1; ++tx) ++tileStart_[size_t(ty * tilesX + tx) + 1];
-  }
-  for (size_t t = 1; t < tileStart_.size(); ++t) tileStart_[t] += tileStart_[t - 1];
-  tileSplats_.resize(tileStart_.back());  // copies, in tile order: a tile reads its lights in a run
-  std::vector<uint32_t> fill(tileStart_.begin(), tileStart_.end() - 1);
-  for (size_t i = 0; i < splats_.size(); ++i) {
-    int tx0, tx1, ty0, ty1;
-    range(splats_[i], tx0, tx1, ty0, ty1);
-    for (int ty = ty0; ty <= ty1; ++ty)
-      for (int tx = tx0; tx <= tx1; ++tx)
-        tileSplats_[fill[size_t(ty * tilesX + tx)]++] = splats_[i];
-  }
+std::vector<Splat> LightPass::splats() const {
+  std::vector<Splat> all;
+  for (const std::vector<Splat>& c : chunks_) all.insert(all.end(), c.begin(), c.end());
+  return all;
 }
 
 // Visibility (docs/lights.md): the fraction of the centre pixel's samples that do not hide the
@@ -210,8 +221,7 @@ float LightPass::visibility(const Splat& s) const {
 
 void LightPass::drawTile(const raster::TileTarget& tile) {
   const auto t0 = core::Clock::now();
-  const int tilesX = (frame_.width + kTileSize - 1) >> kTileLog2;
-  const size_t t = size_t(tile.tileY * tilesX + tile.tileX);
+  const size_t t = size_t(tile.tileY * tilesX_ + tile.tileX);
   const int ox = tile.tileX * kTileSize, oy = tile.tileY * kTileSize;
   const int xEnd = std::min(ox + kTileSize, frame_.width);
   const int yEnd = std::min(oy + kTileSize, frame_.height);
@@ -257,7 +267,9 @@ void LightPass::drawTile(const raster::TileTarget& tile) {
 
 void LightPass::addStats(FrameStats& stats) const {
   stats.lightPoints += candidates_;
-  stats.lightsDrawn += splats_.size();
+  uint64_t drawn = 0;
+  for (const std::vector<Splat>& c : chunks_) drawn += c.size();
+  stats.lightsDrawn += drawn;
   stats.lightsMs += prepareMs_ + *std::max_element(workerMs_.begin(), workerMs_.end());
 }
 

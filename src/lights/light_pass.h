@@ -52,8 +52,8 @@ class LightPass final : public raster::TilePass {
   void drawTile(const raster::TileTarget& tile) override;
   void addStats(FrameStats& stats) const override;
 
-  // The frame's splats in drawing order (after prepare): tests read them.
-  std::span<const Splat> splats() const { return splats_; }
+  // The frame's splats in light order (after prepare), a copy: for tests and the gl reference.
+  std::vector<Splat> splats() const;
 
  private:
   // Lights [begin, end) of the input (stars after the points) into `out`.
@@ -61,7 +61,9 @@ class LightPass final : public raster::TilePass {
   bool projectPoint(const scene::LightPoint& p, Splat& s) const;
   bool projectStar(const scene::Star& star, Splat& s) const;
   bool finishSplat(float energy, Vec3 color, Splat& s) const;
-  void bin();
+  // Calls f(tile index) for every tile the splat's kernel square reaches.
+  template <class F>
+  void forTiles(const Splat& s, F&& f) const;
   // The fraction of the centre pixel's samples that do not hide splat `s`.
   float visibility(const Splat& s) const;
   float eyeDepthOf(float windowDepth) const;
@@ -71,8 +73,10 @@ class LightPass final : public raster::TilePass {
   float m22_ = 0, m32_ = 1, zfar_ = 1;  // the projection's depth row, its far plane
   Vec3 eye_;
   Vec3 starAxes_[3];  // equatorial x, y, z in world at this frame's time
-  std::vector<std::vector<Splat>> chunks_;
-  std::vector<Splat> splats_;
+  std::vector<std::vector<Splat>> chunks_;  // the drawn splats, chunk by chunk, in light order
+  int tilesX_ = 0;
+  size_t tiles_ = 0;
+  std::vector<uint32_t> chunkTileCounts_;  // per chunk and tile: its count, then where it goes
   std::vector<uint32_t> tileStart_;  // per tile: where its splats start in tileSplats_
   std::vector<Splat> tileSplats_;    // every tile's splats, in light order within a tile
   std::vector<double> workerMs_;

@@ -532,8 +532,9 @@ Status GlRenderer::loadLights(const scene::Scene& scene) {
   pass.prepare(raster::PassFrame{w, h, 1, nullptr, &pool, nullptr});
   const float m22 = in.projection.m[2][2], m32 = in.projection.m[3][2];
   std::vector<float> data;
-  data.reserve(pass.splats().size() * 7);
-  for (const lights::Splat& s : pass.splats()) {
+  const std::vector<lights::Splat> splats = pass.splats();
+  data.reserve(splats.size() * 7);
+  for (const lights::Splat& s : splats) {
     // A star lies on the far plane: drawn where nothing else is.
     const float z = s.eyeDepth > 0 ? -m22 + m32 / s.eyeDepth : 1.0f - 1e-6f;
     const float v[7] = {2 * s.x / float(w) - 1, 1 - 2 * s.y / float(h), z, 2 * s.radius,
@@ -550,7 +551,7 @@ Status GlRenderer::loadLights(const scene::Scene& scene) {
   glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 7 * sizeof(float),
                         reinterpret_cast<const void*>(4 * sizeof(float)));
   glBindVertexArray(0);
-  g.pointCount = GLsizei(pass.splats().size());
+  g.pointCount = GLsizei(splats.size());
   return {};
 }
 
