@@ -82,7 +82,7 @@ std::vector<HashCase> hashCases() {
        {"", "scenes/demo.json", "scenes/aa-edges.json", "scenes/mixed.json", "scenes/grazing.json",
         "scenes/grazing-plane.json", "scenes/freeform-mixed.json", "scenes/freeform-sculpture.json",
         "scenes/crate.gltf", "scenes/pyramid.gltf", "scenes/house.obj",
-        "scenes/terrain-olinda.json"})
+        "scenes/terrain-olinda.json", "scenes/airport.json"})
     both(*file ? file : "demo", fileCase(file), none);
   both("tris", generatorCase("tris"), none);
   both("tris-textured", generatorCase("tris"), none, true);
@@ -102,6 +102,9 @@ std::vector<HashCase> hashCases() {
   both("terrain-exact", terrain, [](RenderOptions& o) { o.terrainLod = false; });
   terrain.terrain.bicubic = true;
   both("terrain-bicubic", terrain, none);
+  reference::BenchCase lights = generatorCase("lights");
+  lights.lights.count = 5000;
+  both("lights", lights, none);
   // Other paths through the frame.
   both("demo-priority", fileCase(""),
        [](RenderOptions& o) { o.hsr = RenderOptions::Hsr::priority; });
