@@ -100,9 +100,10 @@ constexpr const char* kPointFragmentShader = R"(#version 330 core
 in vec3 vColor;
 out vec4 fragColor;
 void main() {
+  // synthvis's separable kernel (lights/light_laws.h): (1 − t²/R²)² along each axis.
   vec2 d = gl_PointCoord * 2.0 - 1.0;
-  float u = max(1.0 - dot(d, d), 0.0);
-  fragColor = vec4(vColor * (u * u), 1.0);
+  vec2 u = max(1.0 - d * d, 0.0);
+  fragColor = vec4(vColor * (u.x * u.x * u.y * u.y), 1.0);
 }
 )";
 
