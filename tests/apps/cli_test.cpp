@@ -165,6 +165,39 @@ TEST(Cli, BenchChannelsTimesTheWholeFrameAndWritesTheChannelsField) {
   EXPECT_GT(row["median_ms"].get<double>(), 0);
 }
 
+// Light points (issue 30): --time moves a blinking light (a different image), a non-finite time
+// is a one-line error, and bench lights writes its light and star counts.
+TEST(Cli, RenderTimeBlinksLightsAndBenchLightsWritesItsCounts) {
+  const std::string scene = write("blink.json", R"({"synthvis": 1, "background": [0, 0, 0],
+    "camera": {"position": [0, 0, 5], "target": [0, 0, 0]},
+    "lights": {"settings": {"exposure": 200},
+               "appearances": [{"blink": {"period": 1, "on": 0.5}}],
+               "points": [{"position": [0, 0, 0]}]}})");
+  const std::string on = (tempDir() / "on.png").string(), off = (tempDir() / "off.png").string();
+  const CliRun a = run("render " + scene + " -o " + on + " --width 64 --height 48 --time 0.25");
+  const CliRun b = run("render " + scene + " -o " + off + " --width 64 --height 48 --time 0.75");
+  ASSERT_EQ(a.status, 0) << a.out;
+  ASSERT_EQ(b.status, 0) << b.out;
+  EXPECT_NE(a.out.find("lights 1: drawn 1"), std::string::npos) << a.out;
+  EXPECT_NE(b.out.find("lights 1: drawn 0"), std::string::npos) << b.out;
+  auto bytes = [](const std::string& path) {
+    std::ifstream f(path, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(f)), {});
+  };
+  EXPECT_NE(bytes(on), bytes(off));
+  expectOneLineError(run("render " + scene + " -o " + on + " --time nan"), "--time",
+                     "not a finite number");
+  const std::string json = (tempDir() / "bench_lights.json").string();
+  const CliRun c = run("bench lights --lights 3000 --stars none --width 160 --height 120 "
+                       "--frames 1 --warmup 0 --json " + json);
+  ASSERT_EQ(c.status, 0) << c.out;
+  std::ifstream f(json);
+  const nlohmann::json row = nlohmann::json::parse(f);
+  EXPECT_EQ(row["lights"], 3000);
+  EXPECT_EQ(row["stars"], 0);
+  EXPECT_NE(c.out.find("lights 3000: drawn"), std::string::npos) << c.out;
+}
+
 // --repeat N: each measurement printed and written as a JSON row numbered by its repeat, then the
 // medians over them; an impossible count is a one-line error.
 TEST(Cli, BenchRepeatPrintsEachMeasurementAndTheirMedian) {
