@@ -35,26 +35,40 @@ inline Vec3 lobeAxis(const scene::LightAppearance& a, float lightPhase, double t
 // for a lobe about unit `axis`: (1 − t)^falloff with t = (x / tan(H/2))² + (y / tan(V/2))², where
 // x, y, z are `toViewer` in the lobe's frame (z along the axis, x horizontal — perpendicular to
 // the axis and world up — y the rest) and x, y are taken over z; 0 where z ≤ 0 or t ≥ 1.
-inline float lobeFactor(Vec3 axis, Vec3 toViewer, float horizontalLobe, float verticalLobe,
-                        float falloff) {
+// The tangents of a lobe's half-widths (the same for every light of an appearance: worked out
+// once a frame, not per light).
+struct LobeTangents {
+  float horizontal = 1, vertical = 1;
+};
+inline LobeTangents lobeTangents(float horizontalLobe, float verticalLobe) {
+  return {std::tan(horizontalLobe * (std::numbers::pi_v<float> / 360)),
+          std::tan(verticalLobe * (std::numbers::pi_v<float> / 360))};
+}
+
+inline float lobeFactor(Vec3 axis, Vec3 toViewer, LobeTangents tangents, float falloff) {
   const float z = dot(axis, toViewer);
   if (!(z > 0)) return 0;
   Vec3 right = cross(axis, Vec3{0, 1, 0});
   const float r2 = dot(right, right);
   right = r2 > 1e-12f ? right * (1 / std::sqrt(r2)) : Vec3{1, 0, 0};  // a vertical axis: +x
   const Vec3 up = cross(right, axis);
-  const float th = std::tan(horizontalLobe * (std::numbers::pi_v<float> / 360));
-  const float tv = std::tan(verticalLobe * (std::numbers::pi_v<float> / 360));
-  const float x = dot(right, toViewer) / (z * th), y = dot(up, toViewer) / (z * tv);
+  const float x = dot(right, toViewer) / (z * tangents.horizontal);
+  const float y = dot(up, toViewer) / (z * tangents.vertical);
   const float t = x * x + y * y;
   if (!(t < 1)) return 0;
   return falloff == 1 ? 1 - t : std::pow(1 - t, falloff);
+}
+inline float lobeFactor(Vec3 axis, Vec3 toViewer, float horizontalLobe, float verticalLobe,
+                        float falloff) {
+  return lobeFactor(axis, toViewer, lobeTangents(horizontalLobe, verticalLobe), falloff);
 }
 
 // The colour a light shows a viewer in unit direction `toViewer` (from the light), times its
 // lobe factor: the front lobe in `color` (or, split, blended toward `lowColor` below the split
 // elevation), the back lobe in `backColor`; an omnidirectional light is `color` everywhere.
-inline Vec3 appearanceColor(const scene::LightAppearance& a, Vec3 axis, Vec3 toViewer) {
+// `tangents`: the appearance's lobeTangents.
+inline Vec3 appearanceColor(const scene::LightAppearance& a, Vec3 axis, Vec3 toViewer,
+                            LobeTangents tangents) {
   Vec3 front = a.color;
   if (a.split) {
     // Elevation of the viewer above the light's horizontal plane, degrees.
@@ -65,10 +79,13 @@ inline Vec3 appearanceColor(const scene::LightAppearance& a, Vec3 axis, Vec3 toV
     front = a.lowColor * (1 - high) + a.color * high;
   }
   if (!a.directional) return front;
-  const float f = lobeFactor(axis, toViewer, a.horizontalLobe, a.verticalLobe, a.falloff);
+  const float f = lobeFactor(axis, toViewer, tangents, a.falloff);
   if (f > 0) return front * f;
   if (!a.backLobe) return {};
-  return a.backColor * lobeFactor(-axis, toViewer, a.horizontalLobe, a.verticalLobe, a.falloff);
+  return a.backColor * lobeFactor(-axis, toViewer, tangents, a.falloff);
+}
+inline Vec3 appearanceColor(const scene::LightAppearance& a, Vec3 axis, Vec3 toViewer) {
+  return appearanceColor(a, axis, toViewer, lobeTangents(a.horizontalLobe, a.verticalLobe));
 }
 
 // The fog's transmission for a light at distance d: 2^(−β · punchThrough · d) (SPEC §8's law

@@ -72,7 +72,8 @@ bool LightPass::projectPoint(const scene::LightPoint& p, Splat& s) const {
   const Vec3 toEye = eye_ - p.position;
   const float d = length(toEye);
   if (!(d > 0)) return false;
-  const Vec3 color = appearanceColor(a, lobeAxis(a, p.phase, in_.time), toEye * (1 / d));
+  const Vec3 color = appearanceColor(a, lobeAxis(a, p.phase, in_.time), toEye * (1 / d),
+                                     lobeTangents_[p.appearance]);
   const float transmission = fogTransmission(in_.fogBeta, in_.settings.punchThrough, d);
   const float energy =
       screenEnergy(in_.settings.exposure, a.intensity * dim, transmission, d);
@@ -127,6 +128,9 @@ void LightPass::prepare(const raster::PassFrame& frame) {
     for (int i = 0; i < 3; ++i) e -= v.m[j][i] * v.m[3][i];
     (j == 0 ? eye_.x : j == 1 ? eye_.y : eye_.z) = e;
   }
+  lobeTangents_.clear();
+  for (const scene::LightAppearance& a : in_.appearances)
+    lobeTangents_.push_back(lobeTangents(a.horizontalLobe, a.verticalLobe));
   m22_ = in_.projection.m[2][2];
   m32_ = in_.projection.m[3][2];
   zfar_ = m32_ / (1 + m22_);
@@ -192,8 +196,7 @@ float LightPass::visibility(const Splat& s) const {
   const int cy = std::clamp(floorToInt(s.y), 0, frame_.height - 1);
   const int n = frame_.samples;
   auto depthAt = [&](int x, int y, int k) {
-    const int tile = (y >> kTileLog2) * ((frame_.width + kTileSize - 1) >> kTileLog2) +
-                     (x >> kTileLog2);
+    const int tile = (y >> kTileLog2) * tilesX_ + (x >> kTileLog2);
     return frame_.frame->tileDepth(tile)[FrameBuffer::depthOffset(x, y, n, k)];
   };
   int visible = 0;

@@ -15,6 +15,7 @@
 #include <span>
 #include <vector>
 
+#include "lights/light_laws.h"
 #include "raster/tile_pass.h"
 #include "synthvis/light_points.h"
 
@@ -73,6 +74,7 @@ class LightPass final : public raster::TilePass {
   float m22_ = 0, m32_ = 1, zfar_ = 1;  // the projection's depth row, its far plane
   Vec3 eye_;
   Vec3 starAxes_[3];  // equatorial x, y, z in world at this frame's time
+  std::vector<LobeTangents> lobeTangents_;  // per appearance, this frame
   std::vector<std::vector<Splat>> chunks_;  // the drawn splats, chunk by chunk, in light order
   int tilesX_ = 0;
   size_t tiles_ = 0;

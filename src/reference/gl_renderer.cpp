@@ -13,6 +13,7 @@
 #include "core/thread_pool.h"
 #include "lights/light_pass.h"
 #include "render/camera.h"
+#include "render/passes.h"
 #include "texture/texture.h"
 
 #if SV_HAVE_GL
@@ -516,16 +517,7 @@ Status GlRenderer::loadLights(const scene::Scene& scene) {
   if (scene.lightPoints.empty() && scene.stars.stars.empty()) return {};
   const Result<render::FrameCamera> cam = render::chooseCamera(scene, g.options);
   if (!cam.ok()) return cam.error();
-  lights::LightInput in;
-  in.appearances = scene.lightAppearances;
-  in.points = scene.lightPoints;
-  in.groups = scene.lightGroups;
-  in.settings = scene.lightSettings;
-  in.stars = scene.stars.stars.empty() ? nullptr : &scene.stars;
-  in.time = scene.time;
-  in.view = cam.value().view;
-  in.projection = cam.value().projection;
-  in.fogBeta = scene.fog.enabled ? scene.fog.beta : 0.0f;
+  const lights::LightInput in = render::lightInput(scene, cam.value());
   lights::LightPass pass;
   pass.setLights(in);
   core::ThreadPool pool(1);

@@ -4,6 +4,20 @@
 
 namespace sv::render {
 
+lights::LightInput lightInput(const scene::Scene& scene, const FrameCamera& camera) {
+  lights::LightInput in;
+  in.appearances = scene.lightAppearances;
+  in.points = scene.lightPoints;
+  in.groups = scene.lightGroups;
+  in.settings = scene.lightSettings;
+  in.stars = scene.stars.stars.empty() ? nullptr : &scene.stars;
+  in.time = scene.time;
+  in.view = camera.view;
+  in.projection = camera.projection;
+  in.fogBeta = scene.fog.enabled ? scene.fog.beta : 0.0f;
+  return in;
+}
+
 std::vector<raster::TilePass*> FramePasses::compose(const scene::Scene& scene,
                                                     const RenderOptions& o,
                                                     const FrameCamera& camera,
@@ -22,17 +36,7 @@ std::vector<raster::TilePass*> FramePasses::compose(const scene::Scene& scene,
     passes.push_back(&terrains_);
   }
   if (!scene.lightPoints.empty() || !scene.stars.stars.empty()) {
-    lights::LightInput in;
-    in.appearances = scene.lightAppearances;
-    in.points = scene.lightPoints;
-    in.groups = scene.lightGroups;
-    in.settings = scene.lightSettings;
-    in.stars = scene.stars.stars.empty() ? nullptr : &scene.stars;
-    in.time = scene.time;
-    in.view = camera.view;
-    in.projection = camera.projection;
-    in.fogBeta = scene.fog.enabled ? scene.fog.beta : 0.0f;
-    lights_.setLights(in);
+    lights_.setLights(lightInput(scene, camera));
     passes.push_back(&lights_);
   }
   return passes;

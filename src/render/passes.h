@@ -12,6 +12,9 @@
 
 namespace sv::render {
 
+// What the light pass needs of `scene` as `camera` sees it (the scene must outlive the frame).
+lights::LightInput lightInput(const scene::Scene& scene, const FrameCamera& camera);
+
 class FramePasses {
  public:
   // The passes `scene` needs under `options`, in the order they run (FrameSettings::passes): the

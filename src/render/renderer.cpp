@@ -105,15 +105,15 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
 Status Renderer::renderChannels(const scene::Scene& scene, std::vector<Image>& images,
                                 std::vector<FrameStats>* statsOut) {
   Impl& m = *impl_;
-  if (Status s = validate(m.options); !s) return s;
-  if (Status s = scene::validate(scene, "", false); !s) return s;
-  if (scene.channels.empty()) {
+  if (scene.channels.empty()) {  // the classic view (render validates)
     images.resize(1);
     FrameStats stats;
     if (Status s = render(scene, images[0], &stats); !s) return s;
     if (statsOut) statsOut->assign(1, stats);
     return {};
   }
+  if (Status s = validate(m.options); !s) return s;
+  if (Status s = scene::validate(scene, "", false); !s) return s;
   const size_t n = scene.channels.size();
   images.resize(n);
   std::vector<FrameStats> stats(n);
