@@ -147,6 +147,20 @@ inline int splatAxis(float c, float radius, float* out, int& first) {
   return n;
 }
 
+// splatAxis for a kernel of radius ≤ kSmallSplatRadius — the common light, near the minimum size:
+// the same weights, four of them always (those past the span are 0: their centres lie farther
+// than R), without a loop or a branch to mispredict.
+inline constexpr float kSmallSplatRadius = 1.5f;
+inline int splatAxis4(float c, float radius, float out[4], int& first) {
+  const float invR2 = 1 / (radius * radius);
+  first = floorToInt(c - radius);
+  for (int k = 0; k < 4; ++k) {
+    const float d = float(first + k) + 0.5f - c;
+    out[k] = splatWeight(d * d, invR2);
+  }
+  return floorToInt(c + radius) - first + 1;
+}
+
 // The sum of the kernel's weights over the pixel centres around (x, y): a product of two sums.
 inline float splatWeightSum(float x, float y, float radius) {
   float w[kMaxSplatSpan];

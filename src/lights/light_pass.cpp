@@ -7,6 +7,7 @@
 
 #include "core/timing.h"
 #include "lights/light_laws.h"
+#include "lights/splat_blocks.h"
 #include "raster/framebuffer.h"
 
 namespace sv::lights {
@@ -40,7 +41,26 @@ bool LightPass::finishSplat(float energy, Vec3 color, Splat& s) const {
   if (s.x + s.radius < 0 || s.y + s.radius < 0 || s.x - s.radius > float(frame_.width) ||
       s.y - s.radius > float(frame_.height))
     return false;
-  const float scale = energy * 65535 / splatWeightSum(s.x, s.y, s.radius);
+  // The weight sum, a product of the two axes' sums (light_laws.h: splatWeightSum), from the
+  // axis weights a small splat keeps for drawing.
+  float sx = 0, sy = 0;
+  if (s.radius <= kSmallSplatRadius) {
+    s.spanX = splatAxis4(s.x, s.radius, s.kx, s.firstX);
+    s.spanY = splatAxis4(s.y, s.radius, s.ky, s.firstY);
+    for (int k = 0; k < 4; ++k) sx += s.kx[k];  // + 0 past the span: the same sum
+    for (int k = 0; k < 4; ++k) sy += s.ky[k];
+  } else {
+    float wx[kMaxSplatSpan], wy[kMaxSplatSpan];
+    s.spanX = splatAxis(s.x, s.radius, wx, s.firstX);
+    s.spanY = splatAxis(s.y, s.radius, wy, s.firstY);
+    for (int k = 0; k < s.spanX; ++k) sx += wx[k];
+    for (int k = 0; k < s.spanY; ++k) sy += wy[k];
+    if (s.spanX <= Splat::kKeptSpan && s.spanY <= Splat::kKeptSpan) {
+      std::copy_n(wx, s.spanX, s.kx);
+      std::copy_n(wy, s.spanY, s.ky);
+    }
+  }
+  const float scale = energy * 65535 / (sx * sy);
   // A weight-1 pixel's addition, capped where it saturates anyway (so that it converts to int).
   s.rgb[0] = std::min(color.x * scale, 1e6f);
   s.rgb[1] = std::min(color.y * scale, 1e6f);
@@ -242,28 +262,26 @@ void LightPass::drawTile(const raster::TileTarget& tile) {
     const Splat& s = tileSplats_[e];
     const float v = visibility(s);
     if (!(v > 0)) continue;
+    SplatInTile part;
     float kx[kMaxSplatSpan], ky[kMaxSplatSpan];
-    int fx, fy;
-    const int nx = splatAxis(s.x, s.radius, kx, fx), ny = splatAxis(s.y, s.radius, ky, fy);
-    const int x0 = std::max(ox, fx), x1 = std::min(xEnd - 1, fx + nx - 1);
-    const int y0 = std::max(oy, fy), y1 = std::min(yEnd - 1, fy + ny - 1);
-    const float r = s.rgb[0] * v, g = s.rgb[1] * v, b = s.rgb[2] * v;
-    for (int y = y0; y <= y1; ++y) {
-      const float wy = ky[y - fy];
-      if (!(wy > 0)) continue;
-      for (int x = x0; x <= x1; ++x) {
-        const float w = kx[x - fx] * wy;
-        // Rounded to the nearest 16-bit step (non-negative: + ½ and truncate).
-        const int add[3] = {int(r * w + 0.5f), int(g * w + 0.5f), int(b * w + 0.5f)};
-        if ((add[0] | add[1] | add[2]) == 0) continue;
-        uint16_t* c = tile.color + FrameBuffer::colorOffset(x, y, 0, n, 0);
-        for (int k = 0; k < n; ++k, c += raster::kColorPerBlock)
-          for (int ch = 0; ch < 3; ++ch) {
-            uint16_t& cc = c[ch * raster::kBlockPixels];
-            cc = uint16_t(std::min(65535, int(cc) + add[ch]));
-          }
-      }
+    if (s.spanX <= Splat::kKeptSpan && s.spanY <= Splat::kKeptSpan) {
+      part.kx = s.kx;
+      part.ky = s.ky;
+    } else {
+      int first;
+      splatAxis(s.x, s.radius, kx, first);
+      splatAxis(s.y, s.radius, ky, first);
+      part.kx = kx;
+      part.ky = ky;
     }
+    part.kernelX = s.firstX - ox;
+    part.kernelY = s.firstY - oy;
+    part.x0 = std::max(0, part.kernelX);
+    part.x1 = std::min(xEnd - ox, part.kernelX + s.spanX) - 1;
+    part.y0 = std::max(0, part.kernelY);
+    part.y1 = std::min(yEnd - oy, part.kernelY + s.spanY) - 1;
+    for (int ch = 0; ch < 3; ++ch) part.rgb[ch] = s.rgb[ch] * v;
+    if (part.x0 <= part.x1 && part.y0 <= part.y1) addSplat(tile.color, n, part);
   }
   workerMs_[size_t(tile.worker)] += core::msSince(t0);
 }

@@ -42,6 +42,13 @@ struct Splat {
   float radius = 1;       // the kernel's, pixels (light_laws.h: splatRadius)
   float rgb[3] = {};      // Φ · colour · 65535 / Σw: a weight-1 pixel's 16-bit addition
   float frontDepth = 1;   // the window depth depthBias in front of the light (a star: 1)
+  // The kernel's pixel centres: columns firstX … firstX + spanX − 1, rows likewise. A splat of at
+  // most kKeptSpan a side keeps its axis weights (worked out once, for the weight sum, and read
+  // again by every tile it reaches); a larger one's are worked out again where it is drawn.
+  static constexpr int kKeptSpan = 4;
+  int firstX = 0, firstY = 0;
+  int spanX = 0, spanY = 0;
+  float kx[kKeptSpan] = {}, ky[kKeptSpan] = {};
 };
 
 class LightPass final : public raster::TilePass {
