@@ -18,6 +18,10 @@
 //   synthvis truth [SCENE] -o truth.png [--samples 256] [--width W] [--height H] [--threads T]
 //   synthvis truth … [--edges MASK.png]
 //   synthvis compare IMAGE.png REFERENCE.png [--edges MASK.png]
+//   synthvis ig CONFIG [--output null|png:DIR|y4m:PATH|window[:channels]] [--frames N]
+//               [--record FILE.pcap] [--replay FILE.pcap] [--status FILE|-] [--overlay]
+//               [--test-pattern grid|bars|wedges] [--as-fast-as-possible] [--no-governor]
+//   synthvis host SCRIPT [--ig-port P] [--port P] [--frames N]
 //   (shared BENCH.md defines the scenes and the JSON fields)
 //
 // Errors print one line, "synthvis: <file>: <problem>", and exit with status 1 (2 for usage).
@@ -40,6 +44,9 @@
 #include "synthvis/scene.h"
 #include "synthvis/terrain.h"
 #include "terrain/height_field.h"
+#include "ig/config.h"
+#include "ig/host.h"
+#include "ig/loop.h"
 
 namespace {
 
@@ -564,6 +571,41 @@ int runCompare(const std::string& imagePath, const std::string& referencePath,
 }
 
 // `synthvis terrain SCENE --height X,Y,Z | --los X,Y,Z,X,Y,Z`: the host's queries (synthvis/terrain.h).
+// synthvis ig: the real-time loop a host drives (docs/ig.md).
+int runIg(const std::string& configPath, const sv::ig::IgRunOptions& options) {
+  sv::Result<sv::ig::IgConfig> config = sv::ig::loadIgConfig(configPath);
+  if (!config) return fail(config.error());
+  sv::Result<std::unique_ptr<sv::ig::IgLoop>> loop = sv::ig::IgLoop::create(config.value(), options);
+  if (!loop) return fail(loop.error());
+  if (options.replay.empty())
+    fmt::print(stderr, "synthvis ig: {} at {:.0f} Hz, listening on UDP {}\n", configPath,
+               config->rate, loop.value()->port());
+  sv::Result<sv::ig::IgRunReport> report = loop.value()->run();
+  if (!report) return fail(report.error());
+  fmt::print(stderr, "{}\n", report->summary());
+  return 0;
+}
+
+// synthvis host: the scripted host (docs/ig.md).
+int runHost(const std::string& scriptPath, int igPort, int port, long long frames) {
+  sv::Result<sv::ig::HostScript> script = sv::ig::loadHostScript(scriptPath);
+  if (!script) return fail(script.error());
+  if (igPort > 0) script->igPort = uint16_t(igPort);
+  if (port >= 0) script->port = uint16_t(port);
+  if (frames > 0) script->frames = uint64_t(frames);
+  sv::Result<sv::ig::HostLog> log = sv::ig::runHost(script.value());
+  if (!log) return fail(log.error());
+  fmt::print("host: {} frames sent, {} Start of Frame received (last IG frame {})\n",
+             log->framesSent, log->startOfFrames, log->lastIgFrame);
+  for (const sv::cigi::HatHotResponse& h : log->heights)
+    fmt::print("{} {}: {}\n", h.hot ? "HOT" : "HAT", h.id,
+               h.valid ? fmt::format("{:.3f} m", h.height) : std::string("no ground"));
+  for (const sv::cigi::LosResponse& l : log->linesOfSight)
+    fmt::print("LOS {}: {}\n", l.id,
+               l.valid ? fmt::format("blocked at {:.3f} m", l.range) : std::string("clear"));
+  return 0;
+}
+
 int runTerrainQuery(const std::string& scenePath, const std::vector<double>& at,
                     const std::vector<double>& los, const std::string& filterName) {
   using Filter = sv::RenderOptions::TerrainFilter;
@@ -792,6 +834,36 @@ int main(int argc, char** argv) {
   query->add_option("--terrain-filter", queryFilter, "scene, bilinear or bicubic")
       ->capture_default_str();
 
+  std::string igConfig;
+  sv::ig::IgRunOptions igOptions;
+  bool igFast = false, igNoGovernor = false;
+  CLI::App* ig = app.add_subcommand(
+      "ig", "run as an image generator: a real-time frame loop driven by a CIGI 3.3 host");
+  ig->add_option("config", igConfig, "the IG configuration (docs/ig.md)")->required();
+  ig->add_option("--output", igOptions.output,
+                 "null, png:DIR (a PNG sequence), y4m:PATH (a video stream; - for stdout), "
+                 "window or window:channels (SDL2)")
+      ->capture_default_str();
+  ig->add_option("--frames", igOptions.frames, "stop after N frames (0: run until stopped)");
+  ig->add_option("--record", igOptions.record, "write the session (both directions) as pcap");
+  ig->add_option("--replay", igOptions.replay,
+                 "drive the frames from a recorded session instead of the network");
+  ig->add_option("--status", igOptions.status, "a JSON line a frame to FILE, or - for stdout");
+  ig->add_flag("--overlay", igOptions.overlay, "draw stage times, quality level and counts");
+  ig->add_option("--test-pattern", igOptions.testPattern,
+                 "show grid, bars or wedges on every channel instead of the scene");
+  ig->add_flag("--as-fast-as-possible", igFast, "do not wait for each frame's slot");
+  ig->add_flag("--no-governor", igNoGovernor, "overload protection off (always full quality)");
+
+  std::string hostScript;
+  int hostIgPort = 0, hostPort = -1;
+  long long hostFrames = 0;
+  CLI::App* host = app.add_subcommand("host", "drive an IG with a scripted CIGI host (docs/ig.md)");
+  host->add_option("script", hostScript, "the host script (JSON)")->required();
+  host->add_option("--ig-port", hostIgPort, "the IG's UDP port (default: the script's)");
+  host->add_option("--port", hostPort, "the host's own UDP port (default: the script's)");
+  host->add_option("--frames", hostFrames, "host frames to send (default: the script's)");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -809,5 +881,11 @@ int main(int argc, char** argv) {
   if (*truth) return runTruth(tr);
   if (*compare) return runCompare(compareImage, compareReference, compareEdges);
   if (*query) return runTerrainQuery(queryScene, queryAt, queryLos, queryFilter);
+  if (*ig) {
+    igOptions.realtime = !igFast;
+    igOptions.governor = !igNoGovernor;
+    return runIg(igConfig, igOptions);
+  }
+  if (*host) return runHost(hostScript, hostIgPort, hostPort, hostFrames);
   return 0;
 }

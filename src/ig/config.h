@@ -1,0 +1,39 @@
+// The image generator's configuration (docs/ig.md, "Configuration"): the database, the display
+// channels, the rate, the model table, the network and the quality the frame starts from.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "ig/geo.h"
+#include "synthvis/render.h"
+#include "synthvis/result.h"
+#include "synthvis/scene.h"
+
+namespace sv::ig {
+
+struct IgConfig {
+  std::string scene;          // the database (a scene file), relative paths from the config's folder
+  double rate = 60;           // frames per second, 1 … 240
+  // The channels; empty: the scene's own, or one channel of width × height.
+  std::vector<scene::Channel> channels;
+  int width = 1280, height = 720;
+  std::map<uint16_t, std::string> models;  // CIGI entity type → model file (any scene format)
+  GeoOrigin origin;                        // the database's origin (geo.h)
+  // UDP: the IG listens on `port` (0: no network — replay, tests) and answers the host at
+  // hostAddress:hostPort (or, when hostPort is 0, at whatever address last sent to it).
+  uint16_t port = 8004;
+  std::string hostAddress = "127.0.0.1";
+  uint16_t hostPort = 8005;
+  RenderOptions render;       // threads, anti-aliasing, filters: full quality
+  double deadline = 0.9;      // the share of a frame period a frame may take (overload.h)
+  uint16_t maxEntities = 1024;  // entity IDs 0 … maxEntities − 1
+};
+
+// Reads a configuration file; errors name the file and the field.
+Result<IgConfig> loadIgConfig(const std::string& path);
+Result<IgConfig> parseIgConfig(const std::string& text, const std::string& path);
+
+}  // namespace sv::ig

@@ -1,0 +1,321 @@
+// The scripted host (docs/ig.md, "The scripted host").
+#include "ig/host.h"
+
+#include <arpa/inet.h>
+#include <fmt/format.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "ig/geo.h"
+
+namespace sv::ig {
+namespace {
+
+using Json = nlohmann::json;
+
+struct BadScript {
+  std::string message;
+};
+[[noreturn]] void bad(const std::string& m) { throw BadScript{m}; }
+
+double num(const Json& o, const char* key, const std::string& where, double lo, double hi,
+           double fallback) {
+  if (!o.contains(key)) return fallback;
+  const Json& v = o[key];
+  if (!v.is_number()) bad(fmt::format("{}.{}: expected a number", where, key));
+  const double x = v.get<double>();
+  if (!std::isfinite(x) || x < lo || x > hi)
+    bad(fmt::format("{}.{}: {} is outside [{}, {}]", where, key, x, lo, hi));
+  return x;
+}
+
+// A position: lat/lon/alt, or east/north/up from the script's origin.
+void position(const Json& o, const std::string& where, const GeoOrigin& origin, double& lat,
+              double& lon, double& alt) {
+  if (!o.is_object()) bad(fmt::format("{}: expected an object", where));
+  if (o.contains("east") || o.contains("north") || o.contains("up")) {
+    const DVec3 g = worldToGeodetic(origin, {num(o, "east", where, -1e6, 1e6, 0),
+                                             num(o, "up", where, -1e4, 1e6, 0),
+                                             -num(o, "north", where, -1e6, 1e6, 0)});
+    lat = g.x;
+    lon = g.y;
+    alt = g.z;
+  } else {
+    lat = num(o, "lat", where, -90, 90, origin.lat);
+    lon = num(o, "lon", where, -180, 180, origin.lon);
+    alt = num(o, "alt", where, -1e4, 1e6, origin.alt);
+  }
+}
+
+HostScript read(const Json& root) {
+  if (!root.is_object() || root.value("synthvis-host", 0) != 1)
+    bad("\"synthvis-host\": 1 expected (the script format's version)");
+  HostScript s;
+  GeoOrigin origin;
+  if (root.contains("origin")) {
+    origin.lat = num(root["origin"], "lat", "origin", -89, 89, 0);
+    origin.lon = num(root["origin"], "lon", "origin", -180, 180, 0);
+    origin.alt = num(root["origin"], "alt", "origin", -1e4, 1e5, 0);
+  }
+  if (root.contains("ig")) {
+    const Json& ig = root["ig"];
+    if (ig.contains("address")) {
+      if (!ig["address"].is_string()) bad("ig.address: expected a dotted IPv4 address");
+      s.igAddress = ig["address"].get<std::string>();
+    }
+    s.igPort = uint16_t(num(ig, "port", "ig", 1, 65535, s.igPort));
+  }
+  s.port = uint16_t(num(root, "port", "script", 0, 65535, s.port));
+  s.rate = num(root, "rate", "script", 1, 240, s.rate);
+  s.frames = uint64_t(num(root, "frames", "script", 1, 1e8, double(s.frames)));
+  if (root.contains("entities")) {
+    if (!root["entities"].is_array()) bad("entities: expected a list");
+    for (size_t i = 0; i < root["entities"].size(); ++i) {
+      const Json& e = root["entities"][i];
+      const std::string where = fmt::format("entities[{}]", i);
+      ScriptEntity se;
+      se.id = uint16_t(num(e, "id", where, 0, 65535, 0));
+      se.type = uint16_t(num(e, "type", where, 0, 65535, 0));
+      if (!e.contains("path") || !e["path"].is_array() || e["path"].empty())
+        bad(where + ".path: a list of timed poses expected");
+      for (size_t k = 0; k < e["path"].size(); ++k) {
+        const Json& p = e["path"][k];
+        const std::string at = fmt::format("{}.path[{}]", where, k);
+        PathPoint pp;
+        pp.t = num(p, "t", at, 0, 1e7, 0);
+        position(p, at, origin, pp.lat, pp.lon, pp.alt);
+        pp.yaw = num(p, "yaw", at, -360, 360, 0);
+        pp.pitch = num(p, "pitch", at, -90, 90, 0);
+        pp.roll = num(p, "roll", at, -180, 180, 0);
+        if (!se.path.empty() && pp.t <= se.path.back().t)
+          bad(at + ".t: times must increase along a path");
+        se.path.push_back(pp);
+      }
+      s.entities.push_back(std::move(se));
+    }
+  }
+  if (root.contains("events")) {
+    if (!root["events"].is_array()) bad("events: expected a list");
+    for (size_t i = 0; i < root["events"].size(); ++i) {
+      const Json& e = root["events"][i];
+      const std::string where = fmt::format("events[{}]", i);
+      ScriptEvent ev;
+      ev.t = num(e, "t", where, 0, 1e7, 0);
+      if (e.contains("lights")) {
+        const Json& l = e["lights"];
+        cigi::ComponentControl c;
+        c.componentClass = cigi::ComponentClass::system;
+        c.component = uint16_t(num(l, "group", where + ".lights", 0, 65535, 0));
+        const bool on = l.value("on", true);
+        const float dim = float(num(l, "dim", where + ".lights", 0, 1, 1));
+        c.state = !on ? 0 : dim < 1 ? 2 : 1;
+        std::memcpy(&c.data[0], &dim, sizeof dim);
+        ev.packets.push_back(c);
+      }
+      if (e.contains("visibility")) {
+        cigi::AtmosphereControl a;
+        a.modelEnabled = true;
+        a.visibility = float(num(e, "visibility", where, 1, 1e6, 1e5));
+        ev.packets.push_back(a);
+      }
+      if (e.contains("timeOfDay")) {
+        const Json& t = e["timeOfDay"];
+        int h = -1, m = -1;
+        if (!t.is_string() || std::sscanf(t.get<std::string>().c_str(), "%d:%d", &h, &m) != 2 ||
+            h < 0 || h > 23 || m < 0 || m > 59)
+          bad(where + ".timeOfDay: \"HH:MM\" expected");
+        cigi::CelestialSphereControl c;
+        c.hour = uint8_t(h);
+        c.minute = uint8_t(m);
+        ev.packets.push_back(c);
+      }
+      if (e.contains("hat") || e.contains("hot")) {
+        const bool hot = e.contains("hot");
+        const Json& q = hot ? e["hot"] : e["hat"];
+        cigi::HatHotRequest r;
+        r.id = uint16_t(num(q, "id", where, 0, 65535, 0));
+        r.type = hot ? cigi::HatHotType::hot : cigi::HatHotType::hat;
+        position(q, where + (hot ? ".hot" : ".hat"), origin, r.latOrX, r.lonOrY, r.altOrZ);
+        ev.packets.push_back(r);
+      }
+      if (e.contains("los")) {
+        const Json& q = e["los"];
+        cigi::LosSegmentRequest r;
+        r.id = uint16_t(num(q, "id", where, 0, 65535, 0));
+        if (!q.contains("from") || !q.contains("to")) bad(where + ".los: \"from\" and \"to\" expected");
+        position(q["from"], where + ".los.from", origin, r.source[0], r.source[1], r.source[2]);
+        position(q["to"], where + ".los.to", origin, r.destination[0], r.destination[1],
+                 r.destination[2]);
+        ev.packets.push_back(r);
+      }
+      if (e.contains("destroy")) {
+        cigi::EntityControl c;
+        c.entity = uint16_t(num(e, "destroy", where, 0, 65535, 0));
+        c.state = cigi::EntityState::destroyed;
+        ev.packets.push_back(c);
+      }
+      if (ev.packets.empty())
+        bad(where + ": nothing to do (lights, visibility, timeOfDay, hat, hot, los or destroy)");
+      s.events.push_back(std::move(ev));
+    }
+    std::stable_sort(s.events.begin(), s.events.end(),
+                     [](const ScriptEvent& a, const ScriptEvent& b) { return a.t < b.t; });
+  }
+  return s;
+}
+
+// The pose at time t: the path's first point before it starts, its last after it ends, linear
+// in between (headings along the shorter way round).
+PathPoint poseAt(const std::vector<PathPoint>& path, double t) {
+  if (t <= path.front().t) return path.front();
+  if (t >= path.back().t) return path.back();
+  size_t k = 1;
+  while (path[k].t < t) ++k;
+  const PathPoint &a = path[k - 1], &b = path[k];
+  const double f = (t - a.t) / (b.t - a.t);
+  auto mix = [f](double x, double y) { return x + (y - x) * f; };
+  PathPoint p;
+  p.t = t;
+  p.lat = mix(a.lat, b.lat);
+  p.lon = mix(a.lon, b.lon);
+  p.alt = mix(a.alt, b.alt);
+  p.yaw = a.yaw + std::remainder(b.yaw - a.yaw, 360.0) * f;
+  p.pitch = mix(a.pitch, b.pitch);
+  p.roll = mix(a.roll, b.roll);
+  return p;
+}
+
+}  // namespace
+
+Result<HostScript> parseHostScript(const std::string& text, const std::string& path) {
+  Json root;
+  try {
+    root = Json::parse(text);
+  } catch (const Json::parse_error& e) {
+    return Error{path, fmt::format("byte {}", e.byte), "malformed JSON"};
+  }
+  try {
+    return read(root);
+  } catch (const BadScript& e) {
+    return Error{path, "", e.message};
+  } catch (const Json::exception& e) {
+    return Error{path, "", "a field has the wrong type"};
+  }
+}
+
+Result<HostScript> loadHostScript(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Error{path, "", "cannot open the file"};
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parseHostScript(text.str(), path);
+}
+
+std::vector<cigi::Packet> hostFrame(const HostScript& script, uint64_t frame,
+                                    uint32_t lastIgFrame) {
+  std::vector<cigi::Packet> out;
+  cigi::IgControl c;
+  c.hostFrame = uint32_t(frame);
+  c.lastIgFrame = lastIgFrame;
+  out.push_back(c);
+  const double t = double(frame) / script.rate, before = (double(frame) - 1) / script.rate;
+  for (const ScriptEntity& e : script.entities) {
+    const PathPoint p = poseAt(e.path, t);
+    cigi::EntityControl ec;
+    ec.entity = e.id;
+    ec.type = e.type;
+    ec.latOrX = p.lat;
+    ec.lonOrY = p.lon;
+    ec.altOrZ = p.alt;
+    ec.yaw = float(p.yaw);
+    ec.pitch = float(p.pitch);
+    ec.roll = float(p.roll);
+    out.push_back(ec);
+  }
+  for (const ScriptEvent& ev : script.events)
+    if (ev.t <= t && (frame == 0 || ev.t > before))
+      out.insert(out.end(), ev.packets.begin(), ev.packets.end());
+  return out;
+}
+
+Result<HostLog> runHost(const HostScript& script, int timeoutMs) {
+  const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+  if (fd < 0) return Error{"", "", "cannot open a UDP socket"};
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  sockaddr_in self{};
+  self.sin_family = AF_INET;
+  self.sin_addr.s_addr = htonl(INADDR_ANY);
+  self.sin_port = htons(script.port);
+  if (::bind(fd, reinterpret_cast<sockaddr*>(&self), sizeof self) != 0)
+    return Error{"", "", fmt::format("cannot listen on UDP port {}: {}", script.port,
+                                     std::strerror(errno))};
+  sockaddr_in ig{};
+  ig.sin_family = AF_INET;
+  ig.sin_port = htons(script.igPort);
+  if (::inet_pton(AF_INET, script.igAddress.c_str(), &ig.sin_addr) != 1)
+    return Error{"", "", fmt::format("IG address \"{}\" is not a dotted IPv4 address", script.igAddress)};
+  HostLog log;
+  std::vector<uint8_t> bytes(65536);
+  // The IG sends Start of Frame every frame to the host it knows; one configured to answer
+  // whoever drives it learns the host from its first datagram: announce the host with an IG
+  // Control now, and again while no Start of Frame has come.
+  cigi::IgControl announce;
+  const std::vector<uint8_t> hello = cigi::writeDatagram(std::vector<cigi::Packet>{announce});
+  auto send = [&](const std::vector<uint8_t>& out) {
+    ::sendto(fd, out.data(), out.size(), 0, reinterpret_cast<sockaddr*>(&ig), sizeof ig);
+  };
+  send(hello);
+  // Waits for the next Start of Frame, collecting the answers that come with it.
+  auto nextStartOfFrame = [&]() -> Status {
+    for (int waitedMs = 0;;) {
+      pollfd p{fd, POLLIN, 0};
+      if (::poll(&p, 1, 100) <= 0) {
+        waitedMs += 100;
+        if (waitedMs >= timeoutMs)
+          return Error{"", "", fmt::format("no Start of Frame from the IG at {}:{} for {} ms",
+                                           script.igAddress, script.igPort, timeoutMs)};
+        if (log.startOfFrames == 0) send(hello);
+        continue;
+      }
+      const ssize_t n = ::recv(fd, bytes.data(), bytes.size(), 0);
+      if (n <= 0) continue;
+      Result<cigi::Datagram> d = cigi::parseDatagram({bytes.data(), size_t(n)});
+      if (!d) continue;
+      bool sof = false;
+      for (const cigi::Packet& packet : d->packets) {
+        if (const auto* s = std::get_if<cigi::StartOfFrame>(&packet)) {
+          sof = true;
+          log.lastIgFrame = s->igFrame;
+          ++log.startOfFrames;
+        } else if (const auto* h = std::get_if<cigi::HatHotResponse>(&packet)) {
+          log.heights.push_back(*h);
+        } else if (const auto* l = std::get_if<cigi::LosResponse>(&packet)) {
+          log.linesOfSight.push_back(*l);
+        }
+      }
+      if (sof) return {};
+    }
+  };
+  while (log.framesSent < script.frames) {
+    if (Status s = nextStartOfFrame(); !s) return s.error();
+    send(cigi::writeDatagram(hostFrame(script, log.framesSent, log.lastIgFrame)));
+    ++log.framesSent;
+  }
+  // The answers to the last frame's requests come with the Start of Frame after it.
+  if (Status s = nextStartOfFrame(); !s) return s.error();
+  return log;
+}
+
+}  // namespace sv::ig

@@ -1,0 +1,359 @@
+// Based on: seed 004 (a real-time image generator: a fixed frame rate, built-in test and
+// diagnostics), seed 002 (overload protection), CIGI 3.3 (the host's frame and the IG's Start of
+// Frame).
+#include "ig/loop.h"
+
+#include <arpa/inet.h>
+#include <fmt/format.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <thread>
+
+#include "cigi/cigi.h"
+#include "cigi/pcap.h"
+#include "ig/overload.h"
+#include "ig/world.h"
+#include "present/presenter.h"
+#include "synthvis/render.h"
+
+namespace sv::ig {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double msBetween(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double, std::milli>(b - a).count();
+}
+
+double percentile(std::vector<double> v, double p) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const size_t i = std::min(v.size() - 1, size_t(std::ceil(p * double(v.size()))) - (p > 0));
+  return v[i];
+}
+
+// A UDP socket on 0.0.0.0:port, non-blocking.
+class UdpSocket {
+ public:
+  ~UdpSocket() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  Status open(uint16_t port) {
+    fd_ = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+    if (fd_ < 0) return Error{"", "", fmt::format("cannot open a UDP socket: {}", std::strerror(errno))};
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_addr.s_addr = htonl(INADDR_ANY);
+    a.sin_port = htons(port);
+    if (::bind(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0)
+      return Error{"", "", fmt::format("cannot listen on UDP port {}: {}", port, std::strerror(errno))};
+    socklen_t len = sizeof a;
+    ::getsockname(fd_, reinterpret_cast<sockaddr*>(&a), &len);
+    port_ = ntohs(a.sin_port);
+    return {};
+  }
+  uint16_t port() const { return port_; }
+  // One waiting datagram into `bytes` (false when none); its sender into `from`.
+  bool receive(std::vector<uint8_t>& bytes, sockaddr_in& from) {
+    bytes.resize(65536);
+    socklen_t len = sizeof from;
+    const ssize_t n = ::recvfrom(fd_, bytes.data(), bytes.size(), 0,
+                                 reinterpret_cast<sockaddr*>(&from), &len);
+    if (n < 0) return false;
+    bytes.resize(size_t(n));
+    return true;
+  }
+  void send(const std::vector<uint8_t>& bytes, const sockaddr_in& to) {
+    ::sendto(fd_, bytes.data(), bytes.size(), 0, reinterpret_cast<const sockaddr*>(&to), sizeof to);
+  }
+
+ private:
+  int fd_ = -1;
+  uint16_t port_ = 0;
+};
+
+}  // namespace
+
+struct IgLoop::Impl {
+  IgConfig config;
+  IgRunOptions options;
+  std::optional<IgWorld> world;
+  UdpSocket socket;
+  bool network = false;
+  sockaddr_in host{};
+  bool hostKnown = false;
+  std::vector<cigi::CapturedDatagram> replay;
+  size_t replayAt = 0;
+  cigi::PcapWriter recorder;
+  bool recording = false;
+  std::unique_ptr<present::Presenter> presenter;
+  std::FILE* status = nullptr;
+  bool ownsStatus = false;
+  std::map<int, std::unique_ptr<Renderer>> renderers;  // by quality level
+  bool loggedMalformed = false;
+
+  ~Impl() {
+    if (ownsStatus && status) std::fclose(status);
+  }
+
+  Renderer& rendererFor(int level, const RenderOptions& options) {
+    std::unique_ptr<Renderer>& r = renderers[level];
+    if (!r) r = std::make_unique<Renderer>(options);
+    return *r;
+  }
+
+  // The host datagrams for frame `frame`: those waiting on the socket, or the replay's.
+  void hostDatagrams(uint32_t frame, std::vector<std::vector<uint8_t>>& out, bool& replayEnded) {
+    out.clear();
+    if (!options.replay.empty()) {
+      // A recording holds each frame's host datagrams, then the IG's Start of Frame for it.
+      for (; replayAt < replay.size(); ++replayAt) {
+        const cigi::CapturedDatagram& d = replay[replayAt];
+        if (d.fromHost) {
+          out.push_back(d.bytes);
+          continue;
+        }
+        Result<cigi::Datagram> ig = cigi::parseDatagram(d.bytes);
+        const auto* sof = ig ? std::get_if<cigi::StartOfFrame>(&ig->packets.front()) : nullptr;
+        if (sof && sof->igFrame >= frame) {
+          ++replayAt;
+          return;
+        }
+      }
+      replayEnded = true;
+      return;
+    }
+    if (!network) return;
+    std::vector<uint8_t> bytes;
+    sockaddr_in from{};
+    while (socket.receive(bytes, from)) {
+      if (config.hostPort == 0) {
+        host = from;  // answer whoever drives us
+        hostKnown = true;
+      }
+      out.push_back(bytes);
+    }
+  }
+};
+
+IgLoop::IgLoop() : impl_(std::make_unique<Impl>()) {}
+IgLoop::~IgLoop() = default;
+
+uint16_t IgLoop::port() const { return impl_->socket.port(); }
+
+Result<std::unique_ptr<IgLoop>> IgLoop::create(const IgConfig& config,
+                                               const IgRunOptions& options) {
+  std::unique_ptr<IgLoop> loop(new IgLoop());
+  Impl& m = *loop->impl_;
+  m.config = config;
+  m.options = options;
+  if (Status s = validate(config.render); !s) return s.error();
+  Result<IgWorld> world = IgWorld::load(config);
+  if (!world) return world.error();
+  m.world.emplace(std::move(world.value()));
+  if (!options.replay.empty()) {
+    Result<std::vector<cigi::CapturedDatagram>> r = cigi::readPcap(options.replay);
+    if (!r) return r.error();
+    m.replay = std::move(r.value());
+  } else {
+    if (Status s = m.socket.open(config.port); !s) return s.error();
+    m.network = true;
+    if (config.hostPort != 0) {
+      m.host.sin_family = AF_INET;
+      m.host.sin_port = htons(config.hostPort);
+      if (::inet_pton(AF_INET, config.hostAddress.c_str(), &m.host.sin_addr) != 1)
+        return Error{"", "", fmt::format("host address \"{}\" is not a dotted IPv4 address",
+                                         config.hostAddress)};
+      m.hostKnown = true;
+    }
+  }
+  if (!options.record.empty()) {
+    if (Status s = m.recorder.open(options.record); !s) return s.error();
+    m.recording = true;
+  }
+  Result<std::unique_ptr<present::Presenter>> p = present::makePresenter(options.output, int(std::lround(config.rate)));
+  if (!p) return p.error();
+  m.presenter = std::move(p.value());
+  if (!options.testPattern.empty()) {
+    if (Result<present::TestPattern> t = present::parseTestPattern(options.testPattern); !t)
+      return t.error();
+  }
+  if (options.status == "-") {
+    m.status = stdout;
+  } else if (!options.status.empty()) {
+    m.status = std::fopen(options.status.c_str(), "w");
+    if (!m.status) return Error{options.status, "", "cannot write the status stream"};
+    m.ownsStatus = true;
+  }
+  return loop;
+}
+
+Result<IgRunReport> IgLoop::run() {
+  Impl& m = *impl_;
+  IgWorld& world = *m.world;
+  const double periodMs = 1000 / m.config.rate;
+  const auto period = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double, std::milli>(periodMs));
+  OverloadGovernor governor(qualityLevels(m.config.render), m.config.deadline * periodMs);
+  std::optional<present::TestPattern> pattern;
+  if (!m.options.testPattern.empty()) pattern = present::parseTestPattern(m.options.testPattern).value();
+
+  IgRunReport report;
+  std::vector<double> frameMs, periodsMs, loopMs;
+  std::vector<std::vector<uint8_t>> incoming;
+  std::vector<cigi::Packet> replies;
+  std::vector<Image> images;
+  std::vector<FrameStats> stats;
+  std::vector<std::string> names;
+  const Clock::time_point t0 = Clock::now();
+  Clock::time_point slot = t0, lastStart = t0;
+  bool replayEnded = false;
+
+  for (uint32_t frame = 0; !stop_; ++frame) {
+    if (m.options.frames && frame >= m.options.frames) break;
+    if (m.options.realtime) std::this_thread::sleep_until(slot);
+    const Clock::time_point start = Clock::now();
+    if (frame > 0) periodsMs.push_back(msBetween(lastStart, start));
+    lastStart = start;
+
+    // 1. The host's datagrams, applied in the order they came.
+    m.hostDatagrams(frame, incoming, replayEnded);
+    if (replayEnded && incoming.empty()) break;
+    replies.clear();
+    world.setFrame(frame);
+    if (frame > 0) world.advance(periodMs / 1000);
+    for (const std::vector<uint8_t>& bytes : incoming) {
+      Result<cigi::Datagram> d = cigi::parseDatagram(bytes);
+      if (!d) {
+        ++world.counts().malformed;
+        if (!m.loggedMalformed)
+          std::fprintf(stderr, "synthvis ig: a malformed datagram dropped (%s); further ones are counted, not logged\n",
+                       d.error().str().c_str());
+        m.loggedMalformed = true;
+        continue;
+      }
+      if (!std::holds_alternative<cigi::IgControl>(d->packets.front())) {
+        ++world.counts().malformed;  // an IG's datagram sent to us
+        continue;
+      }
+      if (m.recording) (void)m.recorder.add({msBetween(t0, start) / 1000, true, bytes});
+      world.apply(d.value(), replies);
+    }
+
+    // 2. Start of Frame and the answers, at once: the host sends its next frame on it.
+    cigi::StartOfFrame sof;
+    sof.igFrame = frame;
+    sof.lastHostFrame = world.lastHostFrame();
+    sof.mode = world.mode();
+    sof.timestampValid = true;
+    sof.timestamp = uint32_t(std::llround(msBetween(t0, start) * 100));  // 10 µs ticks
+    replies.insert(replies.begin(), sof);
+    const std::vector<uint8_t> answer = cigi::writeDatagram(replies);
+    if (m.network && m.hostKnown) m.socket.send(answer, m.host);
+    if (m.recording) (void)m.recorder.add({msBetween(t0, start) / 1000, false, answer});
+
+    // 3. The frame at the quality the deadline allows.
+    const scene::Scene& probe = world.frameScene(frame / m.config.rate, true);
+    const double work = double(probe.triangleCount() + probe.lightPoints.size());
+    const int level = m.options.governor ? governor.choose(work) : 0;
+    const QualityLevel& q = governor.at(level);
+    const scene::Scene& scene = world.frameScene(frame / m.config.rate, q.stars);
+    const Clock::time_point renderStart = Clock::now();
+    if (pattern) {
+      images.resize(scene.channels.size());
+      for (size_t c = 0; c < scene.channels.size(); ++c)
+        images[c] = present::testPattern(*pattern, scene.channels[c].width,
+                                         scene.channels[c].height, scene.channels[c].name);
+      stats.assign(images.size(), FrameStats{});
+    } else {
+      Renderer& renderer = m.rendererFor(level, q.options);
+      if (Status s = renderer.renderChannels(scene, images, &stats); !s) return s.error();
+    }
+    const double renderMs = msBetween(renderStart, Clock::now());
+    names.clear();
+    for (const scene::Channel& c : scene.channels) names.push_back(c.name);
+    if (m.options.overlay && !images.empty()) {
+      double vertex = 0, setup = 0, raster = 0, lights = 0;
+      for (const FrameStats& s : stats) {
+        vertex += s.vertexMs;
+        setup += s.setupMs;
+        raster += s.rasterMs;
+        lights += s.lightsMs;
+      }
+      const std::vector<std::string> lines = {
+          fmt::format("frame {}  {:.0f} Hz  render {:.1f} ms / budget {:.1f} ms", frame,
+                      m.config.rate, renderMs, governor.budgetMs()),
+          fmt::format("vertex {:.1f}  setup {:.1f}  tiles {:.1f}  lights {:.1f} ms", vertex,
+                      setup, raster, lights),
+          fmt::format("level {} ({})", level, q.change),
+          fmt::format("entities {}  datagrams {}  malformed {}  missed {}",
+                      world.activeEntities(), world.counts().datagrams, world.counts().malformed,
+                      report.missed)};
+      present::drawOverlay(images[0], lines);
+    }
+    if (Status s = m.presenter->present({frame, images, names}); !s) return s.error();
+    const Clock::time_point end = Clock::now();
+    const double ms = msBetween(start, end);
+    if (!pattern) governor.record(level, work, renderMs);
+
+    frameMs.push_back(ms);
+    loopMs.push_back(ms - renderMs);
+    ++report.frames;
+    report.degraded += level > 0;
+    report.worstLevel = std::max(report.worstLevel, level);
+    report.overruns += ms > governor.budgetMs();
+    slot += period;
+    if (m.options.realtime && end > slot) {
+      // Late: this frame took its successor's slot. The schedule moves on to the next free slot;
+      // no frame is queued behind.
+      ++report.missed;
+      while (slot < end) slot += period;
+    }
+    if (m.status) {
+      std::fprintf(m.status,
+                   "{\"frame\":%u,\"ms\":%.3f,\"renderMs\":%.3f,\"budgetMs\":%.3f,\"level\":%d,"
+                   "\"entities\":%zu,\"datagrams\":%llu,\"malformed\":%llu,\"rejected\":%llu,"
+                   "\"missed\":%llu}\n",
+                   frame, ms, renderMs, governor.budgetMs(), level, world.activeEntities(),
+                   (unsigned long long)world.counts().datagrams,
+                   (unsigned long long)world.counts().malformed,
+                   (unsigned long long)world.counts().rejected,
+                   (unsigned long long)report.missed);
+      std::fflush(m.status);
+    }
+    if (m.presenter->closed()) break;
+  }
+  report.frameMsP50 = percentile(frameMs, 0.5);
+  report.frameMsP99 = percentile(frameMs, 0.99);
+  report.frameMsMax = frameMs.empty() ? 0 : *std::max_element(frameMs.begin(), frameMs.end());
+  report.periodMsP50 = percentile(periodsMs, 0.5);
+  report.periodMsP99 = percentile(periodsMs, 0.99);
+  double sum = 0;
+  for (double x : loopMs) sum += x;
+  report.loopMsMean = loopMs.empty() ? 0 : sum / double(loopMs.size());
+  report.datagrams = world.counts().datagrams;
+  report.malformed = world.counts().malformed;
+  report.rejected = world.counts().rejected;
+  return report;
+}
+
+std::string IgRunReport::summary() const {
+  return fmt::format(
+      "frames {}: missed {}, over the deadline {}, degraded {} (worst level {})\n"
+      "frame time p50 {:.2f} ms, p99 {:.2f} ms, max {:.2f} ms; period p50 {:.2f} ms, p99 {:.2f} ms "
+      "(jitter {:.2f} ms)\n"
+      "loop overhead (receive, update, answer, present) {:.3f} ms a frame\n"
+      "host datagrams {}, malformed {}, packets rejected {}",
+      frames, missed, overruns, degraded, worstLevel, frameMsP50, frameMsP99, frameMsMax,
+      periodMsP50, periodMsP99, periodMsP99 - periodMsP50, loopMsMean, datagrams, malformed,
+      rejected);
+}
+
+}  // namespace sv::ig

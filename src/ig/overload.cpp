@@ -1,0 +1,92 @@
+// Based on: seed 002 (overload protection: a frame that never breaks), seed 004 (a real-time system).
+#include "ig/overload.h"
+
+#include <algorithm>
+#include <fmt/format.h>
+
+namespace sv::ig {
+namespace {
+
+// A level never measured is predicted from the one above it scaled by this prior: anti-aliasing
+// costs about in proportion to the samples' share of the work; the other reductions a little.
+constexpr double kPriorOther = 0.9;
+// The weight of a new measurement in the running estimate.
+constexpr double kSmoothing = 0.2;
+
+}  // namespace
+
+std::vector<QualityLevel> qualityLevels(const RenderOptions& full) {
+  std::vector<QualityLevel> levels{{full, true, "full quality"}};
+  auto next = [&](const char* what, auto&& change) {
+    QualityLevel l = levels.back();
+    change(l);
+    l.change = what;
+    levels.push_back(l);
+  };
+  for (const int to : {16, 8, 4, 1})
+    if (levels.back().options.samples > to) {
+      const std::string what = fmt::format("aa {}", to);
+      next(what.c_str(), [to](QualityLevel& l) { l.options.samples = to; });
+    }
+  if (full.textureFilter == scene::TextureFilter::trilinear ||
+      full.textureFilter == scene::TextureFilter::anisotropic ||
+      full.textureFilter == scene::TextureFilter::trilinearThreePoint)
+    next("bilinear textures",
+         [](QualityLevel& l) { l.options.textureFilter = scene::TextureFilter::bilinear; });
+  next("no stars", [](QualityLevel& l) { l.stars = false; });
+  next("bilinear terrain", [](QualityLevel& l) {
+    l.options.terrainFilter = RenderOptions::TerrainFilter::bilinear;
+  });
+  return levels;
+}
+
+OverloadGovernor::OverloadGovernor(std::vector<QualityLevel> levels, double budgetMs,
+                                   int holdFrames)
+    : levels_(std::move(levels)), estimates_(levels_.size()), budgetMs_(budgetMs),
+      hold_(holdFrames) {}
+
+double OverloadGovernor::predict(int level, double work) const {
+  // The nearest measured level at or above this one, scaled down by the priors in between.
+  double scale = 1;
+  for (int l = level; l >= 0; --l) {
+    if (estimates_[size_t(l)].msPerWork > 0) return estimates_[size_t(l)].msPerWork * work * scale;
+    if (l > 0) {
+      const int from = levels_[size_t(l - 1)].options.samples, to = levels_[size_t(l)].options.samples;
+      scale *= from != to ? std::max(0.25, double(to) / double(from)) : kPriorOther;
+    }
+  }
+  return 0;
+}
+
+int OverloadGovernor::choose(double work) {
+  work = std::max(work, 1.0);
+  if (predict(level_, work) > budgetMs_) {
+    // Down to the first level predicted to fit (or the last).
+    while (level_ + 1 < levels() && predict(level_, work) > budgetMs_) ++level_;
+    fitting_ = 0;
+    return level_;
+  }
+  if (level_ > 0 && predict(level_ - 1, work) <= 0.75 * budgetMs_) {
+    if (++fitting_ >= hold_) {
+      --level_;
+      fitting_ = 0;
+    }
+  } else {
+    fitting_ = 0;
+  }
+  return level_;
+}
+
+void OverloadGovernor::record(int level, double work, double ms) {
+  work = std::max(work, 1.0);
+  Estimate& e = estimates_[size_t(level)];
+  const double rate = ms / work;
+  e.msPerWork = e.msPerWork > 0 ? e.msPerWork + kSmoothing * (rate - e.msPerWork) : rate;
+  // An overrun the prediction missed: down a level at once, and start the hold again.
+  if (ms > budgetMs_ && level == level_ && level_ + 1 < levels()) {
+    ++level_;
+    fitting_ = 0;
+  }
+}
+
+}  // namespace sv::ig

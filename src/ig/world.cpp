@@ -1,0 +1,447 @@
+// Based on: CIGI 3.3 ICD (the packets' meaning, an IG's side); seed 004 (the IG's state, changed by
+// the host between frames); SPEC §8 (fog from visibility), §9 (channels), §13 (light groups).
+#include "ig/world.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <numbers>
+
+#include "synthvis/terrain.h"
+
+namespace sv::ig {
+namespace {
+
+constexpr double kRad = std::numbers::pi / 180;
+
+bool finite3(const double p[3]) {
+  return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
+}
+
+// Visibility V (m) as fog: the distance at which a black object's contrast falls to 5 % (the
+// meteorological convention), 2^(−β·V) = 0.05, β = log2(20) / V.
+float fogBetaForVisibility(float v) { return float(std::log2(20.0) / double(v)); }
+
+}  // namespace
+
+Result<IgWorld> IgWorld::load(const IgConfig& config) {
+  IgWorld w;
+  w.config_ = config;
+  Result<scene::Scene> db = scene::loadScene(config.scene);
+  if (!db) return db.error();
+  w.base_ = std::move(db.value());
+  for (const auto& [type, file] : config.models) {
+    Result<scene::Scene> model = scene::loadScene(file);
+    if (!model) return model.error();
+    if (!model->freeForms.empty() || !model->terrains.empty())
+      return Error{file, "", "an entity model holds triangles only (free forms and terrain belong to the database)"};
+    const size_t before = w.base_.instances.size(), cameras = w.base_.cameras.size();
+    scene::appendScene(w.base_, std::move(model.value()), Mat4{});
+    Model m;
+    m.instances.assign(w.base_.instances.begin() + std::ptrdiff_t(before), w.base_.instances.end());
+    w.base_.instances.resize(before);
+    w.base_.cameras.resize(cameras);
+    w.modelTypes_.push_back(type);
+    w.models_.push_back(std::move(m));
+  }
+  if (Status s = scene::validate(w.base_, config.scene, false); !s) return s.error();
+  w.baseInstances_ = w.base_.instances.size();
+  w.channels_ = config.channels.empty() ? w.base_.channels : config.channels;
+  if (w.channels_.empty()) {
+    scene::Channel c;
+    c.name = "0";
+    c.width = config.width;
+    c.height = config.height;
+    w.channels_.push_back(c);
+  }
+  w.entities_.resize(config.maxEntities);
+  w.views_.resize(w.channels_.size());
+  w.frame_ = w.base_;
+  return w;
+}
+
+size_t IgWorld::activeEntities() const {
+  size_t n = 0;
+  for (const Entity& e : entities_) n += e.exists;
+  return n;
+}
+
+bool IgWorld::pose(uint16_t id, Pose& out, int depth) const {
+  if (id >= entities_.size() || !entities_[id].exists || depth > 16) return false;
+  const cigi::EntityControl& c = entities_[id].control;
+  if (c.attached) {
+    Pose parent;
+    if (!pose(c.parent, parent, depth + 1)) return false;
+    out.position = parent.position + parent.frame.apply({c.latOrX, c.lonOrY, c.altOrZ});
+    out.frame = eulerFrame(parent.frame, c.yaw, c.pitch, c.roll);
+  } else {
+    out.position = geodeticToWorld(config_.origin, c.latOrX, c.lonOrY, c.altOrZ);
+    out.frame = eulerFrame(levelFrame(), c.yaw, c.pitch, c.roll);
+  }
+  return true;
+}
+
+DVec3 IgWorld::requestPoint(bool entityRelative, uint16_t entity, const double p[3],
+                            bool& ok) const {
+  ok = finite3(p);
+  if (!ok) return {};
+  if (!entityRelative) return geodeticToWorld(config_.origin, p[0], p[1], p[2]);
+  Pose e;
+  ok = pose(entity, e);
+  return ok ? e.position + e.frame.apply({p[0], p[1], p[2]}) : DVec3{};
+}
+
+void IgWorld::apply(const cigi::Datagram& datagram, std::vector<cigi::Packet>& replies) {
+  ++counts_.datagrams;
+  counts_.skipped += datagram.skipped;
+  for (const cigi::Packet& p : datagram.packets) {
+    ++counts_.packets;
+    applyPacket(p, replies);
+  }
+}
+
+void IgWorld::applyPacket(const cigi::Packet& packet, std::vector<cigi::Packet>& replies) {
+  using namespace cigi;
+  const uint8_t lsn = uint8_t(lastHostFrame_ & 0xF);
+  if (const auto* p = std::get_if<IgControl>(&packet)) {
+    mode_ = p->mode;
+    extrapolation_ = p->extrapolation;
+    lastHostFrame_ = p->hostFrame;
+    if (p->mode == IgMode::reset)
+      for (Entity& e : entities_) e = Entity{};
+  } else if (const auto* p = std::get_if<EntityControl>(&packet)) {
+    const double v[3] = {p->latOrX, p->lonOrY, p->altOrZ};
+    if (p->entity >= entities_.size() || !finite3(v) || !std::isfinite(p->roll) ||
+        !std::isfinite(p->pitch) || !std::isfinite(p->yaw) ||
+        (p->attached && (p->parent >= entities_.size() || p->parent == p->entity))) {
+      ++counts_.rejected;
+      return;
+    }
+    Entity& e = entities_[p->entity];
+    if (p->state == EntityState::destroyed) {
+      e = Entity{};
+      return;
+    }
+    if (!e.exists || e.control.type != p->type) {
+      e.model = -1;
+      for (size_t m = 0; m < modelTypes_.size(); ++m)
+        if (modelTypes_[m] == p->type) e.model = int(m);
+      e.hasRate = false;
+    }
+    e.exists = true;
+    e.control = *p;
+    e.hasRate = false;  // a new pose from the host ends the extrapolation from the old one
+  } else if (const auto* p = std::get_if<ComponentControl>(&packet)) {
+    if (p->componentClass == ComponentClass::system) {
+      // Light groups (docs/ig.md): component ID = the group's index, state 0 off, 1 on, 2 on and
+      // dimmed to data[0] read as an IEEE float (0 … 1).
+      if (p->component >= base_.lightGroups.size()) {
+        ++counts_.rejected;
+        return;
+      }
+      scene::LightGroup& g = frame_.lightGroups[p->component];
+      g.on = p->state != 0;
+      g.dim = 1;
+      if (p->state == 2) {
+        float dim;
+        std::memcpy(&dim, &p->data[0], sizeof dim);
+        if (!(dim >= 0 && dim <= 1)) {
+          ++counts_.rejected;
+          return;
+        }
+        g.dim = dim;
+      }
+    } else if (p->componentClass == ComponentClass::entity) {
+      // An entity switch: component 0 of entity `instance`, state 0 hidden, 1 shown.
+      if (p->instance >= entities_.size() || p->component != 0) {
+        ++counts_.rejected;
+        return;
+      }
+      entities_[p->instance].visible = p->state != 0;
+    } else {
+      ++counts_.skipped;
+    }
+  } else if (const auto* p = std::get_if<RateControl>(&packet)) {
+    const float r[6] = {p->x, p->y, p->z, p->roll, p->pitch, p->yaw};
+    const bool finite = std::all_of(r, r + 6, [](float x) { return std::isfinite(x); });
+    if (p->entity >= entities_.size() || !entities_[p->entity].exists || !finite) {
+      ++counts_.rejected;
+      return;
+    }
+    if (p->applyToPart) {
+      ++counts_.skipped;  // articulated parts: not modelled
+      return;
+    }
+    entities_[p->entity].rate = *p;
+    entities_[p->entity].hasRate = true;
+  } else if (const auto* p = std::get_if<CelestialSphereControl>(&packet)) {
+    if (p->hour > 23 || p->minute > 59 || !std::isfinite(p->starIntensity)) {
+      ++counts_.rejected;
+      return;
+    }
+    celestial_ = *p;
+    timeOfDay_ = true;
+  } else if (const auto* p = std::get_if<AtmosphereControl>(&packet)) {
+    if (!std::isfinite(p->visibility) || p->visibility < 0) {
+      ++counts_.rejected;
+      return;
+    }
+    atmosphereVisibility_ = p->visibility;
+  } else if (const auto* p = std::get_if<WeatherControl>(&packet)) {
+    if (!std::isfinite(p->visibility) || p->visibility < 0) {
+      ++counts_.rejected;
+      return;
+    }
+    // Global weather (scope 0) sets the visibility; regional and entity weather are not modelled.
+    if (p->scope == 0) weatherVisibility_ = p->enabled ? p->visibility : 0;
+    else ++counts_.skipped;
+  } else if (const auto* p = std::get_if<ViewControl>(&packet)) {
+    const float v[6] = {p->x, p->y, p->z, p->roll, p->pitch, p->yaw};
+    if (p->view >= views_.size() || p->entity >= entities_.size() ||
+        !std::all_of(v, v + 6, [](float x) { return std::isfinite(x); })) {
+      ++counts_.rejected;
+      return;
+    }
+    views_[p->view].controlled = true;
+    views_[p->view].control = *p;
+  } else if (const auto* p = std::get_if<ViewDefinition>(&packet)) {
+    const float v[6] = {p->nearPlane, p->farPlane, p->left, p->right, p->top, p->bottom};
+    const bool ok = std::all_of(v, v + 6, [](float x) { return std::isfinite(x); }) &&
+                    p->left < p->right && p->bottom < p->top && p->left > -90 &&
+                    p->right < 90 && p->bottom > -90 && p->top < 90 && p->nearPlane > 0 &&
+                    p->farPlane > p->nearPlane;
+    if (p->view >= views_.size() || !ok) {
+      ++counts_.rejected;
+      return;
+    }
+    views_[p->view].defined = true;
+    views_[p->view].definition = *p;
+  } else if (const auto* p = std::get_if<HatHotRequest>(&packet)) {
+    ++counts_.hatRequests;
+    const double q[3] = {p->latOrX, p->lonOrY, p->altOrZ};
+    bool ok = false;
+    const DVec3 w = requestPoint(p->entityCoordinates, p->entity, q, ok);
+    HatHotResponse r;
+    r.id = p->id;
+    r.hostFrameLsn = lsn;
+    // A HOT asks for the ground under the point; a HAT for the point's height above it (an
+    // extended request is answered as a HAT: the extended response is not implemented).
+    r.hot = p->type == HatHotType::hot;
+    if (const std::optional<double> g = ok ? groundHeight(w) : std::nullopt) {
+      r.valid = true;
+      r.height = r.hot ? *g + config_.origin.alt : w.y - *g;
+    }
+    replies.push_back(r);
+  } else if (const auto* p = std::get_if<LosSegmentRequest>(&packet)) {
+    ++counts_.losRequests;
+    bool okA = false, okB = false;
+    const DVec3 a = requestPoint(p->sourceEntityCoordinates, p->sourceEntity, p->source, okA);
+    const DVec3 b = requestPoint(p->destinationEntityCoordinates, p->sourceEntity, p->destination, okB);
+    LosResponse r;
+    r.id = p->id;
+    r.hostFrameLsn = lsn;
+    if (okA && okB) {
+      const std::optional<double> t = segmentHit(a, b);
+      const DVec3 d = b - a;
+      r.valid = t.has_value();  // the range is valid where the segment meets something
+      r.visible = !t;
+      r.range = t ? *t * std::sqrt(dot(d, d)) : 0;
+    }
+    replies.push_back(r);
+  } else {
+    ++counts_.skipped;  // decoded but not acted on (environmental regions; IG → host packets)
+  }
+}
+
+void IgWorld::advance(double dt) {
+  if (!extrapolation_) return;
+  for (Entity& e : entities_) {
+    if (!e.exists || !e.hasRate) continue;
+    cigi::EntityControl& c = e.control;
+    const cigi::RateControl& r = e.rate;
+    if (c.attached) {
+      // Offsets and rates both in the parent's body axes.
+      c.latOrX += r.x * dt;
+      c.lonOrY += r.y * dt;
+      c.altOrZ += r.z * dt;
+    } else {
+      // Rates in the entity's body axes, turned into north, east, down and then degrees.
+      const Frame3 f = eulerFrame(levelFrame(), c.yaw, c.pitch, c.roll);
+      const DVec3 v = f.apply({r.x, r.y, r.z});  // world: x east, y up, z south
+      const double north = -v.z * dt, east = v.x * dt, up = v.y * dt;
+      c.latOrX += north / (kEarthRadius * kRad);
+      c.lonOrY += east / (kEarthRadius * kRad * std::cos(config_.origin.lat * kRad));
+      c.altOrZ += up;
+    }
+    c.roll = float(std::remainder(c.roll + r.roll * dt, 360.0));
+    c.pitch = float(std::clamp(c.pitch + r.pitch * dt, -90.0, 90.0));
+    c.yaw = float(std::remainder(c.yaw + r.yaw * dt, 360.0));
+  }
+}
+
+const scene::Scene& IgWorld::frameScene(double time, bool stars) {
+  scene::Scene& s = frame_;
+  s.time = time;
+  s.stars = base_.stars;
+  // The entities' models at their poses.
+  s.instances.resize(baseInstances_);
+  for (uint16_t id = 0; id < entities_.size(); ++id) {
+    const Entity& e = entities_[id];
+    Pose p;
+    if (!e.exists || !e.visible || e.model < 0 || e.control.state != cigi::EntityState::active ||
+        !pose(id, p))
+      continue;
+    const Mat4 place = modelMatrix(p.frame, p.position);
+    for (const scene::Instance& i : models_[size_t(e.model)].instances)
+      s.instances.push_back({i.mesh, place * i.transform, i.priority});
+  }
+  // The eye on the ownship (entity 0), when the host has made it; else the database's camera.
+  s.channels = channels_;
+  Pose own;
+  if (pose(0, own)) {
+    scene::Camera cam = base_.cameras.empty() ? scene::Camera{} : base_.cameras[0];
+    cam.position = toFloat(own.position);
+    cam.target = toFloat(own.position + own.frame.forward * 100.0);
+    cam.up = toFloat(own.frame.down * -1.0);
+    if (s.cameras.empty()) s.cameras.push_back(cam);
+    else s.cameras[0] = cam;
+  }
+  for (size_t v = 0; v < views_.size() && v < s.channels.size(); ++v) {
+    scene::Channel& ch = s.channels[v];
+    const View& view = views_[v];
+    if (view.controlled) {
+      // Offsets in the ownship's body axes (x forward, y right, z down) into the camera's eye
+      // space (x right, y up, z back); the angles replace the channel's where enabled.
+      const cigi::ViewControl& c = view.control;
+      if (c.enable & 1) ch.offset.z = -c.x;
+      if (c.enable & 2) ch.offset.x = c.y;
+      if (c.enable & 4) ch.offset.y = -c.z;
+      if (c.enable & 8) ch.rollDegrees = c.roll;
+      if (c.enable & 16) ch.pitchDegrees = c.pitch;
+      if (c.enable & 32) ch.yawDegrees = c.yaw;
+    }
+    if (view.defined) {
+      const cigi::ViewDefinition& d = view.definition;
+      ch.frustum = scene::ChannelFrustum{d.left, d.right, d.bottom, d.top};
+      if (!s.cameras.empty()) {
+        s.cameras[0].znear = d.nearPlane;
+        s.cameras[0].zfar = d.farPlane;
+      }
+    }
+  }
+  // Fog from the visibility: the nearer of the atmosphere's and the global weather's.
+  float visibility = 0;
+  for (float v : {atmosphereVisibility_, weatherVisibility_})
+    if (v > 0) visibility = visibility > 0 ? std::min(visibility, v) : v;
+  s.fog = base_.fog;
+  if (visibility > 0) {
+    s.fog.enabled = true;
+    s.fog.beta = fogBetaForVisibility(visibility);
+  }
+  // Time of day (docs/ig.md): the sun's elevation from the hour, its light and the sky.
+  if (timeOfDay_) {
+    const double hours = celestial_.hour + celestial_.minute / 60.0;
+    const double elevation = 60 * std::sin(std::numbers::pi * (hours - 6) / 12);  // degrees
+    const double azimuth = 90 + 180 * (hours - 6) / 12;  // from north, east at 6 h, west at 18 h
+    const double ce = std::cos(elevation * kRad);
+    const Vec3 toSun{float(ce * std::sin(azimuth * kRad)), float(std::sin(elevation * kRad)),
+                     float(-ce * std::cos(azimuth * kRad))};
+    const float day = float(std::clamp(std::sin(elevation * kRad) * 4, 0.0, 1.0));
+    s.light = base_.light;
+    s.light.direction = toSun * -1.0f;
+    s.light.enabled = celestial_.sun;
+    s.light.color = base_.light.color * (1 - day) + Vec3{1, 0.97f, 0.9f} * day;
+    s.light.ambient = base_.light.ambient * (1 - day) + 0.3f * day;
+    s.background = base_.background * (1 - day) + Vec3{0.35f, 0.5f, 0.8f} * day;
+    s.stars.brightness = celestial_.starField
+                             ? base_.stars.brightness * (celestial_.starIntensity / 100) * (1 - day)
+                             : 0;
+  }
+  if (!stars) s.stars.stars.clear();
+  return s;
+}
+
+// ---- queries ---------------------------------------------------------------------------------
+
+namespace {
+
+// The nearest t in (0, tMax] where the ray o + t·d meets triangle (a, b, c) — Möller–Trumbore,
+// both faces.
+std::optional<double> rayTriangle(DVec3 o, DVec3 d, DVec3 a, DVec3 b, DVec3 c, double tMax) {
+  const DVec3 e1 = b - a, e2 = c - a;
+  const DVec3 p{d.y * e2.z - d.z * e2.y, d.z * e2.x - d.x * e2.z, d.x * e2.y - d.y * e2.x};
+  const double det = dot(e1, p);
+  if (std::fabs(det) < 1e-12) return std::nullopt;
+  const double inv = 1 / det;
+  const DVec3 s = o - a;
+  const double u = dot(s, p) * inv;
+  if (u < 0 || u > 1) return std::nullopt;
+  const DVec3 q{s.y * e1.z - s.z * e1.y, s.z * e1.x - s.x * e1.z, s.x * e1.y - s.y * e1.x};
+  const double v = dot(d, q) * inv;
+  if (v < 0 || u + v > 1) return std::nullopt;
+  const double t = dot(e2, q) * inv;
+  if (t < 0 || t > tMax) return std::nullopt;
+  return t;
+}
+
+// The nearest hit of the segment o → o + d (t in [0, 1]) with the database's polygons.
+std::optional<double> polygonHit(const scene::Scene& s, size_t instances, DVec3 o, DVec3 d) {
+  std::optional<double> best;
+  for (size_t i = 0; i < instances; ++i) {
+    const scene::Instance& inst = s.instances[i];
+    const scene::Mesh& mesh = s.meshes[size_t(inst.mesh)];
+    // The segment's box against the instance's world box first.
+    const auto box = mesh.bounds();
+    DVec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+    for (int k = 0; k < 8; ++k) {
+      const Vec3 corner = inst.transform.transformPoint(
+          {box[k & 1].x, box[(k >> 1) & 1].y, box[(k >> 2) & 1].z});
+      lo = {std::min(lo.x, double(corner.x)), std::min(lo.y, double(corner.y)),
+            std::min(lo.z, double(corner.z))};
+      hi = {std::max(hi.x, double(corner.x)), std::max(hi.y, double(corner.y)),
+            std::max(hi.z, double(corner.z))};
+    }
+    const DVec3 e = o + d;
+    if (std::max(o.x, e.x) < lo.x || std::min(o.x, e.x) > hi.x || std::max(o.y, e.y) < lo.y ||
+        std::min(o.y, e.y) > hi.y || std::max(o.z, e.z) < lo.z || std::min(o.z, e.z) > hi.z)
+      continue;
+    auto world = [&](uint32_t index) {
+      const Vec3 p = inst.transform.transformPoint(mesh.positions[index]);
+      return DVec3{p.x, p.y, p.z};
+    };
+    for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+      const std::optional<double> hit =
+          rayTriangle(o, d, world(mesh.indices[t]), world(mesh.indices[t + 1]),
+                      world(mesh.indices[t + 2]), best.value_or(1.0));
+      if (hit) best = hit;
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+std::optional<double> IgWorld::groundHeight(DVec3 p) const {
+  std::optional<double> ground;
+  if (const std::optional<TerrainHeight> t = terrainHeight(base_, p.x, p.y, p.z))
+    ground = p.y - t->above;
+  // The polygons under the point: a vertical segment from far above to far below.
+  constexpr double kReach = 1e5;
+  const DVec3 top{p.x, p.y + kReach, p.z};
+  if (const std::optional<double> t = polygonHit(base_, baseInstances_, top, {0, -2 * kReach, 0}))
+    ground = std::max(ground.value_or(-1e300), top.y - *t * 2 * kReach);
+  return ground;
+}
+
+std::optional<double> IgWorld::segmentHit(DVec3 a, DVec3 b) const {
+  std::optional<double> best;
+  const double from[3] = {a.x, a.y, a.z}, to[3] = {b.x, b.y, b.z};
+  if (const std::optional<TerrainHit> t = lineOfSight(base_, from, to)) best = t->fraction;
+  if (const std::optional<double> t = polygonHit(base_, baseInstances_, a, b - a))
+    best = std::min(best.value_or(1.0), *t);
+  return best;
+}
+
+}  // namespace sv::ig

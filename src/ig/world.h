@@ -1,0 +1,103 @@
+// The image generator's state between frames (docs/ig.md, "What the host controls"): the
+// database, the entities the host created with their models, the views, the environment, the
+// light groups and the time of day — changed only by the host's packets, applied between frames,
+// so that a frame is a function of the packets before it (a recorded session replays exactly).
+// Each frame the state becomes one scene (frameScene) that the renderer draws.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "cigi/cigi.h"
+#include "ig/config.h"
+#include "ig/geo.h"
+#include "synthvis/scene.h"
+
+namespace sv::ig {
+
+// What the host's traffic did, since the start (the status stream's counts).
+struct TrafficCounts {
+  uint64_t datagrams = 0, packets = 0, skipped = 0, malformed = 0, rejected = 0;
+  uint64_t hatRequests = 0, losRequests = 0;
+};
+
+class IgWorld {
+ public:
+  // Loads the database and every model of the table; errors name the file.
+  static Result<IgWorld> load(const IgConfig& config);
+
+  // Applies one host datagram's packets in order; HAT/HOT and line-of-sight requests are answered
+  // into `replies`. A packet naming an entity or view out of range, or a non-finite value, is
+  // counted as rejected and ignored.
+  void apply(const cigi::Datagram& datagram, std::vector<cigi::Packet>& replies);
+  // The IG's frame counter and the host frame it last heard of (for Start of Frame and replies).
+  void setFrame(uint32_t igFrame) { igFrame_ = igFrame; }
+  uint32_t lastHostFrame() const { return lastHostFrame_; }
+  cigi::IgMode mode() const { return mode_; }
+  // Moves entities with rates (Rate Control) on by dt seconds, as the host would between its
+  // frames (extrapolation), when the host enabled it.
+  void advance(double dt);
+  // The scene of this instant: the database, the entities' models at their poses, the eye on the
+  // ownship (entity 0) with the views' offsets and frusta, fog from the visibility, the light
+  // groups, the sun and stars from the time of day, and `time` (seconds since the start);
+  // without `stars`, no star field (a quality level, overload.h).
+  const scene::Scene& frameScene(double time, bool stars = true);
+
+  // Height of the ground (terrain or the database's polygons; the highest) under a world point,
+  // and the first point the segment a → b meets (its fraction along the segment).
+  std::optional<double> groundHeight(DVec3 p) const;
+  std::optional<double> segmentHit(DVec3 a, DVec3 b) const;
+
+  const TrafficCounts& counts() const { return counts_; }
+  TrafficCounts& counts() { return counts_; }
+  size_t activeEntities() const;
+  const IgConfig& config() const { return config_; }
+  const scene::Scene& database() const { return base_; }
+
+ private:
+  struct Model {
+    std::vector<scene::Instance> instances;  // in the model's own space
+  };
+  struct Entity {
+    bool exists = false;
+    bool visible = true;  // an entity switch (Component Control)
+    cigi::EntityControl control;
+    cigi::RateControl rate;
+    bool hasRate = false;
+    int model = -1;  // index into models_, −1 for a type the table does not name
+  };
+  struct View {
+    bool controlled = false, defined = false;
+    cigi::ViewControl control;
+    cigi::ViewDefinition definition;
+  };
+  struct Pose {
+    DVec3 position;
+    Frame3 frame;
+  };
+
+  bool pose(uint16_t entity, Pose& out, int depth = 0) const;
+  void applyPacket(const cigi::Packet& packet, std::vector<cigi::Packet>& replies);
+  DVec3 requestPoint(bool entityRelative, uint16_t entity, const double p[3], bool& ok) const;
+
+  IgConfig config_;
+  scene::Scene base_;   // the database as loaded, the models' meshes appended
+  scene::Scene frame_;  // this frame's scene (base_ plus the entities' instances)
+  size_t baseInstances_ = 0;
+  std::vector<scene::Channel> channels_;  // the configured channels before the views' changes
+  std::vector<uint16_t> modelTypes_;
+  std::vector<Model> models_;
+  std::vector<Entity> entities_;
+  std::vector<View> views_;
+  cigi::IgMode mode_ = cigi::IgMode::operate;
+  bool extrapolation_ = false;
+  uint32_t igFrame_ = 0, lastHostFrame_ = 0;
+  // Environment.
+  float atmosphereVisibility_ = 0, weatherVisibility_ = 0;  // m; 0: as the database says
+  bool timeOfDay_ = false;
+  cigi::CelestialSphereControl celestial_;
+  TrafficCounts counts_;
+};
+
+}  // namespace sv::ig

@@ -1,0 +1,252 @@
+// The running IG over loopback UDP, driven by the scripted host (ig/loop.h, ig/host.h): entities
+// appear in the frame after the host sends them, Start of Frame counts on, heights come back,
+// bad datagrams are counted and dropped while the loop keeps its rate, a recorded session replays
+// to the same frames, and overload protection holds the rate of a scene too heavy for it.
+#include "ig/loop.h"
+
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <thread>
+
+#include "cigi/cigi.h"
+#include "cigi/pcap.h"
+#include "ig/geo.h"
+#include "ig/host.h"
+#include "synthvis/image.h"
+
+namespace sv::ig {
+namespace {
+
+namespace fs = std::filesystem;
+const std::string kConfig = std::string(SV_TEST_DATA_DIR) + "/ig/ig.json";
+
+fs::path freshDir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("sv-ig-" + name + "-" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+IgConfig config() {
+  Result<IgConfig> c = loadIgConfig(kConfig);
+  EXPECT_TRUE(c.ok()) << c.error().str();
+  return c.value();
+}
+
+// The frame's PNG (present/'s png: naming, one channel "0").
+Image frameImage(const fs::path& dir, uint32_t frame) {
+  char name[64];
+  std::snprintf(name, sizeof name, "frame-%06u-0.png", frame);
+  Result<Image> image = readPng((dir / name).string());
+  EXPECT_TRUE(image.ok()) << image.error().str();
+  return image.ok() ? image.value() : Image{};
+}
+
+size_t redPixels(const Image& image) {
+  size_t n = 0;
+  for (size_t i = 0; i + 2 < image.rgb.size(); i += 3)
+    n += image.rgb[i] > 200 && image.rgb[i + 1] < 60 && image.rgb[i + 2] < 60;
+  return n;
+}
+
+// The ownship 50 m up at the origin looking north; entity 1 (the red box) is created by an event
+// at `appear` seconds, 150 m ahead.
+HostScript script(uint16_t igPort, uint64_t frames, double appear) {
+  const GeoOrigin o = config().origin;
+  HostScript s;
+  s.igPort = igPort;
+  s.port = 0;
+  s.rate = 50;
+  s.frames = frames;
+  ScriptEntity own;
+  own.id = 0;
+  own.path.push_back({0, o.lat, o.lon, 50, 0, 0, 0});
+  s.entities.push_back(own);
+  const DVec3 ahead = worldToGeodetic(o, {0, 50, -150});
+  cigi::EntityControl box;
+  box.entity = 1;
+  box.type = 7;
+  box.latOrX = ahead.x;
+  box.lonOrY = ahead.y;
+  box.altOrZ = ahead.z;
+  s.events.push_back({appear, {box}});
+  const DVec3 hill = worldToGeodetic(o, {30, 100, -150});
+  cigi::HatHotRequest hat;
+  hat.id = 21;
+  hat.latOrX = hill.x;
+  hat.lonOrY = hill.y;
+  hat.altOrZ = hill.z;
+  s.events.push_back({0.1, {hat}});
+  return s;
+}
+
+struct Session {
+  IgRunReport report;
+  HostLog host;
+};
+
+Session runSession(const IgRunOptions& options, uint64_t hostFrames, double appear) {
+  Result<std::unique_ptr<IgLoop>> loop = IgLoop::create(config(), options);
+  EXPECT_TRUE(loop.ok()) << loop.error().str();
+  Session s;
+  std::optional<Result<IgRunReport>> report;
+  std::thread ig([&] { report.emplace(loop.value()->run()); });
+  Result<HostLog> host = runHost(script(loop.value()->port(), hostFrames, appear));
+  loop.value()->stop();
+  ig.join();
+  EXPECT_TRUE(host.ok()) << host.error().str();
+  EXPECT_TRUE(report->ok()) << report->error().str();
+  if (host.ok()) s.host = host.value();
+  if (report->ok()) s.report = report->value();
+  return s;
+}
+
+TEST(IgLoop, HostDrivenEntitiesAppearInTheNextFrameAndTheSessionReplaysBitForBit) {
+  const fs::path frames = freshDir("frames"), again = freshDir("replay");
+  const fs::path capture = frames / "session.pcap";
+  IgRunOptions options;
+  options.output = "png:" + frames.string();
+  options.record = capture.string();
+  const Session s = runSession(options, 30, 0.3);
+  EXPECT_EQ(s.host.framesSent, 30u);
+  EXPECT_GE(s.host.startOfFrames, 31u);
+  // The height the host asked for, answered from the terrain.
+  ASSERT_EQ(s.host.heights.size(), 1u);
+  EXPECT_EQ(s.host.heights[0].id, 21);
+  EXPECT_TRUE(s.host.heights[0].valid);
+  EXPECT_GT(s.host.heights[0].height, 0);
+
+  // The recording: each frame's host datagrams, then that frame's Start of Frame.
+  Result<std::vector<cigi::CapturedDatagram>> rec = cigi::readPcap(capture.string());
+  ASSERT_TRUE(rec.ok()) << rec.error().str();
+  uint32_t expectFrame = 0, appliedAt = 0, sentAfter = 0;
+  bool found = false;
+  uint32_t lastHostFrame = 0;
+  for (const cigi::CapturedDatagram& d : rec.value()) {
+    Result<cigi::Datagram> p = cigi::parseDatagram(d.bytes);
+    ASSERT_TRUE(p.ok()) << p.error().str();
+    if (!d.fromHost) {
+      const auto& sof = std::get<cigi::StartOfFrame>(p->packets.front());
+      EXPECT_EQ(sof.igFrame, expectFrame++);  // the counter advances a frame at a time
+      EXPECT_GE(sof.lastHostFrame, lastHostFrame);
+      lastHostFrame = sof.lastHostFrame;
+      continue;
+    }
+    if (found) continue;
+    for (const cigi::Packet& packet : p->packets)
+      if (const auto* e = std::get_if<cigi::EntityControl>(&packet); e && e->entity == 1) {
+        found = true;
+        appliedAt = expectFrame;  // the Start of Frame that follows is the frame it is drawn in
+        sentAfter = std::get<cigi::IgControl>(p->packets.front()).lastIgFrame;
+      }
+  }
+  ASSERT_TRUE(found);
+  ASSERT_GT(appliedAt, 0u);
+  EXPECT_LE(appliedAt - sentAfter, 1u) << "latency in frames";
+  EXPECT_EQ(redPixels(frameImage(frames, appliedAt - 1)), 0u);
+  EXPECT_GT(redPixels(frameImage(frames, appliedAt)), 200u);
+
+  // Replayed from the capture, as fast as it renders: the same frames, byte for byte.
+  IgRunOptions replay;
+  replay.output = "png:" + again.string();
+  replay.replay = capture.string();
+  replay.realtime = false;
+  Result<std::unique_ptr<IgLoop>> loop = IgLoop::create(config(), replay);
+  ASSERT_TRUE(loop.ok()) << loop.error().str();
+  Result<IgRunReport> r = loop.value()->run();
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  EXPECT_EQ(r->frames, uint64_t(expectFrame));
+  for (uint32_t f = 0; f < expectFrame; ++f) {
+    const Image a = frameImage(frames, f), b = frameImage(again, f);
+    ASSERT_EQ(a.rgb, b.rgb) << "frame " << f;
+  }
+  fs::remove_all(frames);
+  fs::remove_all(again);
+}
+
+TEST(IgLoop, BadDatagramsAreCountedAndDroppedAndTheLoopKeepsItsRate) {
+  IgConfig c = config();
+  IgRunOptions options;
+  options.frames = 40;
+  Result<std::unique_ptr<IgLoop>> loop = IgLoop::create(c, options);
+  ASSERT_TRUE(loop.ok()) << loop.error().str();
+  std::optional<Result<IgRunReport>> report;
+  std::thread ig([&] { report.emplace(loop.value()->run()); });
+  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+  sockaddr_in to{};
+  to.sin_family = AF_INET;
+  to.sin_port = htons(loop.value()->port());
+  to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  auto send = [&](const std::vector<uint8_t>& b) {
+    ::sendto(fd, b.data(), b.size(), 0, reinterpret_cast<sockaddr*>(&to), sizeof to);
+  };
+  std::mt19937 rng(5);
+  const std::vector<uint8_t> good = cigi::writeDatagram(std::vector<cigi::Packet>{cigi::IgControl{}});
+  size_t malformed = 0;
+  for (int i = 0; i < 50; ++i) {
+    std::vector<uint8_t> junk(1 + rng() % 200);
+    for (uint8_t& b : junk) b = uint8_t(rng());
+    junk[0] = uint8_t(2 + rng() % 200);  // never an IG Control first
+    send(junk);
+    ++malformed;
+    std::vector<uint8_t> truncated(good.begin(), good.begin() + std::ptrdiff_t(rng() % good.size()));
+    send(truncated);
+    ++malformed;
+    std::vector<uint8_t> version = good;
+    version[2] = 2;  // CIGI 2
+    send(version);
+    ++malformed;
+  }
+  // Well-formed datagrams with an unknown packet and an entity out of range: not malformed.
+  std::vector<uint8_t> unknown = good;
+  unknown.insert(unknown.end(), {200, 8, 0, 0, 0, 0, 0, 0});
+  send(unknown);
+  cigi::EntityControl far;
+  far.entity = 65000;
+  send(cigi::writeDatagram(std::vector<cigi::Packet>{cigi::IgControl{}, far}));
+  ::close(fd);
+  ig.join();
+  ASSERT_TRUE(report->ok()) << report->error().str();
+  EXPECT_EQ(report->value().frames, 40u);
+  EXPECT_EQ(report->value().malformed, malformed);
+  EXPECT_EQ(report->value().rejected, 1u);
+  EXPECT_EQ(report->value().datagrams, 2u);
+}
+
+TEST(IgLoop, OverloadProtectionHoldsTheRateOfATooHeavyScene) {
+  // Full quality (16 samples, 480×360): first its frame time, ungoverned, as fast as it goes.
+  IgConfig c = config();
+  c.render.samples = 16;
+  c.channels[0].width = 480;
+  c.channels[0].height = 360;
+  IgRunOptions probe;
+  probe.frames = 8;
+  probe.realtime = false;
+  probe.governor = false;
+  Result<std::unique_ptr<IgLoop>> first = IgLoop::create(c, probe);
+  ASSERT_TRUE(first.ok()) << first.error().str();
+  Result<IgRunReport> full = first.value()->run();
+  ASSERT_TRUE(full.ok());
+  // A rate whose deadline is half that: the scene needs twice the budget at full quality.
+  c.rate = 1000 / (full->frameMsP50 / (2 * c.deadline));
+  IgRunOptions run;
+  run.frames = 200;
+  Result<std::unique_ptr<IgLoop>> loop = IgLoop::create(c, run);
+  ASSERT_TRUE(loop.ok()) << loop.error().str();
+  Result<IgRunReport> r = loop.value()->run();
+  ASSERT_TRUE(r.ok());
+  const double budget = 1000 / c.rate * c.deadline;
+  EXPECT_GT(r->degraded, 150u) << r->summary();
+  EXPECT_LE(r->frameMsP99, budget) << r->summary();
+  EXPECT_LE(r->missed, 2u) << r->summary();
+}
+
+}  // namespace
+}  // namespace sv::ig

@@ -1,0 +1,261 @@
+// The IG's state (ig/world.h): what each host packet does to the next frame's scene, and the
+// answers to height and line-of-sight requests against the terrain query and the polygons.
+#include "ig/world.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+
+#include "ig/config.h"
+#include "ig/geo.h"
+#include "ig/overload.h"
+#include "synthvis/terrain.h"
+
+namespace sv::ig {
+namespace {
+
+const std::string kConfig = std::string(SV_TEST_DATA_DIR) + "/ig/ig.json";
+
+IgWorld loadWorld() {
+  Result<IgConfig> c = loadIgConfig(kConfig);
+  EXPECT_TRUE(c.ok()) << c.error().str();
+  Result<IgWorld> w = IgWorld::load(c.value());
+  EXPECT_TRUE(w.ok()) << w.error().str();
+  return std::move(w.value());
+}
+
+std::vector<cigi::Packet> apply(IgWorld& w, std::vector<cigi::Packet> packets) {
+  cigi::Datagram d;
+  d.packets.push_back(cigi::IgControl{});
+  d.packets.insert(d.packets.end(), packets.begin(), packets.end());
+  std::vector<cigi::Packet> replies;
+  w.apply(d, replies);
+  return replies;
+}
+
+TEST(IgGeo, GeodeticPositionsRoundTripAndHeadingsPointTheWayTheySay) {
+  const GeoOrigin o{45, 7, 100};
+  const DVec3 w = geodeticToWorld(o, 45.01, 7.02, 350);
+  EXPECT_NEAR(-w.z, 0.01 * std::numbers::pi / 180 * kEarthRadius, 1e-6);  // north is −z
+  EXPECT_GT(w.x, 0);                                                      // east is +x
+  EXPECT_DOUBLE_EQ(w.y, 250);
+  const DVec3 g = worldToGeodetic(o, w);
+  EXPECT_NEAR(g.x, 45.01, 1e-12);
+  EXPECT_NEAR(g.y, 7.02, 1e-12);
+  EXPECT_NEAR(g.z, 350, 1e-9);
+  // Heading 90°: forward is east; pitch 90°: forward is up; roll 90° (right wing down): right
+  // points down.
+  const Frame3 east = eulerFrame(levelFrame(), 90, 0, 0);
+  EXPECT_NEAR(east.forward.x, 1, 1e-12);
+  EXPECT_NEAR(east.right.z, 1, 1e-12);  // right of east-facing is south (+z)
+  EXPECT_NEAR(eulerFrame(levelFrame(), 0, 90, 0).forward.y, 1, 1e-12);
+  EXPECT_NEAR(eulerFrame(levelFrame(), 0, 0, 90).right.y, -1, 1e-12);
+}
+
+TEST(IgConfig, MalformedConfigurationsGetAClearError) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"{", "malformed JSON"},
+      {R"({"scene": "db.json"})", "\"synthvis-ig\": 1 expected"},
+      {R"({"synthvis-ig": 1})", "\"scene\""},
+      {R"({"synthvis-ig": 1, "scene": "a.json", "rate": 1000})", "rate: 1000 is outside"},
+      {R"({"synthvis-ig": 1, "scene": "a.json", "models": {"x": "m.json"}})", "not an entity type"},
+      {R"({"synthvis-ig": 1, "scene": "a.json", "render": {"aa": 3}})", "render.aa"},
+      {R"({"synthvis-ig": 1, "scene": "a.json", "colour": 1})", "unknown field \"colour\""},
+  };
+  for (const auto& [text, message] : cases) {
+    Result<IgConfig> c = parseIgConfig(text, "ig.json");
+    ASSERT_FALSE(c.ok()) << text;
+    EXPECT_NE(c.error().str().find(message), std::string::npos) << c.error().str();
+    EXPECT_EQ(c.error().file, "ig.json");
+  }
+}
+
+TEST(IgWorld, AnEntityAppearsWithItsModelAtItsPoseAndGoesWhenDestroyed) {
+  IgWorld w = loadWorld();
+  const size_t base = w.frameScene(0).instances.size();
+  cigi::EntityControl e;
+  e.entity = 3;
+  e.type = 7;
+  e.latOrX = 45.001;
+  e.lonOrY = 7;
+  e.altOrZ = 60;
+  e.yaw = 90;
+  apply(w, {e});
+  const scene::Scene& s = w.frameScene(0);
+  ASSERT_EQ(s.instances.size(), base + 1);
+  const Mat4& m = s.instances.back().transform;
+  const DVec3 at = geodeticToWorld(w.config().origin, 45.001, 7, 60);
+  EXPECT_NEAR(m.m[3][0], at.x, 1e-3);
+  EXPECT_NEAR(m.m[3][1], 60, 1e-3);
+  EXPECT_NEAR(m.m[3][2], at.z, 1e-2);
+  // The model's front (+z) faces the heading, east.
+  EXPECT_NEAR(m.transformDirection({0, 0, 1}).x, 1, 1e-6);
+  // An entity attached to it, 10 m ahead in its body axes.
+  cigi::EntityControl child;
+  child.entity = 4;
+  child.type = 7;
+  child.attached = true;
+  child.parent = 3;
+  child.latOrX = 10;
+  apply(w, {child});
+  EXPECT_NEAR(w.frameScene(0).instances.back().transform.m[3][0], at.x + 10, 1e-3);
+  e.state = cigi::EntityState::destroyed;
+  apply(w, {e});
+  EXPECT_EQ(w.frameScene(0).instances.size(), base);  // the child goes with its parent's pose
+  EXPECT_EQ(w.activeEntities(), 1u);
+}
+
+TEST(IgWorld, OutOfRangeAndNonFinitePacketsAreRejectedAndChangeNothing) {
+  IgWorld w = loadWorld();
+  const size_t base = w.frameScene(0).instances.size();
+  cigi::EntityControl far;
+  far.entity = 60000;  // past maxEntities
+  far.type = 7;
+  cigi::EntityControl nan;
+  nan.entity = 1;
+  nan.type = 7;
+  nan.latOrX = std::nan("");
+  cigi::ViewDefinition badView;
+  badView.view = 9;
+  cigi::ComponentControl badGroup;
+  badGroup.componentClass = cigi::ComponentClass::system;
+  badGroup.component = 5;
+  apply(w, {far, nan, badView, badGroup});
+  EXPECT_EQ(w.counts().rejected, 4u);
+  EXPECT_EQ(w.frameScene(0).instances.size(), base);
+}
+
+TEST(IgWorld, LightGroupsSwitchAndDimAndVisibilityBecomesFog) {
+  IgWorld w = loadWorld();
+  ASSERT_EQ(w.frameScene(0).lightGroups.size(), 1u);
+  EXPECT_TRUE(w.frameScene(0).lightGroups[0].on);
+  cigi::ComponentControl off;
+  off.componentClass = cigi::ComponentClass::system;
+  off.component = 0;
+  off.state = 0;
+  apply(w, {off});
+  EXPECT_FALSE(w.frameScene(0).lightGroups[0].on);
+  cigi::ComponentControl dim = off;
+  dim.state = 2;
+  const float half = 0.5f;
+  std::memcpy(&dim.data[0], &half, sizeof half);
+  apply(w, {dim});
+  EXPECT_TRUE(w.frameScene(0).lightGroups[0].on);
+  EXPECT_FLOAT_EQ(w.frameScene(0).lightGroups[0].dim, 0.5f);
+
+  EXPECT_FALSE(w.frameScene(0).fog.enabled);
+  cigi::AtmosphereControl a;
+  a.visibility = 2000;
+  apply(w, {a});
+  const scene::Fog& fog = w.frameScene(0).fog;
+  EXPECT_TRUE(fog.enabled);
+  // 5 % contrast left at the visibility: 2^(−β·V) = 0.05.
+  EXPECT_NEAR(std::exp2(-fog.beta * 2000), 0.05, 1e-6);
+  cigi::WeatherControl wc;
+  wc.enabled = true;
+  wc.visibility = 500;  // the nearer of the two
+  apply(w, {wc});
+  EXPECT_NEAR(std::exp2(-w.frameScene(0).fog.beta * 500), 0.05, 1e-6);
+}
+
+TEST(IgWorld, HeightsAnswerFromTheTerrainQueryAndThePolygons) {
+  IgWorld w = loadWorld();
+  const GeoOrigin& o = w.config().origin;
+  // Over open ground: the terrain query's own answer.
+  const DVec3 p{30, 100, -150};
+  const std::optional<TerrainHeight> t = terrainHeight(w.database(), p.x, p.y, p.z);
+  ASSERT_TRUE(t.has_value());
+  const DVec3 g = worldToGeodetic(o, p);
+  cigi::HatHotRequest hat;
+  hat.id = 11;
+  hat.latOrX = g.x;
+  hat.lonOrY = g.y;
+  hat.altOrZ = g.z;
+  cigi::HatHotRequest hot = hat;
+  hot.id = 12;
+  hot.type = cigi::HatHotType::hot;
+  // On the tower (80 m tall at x −40, z −250): its roof.
+  const DVec3 roof = worldToGeodetic(o, {-40, 100, -250});
+  cigi::HatHotRequest tower = hat;
+  tower.id = 13;
+  tower.latOrX = roof.x;
+  tower.lonOrY = roof.y;
+  // Off the database: no ground.
+  cigi::HatHotRequest off = hat;
+  off.id = 14;
+  off.latOrX = 46;
+  const std::vector<cigi::Packet> r = apply(w, {hat, hot, tower, off});
+  ASSERT_EQ(r.size(), 4u);
+  const auto& a = std::get<cigi::HatHotResponse>(r[0]);
+  EXPECT_EQ(a.id, 11);
+  EXPECT_TRUE(a.valid);
+  EXPECT_FALSE(a.hot);
+  EXPECT_NEAR(a.height, t->above, 1e-6);
+  const auto& b = std::get<cigi::HatHotResponse>(r[1]);
+  EXPECT_TRUE(b.hot);
+  EXPECT_NEAR(b.height, p.y - t->above + o.alt, 1e-6);
+  EXPECT_NEAR(std::get<cigi::HatHotResponse>(r[2]).height, 100 - 80, 1e-3);
+  EXPECT_FALSE(std::get<cigi::HatHotResponse>(r[3]).valid);
+}
+
+TEST(IgWorld, LinesOfSightStopAtTheTowerAndTheGround) {
+  IgWorld w = loadWorld();
+  const GeoOrigin& o = w.config().origin;
+  auto geo = [&](DVec3 p) { return worldToGeodetic(o, p); };
+  cigi::LosSegmentRequest through;
+  through.id = 5;
+  const DVec3 a = geo({-40, 50, -150}), b = geo({-40, 50, -350});  // through the tower
+  std::memcpy(through.source, &a, sizeof through.source);
+  std::memcpy(through.destination, &b, sizeof through.destination);
+  cigi::LosSegmentRequest clear = through;
+  clear.id = 6;
+  const DVec3 c = geo({40, 200, -150}), d = geo({40, 200, -350});  // above everything
+  std::memcpy(clear.source, &c, sizeof clear.source);
+  std::memcpy(clear.destination, &d, sizeof clear.destination);
+  const std::vector<cigi::Packet> r = apply(w, {through, clear});
+  ASSERT_EQ(r.size(), 2u);
+  const auto& blocked = std::get<cigi::LosResponse>(r[0]);
+  EXPECT_TRUE(blocked.valid);
+  EXPECT_FALSE(blocked.visible);
+  EXPECT_NEAR(blocked.range, 95, 0.05);  // the tower's near face at z −245
+  const auto& open = std::get<cigi::LosResponse>(r[1]);
+  EXPECT_FALSE(open.valid);
+  EXPECT_TRUE(open.visible);
+}
+
+TEST(IgOverload, StepsDownWhenOverrunAndBackUpWithHysteresis) {
+  RenderOptions full;
+  full.samples = 16;
+  const std::vector<QualityLevel> levels = qualityLevels(full);
+  // aa 8, aa 4, aa 1, bilinear textures, no stars, bilinear terrain.
+  ASSERT_EQ(levels.size(), 7u);
+  EXPECT_EQ(levels[1].options.samples, 8);
+  EXPECT_EQ(levels[3].options.samples, 1);
+  EXPECT_FALSE(levels[5].stars);
+  OverloadGovernor g(levels, 10.0, 5);
+  // The frame's cost: 24 ms at full quality, halving with each anti-aliasing step.
+  auto cost = [&](int level) { return 24.0 / (1 << std::min(level, 3)); };
+  EXPECT_EQ(g.choose(1000), 0);  // nothing measured yet
+  g.record(0, 1000, cost(0));    // overran: down at once
+  EXPECT_GE(g.level(), 1);
+  int level = 0;
+  for (int f = 0; f < 20; ++f) {
+    level = g.choose(1000);
+    g.record(level, 1000, cost(level));
+    EXPECT_LE(level, 3);
+  }
+  EXPECT_EQ(level, 2);  // the first that fits 10 ms: aa 4's 6 ms (aa 8 takes 12)
+  // The load falls to 30 % (the work a frame draws): back up, one level per hold, to full
+  // quality (7.2 ms, within three quarters of the budget).
+  std::vector<int> seen;
+  for (int f = 0; f < 40; ++f) {
+    level = g.choose(300);
+    g.record(level, 300, cost(level) * 0.3);
+    if (seen.empty() || seen.back() != level) seen.push_back(level);
+  }
+  EXPECT_EQ(seen, (std::vector<int>{2, 1, 0}));
+}
+
+}  // namespace
+}  // namespace sv::ig
