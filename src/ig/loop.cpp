@@ -20,7 +20,9 @@
 #include "cigi/pcap.h"
 #include "ig/overload.h"
 #include "ig/world.h"
-#include "present/presenter.h"
+#include "present/overlay.h"
+#include "present/present.h"
+#include "present/test_patterns.h"
 #include "synthvis/render.h"
 
 namespace sv::ig {
@@ -103,9 +105,9 @@ struct IgLoop::Impl {
     if (ownsStatus && status) std::fclose(status);
   }
 
-  Renderer& rendererFor(int level, const RenderOptions& options) {
+  Renderer& rendererFor(int level, const RenderOptions& quality) {
     std::unique_ptr<Renderer>& r = renderers[level];
-    if (!r) r = std::make_unique<Renderer>(options);
+    if (!r) r = std::make_unique<Renderer>(quality);
     return *r;
   }
 
@@ -299,6 +301,9 @@ Result<IgRunReport> IgLoop::run() {
       present::drawOverlay(images[0], lines);
     }
     if (Status s = m.presenter->present({frame, images, names}); !s) return s.error();
+    // Not bound to a rate, the loop waits for the writer instead of letting it drop frames.
+    if (!m.options.realtime)
+      if (Status s = m.presenter->flush(); !s) return s.error();
     const Clock::time_point end = Clock::now();
     const double ms = msBetween(start, end);
     if (!pattern) governor.record(level, work, renderMs);
@@ -330,6 +335,8 @@ Result<IgRunReport> IgLoop::run() {
     }
     if (m.presenter->closed()) break;
   }
+  if (Status s = m.presenter->flush(); !s) return s.error();
+  report.dropped = m.presenter->dropped();
   report.frameMsP50 = percentile(frameMs, 0.5);
   report.frameMsP99 = percentile(frameMs, 0.99);
   report.frameMsMax = frameMs.empty() ? 0 : *std::max_element(frameMs.begin(), frameMs.end());
@@ -350,10 +357,10 @@ std::string IgRunReport::summary() const {
       "frame time p50 {:.2f} ms, p99 {:.2f} ms, max {:.2f} ms; period p50 {:.2f} ms, p99 {:.2f} ms "
       "(jitter {:.2f} ms)\n"
       "loop overhead (receive, update, answer, present) {:.3f} ms a frame\n"
-      "host datagrams {}, malformed {}, packets rejected {}",
+      "host datagrams {}, malformed {}, packets rejected {}; frames the output dropped {}",
       frames, missed, overruns, degraded, worstLevel, frameMsP50, frameMsP99, frameMsMax,
       periodMsP50, periodMsP99, periodMsP99 - periodMsP50, loopMsMean, datagrams, malformed,
-      rejected);
+      rejected, dropped);
 }
 
 }  // namespace sv::ig

@@ -42,6 +42,7 @@ struct IgRunReport {
   double periodMsP50 = 0, periodMsP99 = 0;                // from one frame's start to the next's
   double loopMsMean = 0;  // receive, update, answer and present: everything but the render
   uint64_t datagrams = 0, malformed = 0, rejected = 0;
+  uint64_t dropped = 0;  // frames a file output could not keep up with (present/present.h)
   std::string summary() const;  // several lines, for the terminal and the closing notes
 };
 

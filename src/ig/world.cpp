@@ -105,142 +105,142 @@ void IgWorld::apply(const cigi::Datagram& datagram, std::vector<cigi::Packet>& r
 void IgWorld::applyPacket(const cigi::Packet& packet, std::vector<cigi::Packet>& replies) {
   using namespace cigi;
   const uint8_t lsn = uint8_t(lastHostFrame_ & 0xF);
-  if (const auto* p = std::get_if<IgControl>(&packet)) {
-    mode_ = p->mode;
-    extrapolation_ = p->extrapolation;
-    lastHostFrame_ = p->hostFrame;
-    if (p->mode == IgMode::reset)
+  if (const auto* ig = std::get_if<IgControl>(&packet)) {
+    mode_ = ig->mode;
+    extrapolation_ = ig->extrapolation;
+    lastHostFrame_ = ig->hostFrame;
+    if (ig->mode == IgMode::reset)
       for (Entity& e : entities_) e = Entity{};
-  } else if (const auto* p = std::get_if<EntityControl>(&packet)) {
-    const double v[3] = {p->latOrX, p->lonOrY, p->altOrZ};
-    if (p->entity >= entities_.size() || !finite3(v) || !std::isfinite(p->roll) ||
-        !std::isfinite(p->pitch) || !std::isfinite(p->yaw) ||
-        (p->attached && (p->parent >= entities_.size() || p->parent == p->entity))) {
+  } else if (const auto* ec = std::get_if<EntityControl>(&packet)) {
+    const double v[3] = {ec->latOrX, ec->lonOrY, ec->altOrZ};
+    if (ec->entity >= entities_.size() || !finite3(v) || !std::isfinite(ec->roll) ||
+        !std::isfinite(ec->pitch) || !std::isfinite(ec->yaw) ||
+        (ec->attached && (ec->parent >= entities_.size() || ec->parent == ec->entity))) {
       ++counts_.rejected;
       return;
     }
-    Entity& e = entities_[p->entity];
-    if (p->state == EntityState::destroyed) {
+    Entity& e = entities_[ec->entity];
+    if (ec->state == EntityState::destroyed) {
       e = Entity{};
       return;
     }
-    if (!e.exists || e.control.type != p->type) {
+    if (!e.exists || e.control.type != ec->type) {
       e.model = -1;
       for (size_t m = 0; m < modelTypes_.size(); ++m)
-        if (modelTypes_[m] == p->type) e.model = int(m);
+        if (modelTypes_[m] == ec->type) e.model = int(m);
       e.hasRate = false;
     }
     e.exists = true;
-    e.control = *p;
+    e.control = *ec;
     e.hasRate = false;  // a new pose from the host ends the extrapolation from the old one
-  } else if (const auto* p = std::get_if<ComponentControl>(&packet)) {
-    if (p->componentClass == ComponentClass::system) {
+  } else if (const auto* cc = std::get_if<ComponentControl>(&packet)) {
+    if (cc->componentClass == ComponentClass::system) {
       // Light groups (docs/ig.md): component ID = the group's index, state 0 off, 1 on, 2 on and
       // dimmed to data[0] read as an IEEE float (0 … 1).
-      if (p->component >= base_.lightGroups.size()) {
+      if (cc->component >= base_.lightGroups.size()) {
         ++counts_.rejected;
         return;
       }
-      scene::LightGroup& g = frame_.lightGroups[p->component];
-      g.on = p->state != 0;
+      scene::LightGroup& g = frame_.lightGroups[cc->component];
+      g.on = cc->state != 0;
       g.dim = 1;
-      if (p->state == 2) {
+      if (cc->state == 2) {
         float dim;
-        std::memcpy(&dim, &p->data[0], sizeof dim);
+        std::memcpy(&dim, &cc->data[0], sizeof dim);
         if (!(dim >= 0 && dim <= 1)) {
           ++counts_.rejected;
           return;
         }
         g.dim = dim;
       }
-    } else if (p->componentClass == ComponentClass::entity) {
+    } else if (cc->componentClass == ComponentClass::entity) {
       // An entity switch: component 0 of entity `instance`, state 0 hidden, 1 shown.
-      if (p->instance >= entities_.size() || p->component != 0) {
+      if (cc->instance >= entities_.size() || cc->component != 0) {
         ++counts_.rejected;
         return;
       }
-      entities_[p->instance].visible = p->state != 0;
+      entities_[cc->instance].visible = cc->state != 0;
     } else {
       ++counts_.skipped;
     }
-  } else if (const auto* p = std::get_if<RateControl>(&packet)) {
-    const float r[6] = {p->x, p->y, p->z, p->roll, p->pitch, p->yaw};
+  } else if (const auto* rc = std::get_if<RateControl>(&packet)) {
+    const float r[6] = {rc->x, rc->y, rc->z, rc->roll, rc->pitch, rc->yaw};
     const bool finite = std::all_of(r, r + 6, [](float x) { return std::isfinite(x); });
-    if (p->entity >= entities_.size() || !entities_[p->entity].exists || !finite) {
+    if (rc->entity >= entities_.size() || !entities_[rc->entity].exists || !finite) {
       ++counts_.rejected;
       return;
     }
-    if (p->applyToPart) {
+    if (rc->applyToPart) {
       ++counts_.skipped;  // articulated parts: not modelled
       return;
     }
-    entities_[p->entity].rate = *p;
-    entities_[p->entity].hasRate = true;
-  } else if (const auto* p = std::get_if<CelestialSphereControl>(&packet)) {
-    if (p->hour > 23 || p->minute > 59 || !std::isfinite(p->starIntensity)) {
+    entities_[rc->entity].rate = *rc;
+    entities_[rc->entity].hasRate = true;
+  } else if (const auto* cs = std::get_if<CelestialSphereControl>(&packet)) {
+    if (cs->hour > 23 || cs->minute > 59 || !std::isfinite(cs->starIntensity)) {
       ++counts_.rejected;
       return;
     }
-    celestial_ = *p;
+    celestial_ = *cs;
     timeOfDay_ = true;
-  } else if (const auto* p = std::get_if<AtmosphereControl>(&packet)) {
-    if (!std::isfinite(p->visibility) || p->visibility < 0) {
+  } else if (const auto* ac = std::get_if<AtmosphereControl>(&packet)) {
+    if (!std::isfinite(ac->visibility) || ac->visibility < 0) {
       ++counts_.rejected;
       return;
     }
-    atmosphereVisibility_ = p->visibility;
-  } else if (const auto* p = std::get_if<WeatherControl>(&packet)) {
-    if (!std::isfinite(p->visibility) || p->visibility < 0) {
+    atmosphereVisibility_ = ac->visibility;
+  } else if (const auto* wc = std::get_if<WeatherControl>(&packet)) {
+    if (!std::isfinite(wc->visibility) || wc->visibility < 0) {
       ++counts_.rejected;
       return;
     }
     // Global weather (scope 0) sets the visibility; regional and entity weather are not modelled.
-    if (p->scope == 0) weatherVisibility_ = p->enabled ? p->visibility : 0;
+    if (wc->scope == 0) weatherVisibility_ = wc->enabled ? wc->visibility : 0;
     else ++counts_.skipped;
-  } else if (const auto* p = std::get_if<ViewControl>(&packet)) {
-    const float v[6] = {p->x, p->y, p->z, p->roll, p->pitch, p->yaw};
-    if (p->view >= views_.size() || p->entity >= entities_.size() ||
+  } else if (const auto* vc = std::get_if<ViewControl>(&packet)) {
+    const float v[6] = {vc->x, vc->y, vc->z, vc->roll, vc->pitch, vc->yaw};
+    if (vc->view >= views_.size() || vc->entity >= entities_.size() ||
         !std::all_of(v, v + 6, [](float x) { return std::isfinite(x); })) {
       ++counts_.rejected;
       return;
     }
-    views_[p->view].controlled = true;
-    views_[p->view].control = *p;
-  } else if (const auto* p = std::get_if<ViewDefinition>(&packet)) {
-    const float v[6] = {p->nearPlane, p->farPlane, p->left, p->right, p->top, p->bottom};
+    views_[vc->view].controlled = true;
+    views_[vc->view].control = *vc;
+  } else if (const auto* vd = std::get_if<ViewDefinition>(&packet)) {
+    const float v[6] = {vd->nearPlane, vd->farPlane, vd->left, vd->right, vd->top, vd->bottom};
     const bool ok = std::all_of(v, v + 6, [](float x) { return std::isfinite(x); }) &&
-                    p->left < p->right && p->bottom < p->top && p->left > -90 &&
-                    p->right < 90 && p->bottom > -90 && p->top < 90 && p->nearPlane > 0 &&
-                    p->farPlane > p->nearPlane;
-    if (p->view >= views_.size() || !ok) {
+                    vd->left < vd->right && vd->bottom < vd->top && vd->left > -90 &&
+                    vd->right < 90 && vd->bottom > -90 && vd->top < 90 && vd->nearPlane > 0 &&
+                    vd->farPlane > vd->nearPlane;
+    if (vd->view >= views_.size() || !ok) {
       ++counts_.rejected;
       return;
     }
-    views_[p->view].defined = true;
-    views_[p->view].definition = *p;
-  } else if (const auto* p = std::get_if<HatHotRequest>(&packet)) {
+    views_[vd->view].defined = true;
+    views_[vd->view].definition = *vd;
+  } else if (const auto* hr = std::get_if<HatHotRequest>(&packet)) {
     ++counts_.hatRequests;
-    const double q[3] = {p->latOrX, p->lonOrY, p->altOrZ};
+    const double q[3] = {hr->latOrX, hr->lonOrY, hr->altOrZ};
     bool ok = false;
-    const DVec3 w = requestPoint(p->entityCoordinates, p->entity, q, ok);
+    const DVec3 w = requestPoint(hr->entityCoordinates, hr->entity, q, ok);
     HatHotResponse r;
-    r.id = p->id;
+    r.id = hr->id;
     r.hostFrameLsn = lsn;
     // A HOT asks for the ground under the point; a HAT for the point's height above it (an
     // extended request is answered as a HAT: the extended response is not implemented).
-    r.hot = p->type == HatHotType::hot;
+    r.hot = hr->type == HatHotType::hot;
     if (const std::optional<double> g = ok ? groundHeight(w) : std::nullopt) {
       r.valid = true;
       r.height = r.hot ? *g + config_.origin.alt : w.y - *g;
     }
     replies.push_back(r);
-  } else if (const auto* p = std::get_if<LosSegmentRequest>(&packet)) {
+  } else if (const auto* lr = std::get_if<LosSegmentRequest>(&packet)) {
     ++counts_.losRequests;
     bool okA = false, okB = false;
-    const DVec3 a = requestPoint(p->sourceEntityCoordinates, p->sourceEntity, p->source, okA);
-    const DVec3 b = requestPoint(p->destinationEntityCoordinates, p->sourceEntity, p->destination, okB);
+    const DVec3 a = requestPoint(lr->sourceEntityCoordinates, lr->sourceEntity, lr->source, okA);
+    const DVec3 b = requestPoint(lr->destinationEntityCoordinates, lr->sourceEntity, lr->destination, okB);
     LosResponse r;
-    r.id = p->id;
+    r.id = lr->id;
     r.hostFrameLsn = lsn;
     if (okA && okB) {
       const std::optional<double> t = segmentHit(a, b);
