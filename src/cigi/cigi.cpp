@@ -86,16 +86,26 @@ void run(const Io& io, size_t at, T&... fields) {
   ((io.word(at, fields), at += sizeof(T)), ...);
 }
 
-template <class Io>
-void layout(const Io& io, IgControl& p) {
+// IG Control and Start of Frame open a datagram alike: the major version at byte 2, the database
+// at 3, a flags byte (bits 0-1 the IG mode, bit 2 timestamp valid, bit 3 a flag of the packet's
+// own, bits 4-7 the minor version), the byte-swap magic at 6-7, and three 32-bit words from byte 8
+// (the sender's frame, the timestamp, the last frame it received).
+template <class Io, class P>
+void datagramHead(const Io& io, size_t flags, P& p, bool& bit3, uint32_t& frame,
+                  uint32_t& lastFrame) {
   io.fixed8(2, kMajorVersion);
   io.word(3, p.database);
-  io.bits(4, 0, 2, p.mode);
-  io.bits(4, 2, 1, p.timestampValid);
-  io.bits(4, 3, 1, p.extrapolation);
-  io.bits(4, 4, 4, p.minorVersion);
+  io.bits(flags, 0, 2, p.mode);
+  io.bits(flags, 2, 1, p.timestampValid);
+  io.bits(flags, 3, 1, bit3);
+  io.bits(flags, 4, 4, p.minorVersion);
   io.fixed16(6, kByteSwapMagic);
-  run(io, 8, p.hostFrame, p.timestamp, p.lastIgFrame);
+  run(io, 8, frame, p.timestamp, lastFrame);
+}
+
+template <class Io>
+void layout(const Io& io, IgControl& p) {
+  datagramHead(io, 4, p, p.extrapolation, p.hostFrame, p.lastIgFrame);
 }
 
 template <class Io>
@@ -218,14 +228,8 @@ void layout(const Io& io, LosSegmentRequest& p) {
 
 template <class Io>
 void layout(const Io& io, StartOfFrame& p) {
-  io.fixed8(2, kMajorVersion);
-  run(io, 3, p.database, p.igStatus);
-  io.bits(5, 0, 2, p.mode);
-  io.bits(5, 2, 1, p.timestampValid);
-  io.bits(5, 3, 1, p.earthReferenceModel);
-  io.bits(5, 4, 4, p.minorVersion);
-  io.fixed16(6, kByteSwapMagic);
-  run(io, 8, p.igFrame, p.timestamp, p.lastHostFrame);
+  datagramHead(io, 5, p, p.earthReferenceModel, p.igFrame, p.lastHostFrame);
+  io.word(4, p.igStatus);
 }
 
 template <class Io>
