@@ -79,18 +79,33 @@ class Encoder {
 // ---- The layouts (ICD 3.3 §4.1 host → IG, §4.2 IG → host) ------------------------------------
 // Offsets are from the packet's byte 0 (its ID); bytes 0-1 are written by writeDatagram.
 
-template <class Io>
-void layout(const Io& io, IgControl& p) {
+// Whole-byte fields that follow one another from byte `at` (each as long as its type: the ICD's
+// runs of floats and doubles).
+template <class Io, class... T>
+void run(const Io& io, size_t at, T&... fields) {
+  ((io.word(at, fields), at += sizeof(T)), ...);
+}
+
+// IG Control and Start of Frame open a datagram alike: the major version at byte 2, the database
+// at 3, a flags byte (bits 0-1 the IG mode, bit 2 timestamp valid, bit 3 a flag of the packet's
+// own, bits 4-7 the minor version), the byte-swap magic at 6-7, and three 32-bit words from byte 8
+// (the sender's frame, the timestamp, the last frame it received).
+template <class Io, class P>
+void datagramHead(const Io& io, size_t flags, P& p, bool& bit3, uint32_t& frame,
+                  uint32_t& lastFrame) {
   io.fixed8(2, kMajorVersion);
   io.word(3, p.database);
-  io.bits(4, 0, 2, p.mode);
-  io.bits(4, 2, 1, p.timestampValid);
-  io.bits(4, 3, 1, p.extrapolation);
-  io.bits(4, 4, 4, p.minorVersion);
+  io.bits(flags, 0, 2, p.mode);
+  io.bits(flags, 2, 1, p.timestampValid);
+  io.bits(flags, 3, 1, bit3);
+  io.bits(flags, 4, 4, p.minorVersion);
   io.fixed16(6, kByteSwapMagic);
-  io.word(8, p.hostFrame);
-  io.word(12, p.timestamp);
-  io.word(16, p.lastIgFrame);
+  run(io, 8, frame, p.timestamp, lastFrame);
+}
+
+template <class Io>
+void layout(const Io& io, IgControl& p) {
+  datagramHead(io, 4, p, p.extrapolation, p.hostFrame, p.lastIgFrame);
 }
 
 template <class Io>
@@ -104,21 +119,13 @@ void layout(const Io& io, EntityControl& p) {
   io.bits(5, 0, 4, p.animationFlags);
   io.bits(5, 4, 1, p.extrapolation);
   io.word(6, p.alpha);
-  io.word(8, p.type);
-  io.word(10, p.parent);
-  io.word(12, p.roll);
-  io.word(16, p.pitch);
-  io.word(20, p.yaw);
-  io.word(24, p.latOrX);
-  io.word(32, p.lonOrY);
-  io.word(40, p.altOrZ);
+  run(io, 8, p.type, p.parent, p.roll, p.pitch, p.yaw, p.latOrX, p.lonOrY, p.altOrZ);
 }
 
 // Component Control and Short Component Control: the same head, six or two data words.
 template <class Io>
 void layout(const Io& io, ComponentControl& p) {
-  io.word(2, p.component);
-  io.word(4, p.instance);
+  run(io, 2, p.component, p.instance);
   io.bits(6, 0, 6, p.componentClass);
   io.word(7, p.state);
   const int words = p.isShort ? 2 : 6;
@@ -134,37 +141,25 @@ void layout(const Io& io, RateControl& p) {
   bool local = !p.worldCoordinates;
   io.bits(5, 1, 1, local);
   p.worldCoordinates = !local;
-  io.word(8, p.x);
-  io.word(12, p.y);
-  io.word(16, p.z);
-  io.word(20, p.roll);
-  io.word(24, p.pitch);
-  io.word(28, p.yaw);
+  run(io, 8, p.x, p.y, p.z, p.roll, p.pitch, p.yaw);
 }
 
 template <class Io>
 void layout(const Io& io, CelestialSphereControl& p) {
-  io.word(2, p.hour);
-  io.word(3, p.minute);
+  run(io, 2, p.hour, p.minute);
   io.bits(4, 0, 1, p.ephemeris);
   io.bits(4, 1, 1, p.sun);
   io.bits(4, 2, 1, p.moon);
   io.bits(4, 3, 1, p.starField);
   io.bits(4, 4, 1, p.dateValid);
-  io.word(8, p.date);
-  io.word(12, p.starIntensity);
+  run(io, 8, p.date, p.starIntensity);
 }
 
 template <class Io>
 void layout(const Io& io, AtmosphereControl& p) {
   io.bits(2, 0, 1, p.modelEnabled);
-  io.word(3, p.humidity);
-  io.word(4, p.temperature);
-  io.word(8, p.visibility);
-  io.word(12, p.windHorizontal);
-  io.word(16, p.windVertical);
-  io.word(20, p.windDirection);
-  io.word(24, p.pressure);
+  run(io, 3, p.humidity, p.temperature, p.visibility, p.windHorizontal, p.windVertical,
+      p.windDirection, p.pressure);
 }
 
 template <class Io>
@@ -172,20 +167,12 @@ void layout(const Io& io, EnvironmentalRegionControl& p) {
   io.word(2, p.region);
   io.bits(4, 0, 2, p.state);
   io.bits(4, 2, 4, p.mergeFlags);
-  io.word(8, p.lat);
-  io.word(16, p.lon);
-  io.word(24, p.sizeX);
-  io.word(28, p.sizeY);
-  io.word(32, p.cornerRadius);
-  io.word(36, p.rotation);
-  io.word(40, p.transition);
+  run(io, 8, p.lat, p.lon, p.sizeX, p.sizeY, p.cornerRadius, p.rotation, p.transition);
 }
 
 template <class Io>
 void layout(const Io& io, WeatherControl& p) {
-  io.word(2, p.entityOrRegion);
-  io.word(4, p.layer);
-  io.word(5, p.humidity);
+  run(io, 2, p.entityOrRegion, p.layer, p.humidity);
   io.bits(6, 0, 1, p.enabled);
   io.bits(6, 1, 1, p.scud);
   io.bits(6, 2, 1, p.randomWinds);
@@ -193,50 +180,28 @@ void layout(const Io& io, WeatherControl& p) {
   io.bits(6, 4, 4, p.cloudType);
   io.bits(7, 0, 2, p.scope);
   io.bits(7, 2, 3, p.severity);
-  io.word(8, p.temperature);
-  io.word(12, p.visibility);
-  io.word(16, p.scudFrequency);
-  io.word(20, p.coverage);
-  io.word(24, p.baseElevation);
-  io.word(28, p.thickness);
-  io.word(32, p.transitionBand);
-  io.word(36, p.windHorizontal);
-  io.word(40, p.windVertical);
-  io.word(44, p.windDirection);
-  io.word(48, p.pressure);
-  io.word(52, p.aerosol);
+  run(io, 8, p.temperature, p.visibility, p.scudFrequency, p.coverage, p.baseElevation,
+      p.thickness, p.transitionBand, p.windHorizontal, p.windVertical, p.windDirection,
+      p.pressure, p.aerosol);
 }
 
 template <class Io>
 void layout(const Io& io, ViewControl& p) {
-  io.word(2, p.view);
-  io.word(4, p.group);
+  run(io, 2, p.view, p.group);
   io.bits(5, 0, 6, p.enable);
-  io.word(6, p.entity);
-  io.word(8, p.x);
-  io.word(12, p.y);
-  io.word(16, p.z);
-  io.word(20, p.roll);
-  io.word(24, p.pitch);
-  io.word(28, p.yaw);
+  run(io, 6, p.entity, p.x, p.y, p.z, p.roll, p.pitch, p.yaw);
 }
 
 template <class Io>
 void layout(const Io& io, ViewDefinition& p) {
-  io.word(2, p.view);
-  io.word(4, p.group);
+  run(io, 2, p.view, p.group);
   io.bits(5, 0, 6, p.enable);
   io.bits(5, 6, 2, p.mirror);
   io.bits(6, 0, 3, p.pixelReplication);
   io.bits(6, 3, 1, p.orthographic);
   io.bits(6, 4, 1, p.reorder);
   io.bits(6, 5, 3, p.viewType);
-  io.word(8, p.nearPlane);
-  io.word(12, p.farPlane);
-  io.word(16, p.left);
-  io.word(20, p.right);
-  io.word(24, p.top);
-  io.word(28, p.bottom);
+  run(io, 8, p.nearPlane, p.farPlane, p.left, p.right, p.top, p.bottom);
 }
 
 template <class Io>
@@ -244,11 +209,7 @@ void layout(const Io& io, HatHotRequest& p) {
   io.word(2, p.id);
   io.bits(4, 0, 2, p.type);
   io.bits(4, 2, 1, p.entityCoordinates);
-  io.word(5, p.updatePeriod);
-  io.word(6, p.entity);
-  io.word(8, p.latOrX);
-  io.word(16, p.lonOrY);
-  io.word(24, p.altOrZ);
+  run(io, 5, p.updatePeriod, p.entity, p.latOrX, p.lonOrY, p.altOrZ);
 }
 
 template <class Io>
@@ -259,28 +220,16 @@ void layout(const Io& io, LosSegmentRequest& p) {
   io.bits(4, 2, 1, p.destinationEntityCoordinates);
   io.bits(4, 3, 1, p.responseEntityCoordinates);
   io.bits(4, 4, 1, p.destinationEntityValid);
-  io.word(5, p.alphaThreshold);
-  io.word(6, p.sourceEntity);
-  for (size_t i = 0; i < 3; ++i) io.word(8 + 8 * i, p.source[i]);
-  for (size_t i = 0; i < 3; ++i) io.word(32 + 8 * i, p.destination[i]);
-  io.word(56, p.materialMask);
-  io.word(60, p.updatePeriod);
+  run(io, 5, p.alphaThreshold, p.sourceEntity);
+  run(io, 8, p.source[0], p.source[1], p.source[2], p.destination[0], p.destination[1],
+      p.destination[2], p.materialMask, p.updatePeriod);
   io.word(62, p.destinationEntity);
 }
 
 template <class Io>
 void layout(const Io& io, StartOfFrame& p) {
-  io.fixed8(2, kMajorVersion);
-  io.word(3, p.database);
+  datagramHead(io, 5, p, p.earthReferenceModel, p.igFrame, p.lastHostFrame);
   io.word(4, p.igStatus);
-  io.bits(5, 0, 2, p.mode);
-  io.bits(5, 2, 1, p.timestampValid);
-  io.bits(5, 3, 1, p.earthReferenceModel);
-  io.bits(5, 4, 4, p.minorVersion);
-  io.fixed16(6, kByteSwapMagic);
-  io.word(8, p.igFrame);
-  io.word(12, p.timestamp);
-  io.word(16, p.lastHostFrame);
 }
 
 template <class Io>
@@ -299,9 +248,7 @@ void layout(const Io& io, LosResponse& p) {
   io.bits(4, 1, 1, p.entityValid);
   io.bits(4, 2, 1, p.visible);
   io.bits(4, 4, 4, p.hostFrameLsn);
-  io.word(5, p.count);
-  io.word(6, p.entity);
-  io.word(8, p.range);
+  run(io, 5, p.count, p.entity, p.range);
 }
 
 template <class P>

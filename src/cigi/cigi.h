@@ -68,6 +68,8 @@ struct IgControl {  // 24 bytes; byte 2 the major version (3), bytes 6-7 the byt
   uint32_t hostFrame = 0;    // bytes 8-11
   uint32_t timestamp = 0;    // bytes 12-15, 10 µs ticks
   uint32_t lastIgFrame = 0;  // bytes 16-19
+
+  friend bool operator==(const IgControl&, const IgControl&) = default;
 };
 
 enum class EntityState : uint8_t { inactive = 0, active = 1, destroyed = 2 };
@@ -89,6 +91,8 @@ struct EntityControl {  // 48 bytes
   // Bytes 24-47. Top level: latitude, longitude (degrees), altitude (m); attached: x, y, z
   // offsets (m) in the parent's body frame (x forward, y right, z down).
   double latOrX = 0, lonOrY = 0, altOrZ = 0;
+
+  friend bool operator==(const EntityControl&, const EntityControl&) = default;
 };
 
 // Component Control (32 bytes, six data words) and Short Component Control (16 bytes, two). Both:
@@ -119,6 +123,8 @@ struct ComponentControl {
   ComponentClass componentClass = ComponentClass::entity;
   uint8_t state = 0;
   uint32_t data[6] = {};  // a short one carries data[0] and data[1]
+
+  friend bool operator==(const ComponentControl&, const ComponentControl&) = default;
 };
 
 struct RateControl {  // 32 bytes
@@ -130,6 +136,8 @@ struct RateControl {  // 32 bytes
   bool worldCoordinates = false;
   float x = 0, y = 0, z = 0;             // bytes 8-19, m/s
   float roll = 0, pitch = 0, yaw = 0;    // bytes 20-31, degrees/s
+
+  friend bool operator==(const RateControl&, const RateControl&) = default;
 };
 
 struct CelestialSphereControl {  // 16 bytes
@@ -138,6 +146,8 @@ struct CelestialSphereControl {  // 16 bytes
   bool ephemeris = false, sun = true, moon = false, starField = true, dateValid = false;
   uint32_t date = 0;  // bytes 8-11, MMDDYYYY as a decimal number
   float starIntensity = 100;  // bytes 12-15, percent
+
+  friend bool operator==(const CelestialSphereControl&, const CelestialSphereControl&) = default;
 };
 
 struct AtmosphereControl {  // 32 bytes
@@ -147,6 +157,8 @@ struct AtmosphereControl {  // 32 bytes
   float visibility = 1e5f;  // bytes 8-11, m
   float windHorizontal = 0, windVertical = 0, windDirection = 0;  // bytes 12-23, m/s, m/s, degrees
   float pressure = 1013.25f;  // bytes 24-27, mbar
+
+  friend bool operator==(const AtmosphereControl&, const AtmosphereControl&) = default;
 };
 
 struct EnvironmentalRegionControl {  // 48 bytes
@@ -158,6 +170,8 @@ struct EnvironmentalRegionControl {  // 48 bytes
   double lat = 0, lon = 0;  // bytes 8-23, degrees
   // Bytes 24-43: m, m, m, degrees, m (the transition perimeter).
   float sizeX = 0, sizeY = 0, cornerRadius = 0, rotation = 0, transition = 0;
+
+  friend bool operator==(const EnvironmentalRegionControl&, const EnvironmentalRegionControl&) = default;
 };
 
 struct WeatherControl {  // 56 bytes
@@ -173,6 +187,8 @@ struct WeatherControl {  // 56 bytes
   float baseElevation = 0, thickness = 0, transitionBand = 0;
   float windHorizontal = 0, windVertical = 0, windDirection = 0, pressure = 1013.25f,
         aerosol = 0;
+
+  friend bool operator==(const WeatherControl&, const WeatherControl&) = default;
 };
 
 struct ViewControl {  // 32 bytes
@@ -182,6 +198,8 @@ struct ViewControl {  // 32 bytes
   uint16_t entity = 0;  // bytes 6-7
   float x = 0, y = 0, z = 0;           // bytes 8-19, m, in the entity's body frame
   float roll = 0, pitch = 0, yaw = 0;  // bytes 20-31, degrees
+
+  friend bool operator==(const ViewControl&, const ViewControl&) = default;
 };
 
 struct ViewDefinition {  // 32 bytes
@@ -195,6 +213,8 @@ struct ViewDefinition {  // 32 bytes
   uint8_t viewType = 0;          // byte 6, bits 5-7
   float nearPlane = 0.1f, farPlane = 1e5f;  // bytes 8-15, m
   float left = -30, right = 30, top = 20, bottom = -20;  // bytes 16-31, half-angles, degrees
+
+  friend bool operator==(const ViewDefinition&, const ViewDefinition&) = default;
 };
 
 enum class HatHotType : uint8_t { hat = 0, hot = 1, extended = 2 };
@@ -205,6 +225,8 @@ struct HatHotRequest {  // 32 bytes
   uint8_t updatePeriod = 0;  // byte 5
   uint16_t entity = 0;       // bytes 6-7
   double latOrX = 0, lonOrY = 0, altOrZ = 0;  // bytes 8-31
+
+  friend bool operator==(const HatHotRequest&, const HatHotRequest&) = default;
 };
 
 struct LosSegmentRequest {  // 64 bytes
@@ -219,6 +241,8 @@ struct LosSegmentRequest {  // 64 bytes
   uint32_t materialMask = 0;  // bytes 56-59
   uint8_t updatePeriod = 0;   // byte 60
   uint16_t destinationEntity = 0;  // bytes 62-63
+
+  friend bool operator==(const LosSegmentRequest&, const LosSegmentRequest&) = default;
 };
 
 // ---- IG → host -----------------------------------------------------------------------------
@@ -233,6 +257,8 @@ struct StartOfFrame {  // 24 bytes; byte 2 the major version (3), bytes 6-7 the 
   uint32_t igFrame = 0;        // bytes 8-11
   uint32_t timestamp = 0;      // bytes 12-15, 10 µs ticks
   uint32_t lastHostFrame = 0;  // bytes 16-19
+
+  friend bool operator==(const StartOfFrame&, const StartOfFrame&) = default;
 };
 
 struct HatHotResponse {  // 16 bytes
@@ -241,6 +267,8 @@ struct HatHotResponse {  // 16 bytes
   bool hot = false;  // byte 4, bit 1, the type: height of terrain (true) or above it (false)
   uint8_t hostFrameLsn = 0;  // byte 4, bits 4-7: the host frame's four low bits
   double height = 0;  // bytes 8-15, m
+
+  friend bool operator==(const HatHotResponse&, const HatHotResponse&) = default;
 };
 
 struct LosResponse {  // 16 bytes
@@ -250,6 +278,8 @@ struct LosResponse {  // 16 bytes
   uint8_t count = 1;  // byte 5: responses to this request
   uint16_t entity = 0;  // bytes 6-7
   double range = 0;  // bytes 8-15, m
+
+  friend bool operator==(const LosResponse&, const LosResponse&) = default;
 };
 
 using Packet = std::variant<IgControl, EntityControl, ComponentControl, RateControl,
@@ -258,6 +288,7 @@ using Packet = std::variant<IgControl, EntityControl, ComponentControl, RateCont
                             ViewDefinition, HatHotRequest, LosSegmentRequest, StartOfFrame,
                             HatHotResponse, LosResponse>;
 
+// Every struct compares field by field (operator==), as the round-trip tests do.
 struct Datagram {
   std::vector<Packet> packets;  // in the order sent
   size_t skipped = 0;           // packets of IDs this codec does not decode, skipped by size
