@@ -298,7 +298,7 @@ Result<IgRunReport> IgLoop::run() {
           fmt::format("entities {}  datagrams {}  malformed {}  missed {}",
                       world.activeEntities(), world.counts().datagrams, world.counts().malformed,
                       report.missed)};
-      present::drawOverlay(images[0], lines);
+      present::drawOverlay(images[0], lines, std::max(1, images[0].height / 360));
     }
     if (Status s = m.presenter->present({frame, images, names}); !s) return s.error();
     // Not bound to a rate, the loop waits for the writer instead of letting it drop frames.

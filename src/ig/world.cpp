@@ -261,19 +261,22 @@ void IgWorld::advance(double dt) {
     if (!e.exists || !e.hasRate) continue;
     cigi::EntityControl& c = e.control;
     const cigi::RateControl& r = e.rate;
+    // The rates in the parent's axes (CIGI's "world/parent" coordinate system) or in the entity's
+    // own body axes ("local"), turned into the parent's.
+    const Frame3 parentAxes{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};  // forward, right, down as themselves
+    const DVec3 own = r.worldCoordinates
+                          ? DVec3{r.x, r.y, r.z}
+                          : eulerFrame(parentAxes, c.yaw, c.pitch, c.roll).apply({r.x, r.y, r.z});
     if (c.attached) {
-      // Offsets and rates both in the parent's body axes.
-      c.latOrX += r.x * dt;
-      c.lonOrY += r.y * dt;
-      c.altOrZ += r.z * dt;
+      // Offsets in the parent's body axes (forward, right, down).
+      c.latOrX += own.x * dt;
+      c.lonOrY += own.y * dt;
+      c.altOrZ += own.z * dt;
     } else {
-      // Rates in the entity's body axes, turned into north, east, down and then degrees.
-      const Frame3 f = eulerFrame(levelFrame(), c.yaw, c.pitch, c.roll);
-      const DVec3 v = f.apply({r.x, r.y, r.z});  // world: x east, y up, z south
-      const double north = -v.z * dt, east = v.x * dt, up = v.y * dt;
-      c.latOrX += north / (kEarthRadius * kRad);
-      c.lonOrY += east / (kEarthRadius * kRad * std::cos(config_.origin.lat * kRad));
-      c.altOrZ += up;
+      // North, east, down, into degrees and metres up.
+      c.latOrX += own.x * dt / (kEarthRadius * kRad);
+      c.lonOrY += own.y * dt / (kEarthRadius * kRad * std::cos(config_.origin.lat * kRad));
+      c.altOrZ -= own.z * dt;
     }
     c.roll = float(std::remainder(c.roll + r.roll * dt, 360.0));
     c.pitch = float(std::clamp(c.pitch + r.pitch * dt, -90.0, 90.0));

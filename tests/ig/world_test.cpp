@@ -106,6 +106,45 @@ TEST(IgWorld, AnEntityAppearsWithItsModelAtItsPoseAndGoesWhenDestroyed) {
   EXPECT_EQ(w.activeEntities(), 1u);
 }
 
+TEST(IgWorld, RatesMoveAnEntityBetweenHostFramesWhenExtrapolationIsOn) {
+  IgWorld w = loadWorld();
+  cigi::EntityControl e;
+  e.entity = 2;
+  e.type = 7;
+  e.latOrX = 45;
+  e.lonOrY = 7;
+  e.altOrZ = 100;
+  e.yaw = 90;  // facing east
+  cigi::RateControl r;
+  r.entity = 2;
+  r.x = 10;  // forward, in its own axes: east
+  r.z = -2;  // up
+  cigi::Datagram d;
+  cigi::IgControl on;
+  on.extrapolation = true;
+  d.packets = {on, e, r};
+  std::vector<cigi::Packet> replies;
+  w.apply(d, replies);
+  for (int f = 0; f < 50; ++f) w.advance(0.02);
+  const Mat4& m = w.frameScene(1).instances.back().transform;
+  EXPECT_NEAR(m.m[3][0], 10, 1e-3);
+  EXPECT_NEAR(m.m[3][1], 102, 1e-3);
+  EXPECT_NEAR(m.m[3][2], 0, 1e-3);
+  // In world (north, east, down) axes instead: 5 m/s north.
+  r.worldCoordinates = true;
+  r.x = 5;
+  r.z = 0;
+  d.packets = {on, e, r};
+  w.apply(d, replies);
+  w.advance(1);
+  EXPECT_NEAR(w.frameScene(2).instances.back().transform.m[3][2], -5, 1e-3);
+  // Off: the pose stays as the host sent it.
+  d.packets = {cigi::IgControl{}, e, r};
+  w.apply(d, replies);
+  w.advance(1);
+  EXPECT_NEAR(w.frameScene(3).instances.back().transform.m[3][2], 0, 1e-3);
+}
+
 TEST(IgWorld, OutOfRangeAndNonFinitePacketsAreRejectedAndChangeNothing) {
   IgWorld w = loadWorld();
   const size_t base = w.frameScene(0).instances.size();
