@@ -147,11 +147,15 @@ Result<IgConfig> parseIgConfig(const std::string& text, const std::string& path)
     root = Json::parse(text);
   } catch (const Json::parse_error& e) {
     return Error{path, fmt::format("byte {}", e.byte), "malformed JSON"};
+  } catch (const Json::exception& e) {
+    return Error{path, "", "malformed JSON (a number out of range)"};
   }
   try {
     return read(root, path);
   } catch (const BadConfig& e) {
     return Error{path, "", e.message};
+  } catch (const Json::exception& e) {
+    return Error{path, "", "a field has the wrong type"};
   }
 }
 

@@ -202,6 +202,8 @@ Result<HostScript> parseHostScript(const std::string& text, const std::string& p
     root = Json::parse(text);
   } catch (const Json::parse_error& e) {
     return Error{path, fmt::format("byte {}", e.byte), "malformed JSON"};
+  } catch (const Json::exception& e) {
+    return Error{path, "", "malformed JSON (a number out of range)"};
   }
   try {
     return read(root);
