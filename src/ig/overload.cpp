@@ -12,6 +12,8 @@ namespace {
 constexpr double kPriorOther = 0.9;
 // The weight of a new measurement in the running estimate.
 constexpr double kSmoothing = 0.2;
+// How fast a level's stale estimate drifts toward the one implied by a level below it, a frame.
+constexpr double kStaleDrift = 0.05;
 
 }  // namespace
 
@@ -45,15 +47,18 @@ OverloadGovernor::OverloadGovernor(std::vector<QualityLevel> levels, double budg
     : levels_(std::move(levels)), estimates_(levels_.size()), budgetMs_(budgetMs),
       hold_(holdFrames) {}
 
+double OverloadGovernor::prior(int level) const {
+  const int from = levels_[size_t(level - 1)].options.samples,
+            to = levels_[size_t(level)].options.samples;
+  return from != to ? std::max(0.25, double(to) / double(from)) : kPriorOther;
+}
+
 double OverloadGovernor::predict(int level, double work) const {
   // The nearest measured level at or above this one, scaled down by the priors in between.
   double scale = 1;
   for (int l = level; l >= 0; --l) {
     if (estimates_[size_t(l)].msPerWork > 0) return estimates_[size_t(l)].msPerWork * work * scale;
-    if (l > 0) {
-      const int from = levels_[size_t(l - 1)].options.samples, to = levels_[size_t(l)].options.samples;
-      scale *= from != to ? std::max(0.25, double(to) / double(from)) : kPriorOther;
-    }
+    if (l > 0) scale *= prior(l);
   }
   return 0;
 }
@@ -82,6 +87,15 @@ void OverloadGovernor::record(int level, double work, double ms) {
   Estimate& e = estimates_[size_t(level)];
   const double rate = ms / work;
   e.msPerWork = e.msPerWork > 0 ? e.msPerWork + kSmoothing * (rate - e.msPerWork) : rate;
+  // The levels above were last measured when they were drawn, perhaps in a passing overload (the
+  // machine busy, a heavy view): their estimates drift down toward what this level's measurement
+  // implies for them, so that a stale figure cannot keep the quality down for good.
+  double implied = rate;
+  for (int l = level; l > 0; --l) {
+    implied /= prior(l);
+    Estimate& above = estimates_[size_t(l - 1)];
+    if (above.msPerWork > implied) above.msPerWork += kStaleDrift * (implied - above.msPerWork);
+  }
   // An overrun the prediction missed: down a level at once, and start the hold again.
   if (ms > budgetMs_ && level == level_ && level_ + 1 < levels()) {
     ++level_;

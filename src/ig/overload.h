@@ -6,6 +6,8 @@
 // prediction fits. It steps back up one level at a time, only after `holdFrames` frames in a row
 // predicted to fit the level above with a quarter of the budget to spare (hysteresis: no
 // oscillation between two levels). A frame that overran despite the prediction steps down at once.
+// The estimates of levels not drawn lately drift down toward what the drawn level's measurements
+// imply for them, so that one passing overload does not keep the quality down for good.
 //
 // Levels, in the order quality is given up (level 0 is the configuration's quality):
 //   anti-aliasing samples, one step at a time (64 → 16 → 8 → 4 → 1);
@@ -50,6 +52,9 @@ class OverloadGovernor {
   struct Estimate {
     double msPerWork = 0;  // exponentially weighted; 0: never measured
   };
+  // A level's cost against the one above it, before it is measured.
+  double prior(int level) const;
+
   std::vector<QualityLevel> levels_;
   std::vector<Estimate> estimates_;
   double budgetMs_;

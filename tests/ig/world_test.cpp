@@ -296,5 +296,24 @@ TEST(IgOverload, StepsDownWhenOverrunAndBackUpWithHysteresis) {
   EXPECT_EQ(seen, (std::vector<int>{2, 1, 0}));
 }
 
+TEST(IgOverload, OnePassingOverloadDoesNotKeepTheQualityDown) {
+  RenderOptions full;
+  full.samples = 16;
+  OverloadGovernor g(qualityLevels(full), 10.0, 5);
+  auto cost = [](int level) { return 4.0 / (1 << std::min(level, 3)); };  // fits at full quality
+  for (int f = 0; f < 10; ++f) g.record(g.choose(1000), 1000, cost(g.level()));
+  ASSERT_EQ(g.level(), 0);
+  g.record(g.choose(1000), 1000, 100);  // one frame the machine was busy
+  ASSERT_GE(g.level(), 1);
+  int frames = 0;
+  while (g.level() > 0 && frames < 200) {
+    const int level = g.choose(1000);
+    g.record(level, 1000, cost(level));
+    ++frames;
+  }
+  EXPECT_EQ(g.level(), 0);
+  EXPECT_LT(frames, 80);
+}
+
 }  // namespace
 }  // namespace sv::ig
