@@ -49,6 +49,18 @@ Image frameImage(const fs::path& dir, uint32_t frame) {
   return image.ok() ? image.value() : Image{};
 }
 
+// A command's standard output (tshark is installed by scripts/lib.sh).
+std::string shell(const std::string& command) {
+  std::string out;
+  FILE* pipe = ::popen(command.c_str(), "r");
+  if (!pipe) return "popen failed";
+  char buffer[4096];
+  size_t n;
+  while ((n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) out.append(buffer, n);
+  ::pclose(pipe);
+  return out;
+}
+
 size_t redPixels(const Image& image) {
   size_t n = 0;
   for (size_t i = 0; i + 2 < image.rgb.size(); i += 3)
@@ -152,6 +164,23 @@ TEST(IgLoop, HostDrivenEntitiesAppearInTheNextFrameAndTheSessionReplaysBitForBit
   EXPECT_LE(appliedAt - sentAfter, 1u) << "latency in frames";
   EXPECT_EQ(redPixels(frameImage(frames, appliedAt - 1)), 0u);
   EXPECT_GT(redPixels(frameImage(frames, appliedAt)), 200u);
+
+  // An independent decoder agrees: Wireshark's CIGI dissector reads the whole recorded session —
+  // both directions — with no malformed packet, the IG's frame counter 0, 1, 2, …, the host's
+  // entity and the height the host was told.
+  const std::string tshark = "tshark -n -r '" + capture.string() +
+                             "' -d udp.port==8004,cigi -d udp.port==8005,cigi";
+  EXPECT_EQ(shell(tshark + " -Y '_ws.malformed || _ws.expert.severity >= error' 2>/dev/null"), "");
+  const std::string sofs = shell(tshark + " -Y cigi.sof -T fields -e cigi.sof.ig_frame_number 2>/dev/null");
+  std::string counting;
+  for (uint32_t f = 0; f < expectFrame; ++f) counting += std::to_string(f) + "\n";
+  EXPECT_EQ(sofs, counting);
+  EXPECT_NE(shell(tshark + " -Y 'cigi.entity_control.entity_id == 1' -T fields -e frame.number "
+                           "2>/dev/null"),
+            "");
+  const std::string height = shell(tshark + " -Y cigi.hat_hot_response -T fields -e "
+                                             "cigi.hat_hot_response.height 2>/dev/null");
+  EXPECT_NEAR(std::stod(height.empty() ? "nan" : height), s.host.heights[0].height, 1e-6) << height;
 
   // Replayed from the capture, as fast as it renders: the same frames, byte for byte.
   IgRunOptions replay;

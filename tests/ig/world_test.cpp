@@ -10,6 +10,7 @@
 #include "ig/config.h"
 #include "ig/geo.h"
 #include "ig/overload.h"
+#include "synthvis/render.h"
 #include "synthvis/terrain.h"
 
 namespace sv::ig {
@@ -196,6 +197,42 @@ TEST(IgWorld, LightGroupsSwitchAndDimAndVisibilityBecomesFog) {
   wc.visibility = 500;  // the nearer of the two
   apply(w, {wc});
   EXPECT_NEAR(std::exp2(-w.frameScene(0).fog.beta * 500), 0.05, 1e-6);
+}
+
+TEST(IgWorld, SwitchedLightsAndTheVisibilityShowInTheRenderedFrame) {
+  IgWorld w = loadWorld();
+  RenderOptions options;
+  options.threads = 2;
+  Renderer renderer(options);
+  auto frame = [&] {
+    std::vector<Image> images;
+    EXPECT_TRUE(renderer.renderChannels(w.frameScene(0), images).ok());
+    return images.at(0);
+  };
+  auto sum = [](const Image& image) {
+    uint64_t total = 0;
+    for (uint8_t v : image.rgb) total += v;
+    return total;
+  };
+  const Image lit = frame();
+  cigi::ComponentControl off;
+  off.componentClass = cigi::ComponentClass::system;
+  off.state = 0;
+  apply(w, {off});
+  const Image dark = frame();
+  EXPECT_LT(sum(dark), sum(lit));  // the runway light is gone, nothing else changed
+  cigi::AtmosphereControl haze;
+  haze.visibility = 150;
+  apply(w, {haze});
+  const Image foggy = frame();
+  EXPECT_NE(foggy.rgb, dark.rgb);
+  // The ground below the eye takes on the fog's colour (the default haze, 0.6, 0.65, 0.7 linear:
+  // about 203, 211, 219 in sRGB).
+  auto fogDistance = [](const Image& image) {
+    const uint8_t* p = image.pixel(image.width / 2, image.height - 1);
+    return std::abs(p[0] - 203) + std::abs(p[1] - 211) + std::abs(p[2] - 219);
+  };
+  EXPECT_LT(fogDistance(foggy), fogDistance(dark));
 }
 
 TEST(IgWorld, HeightsAnswerFromTheTerrainQueryAndThePolygons) {
