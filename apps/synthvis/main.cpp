@@ -30,6 +30,7 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -573,6 +574,8 @@ int runCompare(const std::string& imagePath, const std::string& referencePath,
 // `synthvis terrain SCENE --height X,Y,Z | --los X,Y,Z,X,Y,Z`: the host's queries (synthvis/terrain.h).
 // synthvis ig: the real-time loop a host drives (docs/ig.md).
 int runIg(const std::string& configPath, const sv::ig::IgRunOptions& options) {
+  // A y4m reader that goes away is the presenter's closed(), not the end of the process.
+  std::signal(SIGPIPE, SIG_IGN);
   sv::Result<sv::ig::IgConfig> config = sv::ig::loadIgConfig(configPath);
   if (!config) return fail(config.error());
   sv::Result<std::unique_ptr<sv::ig::IgLoop>> loop = sv::ig::IgLoop::create(config.value(), options);

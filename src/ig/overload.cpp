@@ -18,7 +18,7 @@ constexpr double kStaleDrift = 0.05;
 }  // namespace
 
 std::vector<QualityLevel> qualityLevels(const RenderOptions& full) {
-  std::vector<QualityLevel> levels{{full, true, "full quality"}};
+  std::vector<QualityLevel> levels{{full, true, 1, "full quality"}};
   auto next = [&](const char* what, auto&& change) {
     QualityLevel l = levels.back();
     change(l);
@@ -39,6 +39,7 @@ std::vector<QualityLevel> qualityLevels(const RenderOptions& full) {
   next("bilinear terrain", [](QualityLevel& l) {
     l.options.terrainFilter = RenderOptions::TerrainFilter::bilinear;
   });
+  next("half resolution", [](QualityLevel& l) { l.replication = 2; });
   return levels;
 }
 
@@ -47,9 +48,19 @@ OverloadGovernor::OverloadGovernor(std::vector<QualityLevel> levels, double budg
     : levels_(std::move(levels)), estimates_(levels_.size()), budgetMs_(budgetMs),
       hold_(holdFrames) {}
 
+void OverloadGovernor::calibrate(int level, double work, double ms) {
+  Estimate& e = estimates_[size_t(level)];
+  e.calibrated = std::max(ms, 1e-3) / std::max(work, 1.0);
+  e.msPerWork = e.calibrated;
+}
+
 double OverloadGovernor::prior(int level) const {
+  const Estimate &a = estimates_[size_t(level - 1)], &b = estimates_[size_t(level)];
+  if (a.calibrated > 0 && b.calibrated > 0) return b.calibrated / a.calibrated;
   const int from = levels_[size_t(level - 1)].options.samples,
             to = levels_[size_t(level)].options.samples;
+  if (levels_[size_t(level)].replication != levels_[size_t(level - 1)].replication)
+    return 0.3;  // a quarter of the pixels, and the per-frame work that does not shrink
   return from != to ? std::max(0.25, double(to) / double(from)) : kPriorOther;
 }
 

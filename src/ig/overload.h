@@ -13,7 +13,9 @@
 //   anti-aliasing samples, one step at a time (64 → 16 → 8 → 4 → 1);
 //   texture filtering, trilinear or anisotropic → bilinear;
 //   the star field off;
-//   terrain interpolation bicubic → bilinear.
+//   terrain interpolation bicubic → bilinear;
+//   half resolution: channels drawn at half their width and height, each pixel shown 2 × 2 times
+//   (pixel replication, as CIGI's View Definition names it).
 #pragma once
 
 #include <string>
@@ -26,6 +28,7 @@ namespace sv::ig {
 struct QualityLevel {
   RenderOptions options;
   bool stars = true;
+  int replication = 1;  // channels drawn at 1/r of their size, each pixel shown r × r times
   std::string change;  // what this level gave up against the one before ("aa 4", "no stars")
 };
 
@@ -40,6 +43,9 @@ class OverloadGovernor {
   int choose(double work);
   // What the frame at `level` took, drawing `work`.
   void record(int level, double work, double ms);
+  // Before the clock starts: what a frame at `level` takes, measured once for every level, so
+  // that the levels' costs against each other are known rather than guessed (prior()).
+  void calibrate(int level, double work, double ms);
 
   int level() const { return level_; }
   int levels() const { return int(levels_.size()); }
@@ -50,9 +56,10 @@ class OverloadGovernor {
 
  private:
   struct Estimate {
-    double msPerWork = 0;  // exponentially weighted; 0: never measured
+    double msPerWork = 0;   // exponentially weighted; 0: never measured
+    double calibrated = 0;  // calibrate()'s measurement; 0: none
   };
-  // A level's cost against the one above it, before it is measured.
+  // A level's cost against the one above it: as calibrated, or else a prior guess.
   double prior(int level) const;
 
   std::vector<QualityLevel> levels_;

@@ -284,7 +284,7 @@ void IgWorld::advance(double dt) {
   }
 }
 
-const scene::Scene& IgWorld::frameScene(double time, bool stars) {
+const scene::Scene& IgWorld::frameScene(double time, bool stars, int replication) {
   scene::Scene& s = frame_;
   s.time = time;
   s.stars = base_.stars;
@@ -363,6 +363,10 @@ const scene::Scene& IgWorld::frameScene(double time, bool stars) {
                              : 0;
   }
   if (!stars) s.stars.stars.clear();
+  for (scene::Channel& ch : s.channels) {
+    ch.width = (ch.width + replication - 1) / replication;
+    ch.height = (ch.height + replication - 1) / replication;
+  }
   return s;
 }
 

@@ -40,9 +40,12 @@ class IgWorld {
   void advance(double dt);
   // The scene of this instant: the database, the entities' models at their poses, the eye on the
   // ownship (entity 0) with the views' offsets and frusta, fog from the visibility, the light
-  // groups, the sun and stars from the time of day, and `time` (seconds since the start);
-  // without `stars`, no star field (a quality level, overload.h).
-  const scene::Scene& frameScene(double time, bool stars = true);
+  // groups, the sun and stars from the time of day, and `time` (seconds since the start).
+  // Quality levels (overload.h): without `stars`, no star field; with `replication` r > 1, every
+  // channel ⌈width / r⌉ × ⌈height / r⌉ pixels, to be shown each pixel r × r times.
+  const scene::Scene& frameScene(double time, bool stars = true, int replication = 1);
+  // The channels' sizes as configured (before any replication).
+  const std::vector<scene::Channel>& channels() const { return channels_; }
 
   // Height of the ground (terrain or the database's polygons; the highest) under a world point,
   // and the first point the segment a → b meets (its fraction along the segment).

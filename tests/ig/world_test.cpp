@@ -304,8 +304,9 @@ TEST(IgOverload, StepsDownWhenOverrunAndBackUpWithHysteresis) {
   RenderOptions full;
   full.samples = 16;
   const std::vector<QualityLevel> levels = qualityLevels(full);
-  // aa 8, aa 4, aa 1, bilinear textures, no stars, bilinear terrain.
-  ASSERT_EQ(levels.size(), 7u);
+  // aa 8, aa 4, aa 1, bilinear textures, no stars, bilinear terrain, half resolution.
+  ASSERT_EQ(levels.size(), 8u);
+  EXPECT_EQ(levels[7].replication, 2);
   EXPECT_EQ(levels[1].options.samples, 8);
   EXPECT_EQ(levels[3].options.samples, 1);
   EXPECT_FALSE(levels[5].stars);
