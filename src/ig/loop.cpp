@@ -82,10 +82,10 @@ class UdpSocket {
   uint16_t port_ = 0;
 };
 
-// Each pixel of `image` shown r × r times, cropped to width × height (pixel replication): each
-// source row expanded once, then copied r times.
-Image replicate(const Image& image, int r, int width, int height) {
-  Image out;
+// Each pixel of `image` shown r × r times in `out`, cropped to width × height (pixel
+// replication): each source row expanded once, then copied r times. `out` keeps its memory from
+// frame to frame (18 MB of fresh pages a frame for three 1080p channels cost more than the copy).
+void replicate(const Image& image, int r, int width, int height, Image& out) {
   out.width = width;
   out.height = height;
   out.rgb.resize(size_t(width) * size_t(height) * 3);
@@ -93,11 +93,11 @@ Image replicate(const Image& image, int r, int width, int height) {
   for (int sy = 0; sy * r < height; ++sy) {
     const uint8_t* src = image.pixel(0, std::min(sy, image.height - 1));
     uint8_t* row = out.pixel(0, sy * r);
-    for (int x = 0; x < width; ++x) std::memcpy(row + 3 * x, src + 3 * std::min(x / r, image.width - 1), 3);
+    for (int x = 0; x < width; ++x)
+      std::memcpy(row + 3 * x, src + 3 * std::min(x / r, image.width - 1), 3);
     for (int k = 1; k < r && sy * r + k < height; ++k)
       std::memcpy(out.pixel(0, sy * r + k), row, rowBytes);
   }
-  return out;
 }
 
 }  // namespace
@@ -230,29 +230,39 @@ Result<IgRunReport> IgLoop::run() {
   std::vector<double> frameMs, periodsMs, loopMs;
   std::vector<std::vector<uint8_t>> incoming;
   std::vector<cigi::Packet> replies;
-  std::vector<Image> images;
+  std::vector<Image> images, enlarged;
   std::vector<FrameStats> stats;
   std::vector<std::string> names;
-  // Before the clock starts, the first frame at every quality level, four times: the first makes
-  // the renderers' threads and buffers and touches their memory (so the first timed frame is not
-  // the slowest); the median of the other three is the governor's calibration — what the levels
-  // cost against each other on this machine and this database.
+  // Before the clock starts, the first frame at every quality level: once each to make the
+  // renderers' threads and buffers and touch their memory (so the first timed frame is not the
+  // slowest), then three rounds over all levels, whose median per level is the governor's
+  // calibration — what the levels cost against each other on this machine and this database.
+  // Round by round, so that a slow moment of the machine weighs on every level alike.
   if (!pattern && m.options.governor) {
-    for (int level = 0; level < governor.levels(); ++level) {
-      const QualityLevel& q = governor.at(level);
-      const scene::Scene& first = world.frameScene(0, q.stars, q.replication);
-      const double work = double(first.triangleCount() + first.lightPoints.size());
-      std::vector<double> times;
-      for (int pass = 0; pass < 4; ++pass) {
+    const int levels = governor.levels();
+    std::vector<std::vector<double>> times(static_cast<size_t>(levels));
+    std::vector<double> works(static_cast<size_t>(levels));
+    for (int round = 0; round < 4; ++round)
+      for (int level = 0; level < levels; ++level) {
+        const QualityLevel& q = governor.at(level);
+        const scene::Scene& first = world.frameScene(0, q.stars, q.replication);
+        works[size_t(level)] = double(first.triangleCount() + first.lightPoints.size());
         const Clock::time_point warm = Clock::now();
         if (Status s = m.rendererFor(level, q.options).renderChannels(first, images, &stats); !s)
           return s.error();
-        if (pass > 0) times.push_back(msBetween(warm, Clock::now()));
+        if (q.replication > 1) {  // the enlargements' memory too
+          enlarged.resize(images.size());
+          for (size_t c = 0; c < images.size(); ++c)
+            replicate(images[c], q.replication, world.channels()[c].width,
+                      world.channels()[c].height, enlarged[c]);
+        }
+        if (round > 0) times[size_t(level)].push_back(msBetween(warm, Clock::now()));
       }
-      const double ms = percentile(times, 0.5);
-      governor.calibrate(level, work, ms);
+    for (int level = 0; level < levels; ++level) {
+      const double ms = percentile(times[size_t(level)], 0.5);
+      governor.calibrate(level, works[size_t(level)], ms);
       std::fprintf(stderr, "synthvis ig: quality level %d (%s): %.2f ms a frame\n", level,
-                   q.change.c_str(), ms);
+                   governor.at(level).change.c_str(), ms);
     }
   }
   const Clock::time_point t0 = Clock::now();
@@ -318,15 +328,20 @@ Result<IgRunReport> IgLoop::run() {
     } else {
       Renderer& renderer = m.rendererFor(level, q.options);
       if (Status s = renderer.renderChannels(scene, images, &stats); !s) return s.error();
-      if (q.replication > 1)
-        for (size_t c = 0; c < images.size(); ++c)
-          images[c] = replicate(images[c], q.replication, world.channels()[c].width,
-                                world.channels()[c].height);
+    }
+    // What is shown: the images, or with replication their enlargements.
+    std::vector<Image>* shown = &images;
+    if (q.replication > 1) {
+      enlarged.resize(images.size());
+      for (size_t c = 0; c < images.size(); ++c)
+        replicate(images[c], q.replication, world.channels()[c].width,
+                  world.channels()[c].height, enlarged[c]);
+      shown = &enlarged;
     }
     const double renderMs = msBetween(renderStart, Clock::now());
     names.clear();
     for (const scene::Channel& c : scene.channels) names.push_back(c.name);
-    if (m.options.overlay && !images.empty()) {
+    if (m.options.overlay && !shown->empty()) {
       double vertex = 0, setup = 0, raster = 0, lights = 0;
       for (const FrameStats& s : stats) {
         vertex += s.vertexMs;
@@ -343,9 +358,9 @@ Result<IgRunReport> IgLoop::run() {
           fmt::format("entities {}  datagrams {}  malformed {}  missed {}",
                       world.activeEntities(), world.counts().datagrams, world.counts().malformed,
                       report.missed)};
-      present::drawOverlay(images[0], lines, std::max(1, images[0].height / 360));
+      present::drawOverlay((*shown)[0], lines, std::max(1, (*shown)[0].height / 360));
     }
-    if (Status s = m.presenter->present({frame, images, names}); !s) return s.error();
+    if (Status s = m.presenter->present({frame, *shown, names}); !s) return s.error();
     // Not bound to a rate, the loop waits for the writer instead of letting it drop frames.
     if (!m.options.realtime)
       if (Status s = m.presenter->flush(); !s) return s.error();
