@@ -235,6 +235,72 @@ TEST(IgWorld, SwitchedLightsAndTheVisibilityShowInTheRenderedFrame) {
   EXPECT_LT(fogDistance(foggy), fogDistance(dark));
 }
 
+TEST(IgWorld, TheEyeRidesTheOwnshipAndViewsSetTheChannels) {
+  IgWorld w = loadWorld();
+  cigi::EntityControl own;  // entity 0: the ownship, heading east, 120 m up
+  own.entity = 0;
+  own.latOrX = 45;
+  own.lonOrY = 7;
+  own.altOrZ = 120;
+  own.yaw = 90;
+  cigi::ViewControl vc;
+  vc.view = 0;
+  vc.enable = 1 | 2 | 32;  // x and y offsets, yaw
+  vc.x = 5;   // 5 m forward
+  vc.y = -2;  // 2 m left
+  vc.yaw = -20;
+  cigi::ViewDefinition vd;
+  vd.view = 0;
+  vd.left = -25;
+  vd.right = 35;
+  vd.bottom = -10;
+  vd.top = 15;
+  vd.nearPlane = 0.5f;
+  vd.farPlane = 9000;
+  apply(w, {own, vc, vd});
+  const scene::Scene& s = w.frameScene(0);
+  ASSERT_FALSE(s.cameras.empty());
+  const scene::Camera& cam = s.cameras[0];
+  EXPECT_NEAR(cam.position.y, 120, 1e-3);
+  EXPECT_NEAR(cam.target.x - cam.position.x, 100, 1e-3);  // looking east
+  EXPECT_NEAR(cam.up.y, 1, 1e-6);
+  EXPECT_FLOAT_EQ(cam.znear, 0.5f);
+  EXPECT_FLOAT_EQ(cam.zfar, 9000);
+  const scene::Channel& ch = s.channels.at(0);
+  EXPECT_FLOAT_EQ(ch.offset.z, -5);  // forward is −z in the eye's space
+  EXPECT_FLOAT_EQ(ch.offset.x, -2);
+  EXPECT_FLOAT_EQ(ch.yawDegrees, -20);
+  ASSERT_TRUE(ch.frustum.has_value());
+  EXPECT_FLOAT_EQ(ch.frustum->leftDegrees, -25);
+  EXPECT_FLOAT_EQ(ch.frustum->upDegrees, 15);
+  // A view beyond the channels is rejected.
+  vc.view = 5;
+  apply(w, {vc});
+  EXPECT_EQ(w.counts().rejected, 1u);
+}
+
+TEST(IgWorld, TheTimeOfDayMovesTheSunAndFadesTheStars) {
+  IgWorld w = loadWorld();
+  cigi::CelestialSphereControl noon;
+  noon.hour = 12;
+  apply(w, {noon});
+  const scene::Scene& day = w.frameScene(0);
+  EXPECT_LT(day.light.direction.y, -0.8f);  // the sun high, shining down
+  EXPECT_LT(day.light.direction.z, 0);      // from the south (+z), travelling north (−z)
+  EXPECT_GT(day.background.z, 0.5f);        // a blue sky
+  EXPECT_FLOAT_EQ(day.stars.brightness, 0);
+  cigi::CelestialSphereControl night = noon;
+  night.hour = 23;
+  apply(w, {night});
+  const scene::Scene& dark = w.frameScene(0);
+  EXPECT_GT(dark.light.direction.y, 0);  // below the horizon
+  EXPECT_LT(dark.background.z, 0.1f);
+  cigi::CelestialSphereControl bad;
+  bad.hour = 24;
+  apply(w, {bad});
+  EXPECT_EQ(w.counts().rejected, 1u);
+}
+
 TEST(IgWorld, HeightsAnswerFromTheTerrainQueryAndThePolygons) {
   IgWorld w = loadWorld();
   const GeoOrigin& o = w.config().origin;
