@@ -157,6 +157,18 @@ HostScript read(const Json& root) {
                  r.destination[2]);
         ev.packets.push_back(r);
       }
+      if (e.contains("create")) {
+        const Json& c = e["create"];
+        const std::string at = where + ".create";
+        cigi::EntityControl ec;
+        ec.entity = uint16_t(num(c, "id", at, 0, 65535, 0));
+        ec.type = uint16_t(num(c, "type", at, 0, 65535, 0));
+        position(c, at, origin, ec.latOrX, ec.lonOrY, ec.altOrZ);
+        ec.yaw = float(num(c, "yaw", at, -360, 360, 0));
+        ec.pitch = float(num(c, "pitch", at, -90, 90, 0));
+        ec.roll = float(num(c, "roll", at, -180, 180, 0));
+        ev.packets.push_back(ec);
+      }
       if (e.contains("destroy")) {
         cigi::EntityControl c;
         c.entity = uint16_t(num(e, "destroy", where, 0, 65535, 0));
@@ -164,7 +176,7 @@ HostScript read(const Json& root) {
         ev.packets.push_back(c);
       }
       if (ev.packets.empty())
-        bad(where + ": nothing to do (lights, visibility, timeOfDay, hat, hot, los or destroy)");
+        bad(where + ": nothing to do (lights, visibility, timeOfDay, hat, hot, los, create or destroy)");
       s.events.push_back(std::move(ev));
     }
     std::stable_sort(s.events.begin(), s.events.end(),
