@@ -1,23 +1,19 @@
 // The IG configuration file (docs/ig.md, "Configuration"), JSON.
 #include "ig/config.h"
 
+#include "ig/json_input.h"
+
 #include <fmt/format.h>
 
 #include <cmath>
-#include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 namespace sv::ig {
 namespace {
 
 using Json = nlohmann::json;
 
-struct BadConfig {
-  std::string message;
-};
-
-[[noreturn]] void bad(const std::string& message) { throw BadConfig{message}; }
+[[noreturn]] void bad(const std::string& message) { badField(message); }
 
 double number(const Json& v, const char* what, double lo, double hi) {
   if (!v.is_number()) bad(fmt::format("{}: expected a number", what));
@@ -142,30 +138,13 @@ IgConfig read(const Json& root, const std::string& path) {
 }  // namespace
 
 Result<IgConfig> parseIgConfig(const std::string& text, const std::string& path) {
-  Json root;
-  try {
-    root = Json::parse(text);
-  } catch (const Json::parse_error& e) {
-    return Error{path, fmt::format("byte {}", e.byte), "malformed JSON"};
-  } catch (const Json::exception& e) {
-    return Error{path, "", "malformed JSON (a number out of range)"};
-  }
-  try {
-    return read(root, path);
-  } catch (const BadConfig& e) {
-    return Error{path, "", e.message};
-  } catch (const Json::exception& e) {
-    return Error{path, "", "a field has the wrong type"};
-  }
+  return parseJsonInput<IgConfig>(text, path, [&](const Json& root) { return read(root, path); });
 }
 
 Result<IgConfig> loadIgConfig(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Error{path, "", "cannot open the file"};
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (text.str().size() > (1u << 20)) return Error{path, "", "larger than 1 MiB"};
-  return parseIgConfig(text.str(), path);
+  Result<std::string> text = readJsonInput(path);
+  if (!text) return text.error();
+  return parseIgConfig(text.value(), path);
 }
 
 }  // namespace sv::ig

@@ -1,31 +1,23 @@
 // The scripted host (docs/ig.md, "The scripted host").
 #include "ig/host.h"
 
-#include <arpa/inet.h>
 #include <fmt/format.h>
-#include <netinet/in.h>
-#include <poll.h>
-#include <sys/socket.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "ig/geo.h"
+#include "ig/json_input.h"
+#include "ig/udp.h"
 
 namespace sv::ig {
 namespace {
 
 using Json = nlohmann::json;
 
-struct BadScript {
-  std::string message;
-};
-[[noreturn]] void bad(const std::string& m) { throw BadScript{m}; }
+[[noreturn]] void bad(const std::string& m) { badField(m); }
 
 double num(const Json& o, const char* key, const std::string& where, double lo, double hi,
            double fallback) {
@@ -209,29 +201,13 @@ PathPoint poseAt(const std::vector<PathPoint>& path, double t) {
 }  // namespace
 
 Result<HostScript> parseHostScript(const std::string& text, const std::string& path) {
-  Json root;
-  try {
-    root = Json::parse(text);
-  } catch (const Json::parse_error& e) {
-    return Error{path, fmt::format("byte {}", e.byte), "malformed JSON"};
-  } catch (const Json::exception& e) {
-    return Error{path, "", "malformed JSON (a number out of range)"};
-  }
-  try {
-    return read(root);
-  } catch (const BadScript& e) {
-    return Error{path, "", e.message};
-  } catch (const Json::exception& e) {
-    return Error{path, "", "a field has the wrong type"};
-  }
+  return parseJsonInput<HostScript>(text, path, [](const Json& root) { return read(root); });
 }
 
 Result<HostScript> loadHostScript(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Error{path, "", "cannot open the file"};
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parseHostScript(text.str(), path);
+  Result<std::string> text = readJsonInput(path);
+  if (!text) return text.error();
+  return parseHostScript(text.value(), path);
 }
 
 std::vector<cigi::Packet> hostFrame(const HostScript& script, uint64_t frame,
@@ -262,40 +238,25 @@ std::vector<cigi::Packet> hostFrame(const HostScript& script, uint64_t frame,
 }
 
 Result<HostLog> runHost(const HostScript& script, int timeoutMs) {
-  const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
-  if (fd < 0) return Error{"", "", "cannot open a UDP socket"};
-  struct Closer {
-    int fd;
-    ~Closer() { ::close(fd); }
-  } closer{fd};
-  sockaddr_in self{};
-  self.sin_family = AF_INET;
-  self.sin_addr.s_addr = htonl(INADDR_ANY);
-  self.sin_port = htons(script.port);
-  if (::bind(fd, reinterpret_cast<sockaddr*>(&self), sizeof self) != 0)
-    return Error{"", "", fmt::format("cannot listen on UDP port {}: {}", script.port,
-                                     std::strerror(errno))};
-  sockaddr_in ig{};
-  ig.sin_family = AF_INET;
-  ig.sin_port = htons(script.igPort);
-  if (::inet_pton(AF_INET, script.igAddress.c_str(), &ig.sin_addr) != 1)
-    return Error{"", "", fmt::format("IG address \"{}\" is not a dotted IPv4 address", script.igAddress)};
+  UdpSocket socket;
+  if (Status s = socket.open(script.port); !s) return s.error();
+  Result<sockaddr_in> address = udpAddress(script.igAddress, script.igPort);
+  if (!address) return address.error();
+  const sockaddr_in ig = address.value();
   HostLog log;
-  std::vector<uint8_t> bytes(65536);
+  std::vector<uint8_t> bytes;
   // The IG sends Start of Frame every frame to the host it knows; one configured to answer
   // whoever drives it learns the host from its first datagram: announce the host with an IG
   // Control now, and again while no Start of Frame has come.
   cigi::IgControl announce;
   const std::vector<uint8_t> hello = cigi::writeDatagram(std::vector<cigi::Packet>{announce});
-  auto send = [&](const std::vector<uint8_t>& out) {
-    ::sendto(fd, out.data(), out.size(), 0, reinterpret_cast<sockaddr*>(&ig), sizeof ig);
-  };
+  auto send = [&](const std::vector<uint8_t>& out) { socket.send(out, ig); };
   send(hello);
   // Waits for the next Start of Frame, collecting the answers that come with it.
   auto nextStartOfFrame = [&]() -> Status {
     for (int waitedMs = 0;;) {
-      pollfd p{fd, POLLIN, 0};
-      if (::poll(&p, 1, 100) <= 0) {
+      sockaddr_in from{};
+      if (!socket.receive(bytes, from, 100)) {
         waitedMs += 100;
         if (waitedMs >= timeoutMs)
           return Error{"", "", fmt::format("no Start of Frame from the IG at {}:{} for {} ms",
@@ -303,9 +264,7 @@ Result<HostLog> runHost(const HostScript& script, int timeoutMs) {
         if (log.startOfFrames == 0) send(hello);
         continue;
       }
-      const ssize_t n = ::recv(fd, bytes.data(), bytes.size(), 0);
-      if (n <= 0) continue;
-      Result<cigi::Datagram> d = cigi::parseDatagram({bytes.data(), size_t(n)});
+      Result<cigi::Datagram> d = cigi::parseDatagram(bytes);
       if (!d) continue;
       bool sof = false;
       for (const cigi::Packet& packet : d->packets) {

@@ -3,11 +3,7 @@
 // Frame).
 #include "ig/loop.h"
 
-#include <arpa/inet.h>
 #include <fmt/format.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -20,6 +16,7 @@
 #include "cigi/cigi.h"
 #include "cigi/pcap.h"
 #include "ig/overload.h"
+#include "ig/udp.h"
 #include "ig/world.h"
 #include "present/overlay.h"
 #include "present/present.h"
@@ -41,46 +38,6 @@ double percentile(std::vector<double> v, double p) {
   const size_t i = std::min(v.size() - 1, size_t(std::ceil(p * double(v.size()))) - (p > 0));
   return v[i];
 }
-
-// A UDP socket on 0.0.0.0:port, non-blocking.
-class UdpSocket {
- public:
-  ~UdpSocket() {
-    if (fd_ >= 0) ::close(fd_);
-  }
-  Status open(uint16_t port) {
-    fd_ = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
-    if (fd_ < 0) return Error{"", "", fmt::format("cannot open a UDP socket: {}", std::strerror(errno))};
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_addr.s_addr = htonl(INADDR_ANY);
-    a.sin_port = htons(port);
-    if (::bind(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0)
-      return Error{"", "", fmt::format("cannot listen on UDP port {}: {}", port, std::strerror(errno))};
-    socklen_t len = sizeof a;
-    ::getsockname(fd_, reinterpret_cast<sockaddr*>(&a), &len);
-    port_ = ntohs(a.sin_port);
-    return {};
-  }
-  uint16_t port() const { return port_; }
-  // One waiting datagram into `bytes` (false when none); its sender into `from`.
-  bool receive(std::vector<uint8_t>& bytes, sockaddr_in& from) {
-    bytes.resize(65536);
-    socklen_t len = sizeof from;
-    const ssize_t n = ::recvfrom(fd_, bytes.data(), bytes.size(), 0,
-                                 reinterpret_cast<sockaddr*>(&from), &len);
-    if (n < 0) return false;
-    bytes.resize(size_t(n));
-    return true;
-  }
-  void send(const std::vector<uint8_t>& bytes, const sockaddr_in& to) {
-    ::sendto(fd_, bytes.data(), bytes.size(), 0, reinterpret_cast<const sockaddr*>(&to), sizeof to);
-  }
-
- private:
-  int fd_ = -1;
-  uint16_t port_ = 0;
-};
 
 // Each pixel of `image` shown r × r times in `out`, cropped to width × height (pixel
 // replication): each source row expanded once, then copied r times. `out` keeps its memory from
@@ -187,11 +144,9 @@ Result<std::unique_ptr<IgLoop>> IgLoop::create(const IgConfig& config,
     if (Status s = m.socket.open(config.port); !s) return s.error();
     m.network = true;
     if (config.hostPort != 0) {
-      m.host.sin_family = AF_INET;
-      m.host.sin_port = htons(config.hostPort);
-      if (::inet_pton(AF_INET, config.hostAddress.c_str(), &m.host.sin_addr) != 1)
-        return Error{"", "", fmt::format("host address \"{}\" is not a dotted IPv4 address",
-                                         config.hostAddress)};
+      Result<sockaddr_in> host = udpAddress(config.hostAddress, config.hostPort);
+      if (!host) return host.error();
+      m.host = host.value();
       m.hostKnown = true;
     }
   }
