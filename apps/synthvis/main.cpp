@@ -2,7 +2,7 @@
 //
 //   synthvis render [SCENE] -o out.png [--width W] [--height H] [--threads T] [--camera I]
 //                   [--channels N [--arc DEG]] [--mosaic FILE]
-//                   [--no-cull] [--debug-view overdraw|levels|occupancy] [--gamma G]
+//                   [--no-cull] [--no-instance-cull] [--debug-view overdraw|levels|occupancy] [--gamma G]
 //                   [--supersample K] [--aa 1|4|8|16|64] [--filter box|tent3]
 //                   [--texture-filter point|nearest|tri3|bilinear|trilinear3|trilinear|aniso]
 //                   [--hsr zbuffer|priority|hybrid]
@@ -79,6 +79,7 @@ struct RenderArgs {
   std::string freeform = "raycast";
   std::string terrainFilter = "scene";
   bool noCull = false;
+  bool noInstanceCull = false;
   // Display channels (SPEC §9): N abutting channels in an arc of `arc` degrees (0: N times the
   // camera's horizontal field of view) for a scene without channels of its own; the mosaic file.
   int channels = 0;
@@ -153,6 +154,7 @@ int renderChannels(const RenderArgs& a, const sv::scene::Scene& scene, sv::Rende
 int runRender(const RenderArgs& a) {
   sv::RenderOptions o = a.options;
   o.cullBackFaces = !a.noCull;
+  o.cullInstances = !a.noInstanceCull;
   auto filter = parseFilter(a.filter);
   if (!filter) return fail(filter.error());
   o.filter = filter.value();
@@ -661,6 +663,8 @@ void addRenderOptions(CLI::App* render, RenderArgs& r) {
                      "simulation time in seconds (blinking and sequenced light points, the "
                      "stars' rotation); default: the scene's own");
   render->add_flag("--no-cull", r.noCull, "draw back faces of single-sided materials too");
+  render->add_flag("--no-instance-cull", r.noInstanceCull,
+                   "transform every instance, also those wholly outside the view");
   render->add_option("--debug-view", r.debugView,
                      "false-colour diagnostic image: overdraw, levels or occupancy (with --hsr "
                      "priority or hybrid)");
@@ -740,6 +744,8 @@ int main(int argc, char** argv) {
   bench->add_option("--width", b.options.width, "image width")->capture_default_str();
   bench->add_option("--height", b.options.height, "image height")->capture_default_str();
   bench->add_option("--threads", b.options.threads, "worker threads")->capture_default_str();
+  bench->add_flag("--no-instance-cull", [&b](int64_t) { b.options.cullInstances = false; },
+                  "transform every instance, also those wholly outside the view");
   bench->add_option("--frames", b.frames, "timed frames")->capture_default_str();
   bench->add_option("--warmup", b.warmup, "untimed frames first")->capture_default_str();
   bench

@@ -15,6 +15,9 @@ struct FrameStats {
   // earlier batches occupied, dropped before setup (object-space culling, SPEC §4).
   uint64_t culledOccluded = 0;
   uint64_t drawn = 0;
+  // Instances dropped whole before the vertex stage (RenderOptions::cullInstances); their
+  // triangles count in trianglesIn and culledOutside.
+  uint64_t culledInstances = 0;
   uint64_t windows[6] = {};
   uint64_t fullWindows = 0, partialBlocks = 0, fragments = 0;
   uint64_t hiddenFragments = 0;  // fragments of which the depth test passed no sample

@@ -7,13 +7,16 @@ namespace sv {
 
 std::string FrameStats::summary() const {
   return fmt::format(
-             "triangles in {} / culled {} (facing {}, outside {}, degenerate {}, invalid {}{}) / "
+             "triangles in {} / culled {} (facing {}, outside {}{}, degenerate {}, invalid {}{}) / "
              "drawn {} "
              "| windows 64:{} 32:{} 16:{} 8:{} 4:{} px-tests:{} full:{} occluded:{} (triangles {}, "
              "objects {}{}) | fragments {} (hidden {}{}) | {:.2f} ms (vertex {:.2f}, setup {:.2f}, "
              "tiles "
              "{:.2f} incl. resolve)",
-             trianglesIn, culled(), culledFacing, culledOutside, culledDegenerate, culledInvalid,
+             trianglesIn, culled(), culledFacing, culledOutside,
+             culledInstances ? fmt::format(" of which {} instances whole", culledInstances)
+                             : std::string(),
+             culledDegenerate, culledInvalid,
              culledOccluded ? fmt::format(", occluded {}", culledOccluded) : std::string(), drawn,
              windows[0], windows[1], windows[2], windows[3], windows[4], windows[5], fullWindows,
              occludedWindows, occludedTriangles, occludedObjects,

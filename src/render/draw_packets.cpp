@@ -100,6 +100,32 @@ bool meshBounds(const scene::Scene& scene, const RenderOptions& o,
   return true;
 }
 
+// Whether the box [lo, hi] placed by `mvp` lies wholly beyond one plane of the view volume, or
+// wholly behind the eye: then every triangle inside it is culled in setup (geometry/setup.cpp's
+// outcodes; the planes are linear in the box's points, so what holds for its corners holds
+// inside). With a margin of 1e-5·|w|, so that rounding between the corners' transform and the
+// vertices' can never drop a triangle setup would have kept. Never for a box that is not finite.
+bool outsideView(const Mat4& mvp, Vec3 lo, Vec3 hi) {
+  unsigned common = 63;
+  bool allBehind = true;
+  for (int c = 0; c < 8; ++c) {
+    const Vec4 v = mvp * Vec4{c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z, 1};
+    if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z) || !std::isfinite(v.w))
+      return false;
+    const float m = v.w + 1e-5f * std::fabs(v.w);
+    unsigned code = 0;
+    if (v.x < -m) code |= 1;
+    if (v.x > m) code |= 2;
+    if (v.y < -m) code |= 4;
+    if (v.y > m) code |= 8;
+    if (v.z < -m) code |= 16;
+    if (v.z > m) code |= 32;
+    common &= code;
+    allBehind = allBehind && v.w < 0;
+  }
+  return common != 0 || allBehind;
+}
+
 // The frame's layout: one call per instance, opaque materials first, then translucent ones (SPEC
 // §4: blended over what is behind them), each with its vertex and index jobs; `stored` gathers the
 // attributes the calls' materials read. Sizes `p`'s vertices and indices.
@@ -113,6 +139,14 @@ Status layOutCalls(const scene::Scene& scene, const RenderOptions& o, const Fram
   const Mat4 viewProj = camera.projection * camera.view;
   const geometry::Viewport boundViewport{o.width * o.supersample, o.height * o.supersample};
   const std::vector<uint32_t> order = drawOrder(scene, camera.view, o.hsr, boxes);
+  // Each mesh's bounds for culling whole instances: those the draw order computed, or now.
+  std::vector<std::array<Vec3, 2>> cullBoxes;
+  if (o.cullInstances && boxes.empty()) {
+    cullBoxes.reserve(scene.meshes.size());
+    for (const scene::Mesh& m : scene.meshes) cullBoxes.push_back(m.bounds());
+  }
+  const std::vector<std::array<Vec3, 2>>& bounds = boxes.empty() ? cullBoxes : boxes;
+  p.culledInstances = p.culledTriangles = 0;
   size_t vertexCount = 0, indexCount = 0;
   for (const bool translucentPass : {false, true})
     for (const uint32_t instance : order) {
@@ -120,6 +154,13 @@ Status layOutCalls(const scene::Scene& scene, const RenderOptions& o, const Fram
       const scene::Mesh& mesh = scene.meshes[inst.mesh];
       const scene::Material& mat = scene.materialAt(mesh.material);
       if ((mat.alphaMode == scene::AlphaMode::blend) != translucentPass) continue;
+      if (o.cullInstances &&
+          outsideView(viewProj * inst.transform, bounds[size_t(inst.mesh)][0],
+                      bounds[size_t(inst.mesh)][1])) {
+        ++p.culledInstances;
+        p.culledTriangles += mesh.triangleCount();
+        continue;
+      }
       // Indices are 32-bit; a frame of more vertices or triangles than that cannot be expressed.
       if (vertexCount + mesh.positions.size() > (size_t(1) << 31) ||
           indexCount + mesh.indices.size() > (size_t(1) << 31))

@@ -38,6 +38,9 @@ struct DrawPackets {
   geometry::AttributeLayout attributeLayout;
   std::vector<uint32_t> indices;  // 3 per triangle, each < vertices.size()
   std::vector<DrawCall> calls;    // in draw order (buildDrawPackets)
+  // Instances left out wholly outside the view volume (RenderOptions::cullInstances), and their
+  // triangles.
+  uint64_t culledInstances = 0, culledTriangles = 0;
 };
 
 // Builds `out` for the scene seen by `camera`: one call per instance in draw order (drawOrder:

@@ -169,7 +169,9 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
   const Frame f = frameOf(packets, settings);
   prepareBuffers(packets, f);
   preparePasses(settings, f);
-  stats.trianglesIn += f.triangles;
+  stats.trianglesIn += f.triangles + packets.culledTriangles;
+  stats.culledOutside += packets.culledTriangles;
+  stats.culledInstances += packets.culledInstances;
   // Always run at least one (empty) batch, so the tiles get cleared.
   for (uint32_t begin = 0; begin == 0 || begin < f.triangles; begin += f.batchTriangles) {
     Batch batch;

@@ -472,6 +472,62 @@ TEST(ObjectCulling, HiddenInstancesAreDroppedWholeWithTheZBufferImage) {
   }
 }
 
+// Instances wholly outside the view volume are dropped before the vertex stage
+// (RenderOptions::cullInstances): a field of boxes all around the eye — in front, behind, beyond
+// every side and the far plane, straddling the edges and the near plane — gives the same image,
+// with the same counts, as transforming every instance, for every hidden-surface method and with
+// anti-aliasing, on one channel and on three.
+TEST(ObjectCulling, InstancesOutsideTheViewAreDroppedWithTheSameImage) {
+  scene::Scene s;
+  scene::Camera cam;
+  cam.position = {0, 1, 0};
+  cam.target = {0.3f, 0.8f, -1};
+  cam.znear = 0.2f;
+  cam.zfar = 40;
+  s.cameras.push_back(cam);
+  scene::Material grey;
+  grey.baseColor = {0.6f, 0.6f, 0.6f, 1};
+  s.materials = {grey};
+  scene::Mesh box = scene::detail::makeBox({0.8f, 0.8f, 0.8f});
+  box.material = 0;
+  s.meshes = {box};
+  for (int x = -12; x <= 12; ++x)
+    for (int z = -30; z <= 12; z += 2)
+      s.instances.push_back(
+          {0, Mat4::translation({float(x) * 1.7f, float((x * 7 + z) % 5) * 0.9f - 1, float(z) * 1.3f})});
+  s.instances.push_back({0, Mat4::translation({0, 1, -0.3f})});  // cut by the near plane
+  for (int samples : {1, 16})
+    for (auto hsr : {RenderOptions::Hsr::zbuffer, RenderOptions::Hsr::priority}) {
+      RenderOptions o;
+      o.width = 160;
+      o.height = 120;
+      o.threads = 2;
+      o.samples = samples;
+      o.hsr = hsr;
+      Image culled, all;
+      FrameStats withCulling, without;
+      ASSERT_TRUE(Renderer(o).render(s, culled, &withCulling).ok());
+      o.cullInstances = false;
+      ASSERT_TRUE(Renderer(o).render(s, all, &without).ok());
+      EXPECT_EQ(culled.rgb, all.rgb) << samples << " samples, " << hsrName(hsr);
+      EXPECT_GT(withCulling.culledInstances, s.instances.size() / 2);
+      EXPECT_EQ(without.culledInstances, 0u);
+      EXPECT_EQ(withCulling.trianglesIn, without.trianglesIn);
+      EXPECT_EQ(withCulling.drawn, without.drawn);
+      EXPECT_EQ(withCulling.culled(), without.culled());
+    }
+  // Three channels in an arc: each channel culls against its own frustum.
+  s.channels = scene::arcChannels(3, 150, 120, 90);
+  RenderOptions o;
+  o.threads = 2;
+  std::vector<Image> culled, all;
+  ASSERT_TRUE(Renderer(o).renderChannels(s, culled).ok());
+  o.cullInstances = false;
+  ASSERT_TRUE(Renderer(o).renderChannels(s, all).ok());
+  ASSERT_EQ(culled.size(), 3u);
+  for (size_t c = 0; c < 3; ++c) EXPECT_EQ(culled[c].rgb, all[c].rgb) << "channel " << c;
+}
+
 // BENCH.md: "every pixel is covered D times" — counted by the renderer, in every order.
 TEST(LayersGenerator, EveryPixelIsCoveredDTimes) {
   for (auto order : {scene::SubmitOrder::random, scene::SubmitOrder::frontToBack,
