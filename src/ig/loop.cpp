@@ -87,9 +87,12 @@ struct IgLoop::Impl {
     return *r;
   }
 
-  // The host datagrams for frame `frame`: those waiting on the socket, or the replay's.
-  void hostDatagrams(uint32_t frame, std::vector<std::vector<uint8_t>>& out, bool& replayEnded) {
+  // The host datagrams for frame `frame`: those waiting on the socket, or the replay's — and then
+  // the quality level the recorded frame was drawn at (its Start of Frame's IG status).
+  void hostDatagrams(uint32_t frame, std::vector<std::vector<uint8_t>>& out, bool& replayEnded,
+                     int& recordedLevel) {
     out.clear();
+    recordedLevel = -1;
     if (!options.replay.empty()) {
       // A recording holds each frame's host datagrams, then the IG's Start of Frame for it.
       for (; replayAt < replay.size(); ++replayAt) {
@@ -101,6 +104,7 @@ struct IgLoop::Impl {
         Result<cigi::Datagram> ig = cigi::parseDatagram(d.bytes);
         const auto* sof = ig ? std::get_if<cigi::StartOfFrame>(&ig->packets.front()) : nullptr;
         if (sof && sof->igFrame >= frame) {
+          recordedLevel = sof->igStatus;
           ++replayAt;
           return;
         }
@@ -193,7 +197,7 @@ Result<IgRunReport> IgLoop::run() {
   // slowest), then three rounds over all levels, whose median per level is the governor's
   // calibration — what the levels cost against each other on this machine and this database.
   // Round by round, so that a slow moment of the machine weighs on every level alike.
-  if (!pattern && m.options.governor) {
+  if (!pattern && m.options.governor && m.options.replay.empty()) {
     const int levels = governor.levels();
     std::vector<std::vector<double>> times(static_cast<size_t>(levels));
     std::vector<double> works(static_cast<size_t>(levels));
@@ -232,7 +236,8 @@ Result<IgRunReport> IgLoop::run() {
     lastStart = start;
 
     // 1. The host's datagrams, applied in the order they came.
-    m.hostDatagrams(frame, incoming, replayEnded);
+    int recordedLevel = -1;
+    m.hostDatagrams(frame, incoming, replayEnded, recordedLevel);
     if (replayEnded && incoming.empty()) break;
     replies.clear();
     world.setFrame(frame);
@@ -255,11 +260,21 @@ Result<IgRunReport> IgLoop::run() {
       world.apply(d.value(), replies);
     }
 
-    // 2. Start of Frame and the answers, at once: the host sends its next frame on it.
+    // 2. The quality the deadline allows. A replay draws each frame at the level it was
+    // recorded at: the governor's choice depends on the machine's timing, the frame must not.
+    const scene::Scene& probe = world.frameScene(frame / m.config.rate);
+    const double work = double(probe.triangleCount() + probe.lightPoints.size());
+    int level = m.options.governor && !pattern ? governor.choose(work) : 0;
+    if (!m.options.replay.empty())
+      level = recordedLevel >= 0 && recordedLevel < governor.levels() ? recordedLevel : 0;
+
+    // 3. Start of Frame and the answers, at once: the host sends its next frame on it. The IG
+    // status is the quality level (0: full quality; docs/ig.md).
     cigi::StartOfFrame sof;
     sof.igFrame = frame;
     sof.lastHostFrame = world.lastHostFrame();
     sof.mode = world.mode();
+    sof.igStatus = uint8_t(level);
     sof.timestampValid = true;
     sof.timestamp = uint32_t(std::llround(msBetween(t0, start) * 100));  // 10 µs ticks
     replies.insert(replies.begin(), sof);
@@ -267,10 +282,7 @@ Result<IgRunReport> IgLoop::run() {
     if (m.network && m.hostKnown) m.socket.send(answer, m.host);
     if (m.recording) (void)m.recorder.add({msBetween(t0, start) / 1000, false, answer});
 
-    // 3. The frame at the quality the deadline allows.
-    const scene::Scene& probe = world.frameScene(frame / m.config.rate);
-    const double work = double(probe.triangleCount() + probe.lightPoints.size());
-    const int level = m.options.governor ? governor.choose(work) : 0;
+    // 4. The frame.
     const QualityLevel& q = governor.at(level);
     const scene::Scene& scene = world.frameScene(frame / m.config.rate, q.stars, q.replication);
     const Clock::time_point renderStart = Clock::now();
