@@ -39,6 +39,9 @@ double percentile(std::vector<double> v, double p) {
   return v[i];
 }
 
+// What the governor scales its estimates by: the frame's triangles and light points.
+double work(const scene::Scene& s) { return double(s.triangleCount() + s.lightPoints.size()); }
+
 // Each pixel of `image` shown r × r times in `out`, cropped to width × height (pixel
 // replication): each source row expanded once, then copied r times. `out` keeps its memory from
 // frame to frame (18 MB of fresh pages a frame for three 1080p channels cost more than the copy).
@@ -204,8 +207,8 @@ Result<IgRunReport> IgLoop::run() {
     for (int round = 0; round < 4; ++round)
       for (int level = 0; level < levels; ++level) {
         const QualityLevel& q = governor.at(level);
-        const scene::Scene& first = world.frameScene(0, q.stars, q.replication);
-        works[size_t(level)] = double(first.triangleCount() + first.lightPoints.size());
+        works[size_t(level)] = work(world.frameScene(0));
+        const scene::Scene& first = world.atQuality(q.stars, q.replication);
         const Clock::time_point warm = Clock::now();
         if (Status s = m.rendererFor(level, q.options).renderChannels(first, images, &stats); !s)
           return s.error();
@@ -262,9 +265,8 @@ Result<IgRunReport> IgLoop::run() {
 
     // 2. The quality the deadline allows. A replay draws each frame at the level it was
     // recorded at: the governor's choice depends on the machine's timing, the frame must not.
-    const scene::Scene& probe = world.frameScene(frame / m.config.rate);
-    const double work = double(probe.triangleCount() + probe.lightPoints.size());
-    int level = m.options.governor && !pattern ? governor.choose(work) : 0;
+    const double frameWork = work(world.frameScene(frame / m.config.rate));
+    int level = m.options.governor && !pattern ? governor.choose(frameWork) : 0;
     if (!m.options.replay.empty())
       level = recordedLevel >= 0 && recordedLevel < governor.levels() ? recordedLevel : 0;
 
@@ -284,7 +286,7 @@ Result<IgRunReport> IgLoop::run() {
 
     // 4. The frame.
     const QualityLevel& q = governor.at(level);
-    const scene::Scene& scene = world.frameScene(frame / m.config.rate, q.stars, q.replication);
+    const scene::Scene& scene = world.atQuality(q.stars, q.replication);
     const Clock::time_point renderStart = Clock::now();
     if (pattern) {
       images.resize(scene.channels.size());
@@ -334,7 +336,7 @@ Result<IgRunReport> IgLoop::run() {
     const Clock::time_point end = Clock::now();
     const double ms = msBetween(start, end);
     // The deadline is the whole frame's: the governor learns what a frame costs, start to shown.
-    if (!pattern) governor.record(level, work, ms);
+    if (!pattern) governor.record(level, frameWork, ms);
 
     frameMs.push_back(ms);
     loopMs.push_back(ms - renderMs);

@@ -284,10 +284,13 @@ void IgWorld::advance(double dt) {
   }
 }
 
-const scene::Scene& IgWorld::frameScene(double time, bool stars, int replication) {
+const scene::Scene& IgWorld::frameScene(double time) {
   scene::Scene& s = frame_;
   s.time = time;
-  s.stars = base_.stars;
+  // The star field's settings as the database has them (its catalogue stays in place: frame_
+  // began as a copy of the database and the stars themselves never change).
+  s.stars.brightness = base_.stars.brightness;
+  s.stars.limit = base_.stars.limit;
   // The entities' models at their poses.
   s.instances.resize(baseInstances_);
   for (uint16_t id = 0; id < entities_.size(); ++id) {
@@ -362,7 +365,14 @@ const scene::Scene& IgWorld::frameScene(double time, bool stars, int replication
                              ? base_.stars.brightness * (celestial_.starIntensity / 100) * (1 - day)
                              : 0;
   }
-  if (!stars) s.stars.stars.clear();
+  return s;
+}
+
+const scene::Scene& IgWorld::atQuality(bool stars, int replication) {
+  scene::Scene& s = frame_;
+  // No star is brighter than this limit (the Sun is −27): the light pass drops each on its
+  // magnitude alone.
+  if (!stars) s.stars.limit = -1000;
   for (scene::Channel& ch : s.channels) {
     ch.width = (ch.width + replication - 1) / replication;
     ch.height = (ch.height + replication - 1) / replication;

@@ -41,9 +41,11 @@ class IgWorld {
   // The scene of this instant: the database, the entities' models at their poses, the eye on the
   // ownship (entity 0) with the views' offsets and frusta, fog from the visibility, the light
   // groups, the sun and stars from the time of day, and `time` (seconds since the start).
-  // Quality levels (overload.h): without `stars`, no star field; with `replication` r > 1, every
-  // channel ⌈width / r⌉ × ⌈height / r⌉ pixels, to be shown each pixel r × r times.
-  const scene::Scene& frameScene(double time, bool stars = true, int replication = 1);
+  const scene::Scene& frameScene(double time);
+  // That scene, once made, at a quality level (overload.h): without `stars`, no star field; with
+  // `replication` r > 1, every channel ⌈width / r⌉ × ⌈height / r⌉ pixels, to be shown each pixel
+  // r × r times. Changed in place: the next frameScene starts again from full quality.
+  const scene::Scene& atQuality(bool stars, int replication);
   // The channels' sizes as configured (before any replication).
   const std::vector<scene::Channel>& channels() const { return channels_; }
 
