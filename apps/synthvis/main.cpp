@@ -2,7 +2,7 @@
 //
 //   synthvis render [SCENE] -o out.png [--width W] [--height H] [--threads T] [--camera I]
 //                   [--channels N [--arc DEG]] [--mosaic FILE]
-//                   [--no-cull] [--no-instance-cull] [--debug-view overdraw|levels|occupancy] [--gamma G]
+//                   [--no-cull] [--no-instance-cull] [--no-lod] [--lod-scale S] [--debug-view overdraw|levels|occupancy] [--gamma G]
 //                   [--supersample K] [--aa 1|4|8|16|64] [--filter box|tent3]
 //                   [--texture-filter point|nearest|tri3|bilinear|trilinear3|trilinear|aniso]
 //                   [--hsr zbuffer|priority|hybrid]
@@ -230,6 +230,7 @@ struct GeneratorArgs {
   std::string terrainFilter = "bilinear";
   std::string stars = "auto";  // lights: the star catalogue, "auto" or "none"
   int lights = 100000;         // lights: light points per channel, stars included
+  sv::scene::CityParams city;
 };
 
 // lights --stars auto: xplanet's catalogue where Debian installs it, or where scripts/lib.sh
@@ -250,6 +251,9 @@ void addGeneratorOptions(CLI::App* app, GeneratorArgs& g) {
   app->add_option("--count", g.tris.count, "tris: number of triangles")->capture_default_str();
   app->add_option("--lights", g.lights, "lights: light points, stars included")
       ->capture_default_str();
+  app->add_option("--buildings", g.city.buildings, "city: buildings, one per 40 m block")
+      ->capture_default_str();
+  app->add_option("--trees", g.city.trees, "city: trees")->capture_default_str();
   app->add_option("--stars", g.stars,
                   "lights: the star catalogue (xplanet's BSC), auto (found where Debian or "
                   "scripts/lib.sh puts it) or none")
@@ -324,6 +328,8 @@ sv::Result<sv::reference::BenchCase> generatorCase(const std::string& kind,
   c.lights.count = g.lights;
   c.lights.seed = g.tris.seed;
   c.lights.starCatalog = starCatalog(g.stars);
+  c.city = g.city;
+  c.city.seed = g.tris.seed;
   return c;
 }
 
@@ -364,10 +370,11 @@ int runBench(BenchArgs a) {
     return fail({"", "", "give either a scene (a generator name or a file) or --suite quick|full"});
   if (a.renderer.empty()) a.renderer = a.suite.empty() ? "synthvis" : "both";
   if (a.renderer != "synthvis" && a.renderer != "gl" && a.renderer != "both" &&
-      a.renderer != "sphere-trace" && a.renderer != "tessellated")
+      a.renderer != "sphere-trace" && a.renderer != "tessellated" &&
+      a.renderer != "full-detail")
     return fail({"", "",
-                 fmt::format("unknown renderer '{}' (synthvis, gl, both, sphere-trace or "
-                             "tessellated)",
+                 fmt::format("unknown renderer '{}' (synthvis, gl, both, sphere-trace, "
+                             "tessellated or full-detail)",
                              a.renderer)});
   if (auto order = sv::scene::parseSubmitOrder(a.generator.order); !order)
     return fail(order.error());
@@ -411,6 +418,7 @@ int runBench(BenchArgs a) {
   settings.synthvis = a.renderer != "gl";
   settings.sphereTrace = a.renderer == "sphere-trace";
   settings.tessellated = a.renderer == "tessellated";
+  settings.fullDetail = a.renderer == "full-detail";
   settings.reference = a.renderer == "gl" || a.renderer == "both";
   ref::BenchRunner runner(settings);
   if (settings.reference) {
@@ -665,6 +673,12 @@ void addRenderOptions(CLI::App* render, RenderArgs& r) {
   render->add_flag("--no-cull", r.noCull, "draw back faces of single-sided materials too");
   render->add_flag("--no-instance-cull", r.noInstanceCull,
                    "transform every instance, also those wholly outside the view");
+  render->add_flag("--no-lod", [&r](int64_t) { r.options.lod = false; },
+                   "draw every instance at full detail (level 0) at every range");
+  render->add_option("--lod-scale", r.options.lodScale,
+                     "multiplies every level-of-detail range (2: coarser levels at half the "
+                     "distance)")
+      ->capture_default_str();
   render->add_option("--debug-view", r.debugView,
                      "false-colour diagnostic image: overdraw, levels or occupancy (with --hsr "
                      "priority or hybrid)");
@@ -746,6 +760,10 @@ int main(int argc, char** argv) {
   bench->add_option("--threads", b.options.threads, "worker threads")->capture_default_str();
   bench->add_flag("--no-instance-cull", [&b](int64_t) { b.options.cullInstances = false; },
                   "transform every instance, also those wholly outside the view");
+  bench->add_flag("--no-lod", [&b](int64_t) { b.options.lod = false; },
+                  "draw every instance at full detail (level 0) at every range");
+  bench->add_option("--lod-scale", b.options.lodScale, "multiplies every level-of-detail range")
+      ->capture_default_str();
   bench->add_option("--frames", b.frames, "timed frames")->capture_default_str();
   bench->add_option("--warmup", b.warmup, "untimed frames first")->capture_default_str();
   bench
@@ -770,7 +788,8 @@ int main(int argc, char** argv) {
                     "synthvis, gl (Mesa llvmpipe) or both, alternating frames; sphere-trace: "
                     "synthvis against its free forms marched in fixed steps (--march-steps); "
                     "tessellated: against its free forms as triangles (the gl reference always "
-                    "draws those); "
+                    "draws those); full-detail: against every instance transformed at full "
+                    "detail (no instance culling, no levels of detail); "
                     "default: synthvis for a scene, both for a suite");
   bench
       ->add_option("--march-steps", b.options.marchSteps,

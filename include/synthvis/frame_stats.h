@@ -18,6 +18,13 @@ struct FrameStats {
   // Instances dropped whole before the vertex stage (RenderOptions::cullInstances); their
   // triangles count in trianglesIn and culledOutside.
   uint64_t culledInstances = 0;
+  // Levels of detail (Scene::lodGroups): instances of a group drawn at each level (a dissolving
+  // instance counts at both of its levels), those dissolving between two, and those beyond their
+  // last level's range (drawn at none; their full-detail triangles count in trianglesIn and
+  // culledOutside).
+  static constexpr int kLodLevels = 8;
+  uint64_t lodDrawn[kLodLevels] = {};
+  uint64_t lodDissolving = 0, lodBeyond = 0;
   uint64_t windows[6] = {};
   uint64_t fullWindows = 0, partialBlocks = 0, fragments = 0;
   uint64_t hiddenFragments = 0;  // fragments of which the depth test passed no sample
@@ -55,6 +62,7 @@ struct FrameStats {
   }
   // One line: triangles in / culled / drawn, windows per level, milliseconds.
   std::string summary() const;
+  std::string lodSummary() const;  // the summary's levels-of-detail part ("" without any)
 };
 
 }  // namespace sv

@@ -20,9 +20,10 @@ enum class Generator : uint8_t {
   terrain,
   volume,
   lights,
+  city,
 };
 // By name, as BENCH.md and the CLI write them: "tris", "layers", "grazing", "freeform",
-// "freeform-one", "terrain", "volume", "lights"; an error lists them.
+// "freeform-one", "terrain", "volume", "lights", "city"; an error lists them.
 Result<Generator> parseGenerator(const std::string& name);
 const char* generatorName(Generator generator);  // "" for none
 // What a generator needs that is not built yet ("height fields", …), or nullptr.
@@ -127,6 +128,20 @@ struct LightsParams {
   std::string starCatalog;  // xplanet's BSC; empty: no stars
 };
 Result<Scene> generateLights(const LightsParams& params);
+
+// BENCH.md `city` (issue 32): a town of `buildings` blocks 40 m apart in a square, one building each
+// (eight kinds, 4–25 storeys, walls of separate window quads: 1 000–4 000 triangles; a 10-triangle
+// box beyond 250 m) turned by multiples of 90°, and `trees` trees scattered between them (three
+// kinds, scaled 0.8–1.3, turned: 420 triangles to 100 m, 72 to 400 m, 8 to 1.5 km, none beyond),
+// every level switch dissolving; on a ground quad, lit by the sun, with haze; the camera 150 m up
+// at the south-west corner looking across (60°, near 1 m, far 8 km). Instanced: one mesh per kind
+// and level; the instance tree built.
+struct CityParams {
+  int buildings = 10000;
+  int trees = 100000;
+  uint64_t seed = 1;
+};
+Scene generateCity(const CityParams& params);
 
 // The frame every generated scene shares: one instance of mesh 0 with material 0 (unlit,
 // double-sided, named `name`), the BENCH.md camera, no light, black background. No meshes yet.

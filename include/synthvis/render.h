@@ -26,6 +26,12 @@ struct RenderOptions {
   // eye) are dropped before the vertex stage: setup would cull each of their triangles anyway, so
   // the image is the same (FrameStats::culledInstances). False: every instance is transformed.
   bool cullInstances = true;
+  // Levels of detail (Scene::lodGroups): chosen by range, with dissolves across each switch, and
+  // nothing drawn beyond the last level. False: every instance at full detail (level 0) at every
+  // range. `lodScale` (> 0) multiplies every range: 2 switches to coarser levels at half the
+  // distance (the overload governor's lever on geometry).
+  bool lod = true;
+  float lodScale = 1;
   int camera = 0;             // index into Scene::cameras (a default camera if there is none)
   // False-colour diagnostics instead of the image (one sample per pixel): how many triangles
   // covered each pixel (no depth test); where the visible triangle's subdivision stopped (the

@@ -107,11 +107,50 @@ struct Mesh {
 
 // A mesh placed in the world.
 struct Instance {
-  int mesh = 0;  // index into Scene::meshes
+  int mesh = 0;  // index into Scene::meshes (with `lod`: its level 0, the full detail)
   Mat4 transform;
   // Priority for hidden-surface masking (SPEC §4, RenderOptions::hsr): opaque instances are drawn
   // in increasing priority, those of equal priority nearest first. 0 unless the scene says.
   int priority = 0;
+  // Levels of detail (SPEC §1 traversal): an index into Scene::lodGroups, whose level 0 is `mesh`;
+  // −1: `mesh` at every range.
+  int lod = -1;
+};
+
+// Levels of detail shared by the instances that name the group (docs/scene-format.md "Levels of
+// detail"). An instance draws level i while its range r lies in [levels[i−1].to, levels[i].to) and
+// nothing beyond the last level's `to`; r is the distance from the eye to the centre of the box
+// around all levels (in world units, through the instance's transform), times tan(v/2)/tan 30°
+// for the view's vertical half-angle v — the same projected size under a zoomed view — and times
+// RenderOptions::lodScale. Across the last `fade` units below each `to`, level i dissolves into
+// level i+1 (or into nothing) by complementary screen-door patterns: every pixel is drawn by
+// exactly one of the two, so nothing pops and nothing is drawn twice.
+struct LodLevel {
+  int mesh = 0;                  // index into Scene::meshes
+  float to = 1e30f;              // the range at which this level gives way to the next, > 0
+};
+struct LodGroup {
+  std::string name;
+  std::vector<LodLevel> levels;  // 1 … kMaxLodLevels, `to` increasing
+  float fade = 0;                // the dissolve band below each switch, ≥ 0, < each level's span
+};
+inline constexpr size_t kMaxLodLevels = 8;
+
+// A bounding-volume hierarchy over a scene's first `instanceCount` instances (their world boxes
+// around all their levels of detail), which the renderer culls against each view before the vertex
+// stage (SPEC §1 traversal). Those instances must not move, change mesh or change level of detail
+// group while the tree is held (rebuild it: buildInstanceTree); instances after them are culled one
+// by one.
+struct InstanceTree {
+  struct Node {
+    Vec3 lo, hi;               // world box of everything below
+    uint32_t first = 0;        // leaf: into `order`; inner: the first of two children, adjacent
+    uint32_t count = 0;        // leaf: its instances (> 0); 0: an inner node
+    uint64_t triangles = 0;    // below it, at full detail (statistics of what culling dropped)
+  };
+  std::vector<Node> nodes;     // nodes[0] the root (none for a scene without instances)
+  std::vector<uint32_t> order;  // instance indices, each leaf's a contiguous range
+  size_t instanceCount = 0;
 };
 
 // A free-form surface (SPEC §11; docs/scene-format.md "Free forms"): the quadric
@@ -248,6 +287,10 @@ struct Scene {
   Fog fog;
   std::vector<TextureMap> textures;
   Vec3 background{0.05f, 0.06f, 0.09f};
+  std::vector<LodGroup> lodGroups;
+  // The hierarchy over the first instances (buildInstanceTree), shared by copies of the scene;
+  // null: every instance is culled on its own.
+  std::shared_ptr<const InstanceTree> instanceTree;
   // Light points (SPEC §13; synthvis/light_points.h): drawn last, over everything, depth-tested.
   std::vector<LightAppearance> lightAppearances;
   std::vector<LightPoint> lightPoints;
@@ -267,6 +310,13 @@ struct Scene {
 // the renderer makes them as its vertex stage reads the data anyway, and asks for the full check
 // only to name the offender.
 Status validate(const Scene& scene, const std::string& file, bool vertexData = true);
+
+// Builds scene.instanceTree over all of its instances (valid meshes and transforms assumed: run
+// validate first). Binned by the centres of the instances' world boxes, leaves of at most 8.
+void buildInstanceTree(Scene& scene);
+// An instance's box in its own space around every level of detail it may draw.
+std::array<Vec3, 2> instanceBounds(const Scene& scene, const Instance& instance,
+                                   const std::vector<std::array<Vec3, 2>>& meshBounds);
 
 // Appends `other`'s meshes and materials to `scene`, placing each of `other`'s instances under
 // `transform`. Cameras and light of `other` are appended/ignored as documented in scene-format.md.

@@ -5,6 +5,16 @@
 
 namespace sv {
 
+// " | LOD 0:n 1:m …, dissolving d, beyond b" when some instance has levels of detail.
+std::string FrameStats::lodSummary() const {
+  int last = kLodLevels - 1;
+  while (last >= 0 && !lodDrawn[last]) --last;
+  if (last < 0 && !lodBeyond) return {};
+  std::string s = " | LOD";
+  for (int i = 0; i <= last; ++i) s += fmt::format(" {}:{}", i, lodDrawn[i]);
+  return s + fmt::format(", dissolving {}, beyond {}", lodDissolving, lodBeyond);
+}
+
 std::string FrameStats::summary() const {
   return fmt::format(
              "triangles in {} / culled {} (facing {}, outside {}{}, degenerate {}, invalid {}{}) / "
@@ -26,6 +36,7 @@ std::string FrameStats::summary() const {
                                                        shadedByList, shadedByScan)
                                          : std::string(),
              totalMs, vertexMs, setupMs, rasterMs) +
+         lodSummary() +
          (freeForms ? fmt::format(" | free forms {}: cells {} (masked {}), bounds {}, rays {}, "
                                   "hits {}",
                                   freeForms, freeFormCells, freeFormMaskedCells, freeFormBounds,

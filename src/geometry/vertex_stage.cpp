@@ -1,9 +1,9 @@
 // Based on: SPEC §8 (seed 002: Gouraud intensity, seed 003: the diffuse term n·l).
 //
-// Vertices are transformed several at once in SIMD lanes (Highway, dispatched per call), with
-// exactly the operations, in exactly the order, of the one-vertex code (VertexRun::vertex), so
-// every vertex gets the same bits whichever path takes it (tests/geometry/vertex_stage_test.cpp);
-// a range's last vertices, fewer than a vector, go through the one-vertex code itself.
+// Vertices are transformed several at once in SIMD lanes (Highway, dispatched per call), every
+// operation lane by lane in IEEE order (no fused multiply-add), so every vertex gets the same bits
+// on every target and in every split of a mesh into ranges (tests/geometry/vertex_stage_test.cpp);
+// a range's last vertices, fewer than a vector, run in the same lanes on a padded copy.
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "geometry/vertex_stage.cpp"
 #include "geometry/vertex_stage.h"
@@ -21,7 +21,7 @@
 namespace sv::geometry {
 namespace {
 
-// What every vertex of one call shares, and the one-vertex transform.
+// What every vertex of one call shares.
 struct VertexRun {
   VertexRun(const VertexArrays& mesh_, const VertexMaterial& material_, const Mat4& model_,
             const VertexContext& context_, const AttributeLayout* layout_)
@@ -40,66 +40,6 @@ struct VertexRun {
     vertexLit = lit && !material.phong;
     toLight = normalize(-light.direction);
     base = material.baseColor;
-  }
-
-  // Vertex i to *out, and its attributes to a[layout slots] when `a` is not null. Returns whether
-  // its position is finite.
-  bool vertex(size_t i, ClipVertex* out, float* a) const {
-    const Vec3 p = mesh.positions[i];
-    const bool finite = isFinite(p);
-    const Vec4 c = mvp * Vec4{p.x, p.y, p.z, 1};
-    Vec4 color = base;
-    if (mesh.colors) {
-      const Vec4 vc = mesh.colors[i];
-      color = {color.x * vc.x, color.y * vc.y, color.z * vc.z, color.w * vc.w};
-    }
-    Vec3 intensity{1, 1, 1};
-    if (vertexLit) {
-      const Vec3 n = normalize(normalToWorld.transformDirection(mesh.normals[i]));
-      Vec3 diffuse{0, 0, 0};
-      if (light.enabled) diffuse = light.color * std::max(0.0f, dot(n, toLight));
-      for (const PointLight& pl : context.pointLights) {
-        const Vec3 l = normalize(pl.position - model.transformPoint(p));
-        diffuse = diffuse + pl.color * std::max(0.0f, dot(n, l));
-      }
-      intensity = Vec3{light.ambient, light.ambient, light.ambient} + diffuse * (1 - light.ambient);
-    }
-    const float alpha = std::clamp(color.w, 0.0f, 1.0f);
-    *out = {c.x,
-            c.y,
-            c.z,
-            c.w,
-            std::clamp(color.x * intensity.x, 0.0f, 1.0f),
-            std::clamp(color.y * intensity.y, 0.0f, 1.0f),
-            std::clamp(color.z * intensity.z, 0.0f, 1.0f),
-            alpha};
-    if (a && layout->stored) {
-      auto put = [&](int k, float value) {
-        if (layout->stored >> k & 1) a[layout->slot[k]] = value;
-      };
-      if (layout->stored & (1u << kU | 1u << kV)) {
-        const Vec2 uv = mesh.uvs ? mesh.uvs[i] : Vec2{0, 0};
-        put(kU, uv.x * material.uvScale.x);
-        put(kV, uv.y * material.uvScale.y);
-      }
-      if (layout->stored & (1u << kNormalX | 1u << kNormalY | 1u << kNormalZ)) {
-        // Phong's normal; a mesh without normals (or an unlit material) gets none and is not lit.
-        const Vec3 n = lit && material.phong
-                           ? normalize(normalToEye.transformDirection(mesh.normals[i]))
-                           : Vec3{0, 0, 0};
-        put(kNormalX, n.x);
-        put(kNormalY, n.y);
-        put(kNormalZ, n.z);
-      }
-      if (layout->stored & (1u << kEyeX | 1u << kEyeY | 1u << kEyeZ)) {
-        const Vec3 e = modelView.transformPoint(p);
-        put(kEyeX, e.x);
-        put(kEyeY, e.y);
-        put(kEyeZ, e.z);
-      }
-      put(kAlpha, alpha);
-    }
-    return finite;
   }
 
   const VertexArrays& mesh;
@@ -179,10 +119,11 @@ bool TransformVertices(const VertexArrays& mesh, const VertexMaterial& material,
   const VF big = hn::Set(df, std::numeric_limits<float>::max());
   auto finiteLanes = hn::Eq(big, big);
   alignas(64) float position[4 * 16], color[4 * 16], attribute[kAttributeCount][16];
-  size_t i = begin;
-  for (; i + N <= end; i += N) {
+  // N vertices from m's index i on, written to o (and the attributes to dst); only the first
+  // `count` of them kept (a tail run on a padded copy).
+  auto run16 = [&](const VertexArrays& m, size_t i, ClipVertex* o, float* dst, size_t count) {
     V3 p;
-    hn::LoadInterleaved3(df, &mesh.positions[i].x, p.x, p.y, p.z);
+    hn::LoadInterleaved3(df, &m.positions[i].x, p.x, p.y, p.z);
     finiteLanes = hn::And(finiteLanes,
                           hn::And(hn::Le(hn::Abs(p.x), big),
                                   hn::And(hn::Le(hn::Abs(p.y), big), hn::Le(hn::Abs(p.z), big))));
@@ -193,14 +134,14 @@ bool TransformVertices(const VertexArrays& mesh, const VertexMaterial& material,
                       hn::Set(df, run.mvp.m[3][3]));
     VF r = hn::Set(df, run.base.x), g = hn::Set(df, run.base.y), b = hn::Set(df, run.base.z),
        a = hn::Set(df, run.base.w);
-    if (mesh.colors) {
+    if (m.colors) {
       VF vr, vg, vb, va;
-      hn::LoadInterleaved4(df, &mesh.colors[i].x, vr, vg, vb, va);
+      hn::LoadInterleaved4(df, &m.colors[i].x, vr, vg, vb, va);
       r = hn::Mul(r, vr), g = hn::Mul(g, vg), b = hn::Mul(b, vb), a = hn::Mul(a, va);
     }
     if (run.vertexLit) {
       V3 n;
-      hn::LoadInterleaved3(df, &mesh.normals[i].x, n.x, n.y, n.z);
+      hn::LoadInterleaved3(df, &m.normals[i].x, n.x, n.y, n.z);
       n = normalized(df, transform(df, run.normalToWorld, n, 0.0f));
       const DirectionalLight& light = run.light;
       V3 diffuse{hn::Zero(df), hn::Zero(df), hn::Zero(df)};
@@ -230,25 +171,24 @@ bool TransformVertices(const VertexArrays& mesh, const VertexMaterial& material,
     a = unitClamp(df, a);
     hn::StoreInterleaved4(c.x, c.y, c.z, cw, df, position);
     hn::StoreInterleaved4(unitClamp(df, r), unitClamp(df, g), unitClamp(df, b), a, df, color);
-    ClipVertex* o = out + (i - begin);
-    for (size_t j = 0; j < N; ++j) {
+    for (size_t j = 0; j < count; ++j) {
       std::memcpy(&o[j].x, position + 4 * j, 4 * sizeof(float));
       std::memcpy(&o[j].r, color + 4 * j, 4 * sizeof(float));
     }
-    if (!stored) continue;
+    if (!stored) return;
     auto put = [&](int k, VF v) {
       if (stored >> k & 1) hn::Store(v, df, attribute[k]);
     };
     if (stored & (1u << kU | 1u << kV)) {
       VF u = hn::Zero(df), v = hn::Zero(df);
-      if (mesh.uvs) hn::LoadInterleaved2(df, &mesh.uvs[i].x, u, v);
+      if (m.uvs) hn::LoadInterleaved2(df, &m.uvs[i].x, u, v);
       put(kU, hn::Mul(u, hn::Set(df, material.uvScale.x)));
       put(kV, hn::Mul(v, hn::Set(df, material.uvScale.y)));
     }
     if (stored & (1u << kNormalX | 1u << kNormalY | 1u << kNormalZ)) {
       V3 n{hn::Zero(df), hn::Zero(df), hn::Zero(df)};
       if (run.lit && material.phong) {
-        hn::LoadInterleaved3(df, &mesh.normals[i].x, n.x, n.y, n.z);
+        hn::LoadInterleaved3(df, &m.normals[i].x, n.x, n.y, n.z);
         n = normalized(df, transform(df, run.normalToEye, n, 0.0f));
       }
       put(kNormalX, n.x);
@@ -262,16 +202,36 @@ bool TransformVertices(const VertexArrays& mesh, const VertexMaterial& material,
       put(kEyeZ, e.z);
     }
     put(kAlpha, a);
-    float* dst = attributes + (i - begin) * stride;
     for (int k = 0; k < kAttributeCount; ++k)
       if (stored >> k & 1)
-        for (size_t j = 0; j < N; ++j) dst[j * stride + layout->slot[k]] = attribute[k][j];
+        for (size_t j = 0; j < count; ++j) dst[j * stride + layout->slot[k]] = attribute[k][j];
+  };
+  size_t i = begin;
+  for (; i + N <= end; i += N)
+    run16(mesh, i, out + (i - begin), stored ? attributes + (i - begin) * stride : nullptr, N);
+  if (i < end) {
+    // The tail, fewer than N vertices: the same lanes on a copy padded with its last vertex (so
+    // a mesh of a few vertices costs one vector pass, and computes exactly as the others).
+    alignas(64) Vec3 positions[16], normals[16];
+    alignas(64) Vec4 colors[16];
+    alignas(64) Vec2 uvs[16];
+    VertexArrays pad = mesh;
+    const size_t count = end - i;
+    for (size_t j = 0; j < N; ++j) {
+      const size_t k = i + std::min(j, count - 1);
+      positions[j] = mesh.positions[k];
+      if (mesh.normals) normals[j] = mesh.normals[k];
+      if (mesh.colors) colors[j] = mesh.colors[k];
+      if (mesh.uvs) uvs[j] = mesh.uvs[k];
+    }
+    pad.positions = positions;
+    pad.count = N;
+    if (mesh.normals) pad.normals = normals;
+    if (mesh.colors) pad.colors = colors;
+    if (mesh.uvs) pad.uvs = uvs;
+    run16(pad, 0, out + (i - begin), stored ? attributes + (i - begin) * stride : nullptr, count);
   }
-  bool finite = hn::AllTrue(df, finiteLanes);
-  for (; i < end; ++i)
-    finite &=
-        run.vertex(i, out + (i - begin), stored ? attributes + (i - begin) * stride : nullptr);
-  return finite;
+  return hn::AllTrue(df, finiteLanes);
 }
 
 }  // namespace HWY_NAMESPACE

@@ -300,8 +300,10 @@ const scene::Scene& IgWorld::frameScene(double time) {
         !pose(id, p))
       continue;
     const Mat4 place = modelMatrix(p.frame, p.position);
-    for (const scene::Instance& i : models_[size_t(e.model)].instances)
-      s.instances.push_back({i.mesh, place * i.transform, i.priority});
+    for (scene::Instance i : models_[size_t(e.model)].instances) {
+      i.transform = place * i.transform;
+      s.instances.push_back(i);
+    }
   }
   // The eye on the ownship (entity 0), when the host has made it; else the database's camera.
   s.channels = channels_;

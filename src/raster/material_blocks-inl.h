@@ -148,7 +148,8 @@ HWY_INLINE int shadeBlockMaterial(const TriangleSetup& t, const PlaneLanes& lane
   shade::shadeFragments(*a.material, env, f, rgba);
   const bool blend = a.material->alpha == shade::AlphaUse::blend;
   const bool cut = a.material->alpha == shade::AlphaUse::mask;
-  const auto passVec = hn::Set(di, static_cast<int32_t>(passBits));
+  // A dissolving level of detail's door (MaterialShading::door): its pixels of the block.
+  const auto passVec = hn::Set(di, static_cast<int32_t>(passBits & a.material->door));
   for (size_t i = 0; i < size_t(kBlockPixels); i += n) {
     auto pass = hn::RebindMask(df, hn::TestBit(passVec, hn::LoadU(di, kLaneBit + i)));
     if (cut) pass = hn::And(pass, hn::Gt(hn::LoadU(df, rgba[3] + i), hn::Zero(df)));
@@ -265,13 +266,16 @@ HWY_INLINE void writeSamples(const TriangleSetup& t, const PlaneLanes& lanes,
   const size_t n = hn::Lanes(df);
   const bool blend = m.alpha == shade::AlphaUse::blend;
   const bool cut = m.alpha == shade::AlphaUse::mask;
+  const hn::RebindToSigned<decltype(df)> di;
   alignas(32) float base[8];
   blockBases(t, lanes, gx, gy, base);
   for (size_t i = 0; i < size_t(kBlockPixels); i += n) {
     const auto p0 = hn::LoadU(du32, pass[0] + i), p1 = hn::LoadU(du32, pass[1] + i);
     if (hn::AllTrue(du32, hn::Eq(hn::Or(p0, p1), hn::Zero(du32)))) continue;
-    auto shown = hn::FirstN(df, n);  // all lanes
-    if (cut) shown = hn::Gt(hn::LoadU(df, rgba[3] + i), hn::Zero(df));
+    // All lanes, or a dissolving level of detail's door (MaterialShading::door).
+    auto shown = hn::RebindMask(df, hn::TestBit(hn::Set(di, static_cast<int32_t>(m.door)),
+                                                hn::LoadU(di, kLaneBit + i)));
+    if (cut) shown = hn::And(shown, hn::Gt(hn::LoadU(df, rgba[3] + i), hn::Zero(df)));
     const auto zPix = hn::Add(hn::Set(df, base[kDepth]), hn::LoadU(df, lanes.offset[kDepth] + i));
     for (int s = 0; s < samples; ++s) {
       const auto passed = hn::And(

@@ -148,6 +148,13 @@ Result<CaseScene> makeScene(const BenchCase& c, const RenderOptions& options) {
                   {"seed", l.seed},
                   {"layers", 1}};
     return out;
+  } else if (c.generator == scene::Generator::city) {
+    const scene::CityParams& p = c.city;
+    if (p.buildings < 1 || p.buildings > 1000000 || p.trees < 0 || p.trees > 10000000)
+      return Error{"", "", "city: buildings must be 1…1e6 and trees 0…1e7"};
+    out.scene = scene::generateCity(p);
+    out.params = {{"buildings", p.buildings}, {"trees", p.trees}, {"seed", p.seed}};
+    return out;
   } else if (c.generator == scene::Generator::none) {
     auto loaded = scene::loadScene(c.file);
     if (!loaded) return loaded.error();
@@ -220,7 +227,10 @@ Result<CaseResult> BenchRunner::run(const BenchCase& c) {
   RenderOptions marchOptions = s.options;
   marchOptions.freeFormMethod = RenderOptions::FreeFormMethod::march;
   std::optional<Renderer> marcher;
-  if (s.sphereTrace || s.tessellated) marcher.emplace(s.sphereTrace ? marchOptions : s.options);
+  RenderOptions fullDetailOptions = s.options;
+  fullDetailOptions.cullInstances = fullDetailOptions.lod = false;
+  if (s.sphereTrace || s.tessellated || s.fullDetail)
+    marcher.emplace(s.sphereTrace ? marchOptions : s.fullDetail ? fullDetailOptions : s.options);
   // Free forms as triangles, for the polygon baseline and for the gl reference.
   std::optional<scene::Scene> tessellated;
   if ((!sc.freeForms.empty() || !sc.terrains.empty()) && (s.tessellated || impl_->gl)) {
@@ -259,6 +269,17 @@ Result<CaseResult> BenchRunner::run(const BenchCase& c) {
                       {},
                       {},
                       {}};
+  } else if (s.fullDetail) {
+    ref = RendererRun{"full-detail",
+                      fmt::format("synthvis, every instance at full detail ({} triangles)",
+                                  sc.triangleCount()),
+                      {},
+                      0,
+                      0,
+                      0,
+                      {},
+                      {},
+                      {}};
   } else if (impl_->gl) {
     if (Status st = impl_->gl->load(polygons); !st) return st.error();
     ref = RendererRun{"gl", impl_->glDescription, {}, 0, 0, 0, {}, {}, {}};
@@ -271,9 +292,11 @@ Result<CaseResult> BenchRunner::run(const BenchCase& c) {
       const double ms = msSince(t0);
       if (i >= s.warmup) ours->frameMs.push_back(ms);
     }
-    if (ref && (s.sphereTrace || s.tessellated)) {
+    if (ref && (s.sphereTrace || s.tessellated || s.fullDetail)) {
       const auto t0 = Clock::now();
-      if (Status st = renderFrame(*marcher, s.sphereTrace ? sc : polygons, *ref, refImages); !st)
+      if (Status st = renderFrame(*marcher, s.sphereTrace || s.fullDetail ? sc : polygons, *ref,
+                                  refImages);
+          !st)
         return st.error();
       const double ms = msSince(t0);
       if (i >= s.warmup) ref->frameMs.push_back(ms);
@@ -294,7 +317,7 @@ Result<CaseResult> BenchRunner::run(const BenchCase& c) {
   if (ref) {
     finish(*ref);
     if (!ref->channelStats.empty()) ref->image = mosaic(refImages);
-    if (!s.sphereTrace && !s.tessellated)
+    if (!s.sphereTrace && !s.tessellated && !s.fullDetail)
       if (Status st = impl_->gl->readImage(ref->image); !st) return st.error();
     if (!r.runs.empty()) r.psnrDb = psnr(r.runs[0].image, ref->image);
     r.runs.push_back(std::move(*ref));

@@ -26,6 +26,7 @@ struct BenchCase {
   scene::FreeFormParams freeform;
   scene::TerrainParams terrain;
   scene::LightsParams lights;
+  scene::CityParams city;
   std::string file;
 };
 
@@ -75,6 +76,10 @@ struct BenchSettings {
   // Time, instead, synthvis on the scene with its free forms tessellated (tessellatedScene) — the
   // polygon baseline, renderer name "tessellated". (The gl reference always draws that scene.)
   bool tessellated = false;
+  // Time, instead, synthvis with the traversal's savings off — every instance transformed at full
+  // detail (RenderOptions cullInstances and lod false) — the baseline of issue 32's city, renderer
+  // name "full-detail".
+  bool fullDetail = false;
   // Count the gl reference's read-back (glReadPixels into an 8-bit image in memory) in its frame
   // time: synthvis's frame always ends with the image in memory.
   bool referenceReadback = false;

@@ -17,11 +17,12 @@ namespace {
 // range-checked).
 struct VertexJob {
   const scene::Instance* instance;
+  const scene::Mesh* mesh;  // the instance's level of detail
   bool indices;  // else vertices
   size_t begin, end, out;
   uint32_t base;  // the instance's first vertex in the frame (indices)
 };
-constexpr size_t kVertexChunk = 1 << 14, kIndexChunk = 1 << 16;
+constexpr size_t kVertexChunk = 1 << 14, kIndexChunk = 1 << 16, kGroupWork = 4096;
 
 // Every vertex and index the frame draws is checked as the vertex stage reads it, not in a pass of
 // its own; the full check runs only to name an offender. (A mesh no instance draws is left to the
@@ -45,146 +46,135 @@ geometry::VertexMaterial toVertexMaterial(const scene::Material& m) {
   return {m.baseColor, m.uvScale, m.unlit, m.phong};
 }
 
-// The order instances are drawn in (indices into scene.instances). Opaque ones: in submission
+// The order the traversal's draws are drawn in (indices into `draws`). Opaque ones: in submission
 // order for the Z-buffer; for masking (SPEC §4) by priority, then nearest first — by the smallest
 // view depth of their bounding box's corners, which orders objects separated in depth correctly
 // (docs/hidden-surfaces.md). Translucent ones, always: farthest first by the view depth of their
 // box's centre, so that nearer ones blend over farther ones. Stable: ties keep submission order.
-// `boxes`: every mesh's bounds (Mesh::bounds), or empty when neither sort applies.
-std::vector<uint32_t> drawOrder(const scene::Scene& scene, const Mat4& view, RenderOptions::Hsr hsr,
-                                const std::vector<std::array<Vec3, 2>>& boxes) {
-  std::vector<uint32_t> order(scene.instances.size());
+// `boxes`: every mesh's bounds; `sort`: whether either sort applies.
+std::vector<uint32_t> drawOrder(const scene::Scene& scene, const std::vector<InstanceDraw>& draws,
+                                const Mat4& view, RenderOptions::Hsr hsr,
+                                const std::vector<std::array<Vec3, 2>>& boxes, bool sort) {
+  std::vector<uint32_t> order(draws.size());
   std::iota(order.begin(), order.end(), 0u);
-  if (boxes.empty()) return order;
+  if (!sort) return order;
   const bool sortOpaque = hsr != RenderOptions::Hsr::zbuffer;
-  // Per instance the view depths of its mesh's box's corners.
+  // Per draw the view depths of its mesh's box's corners.
   std::vector<float> nearest(order.size()), centre(order.size());
   for (size_t i = 0; i < order.size(); ++i) {
-    const scene::Instance& inst = scene.instances[i];
-    const auto& [lo, hi] = boxes[size_t(inst.mesh)];
+    const scene::Instance& inst = scene.instances[draws[i].instance];
+    const auto& [lo, hi] = boxes[size_t(draws[i].mesh)];
     const Mat4 toEye = view * inst.transform;
     nearest[i] = nearestEyeDepth(toEye, lo, hi);
     centre[i] = -toEye.transformPoint((lo + hi) * 0.5f).z;
   }
   auto translucent = [&](uint32_t i) {
-    const int m = scene.meshes[size_t(scene.instances[i].mesh)].material;
+    const int m = scene.meshes[size_t(draws[i].mesh)].material;
     return m >= 0 && scene.materials[size_t(m)].alphaMode == scene::AlphaMode::blend;
   };
+  auto priority = [&](uint32_t i) { return scene.instances[draws[i].instance].priority; };
   std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
     const bool ta = translucent(a), tb = translucent(b);
     if (ta != tb) return tb;  // opaque first (the passes pick them out again)
     if (ta) return centre[a] > centre[b];
     if (!sortOpaque) return false;
-    if (scene.instances[a].priority != scene.instances[b].priority)
-      return scene.instances[a].priority < scene.instances[b].priority;
+    if (priority(a) != priority(b)) return priority(a) < priority(b);
     return nearest[a] < nearest[b];
   });
   return order;
 }
 
-// Every mesh's bounds, for the draw order and the objects' screen bounds, when they are needed
-// (masking, or some translucent material); else nothing. False for a bound that is not finite (an
-// infinite position, not yet checked — the vertex stage checks them — would give the draw order
-// NaN depths to sort by).
+// Every mesh's bounds, for the traversal, the draw order and the objects' screen bounds. False for
+// a bound that is not finite where a sort needs it (an infinite position, not yet checked — the
+// vertex stage checks them — would give the draw order NaN depths to sort by). `sort`: whether the
+// draw order sorts (masking, or some translucent material).
 bool meshBounds(const scene::Scene& scene, const RenderOptions& o,
-                std::vector<std::array<Vec3, 2>>& boxes) {
+                std::vector<std::array<Vec3, 2>>& boxes, bool& sort) {
   bool anyTranslucent = false;
   for (const scene::Material& m : scene.materials)
     anyTranslucent |= m.alphaMode == scene::AlphaMode::blend;
-  if (o.hsr == RenderOptions::Hsr::zbuffer && !anyTranslucent) return true;
+  sort = o.hsr != RenderOptions::Hsr::zbuffer || anyTranslucent;
+  boxes.clear();
+  boxes.reserve(scene.meshes.size());
   for (const scene::Mesh& m : scene.meshes) {
     boxes.push_back(m.bounds());
-    for (const Vec3& corner : boxes.back())
-      if (!isFinite(corner)) return false;
+    if (sort)
+      for (const Vec3& corner : boxes.back())
+        if (!isFinite(corner)) return false;
   }
   return true;
 }
 
-// Whether the box [lo, hi] placed by `mvp` lies wholly beyond one plane of the view volume, or
-// wholly behind the eye: then every triangle inside it is culled in setup (geometry/setup.cpp's
-// outcodes; the planes are linear in the box's points, so what holds for its corners holds
-// inside). With a margin of 1e-5·|w|, so that rounding between the corners' transform and the
-// vertices' can never drop a triangle setup would have kept. Never for a box that is not finite.
-bool outsideView(const Mat4& mvp, Vec3 lo, Vec3 hi) {
-  unsigned common = 63;
-  bool allBehind = true;
-  for (int c = 0; c < 8; ++c) {
-    const Vec4 v = mvp * Vec4{c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z, 1};
-    if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z) || !std::isfinite(v.w))
-      return false;
-    const float m = v.w + 1e-5f * std::fabs(v.w);
-    unsigned code = 0;
-    if (v.x < -m) code |= 1;
-    if (v.x > m) code |= 2;
-    if (v.y < -m) code |= 4;
-    if (v.y > m) code |= 8;
-    if (v.z < -m) code |= 16;
-    if (v.z > m) code |= 32;
-    common &= code;
-    allBehind = allBehind && v.w < 0;
+// The material a dissolving draw reads: `base` with its door, kept in `p` for the frame (one per
+// base and door). Opaque materials become cut-outs (AlphaUse::mask with no alpha threshold):
+// pixels outside the door are cut away, and what they would hide stays drawn.
+const shade::MaterialShading* doorMaterial(const shade::MaterialShading* base, uint16_t door,
+                                           DrawPackets& p) {
+  for (const auto& [from, m] : p.doorMaterials)
+    if (from == base && m.door == door) return &m;
+  shade::MaterialShading m = *base;
+  m.door = door;
+  if (m.alpha == shade::AlphaUse::opaque) {
+    m.alpha = shade::AlphaUse::mask;
+    m.alphaCutoff = -1;  // every alpha passes: only the door cuts
   }
-  return common != 0 || allBehind;
+  return &p.doorMaterials.emplace_back(base, m).second;
 }
 
-// The frame's layout: one call per instance, opaque materials first, then translucent ones (SPEC
-// §4: blended over what is behind them), each with its vertex and index jobs; `stored` gathers the
-// attributes the calls' materials read. Sizes `p`'s vertices and indices.
+// The frame's layout: one call per draw the traversal chose, opaque materials first, then
+// translucent ones (SPEC §4: blended over what is behind them), each with its vertex and index
+// jobs; `stored` gathers the attributes the calls' materials read. Sizes `p`'s vertices and
+// indices.
 Status layOutCalls(const scene::Scene& scene, const RenderOptions& o, const FrameCamera& camera,
                    const ShadingTables* shading, DrawPackets& p, std::vector<VertexJob>& jobs,
                    unsigned& stored) {
-  std::vector<std::array<Vec3, 2>> boxes;
-  if (!meshBounds(scene, o, boxes)) return invalidVertexData(scene);
+  std::vector<std::array<Vec3, 2>>& boxes = p.meshBounds;
+  bool sort = false;
+  if (!meshBounds(scene, o, boxes, sort)) return invalidVertexData(scene);
   const bool masking =
       o.hsr != RenderOptions::Hsr::zbuffer && o.debugView != RenderOptions::DebugView::overdraw;
   const Mat4 viewProj = camera.projection * camera.view;
   const geometry::Viewport boundViewport{o.width * o.supersample, o.height * o.supersample};
-  const std::vector<uint32_t> order = drawOrder(scene, camera.view, o.hsr, boxes);
-  // Each mesh's bounds for culling whole instances: those the draw order computed, or now.
-  std::vector<std::array<Vec3, 2>> cullBoxes;
-  if (o.cullInstances && boxes.empty()) {
-    cullBoxes.reserve(scene.meshes.size());
-    for (const scene::Mesh& m : scene.meshes) cullBoxes.push_back(m.bounds());
-  }
-  const std::vector<std::array<Vec3, 2>>& bounds = boxes.empty() ? cullBoxes : boxes;
-  p.culledInstances = p.culledTriangles = 0;
+  traverse(scene, o, camera, boxes, p.traversal);
+  const std::vector<InstanceDraw>& draws = p.traversal.draws;
+  const std::vector<uint32_t> order = drawOrder(scene, draws, camera.view, o.hsr, boxes, sort);
+  p.doorMaterials.clear();
   size_t vertexCount = 0, indexCount = 0;
   for (const bool translucentPass : {false, true})
-    for (const uint32_t instance : order) {
-      const scene::Instance& inst = scene.instances[instance];
-      const scene::Mesh& mesh = scene.meshes[inst.mesh];
+    for (const uint32_t d : order) {
+      const InstanceDraw& draw = draws[d];
+      const scene::Instance& inst = scene.instances[draw.instance];
+      const scene::Mesh& mesh = scene.meshes[size_t(draw.mesh)];
       const scene::Material& mat = scene.materialAt(mesh.material);
       if ((mat.alphaMode == scene::AlphaMode::blend) != translucentPass) continue;
-      if (o.cullInstances &&
-          outsideView(viewProj * inst.transform, bounds[size_t(inst.mesh)][0],
-                      bounds[size_t(inst.mesh)][1])) {
-        ++p.culledInstances;
-        p.culledTriangles += mesh.triangleCount();
-        continue;
-      }
       // Indices are 32-bit; a frame of more vertices or triangles than that cannot be expressed.
       if (vertexCount + mesh.positions.size() > (size_t(1) << 31) ||
           indexCount + mesh.indices.size() > (size_t(1) << 31))
         return Error{"", "", "scene too large for one frame (over 2^31 vertices or indices)"};
       const auto base = static_cast<uint32_t>(vertexCount);
       for (size_t b = 0; b < mesh.positions.size(); b += kVertexChunk)
-        jobs.push_back({&inst, false, b, std::min(mesh.positions.size(), b + kVertexChunk),
+        jobs.push_back({&inst, &mesh, false, b, std::min(mesh.positions.size(), b + kVertexChunk),
                         vertexCount + b, base});
       for (size_t b = 0; b < mesh.indices.size(); b += kIndexChunk)
-        jobs.push_back(
-            {&inst, true, b, std::min(mesh.indices.size(), b + kIndexChunk), indexCount + b, base});
+        jobs.push_back({&inst, &mesh, true, b, std::min(mesh.indices.size(), b + kIndexChunk),
+                        indexCount + b, base});
       DrawCall call;
-      call.instance = instance;
+      call.instance = draw.instance;
       call.firstTriangle = static_cast<uint32_t>(indexCount / 3);
       call.triangleCount = static_cast<uint32_t>(mesh.triangleCount());
       call.cull =
           o.cullBackFaces && !mat.doubleSided ? geometry::CullMode::back : geometry::CullMode::none;
-      if (shading && (mat.needsPixelShading() || shading->environment.fog))
+      // A dissolving draw is always shaded per pixel: its door cuts pixels there (shading.any is
+      // set for a scene with dissolves, so `shading` is given).
+      if (shading && (mat.needsPixelShading() || shading->environment.fog || draw.door != 0xFFFF))
         call.material = shading->of(mesh.material, !mesh.normals.empty());
+      if (call.material && draw.door != 0xFFFF)
+        call.material = doorMaterial(call.material, draw.door, p);
       if (call.material) stored |= shade::attributesUsed(*call.material, shading->environment);
       if (masking)
         call.bounded =
-            geometry::boundObject(viewProj * inst.transform, boxes[size_t(inst.mesh)][0],
-                                  boxes[size_t(inst.mesh)][1], boundViewport, call.bound);
+            geometry::boundObject(viewProj * inst.transform, boxes[size_t(draw.mesh)][0],
+                                  boxes[size_t(draw.mesh)][1], boundViewport, call.bound);
       p.calls.push_back(call);
       vertexCount += mesh.positions.size();
       indexCount += mesh.indices.size();
@@ -227,9 +217,9 @@ Status buildDrawPackets(const scene::Scene& scene, const RenderOptions& o,
   for (const scene::PointLight& l : scene.pointLights) pointLights.push_back({l.position, l.color});
   context.pointLights = pointLights;
   std::vector<uint8_t> finite(jobs.size());  // positions finite, indices in range
-  pool.parallelFor(jobs.size(), [&](size_t j, int) {
+  auto run = [&](size_t j) {
     const VertexJob& job = jobs[j];
-    const scene::Mesh& mesh = scene.meshes[job.instance->mesh];
+    const scene::Mesh& mesh = *job.mesh;
     if (job.indices) {
       uint32_t maxIndex = 0;
       uint32_t* out = p.indices.data() + job.out;
@@ -244,6 +234,20 @@ Status buildDrawPackets(const scene::Scene& scene, const RenderOptions& o,
         toVertexArrays(mesh), toVertexMaterial(scene.materialAt(mesh.material)),
         job.instance->transform, context, job.begin, job.end, p.vertices.data() + job.out,
         stride ? p.attributes.data() + job.out * stride : nullptr, &p.attributeLayout);
+  };
+  // Small instances' jobs run in groups of consecutive ones (some 4 000 vertices and indices a
+  // group), so that a city of thousands of 20-vertex trees is not thousands of dispatches.
+  std::vector<size_t>& groups = p.jobGroups;
+  groups.assign(1, 0);
+  for (size_t j = 0, work = 0; j < jobs.size(); ++j) {
+    work += jobs[j].end - jobs[j].begin;
+    if (work >= kGroupWork || j + 1 == jobs.size()) {
+      groups.push_back(j + 1);
+      work = 0;
+    }
+  }
+  pool.parallelFor(groups.size() - 1, [&](size_t g, int) {
+    for (size_t j = groups[g]; j < groups[g + 1]; ++j) run(j);
   });
   if (std::find(finite.begin(), finite.end(), 0) != finite.end()) return invalidVertexData(scene);
   return {};

@@ -4,12 +4,14 @@
 
 #include <array>
 #include <cstdint>
+#include <deque>
 #include <vector>
 
 #include "core/thread_pool.h"
 #include "geometry/setup.h"
 #include "render/camera.h"
 #include "render/shading_tables.h"
+#include "render/traversal.h"
 
 namespace sv::render {
 
@@ -38,12 +40,17 @@ struct DrawPackets {
   geometry::AttributeLayout attributeLayout;
   std::vector<uint32_t> indices;  // 3 per triangle, each < vertices.size()
   std::vector<DrawCall> calls;    // in draw order (buildDrawPackets)
-  // Instances left out wholly outside the view volume (RenderOptions::cullInstances), and their
-  // triangles.
-  uint64_t culledInstances = 0, culledTriangles = 0;
+  // What the traversal chose (its draws, what it culled and the levels of detail drawn), and the
+  // frame's meshes' bounds.
+  Traversal traversal;
+  std::vector<std::array<Vec3, 2>> meshBounds;
+  // The materials of dissolving draws (each a scene material's with a door), for the frame.
+  std::deque<std::pair<const shade::MaterialShading*, shade::MaterialShading>> doorMaterials;
+  std::vector<size_t> jobGroups;  // the vertex stage's groups of jobs (their first, and the end)
 };
 
-// Builds `out` for the scene seen by `camera`: one call per instance in draw order (drawOrder:
+// Builds `out` for the scene seen by `camera`: one call per draw the traversal chose (traverse:
+// instances culled to the view, at their levels of detail) in draw order (drawOrder:
 // opaque ones first — by priority and distance under masking — then translucent ones, farthest
 // first), each with its culling mode, its material when `shading` is given (pixel shading; else
 // nullptr: vertex colours only) and, under masking, its object bound; every vertex transformed and

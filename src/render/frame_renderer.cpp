@@ -169,9 +169,13 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
   const Frame f = frameOf(packets, settings);
   prepareBuffers(packets, f);
   preparePasses(settings, f);
-  stats.trianglesIn += f.triangles + packets.culledTriangles;
-  stats.culledOutside += packets.culledTriangles;
-  stats.culledInstances += packets.culledInstances;
+  const Traversal& t = packets.traversal;
+  stats.trianglesIn += f.triangles + t.culledTriangles;
+  stats.culledOutside += t.culledTriangles;
+  stats.culledInstances += t.culledInstances;
+  for (int i = 0; i < FrameStats::kLodLevels; ++i) stats.lodDrawn[i] += t.lodDrawn[i];
+  stats.lodDissolving += t.lodDissolving;
+  stats.lodBeyond += t.lodBeyond;
   // Always run at least one (empty) batch, so the tiles get cleared.
   for (uint32_t begin = 0; begin == 0 || begin < f.triangles; begin += f.batchTriangles) {
     Batch batch;

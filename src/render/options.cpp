@@ -40,6 +40,8 @@ Status validate(const RenderOptions& o) {
     return Error{"", "", "the occupancy view shows masking: use --hsr priority or hybrid"};
   if (o.marchSteps < 1 || o.marchSteps > 1000000)
     return Error{"", "", fmt::format("{} march steps is out of range (1…1000000)", o.marchSteps)};
+  if (!(o.lodScale > 1e-6f && o.lodScale < 1e6f))
+    return Error{"", "", fmt::format("LOD scale {} is out of range (1e-6…1e6)", o.lodScale)};
   if (o.gamma != 0 && !(o.gamma >= 0.5 && o.gamma <= 5))
     return Error{"", "", fmt::format("gamma {} is out of range (0.5…5, or 0 for sRGB)", o.gamma)};
   return {};

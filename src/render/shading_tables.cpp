@@ -59,6 +59,9 @@ void buildShading(const scene::Scene& scene, const RenderOptions& o, const Mat4&
   env.fogBeta = scene.fog.beta;
   out.any = env.fog;
   for (const scene::Material& mat : scene.materials) out.any |= mat.needsPixelShading();
+  // A level of detail dissolving into the next is cut by its door in pixel shading.
+  if (o.lod)
+    for (const scene::LodGroup& g : scene.lodGroups) out.any |= g.fade > 0;
 }
 
 }  // namespace sv::render

@@ -9,7 +9,7 @@
 namespace sv::scene {
 namespace {
 
-constexpr std::array<std::pair<Generator, const char*>, 8> kGenerators = {{
+constexpr std::array<std::pair<Generator, const char*>, 9> kGenerators = {{
     {Generator::tris, "tris"},
     {Generator::layers, "layers"},
     {Generator::grazing, "grazing"},
@@ -18,6 +18,7 @@ constexpr std::array<std::pair<Generator, const char*>, 8> kGenerators = {{
     {Generator::terrain, "terrain"},
     {Generator::volume, "volume"},
     {Generator::lights, "lights"},
+    {Generator::city, "city"},
 }};
 
 }  // namespace

@@ -107,7 +107,10 @@ Result<Scene> loadScene(const std::string& path, const LoadOptions& options) {
   // library running out of memory, which becomes one more error value.
   try {
     detail::LoadContext context{options, {}, {}};
-    return detail::loadFile(path, context);
+    Result<Scene> scene = detail::loadFile(path, context);
+    // The traversal's hierarchy over the file's instances (they do not move once loaded).
+    if (scene) buildInstanceTree(scene.value());
+    return scene;
   } catch (const std::bad_alloc&) {
     return Error{path, "", "out of memory"};
   } catch (const std::exception& e) {

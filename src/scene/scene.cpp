@@ -196,6 +196,39 @@ Status validate(const Scene& scene, const std::string& file, bool vertexData) {
                               scene.meshes.size()));
     if (!isFinite(instance.transform))
       return fail(fmt::format("instances[{}]: transform is not finite", i));
+    if (instance.lod < -1 || (instance.lod >= 0 && size_t(instance.lod) >= scene.lodGroups.size()))
+      return fail(fmt::format("instances[{}]: level-of-detail group {} does not exist ({} groups)",
+                              i, instance.lod, scene.lodGroups.size()));
+    if (instance.lod >= 0 && scene.lodGroups[size_t(instance.lod)].levels[0].mesh != instance.mesh)
+      return fail(fmt::format(
+          "instances[{}]: mesh {} is not level 0 of its level-of-detail group (mesh {})", i,
+          instance.mesh, scene.lodGroups[size_t(instance.lod)].levels[0].mesh));
+  }
+  if (scene.instanceTree && scene.instanceTree->instanceCount > scene.instances.size())
+    return fail(fmt::format("the instance tree covers {} instances, the scene has {}",
+                            scene.instanceTree->instanceCount, scene.instances.size()));
+  for (size_t i = 0; i < scene.lodGroups.size(); ++i) {
+    const LodGroup& g = scene.lodGroups[i];
+    const std::string label =
+        g.name.empty() ? fmt::format("lodGroups[{}]", i) : fmt::format("LOD group '{}'", g.name);
+    if (g.levels.empty() || g.levels.size() > kMaxLodLevels)
+      return fail(fmt::format("{}: {} levels (1 to {})", label, g.levels.size(), kMaxLodLevels));
+    if (!(g.fade >= 0 && g.fade <= 1e30f))
+      return fail(fmt::format("{}: fade {} is negative or not finite", label, g.fade));
+    float from = 0;
+    for (size_t k = 0; k < g.levels.size(); ++k) {
+      const LodLevel& l = g.levels[k];
+      if (l.mesh < 0 || size_t(l.mesh) >= scene.meshes.size())
+        return fail(fmt::format("{}: level {}: mesh {} does not exist ({} meshes)", label, k,
+                                l.mesh, scene.meshes.size()));
+      if (!(l.to > from && l.to <= 1e30f))
+        return fail(fmt::format("{}: level {}: 'to' {} must exceed {} (ranges increase)", label, k,
+                                l.to, from));
+      if (g.fade > 0 && !(l.to - g.fade >= from))
+        return fail(fmt::format("{}: level {}: the fade of {} is longer than its span [{}, {})",
+                                label, k, g.fade, from, l.to));
+      from = l.to;
+    }
   }
   for (size_t i = 0; i < scene.freeForms.size(); ++i) {
     const FreeFormObject& f = scene.freeForms[i];
@@ -278,9 +311,14 @@ void appendScene(Scene& scene, Scene other, const Mat4& transform) {
     if (mesh.material >= 0) mesh.material += materialBase;
     scene.meshes.push_back(std::move(mesh));
   }
+  const int lodBase = static_cast<int>(scene.lodGroups.size());
+  for (LodGroup& group : other.lodGroups) {
+    for (LodLevel& level : group.levels) level.mesh += meshBase;
+    scene.lodGroups.push_back(std::move(group));
+  }
   for (const Instance& instance : other.instances)
-    scene.instances.push_back(
-        {instance.mesh + meshBase, transform * instance.transform, instance.priority});
+    scene.instances.push_back({instance.mesh + meshBase, transform * instance.transform,
+                               instance.priority, instance.lod >= 0 ? instance.lod + lodBase : -1});
   for (FreeFormObject& f : other.freeForms) {
     if (f.material >= 0) f.material += materialBase;
     f.transform = transform * f.transform;

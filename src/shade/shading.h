@@ -35,6 +35,9 @@ struct MaterialShading {
   float specular = 0, shininess = 32;
   AlphaUse alpha = AlphaUse::opaque;
   float alphaCutoff = 0.5f;
+  // The pixels of every screen-aligned 4×4 block drawn (bit x + 4y), the others cut away as by an
+  // alpha mask: a level of detail dissolving into the next (render/traversal.h). 0xFFFF: all.
+  uint16_t door = 0xFFFF;
 };
 
 struct PointLightEye {

@@ -504,17 +504,24 @@ TEST(ObjectCulling, InstancesOutsideTheViewAreDroppedWithTheSameImage) {
       o.threads = 2;
       o.samples = samples;
       o.hsr = hsr;
-      Image culled, all;
-      FrameStats withCulling, without;
+      Image culled, all, tree;
+      FrameStats withCulling, without, withTree;
       ASSERT_TRUE(Renderer(o).render(s, culled, &withCulling).ok());
+      // The same through the instance tree (the traversal's hierarchy).
+      scene::Scene indexed = s;
+      scene::buildInstanceTree(indexed);
+      ASSERT_TRUE(Renderer(o).render(indexed, tree, &withTree).ok());
       o.cullInstances = false;
       ASSERT_TRUE(Renderer(o).render(s, all, &without).ok());
       EXPECT_EQ(culled.rgb, all.rgb) << samples << " samples, " << hsrName(hsr);
+      EXPECT_EQ(tree.rgb, all.rgb) << samples << " samples, " << hsrName(hsr);
       EXPECT_GT(withCulling.culledInstances, s.instances.size() / 2);
+      EXPECT_EQ(withTree.culledInstances, withCulling.culledInstances);
       EXPECT_EQ(without.culledInstances, 0u);
       EXPECT_EQ(withCulling.trianglesIn, without.trianglesIn);
       EXPECT_EQ(withCulling.drawn, without.drawn);
       EXPECT_EQ(withCulling.culled(), without.culled());
+      EXPECT_EQ(withTree.culled(), without.culled());
     }
   // Three channels in an arc: each channel culls against its own frustum.
   s.channels = scene::arcChannels(3, 150, 120, 90);
@@ -522,10 +529,16 @@ TEST(ObjectCulling, InstancesOutsideTheViewAreDroppedWithTheSameImage) {
   o.threads = 2;
   std::vector<Image> culled, all;
   ASSERT_TRUE(Renderer(o).renderChannels(s, culled).ok());
+  scene::buildInstanceTree(s);
+  std::vector<Image> tree;
+  ASSERT_TRUE(Renderer(o).renderChannels(s, tree).ok());
   o.cullInstances = false;
   ASSERT_TRUE(Renderer(o).renderChannels(s, all).ok());
   ASSERT_EQ(culled.size(), 3u);
-  for (size_t c = 0; c < 3; ++c) EXPECT_EQ(culled[c].rgb, all[c].rgb) << "channel " << c;
+  for (size_t c = 0; c < 3; ++c) {
+    EXPECT_EQ(culled[c].rgb, all[c].rgb) << "channel " << c;
+    EXPECT_EQ(tree[c].rgb, all[c].rgb) << "channel " << c;
+  }
 }
 
 // BENCH.md: "every pixel is covered D times" — counted by the renderer, in every order.

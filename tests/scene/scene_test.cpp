@@ -70,6 +70,32 @@ TEST(Scene, ValidateNamesTheFileAndTheBrokenInvariant) {
       {"negative mesh index", [](Scene& s) { s.instances[0].mesh = -1; }, "instances[0]: mesh -1"},
       {"non-finite transform", [](Scene& s) { s.instances[0].transform.m[3][0] = NAN; },
        "transform is not finite"},
+      {"missing level-of-detail group", [](Scene& s) { s.instances[0].lod = 0; },
+       "instances[0]: level-of-detail group 0 does not exist"},
+      {"instance mesh not its level 0",
+       [](Scene& s) {
+         s.lodGroups.push_back({"g", {{0, 10}}, 0});
+         s.meshes.push_back(s.meshes[0]);
+         s.instances[0] = {1, Mat4{}, 0, 0};
+       },
+       "mesh 1 is not level 0 of its level-of-detail group (mesh 0)"},
+      {"ranges that do not increase",
+       [](Scene& s) { s.lodGroups.push_back({"g", {{0, 10}, {0, 10}}, 0}); },
+       "LOD group 'g': level 1: 'to' 10 must exceed 10"},
+      {"a fade longer than a level",
+       [](Scene& s) { s.lodGroups.push_back({"g", {{0, 10}, {0, 12}}, 3}); },
+       "the fade of 3 is longer than its span [10, 12)"},
+      {"a group without levels", [](Scene& s) { s.lodGroups.push_back({}); },
+       "lodGroups[0]: 0 levels (1 to 8)"},
+      {"a level of a missing mesh", [](Scene& s) { s.lodGroups.push_back({"", {{4, 10}}, 0}); },
+       "level 0: mesh 4 does not exist"},
+      {"a stale instance tree",
+       [](Scene& s) {
+         s.instances.push_back(s.instances[0]);
+         buildInstanceTree(s);
+         s.instances.pop_back();
+       },
+       "the instance tree covers 2 instances, the scene has 1"},
   };
   for (const Row& row : rows) {
     SCOPED_TRACE(row.why);
@@ -109,7 +135,8 @@ TEST(Scene, AppendSceneOffsetsIndicesAndComposesTransforms) {
 TEST(Generators, NamesParseBackAndLaterOnesSayWhatTheyNeed) {
   for (Generator g :
        {Generator::tris, Generator::layers, Generator::grazing, Generator::freeform,
-        Generator::freeformOne, Generator::terrain, Generator::volume, Generator::lights}) {
+        Generator::freeformOne, Generator::terrain, Generator::volume, Generator::lights,
+        Generator::city}) {
     const Result<Generator> parsed = parseGenerator(generatorName(g));
     ASSERT_TRUE(parsed.ok()) << generatorName(g);
     EXPECT_EQ(parsed.value(), g);
@@ -122,7 +149,7 @@ TEST(Generators, NamesParseBackAndLaterOnesSayWhatTheyNeed) {
   ASSERT_FALSE(bad.ok());
   EXPECT_EQ(bad.error().message,
             "unknown generator 'trees' (tris, layers, grazing, freeform, freeform-one, terrain, "
-            "volume, lights)");
+            "volume, lights, city)");
 }
 
 }  // namespace

@@ -1,0 +1,49 @@
+// The traversal stage (SPEC §1 stage 1→2): which instances a view draws, and at which level of
+// detail — the instance tree culled against the view volume, levels chosen by range with
+// screen-door dissolves across each switch — before any vertex is transformed.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "render/camera.h"
+#include "synthvis/frame_stats.h"
+
+namespace sv::render {
+
+// One draw the traversal chose: an instance's mesh at one level of detail.
+struct InstanceDraw {
+  uint32_t instance = 0;  // into Scene::instances
+  int mesh = 0;           // the level's mesh
+  // The pixels of every screen-aligned 4×4 block it draws (bit x + 4y; 0xFFFF: all): two levels
+  // dissolving into each other draw complementary patterns (ordered dither, Bayer 4×4).
+  uint16_t door = 0xFFFF;
+};
+
+struct Traversal {
+  std::vector<InstanceDraw> draws;  // in instance order, a dissolving instance's levels adjacent
+  // Instances dropped outside the view volume, and their full-detail triangles.
+  uint64_t culledInstances = 0, culledTriangles = 0;
+  // As FrameStats' (lodDrawn, lodDissolving, lodBeyond); beyond's triangles are in culledTriangles.
+  uint64_t lodDrawn[FrameStats::kLodLevels] = {};
+  uint64_t lodDissolving = 0, lodBeyond = 0;
+  std::vector<uint8_t> state;  // per instance, the walk's scratch
+};
+
+// Fills `out` for the view `camera`: every instance not wholly outside its view volume (with
+// options.cullInstances; the scene's instance tree first, then instance by instance as setup's
+// outcodes would cull every triangle — so the image is the same as with no culling), at the level
+// of detail its range chooses (options.lod; scene.h LodGroup). `meshBounds`: every mesh's bounds.
+void traverse(const scene::Scene& scene, const RenderOptions& options, const FrameCamera& camera,
+              const std::vector<std::array<Vec3, 2>>& meshBounds, Traversal& out);
+
+// The screen-door pattern that draws `k` of 16 pixels of each 4×4 block (0 … 16), by the Bayer
+// ordered-dither matrix: doorPattern(k) and ~doorPattern(k) split every block between two draws.
+uint16_t doorPattern(int k);
+
+// Whether the box [lo, hi] placed by `mvp` lies wholly beyond one plane of the view volume, or
+// wholly behind the eye (then setup culls every triangle inside it).
+bool outsideView(const Mat4& mvp, Vec3 lo, Vec3 hi);
+
+}  // namespace sv::render
