@@ -31,15 +31,19 @@ struct VertexRun {
         context(context_),
         layout(layout_),
         mvp(context_.viewProj * model_),
-        modelView(context_.view * model_),
-        normalToWorld(model_.normalMatrix()),
-        normalToEye(modelView.normalMatrix()),
         light(context_.light) {
     const bool hasLights = light.enabled || !context.pointLights.empty();
     lit = hasLights && !material.unlit && mesh.normals != nullptr;
     vertexLit = lit && !material.phong;
     toLight = normalize(-light.direction);
     base = material.baseColor;
+    // Only the matrices this call's vertices read (a city draws thousands of small instances).
+    const unsigned stored = layout ? layout->stored : 0;
+    if (vertexLit) normalToWorld = model.normalMatrix();
+    if (stored & (1u << kEyeX | 1u << kEyeY | 1u << kEyeZ | 1u << kNormalX)) {
+      modelView = context.view * model;
+      if (lit && material.phong) normalToEye = modelView.normalMatrix();
+    }
   }
 
   const VertexArrays& mesh;
@@ -47,7 +51,8 @@ struct VertexRun {
   const Mat4& model;
   const VertexContext& context;
   const AttributeLayout* layout;
-  const Mat4 mvp, modelView, normalToWorld, normalToEye;
+  const Mat4 mvp;
+  Mat4 modelView, normalToWorld, normalToEye;
   const DirectionalLight& light;
   bool lit = false, vertexLit = false;
   Vec3 toLight;

@@ -126,8 +126,8 @@ const shade::MaterialShading* doorMaterial(const shade::MaterialShading* base, u
 // jobs; `stored` gathers the attributes the calls' materials read. Sizes `p`'s vertices and
 // indices.
 Status layOutCalls(const scene::Scene& scene, const RenderOptions& o, const FrameCamera& camera,
-                   const ShadingTables* shading, DrawPackets& p, std::vector<VertexJob>& jobs,
-                   unsigned& stored) {
+                   const ShadingTables* shading, core::ThreadPool& pool, DrawPackets& p,
+                   std::vector<VertexJob>& jobs, unsigned& stored) {
   std::vector<std::array<Vec3, 2>>& boxes = p.meshBounds;
   bool sort = false;
   if (!meshBounds(scene, o, boxes, sort)) return invalidVertexData(scene);
@@ -135,7 +135,7 @@ Status layOutCalls(const scene::Scene& scene, const RenderOptions& o, const Fram
       o.hsr != RenderOptions::Hsr::zbuffer && o.debugView != RenderOptions::DebugView::overdraw;
   const Mat4 viewProj = camera.projection * camera.view;
   const geometry::Viewport boundViewport{o.width * o.supersample, o.height * o.supersample};
-  traverse(scene, o, camera, boxes, p.traversal);
+  traverse(scene, o, camera, boxes, pool, p.traversal);
   const std::vector<InstanceDraw>& draws = p.traversal.draws;
   const std::vector<uint32_t> order = drawOrder(scene, draws, camera.view, o.hsr, boxes, sort);
   p.doorMaterials.clear();
@@ -203,7 +203,7 @@ Status buildDrawPackets(const scene::Scene& scene, const RenderOptions& o,
   p.calls.clear();
   std::vector<VertexJob> jobs;
   unsigned stored = 0;  // the attributes some material reads (geometry::AttributeLayout)
-  if (Status s = layOutCalls(scene, o, camera, shading, p, jobs, stored); !s) return s;
+  if (Status s = layOutCalls(scene, o, camera, shading, pool, p, jobs, stored); !s) return s;
   // Only the attributes some material reads (geometry::AttributeLayout).
   p.attributeLayout = geometry::AttributeLayout::of(stored);
   const size_t stride = size_t(p.attributeLayout.stride);

@@ -9,6 +9,7 @@ namespace sv::render {
 namespace {
 
 enum State : uint8_t { kCulled, kTest, kInside };
+constexpr size_t kTraversalChunk = 4096;  // instances a job
 
 // The view volume's six planes in world space: a point p is inside plane k where
 // plane[k]·(p, 1) ≥ 0 — the clip-space conditions w ± x, w ± y, w ± z ≥ 0 of setup's outcodes.
@@ -99,7 +100,8 @@ bool outsideView(const Mat4& mvp, Vec3 lo, Vec3 hi) {
 }
 
 void traverse(const scene::Scene& scene, const RenderOptions& o, const FrameCamera& camera,
-              const std::vector<std::array<Vec3, 2>>& meshBounds, Traversal& out) {
+              const std::vector<std::array<Vec3, 2>>& meshBounds, core::ThreadPool& pool,
+              Traversal& out) {
   out.draws.clear();
   out.culledInstances = out.culledTriangles = out.lodDissolving = out.lodBeyond = 0;
   std::fill(std::begin(out.lodDrawn), std::end(out.lodDrawn), 0);
@@ -108,6 +110,7 @@ void traverse(const scene::Scene& scene, const RenderOptions& o, const FrameCame
   out.state.assign(n, o.cullInstances ? kTest : kInside);
   if (o.cullInstances && scene.instanceTree)
     walk(*scene.instanceTree, Planes(viewProj), out.state);
+  const std::vector<uint8_t>& state = out.state;
 
   // Ranges (scene.h LodGroup): from the eye, scaled to the view's field of view and lodScale.
   const auto& v = camera.view.m;
@@ -126,16 +129,17 @@ void traverse(const scene::Scene& scene, const RenderOptions& o, const FrameCame
       groupBounds.push_back(scene::instanceBounds(scene, probe, meshBounds));
     }
 
-  for (size_t i = 0; i < n; ++i) {
+  // Instance i into `part`: culled, beyond its levels, or its draws.
+  auto visit = [&](size_t i, Traversal::Chunk& part) {
     const scene::Instance& inst = scene.instances[i];
     const uint64_t fullTriangles = scene.meshes[size_t(inst.mesh)].triangleCount();
     auto cull = [&] {
-      ++out.culledInstances;
-      out.culledTriangles += fullTriangles;
+      ++part.culledInstances;
+      part.culledTriangles += fullTriangles;
     };
-    if (out.state[i] == kCulled) {
+    if (state[i] == kCulled) {
       cull();
-      continue;
+      return;
     }
     // The level (or two levels) drawn, with their doors.
     InstanceDraw draw[2];
@@ -151,9 +155,9 @@ void traverse(const scene::Scene& scene, const RenderOptions& o, const FrameCame
       size_t level = 0;
       while (level < g.levels.size() && !(range < double(g.levels[level].to))) ++level;
       if (level == g.levels.size()) {
-        ++out.lodBeyond;
-        out.culledTriangles += fullTriangles;
-        continue;
+        ++part.lodBeyond;
+        part.culledTriangles += fullTriangles;
+        return;
       }
       draw[0].mesh = g.levels[level].mesh;
       levels[0] = level;
@@ -162,7 +166,7 @@ void traverse(const scene::Scene& scene, const RenderOptions& o, const FrameCame
         // k of 16 pixels already belong to the next level (or to nothing after the last).
         const int k = std::clamp(int((range - start) / double(g.fade) * 16 + 0.5), 0, 16);
         if (k > 0) {
-          ++out.lodDissolving;
+          ++part.lodDissolving;
           draw[0].door = uint16_t(~doorPattern(k));
           if (level + 1 < g.levels.size()) {
             draw[1] = {uint32_t(i), g.levels[level + 1].mesh, doorPattern(k)};
@@ -176,13 +180,32 @@ void traverse(const scene::Scene& scene, const RenderOptions& o, const FrameCame
     for (int k = 0; k < draws; ++k) {
       if (draw[k].door == 0) continue;
       const auto& [lo, hi] = meshBounds[size_t(draw[k].mesh)];
-      if (out.state[i] == kTest && outsideView(viewProj * inst.transform, lo, hi)) continue;
-      out.draws.push_back(draw[k]);
+      if (state[i] == kTest && outsideView(viewProj * inst.transform, lo, hi)) continue;
+      part.draws.push_back(draw[k]);
       if (inst.lod >= 0 && o.lod)
-        ++out.lodDrawn[std::min<size_t>(levels[k], FrameStats::kLodLevels - 1)];
+        ++part.lodDrawn[std::min<size_t>(levels[k], FrameStats::kLodLevels - 1)];
       drawn = true;
     }
     if (!drawn) cull();
+  };
+  // The instances in chunks on the pool, each with its own draws and counts, joined in order.
+  const size_t chunks = (n + kTraversalChunk - 1) / kTraversalChunk;
+  out.chunks.resize(std::max(out.chunks.size(), chunks));
+  pool.parallelFor(chunks, [&](size_t c, int) {
+    Traversal::Chunk& part = out.chunks[c];
+    part = Traversal::Chunk{std::move(part.draws)};
+    part.draws.clear();
+    for (size_t i = c * kTraversalChunk; i < std::min(n, (c + 1) * kTraversalChunk); ++i)
+      visit(i, part);
+  });
+  for (size_t c = 0; c < chunks; ++c) {
+    const Traversal::Chunk& part = out.chunks[c];
+    out.draws.insert(out.draws.end(), part.draws.begin(), part.draws.end());
+    out.culledInstances += part.culledInstances;
+    out.culledTriangles += part.culledTriangles;
+    for (int l = 0; l < FrameStats::kLodLevels; ++l) out.lodDrawn[l] += part.lodDrawn[l];
+    out.lodDissolving += part.lodDissolving;
+    out.lodBeyond += part.lodBeyond;
   }
 }
 

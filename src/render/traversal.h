@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/thread_pool.h"
 #include "render/camera.h"
 #include "synthvis/frame_stats.h"
 
@@ -22,21 +23,34 @@ struct InstanceDraw {
 };
 
 struct Traversal {
-  std::vector<InstanceDraw> draws;  // in instance order, a dissolving instance's levels adjacent
-  // Instances dropped outside the view volume, and their full-detail triangles.
+  // What a range of instances chose and counted.
+  struct Chunk {
+    std::vector<InstanceDraw> draws;  // in instance order, a dissolving instance's levels adjacent
+    // Instances dropped outside the view volume, and their full-detail triangles.
+    uint64_t culledInstances = 0, culledTriangles = 0;
+    // As FrameStats' (lodDrawn, lodDissolving, lodBeyond); beyond's triangles are in
+    // culledTriangles.
+    uint64_t lodDrawn[FrameStats::kLodLevels] = {};
+    uint64_t lodDissolving = 0, lodBeyond = 0;
+  };
+  // The whole view's: its draws in instance order, and its counts.
+  std::vector<InstanceDraw> draws;
   uint64_t culledInstances = 0, culledTriangles = 0;
-  // As FrameStats' (lodDrawn, lodDissolving, lodBeyond); beyond's triangles are in culledTriangles.
   uint64_t lodDrawn[FrameStats::kLodLevels] = {};
   uint64_t lodDissolving = 0, lodBeyond = 0;
   std::vector<uint8_t> state;  // per instance, the walk's scratch
+  std::vector<Chunk> chunks;   // per job, kept from frame to frame
 };
 
 // Fills `out` for the view `camera`: every instance not wholly outside its view volume (with
 // options.cullInstances; the scene's instance tree first, then instance by instance as setup's
 // outcodes would cull every triangle — so the image is the same as with no culling), at the level
 // of detail its range chooses (options.lod; scene.h LodGroup). `meshBounds`: every mesh's bounds.
+// The instances are visited in parallel chunks on `pool`; the result does not depend on its
+// threads.
 void traverse(const scene::Scene& scene, const RenderOptions& options, const FrameCamera& camera,
-              const std::vector<std::array<Vec3, 2>>& meshBounds, Traversal& out);
+              const std::vector<std::array<Vec3, 2>>& meshBounds, core::ThreadPool& pool,
+              Traversal& out);
 
 // The screen-door pattern that draws `k` of 16 pixels of each 4×4 block (0 … 16), by the Bayer
 // ordered-dither matrix: doorPattern(k) and ~doorPattern(k) split every block between two draws.
