@@ -29,6 +29,7 @@
 #include "scene/channels.h"
 #include "scene/loader_common.h"
 #include "scene/primitives.h"
+#include "terrain/caster.h"
 #include "terrain/ground.h"
 #include "terrain/ortho_image.h"
 #include "texture/texture.h"
@@ -401,6 +402,13 @@ class SceneReader {
   void readColorTable(const Json& v, const std::string& where);
   void readObject(const Json& v, const std::string& where);
   void readObjectGeometry(const Json& v, const std::string& where);
+  // "lodGroups" (docs/scene-format.md#levels-of-detail): named groups of levels, each level an
+  // object of one mesh.
+  void readLodGroups(const Json& v, const std::string& where);
+  // An object with "lod": its group's instances, at its placements ("at") or its transform.
+  void readLodObject(const Json& v, const std::string& where);
+  // The highest terrain's height at world (x, z), for objects placed "onGround".
+  double groundHeight(double x, double z, const std::string& where) const;
   // The object's "material" and "color" keys as a material index (or −1).
   int readObjectMaterial(const Json& object, const std::string& where);
   void readPrimitive(const Json& object, const std::string& where);
@@ -441,6 +449,7 @@ class SceneReader {
   // Where a referenced file's meshes were placed in this scene, by (file, material override), so
   // that further references to it add instances only.
   std::map<std::pair<std::string, int>, int> placedMeshes_;
+  std::map<std::string, int> lodGroupByName_;
 };
 
 Scene SceneReader::read(const Json& root) {
@@ -459,8 +468,8 @@ Scene SceneReader::read(const Json& root) {
                      version->dump(), kFormatVersion));
   expectKeys(root, "",
              {"synthvis", "description", "background", "camera", "cameras", "light", "pointLights",
-              "fog", "textures", "colorTable", "materials", "objects", "terrain", "lights",
-              "time", "channels"});
+              "fog", "textures", "colorTable", "materials", "lodGroups", "objects", "terrain",
+              "lights", "time", "channels"});
 
   if (const Json* description = find(root, "description")) string(*description, "description");
   if (const Json* background = find(root, "background")) {
@@ -483,14 +492,16 @@ Scene SceneReader::read(const Json& root) {
   if (const Json* x = find(root, "textures")) readTextures(*x, "textures");
   if (const Json* x = find(root, "colorTable")) readColorTable(*x, "colorTable");
   if (const Json* materials = find(root, "materials")) readMaterials(*materials, "materials");
-  if (const Json* objects = find(root, "objects")) {
-    array(*objects, "objects");
-    for (size_t i = 0; i < objects->size(); ++i) readObject((*objects)[i], element("objects", i));
-  }
+  // Terrain before the objects: an object may stand on the ground ("onGround").
   if (const Json* x = find(root, "terrain")) {
     array(*x, "terrain");
     if (x->size() > 64) fail("terrain", "more than 64 terrains");
     for (size_t i = 0; i < x->size(); ++i) readTerrain((*x)[i], element("terrain", i));
+  }
+  if (const Json* x = find(root, "lodGroups")) readLodGroups(*x, "lodGroups");
+  if (const Json* objects = find(root, "objects")) {
+    array(*objects, "objects");
+    for (size_t i = 0; i < objects->size(); ++i) readObject((*objects)[i], element("objects", i));
   }
   if (const Json* x = find(root, "lights")) readLights(*x, "lights");
   if (const Json* x = find(root, "time")) scene_.time = number(*x, "time");
@@ -1319,7 +1330,133 @@ void SceneReader::readObject(const Json& v, const std::string& where) {
   }
 }
 
+void SceneReader::readLodGroups(const Json& v, const std::string& where) {
+  if (!v.is_object())
+    fail(where, fmt::format("expected an object of named groups, got {}", typeName(v)));
+  if (v.size() > 65536) fail(where, "more than 65536 groups");
+  for (const auto& [name, group] : v.items()) {
+    const std::string w = member(where, name);
+    if (!group.is_object()) fail(w, fmt::format("expected an object, got {}", typeName(group)));
+    expectKeys(group, w, {"levels", "fade"});
+    LodGroup g;
+    g.name = name;
+    if (const Json* x = find(group, "fade")) g.fade = inRange(*x, member(w, "fade"), 0, 1e30f);
+    const Json* levels = find(group, "levels");
+    if (!levels) fail(w, "missing key 'levels'");
+    const std::string lw = member(w, "levels");
+    array(*levels, lw);
+    if (levels->empty() || levels->size() > kMaxLodLevels)
+      fail(lw, fmt::format("{} levels (1 to {})", levels->size(), kMaxLodLevels));
+    float from = 0;
+    for (size_t i = 0; i < levels->size(); ++i) {
+      const std::string ew = element(lw, i);
+      const Json& level = (*levels)[i];
+      if (!level.is_object()) fail(ew, fmt::format("expected an object, got {}", typeName(level)));
+      const Json* to = find(level, "to");
+      if (!to) fail(ew, "missing key 'to' (the range this level gives way at, metres)");
+      const float range = inRange(*to, member(ew, "to"), 1e-6f, 1e30f);
+      if (!(range > from)) fail(member(ew, "to"), fmt::format("must exceed {} (ranges increase)", from));
+      if (g.fade > 0 && !(range - g.fade >= from))
+        fail(member(w, "fade"), fmt::format("{} is longer than level {}'s span [{}, {})", g.fade,
+                                            i, from, range));
+      from = range;
+      if (find(level, "freeform")) fail(ew, "a level of detail is a mesh, not a free form");
+      if (find(level, "priority")) fail(ew, "a priority belongs to the object, not to a level");
+      // The level is an object of one mesh, read as objects are and then taken out of the scene's
+      // instances: its mesh, with the level's own placement built in.
+      Json object = level;
+      object.erase("to");
+      const size_t before = scene_.instances.size();
+      readObjectGeometry(object, ew);
+      if (scene_.instances.size() != before + 1)
+        fail(ew, fmt::format("a level of detail is one mesh; this one makes {}",
+                             scene_.instances.size() - before));
+      const Instance made = scene_.instances.back();
+      scene_.instances.pop_back();
+      int mesh = made.mesh;
+      if (made.transform.m != Mat4{}.m) {
+        Mesh placed = scene_.meshes[size_t(mesh)];
+        const Mat4 normals = made.transform.normalMatrix();
+        for (Vec3& p : placed.positions) p = made.transform.transformPoint(p);
+        for (Vec3& n : placed.normals) n = normalize(normals.transformDirection(n));
+        mesh = int(scene_.meshes.size());
+        scene_.meshes.push_back(std::move(placed));
+      }
+      g.levels.push_back({mesh, range});
+    }
+    lodGroupByName_[name] = int(scene_.lodGroups.size());
+    scene_.lodGroups.push_back(std::move(g));
+  }
+}
+
+double SceneReader::groundHeight(double x, double z, const std::string& where) const {
+  double best = std::nan("");
+  for (const Terrain& t : scene_.terrains) {
+    const terrain::Interpolation interp =
+        t.bicubic ? terrain::Interpolation::bicubic : terrain::Interpolation::bilinear;
+    const terrain::Caster c(t.ground->field, t.ground->pyramid(interp), interp,
+                            terrain::Placement{t.origin[0], t.origin[1], t.baseRadius});
+    const terrain::Caster::MapPoint m = c.toMap({x, 0, z});
+    const double h = c.surface(m.gx, m.gy);
+    if (!std::isnan(h) && !(h <= best)) best = h;
+  }
+  if (std::isnan(best))
+    fail(where, fmt::format("no terrain under ({}, {}) to stand on", x, z));
+  return best;
+}
+
+void SceneReader::readLodObject(const Json& v, const std::string& where) {
+  expectKeys(v, where, {"name", "lod", "transform", "priority", "at", "onGround"});
+  const Json& ref = *find(v, "lod");
+  const auto group = lodGroupByName_.find(string(ref, member(where, "lod")));
+  if (group == lodGroupByName_.end())
+    fail(member(where, "lod"), fmt::format("no level-of-detail group '{}' in 'lodGroups'",
+                                           ref.get<std::string>()));
+  const LodGroup& g = scene_.lodGroups[size_t(group->second)];
+  Mat4 m;
+  if (const Json* t = find(v, "transform")) m = readTransform(*t, member(where, "transform"));
+  bool onGround = false;
+  if (const Json* x = find(v, "onGround")) onGround = boolean(*x, member(where, "onGround"));
+  auto place = [&](const Mat4& at) {
+    addTriangles(scene_.meshes[size_t(g.levels[0].mesh)].triangleCount(), where);
+    Instance inst;
+    inst.mesh = g.levels[0].mesh;
+    inst.lod = group->second;
+    inst.transform = at * m;
+    scene_.instances.push_back(inst);
+  };
+  const Json* at = find(v, "at");
+  if (!at) {
+    if (onGround) {
+      const Vec3 p = m.transformPoint({0, 0, 0});
+      return place(Mat4::translation({0, float(groundHeight(p.x, p.z, where)), 0}));
+    }
+    return place(Mat4{});
+  }
+  // Placements: [x, y, z] with an optional heading (degrees, about +y) and scale.
+  const std::string aw = member(where, "at");
+  array(*at, aw);
+  for (size_t i = 0; i < at->size(); ++i) {
+    const std::string ew = element(aw, i);
+    const Json& p = (*at)[i];
+    if (!p.is_array() || p.size() < 3 || p.size() > 5)
+      fail(ew, "expected [x, y, z], [x, y, z, heading] or [x, y, z, heading, scale]");
+    float c[5] = {0, 0, 0, 0, 1};
+    for (size_t k = 0; k < p.size(); ++k) c[k] = number(p[k], element(ew, k));
+    if (!(c[4] > 0)) fail(element(ew, 4), "scale must be positive");
+    if (onGround) c[1] += float(groundHeight(c[0], c[2], ew));
+    place(Mat4::translation({c[0], c[1], c[2]}) *
+          Mat4::rotation({0, 1, 0}, c[3] * float(std::numbers::pi) / 180) *
+          Mat4::scaling({c[4], c[4], c[4]}));
+  }
+}
+
 void SceneReader::readObjectGeometry(const Json& v, const std::string& where) {
+  if (find(v, "lod")) {
+    if (find(v, "mesh") || find(v, "primitive") || find(v, "freeform"))
+      fail(where, "an object has one of 'mesh', 'primitive', 'freeform' or 'lod', not several");
+    return readLodObject(v, where);
+  }
   const Json* mesh = find(v, "mesh");
   const Json* primitive = find(v, "primitive");
   const Json* freeform = find(v, "freeform");

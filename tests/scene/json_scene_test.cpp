@@ -496,3 +496,79 @@ TEST(JsonScene, MaterialOverrideAppliesToEveryMeshOfAReferencedFile) {
 
 }  // namespace
 }  // namespace sv::scene
+
+namespace sv::scene {
+namespace {
+
+// "lodGroups" and objects with "lod" (docs/scene-format.md#levels-of-detail): one mesh a level,
+// its own placement built in; every placement of "at" an instance of the group's level 0; and on
+// the ground with "onGround".
+TEST(JsonScene, ReadsLevelOfDetailGroupsAndTheirPlacements) {
+  Result<Scene> r = parse(R"({"synthvis": 1,
+    "terrain": [{"generate": {"size": 65, "spacing": 10, "relief": 50, "seed": 4}}],
+    "lodGroups": {"tree": {"fade": 5, "levels": [
+      {"to": 50, "primitive": "sphere", "radius": 2, "transform": {"translate": [0, 3, 0]}},
+      {"to": 200, "primitive": "box", "size": [1, 1, 1], "color": [0, 1, 0]}]}},
+    "objects": [
+      {"lod": "tree", "at": [[1, 0, 2], [10, 5, -20, 90, 2]]},
+      {"lod": "tree", "onGround": true, "at": [[30, 1.5, 40]]},
+      {"lod": "tree", "transform": {"translate": [7, 8, 9]}}]})");
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  const Scene& s = r.value();
+  ASSERT_EQ(s.lodGroups.size(), 1u);
+  const LodGroup& g = s.lodGroups[0];
+  EXPECT_EQ(g.name, "tree");
+  EXPECT_EQ(g.fade, 5);
+  ASSERT_EQ(g.levels.size(), 2u);
+  EXPECT_EQ(g.levels[0].to, 50);
+  EXPECT_EQ(g.levels[1].to, 200);
+  // Level 0's translate is built into its mesh: the sphere's centre at y = 3.
+  const auto box = s.meshes[size_t(g.levels[0].mesh)].bounds();
+  EXPECT_NEAR((box[0].y + box[1].y) / 2, 3, 1e-5);
+  ASSERT_EQ(s.instances.size(), 4u);
+  for (const Instance& i : s.instances) {
+    EXPECT_EQ(i.lod, 0);
+    EXPECT_EQ(i.mesh, g.levels[0].mesh);
+  }
+  expectNear(s.instances[0].transform.transformPoint({0, 0, 0}), {1, 0, 2});
+  // Heading 90° about +y, scale 2: +x goes to −z, twice as far.
+  expectNear(s.instances[1].transform.transformPoint({1, 0, 0}), {10, 5, -22});
+  // On the ground: 1.5 m above the terrain's surface there.
+  const Vec3 onGround = s.instances[2].transform.transformPoint({0, 0, 0});
+  EXPECT_EQ(onGround.x, 30);
+  EXPECT_EQ(onGround.z, 40);
+  EXPECT_NE(onGround.y, 1.5f);
+  EXPECT_LE(std::fabs(onGround.y - 1.5f), 50.0f);  // within the relief
+  expectNear(s.instances[3].transform.transformPoint({0, 0, 0}), {7, 8, 9});
+  EXPECT_TRUE(validate(s, "t.json").ok());
+
+  // Mistakes, each named.
+  const std::string group = R"("lodGroups": {"g": {"levels": [{"to": 10, "primitive": "box"}]}})";
+  EXPECT_TRUE(contains(errorOf(R"({"synthvis": 1, )" + group +
+                               R"(, "objects": [{"lod": "h"}]})"),
+                       "t.json: objects[0].lod: no level-of-detail group 'h' in 'lodGroups'"));
+  EXPECT_TRUE(contains(errorOf(R"({"synthvis": 1, "lodGroups": {"g": {"levels": [
+      {"to": 10, "primitive": "box"}, {"to": 5, "primitive": "box"}]}}})"),
+                       "lodGroups.g.levels[1].to: must exceed 10"));
+  EXPECT_TRUE(contains(errorOf(R"({"synthvis": 1, "lodGroups": {"g": {"fade": 8, "levels": [
+      {"to": 10, "primitive": "box"}, {"to": 15, "primitive": "box"}]}}})"),
+                       "8 is longer than level 1's span [10, 15)"));
+  EXPECT_TRUE(contains(errorOf(R"({"synthvis": 1, "lodGroups": {"g": {"levels": [
+      {"primitive": "box"}]}}})"),
+                       "lodGroups.g.levels[0]: missing key 'to'"));
+  EXPECT_TRUE(contains(errorOf(R"({"synthvis": 1, "lodGroups": {"g": {"levels": [
+      {"to": 3, "freeform": {"quadric": "sphere"}}]}}})"),
+                       "a level of detail is a mesh, not a free form"));
+  EXPECT_TRUE(contains(errorOf(R"({"synthvis": 1, )" + group +
+                               R"(, "objects": [{"lod": "g", "onGround": true}]})"),
+                       "objects[0]: no terrain under (0, 0) to stand on"));
+  EXPECT_TRUE(contains(errorOf(R"({"synthvis": 1, )" + group +
+                               R"(, "objects": [{"lod": "g", "at": [[1, 2]]}]})"),
+                       "objects[0].at[0]: expected [x, y, z]"));
+  EXPECT_TRUE(contains(errorOf(R"({"synthvis": 1, )" + group +
+                               R"(, "objects": [{"lod": "g", "primitive": "box"}]})"),
+                       "one of 'mesh', 'primitive', 'freeform' or 'lod'"));
+}
+
+}  // namespace
+}  // namespace sv::scene
