@@ -1,6 +1,6 @@
-// Fuzz target: texture images (decodeTextureImage, libpng's simplified API) on arbitrary bytes
-// with the chunks' CRCs made to match (png_crc.h), and the MIP pyramid and samplers (trilinear,
-// and each single-level filter) on what decodes. Beyond "no crash, no sanitizer report": a
+// Fuzz target: texture images (decodeTextureImage: PNG through libpng, JPEG through TurboJPEG) on
+// arbitrary bytes, a PNG's chunks' CRCs made to match (png_crc.h), and the MIP pyramid and
+// samplers (trilinear, and each single-level filter) on what decodes. Beyond "no crash, no sanitizer report": a
 // decoded level has its stated size, the pyramid ends at 1×1 with each level half the one above
 // (rounded up), and samples stay within [0, 1]; a failure carries a message.
 #include <cstddef>

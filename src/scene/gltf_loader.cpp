@@ -24,6 +24,7 @@
 #include <utility>
 
 #include "scene/loader_common.h"
+#include "texture/jpeg.h"
 #include "texture/texture.h"
 
 namespace sv::scene {
@@ -101,7 +102,7 @@ bool nestingWithin(const char* text, size_t size, int limit) {
 
 // --- File access for tinygltf: external buffers only, through readFile's checks. ---
 
-// Images are read only as textures, through decodeImage below (PNG). A missing image is only a
+// Images are read only as textures, through decodeImage below (PNG, JPEG). A missing image is only a
 // warning for tinygltf; a material that uses it then fails with a message naming it.
 
 bool fsFileExists(const std::string& path, void* followReferences) {
@@ -138,15 +139,15 @@ struct DecodedImages {
   uint64_t texels = 0, maxTexels = 0;  // LoadOptions::maxTexels
 };
 
-// tinygltf's image callback: PNG only (texture.h's decoder and limits), into DecodedImages.
+// tinygltf's image callback: PNG or JPEG (texture.h's decoders and limits), into DecodedImages.
 bool decodeImage(tinygltf::Image* image, const int index, std::string* err, std::string*, int, int,
                  const unsigned char* bytes, int size, void* user) {
   const std::string name =
       fmt::format("images[{}]{}", index, image->name.empty() ? "" : " ('" + image->name + "')");
   const bool png = size >= 8 && std::memcmp(bytes, "\x89PNG\r\n\x1a\n", 8) == 0;
-  if (!png) {
+  if (!png && !texture::looksLikeJpeg(bytes, size_t(std::max(size, 0)))) {
     if (err)
-      *err += fmt::format("{}: only PNG textures are supported{}\n", name,
+      *err += fmt::format("{}: only PNG and JPEG textures are supported{}\n", name,
                           image->mimeType.empty() ? "" : " (this is " + image->mimeType + ")");
     return false;
   }

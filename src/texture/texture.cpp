@@ -3,8 +3,12 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
+#include <fstream>
+#include <iterator>
 
+#include "texture/jpeg.h"
 #include "texture/png.h"
 
 namespace sv::texture {
@@ -284,12 +288,34 @@ constexpr PngLimits kTextureLimits{kMaxTextureSide, kMaxTextureTexels};
 }  // namespace
 
 Result<Level> readTextureImage(const std::string& path) {
+  // A JPEG is recognised by its first bytes (a short read; the decoder reads the whole file).
+  if (std::FILE* f = std::fopen(path.c_str(), "rb")) {
+    unsigned char magic[3] = {};
+    const size_t got = std::fread(magic, 1, 3, f);
+    std::fclose(f);
+    if (looksLikeJpeg(magic, got)) {
+      std::ifstream in(path, std::ios::binary);
+      const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+      if (!in.good() && !in.eof()) return Error{path, "", "read error"};
+      return decodeTextureImage(bytes.data(), bytes.size(), path);
+    }
+  }
   auto png = readPng(path, PngLayout::rgba8OrLinear16, kTextureLimits);
   if (!png.ok()) return png.error();
   return toLevel(png.value());
 }
 
 Result<Level> decodeTextureImage(const void* data, size_t size, const std::string& name) {
+  if (looksLikeJpeg(data, size)) {
+    auto jpeg = decodeJpeg(data, size, name, kTextureLimits.maxSide, kTextureLimits.maxPixels);
+    if (!jpeg.ok()) return jpeg.error();
+    // As an 8-bit PNG's samples: sRGB-encoded, opaque.
+    PngPixels pixels;
+    pixels.width = jpeg->width;
+    pixels.height = jpeg->height;
+    pixels.data = std::move(jpeg->rgba);
+    return toLevel(pixels);
+  }
   auto png = decodePng(data, size, name, PngLayout::rgba8OrLinear16, kTextureLimits);
   if (!png.ok()) return png.error();
   return toLevel(png.value());

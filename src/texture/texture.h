@@ -185,9 +185,10 @@ int anisotropicProbes(const Footprint& footprint, float x0, float y0, float& lod
 void anisotropicBlock(const Texture& texture, const Footprint* footprints, const float* x0,
                       const float* y0, int count, float out[4][16]);
 
-// Reads a PNG (8 or 16 bits; grey, grey + alpha, RGB or RGBA; palette) into level 0 in linear light
-// with premultiplied alpha. 8-bit samples are sRGB-encoded and decoded by the exact sRGB curve;
-// 16-bit samples are linear (PNG's convention for them), either unless a gAMA chunk says otherwise.
+// Reads a PNG (8 or 16 bits; grey, grey + alpha, RGB or RGBA; palette) or a JPEG (texture/jpeg.h;
+// recognised by its first bytes, opaque) into level 0 in linear light with premultiplied alpha.
+// 8-bit samples are sRGB-encoded and decoded by the exact sRGB curve; 16-bit samples are linear
+// (PNG's convention for them), either unless a gAMA chunk says otherwise.
 // Errors name the file: unreadable, malformed, larger than the limits above, or shorter than the
 // size its header states could compress to.
 Result<Level> readTextureImage(const std::string& path);

@@ -7,7 +7,10 @@
 #include <numbers>
 #include <string>
 
+#include <turbojpeg.h>
+
 #include "scene/scene_test_util.h"
+#include "texture/texture.h"
 #include "synthvis/scene.h"
 
 namespace sv::scene {
@@ -319,6 +322,42 @@ TEST(Gltf, ExternalBuffersLoadNextToTheFileUnlessReferencesAreOff) {
   Result<Scene> refused = loadGltfFromMemory(doc.dump(), path, closed);
   ASSERT_FALSE(refused.ok());
   EXPECT_TRUE(contains(refused.error().str(), "invalid glTF"));
+}
+
+}  // namespace
+}  // namespace sv::scene
+
+namespace sv::scene {
+namespace {
+
+// A glTF whose texture is a JPEG file beside it (issue 32: JPEG textures were refused): the
+// crate sample with its PNG swapped for the same picture as a JPEG.
+TEST(Gltf, ReadsJpegTextures) {
+  const std::string crate = testing::readText(testing::sourcePath("scenes/crate.gltf"));
+  nlohmann::json doc = nlohmann::json::parse(crate);
+  ASSERT_FALSE(doc["images"].empty());
+  // Decode the embedded PNG, re-encode it as a JPEG with TurboJPEG, point the image at it.
+  Result<Scene> original = loadGltf(testing::sourcePath("scenes/crate.gltf"));
+  ASSERT_TRUE(original.ok());
+  const texture::LevelView png = original->textures[0].texture->level(0);
+  const std::vector<uint8_t> rgba = texture::toSrgb8(png);
+  tjhandle tj = tjInitCompress();
+  unsigned char* jpeg = nullptr;
+  unsigned long size = 0;
+  ASSERT_EQ(tjCompress2(tj, rgba.data(), png.width, 0, png.height, TJPF_RGBA, &jpeg, &size,
+                        TJSAMP_444, 95, 0),
+            0);
+  testing::TempDir dir;
+  dir.write("planks.jpg", std::string(reinterpret_cast<char*>(jpeg), size));
+  tjFree(jpeg);
+  tjDestroy(tj);
+  doc["images"][0] = {{"uri", "planks.jpg"}};
+  const std::string path = dir.write("crate.gltf", doc.dump());
+  Result<Scene> s = loadGltf(path);
+  ASSERT_TRUE(s.ok()) << s.error().str();
+  ASSERT_EQ(s->textures.size(), 1u);
+  EXPECT_EQ(s->textures[0].texture->level(0).width, png.width);
+  EXPECT_EQ(s->textures[0].texture->level(0).height, png.height);
 }
 
 }  // namespace

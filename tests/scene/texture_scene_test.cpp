@@ -143,7 +143,12 @@ TEST(GltfTextures, ProblemsAreNamed) {
       error(texturedTriangle(
           {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}, textures,
           nlohmann::json::array({{{"uri", "data:image/jpeg;base64,/9j/4AAQSkZJRg=="}}}), nullptr)),
-      "only PNG textures are supported"));
+      "images[0]: invalid JPEG"));
+  EXPECT_TRUE(contains(
+      error(texturedTriangle(
+          {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}, textures,
+          nlohmann::json::array({{{"uri", "data:image/gif;base64,R0lGODlhAQABAAAAACw="}}}), nullptr)),
+      "only PNG and JPEG textures are supported"));
   EXPECT_TRUE(contains(
       error(texturedTriangle(
           {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}, {"texCoord", 1}}}}}},
