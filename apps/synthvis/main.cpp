@@ -56,10 +56,14 @@ int fail(const sv::Error& e) {
   return 1;
 }
 
-// The scene at `path`, or the built-in demo scene when no path is given.
+// The scene at `path`, or the built-in demo scene when no path is given; what the file holds but
+// is not drawn is printed as warnings.
 sv::Result<sv::scene::Scene> loadSceneOrDemo(const std::string& path) {
   if (path.empty()) return sv::scene::demoScene();
-  return sv::scene::loadScene(path);
+  sv::Result<sv::scene::Scene> scene = sv::scene::loadScene(path);
+  if (scene)
+    for (const std::string& w : scene->warnings) fmt::print(stderr, "synthvis: warning: {}\n", w);
+  return scene;
 }
 
 // --filter box|tent3.

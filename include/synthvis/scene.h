@@ -299,6 +299,10 @@ struct Scene {
   StarField stars;
   // Simulation time, seconds: what blinking, sequences and the stars' rotation are functions of.
   double time = 0;
+  // What a loader read but does not draw, one line each naming the file and the part ("…: 2
+  // primitives of points are not drawn"), and "nothing to draw" for a file that holds nothing
+  // drawable: never a silently empty image. The CLI prints them.
+  std::vector<std::string> warnings;
 
   size_t triangleCount() const;  // over all instances
   // Material `index` (a Mesh's or a FreeFormObject's), or the default Material for −1 (none).

@@ -13,7 +13,8 @@ namespace sv::render {
 namespace {
 
 // A camera for scenes that have none: looks at the centre of the scene's bounds (its instances'
-// and terrains') from the front and a little above, far enough to see all of it.
+// and terrains') from an oblique three-quarter direction — front, right and above, so that a flat
+// model lying in any axis plane is not seen edge-on — far enough to see all of it.
 scene::Camera defaultCamera(const scene::Scene& s) {
   Vec3 lo{std::numeric_limits<float>::max(), std::numeric_limits<float>::max(),
           std::numeric_limits<float>::max()};
@@ -46,7 +47,7 @@ scene::Camera defaultCamera(const scene::Scene& s) {
   const float distance =
       radius / std::sin(0.5f * cam.yfovDegrees * std::numbers::pi_v<float> / 180.0f);
   cam.target = centre;
-  cam.position = centre + normalize(Vec3{0, 0.35f, 1}) * distance;
+  cam.position = centre + normalize(Vec3{0.6f, 0.45f, 1}) * distance;
   cam.znear = std::max(distance - radius, distance * 1e-3f) * 0.5f;
   cam.zfar = (distance + radius) * 2;
   return cam;

@@ -36,8 +36,9 @@ namespace {
 constexpr int kMaxGltfJsonDepth = 64;
 
 // Extensions whose presence in extensionsRequired we can honour.
-constexpr const char* kSupportedRequiredExtensions[] = {"KHR_materials_unlit",
-                                                        "KHR_mesh_quantization"};
+constexpr const char* kSupportedRequiredExtensions[] = {
+    "KHR_materials_unlit", "KHR_mesh_quantization", "KHR_texture_transform",
+    "EXT_mesh_gpu_instancing"};
 
 // A problem in the model, reported from deep inside the conversion; caught in convertModel and
 // returned as an Error. It never leaves this file.
@@ -274,6 +275,14 @@ class GltfConverter {
   const std::vector<int>& meshesOf(int gltfMesh);
   Mesh convertPrimitive(const tinygltf::Primitive& primitive, const std::string& where) const;
   Mat4 localMatrix(const tinygltf::Node& node, const std::string& where) const;
+  // EXT_mesh_gpu_instancing: the node's instances' transforms (T·R·S each), or none.
+  std::vector<Mat4> gpuInstances(const tinygltf::Node& node, const std::string& where) const;
+  // KHR_texture_transform on material `material`'s base colour texture, as u' = a·u + b·v + c,
+  // v' = d·u + e·v + f; absent for none.
+  struct UvTransform {
+    float a = 1, b = 0, c = 0, d = 0, e = 1, f = 0;
+  };
+  std::map<int, UvTransform> uvTransforms_;
   Camera convertCamera(const tinygltf::Node& node, const Mat4& world,
                        const std::string& where) const;
   void walkNodes();
@@ -362,6 +371,37 @@ void GltfConverter::convertMaterials() {
         fail(fmt::format("{}: baseColorTexture uses TEXCOORD_{}; only TEXCOORD_0 is supported",
                          where, base.texCoord));
       m.texture = textureFor(base.index, where + ".baseColorTexture");
+      // KHR_texture_transform: uv' = offset + R(rotation)·(scale ⊙ uv), R turning
+      // counter-clockwise (the extension's GLSL: columns (cos, sin) and (−sin, cos)). Built into
+      // the uvs of the primitives that use the material (convertPrimitive).
+      const auto ext = base.extensions.find("KHR_texture_transform");
+      if (ext != base.extensions.end()) {
+        const std::string tw = where + ".baseColorTexture.KHR_texture_transform";
+        const tinygltf::Value& t = ext->second;
+        if (!t.IsObject()) fail(tw + ": expected an object");
+        auto pair = [&](const char* key, double fallback, double out[2]) {
+          out[0] = out[1] = fallback;
+          if (!t.Has(key)) return;
+          const tinygltf::Value& v = t.Get(key);
+          if (!v.IsArray() || v.ArrayLen() != 2 || !v.Get(0).IsNumber() || !v.Get(1).IsNumber())
+            fail(fmt::format("{}.{}: expected two numbers", tw, key));
+          out[0] = v.Get(0).GetNumberAsDouble(), out[1] = v.Get(1).GetNumberAsDouble();
+        };
+        double offset[2], scale[2], rotation = 0;
+        pair("offset", 0, offset);
+        pair("scale", 1, scale);
+        if (t.Has("rotation")) {
+          if (!t.Get("rotation").IsNumber()) fail(tw + ".rotation: expected a number");
+          rotation = t.Get("rotation").GetNumberAsDouble();
+        }
+        if (t.Has("texCoord") && (!t.Get("texCoord").IsInt() || t.Get("texCoord").Get<int>() != 0))
+          fail(tw + ".texCoord: only TEXCOORD_0 is supported");
+        for (double x : {offset[0], offset[1], scale[0], scale[1], rotation})
+          if (!(std::fabs(x) <= 1e6)) fail(tw + ": a value is not finite or is out of range");
+        const double c = std::cos(rotation), sn = std::sin(rotation);
+        uvTransforms_[int(i)] = {float(c * scale[0]), float(-sn * scale[1]), float(offset[0]),
+                                 float(sn * scale[0]), float(c * scale[1]), float(offset[1])};
+      }
     }
     // glTF 2.0 §3.9.4: OPAQUE ignores alpha, MASK cuts at alphaCutoff, BLEND composites.
     if (gm.alphaMode == "BLEND")
@@ -482,6 +522,11 @@ Mesh GltfConverter::convertPrimitive(const tinygltf::Primitive& primitive,
     sameCount(v, "TEXCOORD_0");
     mesh.uvs.resize(n);
     for (size_t i = 0; i < n; ++i) mesh.uvs[i] = {v.get(i, 0), v.get(i, 1)};
+    if (const auto t = uvTransforms_.find(primitive.material); t != uvTransforms_.end())
+      for (Vec2& uv : mesh.uvs) {
+        const UvTransform& m = t->second;
+        uv = {m.a * uv.x + m.b * uv.y + m.c, m.d * uv.x + m.e * uv.y + m.f};
+      }
   }
 
   // Step 2: the index sequence, given or implied (0, 1, 2, …), each checked against n.
@@ -553,7 +598,11 @@ const std::vector<int>& GltfConverter::meshesOf(int gltfMesh) {
       case TINYGLTF_MODE_LINE:
       case TINYGLTF_MODE_LINE_LOOP:
       case TINYGLTF_MODE_LINE_STRIP:
-        continue;  // nothing to fill
+        // Nothing to fill: named, never silently left out.
+        scene_.warnings.push_back(fmt::format(
+            "{}: {} are not drawn (only triangles are)", where,
+            primitive.mode == TINYGLTF_MODE_POINTS ? "points" : "lines"));
+        continue;
       default:
         fail(fmt::format("{}: unknown mode {}", where, primitive.mode));
     }
@@ -563,6 +612,65 @@ const std::vector<int>& GltfConverter::meshesOf(int gltfMesh) {
     ours.push_back(int(scene_.meshes.size() - 1));
   }
   return meshes_.emplace(gltfMesh, std::move(ours)).first->second;
+}
+
+// Unit quaternion (x, y, z, w) to matrix; normalized first, since files often store quaternions
+// with a little rounding.
+Mat4 rotationOf(double x, double y, double z, double w, const std::string& where) {
+  const double len = std::sqrt(x * x + y * y + z * z + w * w);
+  if (!(len > 0) || !std::isfinite(len)) fail(where + ": zero or non-finite quaternion");
+  x /= len, y /= len, z /= len, w /= len;
+  Mat4 r;
+  r.m[0] = {float(1 - 2 * (y * y + z * z)), float(2 * (x * y + z * w)), float(2 * (x * z - y * w)),
+            0};
+  r.m[1] = {float(2 * (x * y - z * w)), float(1 - 2 * (x * x + z * z)), float(2 * (y * z + x * w)),
+            0};
+  r.m[2] = {float(2 * (x * z + y * w)), float(2 * (y * z - x * w)), float(1 - 2 * (x * x + y * y)),
+            0};
+  return r;
+}
+
+std::vector<Mat4> GltfConverter::gpuInstances(const tinygltf::Node& node,
+                                              const std::string& where) const {
+  const auto ext = node.extensions.find("EXT_mesh_gpu_instancing");
+  if (ext == node.extensions.end()) return {};
+  const std::string w = where + ".EXT_mesh_gpu_instancing";
+  const tinygltf::Value& e = ext->second;
+  if (!e.IsObject() || !e.Has("attributes") || !e.Get("attributes").IsObject())
+    fail(w + ": expected an object with 'attributes'");
+  const tinygltf::Value& attributes = e.Get("attributes");
+  // TRANSLATION, ROTATION (a unit quaternion) and SCALE, each optional, all of one count.
+  std::optional<AccessorView> views[3];
+  const char* names[3] = {"TRANSLATION", "ROTATION", "SCALE"};
+  size_t count = 0;
+  for (int k = 0; k < 3; ++k) {
+    if (!attributes.Has(names[k])) continue;
+    const tinygltf::Value& a = attributes.Get(names[k]);
+    if (!a.IsInt()) fail(fmt::format("{}.{}: expected an accessor index", w, names[k]));
+    views[k] = accessor(a.Get<int>(), fmt::format("{}.{}", w, names[k]),
+                        {k == 1 ? TINYGLTF_TYPE_VEC4 : TINYGLTF_TYPE_VEC3},
+                        {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE,
+                         TINYGLTF_COMPONENT_TYPE_SHORT});
+    if (count && views[k]->count != count)
+      fail(fmt::format("{}: {} has {} elements, another attribute {}", w, names[k],
+                       views[k]->count, count));
+    count = views[k]->count;
+  }
+  if (!count) fail(w + ": no TRANSLATION, ROTATION or SCALE");
+  std::vector<Mat4> out(count);
+  for (size_t i = 0; i < count; ++i) {
+    Mat4 t, r, s;
+    if (views[0]) t = Mat4::translation({views[0]->get(i, 0), views[0]->get(i, 1), views[0]->get(i, 2)});
+    if (views[1])
+      r = rotationOf(views[1]->get(i, 0), views[1]->get(i, 1), views[1]->get(i, 2),
+                     views[1]->get(i, 3), fmt::format("{}.ROTATION[{}]", w, i));
+    if (views[2]) s = Mat4::scaling({views[2]->get(i, 0), views[2]->get(i, 1), views[2]->get(i, 2)});
+    out[i] = t * r * s;
+    for (const auto& column : out[i].m)
+      for (float x : column)
+        if (!std::isfinite(x)) fail(fmt::format("{}: instance {} is not finite", w, i));
+  }
+  return out;
 }
 
 Mat4 GltfConverter::localMatrix(const tinygltf::Node& node, const std::string& where) const {
@@ -591,16 +699,8 @@ Mat4 GltfConverter::localMatrix(const tinygltf::Node& node, const std::string& w
     finite(node.rotation, "rotation");
     // Unit quaternion (x, y, z, w) to matrix; normalized first, since files often store
     // quaternions with a little rounding.
-    double x = node.rotation[0], y = node.rotation[1], z = node.rotation[2], w = node.rotation[3];
-    double len = std::sqrt(x * x + y * y + z * z + w * w);
-    if (!(len > 0)) fail(where + ".rotation: zero quaternion");
-    x /= len, y /= len, z /= len, w /= len;
-    r.m[0] = {float(1 - 2 * (y * y + z * z)), float(2 * (x * y + z * w)),
-              float(2 * (x * z - y * w)), 0};
-    r.m[1] = {float(2 * (x * y - z * w)), float(1 - 2 * (x * x + z * z)),
-              float(2 * (y * z + x * w)), 0};
-    r.m[2] = {float(2 * (x * z + y * w)), float(2 * (y * z - x * w)),
-              float(1 - 2 * (x * x + y * y)), 0};
+    r = rotationOf(node.rotation[0], node.rotation[1], node.rotation[2], node.rotation[3],
+                   where + ".rotation");
   }
   if (!node.scale.empty()) {
     if (node.scale.size() != 3) fail(where + ".scale: expected 3 numbers");
@@ -677,14 +777,19 @@ void GltfConverter::walkNodes() {
       if (size_t(node.mesh) >= model_.meshes.size())
         fail(fmt::format("{}: mesh {} does not exist ({} meshes)", where, node.mesh,
                          model_.meshes.size()));
-      for (int mesh : meshesOf(node.mesh)) {
-        uint64_t t = scene_.meshes[size_t(mesh)].triangleCount();
-        if (t > options_.maxTriangles - triangles_)
-          fail(fmt::format("{}: the scene would have more than {} triangles", where,
-                           options_.maxTriangles));
-        triangles_ += t;
-        scene_.instances.push_back({mesh, world});
-      }
+      // Without EXT_mesh_gpu_instancing one placement, the node's; with it, one per instance
+      // (each under the node's transform), the meshes shared.
+      std::vector<Mat4> placements = gpuInstances(node, where);
+      if (placements.empty()) placements.push_back(Mat4{});
+      for (const Mat4& placement : placements)
+        for (int mesh : meshesOf(node.mesh)) {
+          uint64_t t = scene_.meshes[size_t(mesh)].triangleCount();
+          if (t > options_.maxTriangles - triangles_)
+            fail(fmt::format("{}: the scene would have more than {} triangles", where,
+                             options_.maxTriangles));
+          triangles_ += t;
+          scene_.instances.push_back({mesh, world * placement});
+        }
     } else if (node.mesh < -1) {
       fail(fmt::format("{}: mesh {} does not exist", where, node.mesh));
     }
@@ -702,6 +807,11 @@ void GltfConverter::walkNodes() {
 }
 
 Scene GltfConverter::convert() {
+  // glTF 1.0 parses as JSON but its objects are dictionaries, not the arrays of 2.0: read as 2.0 it
+  // would be an empty scene.
+  const std::string& version = model_.asset.version;
+  if (version.empty() || version[0] != '2' || (version.size() > 1 && version[1] != '.'))
+    fail(fmt::format("glTF version '{}' is not supported (glTF 2.0 only)", version));
   for (const std::string& extension : model_.extensionsRequired) {
     bool supported = false;
     for (const char* known : kSupportedRequiredExtensions) supported |= extension == known;
@@ -759,6 +869,7 @@ Result<Scene> loadGltfFromMemory(const std::string& bytes, const std::string& pa
 
     // Step 3: the model, checked as it is converted.
     Scene scene = GltfConverter(model, options, images).convert();
+    for (std::string& w : scene.warnings) w = fmt::format("{}: {}", path, w);
     Status valid = validate(scene, path);
     if (!valid) return valid.error();
     return scene;

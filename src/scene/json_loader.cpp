@@ -1822,6 +1822,9 @@ void SceneReader::readMeshFile(const Json& v, const std::string& where, std::opt
   }
   const Scene& file = loaded->second;
   addTriangles(file.triangleCount(), where);
+  // What the file left out is said once, however often it is placed.
+  if (placedMeshes_.find({key, material ? *material : -2}) == placedMeshes_.end())
+    scene_.warnings.insert(scene_.warnings.end(), file.warnings.begin(), file.warnings.end());
 
   // Step 3: place its meshes in this scene once per material override; every further reference
   // only adds instances.

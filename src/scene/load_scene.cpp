@@ -108,8 +108,13 @@ Result<Scene> loadScene(const std::string& path, const LoadOptions& options) {
   try {
     detail::LoadContext context{options, {}, {}};
     Result<Scene> scene = detail::loadFile(path, context);
+    if (!scene) return scene;
     // The traversal's hierarchy over the file's instances (they do not move once loaded).
-    if (scene) buildInstanceTree(scene.value());
+    buildInstanceTree(scene.value());
+    const Scene& s = scene.value();
+    if (s.triangleCount() == 0 && s.freeForms.empty() && s.terrains.empty() &&
+        s.lightPoints.empty() && s.stars.stars.empty())
+      scene.value().warnings.push_back(fmt::format("{}: nothing to draw", path));
     return scene;
   } catch (const std::bad_alloc&) {
     return Error{path, "", "out of memory"};

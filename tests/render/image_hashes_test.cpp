@@ -6,7 +6,7 @@
 //
 // A refactor must leave every image the same; when a change means to alter images, look at them
 // (`synthvis render`), then record the new hashes:
-//   SV_UPDATE_IMAGE_HASHES=1 build/tests/render/render_test --gtest_filter='ImageHashes.*'
+//   SV_UPDATE_IMAGE_HASHES=1 build/tests/render/image_hashes_test
 #include <gtest/gtest.h>
 #include <hwy/targets.h>
 

@@ -245,3 +245,33 @@ TEST(Traversal, TheInstanceTreeBoundsEveryInstanceOnce) {
 
 }  // namespace
 }  // namespace sv
+
+namespace sv {
+namespace {
+
+// A scene without cameras is seen from an oblique three-quarter direction: a flat model lying in
+// any axis plane covers pixels (issue 32: one in the x = 0 plane was seen edge-on, as nothing).
+TEST(DefaultCamera, SeesAFlatModelInEveryAxisPlane) {
+  for (int axis = 0; axis < 3; ++axis) {
+    scene::Scene s;
+    scene::Mesh square = scene::detail::makePlane(2, 2, 1, 1);  // in y = 0
+    for (Vec3& p : square.positions)
+      p = axis == 0 ? Vec3{0, p.x, p.z} : axis == 1 ? p : Vec3{p.x, p.z, 0};
+    square.normals.clear();
+    scene::Material m;
+    m.doubleSided = true;
+    m.unlit = true;
+    s.materials.push_back(m);
+    square.material = 0;
+    s.meshes.push_back(square);
+    s.instances.push_back({0, Mat4{}});
+    s.background = {0, 0, 0};
+    RenderOptions o = small();
+    const Image img = render(s, o);
+    const size_t white = count(img, std::array<uint8_t, 3>{255, 255, 255}.data());
+    EXPECT_GT(white, size_t(o.width) * o.height / 20) << "axis " << axis;
+  }
+}
+
+}  // namespace
+}  // namespace sv

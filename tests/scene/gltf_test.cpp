@@ -248,6 +248,30 @@ TEST(Gltf, ConvertsStripsAndFansAndSkipsPointsAndLines) {
   EXPECT_EQ(r->meshes[0].indices, (std::vector<uint32_t>{0, 1, 2, 2, 1, 3, 2, 3, 4}));
   // Fan: (0 1 2), (0 2 3), (0 3 4).
   EXPECT_EQ(r->meshes[1].indices, (std::vector<uint32_t>{0, 1, 2, 0, 2, 3, 0, 3, 4}));
+  // The lines and points are named, never silently dropped.
+  ASSERT_EQ(r->warnings.size(), 2u);
+  EXPECT_EQ(r->warnings[0], "t.gltf: meshes[2].primitives[0]: lines are not drawn (only triangles are)");
+  EXPECT_EQ(r->warnings[1], "t.gltf: meshes[3].primitives[0]: points are not drawn (only triangles are)");
+}
+
+// Never silently empty: glTF 1.0 (whose objects are dictionaries) is refused by name, and a file
+// with nothing drawable loads with a warning that says so.
+TEST(Gltf, NamesWhatItCannotDrawInsteadOfAnEmptyImage) {
+  GltfBuilder b = oneTriangle();
+  b.doc["asset"]["version"] = "1.0";
+  Result<Scene> old = load(b);
+  ASSERT_FALSE(old.ok());
+  EXPECT_EQ(old.error().str(), "t.gltf: glTF version '1.0' is not supported (glTF 2.0 only)");
+  GltfBuilder points;
+  const int positions = points.addPositions({0, 0, 0, 1, 0, 0});
+  points.addNode({{"mesh", points.addMesh({{"attributes", {{"POSITION", positions}}}, {"mode", 0}})}});
+  testing::TempDir dir;
+  const std::string path = dir.write("points.gltf", points.gltf());
+  Result<Scene> r = loadScene(path);
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  ASSERT_EQ(r->warnings.size(), 2u);
+  EXPECT_TRUE(testing::contains(r->warnings[0], "points are not drawn"));
+  EXPECT_EQ(r->warnings[1], path + ": nothing to draw");
 }
 
 TEST(Gltf, ReadsNormalizedIntegerColoursAndTexcoords) {

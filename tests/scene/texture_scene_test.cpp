@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <string>
 
 #include "scene/scene_test_util.h"
@@ -252,6 +253,79 @@ TEST(ObjTextures, MapKdIsReadAndVRunsDownTheImage) {
   ASSERT_EQ(r->meshes[0].uvs.size(), 3u);
   EXPECT_FLOAT_EQ(r->meshes[0].uvs[0].y, 1.0f);  // OBJ's v = 0 is the image's bottom row
   EXPECT_FLOAT_EQ(r->meshes[0].uvs[2].y, 0.0f);
+}
+
+}  // namespace
+}  // namespace sv::scene
+
+namespace sv::scene {
+namespace {
+
+// KHR_texture_transform is built into the primitive's uvs: uv' = offset + R·(scale ⊙ uv), the
+// rotation counter-clockwise as the extension's GLSL states it.
+TEST(GltfTextures, TextureTransformIsBuiltIntoTheUvs) {
+  TempDir dir;
+  const std::string uri = "data:image/png;base64," + testing::base64(pngBytes(dir));
+  const double quarter = std::numbers::pi / 2;
+  GltfBuilder b = texturedTriangle(
+      {{"pbrMetallicRoughness",
+        {{"baseColorTexture",
+          {{"index", 0},
+           {"extensions",
+            {{"KHR_texture_transform",
+              {{"offset", {0.5, 0.25}}, {"rotation", quarter}, {"scale", {2, 3}}}}}}}}}}},
+      nlohmann::json::array({{{"source", 0}}}), nlohmann::json::array({{{"uri", uri}}}), nullptr);
+  b.doc["extensionsRequired"] = {"KHR_texture_transform"};
+  b.doc["extensionsUsed"] = {"KHR_texture_transform"};
+  Result<Scene> r = loadGltfFromMemory(b.gltf(), "t.gltf");
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  const std::vector<Vec2>& uv = r->meshes[0].uvs;
+  ASSERT_EQ(uv.size(), 3u);
+  // (0, 0) → the offset; (1, 0) → scaled (2, 0), turned a quarter to (0, 2), offset;
+  // (0, 1) → (0, 3) turned to (−3, 0), offset.
+  EXPECT_NEAR(uv[0].x, 0.5f, 1e-6f);
+  EXPECT_NEAR(uv[0].y, 0.25f, 1e-6f);
+  EXPECT_NEAR(uv[1].x, 0.5f, 1e-6f);
+  EXPECT_NEAR(uv[1].y, 2.25f, 1e-6f);
+  EXPECT_NEAR(uv[2].x, -2.5f, 1e-6f);
+  EXPECT_NEAR(uv[2].y, 0.25f, 1e-6f);
+}
+
+// EXT_mesh_gpu_instancing: one instance of the node's meshes per element, each T·R·S under the
+// node's own transform; the mesh is not copied.
+TEST(Gltf, GpuInstancingMakesOneInstanceEach) {
+  GltfBuilder b;
+  const int positions = b.addPositions({0, 0, 0, 1, 0, 0, 0, 1, 0});
+  const int indices = b.addIndices({0, 1, 2});
+  const int mesh = b.addMesh({{"attributes", {{"POSITION", positions}}}, {"indices", indices}});
+  const int translation =
+      b.addAccessor(std::vector<float>{1, 0, 0, 0, 2, 0, 0, 0, 3}, 5126, "VEC3", 3);
+  const int rotation = b.addAccessor(
+      std::vector<float>{0, 0, 0, 1, 0, 0, 0.70710678f, 0.70710678f, 0, 0, 0, 1}, 5126, "VEC4", 3);
+  b.addNode({{"mesh", mesh},
+             {"translation", {10, 0, 0}},
+             {"extensions",
+              {{"EXT_mesh_gpu_instancing",
+                {{"attributes", {{"TRANSLATION", translation}, {"ROTATION", rotation}}}}}}}});
+  b.doc["extensionsUsed"] = {"EXT_mesh_gpu_instancing"};
+  Result<Scene> r = loadGltfFromMemory(b.gltf(), "t.gltf");
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  ASSERT_EQ(r->meshes.size(), 1u);
+  ASSERT_EQ(r->instances.size(), 3u);
+  auto at = [&](size_t i, Vec3 p) { return r->instances[i].transform.transformPoint(p); };
+  EXPECT_NEAR(at(0, {0, 0, 0}).x, 11, 1e-5f);
+  EXPECT_NEAR(at(1, {0, 0, 0}).y, 2, 1e-5f);
+  // Instance 1 turns a quarter about z: +x goes to +y.
+  EXPECT_NEAR(at(1, {1, 0, 0}).x, 10, 1e-5f);
+  EXPECT_NEAR(at(1, {1, 0, 0}).y, 3, 1e-5f);
+  EXPECT_NEAR(at(2, {0, 0, 0}).z, 3, 1e-5f);
+  // Mismatched counts are named.
+  const int two = b.addAccessor(std::vector<float>{1, 1, 1, 2, 2, 2}, 5126, "VEC3", 2);
+  b.doc["nodes"][0]["extensions"]["EXT_mesh_gpu_instancing"]["attributes"]["SCALE"] = two;
+  Result<Scene> bad = loadGltfFromMemory(b.gltf(), "t.gltf");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_TRUE(testing::contains(bad.error().str(), "EXT_mesh_gpu_instancing: SCALE has 2 elements"))
+      << bad.error().str();
 }
 
 }  // namespace
