@@ -38,7 +38,7 @@ constexpr int kMaxGltfJsonDepth = 64;
 // Extensions whose presence in extensionsRequired we can honour.
 constexpr const char* kSupportedRequiredExtensions[] = {
     "KHR_materials_unlit", "KHR_mesh_quantization", "KHR_texture_transform",
-    "EXT_mesh_gpu_instancing"};
+    "EXT_mesh_gpu_instancing", "MSFT_lod"};
 
 // A problem in the model, reported from deep inside the conversion; caught in convertModel and
 // returned as an Error. It never leaves this file.
@@ -283,6 +283,11 @@ class GltfConverter {
     float a = 1, b = 0, c = 0, d = 0, e = 1, f = 0;
   };
   std::map<int, UvTransform> uvTransforms_;
+  // MSFT_lod: the level-of-detail group of the node's levels (its mesh first, then the meshes of
+  // the nodes its `ids` name), or −1 — with a warning — when a level is not one primitive.
+  int lodGroupOf(const tinygltf::Node& node, const std::string& where);
+  // The nodes MSFT_lod names as coarser levels: drawn only as levels, never as nodes of their own.
+  std::vector<uint8_t> lodLevelNode_;
   Camera convertCamera(const tinygltf::Node& node, const Mat4& world,
                        const std::string& where) const;
   void walkNodes();
@@ -673,6 +678,70 @@ std::vector<Mat4> GltfConverter::gpuInstances(const tinygltf::Node& node,
   return out;
 }
 
+int GltfConverter::lodGroupOf(const tinygltf::Node& node, const std::string& where) {
+  const std::string w = where + ".MSFT_lod";
+  const tinygltf::Value& e = node.extensions.at("MSFT_lod");
+  if (!e.IsObject() || !e.Has("ids") || !e.Get("ids").IsArray())
+    fail(w + ": expected an object with 'ids'");
+  const tinygltf::Value& ids = e.Get("ids");
+  std::vector<int> levels = {node.mesh};
+  for (size_t k = 0; k < ids.ArrayLen(); ++k) {
+    const tinygltf::Value& id = ids.Get(int(k));
+    if (!id.IsInt() || id.Get<int>() < 0 || size_t(id.Get<int>()) >= model_.nodes.size())
+      fail(fmt::format("{}.ids[{}]: not a node", w, k));
+    const tinygltf::Node& level = model_.nodes[size_t(id.Get<int>())];
+    if (level.mesh < 0 || size_t(level.mesh) >= model_.meshes.size())
+      fail(fmt::format("{}.ids[{}]: node {} has no mesh", w, k, id.Get<int>()));
+    levels.push_back(level.mesh);
+  }
+  if (levels.size() > kMaxLodLevels)
+    fail(fmt::format("{}: {} levels (at most {})", w, levels.size(), kMaxLodLevels));
+  // A level of detail is one mesh (scene.h LodGroup): a level of several primitives is drawn at
+  // full detail instead, and said so.
+  LodGroup g;
+  g.name = model_.meshes[size_t(node.mesh)].name;
+  for (int mesh : levels) {
+    const std::vector<int>& ours = meshesOf(mesh);
+    if (ours.size() != 1) {
+      scene_.warnings.push_back(fmt::format(
+          "{}: a level of {} primitives; drawn at full detail (levels of one primitive only)", w,
+          ours.size()));
+      return -1;
+    }
+    g.levels.push_back({ours[0], 1e30f});
+  }
+  // MSFT_screencoverage (the node's extras): level i while the model covers at least c_i of the
+  // screen. Coverage is taken as the area of the disc its bounding sphere projects to over a
+  // square screen's area, under the 60° view that ranges refer to: c = π·ρ²/4 with
+  // ρ = R/(d·tan 30°), so c_i ↔ the range d_i = R/(tan 30° · 2·sqrt(c_i/π)). Without it each level
+  // covers a quarter of the one before: from c = 0.25 down.
+  const auto [lo, hi] = scene_.meshes[size_t(g.levels[0].mesh)].bounds();
+  const double radius = std::max(0.5 * double(length(hi - lo)), 1e-6);
+  std::vector<double> coverage;
+  if (node.extras.IsObject() && node.extras.Has("MSFT_screencoverage")) {
+    const tinygltf::Value& c = node.extras.Get("MSFT_screencoverage");
+    if (!c.IsArray()) fail(where + ".extras.MSFT_screencoverage: expected an array of numbers");
+    for (size_t k = 0; k < c.ArrayLen(); ++k) {
+      if (!c.Get(int(k)).IsNumber() || !(c.Get(int(k)).GetNumberAsDouble() > 0))
+        fail(fmt::format("{}.extras.MSFT_screencoverage[{}]: expected a number > 0", where, k));
+      coverage.push_back(c.Get(int(k)).GetNumberAsDouble());
+    }
+  } else {
+    for (size_t k = 0; k + 1 < g.levels.size(); ++k) coverage.push_back(0.25 / std::pow(4.0, k));
+  }
+  const double tan30 = std::tan(std::numbers::pi / 6);
+  double from = 0;
+  for (size_t k = 0; k < g.levels.size() && k < coverage.size(); ++k) {
+    const double range = radius / (tan30 * 2 * std::sqrt(coverage[k] / std::numbers::pi));
+    if (!(range > from) || !std::isfinite(range))
+      fail(fmt::format("{}.extras.MSFT_screencoverage: must decrease level by level", where));
+    g.levels[k].to = float(std::min(range, 1e30));
+    from = range;
+  }
+  scene_.lodGroups.push_back(std::move(g));
+  return int(scene_.lodGroups.size() - 1);
+}
+
 Mat4 GltfConverter::localMatrix(const tinygltf::Node& node, const std::string& where) const {
   auto finite = [&](const std::vector<double>& v, const char* what) {
     for (double x : v)
@@ -746,6 +815,19 @@ void GltfConverter::walkNodes() {
                          child));
     }
 
+  // MSFT_lod's level nodes are levels of another node, not nodes of the scene.
+  lodLevelNode_.assign(nodeCount, 0);
+  for (size_t i = 0; i < nodeCount; ++i) {
+    const auto ext = model_.nodes[i].extensions.find("MSFT_lod");
+    if (ext == model_.nodes[i].extensions.end() || !ext->second.Has("ids")) continue;
+    const tinygltf::Value& ids = ext->second.Get("ids");
+    for (size_t k = 0; ids.IsArray() && k < ids.ArrayLen(); ++k)
+      if (ids.Get(int(k)).IsInt()) {
+        const int id = ids.Get(int(k)).Get<int>();
+        if (id >= 0 && size_t(id) < nodeCount) lodLevelNode_[size_t(id)] = 1;
+      }
+  }
+
   // Step 2: the roots — the default scene's, or every parentless node.
   std::vector<int> roots;
   if (model_.defaultScene >= 0) {
@@ -755,7 +837,7 @@ void GltfConverter::walkNodes() {
     roots = model_.scenes[size_t(model_.defaultScene)].nodes;
   } else {
     for (size_t i = 0; i < nodeCount; ++i)
-      if (!hasParent[i]) roots.push_back(int(i));
+      if (!hasParent[i] && !lodLevelNode_[i]) roots.push_back(int(i));
   }
 
   // Step 3: depth-first with an explicit stack (a hostile file may nest nodes very deep).
@@ -781,6 +863,7 @@ void GltfConverter::walkNodes() {
       // (each under the node's transform), the meshes shared.
       std::vector<Mat4> placements = gpuInstances(node, where);
       if (placements.empty()) placements.push_back(Mat4{});
+      const int lod = node.extensions.count("MSFT_lod") ? lodGroupOf(node, where) : -1;
       for (const Mat4& placement : placements)
         for (int mesh : meshesOf(node.mesh)) {
           uint64_t t = scene_.meshes[size_t(mesh)].triangleCount();
@@ -788,7 +871,7 @@ void GltfConverter::walkNodes() {
             fail(fmt::format("{}: the scene would have more than {} triangles", where,
                              options_.maxTriangles));
           triangles_ += t;
-          scene_.instances.push_back({mesh, world * placement});
+          scene_.instances.push_back({mesh, world * placement, 0, lod});
         }
     } else if (node.mesh < -1) {
       fail(fmt::format("{}: mesh {} does not exist", where, node.mesh));

@@ -386,3 +386,45 @@ TEST(Gltf, ReadsJpegTextures) {
 
 }  // namespace
 }  // namespace sv::scene
+
+namespace sv::scene {
+namespace {
+
+// MSFT_lod: the node's mesh and the meshes of the nodes its ids name become one level-of-detail
+// group, the level nodes are not drawn on their own, and MSFT_screencoverage c becomes the range
+// R/(tan 30° · 2·sqrt(c/π)) for the bounding radius R.
+TEST(Gltf, MsftLodBecomesALevelOfDetailGroup) {
+  GltfBuilder b;
+  const int fine = b.addPositions({0, 0, 0, 2, 0, 0, 0, 2, 0});
+  const int coarse = b.addPositions({0, 0, 0, 2, 0, 0, 0, 2, 1});
+  const int indices = b.addIndices({0, 1, 2});
+  const int meshA = b.addMesh({{"attributes", {{"POSITION", fine}}}, {"indices", indices}});
+  const int meshB = b.addMesh({{"attributes", {{"POSITION", coarse}}}, {"indices", indices}});
+  b.addNode({{"mesh", meshA},
+             {"extensions", {{"MSFT_lod", {{"ids", {1}}}}}},
+             {"extras", {{"MSFT_screencoverage", {0.5, 0.1}}}}});
+  b.addNode({{"mesh", meshB}});
+  b.doc["extensionsUsed"] = {"MSFT_lod"};
+  Result<Scene> r = load(b);
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  ASSERT_EQ(r->instances.size(), 1u);
+  ASSERT_EQ(r->lodGroups.size(), 1u);
+  const LodGroup& g = r->lodGroups[0];
+  ASSERT_EQ(g.levels.size(), 2u);
+  EXPECT_EQ(r->instances[0].lod, 0);
+  EXPECT_EQ(r->instances[0].mesh, g.levels[0].mesh);
+  const double radius = std::sqrt(8.0) / 2, tan30 = std::tan(std::numbers::pi / 6);
+  EXPECT_NEAR(g.levels[0].to, radius / (tan30 * 2 * std::sqrt(0.5 / std::numbers::pi)), 1e-4);
+  EXPECT_NEAR(g.levels[1].to, radius / (tan30 * 2 * std::sqrt(0.1 / std::numbers::pi)), 1e-4);
+  EXPECT_TRUE(validate(r.value(), "t.gltf").ok());
+  // A level of two primitives: drawn at full detail, and said so.
+  b.doc["meshes"][1]["primitives"].push_back(b.doc["meshes"][1]["primitives"][0]);
+  Result<Scene> two = load(b);
+  ASSERT_TRUE(two.ok()) << two.error().str();
+  EXPECT_EQ(two->instances[0].lod, -1);
+  ASSERT_EQ(two->warnings.size(), 1u);
+  EXPECT_TRUE(testing::contains(two->warnings[0], "nodes[0].MSFT_lod: a level of 2 primitives"));
+}
+
+}  // namespace
+}  // namespace sv::scene
