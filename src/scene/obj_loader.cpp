@@ -10,7 +10,9 @@
 #include <tiny_obj_loader.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstring>
 #include <map>
 #include <new>
 #include <sstream>
@@ -23,34 +25,119 @@ namespace sv::scene {
 namespace detail {
 namespace {
 
-// tinyobjloader triangulates an n-gon by ear clipping, which costs O(n²) or worse; it also stores
-// face sizes in a byte. Faces beyond this are refused before parsing.
-constexpr size_t kMaxFaceVertices = 255;
+// tinyobjloader stores face sizes in a byte: faces of more than 255 vertices are taken out of the
+// text before it parses (left as blank lines, so line numbers hold) and triangulated here, up to
+// this many vertices (ear clipping within a budget of 8·n² point tests: under a second).
+constexpr size_t kMaxTinyobjFace = 255;
+constexpr size_t kMaxFaceVertices = 8192;
 
-// Step 0: one pass over the text for what tinyobjloader would choke on. Returns the line and the
-// problem, or an empty problem.
-std::pair<size_t, std::string> objTextProblem(const std::string& text) {
-  size_t line = 1;
+// A face of more than kMaxTinyobjFace vertices, as the text gave it.
+struct BigFace {
+  size_t line = 0;
+  std::vector<std::string> corners;  // "v", "v/vt", "v//vn" or "v/vt/vn" tokens
+  std::string material;              // the `usemtl` in force
+  std::string object;                // the `o` (or `g`) in force, the shape it belongs to
+  size_t positions = 0, texcoords = 0, normals = 0;  // defined before it (relative indices)
+};
+
+// Step 0: one pass over the text: faces too large for tinyobjloader are moved into `big` and
+// blanked; one beyond kMaxFaceVertices is an error. Returns the line and the problem, or an
+// empty problem.
+std::pair<size_t, std::string> takeBigFaces(std::string& text, std::vector<BigFace>& big) {
+  size_t line = 1, v = 0, vt = 0, vn = 0;
+  std::string material, object;
   for (size_t start = 0; start < text.size(); ++line) {
     size_t end = text.find('\n', start);
     if (end == std::string::npos) end = text.size();
     size_t i = start;
     while (i < end && (text[i] == ' ' || text[i] == '\t')) ++i;
-    if (i + 1 < end && text[i] == 'f' && (text[i + 1] == ' ' || text[i + 1] == '\t')) {
-      size_t vertices = 0;
-      bool inToken = false;
-      for (size_t k = i + 1; k < end; ++k) {
-        bool blank = text[k] == ' ' || text[k] == '\t' || text[k] == '\r';
-        if (!blank && !inToken) ++vertices;
-        inToken = !blank;
-      }
-      if (vertices > kMaxFaceVertices)
-        return {line, fmt::format("a face with {} vertices (the limit is {})", vertices,
+    auto keyword = [&](const char* k) {
+      const size_t n = std::strlen(k);
+      return i + n < end && text.compare(i, n, k) == 0 && (text[i + n] == ' ' || text[i + n] == '\t');
+    };
+    auto rest = [&](size_t from) {
+      std::string r = text.substr(from, end - from);
+      while (!r.empty() && (r.back() == '\r' || r.back() == ' ' || r.back() == '\t')) r.pop_back();
+      const size_t first = r.find_first_not_of(" \t");
+      return first == std::string::npos ? std::string() : r.substr(first);
+    };
+    if (keyword("v")) ++v;
+    else if (keyword("vt")) ++vt;
+    else if (keyword("vn")) ++vn;
+    else if (keyword("usemtl")) material = rest(i + 6);
+    else if (keyword("o") || keyword("g")) object = rest(i + 1);
+    else if (keyword("f")) {
+      std::vector<std::string> corners;
+      std::istringstream tokens(text.substr(i + 1, end - i - 1));
+      for (std::string t; tokens >> t;) corners.push_back(t);
+      if (corners.size() > kMaxFaceVertices)
+        return {line, fmt::format("a face with {} vertices (the limit is {})", corners.size(),
                                   kMaxFaceVertices)};
+      if (corners.size() > kMaxTinyobjFace) {
+        big.push_back({line, std::move(corners), material, object, v, vt, vn});
+        std::fill(text.begin() + std::ptrdiff_t(start), text.begin() + std::ptrdiff_t(end), ' ');
+      }
     }
     start = end + 1;
   }
   return {0, {}};
+}
+
+// The polygon `outline` (indices into `p`), possibly concave, as triangles by ear clipping in the
+// plane of its Newell normal, counter-clockwise about that normal as the outline is. An outline
+// that leaves no ear (self-intersecting, or degenerate) is closed by a fan of what remains.
+std::vector<uint32_t> triangulate(const std::vector<Vec3>& p) {
+  const size_t n = p.size();
+  std::vector<uint32_t> out;
+  if (n < 3) return out;
+  double nx = 0, ny = 0, nz = 0;  // Newell's normal
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3 a = p[i], b = p[(i + 1) % n];
+    nx += double(a.y - b.y) * double(a.z + b.z);
+    ny += double(a.z - b.z) * double(a.x + b.x);
+    nz += double(a.x - b.x) * double(a.y + b.y);
+  }
+  // Project onto the plane across the normal's largest component, keeping the winding.
+  const double ax = std::fabs(nx), ay = std::fabs(ny), az = std::fabs(nz);
+  const int drop = ax >= ay && ax >= az ? 0 : ay >= az ? 1 : 2;
+  const double sign = (drop == 0 ? nx : drop == 1 ? ny : nz) >= 0 ? 1 : -1;
+  std::vector<std::array<double, 2>> q(n);
+  for (size_t i = 0; i < n; ++i) {
+    const double c[3] = {p[i].x, p[i].y, p[i].z};
+    q[i] = {c[(drop + 1) % 3], c[(drop + 2) % 3]};
+  }
+  auto cross = [&](size_t a, size_t b, size_t c) {
+    return sign * ((q[b][0] - q[a][0]) * (q[c][1] - q[a][1]) -
+                   (q[b][1] - q[a][1]) * (q[c][0] - q[a][0]));
+  };
+  std::vector<size_t> prev(n), next(n);
+  for (size_t i = 0; i < n; ++i) prev[i] = (i + n - 1) % n, next[i] = (i + 1) % n;
+  auto inside = [&](size_t a, size_t b, size_t c, size_t x) {
+    return cross(a, b, x) >= 0 && cross(b, c, x) >= 0 && cross(c, a, x) >= 0;
+  };
+  size_t remaining = n, at = 0, misses = 0;
+  // Each ear search tests up to `remaining` points; past the budget (a hostile outline) the rest
+  // is closed as a fan, so the work stays O(n²).
+  uint64_t budget = 8 * uint64_t(n) * uint64_t(n);
+  while (remaining > 3) {
+    const size_t a = prev[at], c = next[at];
+    bool ear = cross(a, at, c) > 0;
+    // No other remaining vertex (reflex ones are the only candidates) inside the triangle.
+    for (size_t x = next[c]; ear && x != a && budget; x = next[x], --budget)
+      if (cross(prev[x], x, next[x]) <= 0 && inside(a, at, c, x)) ear = false;
+    if (ear || misses > remaining || !budget) {
+      out.insert(out.end(), {uint32_t(a), uint32_t(at), uint32_t(c)});
+      next[a] = c, prev[c] = a;
+      --remaining;
+      at = c;
+      misses = 0;
+    } else {
+      at = next[at];
+      ++misses;
+    }
+  }
+  out.insert(out.end(), {uint32_t(prev[at]), uint32_t(at), uint32_t(next[at])});
+  return out;
 }
 
 // Reads the .mtl libraries an OBJ names, relative to the OBJ's directory and through readFile's
@@ -112,6 +199,72 @@ struct ObjProblem {
 };
 
 [[noreturn]] void fail(std::string message) { throw ObjProblem{std::move(message)}; }
+
+// The big faces (takeBigFaces), triangulated, as faces of the shapes they belong to (a shape of
+// their object's name, added when the text left it none).
+void addBigFaces(const std::vector<BigFace>& big, const tinyobj::attrib_t& attrib,
+                 const std::vector<tinyobj::material_t>& materials,
+                 std::vector<tinyobj::shape_t>& shapes) {
+  const size_t nv = attrib.vertices.size() / 3;
+  for (const BigFace& f : big) {
+    std::vector<tinyobj::index_t> corners;
+    std::vector<Vec3> outline;
+    for (const std::string& token : f.corners) {
+      // v[/vt[/vn]], 1-based or negative (relative to the elements defined before the face).
+      int parts[3] = {0, 0, 0};
+      bool given[3] = {false, false, false};
+      size_t from = 0;
+      for (int field = 0; field < 3; ++field) {
+        const size_t slash = token.find('/', from);
+        const std::string part =
+            token.substr(from, slash == std::string::npos ? std::string::npos : slash - from);
+        if (!part.empty()) {
+          char* endp = nullptr;
+          const long value = std::strtol(part.c_str(), &endp, 10);
+          if (*endp != 0 || value == 0 || value > (1l << 30) || value < -(1l << 30))
+            fail(fmt::format("line {}: invalid face corner '{}'", f.line, token));
+          parts[field] = int(value);
+          given[field] = true;
+        }
+        if (slash == std::string::npos) break;
+        from = slash + 1;
+      }
+      if (!given[0]) fail(fmt::format("line {}: invalid face corner '{}'", f.line, token));
+      auto index = [](int value, size_t defined) {
+        return value > 0 ? value - 1 : int(defined) + value;
+      };
+      tinyobj::index_t c;
+      c.vertex_index = index(parts[0], f.positions);
+      c.texcoord_index = given[1] ? index(parts[1], f.texcoords) : -1;
+      c.normal_index = given[2] ? index(parts[2], f.normals) : -1;
+      if (c.vertex_index < 0 || size_t(c.vertex_index) >= nv)
+        fail(fmt::format("line {}: face uses vertex {}, but there are {} vertices", f.line,
+                         parts[0], nv));
+      corners.push_back(c);
+      const size_t v = size_t(c.vertex_index);
+      outline.push_back({attrib.vertices[3 * v], attrib.vertices[3 * v + 1],
+                         attrib.vertices[3 * v + 2]});
+    }
+    int material = -1;
+    for (size_t m = 0; m < materials.size(); ++m)
+      if (materials[m].name == f.material) material = int(m);
+    tinyobj::shape_t* shape = nullptr;
+    for (tinyobj::shape_t& s : shapes)
+      if (s.name == f.object) shape = &s;
+    if (!shape) {
+      shapes.emplace_back();
+      shapes.back().name = f.object;
+      shape = &shapes.back();
+    }
+    const std::vector<uint32_t> triangles = triangulate(outline);
+    for (size_t t = 0; t < triangles.size(); t += 3) {
+      for (int k = 0; k < 3; ++k) shape->mesh.indices.push_back(corners[triangles[t + size_t(k)]]);
+      shape->mesh.num_face_vertices.push_back(3);
+      shape->mesh.material_ids.push_back(material);
+      shape->mesh.smoothing_group_ids.push_back(0);
+    }
+  }
+}
 
 Scene convertObj(const tinyobj::attrib_t& attrib, const std::vector<tinyobj::shape_t>& shapes,
                  const std::vector<tinyobj::material_t>& materials, const LoadOptions& options,
@@ -260,7 +413,9 @@ Result<Scene> parseObj(const std::string& text, const std::string& path,
                        const LoadOptions& options) {
   using namespace detail;
   try {
-    auto [line, problem] = objTextProblem(text);
+    std::string body = text;
+    std::vector<BigFace> big;
+    auto [line, problem] = takeBigFaces(body, big);
     if (!problem.empty()) return Error{path, fmt::format("{}", line), problem};
 
     tinyobj::attrib_t attrib;
@@ -268,7 +423,7 @@ Result<Scene> parseObj(const std::string& text, const std::string& path,
     std::vector<tinyobj::material_t> materials;
     std::string warn, err;
     MtlReader mtl(directoryOf(path), options.followReferences);
-    std::istringstream in(text);
+    std::istringstream in(body);
     bool ok = tinyobj::LoadObj(&attrib, &shapes, &materials, &warn, &err, &in, &mtl,
                                /*triangulate=*/true, /*default_vcols_fallback=*/false);
     if (!ok) {
@@ -276,6 +431,7 @@ Result<Scene> parseObj(const std::string& text, const std::string& path,
       return Error{path, lineOf(message),
                    fmt::format("invalid OBJ: {}", message.empty() ? "parse failed" : message)};
     }
+    addBigFaces(big, attrib, materials, shapes);
     Scene scene = convertObj(attrib, shapes, materials, options, directoryOf(path));
     Status valid = validate(scene, path);
     if (!valid) return valid.error();

@@ -1,6 +1,11 @@
 // The Wavefront OBJ loader: the sample house with its .mtl colours, corner de-duplication, vertex
 // colours, and malformed faces.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <numbers>
 
 #include <string>
 
@@ -91,13 +96,49 @@ TEST(Obj, RejectsMalformedFacesWithTheLineNumber) {
   EXPECT_EQ(r.error().str().find('\n'), std::string::npos);
 }
 
-TEST(Obj, RejectsFacesTooLargeToTriangulate) {
-  std::string text = "v 0 0 0\n";
+// Faces of more than tinyobjloader's 255 vertices are triangulated by the loader: a star of 400
+// vertices (concave at every other one), given with relative indices, becomes 398 triangles that
+// tile it exactly — their areas sum to its own, each turns as the outline does — in its material
+// and object; beyond 8 192 vertices a face is refused with its line.
+TEST(Obj, TriangulatesFacesOfAnyVertexCount) {
+  const int n = 400;
+  std::string text = "mtllib none.mtl\no star\nusemtl gold\n";
+  std::vector<std::array<double, 2>> star;
+  for (int i = 0; i < n; ++i) {
+    const double a = 2 * std::numbers::pi * i / n, r = i % 2 ? 0.6 : 1.0;
+    star.push_back({r * std::cos(a), r * std::sin(a)});
+    text += fmt::format("v {} {} 0\n", star.back()[0], star.back()[1]);
+  }
+  text += "f";
+  for (int i = 0; i < n; ++i) text += fmt::format(" {}", i - n);  // -400 … -1
+  text += "\n";
+  Result<Scene> r = parseObj(text, "star.obj");
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  ASSERT_EQ(r->meshes.size(), 1u);
+  const Mesh& m = r->meshes[0];
+  EXPECT_EQ(m.name, "star");
+  ASSERT_EQ(m.triangleCount(), size_t(n - 2));
+  double outline = 0;
+  for (int i = 0; i < n; ++i) {
+    const auto& a = star[size_t(i)];
+    const auto& b = star[size_t((i + 1) % n)];
+    outline += 0.5 * (a[0] * b[1] - a[1] * b[0]);
+  }
+  double sum = 0;
+  for (size_t t = 0; t < m.indices.size(); t += 3) {
+    const Vec3 a = m.positions[m.indices[t]], b = m.positions[m.indices[t + 1]],
+               c = m.positions[m.indices[t + 2]];
+    const double area = 0.5 * ((double(b.x) - a.x) * (double(c.y) - a.y) -
+                               (double(b.y) - a.y) * (double(c.x) - a.x));
+    EXPECT_GT(area, 0) << "triangle " << t / 3;
+    sum += area;
+  }
+  EXPECT_NEAR(sum, outline, 1e-4);
   std::string face = "f";
-  for (int i = 0; i < 300; ++i) face += " 1";
-  Result<Scene> r = parseObj(text + face + "\n", "big.obj");
-  ASSERT_FALSE(r.ok());
-  EXPECT_EQ(r.error().str(), "big.obj:2: a face with 300 vertices (the limit is 255)");
+  for (int i = 0; i < 8193; ++i) face += " 1";
+  Result<Scene> huge = parseObj("v 0 0 0\n" + face + "\n", "big.obj");
+  ASSERT_FALSE(huge.ok());
+  EXPECT_EQ(huge.error().str(), "big.obj:2: a face with 8193 vertices (the limit is 8192)");
 }
 
 TEST(Obj, MissingMaterialLibraryFallsBackToTheDefaultMaterial) {
