@@ -184,7 +184,8 @@ Result<IgRunReport> IgLoop::run() {
   const double periodMs = 1000 / m.config.rate;
   const auto period = std::chrono::duration_cast<Clock::duration>(
       std::chrono::duration<double, std::milli>(periodMs));
-  OverloadGovernor governor(qualityLevels(m.config.render), m.config.deadline * periodMs);
+  OverloadGovernor governor(qualityLevels(m.config.render, !world.database().lodGroups.empty()),
+                            m.config.deadline * periodMs);
   std::optional<present::TestPattern> pattern;
   if (!m.options.testPattern.empty()) pattern = present::parseTestPattern(m.options.testPattern).value();
 

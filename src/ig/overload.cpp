@@ -17,7 +17,7 @@ constexpr double kStaleDrift = 0.05;
 
 }  // namespace
 
-std::vector<QualityLevel> qualityLevels(const RenderOptions& full) {
+std::vector<QualityLevel> qualityLevels(const RenderOptions& full, bool levelsOfDetail) {
   std::vector<QualityLevel> levels{{full, true, 1, "full quality"}};
   auto next = [&](const char* what, auto&& change) {
     QualityLevel l = levels.back();
@@ -39,6 +39,9 @@ std::vector<QualityLevel> qualityLevels(const RenderOptions& full) {
   next("bilinear terrain", [](QualityLevel& l) {
     l.options.terrainFilter = RenderOptions::TerrainFilter::bilinear;
   });
+  // Geometry: every level of detail switched at half its range (RenderOptions::lodScale).
+  if (levelsOfDetail && full.lod)
+    next("coarser levels of detail", [](QualityLevel& l) { l.options.lodScale *= 2; });
   next("half resolution", [](QualityLevel& l) { l.replication = 2; });
   return levels;
 }

@@ -32,8 +32,10 @@ struct QualityLevel {
   std::string change;  // what this level gave up against the one before ("aa 4", "no stars")
 };
 
-// The levels from full quality `full` down, each one reduction more than the last.
-std::vector<QualityLevel> qualityLevels(const RenderOptions& full);
+// The levels from full quality `full` down, each one reduction more than the last; with
+// `levelsOfDetail` (the database has level-of-detail groups) one that switches every group's
+// levels at half their ranges, before half resolution.
+std::vector<QualityLevel> qualityLevels(const RenderOptions& full, bool levelsOfDetail = false);
 
 class OverloadGovernor {
  public:

@@ -376,6 +376,14 @@ TEST(IgOverload, StepsDownWhenOverrunAndBackUpWithHysteresis) {
   EXPECT_EQ(levels[1].options.samples, 8);
   EXPECT_EQ(levels[3].options.samples, 1);
   EXPECT_FALSE(levels[5].stars);
+  // A database with levels of detail gives up geometry before resolution.
+  const std::vector<QualityLevel> withLod = qualityLevels(full, true);
+  ASSERT_EQ(withLod.size(), 9u);
+  EXPECT_EQ(withLod[7].change, "coarser levels of detail");
+  EXPECT_EQ(withLod[7].options.lodScale, 2);
+  EXPECT_EQ(withLod[7].replication, 1);
+  EXPECT_EQ(withLod[8].options.lodScale, 2);
+  EXPECT_EQ(withLod[8].replication, 2);
   OverloadGovernor g(levels, 10.0, 5);
   // The frame's cost: 24 ms at full quality, halving with each anti-aliasing step.
   auto cost = [&](int level) { return 24.0 / (1 << std::min(level, 3)); };
