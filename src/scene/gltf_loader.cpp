@@ -23,6 +23,7 @@
 #include <tuple>
 #include <utility>
 
+#include "scene/draco_mesh.h"
 #include "scene/loader_common.h"
 #include "texture/jpeg.h"
 #include "texture/texture.h"
@@ -38,7 +39,7 @@ constexpr int kMaxGltfJsonDepth = 64;
 // Extensions whose presence in extensionsRequired we can honour.
 constexpr const char* kSupportedRequiredExtensions[] = {
     "KHR_materials_unlit", "KHR_mesh_quantization", "KHR_texture_transform",
-    "EXT_mesh_gpu_instancing", "MSFT_lod"};
+    "EXT_mesh_gpu_instancing", "MSFT_lod", "KHR_draco_mesh_compression"};
 
 // A problem in the model, reported from deep inside the conversion; caught in convertModel and
 // returned as an Error. It never leaves this file.
@@ -274,6 +275,13 @@ class GltfConverter {
   int textureFor(int gltfTexture, const std::string& where);
   const std::vector<int>& meshesOf(int gltfMesh);
   Mesh convertPrimitive(const tinygltf::Primitive& primitive, const std::string& where) const;
+  // A KHR_draco_mesh_compression primitive: its bufferView decoded by libdraco.
+  Mesh convertDracoPrimitive(const tinygltf::Primitive& primitive, const std::string& where) const;
+  // The bytes of bufferView `index`, checked to lie inside its buffer.
+  std::pair<const unsigned char*, size_t> bufferViewBytes(int index, const std::string& where) const;
+  // KHR_texture_transform of the primitive's material on its uvs.
+  void transformUvs(const tinygltf::Primitive& primitive, std::vector<Vec2>& uvs) const;
+  int materialOf(const tinygltf::Primitive& primitive, const std::string& where) const;
   Mat4 localMatrix(const tinygltf::Node& node, const std::string& where) const;
   // EXT_mesh_gpu_instancing: the node's instances' transforms (T·R·S each), or none.
   std::vector<Mat4> gpuInstances(const tinygltf::Node& node, const std::string& where) const;
@@ -473,8 +481,74 @@ int GltfConverter::textureFor(int gltfTexture, const std::string& where) {
   return index;
 }
 
+void GltfConverter::transformUvs(const tinygltf::Primitive& primitive,
+                                 std::vector<Vec2>& uvs) const {
+  if (const auto t = uvTransforms_.find(primitive.material); t != uvTransforms_.end())
+    for (Vec2& uv : uvs) {
+      const UvTransform& m = t->second;
+      uv = {m.a * uv.x + m.b * uv.y + m.c, m.d * uv.x + m.e * uv.y + m.f};
+    }
+}
+
+std::pair<const unsigned char*, size_t> GltfConverter::bufferViewBytes(
+    int index, const std::string& where) const {
+  if (index < 0 || size_t(index) >= model_.bufferViews.size())
+    fail(fmt::format("{}: bufferView {} does not exist", where, index));
+  const tinygltf::BufferView& view = model_.bufferViews[size_t(index)];
+  if (view.buffer < 0 || size_t(view.buffer) >= model_.buffers.size())
+    fail(fmt::format("{}: bufferViews[{}] refers to buffer {}, which does not exist", where, index,
+                     view.buffer));
+  const std::vector<unsigned char>& buffer = model_.buffers[size_t(view.buffer)].data;
+  if (view.byteOffset > buffer.size() || view.byteLength > buffer.size() - view.byteOffset)
+    fail(fmt::format("{}: bufferViews[{}] (offset {}, length {}) lies outside buffers[{}] ({} bytes)",
+                     where, index, view.byteOffset, view.byteLength, view.buffer, buffer.size()));
+  return {buffer.data() + view.byteOffset, view.byteLength};
+}
+
+Mesh GltfConverter::convertDracoPrimitive(const tinygltf::Primitive& primitive,
+                                          const std::string& where) const {
+  const std::string w = where + ".KHR_draco_mesh_compression";
+  const tinygltf::Value& e = primitive.extensions.at("KHR_draco_mesh_compression");
+  if (!e.IsObject() || !e.Has("bufferView") || !e.Get("bufferView").IsInt() ||
+      !e.Has("attributes") || !e.Get("attributes").IsObject())
+    fail(w + ": expected an object with 'bufferView' and 'attributes'");
+  if (primitive.mode != TINYGLTF_MODE_TRIANGLES)
+    fail(fmt::format("{}: mode {} (Draco meshes are triangles)", w, primitive.mode));
+  const tinygltf::Value& attributes = e.Get("attributes");
+  auto id = [&](const char* name) {
+    if (!attributes.Has(name)) return -1;
+    if (!attributes.Get(name).IsInt() || attributes.Get(name).Get<int>() < 0)
+      fail(fmt::format("{}.attributes.{}: expected an attribute id", w, name));
+    return attributes.Get(name).Get<int>();
+  };
+  const DracoAttributes ids{id("POSITION"), id("NORMAL"), id("COLOR_0"), id("TEXCOORD_0")};
+  const auto [bytes, size] = bufferViewBytes(e.Get("bufferView").Get<int>(), w);
+  Result<DracoMesh> decoded =
+      decodeDracoMesh(bytes, size, ids, std::numeric_limits<uint32_t>::max(), options_.maxTriangles);
+  if (!decoded) fail(fmt::format("{}: {}", w, decoded.error().message));
+  Mesh mesh;
+  mesh.positions = std::move(decoded->positions);
+  mesh.normals = std::move(decoded->normals);
+  mesh.colors = std::move(decoded->colors);
+  mesh.uvs = std::move(decoded->uvs);
+  transformUvs(primitive, mesh.uvs);
+  mesh.indices = std::move(decoded->indices);
+  mesh.material = materialOf(primitive, where);
+  return mesh;
+}
+
+int GltfConverter::materialOf(const tinygltf::Primitive& primitive,
+                              const std::string& where) const {
+  if (primitive.material >= 0 && size_t(primitive.material) >= scene_.materials.size())
+    fail(fmt::format("{}: material {} does not exist ({} materials)", where, primitive.material,
+                     scene_.materials.size()));
+  return primitive.material;
+}
+
 Mesh GltfConverter::convertPrimitive(const tinygltf::Primitive& primitive,
                                      const std::string& where) const {
+  if (primitive.extensions.count("KHR_draco_mesh_compression"))
+    return convertDracoPrimitive(primitive, where);
   constexpr int kFloat = TINYGLTF_COMPONENT_TYPE_FLOAT;
   constexpr int kByte = TINYGLTF_COMPONENT_TYPE_BYTE,
                 kUByte = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
@@ -527,11 +601,7 @@ Mesh GltfConverter::convertPrimitive(const tinygltf::Primitive& primitive,
     sameCount(v, "TEXCOORD_0");
     mesh.uvs.resize(n);
     for (size_t i = 0; i < n; ++i) mesh.uvs[i] = {v.get(i, 0), v.get(i, 1)};
-    if (const auto t = uvTransforms_.find(primitive.material); t != uvTransforms_.end())
-      for (Vec2& uv : mesh.uvs) {
-        const UvTransform& m = t->second;
-        uv = {m.a * uv.x + m.b * uv.y + m.c, m.d * uv.x + m.e * uv.y + m.f};
-      }
+    transformUvs(primitive, mesh.uvs);
   }
 
   // Step 2: the index sequence, given or implied (0, 1, 2, …), each checked against n.
@@ -579,10 +649,7 @@ Mesh GltfConverter::convertPrimitive(const tinygltf::Primitive& primitive,
       break;  // points and lines have no triangles
   }
 
-  if (primitive.material >= 0 && size_t(primitive.material) >= scene_.materials.size())
-    fail(fmt::format("{}: material {} does not exist ({} materials)", where, primitive.material,
-                     scene_.materials.size()));
-  mesh.material = primitive.material;
+  mesh.material = materialOf(primitive, where);
   return mesh;
 }
 

@@ -7,6 +7,8 @@
 #include <numbers>
 #include <string>
 
+#include <draco/compression/encode.h>
+#include <draco/mesh/triangle_soup_mesh_builder.h>
 #include <turbojpeg.h>
 
 #include "scene/scene_test_util.h"
@@ -173,8 +175,8 @@ TEST(Gltf, RejectsBrokenReferencesAndHierarchies) {
        },
        "nodes[0].matrix: expected 16 numbers, got 3"},
       {"required extension",
-       [](GltfBuilder& b) { b.doc["extensionsRequired"] = {"KHR_draco_mesh_compression"}; },
-       "requires the unsupported extension 'KHR_draco_mesh_compression'"},
+       [](GltfBuilder& b) { b.doc["extensionsRequired"] = {"EXT_meshopt_compression"}; },
+       "requires the unsupported extension 'EXT_meshopt_compression'"},
       {"sparse accessor",
        [](GltfBuilder& b) {
          b.doc["accessors"][0]["sparse"] = {
@@ -424,6 +426,80 @@ TEST(Gltf, MsftLodBecomesALevelOfDetailGroup) {
   EXPECT_EQ(two->instances[0].lod, -1);
   ASSERT_EQ(two->warnings.size(), 1u);
   EXPECT_TRUE(testing::contains(two->warnings[0], "nodes[0].MSFT_lod: a level of 2 primitives"));
+}
+
+}  // namespace
+}  // namespace sv::scene
+
+namespace sv::scene {
+namespace {
+
+// KHR_draco_mesh_compression: a primitive's Draco bufferView decodes (libdraco) to its triangles,
+// positions within the quantization's step, texture coordinates too; corrupt data is named.
+TEST(Gltf, ReadsDracoCompressedPrimitives) {
+  // A 4 × 4 grid of quads in z = 0, with uvs, as a Draco mesh.
+  std::vector<Vec3> corners;
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 4; ++x)
+      for (const auto& [dx, dy] : {std::pair{0, 0}, {1, 0}, {1, 1}, {0, 0}, {1, 1}, {0, 1}})
+        corners.push_back({float(x + dx), float(y + dy), 0});
+  const int faces = int(corners.size() / 3);
+  draco::TriangleSoupMeshBuilder builder;
+  builder.Start(faces);
+  const int pos = builder.AddAttribute(draco::GeometryAttribute::POSITION, 3, draco::DT_FLOAT32);
+  const int tex = builder.AddAttribute(draco::GeometryAttribute::TEX_COORD, 2, draco::DT_FLOAT32);
+  for (int f = 0; f < faces; ++f) {
+    const Vec3* c = &corners[size_t(3 * f)];
+    const float uv[3][2] = {{c[0].x / 4, c[0].y / 4}, {c[1].x / 4, c[1].y / 4}, {c[2].x / 4, c[2].y / 4}};
+    builder.SetAttributeValuesForFace(pos, draco::FaceIndex(f), &c[0], &c[1], &c[2]);
+    builder.SetAttributeValuesForFace(tex, draco::FaceIndex(f), uv[0], uv[1], uv[2]);
+  }
+  std::unique_ptr<draco::Mesh> mesh = builder.Finalize();
+  ASSERT_TRUE(mesh);
+  draco::Encoder encoder;
+  encoder.SetAttributeQuantization(draco::GeometryAttribute::POSITION, 14);
+  draco::EncoderBuffer encoded;
+  ASSERT_TRUE(encoder.EncodeMeshToBuffer(*mesh, &encoded).ok());
+
+  GltfBuilder b;
+  const size_t offset = b.buffer.size();
+  b.buffer.append(encoded.data(), encoded.size());
+  b.doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", encoded.size()}});
+  b.doc["accessors"].push_back({{"componentType", 5126}, {"count", mesh->num_points()}, {"type", "VEC3"}});
+  b.doc["accessors"].push_back({{"componentType", 5126}, {"count", mesh->num_points()}, {"type", "VEC2"}});
+  b.addNode({{"mesh", b.addMesh({{"attributes", {{"POSITION", 0}, {"TEXCOORD_0", 1}}},
+                                 {"extensions",
+                                  {{"KHR_draco_mesh_compression",
+                                    {{"bufferView", 0},
+                                     {"attributes",
+                                      {{"POSITION", mesh->attribute(pos)->unique_id()},
+                                       {"TEXCOORD_0", mesh->attribute(tex)->unique_id()}}}}}}}})}});
+  b.doc["extensionsRequired"] = {"KHR_draco_mesh_compression"};
+  b.doc["extensionsUsed"] = {"KHR_draco_mesh_compression"};
+  Result<Scene> r = load(b);
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  ASSERT_EQ(r->meshes.size(), 1u);
+  const Mesh& m = r->meshes[0];
+  ASSERT_EQ(m.triangleCount(), size_t(faces));
+  ASSERT_EQ(m.uvs.size(), m.positions.size());
+  double area = 0;
+  for (size_t t = 0; t < m.indices.size(); t += 3) {
+    const Vec3 a = m.positions[m.indices[t]], p = m.positions[m.indices[t + 1]],
+               c = m.positions[m.indices[t + 2]];
+    area += 0.5 * std::fabs(double(p.x - a.x) * (c.y - a.y) - double(p.y - a.y) * (c.x - a.x));
+  }
+  EXPECT_NEAR(area, 16, 1e-2);  // the grid's area, within the 14-bit quantization
+  for (size_t i = 0; i < m.positions.size(); ++i) {
+    EXPECT_NEAR(m.uvs[i].x, m.positions[i].x / 4, 1e-2);
+    EXPECT_NEAR(m.uvs[i].y, m.positions[i].y / 4, 1e-2);
+  }
+  // Corrupt bytes are refused with the place named.
+  for (size_t i = 8; i < 24 && offset + i < b.buffer.size(); ++i) b.buffer[offset + i] = char(0xFF);
+  Result<Scene> bad = load(b);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_TRUE(testing::contains(bad.error().str(),
+                                "meshes[0].primitives[0].KHR_draco_mesh_compression"))
+      << bad.error().str();
 }
 
 }  // namespace
