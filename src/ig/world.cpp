@@ -405,38 +405,83 @@ std::optional<double> rayTriangle(DVec3 o, DVec3 d, DVec3 a, DVec3 b, DVec3 c, d
   return t;
 }
 
-// The nearest hit of the segment o → o + d (t in [0, 1]) with the database's polygons.
+// Whether the segment o → o + d (t in [0, 1]) meets the box [lo, hi] (slabs, in double; a margin
+// of 1e-6 of the extent keeps float boxes conservative).
+bool segmentMeetsBox(DVec3 o, DVec3 d, DVec3 lo, DVec3 hi) {
+  double t0 = 0, t1 = 1;
+  const double os[3] = {o.x, o.y, o.z}, ds[3] = {d.x, d.y, d.z}, ls[3] = {lo.x, lo.y, lo.z},
+               hs[3] = {hi.x, hi.y, hi.z};
+  for (int a = 0; a < 3; ++a) {
+    const double margin = 1e-6 * (std::fabs(ls[a]) + std::fabs(hs[a]) + 1);
+    const double l = ls[a] - margin, h = hs[a] + margin;
+    if (ds[a] == 0) {
+      if (os[a] < l || os[a] > h) return false;
+      continue;
+    }
+    double ta = (l - os[a]) / ds[a], tb = (h - os[a]) / ds[a];
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+    if (t0 > t1) return false;
+  }
+  return true;
+}
+
+// The nearest hit of the segment o → o + d (t in [0, 1]) with instance `i`'s triangles (its full
+// detail), or `best` (the nearest so far).
+std::optional<double> instanceHit(const scene::Scene& s, size_t i, DVec3 o, DVec3 d,
+                                  std::optional<double> best) {
+  const scene::Instance& inst = s.instances[i];
+  const scene::Mesh& mesh = s.meshes[size_t(inst.mesh)];
+  // The segment against the instance's world box first.
+  const auto box = mesh.bounds();
+  DVec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  for (int k = 0; k < 8; ++k) {
+    const Vec3 corner =
+        inst.transform.transformPoint({box[k & 1].x, box[(k >> 1) & 1].y, box[(k >> 2) & 1].z});
+    lo = {std::min(lo.x, double(corner.x)), std::min(lo.y, double(corner.y)),
+          std::min(lo.z, double(corner.z))};
+    hi = {std::max(hi.x, double(corner.x)), std::max(hi.y, double(corner.y)),
+          std::max(hi.z, double(corner.z))};
+  }
+  if (!segmentMeetsBox(o, d, lo, hi)) return best;
+  auto world = [&](uint32_t index) {
+    const Vec3 p = inst.transform.transformPoint(mesh.positions[index]);
+    return DVec3{p.x, p.y, p.z};
+  };
+  for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+    const std::optional<double> hit =
+        rayTriangle(o, d, world(mesh.indices[t]), world(mesh.indices[t + 1]),
+                    world(mesh.indices[t + 2]), best.value_or(1.0));
+    if (hit) best = hit;
+  }
+  return best;
+}
+
+// The nearest hit of the segment o → o + d (t in [0, 1]) with the database's polygons: through
+// the instance tree for the instances it holds (only the leaves the segment meets), one by one for
+// the rest.
 std::optional<double> polygonHit(const scene::Scene& s, size_t instances, DVec3 o, DVec3 d) {
   std::optional<double> best;
-  for (size_t i = 0; i < instances; ++i) {
-    const scene::Instance& inst = s.instances[i];
-    const scene::Mesh& mesh = s.meshes[size_t(inst.mesh)];
-    // The segment's box against the instance's world box first.
-    const auto box = mesh.bounds();
-    DVec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
-    for (int k = 0; k < 8; ++k) {
-      const Vec3 corner = inst.transform.transformPoint(
-          {box[k & 1].x, box[(k >> 1) & 1].y, box[(k >> 2) & 1].z});
-      lo = {std::min(lo.x, double(corner.x)), std::min(lo.y, double(corner.y)),
-            std::min(lo.z, double(corner.z))};
-      hi = {std::max(hi.x, double(corner.x)), std::max(hi.y, double(corner.y)),
-            std::max(hi.z, double(corner.z))};
+  size_t from = 0;
+  if (const scene::InstanceTree* tree = s.instanceTree.get();
+      tree && !tree->nodes.empty() && tree->instanceCount <= instances) {
+    std::vector<uint32_t> stack{0};
+    while (!stack.empty()) {
+      const scene::InstanceTree::Node& n = tree->nodes[stack.back()];
+      stack.pop_back();
+      if (!segmentMeetsBox(o, d, {n.lo.x, n.lo.y, n.lo.z}, {n.hi.x, n.hi.y, n.hi.z})) continue;
+      if (n.count == 0) {
+        stack.push_back(n.first);
+        stack.push_back(n.first + 1);
+        continue;
+      }
+      for (uint32_t k = n.first; k < n.first + n.count; ++k)
+        best = instanceHit(s, tree->order[k], o, d, best);
     }
-    const DVec3 e = o + d;
-    if (std::max(o.x, e.x) < lo.x || std::min(o.x, e.x) > hi.x || std::max(o.y, e.y) < lo.y ||
-        std::min(o.y, e.y) > hi.y || std::max(o.z, e.z) < lo.z || std::min(o.z, e.z) > hi.z)
-      continue;
-    auto world = [&](uint32_t index) {
-      const Vec3 p = inst.transform.transformPoint(mesh.positions[index]);
-      return DVec3{p.x, p.y, p.z};
-    };
-    for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
-      const std::optional<double> hit =
-          rayTriangle(o, d, world(mesh.indices[t]), world(mesh.indices[t + 1]),
-                      world(mesh.indices[t + 2]), best.value_or(1.0));
-      if (hit) best = hit;
-    }
+    from = tree->instanceCount;
   }
+  for (size_t i = from; i < instances; ++i) best = instanceHit(s, i, o, d, best);
   return best;
 }
 
