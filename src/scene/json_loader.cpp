@@ -446,9 +446,10 @@ class SceneReader {
   std::vector<Vec3> colorTable_;
   // Materials made for objects' "color" overrides, by (base material, colour), to share them.
   std::map<std::pair<int, std::array<float, 4>>, int> colorMaterials_;
-  // Where a referenced file's meshes were placed in this scene, by (file, material override), so
-  // that further references to it add instances only.
-  std::map<std::pair<std::string, int>, int> placedMeshes_;
+  // Where a referenced file's meshes and level-of-detail groups were placed in this scene (its
+  // first mesh, its first group), by (file, material override), so that further references to it
+  // add instances only.
+  std::map<std::pair<std::string, int>, std::pair<int, int>> placedMeshes_;
   std::map<std::string, int> lodGroupByName_;
 };
 
@@ -1845,10 +1846,19 @@ void SceneReader::readMeshFile(const Json& v, const std::string& where, std::opt
       mesh.material = material ? *material : mesh.material >= 0 ? mesh.material + materialBase : -1;
       scene_.meshes.push_back(std::move(mesh));
     }
-    placed = placedMeshes_.emplace(std::make_pair(key, overrideKey), meshBase).first;
+    // Its levels of detail, their meshes renumbered.
+    const int lodBase = int(scene_.lodGroups.size());
+    for (LodGroup group : file.lodGroups) {
+      for (LodLevel& level : group.levels) level.mesh += meshBase;
+      scene_.lodGroups.push_back(std::move(group));
+    }
+    placed = placedMeshes_.emplace(std::make_pair(key, overrideKey), std::pair{meshBase, lodBase})
+                 .first;
   }
+  const auto [meshBase, lodBase] = placed->second;
   for (const Instance& instance : file.instances)
-    scene_.instances.push_back({instance.mesh + placed->second, m * instance.transform});
+    scene_.instances.push_back({instance.mesh + meshBase, m * instance.transform, 0,
+                                instance.lod >= 0 ? instance.lod + lodBase : -1});
   for (Camera camera : file.cameras) {
     camera.position = m.transformPoint(camera.position);
     camera.target = m.transformPoint(camera.target);

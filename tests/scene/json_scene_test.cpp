@@ -572,3 +572,35 @@ TEST(JsonScene, ReadsLevelOfDetailGroupsAndTheirPlacements) {
 
 }  // namespace
 }  // namespace sv::scene
+
+namespace sv::scene {
+namespace {
+
+// A scene file placed by another keeps its levels of detail: its groups come along, renumbered,
+// and its instances still name them (a database of tiles referencing tiles).
+TEST(JsonScene, AReferencedFileKeepsItsLevelsOfDetail) {
+  TempDir dir;
+  dir.write("tile.json", R"({"synthvis": 1,
+    "lodGroups": {"tree": {"levels": [{"to": 50, "primitive": "sphere"},
+                                      {"to": 200, "primitive": "box"}]}},
+    "objects": [{"lod": "tree", "at": [[0, 0, 0], [5, 0, 0]]}]})");
+  const std::string path = dir.write("world.json", R"({"synthvis": 1,
+    "objects": [{"primitive": "box"},
+                {"mesh": "tile.json", "transform": {"translate": [100, 0, 0]}},
+                {"mesh": "tile.json", "transform": {"translate": [200, 0, 0]}}]})");
+  Result<Scene> r = loadScene(path);
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  const Scene& s = r.value();
+  ASSERT_EQ(s.lodGroups.size(), 1u);  // placed once, instanced twice
+  ASSERT_EQ(s.instances.size(), 5u);
+  EXPECT_EQ(s.instances[0].lod, -1);
+  for (size_t i = 1; i < 5; ++i) {
+    EXPECT_EQ(s.instances[i].lod, 0);
+    EXPECT_EQ(s.instances[i].mesh, s.lodGroups[0].levels[0].mesh);
+  }
+  EXPECT_NE(s.lodGroups[0].levels[0].mesh, 0);  // renumbered after the box
+  EXPECT_TRUE(validate(s, path).ok());
+}
+
+}  // namespace
+}  // namespace sv::scene
