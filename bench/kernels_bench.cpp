@@ -8,6 +8,8 @@
 //   whole frame, BENCH.md tris     → triangles/s
 //   texture samples, per filter    → samples/s (scalar Texture::sample, SIMD sampleBlock)
 //   resolve, a 1080p frame's tiles → pixels/s (16-bit linear tiles to the 8-bit sRGB image)
+//   traversal, BENCH.md city       → instances/s (the tree culled to the view, levels chosen),
+//                                    with and without the instance tree
 // The tile and frame benchmarks take the samples per pixel as their last argument (1 = point
 // sampling; 4, 16 = anti-aliasing with sub-pixel masks, issue 4).
 #include <benchmark/benchmark.h>
@@ -20,7 +22,10 @@
 #include "raster/coverage_masks.h"
 #include "raster/framebuffer.h"
 #include "raster/rasterizer.h"
+#include "render/camera.h"
 #include "render/frame_renderer.h"
+#include "render/traversal.h"
+#include "synthvis/generators.h"
 #include "texture/texture.h"
 
 namespace sv {
@@ -244,6 +249,30 @@ void BM_ResolveFrame(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * int64_t(kW) * kH);
 }
 BENCHMARK(BM_ResolveFrame);
+
+// The traversal stage over BENCH.md's city (110 001 instances) from its camera, 1 thread: the
+// instance tree classified, every instance's level chosen; argument 1: through the tree, 0: every
+// instance tested on its own.
+void BM_TraverseCity(benchmark::State& state) {
+  scene::Scene city = scene::generateCity({});
+  if (!state.range(0)) city.instanceTree.reset();
+  RenderOptions o;
+  o.width = 1920;
+  o.height = 1080;
+  const render::FrameCamera camera = render::chooseCamera(city, o).value();
+  std::vector<std::array<Vec3, 2>> bounds;
+  for (const scene::Mesh& m : city.meshes) bounds.push_back(m.bounds());
+  core::ThreadPool pool(1);
+  render::Traversal t;
+  for (auto _ : state) {
+    render::traverse(city, o, camera, bounds, pool, t);
+    benchmark::DoNotOptimize(t.draws.data());
+  }
+  state.counters["instances/s"] = benchmark::Counter(
+      double(city.instances.size()) * state.iterations(), benchmark::Counter::kIsRate);
+  state.counters["draws"] = double(t.draws.size());
+}
+BENCHMARK(BM_TraverseCity)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace sv
