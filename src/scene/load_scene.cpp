@@ -8,6 +8,7 @@
 #include <memory>
 #include <new>
 
+#include "scene/assimp_loader.h"
 #include "scene/loader_common.h"
 
 namespace sv::scene {
@@ -87,10 +88,11 @@ std::string oneLine(const std::string& text) {
 
 Result<Scene> loadFile(const std::string& path, LoadContext& context) {
   std::string ext = lowerExtension(path);
-  if (ext != ".json" && ext != ".gltf" && ext != ".glb" && ext != ".obj")
-    return Error{
-        path, "",
-        fmt::format("unknown scene file type '{}' (expected .json, .gltf, .glb or .obj)", ext)};
+  // Other formats (AC3D, COLLADA, 3DS, FBX, PLY, STL, …) through Assimp in a child process.
+  if (ext != ".json" && ext != ".gltf" && ext != ".glb" && ext != ".obj") {
+    if (Result<std::string> bytes = readFile(path); !bytes) return bytes.error();
+    return loadWithAssimp(path, ext, context.options);
+  }
   Result<std::string> bytes = readFile(path);
   if (!bytes) return bytes.error();
   if (ext == ".json") return parseJsonSceneIn(bytes.value(), path, context);
