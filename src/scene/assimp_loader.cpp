@@ -216,6 +216,12 @@ std::string convert(const aiScene& a, const std::string& path, const LoadOptions
     const ssize_t ignored = write(report, line.data(), line.size());
     (void)ignored;
   }
+  // Nothing to draw: no file (a glTF of no buffer is not one); the parent says so.
+  if (ours.meshes.empty()) {
+    const ssize_t ignored = write(report, "empty\n", 6);
+    (void)ignored;
+    _exit(0);
+  }
   if (Status s = saveGltf(ours, out); !s) die(s.error().message);
   _exit(0);
 }
@@ -284,12 +290,15 @@ Result<Scene> loadWithAssimp(const std::string& path, const std::string& extensi
   // The report: warnings, one a line, then (on failure) the reason.
   std::vector<std::string> warnings;
   std::string reason;
+  bool empty = false;
   for (size_t start = 0; start < report.size();) {
     size_t end = report.find('\n', start);
     if (end == std::string::npos) end = report.size();
     const std::string line = report.substr(start, end - start);
     if (line.rfind("warning ", 0) == 0)
       warnings.push_back(fmt::format("{}: {}", path, line.substr(8)));
+    else if (line == "empty")
+      empty = true;
     else
       reason += line;
     start = end + 1;
@@ -297,6 +306,11 @@ Result<Scene> loadWithAssimp(const std::string& path, const std::string& extensi
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
     cleanup();
     return Error{path, "", reason.empty() ? "Assimp failed" : oneLine(reason)};
+  }
+  if (empty) {  // loadScene adds "nothing to draw"
+    Scene none;
+    none.warnings = std::move(warnings);
+    return none;
   }
   Result<Scene> scene = loadGltf(out);
   cleanup();
