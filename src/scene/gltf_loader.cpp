@@ -323,19 +323,9 @@ AccessorView GltfConverter::accessor(int index, const std::string& where,
   if (std::find(componentTypes.begin(), componentTypes.end(), a.componentType) ==
       componentTypes.end())
     fail(fmt::format("{}: unexpected component type {}", name, a.componentType));
-  if (a.bufferView < 0 || size_t(a.bufferView) >= model_.bufferViews.size())
-    fail(fmt::format("{}: bufferView {} does not exist", name, a.bufferView));
-  const tinygltf::BufferView& view = model_.bufferViews[size_t(a.bufferView)];
-  if (view.buffer < 0 || size_t(view.buffer) >= model_.buffers.size())
-    fail(fmt::format("{}: bufferViews[{}] refers to buffer {}, which does not exist", name,
-                     a.bufferView, view.buffer));
-  const std::vector<unsigned char>& buffer = model_.buffers[size_t(view.buffer)].data;
-
   // Step 1: the buffer view inside its buffer.
-  if (view.byteOffset > buffer.size() || view.byteLength > buffer.size() - view.byteOffset)
-    fail(fmt::format(
-        "{}: bufferViews[{}] (offset {}, length {}) lies outside buffers[{}] ({} bytes)", name,
-        a.bufferView, view.byteOffset, view.byteLength, view.buffer, buffer.size()));
+  const auto [viewBytes, viewLength] = bufferViewBytes(a.bufferView, name);
+  const tinygltf::BufferView& view = model_.bufferViews[size_t(a.bufferView)];
 
   // Step 2: the elements inside the buffer view. Element i occupies
   // [byteOffset + i·stride, byteOffset + i·stride + elementSize).
@@ -350,14 +340,14 @@ AccessorView GltfConverter::accessor(int index, const std::string& where,
     fail(fmt::format("{}: byteStride {} is invalid for {}-byte elements", name, view.byteStride,
                      elementSize));
   if (a.count > 0) {
-    const size_t room = a.byteOffset <= view.byteLength ? view.byteLength - a.byteOffset : 0;
-    if (a.byteOffset > view.byteLength || room < elementSize ||
+    const size_t room = a.byteOffset <= viewLength ? viewLength - a.byteOffset : 0;
+    if (a.byteOffset > viewLength || room < elementSize ||
         (a.count - 1) > (room - elementSize) / out.stride)
       fail(fmt::format(
           "{}: {} elements of {} bytes (stride {}, offset {}) do not fit in "
           "bufferViews[{}] ({} bytes)",
-          name, a.count, elementSize, out.stride, a.byteOffset, a.bufferView, view.byteLength));
-    out.data = buffer.data() + view.byteOffset + a.byteOffset;
+          name, a.count, elementSize, out.stride, a.byteOffset, a.bufferView, viewLength));
+    out.data = viewBytes + a.byteOffset;
   }
   return out;
 }
