@@ -52,6 +52,9 @@ struct LightAppearance {
   float rotationPeriod = 0;
 };
 
+// At most this many light points in a scene (32 bytes each): loaders refuse more.
+inline constexpr size_t kMaxLightPoints = size_t(1) << 22;
+
 // One light. `phase` (turns) is added to its appearance's blink and rotation phases: a sequenced
 // flasher string gives each light its place in the sequence.
 struct LightPoint {

@@ -82,4 +82,11 @@ struct Mat4 {
   friend bool operator==(const Mat4& a, const Mat4& b) = default;
 };
 
+inline bool isFinite(const Mat4& m) {
+  for (const auto& column : m.m)
+    for (float x : column)
+      if (!std::isfinite(x)) return false;
+  return true;
+}
+
 }  // namespace sv

@@ -115,6 +115,11 @@ struct Instance {
   // Levels of detail (SPEC §1 traversal): an index into Scene::lodGroups, whose level 0 is `mesh`;
   // −1: `mesh` at every range.
   int lod = -1;
+  // False: not drawn (a switch turned it off; applyArticulations sets it from Scene::switches).
+  bool visible = true;
+  // True: a degree of freedom moves it (applyArticulations sets its transform from Scene::dofs);
+  // the instance tree leaves it out and it is culled on its own.
+  bool articulated = false;
 };
 
 // Levels of detail shared by the instances that name the group (docs/scene-format.md "Levels of
@@ -133,6 +138,9 @@ struct LodGroup {
   std::string name;
   std::vector<LodLevel> levels;  // 1 … kMaxLodLevels, `to` increasing
   float fade = 0;                // the dissolve band below each switch, ≥ 0, < each level's span
+  // The point ranges are measured to, in the instance's own space (OpenFlight's LOD centre);
+  // empty: the centre of the box around all levels.
+  std::optional<Vec3> center;
 };
 inline constexpr size_t kMaxLodLevels = 8;
 
@@ -151,7 +159,45 @@ struct InstanceTree {
   std::vector<Node> nodes;     // nodes[0] the root (none for a scene without instances)
   std::vector<uint32_t> order;  // instance indices, each leaf's a contiguous range
   size_t instanceCount = 0;
+  // The articulated instances below instanceCount, which the tree leaves out (they move).
+  std::vector<uint32_t> loose;
 };
+
+// Articulations (SPEC §1 traversal; docs/scene-format.md "Switches and degrees of freedom"): the
+// parts of a model the host drives between frames — a switch chooses which of its children are
+// drawn (damaged or intact, gear up or down), a degree of freedom moves its parts (a turret, a
+// rudder, a door). Both hold instance indices; applyArticulations turns their current settings
+// into Instance::visible and Instance::transform.
+struct Switch {
+  std::string name;
+  std::vector<std::vector<uint32_t>> children;  // per child, the instances below it
+  // Per mask, one flag per child (true: drawn); `current` indexes it. An instance below several
+  // switches is drawn only where all of them draw it.
+  std::vector<std::vector<bool>> masks;
+  size_t current = 0;
+};
+
+// A degree of freedom: its parts move by M = T(translate) · R · S(scale) about its own frame, the
+// rotation R = Rz(yaw) · Rx(pitch) · Ry(roll) in degrees (OpenFlight's axes: x right, y forward,
+// z up, in the frame). The world transform of a part is A(d) · part, where
+//   A(d) = A(parent) · place · frame · M · frame⁻¹,   A(−1) = identity,
+// `place` taking the DOF node's space to the space its parent moves (or the world), `frame` the
+// DOF's own origin and axes in the node's space.
+struct DofMotion {
+  Vec3 translate{0, 0, 0};
+  Vec3 rotate{0, 0, 0};  // degrees: pitch (about x), roll (about y), yaw (about z)
+  Vec3 scale{1, 1, 1};
+};
+struct Dof {
+  std::string name;
+  int parent = -1;  // the enclosing degree of freedom (an earlier index), or −1
+  Mat4 place;
+  Mat4 frame;       // rigid: orthonormal axes and an origin
+  DofMotion current, min, max;  // current is clamped to [min, max] componentwise
+  std::vector<std::pair<uint32_t, Mat4>> parts;  // instances, each with its transform in the node
+};
+// The motion matrix T·R·S of `m`.
+Mat4 dofMatrix(const DofMotion& m);
 
 // A free-form surface (SPEC §11; docs/scene-format.md "Free forms"): the quadric
 // F = Ax² + By² + Cz² + Dxy + Exz + Fyz + Gx + Hy + Iz + K (coefficients in this order; inside
@@ -288,6 +334,8 @@ struct Scene {
   std::vector<TextureMap> textures;
   Vec3 background{0.05f, 0.06f, 0.09f};
   std::vector<LodGroup> lodGroups;
+  std::vector<Switch> switches;
+  std::vector<Dof> dofs;
   // The hierarchy over the first instances (buildInstanceTree), shared by copies of the scene;
   // null: every instance is culled on its own.
   std::shared_ptr<const InstanceTree> instanceTree;
@@ -315,6 +363,10 @@ struct Scene {
 // only to name the offender.
 Status validate(const Scene& scene, const std::string& file, bool vertexData = true);
 
+// Sets every switched instance's `visible` and every articulated instance's transform from the
+// switches' current masks and the degrees of freedom's current motions (clamped to their limits).
+void applyArticulations(Scene& scene);
+
 // Builds scene.instanceTree over all of its instances (valid meshes and transforms assumed: run
 // validate first). Binned by the centres of the instances' world boxes, leaves of at most 8.
 void buildInstanceTree(Scene& scene);
@@ -329,7 +381,8 @@ void appendScene(Scene& scene, Scene other, const Mat4& transform);
 // Loaders. Each reads one file and returns a Scene or an Error naming the file and the problem.
 // They never crash, hang or allocate without bound on malformed input (each has a fuzz target).
 // The formats and every limit are described in docs/scene-format.md.
-Result<Scene> loadScene(const std::string& path);  // by extension: .json, .gltf, .glb, .obj
+// By extension: .json, .gltf, .glb, .obj, .flt; any other through Assimp.
+Result<Scene> loadScene(const std::string& path);
 Result<Scene> loadJsonScene(const std::string& path);
 // Parses JSON scene text; `path` names it in errors and is the base for relative mesh paths.
 Result<Scene> parseJsonScene(const std::string& text, const std::string& path);
@@ -367,6 +420,10 @@ Result<Scene> loadGltfFromMemory(const std::string& bytes, const std::string& pa
                                  const LoadOptions& options = {});
 Result<Scene> parseObj(const std::string& text, const std::string& path,
                        const LoadOptions& options = {});
+// OpenFlight (.flt, revisions 15.0 to 16.x; docs/scene-format.md "OpenFlight"): `bytes` the whole
+// file, `path` names it and is the base for its textures and external references.
+Result<Scene> parseOpenFlight(const std::string& bytes, const std::string& path,
+                              const LoadOptions& options = {});
 
 // Writes `scene` as glTF 2.0: binary for a path ending in .glb, text with the buffer embedded for
 // .gltf. loadGltf reads it back to the same meshes, materials, instances and cameras.

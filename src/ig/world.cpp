@@ -37,12 +37,24 @@ Result<IgWorld> IgWorld::load(const IgConfig& config) {
     if (!model) return model.error();
     if (!model->freeForms.empty() || !model->terrains.empty())
       return Error{file, "", "an entity model holds triangles only (free forms and terrain belong to the database)"};
-    const size_t before = w.base_.instances.size(), cameras = w.base_.cameras.size();
-    scene::appendScene(w.base_, std::move(model.value()), Mat4{});
+    // Only the model's meshes stay in the database; its placements become the entity's (its
+    // switches, degrees of freedom and light points are not carried by entities).
+    scene::Scene& b = w.base_;
+    const size_t before = b.instances.size(), cameras = b.cameras.size(),
+                 switches = b.switches.size(), dofs = b.dofs.size(),
+                 lights = b.lightPoints.size(), looks = b.lightAppearances.size(),
+                 groups = b.lightGroups.size();
+    scene::appendScene(b, std::move(model.value()), Mat4{});
     Model m;
-    m.instances.assign(w.base_.instances.begin() + std::ptrdiff_t(before), w.base_.instances.end());
-    w.base_.instances.resize(before);
-    w.base_.cameras.resize(cameras);
+    m.instances.assign(b.instances.begin() + std::ptrdiff_t(before), b.instances.end());
+    for (scene::Instance& inst : m.instances) inst.visible = true, inst.articulated = false;
+    b.instances.resize(before);
+    b.cameras.resize(cameras);
+    b.switches.resize(switches);
+    b.dofs.resize(dofs);
+    b.lightPoints.resize(lights);
+    b.lightAppearances.resize(looks);
+    b.lightGroups.resize(groups);
     w.modelTypes_.push_back(type);
     w.models_.push_back(std::move(m));
   }
@@ -432,6 +444,7 @@ bool segmentMeetsBox(DVec3 o, DVec3 d, DVec3 lo, DVec3 hi) {
 std::optional<double> instanceHit(const scene::Scene& s, size_t i, DVec3 o, DVec3 d,
                                   std::optional<double> best) {
   const scene::Instance& inst = s.instances[i];
+  if (!inst.visible) return best;  // switched off
   const scene::Mesh& mesh = s.meshes[size_t(inst.mesh)];
   // The segment against the instance's world box first.
   const auto box = mesh.bounds();
@@ -479,6 +492,7 @@ std::optional<double> polygonHit(const scene::Scene& s, size_t instances, DVec3 
       for (uint32_t k = n.first; k < n.first + n.count; ++k)
         best = instanceHit(s, tree->order[k], o, d, best);
     }
+    for (uint32_t i : tree->loose) best = instanceHit(s, i, o, d, best);
     from = tree->instanceCount;
   }
   for (size_t i = from; i < instances; ++i) best = instanceHit(s, i, o, d, best);

@@ -132,6 +132,7 @@ void traverse(const scene::Scene& scene, const RenderOptions& o, const FrameCame
   // Instance i into `part`: culled, beyond its levels, or its draws.
   auto visit = [&](size_t i, Traversal::Chunk& part) {
     const scene::Instance& inst = scene.instances[i];
+    if (!inst.visible) return;  // switched off: not drawn, not counted
     const uint64_t fullTriangles = scene.meshes[size_t(inst.mesh)].triangleCount();
     auto cull = [&] {
       ++part.culledInstances;
@@ -149,7 +150,7 @@ void traverse(const scene::Scene& scene, const RenderOptions& o, const FrameCame
     if (o.lod && inst.lod >= 0) {
       const scene::LodGroup& g = scene.lodGroups[size_t(inst.lod)];
       const auto& [lo, hi] = groupBounds[size_t(inst.lod)];
-      const Vec3 d = inst.transform.transformPoint((lo + hi) * 0.5f) - eye;
+      const Vec3 d = inst.transform.transformPoint(g.center.value_or((lo + hi) * 0.5f)) - eye;
       const double range =
           std::sqrt(double(d.x) * d.x + double(d.y) * d.y + double(d.z) * d.z) * rangeScale;
       size_t level = 0;

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
-#include <numeric>
 
 #include "synthvis/scene.h"
 
@@ -85,14 +84,20 @@ struct Builder {
 
 std::array<Vec3, 2> instanceBounds(const Scene& scene, const Instance& instance,
                                    const std::vector<std::array<Vec3, 2>>& meshBounds) {
-  std::array<Vec3, 2> box = meshBounds[size_t(instance.mesh)];
+  // Around every level that has vertices (a level may be empty: nothing drawn in its range).
+  std::optional<std::array<Vec3, 2>> box;
+  auto add = [&](int mesh) {
+    if (scene.meshes[size_t(mesh)].positions.empty()) return;
+    const auto& [lo, hi] = meshBounds[size_t(mesh)];
+    if (!box) box = std::array<Vec3, 2>{lo, hi};
+    auto& b = *box;
+    b[0] = {std::min(b[0].x, lo.x), std::min(b[0].y, lo.y), std::min(b[0].z, lo.z)};
+    b[1] = {std::max(b[1].x, hi.x), std::max(b[1].y, hi.y), std::max(b[1].z, hi.z)};
+  };
+  add(instance.mesh);
   if (instance.lod >= 0)
-    for (const LodLevel& level : scene.lodGroups[size_t(instance.lod)].levels) {
-      const auto& [lo, hi] = meshBounds[size_t(level.mesh)];
-      box[0] = {std::min(box[0].x, lo.x), std::min(box[0].y, lo.y), std::min(box[0].z, lo.z)};
-      box[1] = {std::max(box[1].x, hi.x), std::max(box[1].y, hi.y), std::max(box[1].z, hi.z)};
-    }
-  return box;
+    for (const LodLevel& level : scene.lodGroups[size_t(instance.lod)].levels) add(level.mesh);
+  return box.value_or(meshBounds[size_t(instance.mesh)]);
 }
 
 void buildInstanceTree(Scene& scene) {
@@ -111,11 +116,15 @@ void buildInstanceTree(Scene& scene) {
       boxes[i] = worldBox(inst.transform, lo, hi);
       triangles[i] = scene.meshes[size_t(inst.mesh)].triangleCount();
     }
-    tree->order.resize(n);
-    std::iota(tree->order.begin(), tree->order.end(), 0u);
-    tree->nodes.reserve(2 * (n / kLeafInstances + 1));
-    tree->nodes.resize(1);
-    Builder{boxes, triangles, *tree}.build(0, 0, uint32_t(n));
+    // Articulated instances move: they stay out of the tree, culled one by one.
+    for (uint32_t i = 0; i < n; ++i)
+      (scene.instances[i].articulated ? tree->loose : tree->order).push_back(i);
+    const size_t held = tree->order.size();
+    if (held > 0) {
+      tree->nodes.reserve(2 * (held / kLeafInstances + 1));
+      tree->nodes.resize(1);
+      Builder{boxes, triangles, *tree}.build(0, 0, uint32_t(held));
+    }
   }
   scene.instanceTree = std::move(tree);
 }

@@ -861,9 +861,8 @@ void SceneReader::readFog(const Json& v, const std::string& where) {
   if (const Json* x = find(v, "enabled")) fog.enabled = boolean(*x, member(where, "enabled"));
 }
 
-// At most this many light points in a scene, strings and arrays expanded (32 bytes each), and
-// this many appearances and groups.
-constexpr size_t kMaxLightPoints = size_t(1) << 22;
+// At most this many light appearances and groups in a scene (and synthvis/light_points.h's
+// kMaxLightPoints lights).
 constexpr size_t kMaxLightAppearances = 65536, kMaxLightGroups = 4096;
 
 // "lights" (docs/scene-format.md, "Light points").

@@ -89,7 +89,7 @@ std::string oneLine(const std::string& text) {
 Result<Scene> loadFile(const std::string& path, LoadContext& context) {
   std::string ext = lowerExtension(path);
   // Other formats (AC3D, COLLADA, 3DS, FBX, PLY, STL, …) through Assimp in a child process.
-  if (ext != ".json" && ext != ".gltf" && ext != ".glb" && ext != ".obj") {
+  if (ext != ".json" && ext != ".gltf" && ext != ".glb" && ext != ".obj" && ext != ".flt") {
     if (Result<std::string> bytes = readFile(path); !bytes) return bytes.error();
     return loadWithAssimp(path, ext, context.options);
   }
@@ -97,6 +97,7 @@ Result<Scene> loadFile(const std::string& path, LoadContext& context) {
   if (!bytes) return bytes.error();
   if (ext == ".json") return parseJsonSceneIn(bytes.value(), path, context);
   if (ext == ".obj") return parseObj(bytes.value(), path, context.options);
+  if (ext == ".flt") return parseOpenFlightIn(bytes.value(), path, context);
   return loadGltfFromMemory(bytes.value(), path, context.options);
 }
 

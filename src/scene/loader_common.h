@@ -32,6 +32,11 @@ std::string canonicalKey(const std::string& path);
 // Collapses a library's multi-line message into one line: trims, joins lines with "; ".
 std::string oneLine(const std::string& text);
 
+// The polygon `p`, possibly concave, as triangles (indices into `p`) by ear clipping in the plane
+// of its Newell normal, wound as the outline is; an outline that leaves no ear (self-intersecting,
+// or degenerate) is closed by a fan of what remains. O(n²) at worst.
+std::vector<uint32_t> triangulatePolygon(const std::vector<Vec3>& p);
+
 // The state of one top-level load, passed down through scene files that reference others.
 struct LoadContext {
   LoadOptions options;
@@ -43,8 +48,13 @@ struct LoadContext {
   std::map<std::string, Scene> loaded;
 };
 
-// Loads `path` by its extension (.json, .gltf, .glb, .obj) within `context`.
+// Loads `path` by its extension (.json, .gltf, .glb, .obj, .flt; others through Assimp) within
+// `context`.
 Result<Scene> loadFile(const std::string& path, LoadContext& context);
+// The OpenFlight reader proper (openflight_loader.cpp): external references load through
+// `context`.
+Result<Scene> parseOpenFlightIn(const std::string& bytes, const std::string& path,
+                                LoadContext& context);
 // The JSON scene parser proper (json_loader.cpp).
 Result<Scene> parseJsonSceneIn(const std::string& text, const std::string& path,
                                LoadContext& context);

@@ -83,63 +83,6 @@ std::pair<size_t, std::string> takeBigFaces(std::string& text, std::vector<BigFa
   return {0, {}};
 }
 
-// The polygon `outline` (indices into `p`), possibly concave, as triangles by ear clipping in the
-// plane of its Newell normal, counter-clockwise about that normal as the outline is. An outline
-// that leaves no ear (self-intersecting, or degenerate) is closed by a fan of what remains.
-std::vector<uint32_t> triangulate(const std::vector<Vec3>& p) {
-  const size_t n = p.size();
-  std::vector<uint32_t> out;
-  if (n < 3) return out;
-  double nx = 0, ny = 0, nz = 0;  // Newell's normal
-  for (size_t i = 0; i < n; ++i) {
-    const Vec3 a = p[i], b = p[(i + 1) % n];
-    nx += double(a.y - b.y) * double(a.z + b.z);
-    ny += double(a.z - b.z) * double(a.x + b.x);
-    nz += double(a.x - b.x) * double(a.y + b.y);
-  }
-  // Project onto the plane across the normal's largest component, keeping the winding.
-  const double ax = std::fabs(nx), ay = std::fabs(ny), az = std::fabs(nz);
-  const int drop = ax >= ay && ax >= az ? 0 : ay >= az ? 1 : 2;
-  const double sign = (drop == 0 ? nx : drop == 1 ? ny : nz) >= 0 ? 1 : -1;
-  std::vector<std::array<double, 2>> q(n);
-  for (size_t i = 0; i < n; ++i) {
-    const double c[3] = {p[i].x, p[i].y, p[i].z};
-    q[i] = {c[(drop + 1) % 3], c[(drop + 2) % 3]};
-  }
-  auto cross = [&](size_t a, size_t b, size_t c) {
-    return sign * ((q[b][0] - q[a][0]) * (q[c][1] - q[a][1]) -
-                   (q[b][1] - q[a][1]) * (q[c][0] - q[a][0]));
-  };
-  std::vector<size_t> prev(n), next(n);
-  for (size_t i = 0; i < n; ++i) prev[i] = (i + n - 1) % n, next[i] = (i + 1) % n;
-  auto inside = [&](size_t a, size_t b, size_t c, size_t x) {
-    return cross(a, b, x) >= 0 && cross(b, c, x) >= 0 && cross(c, a, x) >= 0;
-  };
-  size_t remaining = n, at = 0, misses = 0;
-  // Each ear search tests up to `remaining` points; past the budget (a hostile outline) the rest
-  // is closed as a fan, so the work stays O(n²).
-  uint64_t budget = 8 * uint64_t(n) * uint64_t(n);
-  while (remaining > 3) {
-    const size_t a = prev[at], c = next[at];
-    bool ear = cross(a, at, c) > 0;
-    // No other remaining vertex (reflex ones are the only candidates) inside the triangle.
-    for (size_t x = next[c]; ear && x != a && budget; x = next[x], --budget)
-      if (cross(prev[x], x, next[x]) <= 0 && inside(a, at, c, x)) ear = false;
-    if (ear || misses > remaining || !budget) {
-      out.insert(out.end(), {uint32_t(a), uint32_t(at), uint32_t(c)});
-      next[a] = c, prev[c] = a;
-      --remaining;
-      at = c;
-      misses = 0;
-    } else {
-      at = next[at];
-      ++misses;
-    }
-  }
-  out.insert(out.end(), {uint32_t(prev[at]), uint32_t(at), uint32_t(next[at])});
-  return out;
-}
-
 // Reads the .mtl libraries an OBJ names, relative to the OBJ's directory and through readFile's
 // checks; with references disabled it reads nothing. A missing library is only a warning for
 // tinyobjloader: faces then get the default material.
@@ -256,7 +199,7 @@ void addBigFaces(const std::vector<BigFace>& big, const tinyobj::attrib_t& attri
       shapes.back().name = f.object;
       shape = &shapes.back();
     }
-    const std::vector<uint32_t> triangles = triangulate(outline);
+    const std::vector<uint32_t> triangles = triangulatePolygon(outline);
     for (size_t t = 0; t < triangles.size(); t += 3) {
       for (int k = 0; k < 3; ++k) shape->mesh.indices.push_back(corners[triangles[t + size_t(k)]]);
       shape->mesh.num_face_vertices.push_back(3);
@@ -407,6 +350,64 @@ Scene convertObj(const tinyobj::attrib_t& attrib, const std::vector<tinyobj::sha
 }
 
 }  // namespace
+
+// The polygon `outline` (indices into `p`), possibly concave, as triangles by ear clipping in the
+// plane of its Newell normal, counter-clockwise about that normal as the outline is. An outline
+// that leaves no ear (self-intersecting, or degenerate) is closed by a fan of what remains.
+std::vector<uint32_t> triangulatePolygon(const std::vector<Vec3>& p) {
+  const size_t n = p.size();
+  std::vector<uint32_t> out;
+  if (n < 3) return out;
+  double nx = 0, ny = 0, nz = 0;  // Newell's normal
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3 a = p[i], b = p[(i + 1) % n];
+    nx += double(a.y - b.y) * double(a.z + b.z);
+    ny += double(a.z - b.z) * double(a.x + b.x);
+    nz += double(a.x - b.x) * double(a.y + b.y);
+  }
+  // Project onto the plane across the normal's largest component, keeping the winding.
+  const double ax = std::fabs(nx), ay = std::fabs(ny), az = std::fabs(nz);
+  const int drop = ax >= ay && ax >= az ? 0 : ay >= az ? 1 : 2;
+  const double sign = (drop == 0 ? nx : drop == 1 ? ny : nz) >= 0 ? 1 : -1;
+  std::vector<std::array<double, 2>> q(n);
+  for (size_t i = 0; i < n; ++i) {
+    const double c[3] = {p[i].x, p[i].y, p[i].z};
+    q[i] = {c[(drop + 1) % 3], c[(drop + 2) % 3]};
+  }
+  auto cross = [&](size_t a, size_t b, size_t c) {
+    return sign * ((q[b][0] - q[a][0]) * (q[c][1] - q[a][1]) -
+                   (q[b][1] - q[a][1]) * (q[c][0] - q[a][0]));
+  };
+  std::vector<size_t> prev(n), next(n);
+  for (size_t i = 0; i < n; ++i) prev[i] = (i + n - 1) % n, next[i] = (i + 1) % n;
+  auto inside = [&](size_t a, size_t b, size_t c, size_t x) {
+    return cross(a, b, x) >= 0 && cross(b, c, x) >= 0 && cross(c, a, x) >= 0;
+  };
+  size_t remaining = n, at = 0, misses = 0;
+  // Each ear search tests up to `remaining` points; past the budget (a hostile outline) the rest
+  // is closed as a fan, so the work stays O(n²).
+  uint64_t budget = 8 * uint64_t(n) * uint64_t(n);
+  while (remaining > 3) {
+    const size_t a = prev[at], c = next[at];
+    bool ear = cross(a, at, c) > 0;
+    // No other remaining vertex (reflex ones are the only candidates) inside the triangle.
+    for (size_t x = next[c]; ear && x != a && budget; x = next[x], --budget)
+      if (cross(prev[x], x, next[x]) <= 0 && inside(a, at, c, x)) ear = false;
+    if (ear || misses > remaining || !budget) {
+      out.insert(out.end(), {uint32_t(a), uint32_t(at), uint32_t(c)});
+      next[a] = c, prev[c] = a;
+      --remaining;
+      at = c;
+      misses = 0;
+    } else {
+      at = next[at];
+      ++misses;
+    }
+  }
+  out.insert(out.end(), {uint32_t(prev[at]), uint32_t(at), uint32_t(next[at])});
+  return out;
+}
+
 }  // namespace detail
 
 Result<Scene> parseObj(const std::string& text, const std::string& path,

@@ -46,13 +46,6 @@ namespace {
 
 bool isFinite(Vec4 v) { return isFinite(Vec3{v.x, v.y, v.z}) && std::isfinite(v.w); }
 
-bool isFinite(const Mat4& m) {
-  for (const auto& column : m.m)
-    for (float x : column)
-      if (!std::isfinite(x)) return false;
-  return true;
-}
-
 // "meshes[3] 'wheel'" — the name helps when a file has hundreds of meshes.
 std::string meshLabel(const Mesh& mesh, size_t i) {
   return mesh.name.empty() ? fmt::format("meshes[{}]", i)
@@ -230,6 +223,33 @@ Status validate(const Scene& scene, const std::string& file, bool vertexData) {
       from = l.to;
     }
   }
+  for (size_t i = 0; i < scene.switches.size(); ++i) {
+    const Switch& sw = scene.switches[i];
+    for (const std::vector<uint32_t>& child : sw.children)
+      for (uint32_t k : child)
+        if (k >= scene.instances.size())
+          return fail(fmt::format("switches[{}]: instance {} does not exist", i, k));
+    for (const std::vector<bool>& mask : sw.masks)
+      if (mask.size() != sw.children.size())
+        return fail(fmt::format("switches[{}]: a mask of {} flags for {} children", i,
+                                mask.size(), sw.children.size()));
+    if (!sw.masks.empty() && sw.current >= sw.masks.size())
+      return fail(fmt::format("switches[{}]: current mask {} of {}", i, sw.current,
+                              sw.masks.size()));
+  }
+  for (size_t i = 0; i < scene.dofs.size(); ++i) {
+    const Dof& d = scene.dofs[i];
+    if (d.parent < -1 || d.parent >= int(i))
+      return fail(fmt::format("dofs[{}]: parent {} is not an earlier degree of freedom", i,
+                              d.parent));
+    if (!isFinite(d.place) || !isFinite(d.frame))
+      return fail(fmt::format("dofs[{}]: a transform is not finite", i));
+    for (const auto& [k, part] : d.parts)
+      if (k >= scene.instances.size() || !scene.instances[k].articulated || !isFinite(part))
+        return fail(fmt::format("dofs[{}]: part instance {} does not exist, is not marked "
+                                "articulated, or has a transform that is not finite",
+                                i, k));
+  }
   for (size_t i = 0; i < scene.freeForms.size(); ++i) {
     const FreeFormObject& f = scene.freeForms[i];
     const std::string label =
@@ -302,6 +322,7 @@ void appendScene(Scene& scene, Scene other, const Mat4& transform) {
   const int materialBase = static_cast<int>(scene.materials.size());
   const int meshBase = static_cast<int>(scene.meshes.size());
   const int textureBase = static_cast<int>(scene.textures.size());
+  const uint32_t instanceBase = static_cast<uint32_t>(scene.instances.size());
   for (TextureMap& map : other.textures) scene.textures.push_back(std::move(map));
   for (Material& material : other.materials) {
     if (material.texture >= 0) material.texture += textureBase;
@@ -316,9 +337,40 @@ void appendScene(Scene& scene, Scene other, const Mat4& transform) {
     for (LodLevel& level : group.levels) level.mesh += meshBase;
     scene.lodGroups.push_back(std::move(group));
   }
-  for (const Instance& instance : other.instances)
-    scene.instances.push_back({instance.mesh + meshBase, transform * instance.transform,
-                               instance.priority, instance.lod >= 0 ? instance.lod + lodBase : -1});
+  for (Instance instance : other.instances) {
+    instance.mesh += meshBase;
+    instance.transform = transform * instance.transform;
+    if (instance.lod >= 0) instance.lod += lodBase;
+    scene.instances.push_back(instance);
+  }
+  // Articulations keep their instances; top-level degrees of freedom move into the new place.
+  for (Switch& s : other.switches) {
+    for (std::vector<uint32_t>& child : s.children)
+      for (uint32_t& i : child) i += instanceBase;
+    scene.switches.push_back(std::move(s));
+  }
+  const int dofBase = static_cast<int>(scene.dofs.size());
+  for (Dof& d : other.dofs) {
+    if (d.parent >= 0) d.parent += dofBase;
+    else d.place = transform * d.place;
+    for (auto& part : d.parts) part.first += instanceBase;
+    scene.dofs.push_back(std::move(d));
+  }
+  // Light points, their appearances turned and their groups kept.
+  const uint32_t appearanceBase = static_cast<uint32_t>(scene.lightAppearances.size());
+  const int32_t groupBase = static_cast<int32_t>(scene.lightGroups.size());
+  for (LightAppearance& a : other.lightAppearances) {
+    if (a.directional) a.direction = normalize(transform.transformDirection(a.direction));
+    scene.lightAppearances.push_back(std::move(a));
+  }
+  for (LightGroup& g : other.lightGroups) scene.lightGroups.push_back(std::move(g));
+  for (LightPoint p : other.lightPoints) {
+    p.position = transform.transformPoint(p.position);
+    p.appearance += appearanceBase;
+    if (p.group >= 0) p.group += groupBase;
+    scene.lightPoints.push_back(p);
+  }
+  for (std::string& w : other.warnings) scene.warnings.push_back(std::move(w));
   for (FreeFormObject& f : other.freeForms) {
     if (f.material >= 0) f.material += materialBase;
     f.transform = transform * f.transform;

@@ -74,20 +74,20 @@ TEST(Scene, ValidateNamesTheFileAndTheBrokenInvariant) {
        "instances[0]: level-of-detail group 0 does not exist"},
       {"instance mesh not its level 0",
        [](Scene& s) {
-         s.lodGroups.push_back({"g", {{0, 10}}, 0});
+         s.lodGroups.push_back({"g", {{0, 10}}, 0, {}});
          s.meshes.push_back(s.meshes[0]);
          s.instances[0] = {1, Mat4{}, 0, 0};
        },
        "mesh 1 is not level 0 of its level-of-detail group (mesh 0)"},
       {"ranges that do not increase",
-       [](Scene& s) { s.lodGroups.push_back({"g", {{0, 10}, {0, 10}}, 0}); },
+       [](Scene& s) { s.lodGroups.push_back({"g", {{0, 10}, {0, 10}}, 0, {}}); },
        "LOD group 'g': level 1: 'to' 10 must exceed 10"},
       {"a fade longer than a level",
-       [](Scene& s) { s.lodGroups.push_back({"g", {{0, 10}, {0, 12}}, 3}); },
+       [](Scene& s) { s.lodGroups.push_back({"g", {{0, 10}, {0, 12}}, 3, {}}); },
        "the fade of 3 is longer than its span [10, 12)"},
       {"a group without levels", [](Scene& s) { s.lodGroups.push_back({}); },
        "lodGroups[0]: 0 levels (1 to 8)"},
-      {"a level of a missing mesh", [](Scene& s) { s.lodGroups.push_back({"", {{4, 10}}, 0}); },
+      {"a level of a missing mesh", [](Scene& s) { s.lodGroups.push_back({"", {{4, 10}}, 0, {}}); },
        "level 0: mesh 4 does not exist"},
       {"a stale instance tree",
        [](Scene& s) {
