@@ -178,8 +178,8 @@ struct Switch {
 };
 
 // A degree of freedom: its parts move by M = T(translate) · R · S(scale) about its own frame, the
-// rotation R = Rz(yaw) · Rx(pitch) · Ry(roll) in degrees (OpenFlight's axes: x right, y forward,
-// z up, in the frame). The world transform of a part is A(d) · part, where
+// rotation R = Rx(pitch) · Ry(roll) · Rz(yaw) in degrees — yaw applied first, as OpenSceneGraph
+// reads OpenFlight's DOF records (axes: x right, y forward, z up, in the frame). The world transform of a part is A(d) · part, where
 //   A(d) = A(parent) · place · frame · M · frame⁻¹,   A(−1) = identity,
 // `place` taking the DOF node's space to the space its parent moves (or the world), `frame` the
 // DOF's own origin and axes in the node's space.

@@ -12,9 +12,11 @@ namespace sv::scene {
 
 Mat4 dofMatrix(const DofMotion& m) {
   constexpr float kRad = std::numbers::pi_v<float> / 180.0f;
-  const Mat4 r = Mat4::rotation({0, 0, 1}, m.rotate.z * kRad) *
-                 Mat4::rotation({1, 0, 0}, m.rotate.x * kRad) *
-                 Mat4::rotation({0, 1, 0}, m.rotate.y * kRad);
+  // Yaw first, then roll, then pitch: the order OpenSceneGraph's OpenFlight reader gives (and
+  // the tests hold us to it).
+  const Mat4 r = Mat4::rotation({1, 0, 0}, m.rotate.x * kRad) *
+                 Mat4::rotation({0, 1, 0}, m.rotate.y * kRad) *
+                 Mat4::rotation({0, 0, 1}, m.rotate.z * kRad);
   return Mat4::translation(m.translate) * r * Mat4::scaling(m.scale);
 }
 

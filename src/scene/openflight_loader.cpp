@@ -215,27 +215,23 @@ struct Place {
 
 // The inverse of an affine matrix (last row 0, 0, 0, 1); nothing when singular.
 std::optional<Mat4> affineInverse(const Mat4& m) {
-  const auto& a = m.m;
-  const double c00 = double(a[1][1]) * a[2][2] - double(a[2][1]) * a[1][2];
-  const double c01 = double(a[2][1]) * a[0][2] - double(a[0][1]) * a[2][2];
-  const double c02 = double(a[0][1]) * a[1][2] - double(a[1][1]) * a[0][2];
-  const double det = a[0][0] * c00 + a[1][0] * c01 + a[2][0] * c02;
+  auto e = [&](int r, int c) { return double(m.m[c][r]); };  // row r, column c
+  double inv[3][3] = {
+      {e(1, 1) * e(2, 2) - e(1, 2) * e(2, 1), e(0, 2) * e(2, 1) - e(0, 1) * e(2, 2),
+       e(0, 1) * e(1, 2) - e(0, 2) * e(1, 1)},
+      {e(1, 2) * e(2, 0) - e(1, 0) * e(2, 2), e(0, 0) * e(2, 2) - e(0, 2) * e(2, 0),
+       e(0, 2) * e(1, 0) - e(0, 0) * e(1, 2)},
+      {e(1, 0) * e(2, 1) - e(1, 1) * e(2, 0), e(0, 1) * e(2, 0) - e(0, 0) * e(2, 1),
+       e(0, 0) * e(1, 1) - e(0, 1) * e(1, 0)}};
+  const double det = e(0, 0) * inv[0][0] + e(0, 1) * inv[1][0] + e(0, 2) * inv[2][0];
   if (!(std::fabs(det) > 1e-30)) return std::nullopt;
-  // Rows of the inverse 3×3 (as columns of m: m.m[c][r]).
-  double inv[3][3];
-  inv[0][0] = c00 / det, inv[0][1] = c01 / det, inv[0][2] = c02 / det;
-  inv[1][0] = (double(a[2][0]) * a[1][2] - double(a[1][0]) * a[2][2]) / det;
-  inv[1][1] = (double(a[0][0]) * a[2][2] - double(a[2][0]) * a[0][2]) / det;
-  inv[1][2] = (double(a[1][0]) * a[0][2] - double(a[0][0]) * a[1][2]) / det;
-  inv[2][0] = (double(a[1][0]) * a[2][1] - double(a[2][0]) * a[1][1]) / det;
-  inv[2][1] = (double(a[2][0]) * a[0][1] - double(a[0][0]) * a[2][1]) / det;
-  inv[2][2] = (double(a[0][0]) * a[1][1] - double(a[1][0]) * a[0][1]) / det;
   Mat4 r;
   for (int row = 0; row < 3; ++row) {
     double t = 0;
-    for (int k = 0; k < 3; ++k) {
-      r.m[k][row] = float(inv[row][k]);
-      t += inv[row][k] * a[3][k];
+    for (int c = 0; c < 3; ++c) {
+      inv[row][c] /= det;
+      r.m[c][row] = float(inv[row][c]);
+      t += inv[row][c] * e(c, 3);
     }
     r.m[3][row] = float(-t);
   }
@@ -260,6 +256,11 @@ class Reader {
       scene_.warnings.push_back(
           fmt::format("{}: {} {} record{} not drawn", path_, count, what, count == 1 ? "" : "s"));
     applyArticulations(scene_);
+    // Matrices and DOF values that are finite can still multiply past the float range.
+    for (const Instance& inst : scene_.instances)
+      if (!isFinite(inst.transform))
+        fail(fmt::format("the transforms of mesh '{}' multiply to values that are not finite",
+                         scene_.meshes[size_t(inst.mesh)].name));
     return std::move(scene_);
   }
 
@@ -683,21 +684,28 @@ class Reader {
   // The level-of-detail group for `mesh` drawn in [near, far): −1 for none needed (the whole
   // range), −2 for never drawn.
   int lodGroup(int mesh, const LodContext& lod, const Mat4& sinceLod) {
-    const double near = std::max(0.0, lod.near * unitScale_);
-    const double far = std::min(1e30, lod.far * unitScale_);
+    // In float, as the ranges are kept and compared (a range that rounds to nothing is empty).
+    float near = float(std::clamp(lod.near * unitScale_, 0.0, 1e30));
+    const float far = float(std::clamp(lod.far * unitScale_, 0.0, 1e30));
     if (!(far > near)) return -2;
-    if (near == 0 && far >= 1e30) return -1;
+    if (near == 0 && far >= 1e30f) return -1;
     LodGroup g;
     g.name = lod.name;
-    if (near > 0) g.levels.push_back({emptyMesh(), float(near)});
-    g.levels.push_back({mesh, float(far)});
-    // The fade must fit every level's span (scene.h LodGroup).
-    double span = far - near;
-    if (near > 0) span = std::min(span, near);
-    g.fade = float(std::clamp(lod.fade * unitScale_, 0.0, span * 0.999));
+    if (near > 0) g.levels.push_back({emptyMesh(), near});
+    g.levels.push_back({mesh, far});
+    // The transition range as the fade, where it fits every level's span (scene.h LodGroup).
+    float fade = float(lod.fade * unitScale_);
+    if (!(fade > 0 && fade < 1e30f)) fade = 0;
+    float from = 0;
+    for (const LodLevel& l : g.levels) {
+      if (!(l.to - fade >= from)) fade = 0;
+      from = l.to;
+    }
+    g.fade = fade;
     // The centre, given in the LOD node's space, in the mesh's own.
     const std::optional<Mat4> back = affineInverse(sinceLod);
-    g.center = back ? back->transformPoint(lod.center) : lod.center;
+    const Vec3 c = back ? back->transformPoint(lod.center) : lod.center;
+    g.center = isFinite(c) ? c : lod.center;
     scene_.lodGroups.push_back(std::move(g));
     return int(scene_.lodGroups.size() - 1);
   }
@@ -1044,8 +1052,12 @@ class Reader {
                 const Place& at) {
     LightAppearance a = look;
     a.color = color;
-    if (a.directional) a.direction = normalize(at.toWorld.transformDirection(normal));
-    if (!isFinite(a.color) || !isFinite(a.direction)) fail("a light's colour or direction is not finite");
+    if (a.directional) {
+      const Vec3 d = at.toWorld.transformDirection(normal);
+      // A normal that is zero or not finite leaves the light omnidirectional.
+      if (isFinite(d) && length(d) > 0) a.direction = normalize(d);
+      else a.directional = a.backLobe = false;
+    }
     const auto key = std::make_tuple(look.name, a.color.x, a.color.y, a.color.z, a.direction.x,
                                      a.direction.y, a.direction.z, a.intensity, a.directional,
                                      a.backLobe, a.blink.period, a.rotationPeriod);
@@ -1063,30 +1075,32 @@ class Reader {
 
   void placeLightPoints(uint32_t index, const Fields& f, const Place& at) {
     const Node& node = nodes_[index];
+    // Each value within what the light pass accepts; one that is not a number gets the default.
+    auto sane = [](float v, float lo, float hi, float otherwise) {
+      return std::isfinite(v) ? std::clamp(v, lo, hi) : otherwise;
+    };
     LightAppearance look;
     look.name = node.name;
     const int32_t directional = f.i32(48);  // 0 omni, 1 one-way, 2 two-way
-    const float intensity = f.f32(24);
-    const float backIntensity = f.f32(28);
-    look.horizontalLobe = std::clamp(f.f32(100), 1.0f, 179.0f);
-    look.verticalLobe = std::clamp(f.f32(104), 1.0f, 179.0f);
-    look.falloff = std::clamp(f.f32(112), 0.0f, 64.0f);
-    const float period = f.f32(120), delay = f.f32(124), enabled = f.f32(128);
+    const float intensity = sane(f.f32(24), 0, 1e6f, 1);
+    const float backIntensity = sane(f.f32(28), 0, 1e6f, 0);
+    look.horizontalLobe = sane(f.f32(100), 1, 179, 30);
+    look.verticalLobe = sane(f.f32(104), 1, 179, 15);
+    look.falloff = sane(f.f32(112), 0, 64, 1);
+    const float period = sane(f.f32(120), 0, 1e6f, 0), delay = sane(f.f32(124), -1e6f, 1e6f, 0),
+                enabled = sane(f.f32(128), 0, 1e6f, 0);
     const uint32_t flags = f.u32(140);
-    if (!std::isfinite(intensity) || !std::isfinite(look.falloff) || !std::isfinite(period) ||
-        !std::isfinite(delay) || !std::isfinite(enabled))
-      fail(fmt::format("light point at byte {}: a value is not finite", f.at()));
     // OpenFlight's intensities are relative (1: the modeller's full brightness); full brightness
     // is taken as the scene format's default light of 200 candela.
     constexpr float kFullCandela = 200;
-    look.intensity = kFullCandela * std::max(0.0f, intensity);
+    look.intensity = kFullCandela * intensity;
     look.directional = directional == 1 || directional == 2;
     look.backLobe = directional == 2 && backIntensity > 0;
     // The back lobe's colour, dimmed by its intensity relative to the front's.
     const Vec4 back = packedColor(f.u32(16));
-    const float backScale = std::clamp(backIntensity / std::max(intensity, 1e-6f), 0.0f, 1.0f);
+    const float backScale = intensity > 0 ? std::min(1.0f, backIntensity / intensity) : 0;
     look.backColor = Vec3{back.x, back.y, back.z} * backScale;
-    // Flags bit 2/3 (…); bits 12–13 (0x00080000, 0x00040000): flashing, rotating animation.
+    // Flags bits 13 and 12 (from the most significant): flashing, rotating.
     const bool flashing = flags & 0x00040000u, rotating = flags & 0x00080000u;
     if (flashing && period > 0 && enabled > 0) {
       look.blink.period = period;
