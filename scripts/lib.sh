@@ -98,3 +98,21 @@ sv_build_fuzz() {
     -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSV_BUILD_FUZZ=ON -DSV_BUILD_TESTS=OFF -DSV_BUILD_BENCH=OFF >/dev/null
   cmake --build "$SV_FUZZ_DIR" --parallel "$(nproc)" --target "${targets[@]/#/fuzz_}"
 }
+
+# sv_assimp_models: Debian's assimp-testmodels, downloaded with apt-get download and unpacked into
+# build-data/ (never installed); prints the models' directory. For scripts/assimp-models and
+# scripts/openflight-peer.
+sv_assimp_models() {
+  local debs=$SV_ROOT/build-data/debs root=$SV_ROOT/build-data/root
+  local models=$root/usr/share/assimp/models
+  if [[ ! -d $models ]]; then
+    mkdir -p "$debs" "$root"
+    if ! compgen -G "$debs/assimp-testmodels_*.deb" >/dev/null; then
+      echo "downloading assimp-testmodels into $debs" >&2
+      (cd "$debs" && apt-get download -qq -o APT::Sandbox::User=root assimp-testmodels) ||
+        { apt-get update -qq && (cd "$debs" && apt-get download -qq -o APT::Sandbox::User=root assimp-testmodels); }
+    fi
+    dpkg -x "$(compgen -G "$debs/assimp-testmodels_*.deb" | head -1)" "$root"
+  fi
+  echo "$models"
+}

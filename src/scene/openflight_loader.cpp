@@ -384,8 +384,10 @@ class Reader {
         case kPopSubface:
           if (parents.size() <= 1)
             fail(fmt::format("pop record at byte {} without a push", r.at));
-          last = parents.back();
+          // Records after a pop (other than a new node) belong to the enclosing node: an
+          // ancillary record follows its own node directly, before any push.
           parents.pop_back();
+          last = parents.back();
           break;
         case kPushExtension:
         case kPushAttribute: {
@@ -412,7 +414,10 @@ class Reader {
           for (int k = 0; k < 16; ++k) v[k] = f.f32(4 + 4 * k);
           const Mat4 m = Mat4::fromColumnMajor(v);
           if (!isFinite(m)) fail(fmt::format("matrix at byte {} is not finite", r.at));
-          nodes_[last].matrix = m;
+          // The header takes no transform (OpenSceneGraph's exporter writes one there, which its
+          // reader, like this one, ignores).
+          // A second matrix on one node goes above the first (as OpenSceneGraph composes them).
+          if (last != 0) nodes_[last].matrix = nodes_[last].matrix ? m * *nodes_[last].matrix : m;
           break;
         }
         case kVertexList:
@@ -456,6 +461,11 @@ class Reader {
           fail(fmt::format("instance reference at byte {}: no instance definition {}", r.at,
                            f.i16(6)));
         ++at.depth;
+        if (const std::optional<Mat4>& m = nodes_[def->second].matrix) {
+          at.toWorld = at.toWorld * *m;
+          at.sinceLod = at.sinceLod * *m;
+          at.sinceDof = at.sinceDof * *m;
+        }
         placeGeometry(def->second, at);
         for (uint32_t child : nodes_[def->second].children) visit(child, at);
         return;
@@ -861,7 +871,8 @@ class Reader {
     int drawType = 0;
     const FaceAttributes a = faceAttributes(f, 0, hidden, drawType);
     if (hidden) return;
-    const std::vector<Vertex> vertices = faceVertices(node);
+    std::vector<Vertex> vertices = faceVertices(node);
+    bake(node, vertices);
     if (drawType == 2 || drawType == 3) {
       ++skipped_["wireframe face"];
       return;
@@ -872,6 +883,18 @@ class Reader {
     }
     if (vertices.size() < 3) return;
     addPolygon(vertices, triangulate(vertices), a, buckets);
+  }
+
+  // A face's or mesh's own matrix, applied to its vertices (positions in double).
+  static void bake(const Node& node, std::vector<Vertex>& vertices) {
+    if (!node.matrix) return;
+    const auto& m = node.matrix->m;
+    const Mat4 normals = node.matrix->normalMatrix();
+    for (Vertex& v : vertices) {
+      const double x = v.p[0], y = v.p[1], z = v.p[2];
+      for (int r = 0; r < 3; ++r) v.p[r] = m[0][r] * x + m[1][r] * y + m[2][r] * z + m[3][r];
+      if (v.normal) v.normal = normals.transformDirection(*v.normal);
+    }
   }
 
   // The polygon's unit normal by Newell's method, in double; +z when it has no area.
@@ -949,6 +972,7 @@ class Reader {
       if (r.op == kLocalVertexPool) {
         p.need(12, "local vertex pool");
         pool = localPool(p);
+        bake(node, pool);
       } else if (r.op == kMeshPrimitive) {
         p.need(12, "mesh primitive");
         const int16_t type = p.i16(4);

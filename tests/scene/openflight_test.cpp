@@ -16,45 +16,21 @@
 #include <vector>
 
 #include "scene/flt_writer.h"
+#include "scene/osg_peer.h"
 #include "scene/scene_test_util.h"
 #include "synthvis/scene.h"
 
 namespace sv::scene {
 namespace {
 
+using testing::allTriangles;
 using testing::contains;
+using testing::corners;
+using testing::distinct;
 using testing::FltWriter;
 using testing::TempDir;
 using V = FltWriter::V;
 using Face = FltWriter::Face;
-
-// OpenFlight's (x, y, z) of a synthvis world point: the reader maps z up to y up, y to −z.
-std::array<double, 3> fltOf(Vec3 p) { return {p.x, -double(p.z), p.y}; }
-
-// Every triangle corner of every instance (visible or not), in OpenFlight coordinates.
-std::vector<std::array<double, 3>> corners(const Scene& s) {
-  std::vector<std::array<double, 3>> out;
-  for (const Instance& inst : s.instances) {
-    std::vector<int> meshes{inst.mesh};
-    if (inst.lod >= 0)
-      for (const LodLevel& l : s.lodGroups[size_t(inst.lod)].levels) meshes.push_back(l.mesh);
-    std::sort(meshes.begin(), meshes.end());
-    meshes.erase(std::unique(meshes.begin(), meshes.end()), meshes.end());
-    for (int m : meshes)
-      for (uint32_t i : s.meshes[size_t(m)].indices)
-        out.push_back(fltOf(inst.transform.transformPoint(s.meshes[size_t(m)].positions[i])));
-  }
-  return out;
-}
-size_t allTriangles(const Scene& s) { return corners(s).size() / 3; }
-
-// The distinct points of `p`, rounded to 1e-3.
-std::set<std::array<long long, 3>> distinct(const std::vector<std::array<double, 3>>& p) {
-  std::set<std::array<long long, 3>> out;
-  for (const auto& q : p)
-    out.insert({std::llround(q[0] * 1e3), std::llround(q[1] * 1e3), std::llround(q[2] * 1e3)});
-  return out;
-}
 
 TEST(OpenFlight, ReadsEveryNodeKind) {
   TempDir dir;
@@ -334,64 +310,20 @@ TEST(OpenFlight, RefusesMalformedFiles) {
 
 // --- OpenSceneGraph as the peer (its osgconv tool, Debian's openscenegraph) -------------------
 
-bool haveOsgconv() { return std::system("command -v osgconv >/dev/null 2>&1") == 0; }
-
-// osgconv `from` `to`; true on success.
-bool osgconv(const std::string& from, const std::string& to) {
-  const std::string cmd = "osgconv '" + from + "' '" + to + "' >/dev/null 2>&1";
-  return std::system(cmd.c_str()) == 0;
-}
-
-// The triangle corners OSG wrote into an OBJ file (its reading of a model), polygons fanned.
-std::vector<std::array<double, 3>> objCorners(const std::string& path) {
-  std::ifstream in(path);
-  std::vector<std::array<double, 3>> v, out;
-  for (std::string line; std::getline(in, line);) {
-    std::istringstream s(line);
-    std::string key;
-    s >> key;
-    if (key == "v") {
-      std::array<double, 3> p{};
-      s >> p[0] >> p[1] >> p[2];
-      v.push_back(p);
-    } else if (key == "f") {
-      std::vector<size_t> f;
-      for (std::string c; s >> c;) {
-        const long i = std::stol(c.substr(0, c.find('/')));
-        f.push_back(i > 0 ? size_t(i - 1) : v.size() + size_t(i));
-      }
-      for (size_t k = 2; k < f.size(); ++k)
-        for (size_t j : {f[0], f[k - 1], f[k]}) out.push_back(v.at(j));
-    }
-  }
-  return out;
-}
-
 // Our reading of `flt` against OSG's (osgconv flt → obj): the same triangle count, bounds and
 // distinct vertices.
 void expectSameAsOsg(const std::string& flt, const TempDir& dir, const std::string& name) {
-  Result<Scene> ours = loadScene(flt);
-  ASSERT_TRUE(ours.ok()) << ours.error().str();
-  const std::string obj = dir.path(name + "-osg.obj");
-  ASSERT_TRUE(osgconv(flt, obj)) << "osgconv could not read " << flt;
-  const auto theirs = objCorners(obj);
-  const auto mine = corners(ours.value());
-  EXPECT_EQ(mine.size() / 3, theirs.size() / 3) << name << ": triangles";
-  auto bounds = [](const std::vector<std::array<double, 3>>& p) {
-    std::array<double, 6> b{1e300, 1e300, 1e300, -1e300, -1e300, -1e300};
-    for (const auto& q : p)
-      for (int k = 0; k < 3; ++k) b[k] = std::min(b[k], q[k]), b[k + 3] = std::max(b[k + 3], q[k]);
-    return b;
-  };
-  const auto bm = bounds(mine), bt = bounds(theirs);
-  for (int k = 0; k < 6; ++k) EXPECT_NEAR(bm[k], bt[k], 1e-3) << name << ": bounds " << k;
-  EXPECT_EQ(distinct(mine), distinct(theirs)) << name << ": vertices";
+  const testing::PeerComparison c = testing::compareWithOsg(flt, dir.path(name + "-osg.obj"));
+  ASSERT_TRUE(c.error.empty()) << name << ": " << c.error;
+  EXPECT_EQ(c.ours, c.theirs) << name << ": triangles";
+  EXPECT_LE(c.boundsDifference, 1e-3) << name << ": bounds";
+  EXPECT_EQ(c.verticesOnlyOurs + c.verticesOnlyTheirs, 0u) << name << ": vertices";
 }
 
 class OpenFlightPeer : public ::testing::Test {
  protected:
   void SetUp() override {
-    if (haveOsgconv()) return;
+    if (testing::haveOsgconv()) return;
     const char* allow = std::getenv("SV_ALLOW_MISSING_DATA");
     if (allow && std::string(allow) == "1") GTEST_SKIP() << "osgconv is missing";
     FAIL() << "osgconv (Debian's openscenegraph) is missing: run scripts/test, which installs it, "
@@ -411,7 +343,7 @@ TEST_F(OpenFlightPeer, WeReadOsgExportsAsOsgDoes) {
   TempDir dir;
   // The house of scenes/ (OBJ with materials) and a concave, textured, many-sided OBJ.
   const std::string house = dir.path("house.flt");
-  ASSERT_TRUE(osgconv(testing::sourcePath("scenes/house.obj"), house));
+  ASSERT_TRUE(testing::osgconv(testing::sourcePath("scenes/house.obj"), house));
   expectSameAsOsg(house, dir, "house");
   std::ostringstream obj;
   obj << "mtllib m.mtl\nusemtl t\n";
@@ -426,7 +358,7 @@ TEST_F(OpenFlightPeer, WeReadOsgExportsAsOsgDoes) {
   dir.write("star.obj", obj.str());
   dir.write("m.mtl", "newmtl t\nKd 0.2 0.8 0.3\n");
   const std::string star = dir.path("star.flt");
-  ASSERT_TRUE(osgconv(dir.path("star.obj"), star));
+  ASSERT_TRUE(testing::osgconv(dir.path("star.obj"), star));
   expectSameAsOsg(star, dir, "star");
 }
 
