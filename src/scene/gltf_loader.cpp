@@ -12,6 +12,7 @@
 #include <tiny_gltf.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -291,6 +292,10 @@ class GltfConverter {
     float a = 1, b = 0, c = 0, d = 0, e = 1, f = 0;
   };
   std::map<int, UvTransform> uvTransforms_;
+  // POINTS primitives by glTF mesh: their vertices become light points where a node places them.
+  std::map<int, std::vector<Mesh>> pointMeshes_;
+  std::map<std::array<float, 3>, uint32_t> pointLooks_;  // light appearance by colour
+  void placePoints(int gltfMesh, const Mat4& world, const std::string& where);
   // MSFT_lod: the level-of-detail group of the node's levels (its mesh first, then the meshes of
   // the nodes its `ids` name), or −1 — with a warning — when a level is not one primitive.
   int lodGroupOf(const tinygltf::Node& node, const std::string& where);
@@ -656,14 +661,19 @@ const std::vector<int>& GltfConverter::meshesOf(int gltfMesh) {
       case TINYGLTF_MODE_TRIANGLE_STRIP:
       case TINYGLTF_MODE_TRIANGLE_FAN:
         break;
-      case TINYGLTF_MODE_POINTS:
+      case TINYGLTF_MODE_POINTS: {
+        // Points are light points (SPEC §13): kept aside, placed with the node (walkNodes).
+        Mesh points = convertPrimitive(primitive, where);
+        points.indices.clear();
+        pointMeshes_[gltfMesh].push_back(std::move(points));
+        continue;
+      }
       case TINYGLTF_MODE_LINE:
       case TINYGLTF_MODE_LINE_LOOP:
       case TINYGLTF_MODE_LINE_STRIP:
         // Nothing to fill: named, never silently left out.
         scene_.warnings.push_back(fmt::format(
-            "{}: {} are not drawn (only triangles are)", where,
-            primitive.mode == TINYGLTF_MODE_POINTS ? "points" : "lines"));
+            "{}: lines are not drawn (only triangles and points are)", where));
         continue;
       default:
         fail(fmt::format("{}: unknown mode {}", where, primitive.mode));
@@ -674,6 +684,35 @@ const std::vector<int>& GltfConverter::meshesOf(int gltfMesh) {
     ours.push_back(int(scene_.meshes.size() - 1));
   }
   return meshes_.emplace(gltfMesh, std::move(ours)).first->second;
+}
+
+// A light point at every vertex of the mesh's POINTS primitives: omnidirectional, of the default
+// intensity, in the vertex colour times the material's base colour (one appearance per colour).
+void GltfConverter::placePoints(int gltfMesh, const Mat4& world, const std::string& where) {
+  auto it = pointMeshes_.find(gltfMesh);
+  if (it == pointMeshes_.end()) return;
+  for (const Mesh& points : it->second) {
+    const Vec4 base = scene_.materialAt(points.material).baseColor;
+    for (size_t i = 0; i < points.positions.size(); ++i) {
+      const Vec4 c = points.colors.empty() ? Vec4{1, 1, 1, 1} : points.colors[i];
+      const std::array<float, 3> color{std::clamp(c.x * base.x, 0.0f, 1.0f),
+                                       std::clamp(c.y * base.y, 0.0f, 1.0f),
+                                       std::clamp(c.z * base.z, 0.0f, 1.0f)};
+      auto look = pointLooks_.find(color);
+      if (look == pointLooks_.end()) {
+        LightAppearance a;
+        a.name = fmt::format("glTF points {} {} {}", color[0], color[1], color[2]);
+        a.color = {color[0], color[1], color[2]};
+        scene_.lightAppearances.push_back(a);
+        look = pointLooks_.emplace(color, uint32_t(scene_.lightAppearances.size() - 1)).first;
+      }
+      const Vec3 p = world.transformPoint(points.positions[i]);
+      if (!isFinite(p)) fail(fmt::format("{}: a point's position is not finite", where));
+      if (scene_.lightPoints.size() >= kMaxLightPoints)
+        fail(fmt::format("{}: more than {} light points", where, kMaxLightPoints));
+      scene_.lightPoints.push_back({p, look->second, 0, -1});
+    }
+  }
 }
 
 // Unit quaternion (x, y, z, w) to matrix; normalized first, since files often store quaternions
@@ -930,6 +969,7 @@ void GltfConverter::walkNodes() {
           triangles_ += t;
           scene_.instances.push_back({mesh, world * placement, 0, lod});
         }
+      for (const Mat4& placement : placements) placePoints(node.mesh, world * placement, where);
     } else if (node.mesh < -1) {
       fail(fmt::format("{}: mesh {} does not exist", where, node.mesh));
     }

@@ -236,7 +236,7 @@ TEST(Gltf, WalksOnlyTheDefaultScene) {
   EXPECT_EQ(r->meshes.size(), 1u);
 }
 
-TEST(Gltf, ConvertsStripsAndFansAndSkipsPointsAndLines) {
+TEST(Gltf, ConvertsStripsAndFansPointsToLightsAndNamesLines) {
   GltfBuilder b;
   int positions = b.addPositions({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 2, 0, 0});
   b.addNode({{"mesh", b.addMesh({{"attributes", {{"POSITION", positions}}}, {"mode", 5}})}});
@@ -250,10 +250,15 @@ TEST(Gltf, ConvertsStripsAndFansAndSkipsPointsAndLines) {
   EXPECT_EQ(r->meshes[0].indices, (std::vector<uint32_t>{0, 1, 2, 2, 1, 3, 2, 3, 4}));
   // Fan: (0 1 2), (0 2 3), (0 3 4).
   EXPECT_EQ(r->meshes[1].indices, (std::vector<uint32_t>{0, 1, 2, 0, 2, 3, 0, 3, 4}));
-  // The lines and points are named, never silently dropped.
-  ASSERT_EQ(r->warnings.size(), 2u);
-  EXPECT_EQ(r->warnings[0], "t.gltf: meshes[2].primitives[0]: lines are not drawn (only triangles are)");
-  EXPECT_EQ(r->warnings[1], "t.gltf: meshes[3].primitives[0]: points are not drawn (only triangles are)");
+  // The lines are named, never silently dropped; the five points are light points.
+  ASSERT_EQ(r->warnings.size(), 1u);
+  EXPECT_EQ(r->warnings[0],
+            "t.gltf: meshes[2].primitives[0]: lines are not drawn (only triangles and points are)");
+  ASSERT_EQ(r->lightPoints.size(), 5u);
+  EXPECT_FLOAT_EQ(r->lightPoints[3].position.x, 1);
+  EXPECT_FLOAT_EQ(r->lightPoints[3].position.y, 1);
+  ASSERT_EQ(r->lightAppearances.size(), 1u);
+  EXPECT_FALSE(r->lightAppearances[0].directional);
 }
 
 // Never silently empty: glTF 1.0 (whose objects are dictionaries) is refused by name, and a file
@@ -264,15 +269,15 @@ TEST(Gltf, NamesWhatItCannotDrawInsteadOfAnEmptyImage) {
   Result<Scene> old = load(b);
   ASSERT_FALSE(old.ok());
   EXPECT_EQ(old.error().str(), "t.gltf: glTF version '1.0' is not supported (glTF 2.0 only)");
-  GltfBuilder points;
-  const int positions = points.addPositions({0, 0, 0, 1, 0, 0});
-  points.addNode({{"mesh", points.addMesh({{"attributes", {{"POSITION", positions}}}, {"mode", 0}})}});
+  GltfBuilder lines;
+  const int positions = lines.addPositions({0, 0, 0, 1, 0, 0});
+  lines.addNode({{"mesh", lines.addMesh({{"attributes", {{"POSITION", positions}}}, {"mode", 1}})}});
   testing::TempDir dir;
-  const std::string path = dir.write("points.gltf", points.gltf());
+  const std::string path = dir.write("lines.gltf", lines.gltf());
   Result<Scene> r = loadScene(path);
   ASSERT_TRUE(r.ok()) << r.error().str();
   ASSERT_EQ(r->warnings.size(), 2u);
-  EXPECT_TRUE(testing::contains(r->warnings[0], "points are not drawn"));
+  EXPECT_TRUE(testing::contains(r->warnings[0], "lines are not drawn"));
   EXPECT_EQ(r->warnings[1], path + ": nothing to draw");
 }
 
