@@ -12,7 +12,7 @@ SV_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 SV_PACKAGES=(cmake g++ ninja-build pkg-config libgtest-dev libgmock-dev libbenchmark-dev
   libhwy-dev libtinygltf-dev libtinyobjloader-dev libstb-dev libpng-dev libturbojpeg0-dev libdraco-dev libassimp-dev nlohmann-json3-dev
   libcli11-dev libfmt-dev libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri python3
-  clang libclang-rt-14-dev libgdal-dev libsdl2-dev xvfb xauth x11-apps tshark openscenegraph)
+  clang libclang-rt-14-dev libgdal-dev libsdl2-dev xvfb xauth x11-apps tshark openscenegraph libmeshoptimizer-dev)
 
 sv_install_packages() {
   local missing=()

@@ -22,6 +22,8 @@
 //               [--record FILE.pcap] [--replay FILE.pcap] [--status FILE|-] [--overlay]
 //               [--test-pattern grid|bars|wedges] [--as-fast-as-possible] [--no-governor]
 //   synthvis host SCRIPT [--ig-port P] [--port P] [--frames N]
+//   synthvis prep INPUT|city -o DB.svdb [--no-optimize] [--no-lods] [--lod-levels N]
+//                [--reduction R] [--pixel-error P] [--buildings N] [--trees N]
 //   (shared BENCH.md defines the scenes and the JSON fields)
 //
 // Errors print one line, "synthvis: <file>: <problem>", and exit with status 1 (2 for usage).
@@ -29,9 +31,11 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -48,6 +52,7 @@
 #include "ig/config.h"
 #include "ig/host.h"
 #include "ig/loop.h"
+#include "prep/prep.h"
 
 namespace {
 
@@ -529,6 +534,64 @@ int runGen(const GenArgs& a) {
   return 0;
 }
 
+struct PrepArgs {
+  std::string input;
+  std::string output;
+  GeneratorArgs generator;
+  bool noOptimize = false, noLods = false;
+  sv::prep::PrepOptions options;
+};
+
+// `synthvis prep INPUT -o DB.svdb`: the database preparation system (docs/prep.md). INPUT is any
+// scene file, or the name of a BENCH.md generator (city).
+int runPrep(const PrepArgs& a) {
+  using Clock = std::chrono::steady_clock;
+  auto seconds = [](Clock::time_point t0) {
+    return std::chrono::duration<double>(Clock::now() - t0).count();
+  };
+  auto t0 = Clock::now();
+  sv::Result<sv::scene::Scene> loaded = sv::Error{"", "", ""};
+  if (std::FILE* f = std::fopen(a.input.c_str(), "rb"); f || a.input.find('.') != std::string::npos) {
+    if (f) std::fclose(f);
+    loaded = loadSceneOrDemo(a.input);
+  } else {
+    auto c = generatorCase(a.input, a.generator);
+    if (!c) return fail(c.error());
+    sv::RenderOptions o;
+    auto made = sv::reference::makeScene(c.value(), o);
+    if (!made) return fail(made.error());
+    loaded = std::move(made.value().scene);
+  }
+  if (!loaded) return fail(loaded.error());
+  sv::scene::Scene scene = std::move(loaded).value();
+  fmt::print("prep: read {} in {:.2f} s: {} meshes, {} instances, {} triangles over them\n",
+             a.input, seconds(t0), scene.meshes.size(), scene.instances.size(),
+             scene.triangleCount());
+  sv::prep::PrepOptions o = a.options;
+  o.optimize = !a.noOptimize;
+  o.generateLods = !a.noLods;
+  t0 = Clock::now();
+  auto report = sv::prep::prepare(scene, o, [](size_t done, size_t total) {
+    fmt::print(stderr, "\rprep: meshes {}/{}", done, total);
+    if (done == total) fmt::print(stderr, "\n");
+  });
+  if (!report) return fail(report.error());
+  fmt::print("prep: prepared in {:.2f} s: {}\n", seconds(t0), report->summary());
+  t0 = Clock::now();
+  if (sv::Status s = sv::scene::saveDatabase(scene, a.output); !s) return fail(s.error());
+  const double written = seconds(t0);
+  // The load time a user of the database will see: mapped, checked, copied out.
+  t0 = Clock::now();
+  auto back = sv::scene::loadDatabase(a.output);
+  if (!back) return fail(back.error());
+  const double load = seconds(t0);
+  std::error_code ec;
+  const auto bytes = std::filesystem::file_size(a.output, ec);
+  fmt::print("prep: wrote {} ({:.1f} MB) in {:.2f} s; it loads in {:.1f} ms\n", a.output,
+             double(bytes) / 1e6, written, load * 1e3);
+  return 0;
+}
+
 struct TruthArgs {
   std::string scene;
   std::string output = "truth.png";
@@ -887,6 +950,28 @@ int main(int argc, char** argv) {
   ig->add_flag("--as-fast-as-possible", igFast, "do not wait for each frame's slot");
   ig->add_flag("--no-governor", igNoGovernor, "overload protection off (always full quality)");
 
+  PrepArgs p;
+  CLI::App* prep = app.add_subcommand(
+      "prep", "prepare a database: optimize meshes, generate levels of detail, write .svdb");
+  prep->add_option("input", p.input, "a scene file of any supported format, or a generator (city)")
+      ->required();
+  prep->add_option("-o,--output", p.output, "the prepared database (.svdb)")->required();
+  prep->add_flag("--no-optimize", p.noOptimize, "keep the meshes' vertex order as it is");
+  prep->add_flag("--no-lods", p.noLods, "generate no levels of detail");
+  prep->add_option("--lod-levels", p.options.maxLevels,
+                   "levels per generated group, the source mesh included (2 to 8)")
+      ->capture_default_str();
+  prep->add_option("--reduction", p.options.reduction,
+                   "each generated level's triangles over the one before's")
+      ->capture_default_str();
+  prep->add_option("--min-triangles", p.options.minTriangles,
+                   "meshes smaller than this get no generated levels")
+      ->capture_default_str();
+  prep->add_option("--pixel-error", p.options.pixelError,
+                   "the error a level may show, in pixels of a 1080-line screen at 60°")
+      ->capture_default_str();
+  addGeneratorOptions(prep, p.generator);
+
   std::string hostScript;
   int hostIgPort = 0, hostPort = -1;
   long long hostFrames = 0;
@@ -919,5 +1004,6 @@ int main(int argc, char** argv) {
     return runIg(igConfig, igOptions);
   }
   if (*host) return runHost(hostScript, hostIgPort, hostPort, hostFrames);
+  if (*prep) return runPrep(p);
   return 0;
 }

@@ -381,7 +381,8 @@ void appendScene(Scene& scene, Scene other, const Mat4& transform);
 // Loaders. Each reads one file and returns a Scene or an Error naming the file and the problem.
 // They never crash, hang or allocate without bound on malformed input (each has a fuzz target).
 // The formats and every limit are described in docs/scene-format.md.
-// By extension: .json, .gltf, .glb, .obj, .flt; any other through Assimp.
+// By extension: .json, .gltf, .glb, .obj, .flt, .svdb (a prepared database); any other through
+// Assimp.
 Result<Scene> loadScene(const std::string& path);
 Result<Scene> loadJsonScene(const std::string& path);
 // Parses JSON scene text; `path` names it in errors and is the base for relative mesh paths.
@@ -424,6 +425,14 @@ Result<Scene> parseObj(const std::string& text, const std::string& path,
 // file, `path` names it and is the base for its textures and external references.
 Result<Scene> parseOpenFlight(const std::string& bytes, const std::string& path,
                               const LoadOptions& options = {});
+
+// The prepared database (docs/prep.md, `synthvis prep`): the scene's own arrays in one file,
+// versioned and checksummed, loaded by mapping the file. Terrain is not stored (an error).
+Status saveDatabase(const Scene& scene, const std::string& path);
+Result<Scene> loadDatabase(const std::string& path, const LoadOptions& options = {});
+// The same from bytes in memory (`path` names them in errors).
+Result<Scene> parseDatabase(const char* data, size_t size, const std::string& path,
+                            const LoadOptions& options = {});
 
 // Writes `scene` as glTF 2.0: binary for a path ending in .glb, text with the buffer embedded for
 // .gltf. loadGltf reads it back to the same meshes, materials, instances and cameras.

@@ -88,6 +88,7 @@ std::string oneLine(const std::string& text) {
 
 Result<Scene> loadFile(const std::string& path, LoadContext& context) {
   std::string ext = lowerExtension(path);
+  if (ext == ".svdb") return loadDatabase(path, context.options);
   // Other formats (AC3D, COLLADA, 3DS, FBX, PLY, STL, …) through Assimp in a child process.
   if (ext != ".json" && ext != ".gltf" && ext != ".glb" && ext != ".obj" && ext != ".flt") {
     if (Result<std::string> bytes = readFile(path); !bytes) return bytes.error();

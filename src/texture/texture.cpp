@@ -91,26 +91,43 @@ Level nextLevel(const Level& src, Wrap wrapX, Wrap wrapY) {
   return dst;
 }
 
-Texture::Texture(Level base, Wrap wrapX, Wrap wrapY) : wrapX_(wrapX), wrapY_(wrapY) {
-  auto last = [](int w, int h) { return w <= 1 && h <= 1; };
+size_t Texture::pyramidTexels(int width, int height) {
   size_t total = 0;
-  for (int w = base.width, h = base.height;; w = (w + 1) / 2, h = (h + 1) / 2) {
+  for (int w = width, h = height;; w = (w + 1) / 2, h = (h + 1) / 2) {
     total += (size_t(w) + 1) * size_t(h);
-    if (last(w, h)) break;
+    if (w <= 1 && h <= 1) break;
   }
-  texels_.reserve(total);
+  return total;
+}
+
+Texture::Texture(Level base, Wrap wrapX, Wrap wrapY) : wrapX_(wrapX), wrapY_(wrapY) {
+  const int width = base.width, height = base.height;
+  texels_.reserve(pyramidTexels(width, height));
   // One 16-bit level at a time: packed into the array, then filtered into the next.
   Level level = std::move(base);
   for (;;) {
-    info_.push_back(
-        {level.width, level.height, int32_t(texels_.size())});  // < 2^27 (kMaxTextureTexels)
     const int border = level.width > 0 ? wrapIndex(level.width, level.width, wrapX_) : 0;
     for (int y = 0; y < level.height; ++y) {
       for (int x = 0; x < level.width; ++x) texels_.push_back(packTexel(level.at(x, y)));
       texels_.push_back(level.width > 0 ? packTexel(level.at(border, y)) : 0);
     }
-    if (last(level.width, level.height)) break;
+    if (level.width <= 1 && level.height <= 1) break;
     level = nextLevel(level, wrapX_, wrapY_);
+  }
+  index(width, height);
+}
+
+Texture::Texture(int width, int height, Wrap wrapX, Wrap wrapY, std::vector<PackedTexel> pyramid)
+    : texels_(std::move(pyramid)), wrapX_(wrapX), wrapY_(wrapY) {
+  index(width, height);
+}
+
+void Texture::index(int width, int height) {
+  int32_t offset = 0;  // < 2^27 (kMaxTextureTexels)
+  for (int w = width, h = height;; w = (w + 1) / 2, h = (h + 1) / 2) {
+    info_.push_back({w, h, offset});
+    offset += int32_t((w + 1) * h);
+    if (w <= 1 && h <= 1) break;
   }
   for (size_t k = 0; k < info_.size() && k < size_t(kMaxLevels); ++k) {
     table_.width[k] = info_[k].width;

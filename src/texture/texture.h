@@ -98,6 +98,13 @@ class Texture {
   // 16 bits (nextLevel) and each is then stored packed (packTexel), so rounding does not accumulate
   // down the pyramid.
   Texture(Level base, Wrap wrapX, Wrap wrapY);
+  // A pyramid as another Texture held it (texels(), allTexels()): level 0 width × height, every
+  // level packed and bordered as above — what a prepared database stores. `pyramid` must have
+  // pyramidTexels(width, height) entries (sides 1 … kMaxTextureSide, checked by the caller).
+  Texture(int width, int height, Wrap wrapX, Wrap wrapY, std::vector<PackedTexel> pyramid);
+  // The packed texels of a whole pyramid whose level 0 is width × height, borders included.
+  static size_t pyramidTexels(int width, int height);
+  std::span<const PackedTexel> allTexels() const { return texels_; }
 
   int levelCount() const { return int(info_.size()); }
   LevelView level(int k) const;
@@ -157,6 +164,8 @@ class Texture {
   struct LevelInfo {
     int32_t width, height, offset;
   };
+  // info_, table_ and the flags, from the sizes and texels_.
+  void index(int width, int height);
   std::vector<PackedTexel> texels_;
   std::vector<LevelInfo> info_;
   LevelTable table_;
