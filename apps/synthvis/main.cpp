@@ -551,16 +551,14 @@ int runPrep(const PrepArgs& a) {
   };
   auto t0 = Clock::now();
   sv::Result<sv::scene::Scene> loaded = sv::Error{"", "", ""};
-  if (std::FILE* f = std::fopen(a.input.c_str(), "rb"); f || a.input.find('.') != std::string::npos) {
-    if (f) std::fclose(f);
-    loaded = loadSceneOrDemo(a.input);
-  } else {
+  if (sv::scene::parseGenerator(a.input).ok()) {
     auto c = generatorCase(a.input, a.generator);
     if (!c) return fail(c.error());
-    sv::RenderOptions o;
-    auto made = sv::reference::makeScene(c.value(), o);
+    auto made = sv::reference::makeScene(c.value(), sv::RenderOptions{});
     if (!made) return fail(made.error());
     loaded = std::move(made.value().scene);
+  } else {
+    loaded = loadSceneOrDemo(a.input);
   }
   if (!loaded) return fail(loaded.error());
   sv::scene::Scene scene = std::move(loaded).value();
