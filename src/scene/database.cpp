@@ -56,7 +56,7 @@ class Writer {
     static_assert(std::is_trivially_copyable_v<T>);
     pod(uint64_t(v.size()));
     out.append((kAlign - out.size() % kAlign) % kAlign, '\0');
-    out.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+    if (!v.empty()) out.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
   }
 };
 
@@ -86,7 +86,7 @@ class Reader {
     // The count is bounded by the bytes that are there: no allocation beyond the file's size.
     if (count > (n_ - at_) / sizeof(T)) fail(fmt::format("{}: {} elements run past the end", what, count));
     std::vector<T> v(static_cast<size_t>(count));
-    std::memcpy(v.data(), p_ + at_, size_t(count) * sizeof(T));
+    if (count > 0) std::memcpy(v.data(), p_ + at_, size_t(count) * sizeof(T));
     at_ += size_t(count) * sizeof(T);
     return v;
   }

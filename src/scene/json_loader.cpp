@@ -1855,9 +1855,18 @@ void SceneReader::readMeshFile(const Json& v, const std::string& where, std::opt
                  .first;
   }
   const auto [meshBase, lodBase] = placed->second;
-  for (const Instance& instance : file.instances)
-    scene_.instances.push_back({instance.mesh + meshBase, m * instance.transform, 0,
-                                instance.lod >= 0 ? instance.lod + lodBase : -1});
+  const uint32_t instanceBase = uint32_t(scene_.instances.size());
+  for (Instance instance : file.instances) {
+    instance.mesh += meshBase;
+    instance.transform = m * instance.transform;
+    instance.priority = 0;
+    if (instance.lod >= 0) instance.lod += lodBase;
+    scene_.instances.push_back(instance);
+  }
+  // Its switches, degrees of freedom and light points come along with every placement.
+  if (scene_.lightPoints.size() + file.lightPoints.size() > kMaxLightPoints)
+    fail(where, fmt::format("placing '{}' makes more than {} light points", ref, kMaxLightPoints));
+  appendArticulationsAndLights(scene_, file, m, instanceBase);
   for (Camera camera : file.cameras) {
     camera.position = m.transformPoint(camera.position);
     camera.target = m.transformPoint(camera.target);

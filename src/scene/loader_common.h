@@ -37,6 +37,12 @@ std::string oneLine(const std::string& text);
 // or degenerate) is closed by a fan of what remains. O(n²) at worst.
 std::vector<uint32_t> triangulatePolygon(const std::vector<Vec3>& p);
 
+// The switches, degrees of freedom and light points of `other`, whose instances were appended to
+// `scene` from index `instanceBase` on, placed by `transform` (appendScene, and scene files that
+// place other files).
+void appendArticulationsAndLights(Scene& scene, const Scene& other, const Mat4& transform,
+                                  uint32_t instanceBase);
+
 // The state of one top-level load, passed down through scene files that reference others.
 struct LoadContext {
   LoadOptions options;

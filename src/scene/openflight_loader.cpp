@@ -256,6 +256,8 @@ class Reader {
       scene_.warnings.push_back(
           fmt::format("{}: {} {} record{} not drawn", path_, count, what, count == 1 ? "" : "s"));
     applyArticulations(scene_);
+    if (scene_.lightPoints.size() > kMaxLightPoints)
+      fail(fmt::format("more than {} light points", kMaxLightPoints));
     // Matrices and DOF values that are finite can still multiply past the float range.
     for (const Instance& inst : scene_.instances)
       if (!isFinite(inst.transform))

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "scene/channels.h"
+#include "scene/loader_common.h"
 
 namespace sv::scene {
 
@@ -318,6 +319,42 @@ Status validate(const Scene& scene, const std::string& file, bool vertexData) {
   return {};
 }
 
+namespace detail {
+
+void appendArticulationsAndLights(Scene& scene, const Scene& other, const Mat4& transform,
+                                  uint32_t instanceBase) {
+  // Articulations keep their instances; top-level degrees of freedom move into the new place.
+  for (Switch s : other.switches) {
+    for (std::vector<uint32_t>& child : s.children)
+      for (uint32_t& i : child) i += instanceBase;
+    scene.switches.push_back(std::move(s));
+  }
+  const int dofBase = static_cast<int>(scene.dofs.size());
+  for (Dof d : other.dofs) {
+    if (d.parent >= 0) d.parent += dofBase;
+    else d.place = transform * d.place;
+    for (auto& part : d.parts) part.first += instanceBase;
+    scene.dofs.push_back(std::move(d));
+  }
+  // Light points, their appearances turned and their groups kept.
+  const uint32_t appearanceBase = static_cast<uint32_t>(scene.lightAppearances.size());
+  const int32_t groupBase = static_cast<int32_t>(scene.lightGroups.size());
+  for (LightAppearance a : other.lightAppearances) {
+    if (a.directional) a.direction = normalize(transform.transformDirection(a.direction));
+    scene.lightAppearances.push_back(std::move(a));
+  }
+  scene.lightGroups.insert(scene.lightGroups.end(), other.lightGroups.begin(),
+                           other.lightGroups.end());
+  for (LightPoint p : other.lightPoints) {
+    p.position = transform.transformPoint(p.position);
+    p.appearance += appearanceBase;
+    if (p.group >= 0) p.group += groupBase;
+    scene.lightPoints.push_back(p);
+  }
+}
+
+}  // namespace detail
+
 void appendScene(Scene& scene, Scene other, const Mat4& transform) {
   const int materialBase = static_cast<int>(scene.materials.size());
   const int meshBase = static_cast<int>(scene.meshes.size());
@@ -343,33 +380,7 @@ void appendScene(Scene& scene, Scene other, const Mat4& transform) {
     if (instance.lod >= 0) instance.lod += lodBase;
     scene.instances.push_back(instance);
   }
-  // Articulations keep their instances; top-level degrees of freedom move into the new place.
-  for (Switch& s : other.switches) {
-    for (std::vector<uint32_t>& child : s.children)
-      for (uint32_t& i : child) i += instanceBase;
-    scene.switches.push_back(std::move(s));
-  }
-  const int dofBase = static_cast<int>(scene.dofs.size());
-  for (Dof& d : other.dofs) {
-    if (d.parent >= 0) d.parent += dofBase;
-    else d.place = transform * d.place;
-    for (auto& part : d.parts) part.first += instanceBase;
-    scene.dofs.push_back(std::move(d));
-  }
-  // Light points, their appearances turned and their groups kept.
-  const uint32_t appearanceBase = static_cast<uint32_t>(scene.lightAppearances.size());
-  const int32_t groupBase = static_cast<int32_t>(scene.lightGroups.size());
-  for (LightAppearance& a : other.lightAppearances) {
-    if (a.directional) a.direction = normalize(transform.transformDirection(a.direction));
-    scene.lightAppearances.push_back(std::move(a));
-  }
-  for (LightGroup& g : other.lightGroups) scene.lightGroups.push_back(std::move(g));
-  for (LightPoint p : other.lightPoints) {
-    p.position = transform.transformPoint(p.position);
-    p.appearance += appearanceBase;
-    if (p.group >= 0) p.group += groupBase;
-    scene.lightPoints.push_back(p);
-  }
+  detail::appendArticulationsAndLights(scene, other, transform, instanceBase);
   for (std::string& w : other.warnings) scene.warnings.push_back(std::move(w));
   for (FreeFormObject& f : other.freeForms) {
     if (f.material >= 0) f.material += materialBase;

@@ -140,6 +140,30 @@ TEST(OpenFlight, ReadsEveryNodeKind) {
   EXPECT_NEAR(s.lightPoints[2].position.y, 3, 1e-5);
 }
 
+// A scene file placing an OpenFlight model twice gets its switches, degrees of freedom and light
+// points twice, each placement's own.
+TEST(OpenFlight, PlacedByASceneFileKeepsItsArticulationsAndLights) {
+  TempDir dir;
+  dir.write("every.flt", testing::everyNodeFlt());
+  const std::string json = dir.write("two.json", R"({"synthvis": 1, "objects": [
+    {"mesh": "every.flt"}, {"mesh": "every.flt", "transform": {"translate": [0, 0, -50]}}]})");
+  Result<Scene> r = loadScene(json);
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  ASSERT_EQ(r->switches.size(), 2u);
+  ASSERT_EQ(r->dofs.size(), 2u);
+  ASSERT_EQ(r->lightPoints.size(), 6u);
+  EXPECT_NEAR(r->lightPoints[3].position.z - r->lightPoints[0].position.z, -50, 1e-4);
+  // Each switch holds its own placement's instances; the second DOF moves the second copy.
+  EXPECT_NE(r->switches[0].children[0], r->switches[1].children[0]);
+  const uint32_t part = r->dofs[1].parts[0].first;
+  EXPECT_TRUE(r->instances[part].articulated);
+  Scene t = r.value();
+  t.dofs[1].current.rotate = {0, 0, 0};
+  applyArticulations(t);
+  EXPECT_NEAR(t.instances[part].transform.transformPoint({6, 0, 0.25f}).z, -50, 1e-4);
+  ASSERT_TRUE(validate(t, json).ok());
+}
+
 // Units (feet here) become metres; a long local vertex pool arrives in continuation records.
 TEST(OpenFlight, UnitsAndContinuationRecords) {
   FltWriter w;
