@@ -113,8 +113,11 @@ Result<Scene> loadScene(const std::string& path, const LoadOptions& options) {
     detail::LoadContext context{options, {}, {}};
     Result<Scene> scene = detail::loadFile(path, context);
     if (!scene) return scene;
-    // The traversal's hierarchy over the file's instances (they do not move once loaded).
-    buildInstanceTree(scene.value());
+    // The traversal's hierarchy over the file's instances (they do not move once loaded); a
+    // prepared database brings its own.
+    const Scene& loaded = scene.value();
+    if (!loaded.instanceTree || loaded.instanceTree->instanceCount != loaded.instances.size())
+      buildInstanceTree(scene.value());
     const Scene& s = scene.value();
     if (s.triangleCount() == 0 && s.freeForms.empty() && s.terrains.empty() &&
         s.lightPoints.empty() && s.stars.stars.empty())
