@@ -493,6 +493,10 @@ class Reader {
         if (masks < 0 || words < 0 || size_t(28) + size_t(masks) * size_t(words) * 4 > f.size())
           fail(fmt::format("switch at byte {}: {} masks of {} words do not fit its record", r.at,
                            masks, words));
+        // One flag per mask and child, for every switch placed: bounded like the nodes visited.
+        switchFlags_ += uint64_t(std::max(masks, 1)) * uint64_t(node.children.size());
+        if (switchFlags_ > kMaxVisits)
+          fail(fmt::format("switches hold more than {} mask flags", kMaxVisits));
         Switch s;
         s.name = node.name;
         s.children.resize(node.children.size());
@@ -641,6 +645,11 @@ class Reader {
       loaded = context_.loaded.emplace(key, std::move(s.value())).first;
     }
     const Scene& referenced = loaded->second;
+    // Every placement copies the file's meshes: they count against the budget each time.
+    triangles_ += referenced.triangleCount();
+    if (triangles_ > context_.options.maxTriangles)
+      fail(fmt::format("more than {} triangles (external reference '{}')",
+                       context_.options.maxTriangles, name));
     const size_t firstInstance = scene_.instances.size(), firstDof = scene_.dofs.size();
     // The file is already in metres and y up: its root change undone, then the path to here.
     const Mat4 toNode = at.sinceDof * rootInverse_;
@@ -1224,7 +1233,7 @@ class Reader {
   Mat4 root_, rootInverse_;
   double unitScale_ = 1;
   int emptyMesh_ = -1;
-  uint64_t visits_ = 0, triangles_ = 0, texels_ = 0;
+  uint64_t visits_ = 0, triangles_ = 0, texels_ = 0, switchFlags_ = 0;
 };
 
 }  // namespace
