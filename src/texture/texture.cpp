@@ -9,6 +9,7 @@
 #include <iterator>
 
 #include "texture/jpeg.h"
+#include "texture/sgi.h"
 #include "texture/png.h"
 
 namespace sv::texture {
@@ -305,12 +306,12 @@ constexpr PngLimits kTextureLimits{kMaxTextureSide, kMaxTextureTexels};
 }  // namespace
 
 Result<Level> readTextureImage(const std::string& path) {
-  // A JPEG is recognised by its first bytes (a short read; the decoder reads the whole file).
+  // A JPEG or SGI image is recognised by its first bytes (a short read; the decoder reads the whole file).
   if (std::FILE* f = std::fopen(path.c_str(), "rb")) {
     unsigned char magic[3] = {};
     const size_t got = std::fread(magic, 1, 3, f);
     std::fclose(f);
-    if (looksLikeJpeg(magic, got)) {
+    if (looksLikeJpeg(magic, got) || looksLikeSgi(magic, got)) {
       std::ifstream in(path, std::ios::binary);
       const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
       if (!in.good() && !in.eof()) return Error{path, "", "read error"};
@@ -323,15 +324,23 @@ Result<Level> readTextureImage(const std::string& path) {
 }
 
 Result<Level> decodeTextureImage(const void* data, size_t size, const std::string& name) {
+  // JPEG and SGI decode to 8-bit sRGB-encoded RGBA with straight alpha: an 8-bit PNG's samples.
+  auto asPng = [](auto pixels) {
+    PngPixels png;
+    png.width = pixels.width;
+    png.height = pixels.height;
+    png.data = std::move(pixels.rgba);
+    return toLevel(png);
+  };
   if (looksLikeJpeg(data, size)) {
     auto jpeg = decodeJpeg(data, size, name, kTextureLimits.maxSide, kTextureLimits.maxPixels);
     if (!jpeg.ok()) return jpeg.error();
-    // As an 8-bit PNG's samples: sRGB-encoded, opaque.
-    PngPixels pixels;
-    pixels.width = jpeg->width;
-    pixels.height = jpeg->height;
-    pixels.data = std::move(jpeg->rgba);
-    return toLevel(pixels);
+    return asPng(std::move(jpeg.value()));
+  }
+  if (looksLikeSgi(data, size)) {
+    auto sgi = decodeSgi(data, size, name, kTextureLimits.maxSide, kTextureLimits.maxPixels);
+    if (!sgi.ok()) return sgi.error();
+    return asPng(std::move(sgi.value()));
   }
   auto png = decodePng(data, size, name, PngLayout::rgba8OrLinear16, kTextureLimits);
   if (!png.ok()) return png.error();

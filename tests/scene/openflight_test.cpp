@@ -164,6 +164,55 @@ TEST(OpenFlight, PlacedByASceneFileKeepsItsArticulationsAndLights) {
   ASSERT_TRUE(validate(t, json).ok());
 }
 
+// Textures: an SGI image (OpenFlight's own format) is read; one that cannot be read is named in a
+// warning and its faces drawn without it. Texture coordinates run up the image in OpenFlight.
+TEST(OpenFlight, ReadsSgiTexturesAndNamesMissingOnes) {
+  TempDir dir;
+  std::string rgb(512, '\0');
+  const unsigned char head[] = {0x01, 0xDA, 0, 1, 0, 3, 0, 2, 0, 2, 0, 3};  // verbatim 2×2 RGB
+  std::copy(std::begin(head), std::end(head), rgb.begin());
+  rgb += std::string(12, char(200));
+  dir.write("wall.rgb", rgb);
+  FltWriter w;
+  w.header();
+  w.texture(0, "wall.rgb");
+  w.texture(1, "missing.rgb");
+  w.vertexPalette();
+  std::vector<int32_t> v;
+  for (double x : {0.0, 1.0, 0.0}) {
+    V corner = V::at(x, x == 0 && v.size() == 2 ? 1 : 0, 0);
+    corner.uv = std::array<float, 2>{float(x), 0.25f};
+    v.push_back(w.vertex(corner));
+  }
+  w.push();
+  w.object("o");
+  w.push();
+  Face textured;
+  textured.texture = 0;
+  w.polygon(textured, v);
+  Face missing;
+  missing.texture = 1;
+  w.polygon(missing, v);
+  w.pop();
+  w.pop();
+  const std::string path = dir.write("tex.flt", w.bytes);
+  Result<Scene> r = loadScene(path);
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  ASSERT_EQ(r->textures.size(), 1u);
+  ASSERT_EQ(r->warnings.size(), 1u);
+  EXPECT_TRUE(contains(r->warnings[0], "texture 'missing.rgb'"));
+  EXPECT_TRUE(contains(r->warnings[0], "drawn without it"));
+  size_t withTexture = 0;
+  for (const Mesh& m : r->meshes)
+    if (m.material >= 0 && r->materials[size_t(m.material)].texture == 0) {
+      ++withTexture;
+      ASSERT_EQ(m.uvs.size(), m.positions.size());
+      EXPECT_FLOAT_EQ(m.uvs[0].y, 0.75f);  // t 0.25 up the image is v 0.75 down it
+    }
+  EXPECT_EQ(withTexture, 1u);
+  EXPECT_EQ(r->triangleCount(), 2u);
+}
+
 // Units (feet here) become metres; a long local vertex pool arrives in continuation records.
 TEST(OpenFlight, UnitsAndContinuationRecords) {
   FltWriter w;
