@@ -32,7 +32,6 @@ constexpr size_t kAlign = 16;  // arrays start on 16-byte boundaries of the file
 
 // Header: magic (8), version (4), byte order (4), payload bytes (8), payload checksum (8), zeros
 // (database.h).
-uint64_t checksum(const char* p, size_t n) { return detail::databaseChecksum(p, n); }
 
 struct DbProblem {
   std::string message;
@@ -450,7 +449,7 @@ Status saveDatabase(const Scene& scene, const std::string& path) {
   }
   char header[kHeaderBytes] = {};
   std::memcpy(header, kMagic, 8);
-  const uint64_t bytes = payload.size(), sum = checksum(payload.data(), payload.size());
+  const uint64_t bytes = payload.size(), sum = detail::databaseChecksum(payload.data(), payload.size());
   std::memcpy(header + 8, &kVersion, 4);
   std::memcpy(header + 12, &kByteOrder, 4);
   std::memcpy(header + detail::kDatabasePayloadBytesAt, &bytes, 8);
@@ -494,7 +493,7 @@ Result<Scene> parseDatabase(const char* data, size_t size, const std::string& pa
                    fmt::format("database is {} bytes, its header says {} (truncated or "
                                "appended to)",
                                size, bytes + kHeaderBytes)};
-    if (checksum(data + kHeaderBytes, bytes) != sum)
+    if (detail::databaseChecksum(data + kHeaderBytes, bytes) != sum)
       return Error{path, "", "database is damaged (its checksum does not match)"};
     Scene scene = decode(data + kHeaderBytes, size_t(bytes), options);
     if (Status s = validate(scene, path); !s) return s.error();

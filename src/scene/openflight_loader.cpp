@@ -884,16 +884,24 @@ class Reader {
     if (hidden) return;
     std::vector<Vertex> vertices = faceVertices(node);
     bake(node, vertices);
-    if (drawType == 2 || drawType == 3) {
-      ++skipped_["wireframe face"];
-      return;
-    }
-    if (drawType >= 8 && drawType <= 10) {
-      lights.push_back({vertices, a, drawType, newellNormal(vertices)});
-      return;
-    }
+    if (drawnAside(drawType, vertices, a, lights, "wireframe face")) return;
     if (vertices.size() < 3) return;
     addPolygon(vertices, triangulate(vertices), a, buckets);
+  }
+
+  // Draw types that are not polygons: wireframes (2, 3), counted as `wireframe` records not drawn;
+  // lights (8–10), kept for placeLightFace. True when `v` went either way.
+  bool drawnAside(int drawType, const std::vector<Vertex>& v, const FaceAttributes& a,
+                  std::vector<LightFace>& lights, const char* wireframe) {
+    if (drawType == 2 || drawType == 3) {
+      ++skipped_[wireframe];
+      return true;
+    }
+    if (drawType >= 8 && drawType <= 10) {
+      lights.push_back({v, a, drawType, newellNormal(v)});
+      return true;
+    }
+    return false;
   }
 
   // A face's or mesh's own matrix, applied to its vertices (positions in double).
@@ -1003,14 +1011,7 @@ class Reader {
                              r.at, i, pool.size()));
           v[k] = pool[i];
         }
-        if (drawType == 2 || drawType == 3) {
-          ++skipped_["wireframe mesh"];
-          continue;
-        }
-        if (drawType >= 8 && drawType <= 10) {
-          lights.push_back({v, a, drawType, newellNormal(v)});
-          continue;
-        }
+        if (drawnAside(drawType, v, a, lights, "wireframe mesh")) continue;
         std::vector<uint32_t> tri;
         switch (type) {
           case 1:  // triangle strip, every other triangle turned to keep the winding

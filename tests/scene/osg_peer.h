@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -48,8 +49,14 @@ inline std::set<std::array<long long, 3>> distinct(const std::vector<std::array<
 inline bool haveOsgconv() { return std::system("command -v osgconv >/dev/null 2>&1") == 0; }
 
 // osgconv `from` `to`; true on success.
+// Run in the output's directory: OSG's OpenFlight exporter writes a texture attribute file
+// (`<texture>.attr`) into the current directory for every texture it exports.
 inline bool osgconv(const std::string& from, const std::string& to) {
-  const std::string cmd = "osgconv '" + from + "' '" + to + "' >/dev/null 2>&1";
+  namespace fs = std::filesystem;
+  const fs::path out = fs::absolute(to);
+  const std::string cmd = "cd '" + out.parent_path().string() + "' && osgconv '" +
+                          fs::absolute(from).string() + "' '" + out.string() +
+                          "' >/dev/null 2>&1";
   return std::system(cmd.c_str()) == 0;
 }
 
