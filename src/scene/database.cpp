@@ -15,6 +15,7 @@
 #include <cstring>
 #include <memory>
 #include <new>
+#include <span>
 #include <type_traits>
 
 #include "scene/database.h"
@@ -52,6 +53,10 @@ class Writer {
   }
   template <typename T>
   void array(const std::vector<T>& v) {
+    array(std::span<const T>(v));
+  }
+  template <typename T>
+  void array(std::span<const T> v) {
     static_assert(std::is_trivially_copyable_v<T>);
     pod(uint64_t(v.size()));
     out.append((kAlign - out.size() % kAlign) % kAlign, '\0');
@@ -198,7 +203,7 @@ std::string encode(const Scene& s) {
     const texture::Texture& tex = *t.texture;
     w.pod(int32_t(tex.level(0).width)), w.pod(int32_t(tex.level(0).height));
     w.pod(tex.wrapX()), w.pod(tex.wrapY());
-    w.array(std::vector<texture::PackedTexel>(tex.allTexels().begin(), tex.allTexels().end()));
+    w.array(tex.allTexels());
   }
   w.pod(uint64_t(s.materials.size()));
   for (const Material& m : s.materials) put(w, m);
