@@ -54,6 +54,11 @@ struct FrameStats {
   // busiest worker's tile work).
   uint64_t lightPoints = 0, lightsDrawn = 0;
   double lightsMs = 0;
+  // Lines (synthvis/lines.h): segments considered, those drawn (some part in front of the eye,
+  // within the far plane and near the screen), and the line pass's time (its preparation plus the
+  // busiest worker's tile work).
+  uint64_t lines = 0, linesDrawn = 0;
+  double linesMs = 0;
   // rasterMs: the tile pass, which includes resolving each finished tile into the image.
   double vertexMs = 0, setupMs = 0, rasterMs = 0, totalMs = 0;
 

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "synthvis/light_points.h"
+#include "synthvis/lines.h"
 #include "synthvis/math.h"
 #include "synthvis/result.h"
 
@@ -345,6 +346,9 @@ struct Scene {
   std::vector<LightGroup> lightGroups;  // the host switches and dims them between frames
   LightSettings lightSettings;
   StarField stars;
+  // Lines (LineSegment): drawn after the opaque surfaces, depth-tested and writing depth.
+  std::vector<LineSegment> lines;
+  LineSettings lineSettings;
   // Simulation time, seconds: what blinking, sequences and the stars' rotation are functions of.
   double time = 0;
   // What a loader read but does not draw, one line each naming the file and the part ("…: 2

@@ -49,7 +49,9 @@ std::string FrameStats::summary() const {
                    : std::string()) +
          (lightPoints ? fmt::format(" | lights {}: drawn {}, {:.2f} ms", lightPoints, lightsDrawn,
                                     lightsMs)
-                      : std::string());
+                      : std::string()) +
+         (lines ? fmt::format(" | lines {}: drawn {}, {:.2f} ms", lines, linesDrawn, linesMs)
+                : std::string());
 }
 
 }  // namespace sv

@@ -38,12 +38,12 @@ Result<IgWorld> IgWorld::load(const IgConfig& config) {
     if (!model->freeForms.empty() || !model->terrains.empty())
       return Error{file, "", "an entity model holds triangles only (free forms and terrain belong to the database)"};
     // Only the model's meshes stay in the database; its placements become the entity's (its
-    // switches, degrees of freedom and light points are not carried by entities).
+    // switches, degrees of freedom, light points and lines are not carried by entities).
     scene::Scene& b = w.base_;
     const size_t before = b.instances.size(), cameras = b.cameras.size(),
                  switches = b.switches.size(), dofs = b.dofs.size(),
                  lights = b.lightPoints.size(), looks = b.lightAppearances.size(),
-                 groups = b.lightGroups.size();
+                 groups = b.lightGroups.size(), lines = b.lines.size();
     scene::appendScene(b, std::move(model.value()), Mat4{});
     Model m;
     m.instances.assign(b.instances.begin() + std::ptrdiff_t(before), b.instances.end());
@@ -55,6 +55,7 @@ Result<IgWorld> IgWorld::load(const IgConfig& config) {
     b.lightPoints.resize(lights);
     b.lightAppearances.resize(looks);
     b.lightGroups.resize(groups);
+    b.lines.resize(lines);
     w.modelTypes_.push_back(type);
     w.models_.push_back(std::move(m));
   }

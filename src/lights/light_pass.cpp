@@ -170,30 +170,12 @@ void LightPass::prepare(const raster::PassFrame& frame) {
   chunks_.resize(chunks);
   tilesX_ = (frame_.width + kTileSize - 1) >> kTileLog2;
   tiles_ = size_t(tilesX_) * size_t((frame_.height + kTileSize - 1) >> kTileLog2);
-  chunkTileCounts_.assign(chunks * tiles_, 0);
-  frame.pool->parallelFor(chunks, [&](size_t c, int) {
-    projectRange(c * chunk, std::min(total, (c + 1) * chunk), chunks_[c]);
-    for (const Splat& sp : chunks_[c])
-      forTiles(sp, [&](size_t t) { ++chunkTileCounts_[c * tiles_ + t]; });
-  });
-  // Each tile's list is its chunks' splats in chunk order, each chunk's in light order (a counting
-  // sort): where chunk c's splats for tile t start.
-  tileStart_.assign(tiles_ + 1, 0);
-  uint32_t at = 0;
-  for (size_t t = 0; t < tiles_; ++t) {
-    tileStart_[t] = at;
-    for (size_t c = 0; c < chunks; ++c) {
-      const uint32_t n = chunkTileCounts_[c * tiles_ + t];
-      chunkTileCounts_[c * tiles_ + t] = at;
-      at += n;
-    }
-  }
-  tileStart_[tiles_] = at;
-  tileSplats_.resize(at);  // copies, in tile order: a tile reads its lights in a run
-  frame.pool->parallelFor(chunks, [&](size_t c, int) {
-    for (const Splat& sp : chunks_[c])
-      forTiles(sp, [&](size_t t) { tileSplats_[chunkTileCounts_[c * tiles_ + t]++] = sp; });
-  });
+  tileSplats_.build(
+      chunks_, tiles_, *frame.pool,
+      [&](size_t c, std::vector<Splat>& out) {
+        projectRange(c * chunk, std::min(total, (c + 1) * chunk), out);
+      },
+      [&](const Splat& s, auto&& f) { forTiles(s, f); });
   workerMs_.assign(size_t(frame.pool->threadCount()), 0.0);
   prepareMs_ = core::msSince(t0);
 }
@@ -249,7 +231,8 @@ void LightPass::drawTile(const raster::TileTarget& tile) {
   const int xEnd = std::min(ox + kTileSize, frame_.width);
   const int yEnd = std::min(oy + kTileSize, frame_.height);
   const int n = frame_.samples;
-  if (tileStart_[t] == tileStart_[t + 1]) return;
+  const std::span<const Splat> splats = tileSplats_.tile(t);
+  if (splats.empty()) return;
   // The tile's depth and colour left the caches while the rest of the frame was drawn: stream
   // them back in order (the lights then touch them at random).
   const char* depth = reinterpret_cast<const char*>(tile.depth);
@@ -258,8 +241,7 @@ void LightPass::drawTile(const raster::TileTarget& tile) {
     __builtin_prefetch(depth + b);
   for (size_t b = 0; b < size_t(raster::kTilePixels) * size_t(n) * 6; b += 64)
     __builtin_prefetch(color + b, 1);
-  for (uint32_t e = tileStart_[t]; e < tileStart_[t + 1]; ++e) {
-    const Splat& s = tileSplats_[e];
+  for (const Splat& s : splats) {
     const float v = visibility(s);
     if (!(v > 0)) continue;
     SplatInTile part;

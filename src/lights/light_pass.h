@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "lights/light_laws.h"
+#include "raster/tile_lists.h"
 #include "raster/tile_pass.h"
 #include "synthvis/light_points.h"
 
@@ -85,9 +86,7 @@ class LightPass final : public raster::TilePass {
   std::vector<std::vector<Splat>> chunks_;  // the drawn splats, chunk by chunk, in light order
   int tilesX_ = 0;
   size_t tiles_ = 0;
-  std::vector<uint32_t> chunkTileCounts_;  // per chunk and tile: its count, then where it goes
-  std::vector<uint32_t> tileStart_;  // per tile: where its splats start in tileSplats_
-  std::vector<Splat> tileSplats_;    // every tile's splats, in light order within a tile
+  raster::TileLists<Splat> tileSplats_;  // every tile's splats, in light order
   std::vector<double> workerMs_;
   double prepareMs_ = 0;
   uint64_t candidates_ = 0;

@@ -35,6 +35,12 @@ std::vector<raster::TilePass*> FramePasses::compose(const scene::Scene& scene,
     terrains_.setTerrains(scene, camera, shading, o);
     passes.push_back(&terrains_);
   }
+  if (!scene.lines.empty()) {
+    lines_.setLines(lines::LineInput{scene.lines, scene.lineSettings, camera.view,
+                                     camera.projection, scene.fog.enabled, scene.fog.color,
+                                     scene.fog.beta});
+    passes.push_back(&lines_);
+  }
   if (!scene.lightPoints.empty() || !scene.stars.stars.empty()) {
     lights_.setLights(lightInput(scene, camera));
     passes.push_back(&lights_);

@@ -1,11 +1,12 @@
 // The frame's passes besides the polygons (raster/tile_pass.h), composed in tile order:
-// ray-cast surfaces (free forms, then terrain), volumes, light points (and stars).
+// ray-cast surfaces (free forms, then terrain), lines, volumes, light points (and stars).
 #pragma once
 
 #include <vector>
 
 #include "freeform/freeform_pass.h"
 #include "lights/light_pass.h"
+#include "lines/line_pass.h"
 #include "render/camera.h"
 #include "render/shading_tables.h"
 #include "render/terrain_pass.h"
@@ -26,6 +27,7 @@ class FramePasses {
  private:
   freeform::FreeFormPass freeForms_;
   TerrainPass terrains_;
+  lines::LinePass lines_;
   lights::LightPass lights_;
 };
 

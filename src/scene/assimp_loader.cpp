@@ -56,6 +56,32 @@ Mat4 toMat4(const aiMatrix4x4& a) {  // Assimp's is row-major, ours column-major
   return m;
 }
 
+// The line faces (two indices) of `am` placed by `world`: segments in the vertex colours (averaged)
+// times the material's diffuse colour. Returns an empty string or what is wrong.
+std::string placeLines(const aiMesh& am, const Mat4& world, Scene& s) {
+  if (!(am.mPrimitiveTypes & aiPrimitiveType_LINE)) return {};
+  const Vec4 base = am.mMaterialIndex < s.materials.size()
+                        ? s.materials[am.mMaterialIndex].baseColor
+                        : Vec4{1, 1, 1, 1};
+  auto color = [&](unsigned v) {
+    if (!am.mColors[0]) return Vec3{base.x, base.y, base.z};
+    const aiColor4D& c = am.mColors[0][v];
+    return Vec3{std::clamp(c.r, 0.0f, 1.0f) * base.x, std::clamp(c.g, 0.0f, 1.0f) * base.y,
+                std::clamp(c.b, 0.0f, 1.0f) * base.z};
+  };
+  for (unsigned f = 0; f < am.mNumFaces; ++f) {
+    const aiFace& face = am.mFaces[f];
+    if (face.mNumIndices != 2) continue;
+    const unsigned i = face.mIndices[0], j = face.mIndices[1];
+    if (i >= am.mNumVertices || j >= am.mNumVertices) return "a line's index is out of range";
+    if (s.lines.size() >= kMaxLines) return fmt::format("more than {} line segments", kMaxLines);
+    const aiVector3D &p = am.mVertices[i], &q = am.mVertices[j];
+    s.lines.push_back({world.transformPoint({p.x, p.y, p.z}), world.transformPoint({q.x, q.y, q.z}),
+                       (color(i) + color(j)) * 0.5f});
+  }
+  return {};
+}
+
 // Assimp's scene as ours: one mesh per triangle mesh, its diffuse colour, opacity and diffuse
 // texture (a file beside the model: PNG or JPEG) as the material, one instance per node that holds
 // it. Returns an empty string or what is wrong.
@@ -107,13 +133,14 @@ std::string convert(const aiScene& a, const std::string& path, const LoadOptions
     }
     s.materials.push_back(std::move(m));
   }
-  // Meshes: triangles only (SortByPType split the others off; they are named, not drawn).
+  // Meshes: triangles, and lines (SortByPType split each kind into meshes of its own; lines are
+  // placed with their nodes below, points are named, not drawn).
   std::vector<int> ours(a.mNumMeshes, -1);
-  uint64_t points = 0, lines = 0;
+  uint64_t points = 0;
   for (unsigned i = 0; i < a.mNumMeshes; ++i) {
     const aiMesh* am = a.mMeshes[i];
     if (!(am->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) {
-      (am->mPrimitiveTypes & aiPrimitiveType_POINT ? points : lines) += am->mNumFaces;
+      if (am->mPrimitiveTypes & aiPrimitiveType_POINT) points += am->mNumFaces;
       continue;
     }
     Mesh m;
@@ -151,8 +178,8 @@ std::string convert(const aiScene& a, const std::string& path, const LoadOptions
     ours[i] = int(s.meshes.size());
     s.meshes.push_back(std::move(m));
   }
-  if (points) s.warnings.push_back(fmt::format("{} points are not drawn (only triangles are)", points));
-  if (lines) s.warnings.push_back(fmt::format("{} lines are not drawn (only triangles are)", lines));
+  if (points)
+    s.warnings.push_back(fmt::format("{} points are not drawn (only triangles and lines are)", points));
   // Nodes, depth first with an explicit stack (a hostile file may nest deeply).
   uint64_t triangles = 0;
   std::vector<std::pair<const aiNode*, Mat4>> stack;
@@ -166,7 +193,10 @@ std::string convert(const aiScene& a, const std::string& path, const LoadOptions
     for (unsigned k = 0; k < node->mNumMeshes; ++k) {
       const unsigned mesh = node->mMeshes[k];
       if (mesh >= a.mNumMeshes) return fmt::format("a node names mesh {} of {}", mesh, a.mNumMeshes);
-      if (ours[mesh] < 0) continue;
+      if (ours[mesh] < 0) {
+        if (std::string e = placeLines(*a.mMeshes[mesh], world, s); !e.empty()) return e;
+        continue;
+      }
       triangles += s.meshes[size_t(ours[mesh])].triangleCount();
       if (triangles > options.maxTriangles)
         return fmt::format("the scene would have more than {} triangles", options.maxTriangles);
@@ -217,7 +247,7 @@ std::string convert(const aiScene& a, const std::string& path, const LoadOptions
     (void)ignored;
   }
   // Nothing to draw: no file (a glTF of no buffer is not one); the parent says so.
-  if (ours.meshes.empty()) {
+  if (ours.meshes.empty() && ours.lines.empty()) {
     const ssize_t ignored = write(report, "empty\n", 6);
     (void)ignored;
     _exit(0);

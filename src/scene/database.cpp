@@ -26,7 +26,7 @@ namespace sv::scene {
 namespace {
 
 constexpr char kMagic[8] = {'S', 'V', 'D', 'B', '\r', '\n', 0x1A, '\n'};
-constexpr uint32_t kVersion = 1;
+constexpr uint32_t kVersion = 2;  // 2: lines
 constexpr uint32_t kByteOrder = 0x01020304;  // as this machine writes it
 constexpr size_t kHeaderBytes = detail::kDatabaseHeaderBytes;
 constexpr size_t kAlign = 16;  // arrays start on 16-byte boundaries of the file
@@ -271,6 +271,8 @@ std::string encode(const Scene& s) {
   w.array(s.stars.stars);
   w.pod(s.stars.latitude), w.pod(s.stars.siderealTime), w.pod(s.stars.brightness);
   w.pod(s.stars.limit);
+  w.array(s.lines);
+  w.pod(s.lineSettings);
   w.pod(uint64_t(s.warnings.size()));
   for (const std::string& warning : s.warnings) w.str(warning);
   return std::move(w.out);
@@ -413,6 +415,8 @@ Scene decode(const char* data, size_t size, const LoadOptions& options) {
   s.stars.stars = r.array<Star>("stars");
   s.stars.latitude = r.pod<float>("stars"), s.stars.siderealTime = r.pod<float>("stars");
   s.stars.brightness = r.pod<float>("stars"), s.stars.limit = r.pod<float>("stars");
+  s.lines = r.array<LineSegment>("lines");
+  s.lineSettings = r.pod<LineSettings>("line settings");
   for (size_t k = r.count("warnings", 4); k > 0; --k) s.warnings.push_back(r.str("warning"));
   if (!r.done()) fail("bytes after the last record");
   return s;

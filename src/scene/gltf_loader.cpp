@@ -292,10 +292,15 @@ class GltfConverter {
     float a = 1, b = 0, c = 0, d = 0, e = 1, f = 0;
   };
   std::map<int, UvTransform> uvTransforms_;
-  // POINTS primitives by glTF mesh: their vertices become light points where a node places them.
-  std::map<int, std::vector<Mesh>> pointMeshes_;
+  // POINTS and LINE* primitives by glTF mesh: where a node places them, a points mesh's vertices
+  // become light points, a lines mesh's index pairs line segments.
+  struct Aside {
+    Mesh mesh;
+    bool lines = false;
+  };
+  std::map<int, std::vector<Aside>> asideMeshes_;
   std::map<std::array<float, 3>, uint32_t> pointLooks_;  // light appearance by colour
-  void placePoints(int gltfMesh, const Mat4& world, const std::string& where);
+  void placeAside(int gltfMesh, const Mat4& world, const std::string& where);
   // MSFT_lod: the level-of-detail group of the node's levels (its mesh first, then the meshes of
   // the nodes its `ids` name), or −1 — with a warning — when a level is not one primitive.
   int lodGroupOf(const tinygltf::Node& node, const std::string& where);
@@ -640,8 +645,19 @@ Mesh GltfConverter::convertPrimitive(const tinygltf::Primitive& primitive,
     case TINYGLTF_MODE_TRIANGLE_FAN:
       for (size_t i = 1; i + 1 < m; ++i) emit(sequence[0], sequence[i], sequence[i + 1]);
       break;
+    // Lines: segments as index pairs (placeAside draws them as lines).
+    case TINYGLTF_MODE_LINE:
+      out.reserve(m - m % 2);
+      for (size_t i = 0; i + 1 < m; i += 2) out.insert(out.end(), {sequence[i], sequence[i + 1]});
+      break;
+    case TINYGLTF_MODE_LINE_STRIP:
+    case TINYGLTF_MODE_LINE_LOOP:
+      for (size_t i = 0; i + 1 < m; ++i) out.insert(out.end(), {sequence[i], sequence[i + 1]});
+      if (primitive.mode == TINYGLTF_MODE_LINE_LOOP && m > 2)
+        out.insert(out.end(), {sequence[m - 1], sequence[0]});
+      break;
     default:
-      break;  // points and lines have no triangles
+      break;  // points have no triangles
   }
 
   mesh.material = materialOf(primitive, where);
@@ -661,20 +677,16 @@ const std::vector<int>& GltfConverter::meshesOf(int gltfMesh) {
       case TINYGLTF_MODE_TRIANGLE_STRIP:
       case TINYGLTF_MODE_TRIANGLE_FAN:
         break;
-      case TINYGLTF_MODE_POINTS: {
-        // Points are light points (SPEC §13): kept aside, placed with the node (walkNodes).
-        Mesh points = convertPrimitive(primitive, where);
-        points.indices.clear();
-        pointMeshes_[gltfMesh].push_back(std::move(points));
-        continue;
-      }
+      case TINYGLTF_MODE_POINTS:
       case TINYGLTF_MODE_LINE:
       case TINYGLTF_MODE_LINE_LOOP:
-      case TINYGLTF_MODE_LINE_STRIP:
-        // Nothing to fill: named, never silently left out.
-        scene_.warnings.push_back(fmt::format(
-            "{}: lines are not drawn (only triangles and points are)", where));
+      case TINYGLTF_MODE_LINE_STRIP: {
+        // Points are light points (SPEC §13), lines the line pass's: kept aside, placed with the
+        // node (walkNodes, placeAside). A points mesh has no indices; a lines mesh index pairs.
+        asideMeshes_[gltfMesh].push_back(
+            {convertPrimitive(primitive, where), primitive.mode != TINYGLTF_MODE_POINTS});
         continue;
+      }
       default:
         fail(fmt::format("{}: unknown mode {}", where, primitive.mode));
     }
@@ -686,18 +698,40 @@ const std::vector<int>& GltfConverter::meshesOf(int gltfMesh) {
   return meshes_.emplace(gltfMesh, std::move(ours)).first->second;
 }
 
-// A light point at every vertex of the mesh's POINTS primitives: omnidirectional, of the default
-// intensity, in the vertex colour times the material's base colour (one appearance per colour).
-void GltfConverter::placePoints(int gltfMesh, const Mat4& world, const std::string& where) {
-  auto it = pointMeshes_.find(gltfMesh);
-  if (it == pointMeshes_.end()) return;
-  for (const Mesh& points : it->second) {
-    const Vec4 base = scene_.materialAt(points.material).baseColor;
-    for (size_t i = 0; i < points.positions.size(); ++i) {
-      const Vec4 c = points.colors.empty() ? Vec4{1, 1, 1, 1} : points.colors[i];
-      const std::array<float, 3> color{std::clamp(c.x * base.x, 0.0f, 1.0f),
-                                       std::clamp(c.y * base.y, 0.0f, 1.0f),
-                                       std::clamp(c.z * base.z, 0.0f, 1.0f)};
+// Where a node places glTF mesh `gltfMesh`, its POINTS and LINE* primitives: a light point at every
+// vertex of a points primitive (omnidirectional, of the default intensity, one appearance per
+// colour), a line segment for every index pair of a lines primitive — each in the vertex colour
+// (a segment's two averaged) times the material's base colour.
+void GltfConverter::placeAside(int gltfMesh, const Mat4& world, const std::string& where) {
+  auto it = asideMeshes_.find(gltfMesh);
+  if (it == asideMeshes_.end()) return;
+  for (const auto& [mesh, lines] : it->second) {
+    const Vec4 base = scene_.materialAt(mesh.material).baseColor;
+    auto colorAt = [&](uint32_t i) {
+      const Vec4 c = mesh.colors.empty() ? Vec4{1, 1, 1, 1} : mesh.colors[i];
+      return std::array<float, 3>{std::clamp(c.x * base.x, 0.0f, 1.0f),
+                                  std::clamp(c.y * base.y, 0.0f, 1.0f),
+                                  std::clamp(c.z * base.z, 0.0f, 1.0f)};
+    };
+    auto placed = [&](uint32_t i) {
+      const Vec3 p = world.transformPoint(mesh.positions[i]);
+      if (!isFinite(p)) fail(fmt::format("{}: a vertex's position is not finite", where));
+      return p;
+    };
+    if (lines) {
+      if (scene_.lines.size() + mesh.indices.size() / 2 > kMaxLines)
+        fail(fmt::format("{}: more than {} line segments", where, kMaxLines));
+      for (size_t k = 0; k + 1 < mesh.indices.size(); k += 2) {
+        const uint32_t a = mesh.indices[k], b = mesh.indices[k + 1];
+        const std::array<float, 3> ca = colorAt(a), cb = colorAt(b);
+        scene_.lines.push_back({placed(a), placed(b),
+                                {0.5f * (ca[0] + cb[0]), 0.5f * (ca[1] + cb[1]),
+                                 0.5f * (ca[2] + cb[2])}});
+      }
+      continue;
+    }
+    for (uint32_t i = 0; i < uint32_t(mesh.positions.size()); ++i) {
+      const std::array<float, 3> color = colorAt(i);
       auto look = pointLooks_.find(color);
       if (look == pointLooks_.end()) {
         LightAppearance a;
@@ -706,11 +740,9 @@ void GltfConverter::placePoints(int gltfMesh, const Mat4& world, const std::stri
         scene_.lightAppearances.push_back(a);
         look = pointLooks_.emplace(color, uint32_t(scene_.lightAppearances.size() - 1)).first;
       }
-      const Vec3 p = world.transformPoint(points.positions[i]);
-      if (!isFinite(p)) fail(fmt::format("{}: a point's position is not finite", where));
       if (scene_.lightPoints.size() >= kMaxLightPoints)
         fail(fmt::format("{}: more than {} light points", where, kMaxLightPoints));
-      scene_.lightPoints.push_back({p, look->second, 0, -1});
+      scene_.lightPoints.push_back({placed(i), look->second, 0, -1});
     }
   }
 }
@@ -969,7 +1001,7 @@ void GltfConverter::walkNodes() {
           triangles_ += t;
           scene_.instances.push_back({mesh, world * placement, 0, lod});
         }
-      for (const Mat4& placement : placements) placePoints(node.mesh, world * placement, where);
+      for (const Mat4& placement : placements) placeAside(node.mesh, world * placement, where);
     } else if (node.mesh < -1) {
       fail(fmt::format("{}: mesh {} does not exist", where, node.mesh));
     }

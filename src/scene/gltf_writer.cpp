@@ -8,11 +8,13 @@
 // baseColorTexture), one image per texture (its level 0 as an 8-bit sRGB RGBA PNG in the buffer,
 // glTF's encoding for base colour) with a sampler of its wrap modes, one node per Instance (its
 // matrix), one node per Camera (camera-to-world matrix, looking down −Z with +Y up; yfov in
-// radians). Not written, as glTF core has no place for them: lights, fog, the background, Phong
-// and specular terms, the colour table.
+// radians), the lines as one LINES primitive in world coordinates (COLOR_0 each segment's colour).
+// Not written, as glTF core has no place for them: lights, fog, the background, Phong and specular
+// terms, the colour table, the line settings.
 #include <fmt/format.h>
 #include <tiny_gltf.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <numbers>
@@ -165,6 +167,40 @@ Status saveGltf(const Scene& scene, const std::string& path) {
     tinygltf::Node node;
     node.mesh = inst.mesh;
     node.matrix = columnMajor(inst.transform);
+    model.nodes.push_back(node);
+    root.nodes.push_back(int(model.nodes.size()) - 1);
+  }
+  // The lines: one LINES primitive in world coordinates, each segment's colour on both its ends.
+  if (!scene.lines.empty()) {
+    std::vector<Vec3> positions;
+    std::vector<Vec4> colors;
+    for (const LineSegment& l : scene.lines) {
+      positions.insert(positions.end(), {l.a, l.b});
+      const Vec4 c{l.color.x, l.color.y, l.color.z, 1};
+      colors.insert(colors.end(), {c, c});
+    }
+    tinygltf::Primitive prim;
+    prim.mode = TINYGLTF_MODE_LINE;
+    const int pos =
+        addAccessor(model, positions.data(), positions.size(), sizeof(Vec3), TINYGLTF_TYPE_VEC3,
+                    TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
+    Vec3 lo = positions[0], hi = positions[0];
+    for (const Vec3& p : positions) {
+      lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+      hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+    }
+    model.accessors[size_t(pos)].minValues = {lo.x, lo.y, lo.z};
+    model.accessors[size_t(pos)].maxValues = {hi.x, hi.y, hi.z};
+    prim.attributes["POSITION"] = pos;
+    prim.attributes["COLOR_0"] =
+        addAccessor(model, colors.data(), colors.size(), sizeof(Vec4), TINYGLTF_TYPE_VEC4,
+                    TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
+    tinygltf::Mesh lines;
+    lines.name = "lines";
+    lines.primitives.push_back(prim);
+    model.meshes.push_back(lines);
+    tinygltf::Node node;
+    node.mesh = int(model.meshes.size()) - 1;
     model.nodes.push_back(node);
     root.nodes.push_back(int(model.nodes.size()) - 1);
   }

@@ -426,6 +426,8 @@ class SceneReader {
                       const std::map<std::string, int>& appearances,
                       const std::map<std::string, int>& groups);
   void addLight(const LightPoint& p, const std::string& where);
+  // "lines" (docs/scene-format.md#lines): settings and polylines.
+  void readLines(const Json& v, const std::string& where);
   std::shared_ptr<terrain::Ground> readHeights(const Json& v, const std::string& where);
   int textureRef(const Json& v, const std::string& where) const;
   FreeFormNode readFreeForm(const Json& v, const std::string& where, int depth, int& quadrics,
@@ -470,7 +472,7 @@ Scene SceneReader::read(const Json& root) {
   expectKeys(root, "",
              {"synthvis", "description", "background", "camera", "cameras", "light", "pointLights",
               "fog", "textures", "colorTable", "materials", "lodGroups", "objects", "terrain",
-              "lights", "time", "channels"});
+              "lights", "lines", "time", "channels"});
 
   if (const Json* description = find(root, "description")) string(*description, "description");
   if (const Json* background = find(root, "background")) {
@@ -505,6 +507,7 @@ Scene SceneReader::read(const Json& root) {
     for (size_t i = 0; i < objects->size(); ++i) readObject((*objects)[i], element("objects", i));
   }
   if (const Json* x = find(root, "lights")) readLights(*x, "lights");
+  if (const Json* x = find(root, "lines")) readLines(*x, "lines");
   if (const Json* x = find(root, "time")) scene_.time = number(*x, "time");
   return std::move(scene_);
 }
@@ -864,6 +867,43 @@ void SceneReader::readFog(const Json& v, const std::string& where) {
 // At most this many light appearances and groups in a scene (and synthvis/light_points.h's
 // kMaxLightPoints lights).
 constexpr size_t kMaxLightAppearances = 65536, kMaxLightGroups = 4096;
+
+// "lines" (docs/scene-format.md, "Lines"): {"width", "depthBias", "polylines": [{"points",
+// "color", "closed"}]}, in world coordinates.
+void SceneReader::readLines(const Json& v, const std::string& where) {
+  expectKeys(v, where, {"width", "depthBias", "polylines"});
+  LineSettings& l = scene_.lineSettings;
+  if (const Json* x = find(v, "width")) l.width = inRange(*x, member(where, "width"), 1.0f / 64, 64);
+  if (const Json* x = find(v, "depthBias"))
+    l.depthBias = inRange(*x, member(where, "depthBias"), 0, 0.5f);
+  const Json* polylines = find(v, "polylines");
+  if (!polylines) return;
+  const std::string w = member(where, "polylines");
+  array(*polylines, w);
+  for (size_t i = 0; i < polylines->size(); ++i) {
+    const Json& p = (*polylines)[i];
+    const std::string wp = element(w, i);
+    expectKeys(p, wp, {"points", "color", "closed"});
+    const Json* points = find(p, "points");
+    if (!points) fail(wp, "missing key 'points'");
+    const std::string wpts = member(wp, "points");
+    array(*points, wpts);
+    if (points->size() < 2) fail(wpts, "a polyline needs at least 2 points");
+    Vec3 c{1, 1, 1};
+    if (const Json* x = find(p, "color")) {
+      const Vec4 c4 = color(*x, member(wp, "color"), false);
+      c = {c4.x, c4.y, c4.z};
+    }
+    const bool closed = find(p, "closed") && boolean(*find(p, "closed"), member(wp, "closed"));
+    const size_t n = points->size();
+    const size_t segments = closed && n > 2 ? n : n - 1;
+    if (scene_.lines.size() + segments > kMaxLines)
+      fail(wp, fmt::format("more than {} line segments", kMaxLines));
+    std::vector<Vec3> q(n);
+    for (size_t k = 0; k < n; ++k) q[k] = vec3((*points)[k], element(wpts, k));
+    for (size_t k = 0; k < segments; ++k) scene_.lines.push_back({q[k], q[(k + 1) % n], c});
+  }
+}
 
 // "lights" (docs/scene-format.md, "Light points").
 void SceneReader::readLights(const Json& v, const std::string& where) {
@@ -1866,6 +1906,8 @@ void SceneReader::readMeshFile(const Json& v, const std::string& where, std::opt
   // Its switches, degrees of freedom and light points come along with every placement.
   if (scene_.lightPoints.size() + file.lightPoints.size() > kMaxLightPoints)
     fail(where, fmt::format("placing '{}' makes more than {} light points", ref, kMaxLightPoints));
+  if (scene_.lines.size() + file.lines.size() > kMaxLines)
+    fail(where, fmt::format("placing '{}' makes more than {} lines", ref, kMaxLines));
   appendArticulationsAndLights(scene_, file, m, instanceBase);
   for (Camera camera : file.cameras) {
     camera.position = m.transformPoint(camera.position);

@@ -120,7 +120,7 @@ Result<Scene> loadScene(const std::string& path, const LoadOptions& options) {
       buildInstanceTree(scene.value());
     const Scene& s = scene.value();
     if (s.triangleCount() == 0 && s.freeForms.empty() && s.terrains.empty() &&
-        s.lightPoints.empty() && s.stars.stars.empty())
+        s.lightPoints.empty() && s.stars.stars.empty() && s.lines.empty())
       scene.value().warnings.push_back(fmt::format("{}: nothing to draw", path));
     return scene;
   } catch (const std::bad_alloc&) {

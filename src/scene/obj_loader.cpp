@@ -261,6 +261,7 @@ Scene convertObj(const tinyobj::attrib_t& attrib, const std::vector<tinyobj::sha
   // first one without).
   const bool hasColors = nv > 0 && attrib.colors.size() == attrib.vertices.size();
   uint64_t triangles = 0;
+  size_t points = 0;
 
   for (const tinyobj::shape_t& shape : shapes) {
     const tinyobj::mesh_t& m = shape.mesh;
@@ -345,7 +346,44 @@ Scene convertObj(const tinyobj::attrib_t& attrib, const std::vector<tinyobj::sha
       scene.meshes.push_back(std::move(mesh));
       scene.instances.push_back({int(scene.meshes.size() - 1), Mat4{}});
     }
+
+    // `l` elements: polylines, each consecutive pair a line segment in the vertices' colour
+    // (white without vertex colours; tinyobjloader keeps no material for lines).
+    const tinyobj::lines_t& l = shape.lines;
+    size_t at = 0;
+    for (size_t k = 0; k < l.num_line_vertices.size(); ++k) {
+      const size_t n = size_t(std::max(l.num_line_vertices[k], 0));
+      if (at + n > l.indices.size())
+        fail(fmt::format("shape '{}': inconsistent line data", shape.name));
+      if (n >= 2 && scene.lines.size() + n - 1 > kMaxLines)
+        fail(fmt::format("more than {} line segments", kMaxLines));
+      for (size_t j = 0; j < n; ++j) {
+        const int v = l.indices[at + j].vertex_index;
+        if (v < 0 || size_t(v) >= nv)
+          fail(fmt::format("shape '{}': line {} uses vertex {}, but there are {} vertices",
+                           shape.name, k + 1, v + 1, nv));
+      }
+      auto position = [&](size_t j) {
+        const size_t v = size_t(l.indices[at + j].vertex_index);
+        return Vec3{attrib.vertices[3 * v], attrib.vertices[3 * v + 1], attrib.vertices[3 * v + 2]};
+      };
+      auto color = [&](size_t j) {
+        if (!hasColors) return Vec3{1, 1, 1};
+        const size_t v = size_t(l.indices[at + j].vertex_index);
+        return Vec3{std::clamp(attrib.colors[3 * v], 0.0f, 1.0f),
+                    std::clamp(attrib.colors[3 * v + 1], 0.0f, 1.0f),
+                    std::clamp(attrib.colors[3 * v + 2], 0.0f, 1.0f)};
+      };
+      for (size_t j = 0; j + 1 < n; ++j)
+        scene.lines.push_back({position(j), position(j + 1), (color(j) + color(j + 1)) * 0.5f});
+      at += n;
+    }
+    points += shape.points.indices.size();
   }
+  // `p` elements: named, not drawn.
+  if (points)
+    scene.warnings.push_back(
+        fmt::format("{} points (`p`) are not drawn (only faces and lines are)", points));
   return scene;
 }
 
@@ -434,6 +472,7 @@ Result<Scene> parseObj(const std::string& text, const std::string& path,
     }
     addBigFaces(big, attrib, materials, shapes);
     Scene scene = convertObj(attrib, shapes, materials, options, directoryOf(path));
+    for (std::string& w : scene.warnings) w = fmt::format("{}: {}", path, w);
     Status valid = validate(scene, path);
     if (!valid) return valid.error();
     return scene;

@@ -675,7 +675,9 @@ class Reader {
   void placeGeometry(uint32_t index, const Place& at) {
     auto built = builtOf_.find(index);
     if (built == builtOf_.end()) built = builtOf_.emplace(index, build(index)).first;
-    for (const LightFace& face : built->second.lights) placeLightFace(face, at);
+    for (const AsideFace& face : built->second.aside)
+      if (face.drawType == 2 || face.drawType == 3) placeWireFace(face, at);
+      else placeLightFace(face, at);
     for (int mesh : built->second.meshes) {
       const uint64_t triangles = scene_.meshes[size_t(mesh)].triangleCount();
       triangles_ += triangles;
@@ -751,24 +753,25 @@ class Reader {
     bool operator<(const MaterialKey& o) const { return tie() < o.tie(); }
   };
 
-  // A face drawn as lights (draw types 8, 9, 10): a light at each vertex.
-  struct LightFace {
+  // A face drawn as lines (draw types 2, closed, and 3) or lights (8, 9, 10: a light at each
+  // vertex).
+  struct AsideFace {
     std::vector<Vertex> vertices;
     FaceAttributes attributes;
     int drawType = 8;
     Vec3 normal{0, 0, 1};
   };
-  // What a node's own faces make: meshes (built once, placed by every path to the node) and
-  // lights.
+  // What a node's own faces make: meshes (built once, placed by every path to the node), and the
+  // faces drawn as lines or lights.
   struct Built {
     std::vector<int> meshes;
-    std::vector<LightFace> lights;
+    std::vector<AsideFace> aside;
   };
 
   Built build(uint32_t index) {
     std::map<MaterialKey, Mesh> buckets;
     Built out;
-    gatherFaces(index, buckets, out.lights, 0);
+    gatherFaces(index, buckets, out.aside, 0);
     for (auto& [key, mesh] : buckets) {
       if (mesh.indices.empty()) continue;
       mesh.name = nodes_[index].name;
@@ -780,15 +783,15 @@ class Reader {
   }
 
   void gatherFaces(uint32_t index, std::map<MaterialKey, Mesh>& buckets,
-                   std::vector<LightFace>& lights, int depth) {
+                   std::vector<AsideFace>& aside, int depth) {
     if (depth > kMaxDepth) fail(fmt::format("subfaces nest deeper than {} levels", kMaxDepth));
     for (uint32_t child : nodes_[index].children) {
       const Record& r = records_[nodes_[child].record];
       if (r.op == kFace) {
-        addFace(child, buckets, lights);
-        gatherFaces(child, buckets, lights, depth + 1);  // subfaces
+        addFace(child, buckets, aside);
+        gatherFaces(child, buckets, aside, depth + 1);  // subfaces
       } else if (r.op == kMesh) {
-        addMesh(child, buckets, lights);
+        addMesh(child, buckets, aside);
       }
     }
   }
@@ -873,7 +876,7 @@ class Reader {
   }
 
   void addFace(uint32_t index, std::map<MaterialKey, Mesh>& buckets,
-               std::vector<LightFace>& lights) {
+               std::vector<AsideFace>& aside) {
     const Node& node = nodes_[index];
     const Record& r = records_[node.record];
     Fields f(r);
@@ -884,21 +887,17 @@ class Reader {
     if (hidden) return;
     std::vector<Vertex> vertices = faceVertices(node);
     bake(node, vertices);
-    if (drawnAside(drawType, vertices, a, lights, "wireframe face")) return;
+    if (drawnAside(drawType, vertices, a, aside)) return;
     if (vertices.size() < 3) return;
     addPolygon(vertices, triangulate(vertices), a, buckets);
   }
 
-  // Draw types that are not polygons: wireframes (2, 3), counted as `wireframe` records not drawn;
-  // lights (8–10), kept for placeLightFace. True when `v` went either way.
-  bool drawnAside(int drawType, const std::vector<Vertex>& v, const FaceAttributes& a,
-                  std::vector<LightFace>& lights, const char* wireframe) {
-    if (drawType == 2 || drawType == 3) {
-      ++skipped_[wireframe];
-      return true;
-    }
-    if (drawType >= 8 && drawType <= 10) {
-      lights.push_back({v, a, drawType, newellNormal(v)});
+  // Draw types that are not polygons: wireframes (2, 3) and lights (8–10), kept for placeGeometry.
+  // True when `v` went aside.
+  static bool drawnAside(int drawType, const std::vector<Vertex>& v, const FaceAttributes& a,
+                         std::vector<AsideFace>& aside) {
+    if (drawType == 2 || drawType == 3 || (drawType >= 8 && drawType <= 10)) {
+      aside.push_back({v, a, drawType, newellNormal(v)});
       return true;
     }
     return false;
@@ -976,7 +975,7 @@ class Reader {
 
   // A mesh record: its local vertex pool and primitives.
   void addMesh(uint32_t index, std::map<MaterialKey, Mesh>& buckets,
-               std::vector<LightFace>& lights) {
+               std::vector<AsideFace>& aside) {
     const Node& node = nodes_[index];
     Fields f(records_[node.record]);
     f.need(52, "mesh");
@@ -1011,7 +1010,7 @@ class Reader {
                              r.at, i, pool.size()));
           v[k] = pool[i];
         }
-        if (drawnAside(drawType, v, a, lights, "wireframe mesh")) continue;
+        if (drawnAside(drawType, v, a, aside)) continue;
         std::vector<uint32_t> tri;
         switch (type) {
           case 1:  // triangle strip, every other triangle turned to keep the winding
@@ -1070,7 +1069,7 @@ class Reader {
 
   // One light per vertex of a light-drawn face: omnidirectional (8), or shining along the vertex
   // normal (the face's without one) one way (9) or both ways (10), in the vertex or face colour.
-  void placeLightFace(const LightFace& face, const Place& at) {
+  void placeLightFace(const AsideFace& face, const Place& at) {
     LightAppearance look;
     look.directional = face.drawType != 8;
     look.backLobe = face.drawType == 10;
@@ -1079,6 +1078,30 @@ class Reader {
       const Vec3 n = v.normal && isFinite(*v.normal) && length(*v.normal) > 0 ? *v.normal
                                                                             : face.normal;
       addLight(look, {c.x, c.y, c.z}, n, v, at);
+    }
+  }
+
+  // A wireframe face: a line along each edge, the last vertex back to the first when closed
+  // (draw type 2), in the vertex colours (averaged) or the face's colour.
+  void placeWireFace(const AsideFace& face, const Place& at) {
+    const std::vector<Vertex>& v = face.vertices;
+    const size_t n = v.size();
+    const size_t edges = n < 2 ? 0 : face.drawType == 2 && n > 2 ? n : n - 1;
+    if (scene_.lines.size() + edges > kMaxLines)
+      fail(fmt::format("more than {} line segments", kMaxLines));
+    auto point = [&](const Vertex& x) {
+      const Vec3 p = at.toWorld.transformPoint({float(x.p[0]), float(x.p[1]), float(x.p[2])});
+      if (!isFinite(p)) fail("a wireframe vertex's position is not finite");
+      return p;
+    };
+    auto color = [&](const Vertex& x) {
+      const Vec4 c = face.attributes.vertexColors && x.color ? *x.color : face.attributes.color;
+      return Vec3{c.x, c.y, c.z};
+    };
+    for (size_t k = 0; k < edges; ++k) {
+      const Vertex& a = v[k];
+      const Vertex& b = v[(k + 1) % n];
+      scene_.lines.push_back({point(a), point(b), (color(a) + color(b)) * 0.5f});
     }
   }
 
@@ -1223,7 +1246,7 @@ class Reader {
   std::map<int32_t, std::string> textureFiles_;
   std::unordered_map<uint32_t, uint32_t> vertexAt_;  // palette offset → record
   std::map<int16_t, uint32_t> definitions_;          // instance definitions → node
-  std::map<uint32_t, Built> builtOf_;                // node → its meshes and lights, built once
+  std::map<uint32_t, Built> builtOf_;                // node → its meshes and aside faces, built once
   std::map<std::tuple<std::string, float, float, float, float, float, float, float, bool, bool,
                       float, float>,
            uint32_t>

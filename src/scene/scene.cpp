@@ -130,6 +130,15 @@ Status validateLights(const Scene& scene) {
       !inRange(l.depthBias, 0, 1e6f))
     return fail("lightSettings: a value is not finite or out of range (sizes 0.5 … 64 pixels, "
                 "min ≤ max; punchThrough 0 … 1)");
+  for (size_t i = 0; i < scene.lines.size(); ++i) {
+    const LineSegment& seg = scene.lines[i];
+    if (!isFinite(seg.a) || !isFinite(seg.b) || !inRange(seg.color.x, 0, 1e6f) ||
+        !inRange(seg.color.y, 0, 1e6f) || !inRange(seg.color.z, 0, 1e6f))
+      return fail(fmt::format("lines[{}]: not finite, or a negative colour", i));
+  }
+  if (!inRange(scene.lineSettings.width, 1.0f / 64, 64) ||
+      !inRange(scene.lineSettings.depthBias, 0, 0.5f))
+    return fail("lineSettings: width must be 1/64 … 64 pixels and depthBias 0 … 0.5");
   const StarField& f = scene.stars;
   if (!inRange(f.latitude, -90, 90) || !std::isfinite(f.siderealTime) ||
       !inRange(f.brightness, 0, 1e6f) || !std::isfinite(f.limit))
@@ -350,6 +359,11 @@ void appendArticulationsAndLights(Scene& scene, const Scene& other, const Mat4& 
     p.appearance += appearanceBase;
     if (p.group >= 0) p.group += groupBase;
     scene.lightPoints.push_back(p);
+  }
+  for (LineSegment l : other.lines) {
+    l.a = transform.transformPoint(l.a);
+    l.b = transform.transformPoint(l.b);
+    scene.lines.push_back(l);
   }
 }
 

@@ -74,6 +74,10 @@ scene::Scene richScene() {
   s.fog.enabled = true;
   s.fog.beta = 0.004f;
   s.channels = scene::arcChannels(2, 90, 160, 90);
+  // A wireframe square on the ground, drawn by the line pass.
+  const Vec3 square[4] = {{-4, 0.01f, -10}, {4, 0.01f, -10}, {4, 0.01f, -18}, {-4, 0.01f, -18}};
+  for (int k = 0; k < 4; ++k) s.lines.push_back({square[k], square[(k + 1) % 4], {1, 0.8f, 0.1f}});
+  s.lineSettings.width = 1.5f;
   scene::buildInstanceTree(s);
   return s;
 }
@@ -143,6 +147,12 @@ void expectSameScene(const scene::Scene& a, const scene::Scene& b) {
   for (size_t i = 0; i < a.lightPoints.size(); ++i)
     EXPECT_EQ(a.lightPoints[i].appearance, b.lightPoints[i].appearance);
   EXPECT_EQ(a.lightAppearances.size(), b.lightAppearances.size());
+  ASSERT_EQ(a.lines.size(), b.lines.size());
+  if (!a.lines.empty()) {
+    EXPECT_EQ(0, std::memcmp(a.lines.data(), b.lines.data(),
+                             a.lines.size() * sizeof(scene::LineSegment)));
+  }
+  EXPECT_EQ(a.lineSettings.width, b.lineSettings.width);
   EXPECT_EQ(a.cameras.size(), b.cameras.size());
   EXPECT_EQ(a.channels.size(), b.channels.size());
   EXPECT_EQ(a.fog.beta, b.fog.beta);
@@ -249,9 +259,9 @@ TEST(Database, RefusesDamagedFiles) {
   flipped[200] ^= 4;
   EXPECT_EQ(error(flipped), "database is damaged (its checksum does not match)");
   std::string newer = good;
-  newer[8] = 2;
+  newer[8] = 3;
   EXPECT_EQ(error(newer),
-            "database version 2, this synthvis reads version 1 (run `synthvis prep` again on the "
+            "database version 3, this synthvis reads version 2 (run `synthvis prep` again on the "
             "source)");
   EXPECT_EQ(error("glTF" + good), "not a synthvis database (no SVDB header)");
   EXPECT_EQ(error(""), "not a synthvis database (empty file)");

@@ -70,6 +70,43 @@ endsolid t
   EXPECT_EQ(s->triangleCount(), 2u);
 }
 
+// AC3D's line surfaces (type 1 closed, 2 open) become line segments in the material's colour.
+TEST(Assimp, ReadsLines) {
+  TempDir dir;
+  const std::string ac = dir.write("lines.ac", R"(AC3Db
+MATERIAL "green" rgb 0 1 0  amb 0.2 0.2 0.2  emis 0 0 0  spec 0.5 0.5 0.5  shi 10  trans 0
+OBJECT world
+kids 1
+OBJECT poly
+name "outline"
+numvert 4
+0 0 0
+2 0 0
+2 1 0
+0 1 0
+numsurf 2
+SURF 0x1
+mat 0
+refs 4
+0 0 0
+1 0 0
+2 0 0
+3 0 0
+SURF 0x2
+mat 0
+refs 2
+0 0 0
+2 0 0
+kids 0
+)");
+  Result<Scene> r = loadScene(ac);
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  EXPECT_TRUE(r->warnings.empty()) << r->warnings[0];
+  ASSERT_EQ(r->lines.size(), 4u + 1u);
+  for (const LineSegment& l : r->lines) EXPECT_NEAR(l.color.y, 1, 1e-6);
+  EXPECT_NEAR(r->lines[4].b.x, 2, 1e-6);  // the open line, vertex 0 to vertex 2
+}
+
 TEST(Assimp, ItsFailuresAreOneLineNamingTheFile) {
   TempDir dir;
   const std::string bad = dir.write("bad.3ds", "garbage that is not a model");

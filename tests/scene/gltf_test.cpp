@@ -236,13 +236,16 @@ TEST(Gltf, WalksOnlyTheDefaultScene) {
   EXPECT_EQ(r->meshes.size(), 1u);
 }
 
-TEST(Gltf, ConvertsStripsAndFansPointsToLightsAndNamesLines) {
+TEST(Gltf, ConvertsStripsFansLinesAndPoints) {
   GltfBuilder b;
   int positions = b.addPositions({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 2, 0, 0});
   b.addNode({{"mesh", b.addMesh({{"attributes", {{"POSITION", positions}}}, {"mode", 5}})}});
   b.addNode({{"mesh", b.addMesh({{"attributes", {{"POSITION", positions}}}, {"mode", 6}})}});
   b.addNode({{"mesh", b.addMesh({{"attributes", {{"POSITION", positions}}}, {"mode", 1}})}});
   b.addNode({{"mesh", b.addMesh({{"attributes", {{"POSITION", positions}}}, {"mode", 0}})}});
+  b.addNode({{"mesh", b.addMesh({{"attributes", {{"POSITION", positions}}}, {"mode", 3}})},
+             {"translation", {0, 0, 5}}});
+  b.addNode({{"mesh", b.addMesh({{"attributes", {{"POSITION", positions}}}, {"mode", 2}})}});
   Result<Scene> r = load(b);
   ASSERT_TRUE(r.ok()) << r.error().str();
   ASSERT_EQ(r->meshes.size(), 2u);
@@ -250,15 +253,39 @@ TEST(Gltf, ConvertsStripsAndFansPointsToLightsAndNamesLines) {
   EXPECT_EQ(r->meshes[0].indices, (std::vector<uint32_t>{0, 1, 2, 2, 1, 3, 2, 3, 4}));
   // Fan: (0 1 2), (0 2 3), (0 3 4).
   EXPECT_EQ(r->meshes[1].indices, (std::vector<uint32_t>{0, 1, 2, 0, 2, 3, 0, 3, 4}));
-  // The lines are named, never silently dropped; the five points are light points.
-  ASSERT_EQ(r->warnings.size(), 1u);
-  EXPECT_EQ(r->warnings[0],
-            "t.gltf: meshes[2].primitives[0]: lines are not drawn (only triangles and points are)");
+  EXPECT_TRUE(r->warnings.empty());
+  // Lines (0 1) (2 3), the fifth vertex unpaired; the strip's 4 segments, placed by its node;
+  // the loop's 5 (closed).
+  ASSERT_EQ(r->lines.size(), 2u + 4u + 5u);
+  expectNear(r->lines[1].a, {0, 1, 0});
+  expectNear(r->lines[1].b, {1, 1, 0});
+  expectNear(r->lines[2].a, {0, 0, 5});
+  expectNear(r->lines[5].b, {2, 0, 5});
+  expectNear(r->lines[10].a, {2, 0, 0});
+  expectNear(r->lines[10].b, {0, 0, 0});
+  // The five points are light points.
   ASSERT_EQ(r->lightPoints.size(), 5u);
   EXPECT_FLOAT_EQ(r->lightPoints[3].position.x, 1);
   EXPECT_FLOAT_EQ(r->lightPoints[3].position.y, 1);
   ASSERT_EQ(r->lightAppearances.size(), 1u);
   EXPECT_FALSE(r->lightAppearances[0].directional);
+}
+
+// A line's colour: its two vertices' colours averaged, times the material's base colour.
+TEST(Gltf, ColoursLinesByVertexAndMaterial) {
+  GltfBuilder b;
+  const int positions = b.addPositions({0, 0, 0, 1, 0, 0});
+  const int colors = b.addAccessor(std::vector<float>{1, 0, 0, 1, 0, 1, 0, 1}, 5126, "VEC4", 2);
+  b.doc["materials"] = {{{"pbrMetallicRoughness", {{"baseColorFactor", {1, 0.5, 1, 1}}}}}};
+  b.addNode({{"mesh", b.addMesh({{"attributes", {{"POSITION", positions}, {"COLOR_0", colors}}},
+                                 {"mode", 1},
+                                 {"material", 0}})}});
+  Result<Scene> r = load(b);
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  ASSERT_EQ(r->lines.size(), 1u);
+  EXPECT_FLOAT_EQ(r->lines[0].color.x, 0.5f);
+  EXPECT_FLOAT_EQ(r->lines[0].color.y, 0.25f);
+  EXPECT_FLOAT_EQ(r->lines[0].color.z, 0.0f);
 }
 
 // Never silently empty: glTF 1.0 (whose objects are dictionaries) is refused by name, and a file
@@ -269,16 +296,25 @@ TEST(Gltf, NamesWhatItCannotDrawInsteadOfAnEmptyImage) {
   Result<Scene> old = load(b);
   ASSERT_FALSE(old.ok());
   EXPECT_EQ(old.error().str(), "t.gltf: glTF version '1.0' is not supported (glTF 2.0 only)");
-  GltfBuilder lines;
-  const int positions = lines.addPositions({0, 0, 0, 1, 0, 0});
-  lines.addNode({{"mesh", lines.addMesh({{"attributes", {{"POSITION", positions}}}, {"mode", 1}})}});
+  GltfBuilder empty;
+  const int positions = empty.addPositions({0, 0, 0, 1, 0, 0});
+  // Two points make one degenerate triangle-less primitive: nothing to draw.
+  empty.addNode({{"mesh", empty.addMesh({{"attributes", {{"POSITION", positions}}}, {"mode", 4}})}});
   testing::TempDir dir;
-  const std::string path = dir.write("lines.gltf", lines.gltf());
+  const std::string path = dir.write("empty.gltf", empty.gltf());
   Result<Scene> r = loadScene(path);
   ASSERT_TRUE(r.ok()) << r.error().str();
-  ASSERT_EQ(r->warnings.size(), 2u);
-  EXPECT_TRUE(testing::contains(r->warnings[0], "lines are not drawn"));
-  EXPECT_EQ(r->warnings[1], path + ": nothing to draw");
+  ASSERT_EQ(r->warnings.size(), 1u);
+  EXPECT_EQ(r->warnings[0], path + ": nothing to draw");
+  // A file of lines alone draws them: no warning.
+  GltfBuilder lines;
+  const int ends = lines.addPositions({0, 0, 0, 1, 0, 0});
+  lines.addNode({{"mesh", lines.addMesh({{"attributes", {{"POSITION", ends}}}, {"mode", 1}})}});
+  const std::string linesPath = dir.write("lines.gltf", lines.gltf());
+  r = loadScene(linesPath);
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  EXPECT_TRUE(r->warnings.empty());
+  EXPECT_EQ(r->lines.size(), 1u);
 }
 
 TEST(Gltf, ReadsNormalizedIntegerColoursAndTexcoords) {

@@ -120,6 +120,23 @@ TEST(GltfWriter, TexturesWrapModesAndUvScaleRoundTrip) {
   }
 }
 
+// Lines go out as one LINES primitive in world coordinates and come back as the same segments.
+TEST(GltfWriter, LinesRoundTrip) {
+  Scene s = generateTris({});
+  s.lines = {{{0, 0, 0}, {1, 2, 3}, {1, 0, 0}}, {{-1, 0, 5}, {0, 4, 5}, {0.5f, 0.25f, 1}}};
+  const std::string path = tempPath("lines.glb");
+  ASSERT_TRUE(saveGltf(s, path).ok());
+  Result<Scene> r = loadGltf(path);
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  ASSERT_EQ(r->lines.size(), 2u);
+  for (size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(r->lines[i].a, s.lines[i].a);
+    EXPECT_EQ(r->lines[i].b, s.lines[i].b);
+    EXPECT_EQ(r->lines[i].color, s.lines[i].color);
+  }
+  EXPECT_EQ(r->triangleCount(), s.triangleCount());
+}
+
 TEST(GltfWriter, RefusesOtherExtensions) {
   const Status st = saveGltf(generateTris({}), tempPath("x.obj"));
   ASSERT_FALSE(st.ok());

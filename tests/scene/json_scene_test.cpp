@@ -121,6 +121,23 @@ TEST(JsonScene, DefaultsMatchTheSceneTypes) {
   EXPECT_EQ(r->light.direction, Light{}.direction);
 }
 
+// "lines": polylines (open, and closed back to their first point) and the settings.
+TEST(JsonScene, ReadsPolylines) {
+  Result<Scene> r = parse(R"({"synthvis": 1, "lines": {"width": 2, "depthBias": 0.01,
+      "polylines": [{"points": [[0, 0, 0], [1, 0, 0], [1, 1, 0]], "color": [1, 0, 0]},
+                    {"points": [[0, 0, 5], [1, 0, 5], [1, 1, 5]], "closed": true}]}})");
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  ASSERT_EQ(r->lines.size(), 2u + 3u);
+  EXPECT_EQ(r->lines[1].a, (Vec3{1, 0, 0}));
+  EXPECT_EQ(r->lines[1].b, (Vec3{1, 1, 0}));
+  EXPECT_EQ(r->lines[0].color, (Vec3{1, 0, 0}));
+  EXPECT_EQ(r->lines[4].a, (Vec3{1, 1, 5}));
+  EXPECT_EQ(r->lines[4].b, (Vec3{0, 0, 5}));
+  EXPECT_EQ(r->lines[4].color, (Vec3{1, 1, 1}));
+  EXPECT_EQ(r->lineSettings.width, 2);
+  EXPECT_FLOAT_EQ(r->lineSettings.depthBias, 0.01f);
+}
+
 TEST(JsonScene, ReadsACameraList) {
   Result<Scene> r =
       parse(R"({"synthvis": 1, "cameras": [{"name": "a"}, {"name": "b", "yfov": 30}]})");
@@ -384,6 +401,11 @@ TEST(JsonScene, RejectsEachMalformedClassWithAClearMessage) {
        "objects[0].mesh: expected a file path, got an empty string"},
       {R"({"synthvis": 1, "objects": [{"mesh": "model.fbx"}]})",
        "objects[0].mesh: cannot open 'model.fbx'"},
+      {R"({"synthvis": 1, "lines": {"polylines": [{"points": [[0, 0, 0]]}]}})",
+       "lines.polylines[0].points: a polyline needs at least 2 points"},
+      {R"({"synthvis": 1, "lines": {"width": 0}})", "lines.width: "},
+      {R"({"synthvis": 1, "lines": {"polylines": [{"color": [1, 0, 0]}]}})",
+       "lines.polylines[0]: missing key 'points'"},
   };
   for (const Row& row : rows) {
     SCOPED_TRACE(row.text);

@@ -83,6 +83,27 @@ TEST(Obj, ReadsVertexColours) {
   EXPECT_EQ(r->meshes[0].colors[1], (Vec4{0, 1, 0, 1}));
 }
 
+// `l` elements: each polyline's consecutive pairs, in the vertex colours averaged.
+TEST(Obj, ReadsLinesAsSegments) {
+  Result<Scene> r = parseObj(
+      "v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\nl 1 2 3\nl 3 1\nf 1 2 3\n", "l.obj");
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  EXPECT_EQ(r->triangleCount(), 1u);
+  ASSERT_EQ(r->lines.size(), 3u);
+  EXPECT_EQ(r->lines[1].a, (Vec3{1, 0, 0}));
+  EXPECT_EQ(r->lines[1].b, (Vec3{0, 1, 0}));
+  EXPECT_EQ(r->lines[0].color, (Vec3{0.5f, 0.5f, 0}));
+  EXPECT_EQ(r->lines[2].b, (Vec3{0, 0, 0}));
+  Result<Scene> withPoints = parseObj("v 0 0 0\nv 1 0 0\np 1 2\nl 1 2\n", "p.obj");
+  ASSERT_TRUE(withPoints.ok()) << withPoints.error().str();
+  ASSERT_EQ(withPoints->warnings.size(), 1u);
+  EXPECT_EQ(withPoints->warnings[0], "p.obj: 2 points (`p`) are not drawn (only faces and lines are)");
+  Result<Scene> bad = parseObj("v 0 0 0\nl 1 7\n", "bad.obj");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_TRUE(contains(bad.error().str(), "line 1 uses vertex 7, but there are 1 vertices"))
+      << bad.error().str();
+}
+
 TEST(Obj, RejectsAFaceIndexPastTheVertices) {
   expectLoadError("scene/bad_index.obj",
                   "shape '': face 1 uses vertex 4, but there are 3 vertices");

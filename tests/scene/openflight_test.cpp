@@ -305,8 +305,8 @@ TEST(OpenFlight, InstancesAndExternalReferences) {
   EXPECT_EQ(l.error().str(), loopPath + ": external reference 'loop.flt' refers back to itself");
 }
 
-// Faces drawn as lights (draw types 8–10) become light points; wireframe faces are named in a
-// warning; hidden faces are not drawn.
+// Faces drawn as lights (draw types 8–10) become light points; wireframe faces (2 closed, 3 open)
+// lines along their edges; hidden faces are not drawn.
 TEST(OpenFlight, LightFacesWireframesAndHiddenFaces) {
   FltWriter w;
   w.header();
@@ -318,7 +318,8 @@ TEST(OpenFlight, LightFacesWireframesAndHiddenFaces) {
   w.object("o");
   w.push();
   w.polygon(Face().draw(10).rgb(0xFF00FF00u), v);  // two-way green lights
-  w.polygon(Face().draw(3), v);
+  w.polygon(Face().draw(3).rgb(0xFFFF0000u), v);
+  w.polygon(Face().draw(2), v);
   w.polygon(Face().hide(), v);
   w.polygon({}, v);
   w.pop();
@@ -332,8 +333,15 @@ TEST(OpenFlight, LightFacesWireframesAndHiddenFaces) {
   EXPECT_TRUE(a.backLobe);
   EXPECT_FLOAT_EQ(a.color.y, 1);
   EXPECT_NEAR(a.direction.z, 1, 1e-6);  // OpenFlight −y (south) is synthvis +z
-  ASSERT_EQ(r->warnings.size(), 1u);
-  EXPECT_EQ(r->warnings[0], "lights.flt: 1 wireframe face record not drawn");
+  EXPECT_TRUE(r->warnings.empty());
+  // The open wireframe's 2 edges in its colour, then the closed one's 3.
+  ASSERT_EQ(r->lines.size(), 5u);
+  EXPECT_FLOAT_EQ(r->lines[0].color.z, 1);  // packed ABGR: 0xFFFF0000 is blue
+  EXPECT_FLOAT_EQ(r->lines[0].color.x, 0);
+  EXPECT_NEAR(r->lines[1].b.y, 0, 1e-6);   // (0.5, 1, 0) in OpenFlight: z-up → y-up is (x, z, −y)
+  EXPECT_NEAR(r->lines[1].b.z, -1, 1e-6);
+  EXPECT_NEAR(r->lines[4].a.x, 0.5, 1e-6);  // the closing edge, back to the first vertex
+  EXPECT_NEAR(r->lines[4].b.x, 0, 1e-6);
 }
 
 // Malformed files: one line naming the file and the problem.
