@@ -11,6 +11,8 @@
 
 #include <bit>
 #include <cerrno>
+#include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <memory>
@@ -20,6 +22,7 @@
 
 #include "scene/database.h"
 #include "scene/loader_common.h"
+#include "terrain/ground.h"
 #include "texture/texture.h"
 
 namespace sv::scene {
@@ -185,10 +188,87 @@ DofMotion getMotion(Reader& r) {
   return m;
 }
 
+// Terrain: the height table (its codes and placement) and how the scene draws it. The pyramid is
+// not stored: it is built on load, as the other loaders build it (part of loading, not of the
+// first frame).
+void put(Writer& w, const Terrain& t) {
+  w.str(t.name);
+  const terrain::HeightField& f = t.ground->field;
+  w.pod(int32_t(f.width)), w.pod(int32_t(f.height));
+  w.pod(f.originU), w.pod(f.originV), w.pod(f.spacingU), w.pod(f.spacingV);
+  w.pod(f.offset), w.pod(f.scale);
+  w.str(f.source);
+  const auto& g = f.geographic;
+  w.pod(uint8_t(g.on)), w.pod(g.lon0), w.pod(g.lat0), w.pod(g.dLon), w.pod(g.dLat);
+  w.pod(g.radiansPerUnit);
+  w.array(f.q);
+  w.pod(t.origin[0]), w.pod(t.origin[1]), w.pod(t.baseRadius), w.pod(uint8_t(t.bicubic));
+  w.pod(int32_t(t.material)), w.pod(int32_t(t.image));
+  for (double b : t.imageBounds) w.pod(b);
+  w.pod(int32_t(t.detail)), w.pod(t.detailSize);
+  w.pod(uint64_t(t.ramp.size()));
+  for (const TerrainColorStop& c : t.ramp) w.pod(c.height), w.pod(c.color);
+}
+Terrain getTerrain(Reader& r, const Scene& s, uint64_t& texels, const LoadOptions& options) {
+  Terrain t;
+  t.name = r.str("terrain");
+  terrain::HeightField f;
+  f.width = r.pod<int32_t>("terrain"), f.height = r.pod<int32_t>("terrain");
+  if (f.width < 2 || f.height < 2 || f.width > 16384 || f.height > 16384)
+    fail(fmt::format("terrain '{}': a {}×{} table (2 … 16384 a side)", t.name, f.width, f.height));
+  f.originU = r.pod<double>("terrain"), f.originV = r.pod<double>("terrain");
+  f.spacingU = r.pod<double>("terrain"), f.spacingV = r.pod<double>("terrain");
+  f.offset = r.pod<double>("terrain"), f.scale = r.pod<double>("terrain");
+  f.source = r.str("terrain");
+  auto& g = f.geographic;
+  g.on = r.pod<uint8_t>("terrain"), g.lon0 = r.pod<double>("terrain");
+  g.lat0 = r.pod<double>("terrain"), g.dLon = r.pod<double>("terrain");
+  g.dLat = r.pod<double>("terrain"), g.radiansPerUnit = r.pod<double>("terrain");
+  f.q = r.array<uint16_t>("terrain heights");
+  if (f.q.size() != size_t(f.width) * size_t(f.height))
+    fail(fmt::format("terrain '{}': {} heights for a {}×{} table", t.name, f.q.size(), f.width,
+                     f.height));
+  texels += f.q.size();
+  if (texels > options.maxTexels)
+    fail(fmt::format("the textures and terrains exceed {} texels", options.maxTexels));
+  t.origin[0] = r.pod<double>("terrain"), t.origin[1] = r.pod<double>("terrain");
+  t.baseRadius = r.pod<double>("terrain"), t.bicubic = r.pod<uint8_t>("terrain");
+  t.material = r.pod<int32_t>("terrain"), t.image = r.pod<int32_t>("terrain");
+  for (double& b : t.imageBounds) b = r.pod<double>("terrain");
+  t.detail = r.pod<int32_t>("terrain"), t.detailSize = r.pod<double>("terrain");
+  for (size_t k = r.count("terrain ramp", 20); k > 0; --k) {
+    TerrainColorStop c;
+    c.height = r.pod<double>("terrain ramp"), c.color = r.pod<Vec3>("terrain ramp");
+    t.ramp.push_back(c);
+  }
+  // What the renderer relies on, as the scene file's reader checks it.
+  auto finite = [](std::initializer_list<double> v) {
+    for (double x : v)
+      if (!std::isfinite(x) || std::fabs(x) > 1e30) return false;
+    return true;
+  };
+  const int textures = int(s.textures.size()), materials = int(s.materials.size());
+  bool ok = finite({f.originU, f.originV, f.spacingU, f.spacingV, f.offset, f.scale, t.origin[0],
+                    t.origin[1], t.baseRadius, t.detailSize, t.imageBounds[0], t.imageBounds[1],
+                    t.imageBounds[2], t.imageBounds[3]}) &&
+            f.spacingU > 0 && f.spacingV > 0 && t.baseRadius >= 0 && t.detailSize > 0 &&
+            t.imageBounds[2] > t.imageBounds[0] && t.imageBounds[3] > t.imageBounds[1] &&
+            t.material >= -1 && t.material < materials && t.image >= -1 && t.image < textures &&
+            t.detail >= -1 && t.detail < textures && t.ramp.size() <= 64;
+  for (size_t k = 0; k < t.ramp.size(); ++k)
+    ok &= finite({t.ramp[k].height}) && isFinite(t.ramp[k].color) &&
+          (k == 0 || t.ramp[k].height > t.ramp[k - 1].height);
+  if (!ok) fail(fmt::format("terrain '{}': a value is not finite or out of range", t.name));
+  auto ground = std::make_shared<terrain::Ground>(std::move(f));
+  const auto start = std::chrono::steady_clock::now();
+  ground->pyramid(t.bicubic ? terrain::Interpolation::bicubic : terrain::Interpolation::bilinear);
+  ground->loadMs =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  t.ground = std::move(ground);
+  return t;
+}
+
 std::string encode(const Scene& s) {
-  if (!s.terrains.empty())
-    fail("terrain is not stored in a prepared database (prepare the polygons, and keep the "
-         "terrain in a scene file that references the database)");
   Writer w;
   // Structures with padding or bools go field by field (the file's bytes are all defined, and
   // every bool read back is 0 or 1).
@@ -247,6 +327,8 @@ std::string encode(const Scene& s) {
     w.array(s.instanceTree->nodes), w.array(s.instanceTree->order);
     w.array(s.instanceTree->loose), w.pod(uint64_t(s.instanceTree->instanceCount));
   }
+  w.pod(uint64_t(s.terrains.size()));
+  for (const Terrain& t : s.terrains) put(w, t);
   w.pod(uint64_t(s.freeForms.size()));
   for (const FreeFormObject& f : s.freeForms) {
     w.str(f.name), put(w, f.form), w.pod(f.transform), w.pod(int32_t(f.material));
@@ -378,6 +460,9 @@ Scene decode(const char* data, size_t size, const LoadOptions& options) {
       if (i >= s.instances.size()) fail("instance tree: an instance out of range");
     s.instanceTree = std::move(tree);
   }
+  const size_t terrains = r.count("terrains", 120);
+  if (terrains > 64) fail(fmt::format("{} terrains (at most 64)", terrains));
+  for (size_t k = 0; k < terrains; ++k) s.terrains.push_back(getTerrain(r, s, texels, options));
   for (size_t k = r.count("free forms", 100); k > 0; --k) {
     FreeFormObject f;
     f.name = r.str("free form"), f.form = getFreeForm(r, 0);

@@ -14,6 +14,8 @@
 
 #include "scene/flt_writer.h"
 #include "scene/primitives.h"
+#include "synthvis/generators.h"
+#include "terrain/ground.h"
 #include "synthvis/render.h"
 #include "synthvis/scene.h"
 
@@ -265,10 +267,36 @@ TEST(Database, RefusesDamagedFiles) {
             "source)");
   EXPECT_EQ(error("glTF" + good), "not a synthvis database (no SVDB header)");
   EXPECT_EQ(error(""), "not a synthvis database (empty file)");
-  // Terrain is not stored: an error, not a silent omission.
-  scene::Scene withTerrain = s;
-  withTerrain.terrains.emplace_back();
-  EXPECT_FALSE(scene::saveDatabase(withTerrain, db.path).ok());
+  // A terrain whose draped image does not exist is refused on load, by name.
+  Result<scene::Scene> terrain = scene::generateTerrain({.size = 65});
+  ASSERT_TRUE(terrain.ok()) << terrain.error().str();
+  terrain->terrains[0].name = "hills";
+  terrain->terrains[0].image = 7;
+  ASSERT_TRUE(scene::saveDatabase(terrain.value(), db.path).ok());
+  Result<scene::Scene> bad = scene::loadScene(db.path);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_EQ(bad.error().str().substr(db.path.size() + 2),
+            "database: terrain 'hills': a value is not finite or out of range");
+}
+
+// Terrain is stored with its table and how it is drawn; the pyramid is built on load. The frame
+// is the same, for both filters.
+TEST(Database, HoldsTerrainAndDrawsItTheSame) {
+  for (bool bicubic : {false, true}) {
+    Result<scene::Scene> s = scene::generateTerrain({.size = 257, .seed = 3, .bicubic = bicubic});
+    ASSERT_TRUE(s.ok()) << s.error().str();
+    TempFile db("terrain.svdb");
+    ASSERT_TRUE(scene::saveDatabase(s.value(), db.path).ok());
+    Result<scene::Scene> back = scene::loadScene(db.path);
+    ASSERT_TRUE(back.ok()) << back.error().str();
+    ASSERT_EQ(back->terrains.size(), 1u);
+    const scene::Terrain &a = s->terrains[0], &b = back->terrains[0];
+    EXPECT_EQ(a.ground->field.q, b.ground->field.q);
+    EXPECT_EQ(a.ground->field.spacingU, b.ground->field.spacingU);
+    EXPECT_EQ(a.bicubic, b.bicubic);
+    EXPECT_EQ(a.image, b.image);
+    EXPECT_EQ(render(s.value(), true), render(back.value(), true)) << bicubic;
+  }
 }
 
 }  // namespace
