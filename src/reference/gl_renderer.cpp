@@ -116,6 +116,7 @@ std::string glError(const char* what) {
 struct Mesh {
   GLuint vao = 0, buffers[5] = {};
   GLsizei indexCount = 0;
+  GLenum mode = GL_TRIANGLES;  // GL_LINES: the scene's lines
   bool hasNormals = false, hasColors = false, hasUvs = false;
 };
 
@@ -140,6 +141,7 @@ struct GlRenderer::Impl {
   GLuint program = 0;
   GLuint pointProgram = 0, pointVao = 0, pointBuffer = 0;
   GLsizei pointCount = 0;
+  float lineWidth = 1;
   GLuint fbo = 0, colorRb = 0, depthRb = 0;  // the render target (multisampled if msaa)
   GLuint resolveFbo = 0, resolveRb = 0;      // single-sampled copy for readback (msaa)
   GLint uMvp = -1, uNormal = -1, uBase = -1, uToLight = -1, uLightColor = -1, uAmbient = -1,
@@ -372,8 +374,23 @@ Status GlRenderer::load(const scene::Scene& scene) {
   if (!view.ok()) return view.error();
   g.freeMeshes();
   g.draws.clear();
-  for (const scene::Mesh& m : scene.meshes) {
+  // The scene's lines as one mesh of GL lines in world coordinates, each segment's colour on its
+  // two ends; drawn unlit (GL's own wide lines: not synthvis's strips — the reference).
+  scene::Mesh lines;
+  for (const scene::LineSegment& l : scene.lines) {
+    lines.positions.insert(lines.positions.end(), {l.a, l.b});
+    const Vec4 c{l.color.x, l.color.y, l.color.z, 1};
+    lines.colors.insert(lines.colors.end(), {c, c});
+    lines.indices.insert(lines.indices.end(),
+                         {uint32_t(lines.indices.size()), uint32_t(lines.indices.size() + 1)});
+  }
+  std::vector<const scene::Mesh*> meshes;
+  for (const scene::Mesh& m : scene.meshes) meshes.push_back(&m);
+  if (!scene.lines.empty()) meshes.push_back(&lines);
+  for (const scene::Mesh* mp : meshes) {
+    const scene::Mesh& m = *mp;
     Mesh out;
+    if (mp == &lines) out.mode = GL_LINES;
     glGenVertexArrays(1, &out.vao);
     glGenBuffers(5, out.buffers);
     glBindVertexArray(out.vao);
@@ -488,6 +505,20 @@ Status GlRenderer::load(const scene::Scene& scene) {
     d.cull = g.options.cullBackFaces && !mat.doubleSided;
     g.draws.push_back(d);
   }
+  if (!scene.lines.empty()) {
+    Draw d{};
+    d.mesh = g.meshes.size() - 1;
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r) {
+        d.mvp[c * 4 + r] = camera.value().m[c][r];
+        d.modelView[c * 4 + r] = view.value().m[c][r];
+      }
+    for (int c = 0; c < 3; ++c) d.normalToWorld[c * 3 + c] = 1;
+    for (float& b : d.baseColor) b = 1;
+    d.uvScale[0] = d.uvScale[1] = 1;
+    g.draws.push_back(d);
+    g.lineWidth = scene.lineSettings.width;
+  }
   const Vec3 toLight = normalize(-scene.light.direction);
   g.toLight[0] = toLight.x;
   g.toLight[1] = toLight.y;
@@ -582,7 +613,11 @@ Status GlRenderer::render() {
     if (!m.hasNormals) glVertexAttrib3f(1, 0, 0, 1);
     if (!m.hasColors) glVertexAttrib4f(2, 1, 1, 1, 1);
     if (!m.hasUvs) glVertexAttrib2f(3, 0, 0);
-    glDrawElements(GL_TRIANGLES, m.indexCount, GL_UNSIGNED_INT, nullptr);
+    if (m.mode == GL_LINES) {
+      glLineWidth(g.lineWidth);
+      glGetError();  // a width the implementation does not have: its nearest, as GL clamps
+    }
+    glDrawElements(m.mode, m.indexCount, GL_UNSIGNED_INT, nullptr);
   }
   if (g.pointCount) {
     glUseProgram(g.pointProgram);
