@@ -81,6 +81,8 @@ enum Op : uint16_t {
   kPopAttribute = 123,
   kCurve = 126,
   kRoadConstruction = 127,
+  kLightPointAppearancePalette = 128,
+  kLightPointAnimationPalette = 129,
   kIndexedLightPoint = 130,
   kLightPointSystem = 131,
 };
@@ -107,7 +109,6 @@ const char* unsupportedName(uint16_t op) {
     case kClipRegion: return "clip region";
     case kCat: return "continuously adaptive terrain";
     case kCurve: return "curve";
-    case kIndexedLightPoint: return "indexed light point (light point palettes)";
     default: return nullptr;
   }
 }
@@ -194,6 +195,22 @@ struct FaceAttributes {
   bool blend = false;     // alpha blending asked for (billboard template 1)
 };
 
+// What a light point record (111), or an indexed light point's (130) appearance (128) with its
+// animation (129), says of its lights.
+struct LightLook {
+  std::string name;
+  int32_t directionality = 0;  // 0 omnidirectional, 1 one way, 2 both ways
+  float intensity = 1, backIntensity = 0;
+  float horizontalLobe = 30, verticalLobe = 15, falloff = 1;
+  Vec4 back{1, 1, 1, 1};
+  float period = 0, delay = 0, enabled = 0;  // seconds
+  bool flashing = false, rotating = false;
+};
+struct LightAnimation {
+  float period = 0, delay = 0, enabled = 0;
+  int32_t type = 1;  // 0 flashing sequence, 1 rotating, 2 strobe, 3 Morse code
+};
+
 // What the level of detail above a node says: draw in [near, far) of the range to `center`
 // (given in the space of `fromLod`'s start).
 struct LodContext {
@@ -255,6 +272,10 @@ class Reader {
     for (const auto& [what, count] : skipped_)
       scene_.warnings.push_back(
           fmt::format("{}: {} {} record{} not drawn", path_, count, what, count == 1 ? "" : "s"));
+    if (morse_)
+      scene_.warnings.push_back(fmt::format(
+          "{}: {} light point record{} animated by Morse code drawn steady", path_, morse_,
+          morse_ == 1 ? "" : "s"));
     applyArticulations(scene_);
     if (scene_.lightPoints.size() > kMaxLightPoints)
       fail(fmt::format("more than {} light points", kMaxLightPoints));
@@ -348,6 +369,42 @@ class Reader {
           if (!isFinite(m.diffuse) || !std::isfinite(m.alpha))
             fail(fmt::format("material palette at byte {}: colour is not finite", r.at));
           materials_[f.i32(4)] = m;
+          break;
+        }
+        case kLightPointAppearancePalette: {
+          // What a light point record says, by appearance (OpenFlight 15.8+): intensities, back
+          // colour (a colour index), directionality, lobes.
+          f.need(372, "light point appearance palette");
+          LightLook look;
+          look.name = f.text(8, 256);
+          look.back = indexedColor(f.u32(272));
+          look.intensity = f.f32(280), look.backIntensity = f.f32(284);
+          look.directionality = f.i32(352);
+          look.horizontalLobe = f.f32(356), look.verticalLobe = f.f32(360);
+          look.falloff = f.f32(368);
+          lightLooks_[f.i32(264)] = look;
+          break;
+        }
+        case kLightPointAnimationPalette: {
+          // Rotating (1) and strobe (2) beacons by period, phase delay and time lit; a flashing
+          // sequence (0) by its pulses (lit while on: their on time over their sum); Morse code
+          // (3) is not drawn as such (steady, counted in the warnings).
+          f.need(300, "light point animation palette");
+          LightAnimation a;
+          a.period = f.f32(268), a.delay = f.f32(272), a.enabled = f.f32(276);
+          a.type = f.i32(296);
+          if (a.type == 0 && f.size() >= 1340) {
+            const size_t n = std::min<size_t>(f.u32(1336), (f.size() - 1340) / 12);
+            float total = 0, lit = 0;
+            for (size_t k = 0; k < n; ++k) {
+              const float d = f.f32(1340 + 12 * k + 4);
+              if (!(d >= 0 && d < 1e6f)) continue;
+              total += d;
+              if (f.u32(1340 + 12 * k) != 1) lit += d;  // states: 0 on, 1 off, 2 colour change
+            }
+            a.period = total, a.enabled = lit;
+          }
+          animations_[f.i32(264)] = a;
           break;
         }
         case kTexturePalette:
@@ -533,7 +590,26 @@ class Reader {
       }
       case kLightPoint: {
         f.need(156, "light point");
-        placeLightPoints(index, f, at);
+        placeLightPoints(index, lightLookOf(f), at);
+        return;
+      }
+      case kIndexedLightPoint: {
+        f.need(20, "indexed light point");
+        auto look = lightLooks_.find(f.i32(12));
+        if (look == lightLooks_.end()) {
+          ++skipped_["indexed light point (its appearance not in the palette)"];
+          return;
+        }
+        LightLook l = look->second;
+        auto animation = animations_.find(f.i32(16));
+        if (animation != animations_.end()) {
+          const LightAnimation& a = animation->second;
+          if (a.type == 3) ++morse_;
+          l.flashing = a.type == 0 || a.type == 2;
+          l.rotating = a.type == 1;
+          l.period = a.period, l.delay = a.delay, l.enabled = a.enabled;
+        }
+        placeLightPoints(index, l, at);
         return;
       }
       case kFace:
@@ -1132,7 +1208,22 @@ class Reader {
     scene_.lightPoints.push_back({p, it->second, 0, -1});
   }
 
-  void placeLightPoints(uint32_t index, const Fields& f, const Place& at) {
+  // A light point record (111) as the look its lights share.
+  static LightLook lightLookOf(const Fields& f) {
+    LightLook l;
+    l.back = packedColor(f.u32(16));
+    l.intensity = f.f32(24), l.backIntensity = f.f32(28);
+    l.directionality = f.i32(48);
+    l.horizontalLobe = f.f32(100), l.verticalLobe = f.f32(104), l.falloff = f.f32(112);
+    l.period = f.f32(120), l.delay = f.f32(124), l.enabled = f.f32(128);
+    // Flags bits 13 and 12 (from the most significant): flashing, rotating.
+    const uint32_t flags = f.u32(140);
+    l.flashing = flags & 0x00040000u, l.rotating = flags & 0x00080000u;
+    return l;
+  }
+
+  // A light at each vertex of light point node `index` (a 111 or 130 record), as `l` says.
+  void placeLightPoints(uint32_t index, const LightLook& l, const Place& at) {
     const Node& node = nodes_[index];
     // Each value within what the light pass accepts; one that is not a number gets the default.
     auto sane = [](float v, float lo, float hi, float otherwise) {
@@ -1140,33 +1231,28 @@ class Reader {
     };
     LightAppearance look;
     look.name = node.name;
-    const int32_t directional = f.i32(48);  // 0 omni, 1 one-way, 2 two-way
-    const float intensity = sane(f.f32(24), 0, 1e6f, 1);
-    const float backIntensity = sane(f.f32(28), 0, 1e6f, 0);
-    look.horizontalLobe = sane(f.f32(100), 1, 179, 30);
-    look.verticalLobe = sane(f.f32(104), 1, 179, 15);
-    look.falloff = sane(f.f32(112), 0, 64, 1);
-    const float period = sane(f.f32(120), 0, 1e6f, 0), delay = sane(f.f32(124), -1e6f, 1e6f, 0),
-                enabled = sane(f.f32(128), 0, 1e6f, 0);
-    const uint32_t flags = f.u32(140);
+    const float intensity = sane(l.intensity, 0, 1e6f, 1);
+    const float backIntensity = sane(l.backIntensity, 0, 1e6f, 0);
+    look.horizontalLobe = sane(l.horizontalLobe, 1, 179, 30);
+    look.verticalLobe = sane(l.verticalLobe, 1, 179, 15);
+    look.falloff = sane(l.falloff, 0, 64, 1);
+    const float period = sane(l.period, 0, 1e6f, 0), delay = sane(l.delay, -1e6f, 1e6f, 0),
+                enabled = sane(l.enabled, 0, 1e6f, 0);
     // OpenFlight's intensities are relative (1: the modeller's full brightness); full brightness
     // is taken as the scene format's default light of 200 candela.
     constexpr float kFullCandela = 200;
     look.intensity = kFullCandela * intensity;
-    look.directional = directional == 1 || directional == 2;
-    look.backLobe = directional == 2 && backIntensity > 0;
+    look.directional = l.directionality == 1 || l.directionality == 2;  // 0 omni, 1/2 one/two-way
+    look.backLobe = l.directionality == 2 && backIntensity > 0;
     // The back lobe's colour, dimmed by its intensity relative to the front's.
-    const Vec4 back = packedColor(f.u32(16));
     const float backScale = intensity > 0 ? std::min(1.0f, backIntensity / intensity) : 0;
-    look.backColor = Vec3{back.x, back.y, back.z} * backScale;
-    // Flags bits 13 and 12 (from the most significant): flashing, rotating.
-    const bool flashing = flags & 0x00040000u, rotating = flags & 0x00080000u;
-    if (flashing && period > 0 && enabled > 0) {
+    look.backColor = Vec3{l.back.x, l.back.y, l.back.z} * backScale;
+    if (l.flashing && period > 0 && enabled > 0) {
       look.blink.period = period;
       look.blink.onFraction = std::clamp(enabled / period, 0.01f, 1.0f);
       look.blink.phase = std::fmod(delay / period, 1.0f);
     }
-    if (rotating && period > 0) look.rotationPeriod = period;
+    if (l.rotating && period > 0) look.rotationPeriod = period;
     for (const Vertex& v : faceVertices(node)) {
       const Vec4 c = v.color.value_or(Vec4{1, 1, 1, 1});
       addLight(look, {c.x, c.y, c.z}, v.normal.value_or(Vec3{0, 0, 1}), v, at);
@@ -1243,6 +1329,8 @@ class Reader {
   std::vector<Node> nodes_;
   std::vector<Vec4> colors_;
   std::map<int32_t, FltMaterial> materials_;
+  std::map<int32_t, LightLook> lightLooks_;         // light point appearance palette
+  std::map<int32_t, LightAnimation> animations_;    // light point animation palette
   std::map<int32_t, std::string> textureFiles_;
   std::unordered_map<uint32_t, uint32_t> vertexAt_;  // palette offset → record
   std::map<int16_t, uint32_t> definitions_;          // instance definitions → node
@@ -1254,6 +1342,7 @@ class Reader {
   std::map<int, int> textureByPattern_;
   std::map<MaterialKey, int> materialIndex_;
   std::map<std::string, size_t> skipped_;
+  size_t morse_ = 0;  // indexed light points whose animation is Morse code (drawn steady)
   Mat4 root_, rootInverse_;
   double unitScale_ = 1;
   int emptyMesh_ = -1;

@@ -257,6 +257,30 @@ class FltWriter {
     p.f32(period).f32(0).f32(enabled).to(140 - 4).u32(flashing ? 0x00040000u : 0);
     record(111, p.to(156 - 4));
   }
+  // A light point appearance palette entry (128): directional 0 omni, 1 one-way, 2 two-way.
+  void lightPointAppearance(int32_t index, float intensity, int32_t directional,
+                            uint32_t backColorIndex = 0xFFFFFFFFu, float backIntensity = 0) {
+    Bytes p;
+    p.zeros(4).text("look", 256).i32(index).i16(0).i16(0).u32(backColorIndex).i32(0);
+    p.f32(intensity).f32(backIntensity).to(352 - 4).i32(directional).f32(40).f32(10).f32(0);
+    p.f32(1);
+    record(128, p.to(412 - 4));
+  }
+  // A light point animation palette entry (129): type 0 flashing sequence (pulses: state 0 on,
+  // 1 off, and duration), 1 rotating, 2 strobe, 3 Morse code.
+  void lightPointAnimation(int32_t index, int32_t type, float period, float delay, float enabled,
+                           const std::vector<std::pair<uint32_t, float>>& pulses = {}) {
+    Bytes p;
+    p.zeros(4).text("anim", 256).i32(index).f32(period).f32(delay).f32(enabled);
+    p.f32(0).f32(0).f32(1).u32(0).i32(type).to(1336 - 4).i32(int32_t(pulses.size()));
+    for (const auto& [state, duration] : pulses) p.u32(state).f32(duration).u32(0xFFFFFFFFu);
+    record(129, p);
+  }
+  // An indexed light point (130) of appearance `appearance` and animation `animation` (−1: none).
+  void indexedLightPoint(const std::string& name, int32_t appearance, int32_t animation = -1) {
+    Bytes p;
+    record(130, p.text(name, 8).i32(appearance).i32(animation).i32(0).to(28 - 4));
+  }
 
  private:
   size_t paletteStart_ = 0;

@@ -344,6 +344,61 @@ TEST(OpenFlight, LightFacesWireframesAndHiddenFaces) {
   EXPECT_NEAR(r->lines[4].b.x, 0, 1e-6);
 }
 
+// Indexed light points (130) take their look from the appearance palette (128) and their blinking
+// from the animation palette (129): a strobe, a rotating beacon, a flashing sequence; one whose
+// appearance is not in the palette, and Morse code (drawn steady), are named in warnings.
+TEST(OpenFlight, IndexedLightPointsUseTheirPalettes) {
+  FltWriter w;
+  w.header();
+  w.colorPalette({0xFF000000u, 0xFF0000FFu});  // entry 1: red (ABGR)
+  w.lightPointAppearance(3, 2.0f, 2, 1u << 7 | 127, 1.0f);  // two-way, red back at half
+  w.lightPointAppearance(4, 0.5f, 0);                       // omnidirectional
+  w.lightPointAnimation(7, 2, 1.0f, 0.25f, 0.1f);           // strobe: 0.1 s of every 1 s
+  w.lightPointAnimation(8, 1, 4.0f, 0, 0);                  // rotating every 4 s
+  w.lightPointAnimation(9, 0, 0, 0, 0, {{0, 0.2f}, {1, 0.6f}});  // on 0.2 s, off 0.6 s
+  w.lightPointAnimation(10, 3, 1.0f, 0, 0.5f);                    // Morse code: drawn steady
+  w.vertexPalette();
+  const int32_t v = w.vertex(V::at(1, 2, 3, std::array<float, 3>{0, -1, 0}));
+  w.push();
+  int k = 0;
+  for (auto [look, animation] :
+       {std::pair{3, 7}, std::pair{4, 8}, std::pair{4, 9}, std::pair{4, -1}, std::pair{5, -1},
+        std::pair{4, 10}}) {
+    w.indexedLightPoint("lp" + std::to_string(k++), look, animation);
+    w.push();
+    w.vertexList({v});
+    w.pop();
+  }
+  w.pop();
+  Result<Scene> r = parseOpenFlight(w.bytes, "indexed.flt");
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  ASSERT_EQ(r->lightPoints.size(), 5u);
+  auto look = [&](size_t i) -> const LightAppearance& {
+    return r->lightAppearances[r->lightPoints[i].appearance];
+  };
+  EXPECT_FLOAT_EQ(look(0).intensity, 400);  // 2 × the full 200 cd
+  EXPECT_TRUE(look(0).directional);
+  EXPECT_TRUE(look(0).backLobe);
+  EXPECT_NEAR(look(0).backColor.x, 0.5, 1e-6);  // red at half the front's intensity
+  EXPECT_NEAR(look(0).backColor.y, 0, 1e-6);
+  EXPECT_FLOAT_EQ(look(0).blink.period, 1);
+  EXPECT_FLOAT_EQ(look(0).blink.onFraction, 0.1f);
+  EXPECT_FLOAT_EQ(look(0).blink.phase, 0.25f);
+  EXPECT_FALSE(look(1).directional);
+  EXPECT_FLOAT_EQ(look(1).intensity, 100);
+  EXPECT_FLOAT_EQ(look(1).rotationPeriod, 4);
+  EXPECT_FLOAT_EQ(look(2).blink.period, 0.8f);
+  EXPECT_FLOAT_EQ(look(2).blink.onFraction, 0.25f);
+  EXPECT_FLOAT_EQ(look(3).blink.period, 0);
+  EXPECT_NEAR(r->lightPoints[3].position.z, -2, 1e-6);  // OpenFlight y north is −z
+  EXPECT_FLOAT_EQ(look(4).blink.period, 0);
+  ASSERT_EQ(r->warnings.size(), 2u);
+  EXPECT_EQ(r->warnings[0],
+            "indexed.flt: 1 indexed light point (its appearance not in the palette) record not "
+            "drawn");
+  EXPECT_EQ(r->warnings[1], "indexed.flt: 1 light point record animated by Morse code drawn steady");
+}
+
 // Malformed files: one line naming the file and the problem.
 TEST(OpenFlight, RefusesMalformedFiles) {
   auto error = [](const std::string& bytes) {
