@@ -187,12 +187,6 @@ void LinePass::prepare(const raster::PassFrame& frame) {
   prepareMs_ = core::msSince(t0);
 }
 
-std::vector<Strip> LinePass::strips() const {
-  std::vector<Strip> all;
-  for (const std::vector<Strip>& c : chunks_) all.insert(all.end(), c.begin(), c.end());
-  return all;
-}
-
 // The strip over the tile's pixels, row by row: a sample inside the rectangle and nearer than the
 // depth there takes the strip's depth (affine along it) and colour (at the pixel centre's place
 // along it, fogged).

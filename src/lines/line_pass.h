@@ -57,9 +57,6 @@ class LinePass final : public raster::TilePass {
   void drawTile(const raster::TileTarget& tile) override;
   void addStats(FrameStats& stats) const override;
 
-  // The frame's strips in segment order (after prepare): for tests.
-  std::vector<Strip> strips() const;
-
  private:
   bool project(const scene::LineSegment& segment, Strip& s) const;
   // Calls f(tile index) for every tile the strip's rectangle reaches.
