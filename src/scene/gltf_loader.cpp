@@ -705,7 +705,8 @@ const std::vector<int>& GltfConverter::meshesOf(int gltfMesh) {
 void GltfConverter::placeAside(int gltfMesh, const Mat4& world, const std::string& where) {
   auto it = asideMeshes_.find(gltfMesh);
   if (it == asideMeshes_.end()) return;
-  for (const auto& [mesh, lines] : it->second) {
+  for (const Aside& aside : it->second) {
+    const Mesh& mesh = aside.mesh;  // (not a structured binding: lambdas below capture it)
     const Vec4 base = scene_.materialAt(mesh.material).baseColor;
     auto colorAt = [&](uint32_t i) {
       const Vec4 c = mesh.colors.empty() ? Vec4{1, 1, 1, 1} : mesh.colors[i];
@@ -718,7 +719,7 @@ void GltfConverter::placeAside(int gltfMesh, const Mat4& world, const std::strin
       if (!isFinite(p)) fail(fmt::format("{}: a vertex's position is not finite", where));
       return p;
     };
-    if (lines) {
+    if (aside.lines) {
       if (scene_.lines.size() + mesh.indices.size() / 2 > kMaxLines)
         fail(fmt::format("{}: more than {} line segments", where, kMaxLines));
       for (size_t k = 0; k + 1 < mesh.indices.size(); k += 2) {
