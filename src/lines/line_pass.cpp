@@ -139,15 +139,15 @@ bool LinePass::project(const scene::LineSegment& segment, Strip& s) const {
                          {s.x1 + ax + nx, s.y1 + ay + ny},
                          {s.x0 - ax + nx, s.y0 - ay + ny}};
   std::copy(&c[0][0], &c[0][0] + 8, &s.corners[0][0]);
+  s.yMin = std::min({c[0][1], c[1][1], c[2][1], c[3][1]});
+  s.yMax = std::max({c[0][1], c[1][1], c[2][1], c[3][1]});
   return true;
 }
 
 template <class F>
 void LinePass::forTiles(const Strip& s, F&& f) const {
-  float ymin = s.corners[0][1], ymax = ymin;
-  for (const auto& c : s.corners) ymin = std::min(ymin, c[1]), ymax = std::max(ymax, c[1]);
-  const int ty0 = std::max(0, floorToInt(ymin) >> kTileLog2);
-  const int ty1 = std::min(tilesY_ - 1, floorToInt(ymax) >> kTileLog2);
+  const int ty0 = std::max(0, floorToInt(s.yMin) >> kTileLog2);
+  const int ty1 = std::min(tilesY_ - 1, floorToInt(s.yMax) >> kTileLog2);
   for (int ty = ty0; ty <= ty1; ++ty) {
     float xmin, xmax;
     if (!bandRange(s.corners, float(ty * kTileSize), float((ty + 1) * kTileSize), xmin, xmax))
@@ -195,11 +195,9 @@ void LinePass::drawStrip(const Strip& s, const raster::TileTarget& tile) const {
   const int ox = tile.tileX * kTileSize, oy = tile.tileY * kTileSize;
   const int xEnd = std::min(ox + kTileSize, frame_.width) - 1;
   const int yEnd = std::min(oy + kTileSize, frame_.height) - 1;
-  float ymin = s.corners[0][1], ymax = ymin;
-  for (const auto& c : s.corners) ymin = std::min(ymin, c[1]), ymax = std::max(ymax, c[1]);
   const float h = 0.5f * in_.settings.width;
   const float invLength = s.length > 0 ? 1 / s.length : 0;
-  for (int py = std::max(oy, floorToInt(ymin)); py <= std::min(yEnd, floorToInt(ymax)); ++py) {
+  for (int py = std::max(oy, floorToInt(s.yMin)); py <= std::min(yEnd, floorToInt(s.yMax)); ++py) {
     float xmin, xmax;
     if (!bandRange(s.corners, float(py), float(py + 1), xmin, xmax)) continue;
     for (int px = std::max(ox, floorToInt(xmin)); px <= std::min(xEnd, floorToInt(xmax)); ++px) {

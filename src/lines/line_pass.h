@@ -46,6 +46,7 @@ struct Strip {
   Vec3 e0, e1;
   Vec3 color;
   float corners[4][2] = {};  // the rectangle, ½ width around the segment and past its ends
+  float yMin = 0, yMax = 0;  // the rectangle's rows
 };
 
 class LinePass final : public raster::TilePass {

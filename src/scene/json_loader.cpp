@@ -894,7 +894,8 @@ void SceneReader::readLines(const Json& v, const std::string& where) {
       const Vec4 c4 = color(*x, member(wp, "color"), false);
       c = {c4.x, c4.y, c4.z};
     }
-    const bool closed = find(p, "closed") && boolean(*find(p, "closed"), member(wp, "closed"));
+    const Json* closedKey = find(p, "closed");
+    const bool closed = closedKey && boolean(*closedKey, member(wp, "closed"));
     const size_t n = points->size();
     const size_t segments = closed && n > 2 ? n : n - 1;
     if (scene_.lines.size() + segments > kMaxLines)
