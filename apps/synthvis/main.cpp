@@ -2,7 +2,7 @@
 //
 //   synthvis render [SCENE] -o out.png [--width W] [--height H] [--threads T] [--camera I]
 //                   [--channels N [--arc DEG]] [--mosaic FILE]
-//                   [--no-cull] [--no-instance-cull] [--no-lod] [--lod-scale S] [--debug-view overdraw|levels|occupancy] [--gamma G]
+//                   [--no-cull] [--no-instance-cull] [--no-lod] [--no-merge] [--lod-scale S] [--debug-view overdraw|levels|occupancy] [--gamma G]
 //                   [--supersample K] [--aa 1|4|8|16|64] [--filter box|tent3]
 //                   [--texture-filter point|nearest|tri3|bilinear|trilinear3|trilinear|aniso]
 //                   [--hsr zbuffer|priority|hybrid]
@@ -740,6 +740,8 @@ void addRenderOptions(CLI::App* render, RenderArgs& r) {
                    "transform every instance, also those wholly outside the view");
   render->add_flag("--no-lod", [&r](int64_t) { r.options.lod = false; },
                    "draw every instance at full detail (level 0) at every range");
+  render->add_flag("--no-merge", [&r](int64_t) { r.options.mergeCells = false; },
+                   "draw every instance on its own, also where its merged cell would do");
   render->add_option("--lod-scale", r.options.lodScale,
                      "multiplies every level-of-detail range (2: coarser levels at half the "
                      "distance)")
@@ -827,6 +829,8 @@ int main(int argc, char** argv) {
                   "transform every instance, also those wholly outside the view");
   bench->add_flag("--no-lod", [&b](int64_t) { b.options.lod = false; },
                   "draw every instance at full detail (level 0) at every range");
+  bench->add_flag("--no-merge", [&b](int64_t) { b.options.mergeCells = false; },
+                  "draw every instance on its own, also where its merged cell would do");
   bench->add_option("--lod-scale", b.options.lodScale, "multiplies every level-of-detail range")
       ->capture_default_str();
   bench->add_option("--frames", b.frames, "timed frames")->capture_default_str();

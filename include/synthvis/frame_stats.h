@@ -25,6 +25,9 @@ struct FrameStats {
   static constexpr int kLodLevels = 8;
   uint64_t lodDrawn[kLodLevels] = {};
   uint64_t lodDissolving = 0, lodBeyond = 0;
+  // Merged cells drawn in place of their members (RenderOptions::mergeCells), and those members
+  // (counted in lodDrawn at the cell's level).
+  uint64_t mergedCells = 0, mergedInstances = 0;
   uint64_t windows[6] = {};
   uint64_t fullWindows = 0, partialBlocks = 0, fragments = 0;
   uint64_t hiddenFragments = 0;  // fragments of which the depth test passed no sample

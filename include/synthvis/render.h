@@ -32,6 +32,12 @@ struct RenderOptions {
   // distance (the overload governor's lever on geometry).
   bool lod = true;
   float lodScale = 1;
+  // Hierarchical levels of detail (InstanceTree::Cell): where every member of a merged cell draws
+  // the same far level alone, the cell's one mesh is drawn instead of its members — the same
+  // triangles placed once at load time, so the image differs from drawing each member only in the
+  // rounding of the vertices' placement. Only with `lod`, under the Z-buffer (masking draws
+  // objects nearest first, which a merged cell is not). False: every member drawn on its own.
+  bool mergeCells = true;
   int camera = 0;             // index into Scene::cameras (a default camera if there is none)
   // False-colour diagnostics instead of the image (one sample per pixel): how many triangles
   // covered each pixel (no depth test); where the visible triangle's subdivision stopped (the

@@ -162,6 +162,24 @@ struct InstanceTree {
   size_t instanceCount = 0;
   // The articulated instances below instanceCount, which the tree leaves out (they move).
   std::vector<uint32_t> loose;
+
+  // Hierarchical levels of detail (mergeFarLevels): nearby instances' small far levels merged
+  // into one mesh per cell, drawn as one when every member would draw that level alone (its range
+  // within [from, until)) — a few hundred draws instead of thousands of ten-triangle ones. A cell
+  // `beyond` its members' last level has no mesh: while all of them are beyond it, none is visited.
+  struct Cell {
+    bool beyond = false;
+    Mesh mesh;          // the members' level meshes, their vertices placed in the world
+    std::array<Vec3, 2> bounds;  // the mesh's (Mesh::bounds)
+    Vec3 rangeLo, rangeHi;  // the box around the members' range points (LodGroup), world
+    double from = 0, until = 0;  // the range band in which each member draws `level` alone
+    int level = 0;
+    int priority = 0;   // the members' Instance::priority
+    uint32_t firstMember = 0, memberCount = 0;  // into `members`
+    uint64_t fullTriangles = 0;  // the members' at full detail (statistics: what was not drawn)
+  };
+  std::vector<Cell> cells;
+  std::vector<uint32_t> members;  // instance indices, each cell's a contiguous range
 };
 
 // Articulations (SPEC §1 traversal; docs/scene-format.md "Switches and degrees of freedom"): the
@@ -372,8 +390,18 @@ Status validate(const Scene& scene, const std::string& file, bool vertexData = t
 void applyArticulations(Scene& scene);
 
 // Builds scene.instanceTree over all of its instances (valid meshes and transforms assumed: run
-// validate first). Binned by the centres of the instances' world boxes, leaves of at most 8.
+// validate first). Binned by the centres of the instances' world boxes, leaves of at most 8; with
+// its merged cells (mergeFarLevels).
 void buildInstanceTree(Scene& scene);
+// Fills tree.cells for the instances the tree holds: for each level of detail beyond the first
+// whose mesh is small (at most kMergeTriangles) and not translucent, the instances drawing it are
+// grouped by their range band, material, priority, attributes and a grid cell of the band's
+// quarter width (at most half its start); a cell of two or more members gets one mesh of all
+// their level meshes placed in the world (at most kMergeVertices over all cells, in the order the
+// cells are found). Beyond a group's last level (a finite `to`), cells of half its range without
+// a mesh. Deterministic: the same cells on every run.
+inline constexpr size_t kMergeTriangles = 32, kMergeVertices = size_t(1) << 22;
+void mergeFarLevels(const Scene& scene, InstanceTree& tree);
 // An instance's box in its own space around every level of detail it may draw.
 std::array<Vec3, 2> instanceBounds(const Scene& scene, const Instance& instance,
                                    const std::vector<std::array<Vec3, 2>>& meshBounds);

@@ -12,7 +12,9 @@ std::string FrameStats::lodSummary() const {
   if (last < 0 && !lodBeyond) return {};
   std::string s = " | LOD";
   for (int i = 0; i <= last; ++i) s += fmt::format(" {}:{}", i, lodDrawn[i]);
-  return s + fmt::format(", dissolving {}, beyond {}", lodDissolving, lodBeyond);
+  s += fmt::format(", dissolving {}, beyond {}", lodDissolving, lodBeyond);
+  if (mergedCells) s += fmt::format(", merged {} in {} cells", mergedInstances, mergedCells);
+  return s;
 }
 
 std::string FrameStats::summary() const {

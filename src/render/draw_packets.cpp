@@ -16,8 +16,8 @@ namespace {
 // instance's vertices, or of its indices (copied offset to the frame's vertex numbering and
 // range-checked).
 struct VertexJob {
-  const scene::Instance* instance;
-  const scene::Mesh* mesh;  // the instance's level of detail
+  const Mat4* transform;    // the instance's (a merged cell's: the identity)
+  const scene::Mesh* mesh;  // the instance's level of detail, or a merged cell's mesh
   bool indices;  // else vertices
   size_t begin, end, out;
   uint32_t base;  // the instance's first vertex in the frame (indices)
@@ -46,6 +46,26 @@ geometry::VertexMaterial toVertexMaterial(const scene::Material& m) {
   return {m.baseColor, m.uvScale, m.unlit, m.phong};
 }
 
+// What a draw places where: an instance's level mesh by its transform, or a merged cell's mesh
+// (its vertices already in the world) by the identity.
+struct DrawSource {
+  const Mat4* transform;
+  const scene::Mesh* mesh;
+  const std::array<Vec3, 2>* bounds;
+  int priority;
+};
+const Mat4 kIdentity{};
+DrawSource sourceOf(const scene::Scene& scene, const std::vector<std::array<Vec3, 2>>& boxes,
+                    const InstanceDraw& draw) {
+  if (draw.cell >= 0) {
+    const scene::InstanceTree::Cell& cell = scene.instanceTree->cells[size_t(draw.cell)];
+    return {&kIdentity, &cell.mesh, &cell.bounds, cell.priority};
+  }
+  const scene::Instance& inst = scene.instances[draw.instance];
+  return {&inst.transform, &scene.meshes[size_t(draw.mesh)], &boxes[size_t(draw.mesh)],
+          inst.priority};
+}
+
 // The order the traversal's draws are drawn in (indices into `draws`). Opaque ones: in submission
 // order for the Z-buffer; for masking (SPEC §4) by priority, then nearest first — by the smallest
 // view depth of their bounding box's corners, which orders objects separated in depth correctly
@@ -61,18 +81,20 @@ std::vector<uint32_t> drawOrder(const scene::Scene& scene, const std::vector<Ins
   const bool sortOpaque = hsr != RenderOptions::Hsr::zbuffer;
   // Per draw the view depths of its mesh's box's corners.
   std::vector<float> nearest(order.size()), centre(order.size());
+  std::vector<DrawSource> sources;
+  sources.reserve(order.size());
   for (size_t i = 0; i < order.size(); ++i) {
-    const scene::Instance& inst = scene.instances[draws[i].instance];
-    const auto& [lo, hi] = boxes[size_t(draws[i].mesh)];
-    const Mat4 toEye = view * inst.transform;
+    const DrawSource& source = sources.emplace_back(sourceOf(scene, boxes, draws[i]));
+    const auto& [lo, hi] = *source.bounds;
+    const Mat4 toEye = view * *source.transform;
     nearest[i] = nearestEyeDepth(toEye, lo, hi);
     centre[i] = -toEye.transformPoint((lo + hi) * 0.5f).z;
   }
   auto translucent = [&](uint32_t i) {
-    const int m = scene.meshes[size_t(draws[i].mesh)].material;
+    const int m = sources[i].mesh->material;
     return m >= 0 && scene.materials[size_t(m)].alphaMode == scene::AlphaMode::blend;
   };
-  auto priority = [&](uint32_t i) { return scene.instances[draws[i].instance].priority; };
+  auto priority = [&](uint32_t i) { return sources[i].priority; };
   std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
     const bool ta = translucent(a), tb = translucent(b);
     if (ta != tb) return tb;  // opaque first (the passes pick them out again)
@@ -143,8 +165,8 @@ Status layOutCalls(const scene::Scene& scene, const RenderOptions& o, const Fram
   for (const bool translucentPass : {false, true})
     for (const uint32_t d : order) {
       const InstanceDraw& draw = draws[d];
-      const scene::Instance& inst = scene.instances[draw.instance];
-      const scene::Mesh& mesh = scene.meshes[size_t(draw.mesh)];
+      const DrawSource source = sourceOf(scene, boxes, draw);
+      const scene::Mesh& mesh = *source.mesh;
       const scene::Material& mat = scene.materialAt(mesh.material);
       if ((mat.alphaMode == scene::AlphaMode::blend) != translucentPass) continue;
       // Indices are 32-bit; a frame of more vertices or triangles than that cannot be expressed.
@@ -153,10 +175,10 @@ Status layOutCalls(const scene::Scene& scene, const RenderOptions& o, const Fram
         return Error{"", "", "scene too large for one frame (over 2^31 vertices or indices)"};
       const auto base = static_cast<uint32_t>(vertexCount);
       for (size_t b = 0; b < mesh.positions.size(); b += kVertexChunk)
-        jobs.push_back({&inst, &mesh, false, b, std::min(mesh.positions.size(), b + kVertexChunk),
+        jobs.push_back({source.transform, &mesh, false, b, std::min(mesh.positions.size(), b + kVertexChunk),
                         vertexCount + b, base});
       for (size_t b = 0; b < mesh.indices.size(); b += kIndexChunk)
-        jobs.push_back({&inst, &mesh, true, b, std::min(mesh.indices.size(), b + kIndexChunk),
+        jobs.push_back({source.transform, &mesh, true, b, std::min(mesh.indices.size(), b + kIndexChunk),
                         indexCount + b, base});
       DrawCall call;
       call.instance = draw.instance;
@@ -172,9 +194,8 @@ Status layOutCalls(const scene::Scene& scene, const RenderOptions& o, const Fram
         call.material = doorMaterial(call.material, draw.door, p);
       if (call.material) stored |= shade::attributesUsed(*call.material, shading->environment);
       if (masking)
-        call.bounded =
-            geometry::boundObject(viewProj * inst.transform, boxes[size_t(draw.mesh)][0],
-                                  boxes[size_t(draw.mesh)][1], boundViewport, call.bound);
+        call.bounded = geometry::boundObject(viewProj * *source.transform, (*source.bounds)[0],
+                                             (*source.bounds)[1], boundViewport, call.bound);
       p.calls.push_back(call);
       vertexCount += mesh.positions.size();
       indexCount += mesh.indices.size();
@@ -232,7 +253,7 @@ Status buildDrawPackets(const scene::Scene& scene, const RenderOptions& o,
     }
     finite[j] = geometry::transformVertices(
         toVertexArrays(mesh), toVertexMaterial(scene.materialAt(mesh.material)),
-        job.instance->transform, context, job.begin, job.end, p.vertices.data() + job.out,
+        *job.transform, context, job.begin, job.end, p.vertices.data() + job.out,
         stride ? p.attributes.data() + job.out * stride : nullptr, &p.attributeLayout);
   };
   // Small instances' jobs run in groups of consecutive ones (some 4 000 vertices and indices a

@@ -175,6 +175,8 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
   stats.culledInstances += t.culledInstances;
   for (int i = 0; i < FrameStats::kLodLevels; ++i) stats.lodDrawn[i] += t.lodDrawn[i];
   stats.lodDissolving += t.lodDissolving;
+  stats.mergedCells += t.mergedCells;
+  stats.mergedInstances += t.mergedInstances;
   stats.lodBeyond += t.lodBeyond;
   // Always run at least one (empty) batch, so the tiles get cleared.
   for (uint32_t begin = 0; begin == 0 || begin < f.triangles; begin += f.batchTriangles) {

@@ -8,7 +8,8 @@
 namespace sv::render {
 namespace {
 
-enum State : uint8_t { kCulled, kTest, kInside };
+// kMerged: drawn by its merged cell (or culled with it), not on its own.
+enum State : uint8_t { kCulled, kTest, kInside, kMerged };
 constexpr size_t kTraversalChunk = 4096;  // instances a job
 
 // The view volume's six planes in world space: a point p is inside plane k where
@@ -63,6 +64,66 @@ void walk(const scene::InstanceTree& tree, const Planes& planes, std::vector<uin
   }
 }
 
+// The smallest and largest distance from `eye` to the box [lo, hi], in double.
+std::array<double, 2> distanceRange(Vec3 eye, Vec3 lo, Vec3 hi) {
+  const double e[3] = {eye.x, eye.y, eye.z}, l[3] = {lo.x, lo.y, lo.z}, h[3] = {hi.x, hi.y, hi.z};
+  double nearest = 0, farthest = 0;
+  for (int a = 0; a < 3; ++a) {
+    const double below = l[a] - e[a], above = e[a] - h[a];
+    const double in = std::max({below, above, 0.0});
+    const double out = std::max(std::fabs(e[a] - l[a]), std::fabs(h[a] - e[a]));
+    nearest += in * in;
+    farthest += out * out;
+  }
+  return {std::sqrt(nearest), std::sqrt(farthest)};
+}
+
+// The merged cells whose members all draw the cell's level alone this frame: each drawn as one
+// (or culled whole) and its members marked kMerged, counted at that level; or all beyond their
+// last level, marked kMerged and counted beyond. A cell with a member
+// switched off is left to its members. Ranges as the visit's (the distance to each member's range
+// point, which lies in the cell's range box), with a relative margin of 1e-5 for the rounding of
+// the visit's float differences.
+void drawMergedCells(const scene::InstanceTree& tree, const scene::Scene& scene,
+                     const RenderOptions& o, const Mat4& viewProj, Vec3 eye, double rangeScale,
+                     Traversal& out) {
+  for (const scene::InstanceTree::Cell& cell : tree.cells) {
+    const auto [nearest, farthest] = distanceRange(eye, cell.rangeLo, cell.rangeHi);
+    if (!(nearest * rangeScale * (1 - 1e-5) >= cell.from &&
+          farthest * rangeScale * (1 + 1e-5) < cell.until))
+      continue;
+    const uint32_t* members = tree.members.data() + cell.firstMember;
+    if (!std::all_of(members, members + cell.memberCount,
+                     [&](uint32_t i) { return scene.instances[i].visible; }))
+      continue;
+    if (cell.beyond) {
+      // As the visit would count them, without visiting them: those outside the view culled, the
+      // others beyond; the triangles of both not drawn.
+      uint32_t culled = 0;
+      for (uint32_t k = 0; k < cell.memberCount; ++k) {
+        culled += out.state[members[k]] == kCulled;
+        out.state[members[k]] = kMerged;
+      }
+      out.culledInstances += culled;
+      out.lodBeyond += cell.memberCount - culled;
+      out.culledTriangles += cell.fullTriangles;
+      continue;
+    }
+    if (o.cullInstances && outsideView(viewProj, cell.bounds[0], cell.bounds[1])) {
+      // Left to the visit as culled, which counts them as it would have.
+      for (uint32_t k = 0; k < cell.memberCount; ++k) out.state[members[k]] = kCulled;
+      continue;
+    }
+    for (uint32_t k = 0; k < cell.memberCount; ++k) out.state[members[k]] = kMerged;
+    const auto index = int(&cell - tree.cells.data());
+    out.draws.push_back({members[0], -1, 0xFFFF, index});
+    out.lodDrawn[std::min<size_t>(size_t(cell.level), FrameStats::kLodLevels - 1)] +=
+        cell.memberCount;
+    ++out.mergedCells;
+    out.mergedInstances += cell.memberCount;
+  }
+}
+
 // The Bayer 4×4 ordered-dither thresholds, pixel (x, y) at x + 4y.
 constexpr uint8_t kBayer[16] = {0, 8, 2, 10, 12, 4, 14, 6, 3, 11, 1, 9, 15, 7, 13, 5};
 
@@ -104,13 +165,13 @@ void traverse(const scene::Scene& scene, const RenderOptions& o, const FrameCame
               Traversal& out) {
   out.draws.clear();
   out.culledInstances = out.culledTriangles = out.lodDissolving = out.lodBeyond = 0;
+  out.mergedCells = out.mergedInstances = 0;
   std::fill(std::begin(out.lodDrawn), std::end(out.lodDrawn), 0);
   const size_t n = scene.instances.size();
   const Mat4 viewProj = camera.projection * camera.view;
   out.state.assign(n, o.cullInstances ? kTest : kInside);
   if (o.cullInstances && scene.instanceTree)
     walk(*scene.instanceTree, Planes(viewProj), out.state);
-  const std::vector<uint8_t>& state = out.state;
 
   // Ranges (scene.h LodGroup): from the eye, scaled to the view's field of view and lodScale.
   const auto& v = camera.view.m;
@@ -120,6 +181,7 @@ void traverse(const scene::Scene& scene, const RenderOptions& o, const FrameCame
                  -(v[2][0] * t.x + v[2][1] * t.y + v[2][2] * t.z)};
   const double rangeScale =
       0.5 * (camera.tanTop - camera.tanBottom) / std::tan(M_PI / 6) * double(o.lodScale);
+  const std::vector<uint8_t>& state = out.state;
   std::vector<std::array<Vec3, 2>> groupBounds;
   if (o.lod)
     for (const scene::LodGroup& g : scene.lodGroups) {
@@ -129,10 +191,13 @@ void traverse(const scene::Scene& scene, const RenderOptions& o, const FrameCame
       groupBounds.push_back(scene::instanceBounds(scene, probe, meshBounds));
     }
 
+  if (o.lod && o.mergeCells && o.hsr == RenderOptions::Hsr::zbuffer && scene.instanceTree)
+    drawMergedCells(*scene.instanceTree, scene, o, viewProj, eye, rangeScale, out);
+
   // Instance i into `part`: culled, beyond its levels, or its draws.
   auto visit = [&](size_t i, Traversal::Chunk& part) {
     const scene::Instance& inst = scene.instances[i];
-    if (!inst.visible) return;  // switched off: not drawn, not counted
+    if (!inst.visible || state[i] == kMerged) return;  // switched off, or drawn by its cell
     const uint64_t fullTriangles = scene.meshes[size_t(inst.mesh)].triangleCount();
     auto cull = [&] {
       ++part.culledInstances;

@@ -15,11 +15,12 @@ namespace sv::render {
 
 // One draw the traversal chose: an instance's mesh at one level of detail.
 struct InstanceDraw {
-  uint32_t instance = 0;  // into Scene::instances
-  int mesh = 0;           // the level's mesh
+  uint32_t instance = 0;  // into Scene::instances (a merged cell's: its first member)
+  int mesh = 0;           // the level's mesh (into Scene::meshes; a merged cell's: −1)
   // The pixels of every screen-aligned 4×4 block it draws (bit x + 4y; 0xFFFF: all): two levels
   // dissolving into each other draw complementary patterns (ordered dither, Bayer 4×4).
   uint16_t door = 0xFFFF;
+  int cell = -1;  // a merged cell drawn for its members (into InstanceTree::cells), or −1
 };
 
 struct Traversal {
@@ -33,9 +34,11 @@ struct Traversal {
     uint64_t lodDrawn[FrameStats::kLodLevels] = {};
     uint64_t lodDissolving = 0, lodBeyond = 0;
   };
-  // The whole view's: its draws in instance order, and its counts.
+  // The whole view's: its draws (the merged cells', then the instances' in instance order), and
+  // its counts.
   std::vector<InstanceDraw> draws;
   uint64_t culledInstances = 0, culledTriangles = 0;
+  uint64_t mergedCells = 0, mergedInstances = 0;  // cells drawn, and their members
   uint64_t lodDrawn[FrameStats::kLodLevels] = {};
   uint64_t lodDissolving = 0, lodBeyond = 0;
   std::vector<uint8_t> state;  // per instance, the walk's scratch
@@ -45,7 +48,9 @@ struct Traversal {
 // Fills `out` for the view `camera`: every instance not wholly outside its view volume (with
 // options.cullInstances; the scene's instance tree first, then instance by instance as setup's
 // outcodes would cull every triangle — so the image is the same as with no culling), at the level
-// of detail its range chooses (options.lod; scene.h LodGroup). `meshBounds`: every mesh's bounds.
+// of detail its range chooses (options.lod; scene.h LodGroup) — drawn by its merged cell where
+// every member of the cell draws that level alone (options.mergeCells; InstanceTree::Cell).
+// `meshBounds`: every mesh's bounds.
 // The instances are visited in parallel chunks on `pool`; the result does not depend on its
 // threads.
 void traverse(const scene::Scene& scene, const RenderOptions& options, const FrameCamera& camera,

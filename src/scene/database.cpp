@@ -591,6 +591,10 @@ Result<Scene> parseDatabase(const char* data, size_t size, const std::string& pa
       return Error{path, "", "database is damaged (its checksum does not match)"};
     Scene scene = decode(data + kHeaderBytes, size_t(bytes), options);
     if (Status s = validate(scene, path); !s) return s.error();
+    // The merged cells are not stored: made again from the valid instances, as buildInstanceTree
+    // made them for the source (the same cells, so the same image). The tree was made here.
+    if (scene.instanceTree)
+      mergeFarLevels(scene, *std::const_pointer_cast<InstanceTree>(scene.instanceTree));
     return scene;
   } catch (const DbProblem& p) {
     return Error{path, "", "database: " + p.message};

@@ -126,6 +126,7 @@ void buildInstanceTree(Scene& scene) {
       Builder{boxes, triangles, *tree}.build(0, 0, uint32_t(held));
     }
   }
+  mergeFarLevels(scene, *tree);
   scene.instanceTree = std::move(tree);
 }
 

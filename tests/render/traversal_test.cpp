@@ -243,6 +243,185 @@ TEST(Traversal, TheInstanceTreeBoundsEveryInstanceOnce) {
   EXPECT_GE(leaves, city.instances.size() / 8);
 }
 
+// Hierarchical levels of detail (InstanceTree::Cell): a 6 × 6 grid of instances 1.2 m apart whose
+// level 1 (at any range) is a 12-triangle box and level 0 (to `near` m) a sphere, lit, seen from
+// `distance` m. Its tree merges the boxes by cells of 5 m: four cells, of 16, 8, 8 and 4.
+scene::Scene gridScene(float distance, float near = 10) {
+  scene::Scene s;
+  scene::Material m;
+  m.baseColor = {0.8f, 0.6f, 0.3f, 1};
+  s.materials.push_back(m);
+  scene::Mesh sphere = scene::detail::makeSphere(0.4f, 12, 8);
+  sphere.material = 0;
+  s.meshes.push_back(sphere);
+  scene::Mesh box = scene::detail::makeBox({0.7f, 0.9f, 0.5f});
+  box.material = 0;
+  s.meshes.push_back(box);
+  scene::LodGroup g;
+  g.levels = {{0, near}, {1, 1e30f}};
+  s.lodGroups.push_back(g);
+  for (int i = 0; i < 36; ++i) {
+    scene::Instance inst;
+    inst.mesh = 0;
+    inst.lod = 0;
+    inst.transform = Mat4::translation({0.3f + 1.2f * float(i % 6), 0, -0.3f - 1.2f * float(i / 6)}) *
+                     Mat4::rotation({0, 1, 0}, 0.3f * float(i)) *
+                     Mat4::scaling({1 + 0.05f * float(i % 5), 1, 1});
+    s.instances.push_back(inst);
+  }
+  scene::Camera cam;
+  cam.position = {3.3f - 0.3f * distance, 0.5f * distance, 0.8f * distance};
+  cam.target = {3.3f, 0, -3.3f};
+  cam.znear = 0.1f;
+  cam.zfar = 2000;
+  s.cameras.push_back(cam);
+  scene::buildInstanceTree(s);
+  return s;
+}
+
+// Drawn merged, the instances' far levels are the cells' meshes: the same image as one instance
+// of each cell's mesh (its vertices placed at load time), bit for bit, for any thread count.
+TEST(MergedCells, DrawAsTheirMeshesPlacedInTheWorld) {
+  const scene::Scene grid = gridScene(12);
+  const scene::InstanceTree& tree = *grid.instanceTree;
+  ASSERT_EQ(tree.cells.size(), 4u);
+  EXPECT_EQ(tree.members.size(), 36u);
+  scene::Scene placed = grid;
+  placed.instances.clear();
+  placed.lodGroups.clear();
+  placed.meshes.clear();
+  for (const scene::InstanceTree::Cell& cell : tree.cells) {
+    placed.instances.push_back({int(placed.meshes.size()), Mat4{}});
+    placed.meshes.push_back(cell.mesh);
+  }
+  scene::buildInstanceTree(placed);
+  EXPECT_TRUE(placed.instanceTree->cells.empty());  // no levels of detail: nothing to merge
+  RenderOptions o = small();
+  FrameStats merged, plain;
+  const Image image = render(grid, o, &merged);
+  EXPECT_EQ(image.rgb, render(placed, o, &plain).rgb);
+  EXPECT_EQ(merged.mergedCells, tree.cells.size());
+  EXPECT_EQ(merged.mergedInstances, 36u);
+  EXPECT_EQ(merged.lodDrawn[1], 36u);
+  EXPECT_EQ(merged.drawn, plain.drawn);
+  EXPECT_GT(merged.drawn, 100u);
+  for (int threads : {1, 3}) {
+    o.threads = threads;
+    EXPECT_EQ(render(grid, o).rgb, image.rgb) << threads << " threads";
+  }
+}
+
+// Against each member drawn on its own, only the rounding of the vertices' placement differs: the
+// same levels, nearly every pixel the same.
+TEST(MergedCells, DifferFromTheirMembersOnlyInRounding) {
+  const scene::Scene grid = gridScene(12);
+  RenderOptions o = small();
+  o.width = 320;
+  o.height = 240;
+  FrameStats merged, members;
+  const Image a = render(grid, o, &merged);
+  o.mergeCells = false;
+  const Image b = render(grid, o, &members);
+  EXPECT_EQ(members.mergedCells, 0u);
+  EXPECT_EQ(merged.lodDrawn[1], members.lodDrawn[1]);
+  size_t differ = 0, covered = 0;
+  const uint8_t background[3] = {uint8_t(a.rgb[0]), uint8_t(a.rgb[1]), uint8_t(a.rgb[2])};
+  for (size_t i = 0; i < a.rgb.size(); i += 3) {
+    differ += a.rgb[i] != b.rgb[i] || a.rgb[i + 1] != b.rgb[i + 1] || a.rgb[i + 2] != b.rgb[i + 2];
+    covered += b.rgb[i] != background[0] || b.rgb[i + 1] != background[1] ||
+               b.rgb[i + 2] != background[2];
+  }
+  EXPECT_GT(covered, 3000u);
+  EXPECT_LT(differ, covered / 100) << differ << " of " << covered << " covered pixels differ";
+  // Under masking, objects are drawn nearest first, which a cell is not: never merged.
+  o.mergeCells = true;
+  o.hsr = RenderOptions::Hsr::priority;
+  FrameStats masked;
+  render(grid, o, &masked);
+  EXPECT_EQ(masked.mergedCells, 0u);
+}
+
+// A cell is drawn only where every member draws its level alone: not while one is still at level
+// 0 nearer the eye, nor while one is switched off.
+TEST(MergedCells, OnlyWhereEveryMemberDrawsTheLevelAlone) {
+  RenderOptions o = small();
+  // The near switch at 12.5 m: the grid's nearer members are at level 0, its farther at level 1.
+  const scene::Scene straddling = gridScene(12, 12.5f);
+  FrameStats merged, members;
+  const Image a = render(straddling, o, &merged);
+  o.mergeCells = false;
+  EXPECT_EQ(render(straddling, o, &members).rgb.size(), a.rgb.size());
+  EXPECT_GT(members.lodDrawn[0], 0u);
+  EXPECT_GT(members.lodDrawn[1], 0u);
+  EXPECT_EQ(merged.lodDrawn[0], members.lodDrawn[0]);
+  EXPECT_EQ(merged.lodDrawn[1], members.lodDrawn[1]);
+  EXPECT_LT(merged.mergedInstances, members.lodDrawn[1]);
+  o.mergeCells = true;
+  scene::Scene switched = gridScene(12);
+  const scene::InstanceTree::Cell& first = switched.instanceTree->cells[0];
+  switched.instances[switched.instanceTree->members[first.firstMember]].visible = false;
+  FrameStats off;
+  render(switched, o, &off);
+  EXPECT_EQ(off.mergedCells, switched.instanceTree->cells.size() - 1);
+  EXPECT_EQ(off.mergedInstances, 36u - first.memberCount);
+  EXPECT_EQ(off.lodDrawn[1], 35u);
+}
+
+// Beyond their last level, the members of a cell are counted as the visit counts them, without
+// being visited; a cell nearer than that is left to its members.
+TEST(MergedCells, CountMembersBeyondTheLastLevelWithoutVisitingThem) {
+  scene::Scene grid = gridScene(60);
+  grid.lodGroups[0].levels[1].to = 40;
+  scene::buildInstanceTree(grid);
+  ASSERT_EQ(grid.instanceTree->cells.size(), 5u);  // the four cells, and one beyond 40 m
+  const scene::InstanceTree::Cell& beyond = grid.instanceTree->cells.back();
+  EXPECT_TRUE(beyond.beyond);
+  EXPECT_EQ(beyond.memberCount, 36u);
+  EXPECT_TRUE(beyond.mesh.positions.empty());
+  RenderOptions o = small();
+  for (float distance : {60.0f, 30.0f}) {  // all beyond 40 m, then none
+    grid.cameras[0].position = {3.3f - 0.3f * distance, 0.5f * distance, 0.8f * distance};
+    FrameStats merged, members;
+    const Image a = render(grid, o, &merged);
+    o.mergeCells = false;
+    EXPECT_EQ(render(grid, o, &members).rgb.size(), a.rgb.size());
+    o.mergeCells = true;
+    EXPECT_EQ(merged.lodBeyond, distance > 40 ? 36u : 0u);
+    EXPECT_EQ(merged.lodBeyond, members.lodBeyond);
+    EXPECT_EQ(merged.culledInstances, members.culledInstances);
+    EXPECT_EQ(merged.trianglesIn, members.trianglesIn);
+    EXPECT_EQ(merged.culledOutside, members.culledOutside);
+    EXPECT_EQ(merged.mergedCells, distance > 40 ? 0u : 4u);
+  }
+}
+
+// What is merged: levels beyond the first of at most kMergeTriangles triangles, not translucent,
+// in cells of two or more; every member once a level, in instance order within its cell.
+TEST(MergedCells, MergeOnlySmallOpaqueFarLevels) {
+  scene::Scene grid = gridScene(12);
+  EXPECT_EQ(grid.instanceTree->cells[0].level, 1);
+  for (const scene::InstanceTree::Cell& cell : grid.instanceTree->cells) {
+    EXPECT_GE(cell.memberCount, 2u);
+    EXPECT_EQ(cell.mesh.triangleCount(), 12u * cell.memberCount);
+    for (uint32_t k = 1; k < cell.memberCount; ++k)
+      EXPECT_LT(grid.instanceTree->members[cell.firstMember + k - 1],
+                grid.instanceTree->members[cell.firstMember + k]);
+  }
+  grid.meshes[1] = scene::detail::makeSphere(0.4f, 6, 4);  // 36 triangles: a draw of its own
+  ASSERT_GT(grid.meshes[1].triangleCount(), scene::kMergeTriangles);
+  scene::buildInstanceTree(grid);
+  EXPECT_TRUE(grid.instanceTree->cells.empty());
+  grid.meshes[1] = scene::detail::makeBox({0.7f, 0.9f, 0.5f});
+  grid.meshes[1].material = 0;
+  grid.materials[0].alphaMode = scene::AlphaMode::blend;  // sorted far to near: not merged
+  scene::buildInstanceTree(grid);
+  EXPECT_TRUE(grid.instanceTree->cells.empty());
+  grid.materials[0].alphaMode = scene::AlphaMode::opaque;
+  grid.instances.resize(1);  // alone: nothing saved
+  scene::buildInstanceTree(grid);
+  EXPECT_TRUE(grid.instanceTree->cells.empty());
+}
+
 }  // namespace
 }  // namespace sv
 
