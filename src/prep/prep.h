@@ -11,7 +11,8 @@
 //      each simplified to about `reduction` of the one before (meshopt_simplify, topology kept),
 //      switching where its geometric error projects to `pixelError` pixels on a `screenHeight`
 //      pixel screen under the 60° view ranges refer to (scene.h LodGroup).
-//   3. Build the instance tree (scene::buildInstanceTree), which the database stores.
+//   3. Build the instance tree (scene::buildInstanceTree), which the database stores (its merged
+//      cells are made again on load).
 #pragma once
 
 #include <cstdint>
