@@ -135,25 +135,8 @@ void TerrainPass::setTerrains(const scene::Scene& scene, const FrameCamera& came
   environment_ = &shading.environment;
   groundBytes_ = 0;
   loadMs_ = 0;
-  const Mat4& v = camera.view;
-  right_ = {v.m[0][0], v.m[1][0], v.m[2][0]};
-  up_ = {v.m[0][1], v.m[1][1], v.m[2][1]};
-  const Vec3d back{v.m[0][2], v.m[1][2], v.m[2][2]};
-  forward_ = back * -1.0;
-  eye_ = (right_ * v.m[3][0] + up_ * v.m[3][1] + back * v.m[3][2]) * -1.0;
-  // The view window (SPEC §9: a channel's may be asymmetric) as its centre and half-size at unit
-  // depth. A centre of 0 is stored as −0, which adds to any value without changing a bit, so the
-  // classic symmetric view casts exactly the rays it always did.
-  halfX_ = 0.5 * (camera.tanRight - camera.tanLeft);
-  halfY_ = 0.5 * (camera.tanTop - camera.tanBottom);
-  centreX_ = 0.5 * (camera.tanRight + camera.tanLeft);
-  centreY_ = 0.5 * (camera.tanTop + camera.tanBottom);
-  if (centreX_ == 0) centreX_ = -0.0;
-  if (centreY_ == 0) centreY_ = -0.0;
-  znear_ = camera.camera.znear;
-  zfar_ = camera.camera.zfar;
-  p22_ = camera.projection.m[2][2];
-  p23_ = camera.projection.m[3][2];
+  rays_ = EyeRays::of(camera.view, camera.projection, camera.tanLeft, camera.tanRight,
+                      camera.tanBottom, camera.tanTop, camera.camera.znear, camera.camera.zfar);
   const bool lights = shading.environment.lightOn || !shading.environment.points.empty();
   for (const scene::Terrain& t : scene.terrains) {
     if (!t.ground) continue;
@@ -178,7 +161,7 @@ void TerrainPass::setTerrains(const scene::Scene& scene, const FrameCamera& came
     d.ramp = t.ramp.empty() ? defaultRamp(f.offset, f.offset + 65535 * f.scale) : t.ramp;
     // A pixel's width per unit eye depth, in grid steps (at the view's centre: the level of
     // detail needs no more), or 0 for the exact surface everywhere.
-    d.pixel = options.terrainLod ? 2 * halfY_ / (options.height * options.supersample) /
+    d.pixel = options.terrainLod ? 2 * rays_.halfY / (options.height * options.supersample) /
                                        std::min(f.spacingU, f.spacingV)
                                  : 0.0;
     groundBytes_ += t.ground->bytes();
@@ -188,8 +171,8 @@ void TerrainPass::setTerrains(const scene::Scene& scene, const FrameCamera& came
 }
 
 void TerrainPass::prepare(const raster::PassFrame& frame) {
-  width_ = frame.width;
-  height_ = frame.height;
+  width_ = rays_.width = frame.width;
+  height_ = rays_.height = frame.height;
   samples_ = frame.samples;
   for (int s = 0; s < samples_; ++s) {
     offsetX_[s] = frame.coverage ? frame.coverage->offsetX[s] / 256.0 : 0.0;
@@ -212,19 +195,6 @@ void TerrainPass::addStats(FrameStats& stats) const {
   stats.terrainLoadMs += loadMs_;
 }
 
-Vec3d TerrainPass::direction(double px, double py) const {
-  return forward_ + right_ * ((2 * px / width_ - 1) * halfX_ + centreX_) +
-         up_ * ((1 - 2 * py / height_) * halfY_ + centreY_);
-}
-
-// Window depth (z + 1)/2 ↔ eye depth s: ndc z = −p22 + p23/s (the GL projection's depth row).
-double TerrainPass::depthToS(float depth) const {
-  if (!(depth < 1.0f)) return zfar_;
-  const double ndc = 2.0 * depth - 1.0;
-  return std::clamp(p23_ / (ndc + p22_), znear_, zfar_);
-}
-float TerrainPass::sToDepth(double s) const { return float(0.5 * (-p22_ + p23_ / s) + 0.5); }
-
 void TerrainPass::drawTile(const raster::TileTarget& tile) {
   if (terrains_.empty()) return;
   Scratch& w = *scratch_[size_t(tile.worker)];
@@ -244,7 +214,7 @@ void TerrainPass::drawTile(const raster::TileTarget& tile) {
         double far = 0;
         for (int k = 0; k < s; ++k) {
           const float z = tile.depth[FrameBuffer::depthOffset(lx, ly, s, k)];
-          const double v = depthToS(z);
+          const double v = rays_.depthToS(z);
           w.depth[kPlane * size_t(k) + size_t(ly * kTileSize + lx)] = z;
           w.limit[kPlane * size_t(k) + size_t(ly * kTileSize + lx)] = v;
           far = std::max(far, v);
@@ -263,7 +233,7 @@ void TerrainPass::drawTile(const raster::TileTarget& tile) {
     }
     std::fill(w.hit.begin(), w.hit.end(), kNaN);
     w.pixels.clear();
-    castWindow(w, t, 0, 0, kTileSize, znear_);
+    castWindow(w, t, 0, 0, kTileSize, rays_.znear);
     shadeHits(w, t, tile);
   }
 }
@@ -280,9 +250,9 @@ void TerrainPass::castWindow(Scratch& w, const Drawn& t, int x0, int y0, int siz
   const double limit = w.windowLimit[level][size_t((y0 >> level) * (64 >> level) + (x0 >> level))];
   if (!(start < limit)) return;  // masked: what is there already is nearer
   const double x1 = std::min(gx + size, width_), y1 = std::min(gy + size, height_);
-  const terrain::Bundle b{eye_,
-                          {direction(gx, gy), direction(x1, gy), direction(gx, y1),
-                           direction(x1, y1)}};
+  const terrain::Bundle b{rays_.eye,
+                          {rays_.direction(gx, gy), rays_.direction(x1, gy), rays_.direction(gx, y1),
+                           rays_.direction(x1, y1)}};
   // The bundle's width per unit depth, in grid steps (for the pyramid level of its steps).
   const terrain::HeightField& f = t.ground->field;
   const Vec3d d1 = b.corner[3] - b.corner[0], d2 = b.corner[2] - b.corner[1];
@@ -311,9 +281,9 @@ void TerrainPass::castPixel(Scratch& w, const Drawn& t, int x, int y, double sta
     const size_t at = kPlane * size_t(k) + p;
     const double lim = w.limit[at];
     if (!(start < lim)) continue;
-    const Vec3d d = direction(gx + 0.5 + offsetX_[k], gy + 0.5 + offsetY_[k]);
-    const double hs = t.caster->cast(eye_, d, start, lim, *w.counts, t.pixel);
-    if (std::isnan(hs) || !(sToDepth(hs) < w.depth[at])) continue;
+    const Vec3d d = rays_.direction(gx + 0.5 + offsetX_[k], gy + 0.5 + offsetY_[k]);
+    const double hs = t.caster->cast(rays_.eye, d, start, lim, *w.counts, t.pixel);
+    if (std::isnan(hs) || !(rays_.sToDepth(hs) < w.depth[at])) continue;
     w.hit[at] = hs;
     any = true;
   }
@@ -347,9 +317,9 @@ void TerrainPass::shadeHits(Scratch& w, const Drawn& t, const raster::TileTarget
       int k = 0;
       while (std::isnan(w.hit[kPlane * size_t(k) + size_t(p)])) ++k;
       const double sx = w.ox + lx + 0.5 + offsetX_[k], sy = w.oy + ly + 0.5 + offsetY_[k];
-      const Vec3d d = direction(sx, sy);
+      const Vec3d d = rays_.direction(sx, sy);
       const double hs = w.hit[kPlane * size_t(k) + size_t(p)];
-      const Vec3d point = eye_ + d * hs;
+      const Vec3d point = rays_.eye + d * hs;
       const terrain::Caster::MapPoint m = c.toMap(point);
       const double gxc = std::clamp(m.gx, 0.0, double(f.width - 1));
       const double gyc = std::clamp(m.gy, 0.0, double(f.height - 1));
@@ -357,13 +327,13 @@ void TerrainPass::shadeHits(Scratch& w, const Drawn& t, const raster::TileTarget
       // The normal of the surface the ray met: its level of detail's.
       const Vec3d normal =
           c.normal(gxc, gyc, &eastDir, &northDir, c.lodLevel(hs, t.pixel, c.stretch(d)));
-      const Vec3d rel = point - eye_;
-      frag.attribute[shade::kEyeX][i] = float(dot(rel, right_));
-      frag.attribute[shade::kEyeY][i] = float(dot(rel, up_));
-      frag.attribute[shade::kEyeZ][i] = float(-dot(rel, forward_));
-      frag.attribute[shade::kNormalX][i] = float(dot(normal, right_));
-      frag.attribute[shade::kNormalY][i] = float(dot(normal, up_));
-      frag.attribute[shade::kNormalZ][i] = float(-dot(normal, forward_));
+      const Vec3d rel = point - rays_.eye;
+      frag.attribute[shade::kEyeX][i] = float(dot(rel, rays_.right));
+      frag.attribute[shade::kEyeY][i] = float(dot(rel, rays_.up));
+      frag.attribute[shade::kEyeZ][i] = float(-dot(rel, rays_.forward));
+      frag.attribute[shade::kNormalX][i] = float(dot(normal, rays_.right));
+      frag.attribute[shade::kNormalY][i] = float(dot(normal, rays_.up));
+      frag.attribute[shade::kNormalZ][i] = float(-dot(normal, rays_.forward));
       const double u = c.mapU(gxc), v = c.mapV(gyc);
       Vec3 color{t.color[0], t.color[1], t.color[2]};
       if (!image) {
@@ -375,7 +345,7 @@ void TerrainPass::shadeHits(Scratch& w, const Drawn& t, const raster::TileTarget
       double du[2] = {0, 0}, dv[2] = {0, 0};
       bool finite = true;
       for (int axis = 0; axis < 2; ++axis) {
-        const Vec3d dn = direction(sx + (axis == 0), sy + (axis == 1));
+        const Vec3d dn = rays_.direction(sx + (axis == 0), sy + (axis == 1));
         const double den = dot(normal, dn);
         const double tt = std::fabs(den) > 1e-12 ? dot(normal, rel) / den : -1;
         if (!(tt > 0) || !std::isfinite(tt)) {
@@ -418,7 +388,7 @@ void TerrainPass::shadeHits(Scratch& w, const Drawn& t, const raster::TileTarget
       for (int k = 0; k < s; ++k) {
         const double hs = w.hit[kPlane * size_t(k) + size_t(p)];
         if (std::isnan(hs)) continue;
-        tile.depth[FrameBuffer::depthOffset(lx, ly, s, k)] = sToDepth(hs);
+        tile.depth[FrameBuffer::depthOffset(lx, ly, s, k)] = rays_.sToDepth(hs);
         for (int ch = 0; ch < 3; ++ch)
           tile.color[FrameBuffer::colorOffset(lx, ly, ch, s, k)] = c16[ch];
       }

@@ -12,6 +12,7 @@
 #include <memory>
 #include <vector>
 
+#include "core/eye_rays.h"
 #include "raster/tile_pass.h"
 #include "render/camera.h"
 #include "render/shading_tables.h"
@@ -59,18 +60,9 @@ class TerrainPass final : public raster::TilePass {
   void castWindow(Scratch& w, const Drawn& t, int x0, int y0, int size, double start) const;
   void castPixel(Scratch& w, const Drawn& t, int x, int y, double start) const;
   void shadeHits(Scratch& w, const Drawn& t, const raster::TileTarget& tile) const;
-  Vec3d direction(double px, double py) const;  // the ray through raster point (px, py)
-  double depthToS(float windowDepth) const;
-  float sToDepth(double s) const;
-
   std::vector<Drawn> terrains_;
   const shade::Environment* environment_ = nullptr;
-  // The camera in the world: eye, and the ray direction's parts (a point at eye depth s is
-  // eye + s·(forward + px·right + py·up)), and the eye-space rotation; the view window at unit
-  // depth, its centre and half-size (FrameCamera's tangents).
-  Vec3d eye_, forward_, right_, up_;
-  double halfX_ = 1, halfY_ = 1, centreX_ = -0.0, centreY_ = -0.0, znear_ = 0.1, zfar_ = 1000;
-  double p22_ = 0, p23_ = 0;  // the projection's depth row: ndc z = −p22 + p23/s
+  EyeRays rays_;  // the camera's rays and depths (its raster set by prepare)
   int width_ = 0, height_ = 0, samples_ = 1;
   double offsetX_[64] = {}, offsetY_[64] = {};
   std::vector<std::unique_ptr<Scratch>> scratch_;
