@@ -143,6 +143,14 @@ struct CityParams {
 };
 Scene generateCity(const CityParams& params);
 
+// The Marschner–Lobb test signal (Marschner and Lobb 1994, f_M = 6, α = 1/4) on [−1, 1]³, in
+// [0, 1]: ρ = (1 − sin(πz/2) + α(1 + cos(2π f_M cos(π r / 2)))) / (2(1 + α)), r = √(x² + y²).
+double marschnerLobb(double x, double y, double z);
+// It sampled on a size³ grid spanning [−1, 1]³ (spacing 2/(size − 1), its own space's origin at
+// (−1, −1, −1): place it by a translation of (−1, −1, −1)), quantized to `bits` (8 or 16) — values
+// 0 … 1. size 2 … 1024.
+VolumeGrid marschnerLobbGrid(int size, int bits = 8);
+
 // The frame every generated scene shares: one instance of mesh 0 with material 0 (unlit,
 // double-sided, named `name`), the BENCH.md camera, no light, black background. No meshes yet.
 Scene benchCameraScene(const std::string& name);

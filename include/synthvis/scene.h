@@ -16,6 +16,7 @@
 #include "synthvis/light_points.h"
 #include "synthvis/lines.h"
 #include "synthvis/math.h"
+#include "synthvis/volumes.h"
 #include "synthvis/result.h"
 
 namespace sv::texture {
@@ -367,6 +368,10 @@ struct Scene {
   // Lines (LineSegment): drawn after the opaque surfaces, depth-tested and writing depth.
   std::vector<LineSegment> lines;
   LineSettings lineSettings;
+  // Voxel volumes (synthvis/volumes.h): ray cast after the opaque surfaces, composited front to
+  // back over them, before the translucent polygons.
+  std::vector<VolumeObject> volumes;
+  VolumeSettings volumeSettings;
   // Simulation time, seconds: what blinking, sequences and the stars' rotation are functions of.
   double time = 0;
   // What a loader read but does not draw, one line each naming the file and the part ("…: 2

@@ -53,7 +53,11 @@ std::string FrameStats::summary() const {
                                     lightsMs)
                       : std::string()) +
          (lines ? fmt::format(" | lines {}: drawn {}, {:.2f} ms", lines, linesDrawn, linesMs)
-                : std::string());
+                : std::string()) +
+         (volumes ? fmt::format(" | volumes {}: rays {}, samples {}, skipped {}, terminated {}",
+                                volumes, volumeRays, volumeSamples, volumeSkipped,
+                                volumeTerminated)
+                  : std::string());
 }
 
 }  // namespace sv

@@ -41,6 +41,22 @@ std::vector<raster::TilePass*> FramePasses::compose(const scene::Scene& scene,
                                      scene.fog.beta});
     passes.push_back(&lines_);
   }
+  if (!scene.volumes.empty()) {
+    volume::VolumeInput in;
+    in.volumes = &scene.volumes;
+    in.settings = scene.volumeSettings;
+    in.rays = EyeRays::of(camera.view, camera.projection, camera.tanLeft, camera.tanRight,
+                          camera.tanBottom, camera.tanTop, camera.camera.znear,
+                          camera.camera.zfar);
+    in.viewProjection = camera.projection * camera.view;
+    in.lightOn = scene.light.enabled;
+    in.toLight = normalize(scene.light.direction * -1.0f);
+    in.lightColor = scene.light.color;
+    in.ambient = scene.light.ambient;
+    if (scene.fog.enabled) in.fogBeta = scene.fog.beta, in.fogColor = scene.fog.color;
+    volumes_.setVolumes(in);
+    passes.push_back(&volumes_);
+  }
   if (!scene.lightPoints.empty() || !scene.stars.stars.empty()) {
     lights_.setLights(lightInput(scene, camera));
     passes.push_back(&lights_);

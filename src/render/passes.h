@@ -10,6 +10,7 @@
 #include "render/camera.h"
 #include "render/shading_tables.h"
 #include "render/terrain_pass.h"
+#include "volume/volume_pass.h"
 
 namespace sv::render {
 
@@ -28,6 +29,7 @@ class FramePasses {
   freeform::FreeFormPass freeForms_;
   TerrainPass terrains_;
   lines::LinePass lines_;
+  volume::VolumePass volumes_;
   lights::LightPass lights_;
 };
 

@@ -85,6 +85,59 @@ namespace {
 
 bool inRange(float v, float lo, float hi) { return v >= lo && v <= hi; }
 
+// The volumes' invariants (synthvis/volumes.h): a grid of the size it says, within the limits,
+// finite positive spacing and scale; a finite affine invertible transform; a transfer function of
+// 1 … 256 points, values increasing, colours finite and non-negative, opacities in [0, 1].
+Status validateVolumes(const Scene& scene) {
+  auto fail = [](size_t i, const std::string& name, std::string message) {
+    return Status(Error{"", "", fmt::format("volumes[{}] ('{}'): {}", i, name, message)});
+  };
+  for (size_t i = 0; i < scene.volumes.size(); ++i) {
+    const VolumeObject& v = scene.volumes[i];
+    if (!v.grid) return fail(i, v.name, "no grid");
+    const VolumeGrid& g = *v.grid;
+    if (g.nx < 2 || g.ny < 2 || g.nz < 2 || g.nx > kMaxVolumeSide || g.ny > kMaxVolumeSide ||
+        g.nz > kMaxVolumeSide || size_t(g.nx) * size_t(g.ny) * size_t(g.nz) > kMaxVolumeSamples)
+      return fail(i, v.name,
+                  fmt::format("{} × {} × {} samples (2 … {} a side, at most {} in all)", g.nx, g.ny,
+                              g.nz, kMaxVolumeSide, kMaxVolumeSamples));
+    if (g.codes.size() != size_t(g.nx) * size_t(g.ny) * size_t(g.nz))
+      return fail(i, v.name, fmt::format("{} codes for {} samples", g.codes.size(),
+                                         size_t(g.nx) * size_t(g.ny) * size_t(g.nz)));
+    if (!(g.scale > 0) || !std::isfinite(g.scale) || !std::isfinite(g.offset) ||
+        !std::isfinite(g.offset + 65535 * g.scale) || !(g.spacing.x > 0) || !(g.spacing.y > 0) ||
+        !(g.spacing.z > 0) || !isFinite(g.spacing))
+      return fail(i, v.name, "its value scale and spacing must be finite and positive");
+    bool finite = true;
+    for (const auto& row : v.transform.m)
+      for (float x : row) finite &= std::isfinite(x);
+    const Mat4& m = v.transform;
+    const double det = double(m.m[0][0]) * (double(m.m[1][1]) * m.m[2][2] - double(m.m[2][1]) * m.m[1][2]) -
+                       double(m.m[1][0]) * (double(m.m[0][1]) * m.m[2][2] - double(m.m[2][1]) * m.m[0][2]) +
+                       double(m.m[2][0]) * (double(m.m[0][1]) * m.m[1][2] - double(m.m[1][1]) * m.m[0][2]);
+    if (!finite || m.m[0][3] != 0 || m.m[1][3] != 0 || m.m[2][3] != 0 || m.m[3][3] != 1 ||
+        !(std::fabs(det) > 1e-30) || !std::isfinite(det))
+      return fail(i, v.name, "its transform must be finite, affine and invertible");
+    if (v.transfer.empty() || v.transfer.size() > 256)
+      return fail(i, v.name, fmt::format("{} transfer points (1 … 256)", v.transfer.size()));
+    for (size_t k = 0; k < v.transfer.size(); ++k) {
+      const TransferPoint& p = v.transfer[k];
+      if (!std::isfinite(p.value) || (k > 0 && !(p.value > v.transfer[k - 1].value)) ||
+          !inRange(p.color.x, 0, 1e6f) || !inRange(p.color.y, 0, 1e6f) ||
+          !inRange(p.color.z, 0, 1e6f) || !inRange(p.opacity, 0, 1))
+        return fail(i, v.name,
+                    fmt::format("transfer point {}: values must increase, colours be finite and "
+                                "non-negative, opacities in [0, 1]",
+                                k));
+    }
+    if (!inRange(v.opacityUnit, 0, 1e30f)) return fail(i, v.name, "opacityUnit must be ≥ 0");
+  }
+  const VolumeSettings& s = scene.volumeSettings;
+  if (!inRange(s.step, 0.05f, 8) || !inRange(s.termination, 0, 0.5f))
+    return Status(Error{"", "", "volumeSettings: step must be 0.05 … 8 voxels, termination 0 … 0.5"});
+  return {};
+}
+
 // The light points' invariants (synthvis/light_points.h): every number finite and in its range,
 // every index in range. The per-light checks are branch-free reductions (they run every frame).
 Status validateLights(const Scene& scene) {
@@ -139,6 +192,7 @@ Status validateLights(const Scene& scene) {
   if (!inRange(scene.lineSettings.width, 1.0f / 64, 64) ||
       !inRange(scene.lineSettings.depthBias, 0, 0.5f))
     return fail("lineSettings: width must be 1/64 … 64 pixels and depthBias 0 … 0.5");
+  if (Status st = validateVolumes(scene); !st) return st;
   const StarField& f = scene.stars;
   if (!inRange(f.latitude, -90, 90) || !std::isfinite(f.siderealTime) ||
       !inRange(f.brightness, 0, 1e6f) || !std::isfinite(f.limit))
@@ -364,6 +418,10 @@ void appendArticulationsAndLights(Scene& scene, const Scene& other, const Mat4& 
     l.a = transform.transformPoint(l.a);
     l.b = transform.transformPoint(l.b);
     scene.lines.push_back(l);
+  }
+  for (VolumeObject v : other.volumes) {
+    v.transform = transform * v.transform;
+    scene.volumes.push_back(std::move(v));
   }
 }
 

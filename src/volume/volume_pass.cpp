@@ -1,0 +1,411 @@
+#include "volume/volume_pass.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "raster/framebuffer.h"
+
+namespace sv::volume {
+namespace {
+
+using raster::FrameBuffer;
+using raster::kTileSize;
+
+// The transfer function (synthvis/volumes.h TransferPoint) at `value`: linear between points, the
+// end points' beyond them.
+std::array<float, 4> classify(const std::vector<scene::TransferPoint>& tf, float value) {
+  auto of = [](const scene::TransferPoint& p) {
+    return std::array<float, 4>{p.color.x, p.color.y, p.color.z, p.opacity};
+  };
+  if (!(value > tf.front().value)) return of(tf.front());
+  if (!(value < tf.back().value)) return of(tf.back());
+  const auto hi = std::upper_bound(tf.begin(), tf.end(), value,
+                                   [](float v, const scene::TransferPoint& p) { return v < p.value; });
+  const scene::TransferPoint& b = *hi;
+  const scene::TransferPoint& a = *(hi - 1);
+  const float t = (value - a.value) / (b.value - a.value);
+  const auto ca = of(a), cb = of(b);
+  return {ca[0] + t * (cb[0] - ca[0]), ca[1] + t * (cb[1] - ca[1]), ca[2] + t * (cb[2] - ca[2]),
+          ca[3] + t * (cb[3] - ca[3])};
+}
+
+// A grid read trilinearly in code units at a point of its own space (clamped to the box).
+struct Sampler {
+  const scene::VolumeGrid& g;
+  const double* inverseSpacing;
+
+  // The trilinear code at own-space point (x, y, z), and the cell it lies in.
+  float at(double x, double y, double z) const {
+    const double fx = std::clamp(x * inverseSpacing[0], 0.0, double(g.nx - 1));
+    const double fy = std::clamp(y * inverseSpacing[1], 0.0, double(g.ny - 1));
+    const double fz = std::clamp(z * inverseSpacing[2], 0.0, double(g.nz - 1));
+    const int i = std::min(int(fx), g.nx - 2), j = std::min(int(fy), g.ny - 2),
+              k = std::min(int(fz), g.nz - 2);
+    const float tx = float(fx - i), ty = float(fy - j), tz = float(fz - k);
+    const uint16_t* c = g.codes.data() + g.at(i, j, k);
+    const size_t sy = size_t(g.nx), sz = size_t(g.nx) * size_t(g.ny);
+    auto lerp = [](float a, float b, float t) { return a + t * (b - a); };
+    const float c00 = lerp(c[0], c[1], tx), c10 = lerp(c[sy], c[sy + 1], tx);
+    const float c01 = lerp(c[sz], c[sz + 1], tx), c11 = lerp(c[sz + sy], c[sz + sy + 1], tx);
+    return lerp(lerp(c00, c10, ty), lerp(c01, c11, ty), tz);
+  }
+};
+
+// The ray o + s·d (own space) against the box [0, e]: its entry and exit s, empty when s0 ≥ s1.
+void clipToBox(const double o[3], const double d[3], const double lo[3], const double hi[3],
+               double& s0, double& s1) {
+  for (int a = 0; a < 3; ++a) {
+    if (d[a] == 0) {
+      if (o[a] < lo[a] || o[a] > hi[a]) s0 = s1;
+      continue;
+    }
+    double t0 = (lo[a] - o[a]) / d[a], t1 = (hi[a] - o[a]) / d[a];
+    if (t0 > t1) std::swap(t0, t1);
+    s0 = std::max(s0, t0);
+    s1 = std::min(s1, t1);
+  }
+}
+
+// One pixel's compositing: the running colour and transparency, and per sample of the pixel the
+// value they had when the ray reached that sample's depth.
+struct PixelComposite {
+  double C[3] = {0, 0, 0};
+  double T = 1;
+  int samples = 1;
+  double limit[64];   // per sample: its eye depth (the surface already there)
+  bool done[64];
+  double snapC[64][3], snapT[64];
+
+  // Records the samples whose surface lies at or before eye depth s.
+  void reach(double s) {
+    for (int k = 0; k < samples; ++k)
+      if (!done[k] && limit[k] <= s) {
+        done[k] = true;
+        snapC[k][0] = C[0], snapC[k][1] = C[1], snapC[k][2] = C[2];
+        snapT[k] = T;
+      }
+  }
+};
+
+}  // namespace
+
+void VolumePass::setVolumes(const VolumeInput& input) {
+  input_ = input;
+  const auto& objects = *input.volumes;
+  volumes_.resize(objects.size());
+  for (size_t i = 0; i < objects.size(); ++i) {
+    Prepared& p = volumes_[i];
+    const scene::VolumeObject& v = objects[i];
+    const bool same = p.grid == v.grid.get() && p.transferKey == &v.transfer &&
+                      p.transfer.size() == v.transfer.size() &&
+                      std::equal(p.transfer.begin(), p.transfer.end(), v.transfer.begin(),
+                                 [](const scene::TransferPoint& a, const scene::TransferPoint& b) {
+                                   return a.value == b.value && a.opacity == b.opacity &&
+                                          a.color.x == b.color.x && a.color.y == b.color.y &&
+                                          a.color.z == b.color.z;
+                                 });
+    p.object = &v;
+    if (!same) {
+      p.grid = v.grid.get();
+      p.transferKey = &v.transfer;
+      p.transfer = v.transfer;
+      prepareTables(p);
+    }
+    // World → own: the inverse of the affine transform, in double.
+    const Mat4& m = v.transform;
+    double a[3][3], inv[3][3];
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) a[r][c] = m.m[c][r];
+    const double det = a[0][0] * (a[1][1] * a[2][2] - a[2][1] * a[1][2]) -
+                       a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
+                       a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
+    const double id = 1 / det;
+    inv[0][0] = (a[1][1] * a[2][2] - a[2][1] * a[1][2]) * id;
+    inv[0][1] = (a[0][2] * a[2][1] - a[0][1] * a[2][2]) * id;
+    inv[0][2] = (a[0][1] * a[1][2] - a[0][2] * a[1][1]) * id;
+    inv[1][0] = (a[1][2] * a[2][0] - a[1][0] * a[2][2]) * id;
+    inv[1][1] = (a[0][0] * a[2][2] - a[0][2] * a[2][0]) * id;
+    inv[1][2] = (a[1][0] * a[0][2] - a[0][0] * a[1][2]) * id;
+    inv[2][0] = (a[1][0] * a[2][1] - a[2][0] * a[1][1]) * id;
+    inv[2][1] = (a[2][0] * a[0][1] - a[0][0] * a[2][1]) * id;
+    inv[2][2] = (a[0][0] * a[1][1] - a[1][0] * a[0][1]) * id;
+    const double t[3] = {m.m[3][0], m.m[3][1], m.m[3][2]};
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) p.toOwn[r][c] = inv[r][c];
+      p.toOwn[r][3] = -(inv[r][0] * t[0] + inv[r][1] * t[1] + inv[r][2] * t[2]);
+    }
+    const scene::VolumeGrid& g = *v.grid;
+    const Vec3 e = g.extent();
+    p.extent[0] = e.x, p.extent[1] = e.y, p.extent[2] = e.z;
+    p.inverseSpacing[0] = 1.0 / g.spacing.x;
+    p.inverseSpacing[1] = 1.0 / g.spacing.y;
+    p.inverseSpacing[2] = 1.0 / g.spacing.z;
+    const double smallest = std::min({double(g.spacing.x), double(g.spacing.y), double(g.spacing.z)});
+    p.stepOwn = double(input.settings.step) * smallest;
+    // The smallest spacing in the world: the shortest image of a voxel's edge.
+    double unit = 1e300;
+    for (int axis = 0; axis < 3; ++axis) {
+      const double sp = axis == 0 ? g.spacing.x : axis == 1 ? g.spacing.y : g.spacing.z;
+      const double len = std::sqrt(double(m.m[axis][0]) * m.m[axis][0] +
+                                   double(m.m[axis][1]) * m.m[axis][1] +
+                                   double(m.m[axis][2]) * m.m[axis][2]) * sp;
+      unit = std::min(unit, len);
+    }
+    p.opacityUnit = v.opacityUnit > 0 ? double(v.opacityUnit) : unit;
+  }
+}
+
+// The transfer function as a table over the grid's codes, and the map of bricks whose every sample
+// it makes transparent. A sample reads the table linearly between the two entries around its code,
+// so a brick is transparent when every entry from below its smallest code to above its largest is.
+void VolumePass::prepareTables(Prepared& p) const {
+  const scene::VolumeGrid& g = *p.grid;
+  const uint16_t top = g.codes.empty() ? 1 : std::max<uint16_t>(1, *std::max_element(g.codes.begin(), g.codes.end()));
+  const int entries = std::min(kTableSize, int(top) + 1);
+  p.codeScale = double(entries - 1) / double(top);
+  p.table.assign(size_t(entries) * 4, 0.0f);
+  std::vector<uint32_t> opaqueBefore(size_t(entries) + 1, 0);  // entries with opacity > 0 before e
+  for (int e = 0; e < entries; ++e) {
+    const float code = float(double(e) / p.codeScale);
+    const auto c = classify(p.transfer, g.offset + g.scale * code);
+    for (int k = 0; k < 4; ++k) p.table[size_t(e) * 4 + size_t(k)] = c[size_t(k)];
+    opaqueBefore[size_t(e) + 1] = opaqueBefore[size_t(e)] + (c[3] > 0);
+  }
+  const int n[3] = {g.nx, g.ny, g.nz};
+  for (int a = 0; a < 3; ++a) p.bricks[a] = (n[a] - 2) / kBrick + 1;
+  p.emptyBrick.assign(size_t(p.bricks[0]) * size_t(p.bricks[1]) * size_t(p.bricks[2]), 0);
+  for (int bz = 0; bz < p.bricks[2]; ++bz)
+    for (int by = 0; by < p.bricks[1]; ++by)
+      for (int bx = 0; bx < p.bricks[0]; ++bx) {
+        // The brick's cells' corner samples: [8b, 8b + 8] on each axis, within the grid.
+        uint16_t lo = 65535, hi = 0;
+        for (int k = bz * kBrick; k <= std::min(bz * kBrick + kBrick, g.nz - 1); ++k)
+          for (int j = by * kBrick; j <= std::min(by * kBrick + kBrick, g.ny - 1); ++j) {
+            const uint16_t* row = g.codes.data() + g.at(0, j, k);
+            for (int i = bx * kBrick; i <= std::min(bx * kBrick + kBrick, g.nx - 1); ++i) {
+              lo = std::min(lo, row[i]);
+              hi = std::max(hi, row[i]);
+            }
+          }
+        const int first = std::max(0, int(std::floor(lo * p.codeScale)));
+        const int last = std::min(entries - 1, int(std::floor(hi * p.codeScale)) + 1);
+        p.emptyBrick[(size_t(bz) * size_t(p.bricks[1]) + size_t(by)) * size_t(p.bricks[0]) +
+                     size_t(bx)] = opaqueBefore[size_t(last) + 1] == opaqueBefore[size_t(first)];
+      }
+}
+
+// The pixels the volume's box may cover: its corners projected, or the whole raster when one lies
+// behind the eye.
+void VolumePass::screenBounds(Prepared& p) const {
+  const Mat4& m = p.object->transform;
+  const EyeRays& r = input_.rays;
+  double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
+  bool behind = false;
+  for (int c = 0; c < 8; ++c) {
+    const Vec3 own{c & 1 ? float(p.extent[0]) : 0.0f, c & 2 ? float(p.extent[1]) : 0.0f,
+                   c & 4 ? float(p.extent[2]) : 0.0f};
+    const Vec3 world = m.transformPoint(own);
+    const Vec4 clip = input_.viewProjection * Vec4{world.x, world.y, world.z, 1.0f};
+    if (!(clip.w > 1e-6f * std::fabs(clip.x) + 1e-20f)) {
+      behind = true;
+      break;
+    }
+    const double px = (clip.x / clip.w + 1) * 0.5 * r.width;
+    const double py = (1 - clip.y / clip.w) * 0.5 * r.height;
+    x0 = std::min(x0, px), x1 = std::max(x1, px), y0 = std::min(y0, py), y1 = std::max(y1, py);
+  }
+  if (behind) {
+    p.x0 = p.y0 = 0, p.x1 = r.width, p.y1 = r.height;
+    return;
+  }
+  p.x0 = int(std::clamp(std::floor(x0) - 1, 0.0, double(r.width)));
+  p.y0 = int(std::clamp(std::floor(y0) - 1, 0.0, double(r.height)));
+  p.x1 = int(std::clamp(std::ceil(x1) + 1, 0.0, double(r.width)));
+  p.y1 = int(std::clamp(std::ceil(y1) + 1, 0.0, double(r.height)));
+}
+
+void VolumePass::prepare(const raster::PassFrame& frame) {
+  input_.rays.width = frame.width;
+  input_.rays.height = frame.height;
+  samples_ = frame.samples;
+  for (Prepared& p : volumes_) screenBounds(p);
+  const int workers = frame.pool ? frame.pool->threadCount() : 1;
+  counts_.assign(size_t(workers), WorkerCounts{});
+}
+
+void VolumePass::addStats(FrameStats& stats) const {
+  VolumeCounts c;
+  for (const WorkerCounts& w : counts_) c.add(w.counts);
+  stats.volumes += volumes_.size();
+  stats.volumeRays += c.rays;
+  stats.volumeSamples += c.samples;
+  stats.volumeSkipped += c.skipped;
+  stats.volumeTerminated += c.terminated;
+}
+
+void VolumePass::drawTile(const raster::TileTarget& tile) {
+  if (volumes_.empty()) return;
+  VolumeCounts& counts = counts_[size_t(tile.worker)].counts;
+  const EyeRays& r = input_.rays;
+  const int ox = tile.tileX * kTileSize, oy = tile.tileY * kTileSize;
+  const int s = samples_;
+  const scene::VolumeSettings& settings = input_.settings;
+  const double epsilon = settings.termination;
+  // The volumes this tile may show, by their screen bounds.
+  std::array<const Prepared*, 64> listed{};
+  int count = 0;
+  for (const Prepared& p : volumes_)
+    if (p.x0 < ox + kTileSize && p.x1 > ox && p.y0 < oy + kTileSize && p.y1 > oy && count < 64)
+      listed[size_t(count++)] = &p;
+  if (count == 0) return;
+  for (int ly = 0; ly < kTileSize && oy + ly < r.height; ++ly)
+    for (int lx = 0; lx < kTileSize && ox + lx < r.width; ++lx) {
+      const int px = ox + lx, py = oy + ly;
+      const Vec3d d = r.direction(px + 0.5, py + 0.5);
+      const double worldPerS = std::sqrt(dot(d, d));
+      // Each listed volume's stretch of the ray, nearest entry first.
+      struct Stretch {
+        const Prepared* p;
+        double s0, s1, o[3], dir[3];
+      };
+      std::array<Stretch, 64> stretches;
+      int n = 0;
+      for (int v = 0; v < count; ++v) {
+        const Prepared& p = *listed[size_t(v)];
+        if (px < p.x0 || px >= p.x1 || py < p.y0 || py >= p.y1) continue;
+        Stretch st{&p, r.znear, r.zfar, {}, {}};
+        for (int a = 0; a < 3; ++a) {
+          st.o[a] = p.toOwn[a][0] * r.eye.x + p.toOwn[a][1] * r.eye.y + p.toOwn[a][2] * r.eye.z +
+                    p.toOwn[a][3];
+          st.dir[a] = p.toOwn[a][0] * d.x + p.toOwn[a][1] * d.y + p.toOwn[a][2] * d.z;
+        }
+        const double lo[3] = {0, 0, 0};
+        clipToBox(st.o, st.dir, lo, p.extent, st.s0, st.s1);
+        if (st.s0 < st.s1) stretches[size_t(n++)] = st;
+      }
+      if (n == 0) continue;
+      std::sort(stretches.begin(), stretches.begin() + n,
+                [](const Stretch& a, const Stretch& b) { return a.s0 < b.s0; });
+      PixelComposite pc;
+      pc.samples = s;
+      double farthest = 0;
+      for (int k = 0; k < s; ++k) {
+        pc.limit[k] = r.depthToS(tile.depth[FrameBuffer::depthOffset(lx, ly, s, k)]);
+        pc.done[k] = false;
+        farthest = std::max(farthest, pc.limit[k]);
+      }
+      ++counts.rays;
+      bool terminated = false;
+      for (int v = 0; v < n && !terminated; ++v) {
+        const Stretch& st = stretches[size_t(v)];
+        const Prepared& p = *st.p;
+        const scene::VolumeGrid& g = *p.grid;
+        const Sampler sampler{g, p.inverseSpacing};
+        const double dirLength = std::sqrt(st.dir[0] * st.dir[0] + st.dir[1] * st.dir[1] +
+                                           st.dir[2] * st.dir[2]);
+        const double ds = p.stepOwn / dirLength;  // a step in s
+        const double end = std::min(st.s1, farthest);
+        const scene::VolumeObject& object = *p.object;
+        const int entries = int(p.table.size() / 4);
+        const double brickSize[3] = {kBrick * double(g.spacing.x), kBrick * double(g.spacing.y),
+                                     kBrick * double(g.spacing.z)};
+        // Segments [s0 + i·ds, s0 + (i + 1)·ds) ∩ [s0, end), each sampled at its middle.
+        for (int64_t i = 0;; ++i) {
+          const double a = st.s0 + double(i) * ds;
+          if (!(a < end)) break;
+          pc.reach(a);
+          const double b = std::min(a + ds, end), mid = 0.5 * (a + b);
+          const double q[3] = {st.o[0] + mid * st.dir[0], st.o[1] + mid * st.dir[1],
+                               st.o[2] + mid * st.dir[2]};
+          if (settings.skipEmpty) {
+            int bi[3];
+            for (int ax = 0; ax < 3; ++ax)
+              bi[ax] = std::clamp(int(std::floor(q[ax] / brickSize[ax])), 0, p.bricks[ax] - 1);
+            if (p.emptyBrick[(size_t(bi[2]) * size_t(p.bricks[1]) + size_t(bi[1])) *
+                                 size_t(p.bricks[0]) + size_t(bi[0])]) {
+              // To the last segment whose middle is still in this brick: its samples would all be
+              // transparent (the brick holds their cells' corners).
+              double lo[3], hi[3];
+              for (int ax = 0; ax < 3; ++ax) {
+                lo[ax] = bi[ax] * brickSize[ax];
+                hi[ax] = bi[ax] == p.bricks[ax] - 1 ? 1e300 : (bi[ax] + 1) * brickSize[ax];
+                if (bi[ax] == 0) lo[ax] = -1e300;
+              }
+              double e0 = -1e300, e1 = 1e300;
+              clipToBox(st.o, st.dir, lo, hi, e0, e1);
+              // Segment j's middle is s0 + (j + ½)·ds; those with it below e1 are in the brick.
+              const double last = std::ceil((e1 - st.s0) / ds - 0.5) - 1;
+              const int64_t skipTo = std::max<int64_t>(i, int64_t(std::min(last, 1e15)));
+              counts.skipped += uint64_t(skipTo - i + 1);
+              i = skipTo;
+              continue;
+            }
+          }
+          ++counts.samples;
+          const float code = sampler.at(q[0], q[1], q[2]);
+          const double pos = code * p.codeScale;
+          const int e = std::min(int(pos), entries - 2 < 0 ? 0 : entries - 2);
+          const float f = entries > 1 ? float(pos - e) : 0.0f;
+          const float* t0 = &p.table[size_t(e) * 4];
+          const float* t1 = entries > 1 ? t0 + 4 : t0;
+          const float opacity = t0[3] + f * (t1[3] - t0[3]);
+          if (!(opacity > 0)) continue;
+          // SPEC §12: the opacity of a sample of length l is 1 − (1 − W)^(l / unit).
+          const double length = (b - a) * worldPerS;
+          const double w = opacity >= 1 ? 1.0 : 1 - std::pow(1 - double(opacity), length / p.opacityUnit);
+          double color[3] = {t0[0] + f * (t1[0] - t0[0]), t0[1] + f * (t1[1] - t0[1]),
+                             t0[2] + f * (t1[2] - t0[2])};
+          if (object.shaded && input_.lightOn) {
+            // The gradient by central differences over one sample spacing, to the world by the
+            // inverse transpose (the rows of world → own, transposed).
+            const double h[3] = {g.spacing.x, g.spacing.y, g.spacing.z};
+            double grad[3];
+            for (int ax = 0; ax < 3; ++ax) {
+              double up[3] = {q[0], q[1], q[2]}, down[3] = {q[0], q[1], q[2]};
+              up[ax] += h[ax], down[ax] -= h[ax];
+              grad[ax] = (double(sampler.at(up[0], up[1], up[2])) -
+                          double(sampler.at(down[0], down[1], down[2]))) /
+                         (2 * h[ax]);
+            }
+            Vec3d nw{p.toOwn[0][0] * grad[0] + p.toOwn[1][0] * grad[1] + p.toOwn[2][0] * grad[2],
+                     p.toOwn[0][1] * grad[0] + p.toOwn[1][1] * grad[1] + p.toOwn[2][1] * grad[2],
+                     p.toOwn[0][2] * grad[0] + p.toOwn[1][2] * grad[1] + p.toOwn[2][2] * grad[2]};
+            const double len = std::sqrt(dot(nw, nw));
+            if (len > 0) {
+              // Two-sided (a volume's gradient points either way through a surface), SPEC §8's
+              // weighting with Q_diff = 1 − Q_amb.
+              const double cosine = std::fabs(dot(nw, Vec3d{input_.toLight.x, input_.toLight.y,
+                                                            input_.toLight.z})) / len;
+              const double diffuse = (1 - input_.ambient) * cosine;
+              const double lc[3] = {input_.lightColor.x, input_.lightColor.y, input_.lightColor.z};
+              for (int c = 0; c < 3; ++c) color[c] *= input_.ambient + diffuse * lc[c];
+            }
+          }
+          if (input_.fogBeta > 0) {
+            const double fog = std::exp2(-double(input_.fogBeta) * mid * worldPerS);  // SPEC §8
+            const double fc[3] = {input_.fogColor.x, input_.fogColor.y, input_.fogColor.z};
+            for (int c = 0; c < 3; ++c) color[c] = color[c] * fog + fc[c] * (1 - fog);
+          }
+          for (int c = 0; c < 3; ++c) pc.C[c] += pc.T * w * color[c];
+          pc.T *= 1 - w;
+          if (pc.T < epsilon) {
+            terminated = true;
+            ++counts.terminated;
+            break;
+          }
+        }
+      }
+      // Samples the rays did not reach take the whole composite; then each over its surface.
+      pc.reach(1e300);
+      for (int k = 0; k < s; ++k) {
+        for (int c = 0; c < 3; ++c) {
+          uint16_t& out = tile.color[FrameBuffer::colorOffset(lx, ly, c, s, k)];
+          const double v = pc.snapC[k][c] + pc.snapT[k] * (out / 65535.0);
+          out = uint16_t(std::lrint(std::clamp(v, 0.0, 1.0) * 65535.0));
+        }
+      }
+    }
+}
+
+}  // namespace sv::volume

@@ -1,0 +1,97 @@
+// Voxel volumes in the frame: a tile pass (raster/tile_pass.h, stage `volumes`) that casts a ray
+// per pixel through each volume after the opaque surfaces, classifies its samples by the volume's
+// transfer function, shades them by the gradient and composites them front to back over what the
+// pixel's samples already hold, each ray ending at its sample's depth (an aircraft inside a cloud).
+//
+// Based on: SPEC §11 (voxel arrays in their own coordinate system; classified while traversing:
+// opacity from the value, normal from its gradient), §12 (inner voxels are not discarded: the ray
+// continues through the object accumulating colour front to back, P = Σ I_n W_n Π_{m<n} (1 − W_m),
+// until the volume is exhausted or the transparency falls below ε; empty regions skipped without
+// descending to their samples; opacity corrected for the sample's length), §8 (Phong weighting,
+// fog by distance).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/eye_rays.h"
+#include "raster/tile_pass.h"
+#include "synthvis/volumes.h"
+
+namespace sv::volume {
+
+// What the pass needs of the scene and the view. The volumes must outlive the frame.
+struct VolumeInput {
+  const std::vector<scene::VolumeObject>* volumes = nullptr;
+  scene::VolumeSettings settings;
+  EyeRays rays;            // the view's (its raster is set by prepare)
+  Mat4 viewProjection;     // world → clip, for the volumes' screen bounds
+  bool lightOn = false;    // the scene's directional light, in the world
+  Vec3 toLight{0, 0, 1};   // unit, toward the light
+  Vec3 lightColor{1, 1, 1};
+  float ambient = 0.25f;   // Q_amb (SPEC §8); Q_diff = 1 − Q_amb
+  float fogBeta = 0;       // 0: no fog
+  Vec3 fogColor{0, 0, 0};
+};
+
+// Counts of one frame's casts (FrameStats' volume fields).
+struct VolumeCounts {
+  uint64_t rays = 0;            // pixels whose ray met a volume's box
+  uint64_t samples = 0;         // samples classified
+  uint64_t skipped = 0;         // samples stepped over in empty regions
+  uint64_t terminated = 0;      // rays ended by their transparency falling below ε
+  void add(const VolumeCounts& o) {
+    rays += o.rays, samples += o.samples, skipped += o.skipped, terminated += o.terminated;
+  }
+};
+
+class VolumePass final : public raster::TilePass {
+ public:
+  // The frame's volumes; call before prepare. Classification tables and the empty-region map are
+  // made once per volume grid and transfer function and kept from frame to frame.
+  void setVolumes(const VolumeInput& input);
+
+  raster::PassStage stage() const override { return raster::PassStage::volumes; }
+  void prepare(const raster::PassFrame& frame) override;
+  void drawTile(const raster::TileTarget& tile) override;
+  void addStats(FrameStats& stats) const override;
+
+  // The edge of the cubes of grid cells the empty-region map is made of.
+  static constexpr int kBrick = 8;
+  // Entries of the transfer function's table over the grid's codes (fewer for 8-bit data: one per
+  // code).
+  static constexpr int kTableSize = 4096;
+
+  // One volume as the pass casts it.
+  struct Prepared {
+    const scene::VolumeObject* object = nullptr;
+    const scene::VolumeGrid* grid = nullptr;
+    const void* transferKey = nullptr;  // what the tables were made for (the object's transfer)
+    std::vector<scene::TransferPoint> transfer;
+    double toOwn[3][4] = {};   // world → the volume's own space (affine rows)
+    double extent[3] = {};     // the grid's box in its own space: [0, extent]
+    double inverseSpacing[3] = {};
+    double stepOwn = 0.5;      // sample step, own units
+    double opacityUnit = 1;    // world units
+    // The transfer function at table entry e (code e / codeScale): red, green, blue, opacity.
+    std::vector<float> table;
+    double codeScale = 1;      // table position of code c: c · codeScale
+    int bricks[3] = {};
+    std::vector<uint8_t> emptyBrick;  // per brick (x fastest): every sample it holds transparent
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // the pixels its box may cover this frame, [x0, x1)
+  };
+
+ private:
+  struct alignas(64) WorkerCounts {
+    VolumeCounts counts;
+  };
+  void prepareTables(Prepared& p) const;
+  void screenBounds(Prepared& p) const;
+
+  VolumeInput input_;
+  std::vector<Prepared> volumes_;
+  int samples_ = 1;
+  std::vector<WorkerCounts> counts_;
+};
+
+}  // namespace sv::volume

@@ -1,0 +1,250 @@
+// The volume pass (SPEC §11–§12): a homogeneous slab composites to the analytic 1 − (1 − α)^(L/u),
+// two sample steps give the same image within a stated tolerance (opacity corrected for the
+// length), early termination moves no pixel by more than ε, empty-space skipping and thread counts
+// move none, an opaque polygon inside the volume cuts the rays at its depth, the gradient lights the
+// samples as an analytic field's normal does, and malformed volumes are refused by name.
+#include "volume/volume_pass.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+
+#include "synthvis/generators.h"
+#include "synthvis/image.h"
+#include "synthvis/render.h"
+#include "synthvis/scene.h"
+
+namespace sv {
+namespace {
+
+constexpr int kW = 120, kH = 96;
+
+// A camera at the origin looking down −z (90° vertical field), black background, no fog.
+scene::Scene emptyScene() {
+  scene::Scene s;
+  s.background = {0, 0, 0};
+  scene::Camera cam;
+  cam.position = {0, 0, 0};
+  cam.target = {0, 0, -1};
+  cam.yfovDegrees = 90;
+  cam.znear = 0.1f;
+  cam.zfar = 1000;
+  s.cameras = {cam};
+  return s;
+}
+
+// An 11³ grid of unit spacing whose code at (i, j, k) is `code(i, j, k)`, values code / 255.
+template <class F>
+std::shared_ptr<scene::VolumeGrid> grid(F code) {
+  auto g = std::make_shared<scene::VolumeGrid>();
+  g->nx = g->ny = g->nz = 11;
+  g->scale = 1.0f / 255;
+  g->codes.resize(11 * 11 * 11);
+  for (int k = 0; k < 11; ++k)
+    for (int j = 0; j < 11; ++j)
+      for (int i = 0; i < 11; ++i) g->codes[g->at(i, j, k)] = uint16_t(code(i, j, k));
+  return g;
+}
+
+// The slab: x, y in [−5, 5], z in [−20, −10] (10 units thick), every sample of opacity `alpha`
+// per unit and colour (1, 0.5, 0.25), unlit.
+scene::VolumeObject slab(float alpha) {
+  scene::VolumeObject v;
+  v.name = "slab";
+  v.grid = grid([](int, int, int) { return 100; });
+  v.transform = Mat4::translation({-5, -5, -20});
+  v.transfer = {{0, {1, 0.5f, 0.25f}, alpha}};
+  v.opacityUnit = 1;
+  v.shaded = false;
+  return v;
+}
+
+RenderOptions options(int samples = 1, int threads = 2) {
+  RenderOptions o;
+  o.width = kW;
+  o.height = kH;
+  o.samples = samples;
+  o.threads = threads;
+  o.gamma = 1;  // linear 8-bit
+  return o;
+}
+
+Image render(const scene::Scene& s, const RenderOptions& o, FrameStats* stats = nullptr) {
+  Image img;
+  Status st = Renderer(o).render(s, img, stats);
+  EXPECT_TRUE(st.ok()) << (st.ok() ? "" : st.error().str());
+  return img;
+}
+
+// The Marschner–Lobb signal (41³, 8-bit) over [−6, 6]² × [−20, −8], its low values transparent,
+// shaded by a light from the upper left.
+scene::Scene marschnerLobbScene() {
+  scene::Scene s = emptyScene();
+  scene::VolumeObject v;
+  v.name = "marschner-lobb";
+  v.grid = std::make_shared<scene::VolumeGrid>(scene::marschnerLobbGrid(41));
+  v.transform = Mat4::translation({0, 0, -14}) * Mat4::scaling({6, 6, 6}) *
+                Mat4::translation({-1, -1, -1});
+  v.transfer = {{0.0f, {0.2f, 0.4f, 1}, 0}, {0.45f, {0.2f, 0.4f, 1}, 0},
+                {0.55f, {1, 0.8f, 0.4f}, 0.6f}, {1.0f, {1, 1, 1}, 0.9f}};
+  s.volumes.push_back(v);
+  s.light.direction = {0.5f, -0.6f, -0.6f};
+  return s;
+}
+
+int maxDifference(const Image& a, const Image& b) {
+  int most = 0;
+  for (size_t i = 0; i < a.rgb.size(); ++i) most = std::max(most, std::abs(int(a.rgb[i]) - int(b.rgb[i])));
+  return most;
+}
+
+TEST(VolumePass, AHomogeneousSlabCompositesToTheAnalyticSolution) {
+  for (float alpha : {0.05f, 0.1f, 0.3f}) {
+    scene::Scene s = emptyScene();
+    s.volumes.push_back(slab(alpha));
+    FrameStats stats;
+    const Image img = render(s, options(), &stats);
+    // The centre ray crosses 10 units: P = c·(1 − (1 − α)^10).
+    const double covered = 1 - std::pow(1 - double(alpha), 10.0);
+    const uint8_t* p = img.pixel(kW / 2, kH / 2);
+    EXPECT_NEAR(p[0], 255 * covered, 1.0) << alpha;
+    EXPECT_NEAR(p[1], 255 * 0.5 * covered, 1.0) << alpha;
+    EXPECT_NEAR(p[2], 255 * 0.25 * covered, 1.0) << alpha;
+    EXPECT_EQ(stats.volumes, 1u);
+    EXPECT_GT(stats.volumeRays, 0u);
+    // Outside the slab's square (it covers the pixels within 5/20 … 5/10 of the centre), nothing.
+    EXPECT_EQ(img.pixel(2, 2)[0], 0);
+  }
+}
+
+TEST(VolumePass, AnOpaquePolygonInsideTheVolumeCutsTheRaysAtItsDepth) {
+  scene::Scene s = emptyScene();
+  s.volumes.push_back(slab(0.1f));
+  // An unlit quad across the slab's middle, z = −15.
+  scene::Material m;
+  m.baseColor = {0.2f, 0.4f, 0.6f, 1};
+  m.unlit = true;
+  m.doubleSided = true;
+  s.materials.push_back(m);
+  scene::Mesh quad;
+  quad.positions = {{-2, -2, -15}, {2, -2, -15}, {2, 2, -15}, {-2, 2, -15}};
+  quad.indices = {0, 1, 2, 0, 2, 3};
+  quad.material = 0;
+  s.meshes.push_back(quad);
+  s.instances.push_back({0, Mat4{}});
+  const Image img = render(s, options());
+  const double front = std::pow(0.9, 5.0);  // the transparency of the 5 units before the quad
+  const uint8_t* p = img.pixel(kW / 2, kH / 2);
+  EXPECT_NEAR(p[0], 255 * ((1 - front) * 1 + front * 0.2), 1.5);
+  EXPECT_NEAR(p[1], 255 * ((1 - front) * 0.5 + front * 0.4), 1.5);
+  EXPECT_NEAR(p[2], 255 * ((1 - front) * 0.25 + front * 0.6), 1.5);
+}
+
+TEST(VolumePass, TheGradientLightsSamplesAsTheFieldsNormal) {
+  // Values rising along x: the normal is ±x everywhere; lit from +x the samples take their whole
+  // colour, lit from +y only the ambient share (0.25).
+  scene::Scene s = emptyScene();
+  scene::VolumeObject v = slab(0.2f);
+  v.grid = grid([](int i, int, int) { return 20 * i; });
+  v.transfer = {{0, {1, 1, 1}, 0.2f}};
+  v.shaded = true;
+  s.volumes.push_back(v);
+  s.light.ambient = 0.25f;
+  s.light.direction = {-1, 0, 0};
+  const Image side = render(s, options());
+  s.light.direction = {0, -1, 0};
+  const Image above = render(s, options());
+  const double covered = 1 - std::pow(0.8, 10.0);
+  EXPECT_NEAR(side.pixel(kW / 2, kH / 2)[0], 255 * covered, 1.0);
+  EXPECT_NEAR(above.pixel(kW / 2, kH / 2)[0], 255 * 0.25 * covered, 1.0);
+}
+
+TEST(VolumePass, TwoSampleStepsGiveTheSameImageWithinTolerance) {
+  scene::Scene s = marschnerLobbScene();
+  s.volumeSettings.step = 0.5f;
+  const Image coarse = render(s, options());
+  s.volumeSettings.step = 0.25f;
+  const Image fine = render(s, options());
+  double sum = 0;
+  for (size_t i = 0; i < fine.rgb.size(); ++i) sum += std::abs(int(fine.rgb[i]) - int(coarse.rgb[i]));
+  const double mean = sum / double(fine.rgb.size());
+  // The opacity correction keeps the mean difference below half a level and every pixel within
+  // a few (the sampled signal itself differs between the steps).
+  EXPECT_LT(mean, 0.5);
+  EXPECT_LE(maxDifference(coarse, fine), 12);
+  size_t lit = 0;
+  for (uint8_t b : fine.rgb) lit += b > 20;
+  EXPECT_GT(lit, fine.rgb.size() / 10);
+}
+
+TEST(VolumePass, EarlyTerminationMovesNoPixelByMoreThanEpsilon) {
+  scene::Scene s = marschnerLobbScene();
+  s.volumeSettings.termination = 0;
+  const Image all = render(s, options());
+  s.volumeSettings.termination = 1.0f / 64;
+  FrameStats stats;
+  const Image early = render(s, options(), &stats);
+  EXPECT_GT(stats.volumeTerminated, 0u);
+  // What the ended rays leave out is at most ε of the colour (≤ 1): 255/64 ≈ 4 levels.
+  EXPECT_LE(maxDifference(all, early), 4);
+}
+
+TEST(VolumePass, EmptySpaceSkippingMovesNoPixel) {
+  scene::Scene s = marschnerLobbScene();
+  s.volumeSettings.skipEmpty = false;
+  FrameStats every, skipping;
+  const Image all = render(s, options(), &every);
+  s.volumeSettings.skipEmpty = true;
+  const Image skipped = render(s, options(), &skipping);
+  EXPECT_EQ(all.rgb, skipped.rgb);
+  EXPECT_EQ(every.volumeSkipped, 0u);
+  EXPECT_GT(skipping.volumeSkipped, 0u);
+  EXPECT_LT(skipping.volumeSamples, every.volumeSamples);
+}
+
+TEST(VolumePass, TheSameImageForAnyThreadCount) {
+  scene::Scene s = marschnerLobbScene();
+  s.meshes.push_back({});
+  s.meshes[0].positions = {{-8, -8, -17}, {8, -8, -11}, {0, 8, -14}};
+  s.meshes[0].indices = {0, 1, 2};
+  s.instances.push_back({0, Mat4{}});
+  for (int samples : {1, 4}) {
+    const Image two = render(s, options(samples, 2));
+    for (int threads : {1, 3}) EXPECT_EQ(render(s, options(samples, threads)).rgb, two.rgb);
+  }
+}
+
+TEST(VolumePass, MalformedVolumesAreRefusedByName) {
+  auto refused = [](scene::VolumeObject v, const char* part) {
+    scene::Scene s = emptyScene();
+    s.volumes.push_back(std::move(v));
+    Status st = scene::validate(s, "file.json");
+    ASSERT_FALSE(st.ok()) << part;
+    EXPECT_NE(st.error().str().find(part), std::string::npos) << st.error().str();
+    EXPECT_NE(st.error().str().find("file.json"), std::string::npos);
+  };
+  scene::VolumeObject v = slab(0.1f);
+  v.transfer = {{0.5f, {1, 1, 1}, 0.1f}, {0.5f, {1, 1, 1}, 0.2f}};
+  refused(v, "transfer point 1");
+  v = slab(0.1f);
+  v.transfer[0].opacity = 1.5f;
+  refused(v, "transfer point 0");
+  v = slab(0.1f);
+  v.transfer.clear();
+  refused(v, "0 transfer points");
+  v = slab(0.1f);
+  auto g = std::make_shared<scene::VolumeGrid>(*v.grid);
+  g->codes.pop_back();
+  v.grid = g;
+  refused(v, "codes for");
+  v = slab(0.1f);
+  v.transform = Mat4::scaling({1, 0, 1});
+  refused(v, "invertible");
+  v = slab(0.1f);
+  v.grid = nullptr;
+  refused(v, "no grid");
+}
+
+}  // namespace
+}  // namespace sv
