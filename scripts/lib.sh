@@ -10,7 +10,7 @@ SV_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 # libgdal-dev is the terrain loaders' reader of DEM rasters (GeoTIFF, SRTM .hgt, …); openscenegraph's
 # osgconv is the OpenFlight tests' independent peer (it writes and reads .flt).
 SV_PACKAGES=(cmake g++ ninja-build pkg-config libgtest-dev libgmock-dev libbenchmark-dev
-  libhwy-dev libtinygltf-dev libtinyobjloader-dev libstb-dev libpng-dev libturbojpeg0-dev libdraco-dev libassimp-dev nlohmann-json3-dev
+  libhwy-dev libtinygltf-dev libtinyobjloader-dev libstb-dev libpng-dev zlib1g-dev libturbojpeg0-dev libdraco-dev libassimp-dev nlohmann-json3-dev
   libcli11-dev libfmt-dev libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri python3
   clang libclang-rt-14-dev libgdal-dev libsdl2-dev xvfb xauth x11-apps tshark openscenegraph libmeshoptimizer-dev)
 
@@ -31,17 +31,19 @@ sv_install_packages() {
 # — with `dpkg -x`, not installed, so without their runtimes: r-cran-stars (tif/olinda_dem_utm25s.tif,
 # a 111×111 float32 DEM in UTM 25S, and tif/L7_ETMs.tif, Landsat bands of the same ground),
 # r-cran-terra (ex/elev.tif, 95×90 int16 heights in longitude/latitude with no-data cells) and
-# xplanet (stars/BSC, the Yale Bright Star Catalogue: the light points' star field). The .debs are
+# xplanet (stars/BSC, the Yale Bright Star Catalogue: the light points' star field) and
+# mricron-data (templates/ch2.nii.gz, the Colin 27 T1 MRI head: the volumes' real data). The .debs are
 # cached in build-data/debs and unpacked into build-data/root; the tests find the DEMs under
 # build-data/root/usr/lib/R/site-library (SV_TERRAIN_DATA_DIR) and the stars under
-# build-data/root/usr/share/xplanet (SV_STAR_CATALOG).
-SV_DATA_DEBS=(r-cran-stars r-cran-terra xplanet)
+# build-data/root/usr/share/xplanet (SV_STAR_CATALOG) and the head under
+# build-data/root/usr/share/mricron/templates (SV_VOLUME_DATA_DIR).
+SV_DATA_DEBS=(r-cran-stars r-cran-terra xplanet mricron-data)
 
 sv_data() {
   local debs="$SV_ROOT/build-data/debs" root="$SV_ROOT/build-data/root"
   local lib="$root/usr/lib/R/site-library"
   if [ -f "$lib/stars/tif/olinda_dem_utm25s.tif" ] && [ -f "$lib/terra/ex/elev.tif" ] &&
-    [ -f "$root/usr/share/xplanet/stars/BSC" ]; then
+    [ -f "$root/usr/share/xplanet/stars/BSC" ] && [ -f "$root/usr/share/mricron/templates/ch2.nii.gz" ]; then
     return 0
   fi
   mkdir -p "$debs" "$root"

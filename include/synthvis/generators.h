@@ -150,6 +150,10 @@ double marschnerLobb(double x, double y, double z);
 // (−1, −1, −1): place it by a translation of (−1, −1, −1)), quantized to `bits` (8 or 16) — values
 // 0 … 1. size 2 … 1024.
 VolumeGrid marschnerLobbGrid(int size, int bits = 8);
+// A seeded cloud: fractal value noise (4 octaves) over a size × size/4 × size grid (x, z across,
+// y up; spacing 1), thinned toward the layer's top and bottom and cut below `cover` (0 … 1: the
+// share of the layer left empty), 8-bit densities 0 … 1. size 8 … 1024.
+VolumeGrid cloudGrid(int size, uint64_t seed, float cover = 0.55f);
 
 // The frame every generated scene shares: one instance of mesh 0 with material 0 (unlit,
 // double-sided, named `name`), the BENCH.md camera, no light, black background. No meshes yet.

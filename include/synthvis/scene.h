@@ -450,6 +450,17 @@ struct LoadOptions {
 };
 
 Result<Scene> loadScene(const std::string& path, const LoadOptions& options);
+// A volume file (docs/scene-format.md "Volumes"): NIfTI-1 (.nii, .nii.gz: one volume, unsigned
+// or signed 8-, 16- or 32-bit, float or double, scl_slope and scl_inter applied, the voxel sizes
+// as its spacing) or NRRD (.nrrd, or .nhdr with a detached data file; 3 dimensions, raw or gzip,
+// spacings or space directions' lengths). Orientation (qform, sform, space origin) is not
+// applied: the volume's own space is index × spacing, placed by the scene. Every size is checked
+// before allocating; the error names the file and the problem. parseVolume reads `bytes`, the
+// whole file, named `path` (whose directory a detached data file is found in, unless
+// !followReferences).
+Result<VolumeGrid> loadVolume(const std::string& path);
+Result<VolumeGrid> parseVolume(const std::string& bytes, const std::string& path,
+                               bool followReferences);
 Result<Scene> parseJsonScene(const std::string& text, const std::string& path,
                              const LoadOptions& options);
 // In-memory variants of loadGltf and loadObj: `path` names the input in errors and is the base

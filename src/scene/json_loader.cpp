@@ -29,6 +29,7 @@
 #include "scene/channels.h"
 #include "scene/loader_common.h"
 #include "scene/primitives.h"
+#include "synthvis/generators.h"
 #include "terrain/caster.h"
 #include "terrain/ground.h"
 #include "terrain/ortho_image.h"
@@ -428,6 +429,8 @@ class SceneReader {
   void addLight(const LightPoint& p, const std::string& where);
   // "lines" (docs/scene-format.md#lines): settings and polylines.
   void readLines(const Json& v, const std::string& where);
+  // "volumes" (docs/scene-format.md#volumes): settings and volume objects.
+  void readVolumes(const Json& v, const std::string& where);
   std::shared_ptr<terrain::Ground> readHeights(const Json& v, const std::string& where);
   int textureRef(const Json& v, const std::string& where) const;
   FreeFormNode readFreeForm(const Json& v, const std::string& where, int depth, int& quadrics,
@@ -472,7 +475,7 @@ Scene SceneReader::read(const Json& root) {
   expectKeys(root, "",
              {"synthvis", "description", "background", "camera", "cameras", "light", "pointLights",
               "fog", "textures", "colorTable", "materials", "lodGroups", "objects", "terrain",
-              "lights", "lines", "time", "channels"});
+              "lights", "lines", "volumes", "time", "channels"});
 
   if (const Json* description = find(root, "description")) string(*description, "description");
   if (const Json* background = find(root, "background")) {
@@ -508,6 +511,7 @@ Scene SceneReader::read(const Json& root) {
   }
   if (const Json* x = find(root, "lights")) readLights(*x, "lights");
   if (const Json* x = find(root, "lines")) readLines(*x, "lines");
+  if (const Json* x = find(root, "volumes")) readVolumes(*x, "volumes");
   if (const Json* x = find(root, "time")) scene_.time = number(*x, "time");
   return std::move(scene_);
 }
@@ -903,6 +907,95 @@ void SceneReader::readLines(const Json& v, const std::string& where) {
     std::vector<Vec3> q(n);
     for (size_t k = 0; k < n; ++k) q[k] = vec3((*points)[k], element(wpts, k));
     for (size_t k = 0; k < segments; ++k) scene_.lines.push_back({q[k], q[(k + 1) % n], c});
+  }
+}
+
+void SceneReader::readVolumes(const Json& v, const std::string& where) {
+  expectKeys(v, where, {"step", "termination", "skipEmpty", "objects"});
+  VolumeSettings& settings = scene_.volumeSettings;
+  if (const Json* x = find(v, "step")) settings.step = inRange(*x, member(where, "step"), 0.05f, 8);
+  if (const Json* x = find(v, "termination"))
+    settings.termination = inRange(*x, member(where, "termination"), 0, 0.5f);
+  if (const Json* x = find(v, "skipEmpty")) settings.skipEmpty = boolean(*x, member(where, "skipEmpty"));
+  const Json* objects = find(v, "objects");
+  if (!objects) return;
+  const std::string w = member(where, "objects");
+  array(*objects, w);
+  if (objects->size() > 64) fail(w, fmt::format("{} volumes (at most 64)", objects->size()));
+  for (size_t i = 0; i < objects->size(); ++i) {
+    const Json& o = (*objects)[i];
+    const std::string wo = element(w, i);
+    expectKeys(o, wo, {"name", "file", "generate", "transform", "transfer", "opacityUnit", "shaded"});
+    VolumeObject vo;
+    if (const Json* x = find(o, "name")) vo.name = string(*x, member(wo, "name"));
+    const Json* file = find(o, "file");
+    const Json* generate = find(o, "generate");
+    if (bool(file) == bool(generate)) fail(wo, "needs one of 'file' and 'generate'");
+    if (file) {
+      const std::string ref = string(*file, member(wo, "file"));
+      if (!context_.options.followReferences)
+        fail(member(wo, "file"), fmt::format("'{}' is not opened here", ref));
+      Result<VolumeGrid> grid = loadVolume(resolvePath(directoryOf(path_), ref));
+      if (!grid) fail(member(wo, "file"), grid.error().str());
+      vo.grid = std::make_shared<VolumeGrid>(std::move(grid.value()));
+      if (vo.name.empty()) vo.name = ref;
+    } else {
+      const std::string wg = member(wo, "generate");
+      expectKeys(*generate, wg, {"kind", "size", "bits", "seed", "cover"});
+      const Json* kind = find(*generate, "kind");
+      if (!kind) fail(wg, "missing key 'kind'");
+      const std::string k = string(*kind, member(wg, "kind"));
+      const Json* size = find(*generate, "size");
+      if (k == "marschner-lobb") {
+        const int n = size ? int(integer(*size, member(wg, "size"), 2, 512)) : 41;
+        int bits = 8;
+        if (const Json* b = find(*generate, "bits")) {
+          bits = int(integer(*b, member(wg, "bits"), 8, 16));
+          if (bits != 8 && bits != 16) fail(member(wg, "bits"), "must be 8 or 16");
+        }
+        vo.grid = std::make_shared<VolumeGrid>(marschnerLobbGrid(n, bits));
+      } else if (k == "cloud") {
+        const int n = size ? int(integer(*size, member(wg, "size"), 8, 512)) : 128;
+        const uint64_t seed = find(*generate, "seed")
+                                  ? uint64_t(integer(*find(*generate, "seed"), member(wg, "seed"), 0, int64_t(1) << 53))
+                                  : 1;
+        const float cover = find(*generate, "cover")
+                                ? inRange(*find(*generate, "cover"), member(wg, "cover"), 0, 0.95f)
+                                : 0.55f;
+        vo.grid = std::make_shared<VolumeGrid>(cloudGrid(n, seed, cover));
+      } else {
+        fail(member(wg, "kind"), fmt::format("unknown volume generator '{}' (marschner-lobb or cloud)", k));
+      }
+      if (vo.name.empty()) vo.name = k;
+    }
+    if (const Json* x = find(o, "transform")) vo.transform = readTransform(*x, member(wo, "transform"));
+    const Json* transfer = find(o, "transfer");
+    if (!transfer) fail(wo, "missing key 'transfer'");
+    const std::string wt = member(wo, "transfer");
+    array(*transfer, wt);
+    if (transfer->empty() || transfer->size() > 256)
+      fail(wt, fmt::format("{} points (1 … 256)", transfer->size()));
+    for (size_t k = 0; k < transfer->size(); ++k) {
+      const Json& t = (*transfer)[k];
+      const std::string wk = element(wt, k);
+      expectKeys(t, wk, {"value", "color", "opacity"});
+      TransferPoint point;
+      const Json* value = find(t, "value");
+      if (!value) fail(wk, "missing key 'value'");
+      point.value = number(*value, member(wk, "value"));
+      if (k > 0 && !(point.value > vo.transfer.back().value))
+        fail(member(wk, "value"), "values must increase from point to point");
+      if (const Json* x = find(t, "color")) {
+        const Vec4 c = color(*x, member(wk, "color"), false);
+        point.color = {c.x, c.y, c.z};
+      }
+      if (const Json* x = find(t, "opacity")) point.opacity = inRange(*x, member(wk, "opacity"), 0, 1);
+      vo.transfer.push_back(point);
+    }
+    if (const Json* x = find(o, "opacityUnit"))
+      vo.opacityUnit = inRange(*x, member(wo, "opacityUnit"), 0, 1e30f);
+    if (const Json* x = find(o, "shaded")) vo.shaded = boolean(*x, member(wo, "shaded"));
+    scene_.volumes.push_back(std::move(vo));
   }
 }
 

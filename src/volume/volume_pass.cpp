@@ -335,7 +335,9 @@ void VolumePass::drawTile(const raster::TileTarget& tile) {
               double e0 = -1e300, e1 = 1e300;
               clipToBox(st.o, st.dir, lo, hi, e0, e1);
               // Segment j's middle is s0 + (j + ½)·ds; those with it below e1 are in the brick.
-              const double last = std::ceil((e1 - st.s0) / ds - 0.5) - 1;
+              // (No further than the stretch's last segment.)
+              const double last = std::min(std::ceil((e1 - st.s0) / ds - 0.5) - 1,
+                                           std::ceil((end - st.s0) / ds) - 1);
               const int64_t skipTo = std::max<int64_t>(i, int64_t(std::min(last, 1e15)));
               counts.skipped += uint64_t(skipTo - i + 1);
               i = skipTo;

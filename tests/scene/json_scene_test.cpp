@@ -138,6 +138,43 @@ TEST(JsonScene, ReadsPolylines) {
   EXPECT_FLOAT_EQ(r->lineSettings.depthBias, 0.01f);
 }
 
+// "volumes": settings, a generated volume placed by its transform, its transfer function; the
+// errors name the key.
+TEST(JsonScene, ReadsVolumes) {
+  Result<Scene> r = parse(R"({"synthvis": 1, "volumes": {"step": 0.25, "termination": 0.01,
+      "skipEmpty": false, "objects": [{"name": "ml", "generate": {"kind": "marschner-lobb",
+      "size": 9}, "transform": {"translate": [1, 2, 3]}, "transfer": [{"value": 0.2,
+      "color": [1, 0, 0], "opacity": 0}, {"value": 0.8, "opacity": 0.5}], "opacityUnit": 0.1,
+      "shaded": false}, {"generate": {"kind": "cloud", "size": 16, "seed": 7},
+      "transfer": [{"value": 0, "opacity": 0.1}]}]}})");
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  ASSERT_EQ(r->volumes.size(), 2u);
+  const VolumeObject& v = r->volumes[0];
+  EXPECT_EQ(v.name, "ml");
+  EXPECT_EQ(v.grid->nx, 9);
+  EXPECT_EQ(v.transform.transformPoint({0, 0, 0}), (Vec3{1, 2, 3}));
+  ASSERT_EQ(v.transfer.size(), 2u);
+  EXPECT_EQ(v.transfer[0].color, (Vec3{1, 0, 0}));
+  EXPECT_FLOAT_EQ(v.transfer[1].opacity, 0.5f);
+  EXPECT_FLOAT_EQ(v.opacityUnit, 0.1f);
+  EXPECT_FALSE(v.shaded);
+  EXPECT_EQ(r->volumes[1].name, "cloud");
+  EXPECT_EQ(r->volumes[1].grid->ny, 4);
+  EXPECT_FLOAT_EQ(r->volumeSettings.step, 0.25f);
+  EXPECT_FALSE(r->volumeSettings.skipEmpty);
+  auto error = [](const std::string& body) {
+    Result<Scene> e = parse(R"({"synthvis": 1, "volumes": {"objects": [)" + body + "]}}");
+    return e.ok() ? std::string("loaded") : e.error().str();
+  };
+  EXPECT_TRUE(contains(error(R"({"transfer": [{"value": 0}]})"), "one of 'file' and 'generate'"));
+  EXPECT_TRUE(contains(error(R"({"generate": {"kind": "smoke"}, "transfer": [{"value": 0}]})"),
+                       "unknown volume generator 'smoke'"));
+  EXPECT_TRUE(contains(error(R"({"generate": {"kind": "cloud"}})"), "missing key 'transfer'"));
+  EXPECT_TRUE(contains(error(R"({"generate": {"kind": "cloud"}, "transfer": [{"value": 1},
+      {"value": 0}]})"), "values must increase"));
+  EXPECT_TRUE(contains(error(R"({"file": "x.nii", "transfer": [{"value": 0}]})"), "x.nii"));
+}
+
 TEST(JsonScene, ReadsACameraList) {
   Result<Scene> r =
       parse(R"({"synthvis": 1, "cameras": [{"name": "a"}, {"name": "b", "yfov": 30}]})");
