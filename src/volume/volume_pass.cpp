@@ -188,8 +188,11 @@ void VolumePass::prepareTables(Prepared& p) const {
               hi = std::max(hi, row[i]);
             }
           }
+        // A sample at table position x reads entries ⌊x⌋ and ⌊x⌋ + 1, the second with weight
+        // x − ⌊x⌋: so positions in [lo, hi] read entries ⌊lo⌋ … ⌈hi⌉ (a brick of one code reads
+        // that code's entry alone: trilinear weights of equal codes give the code exactly).
         const int first = std::max(0, int(std::floor(lo * p.codeScale)));
-        const int last = std::min(entries - 1, int(std::floor(hi * p.codeScale)) + 1);
+        const int last = std::min(entries - 1, int(std::ceil(hi * p.codeScale)));
         p.emptyBrick[(size_t(bz) * size_t(p.bricks[1]) + size_t(by)) * size_t(p.bricks[0]) +
                      size_t(bx)] = opaqueBefore[size_t(last) + 1] == opaqueBefore[size_t(first)];
       }
