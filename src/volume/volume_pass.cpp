@@ -153,6 +153,23 @@ void VolumePass::setVolumes(const VolumeInput& input) {
       unit = std::min(unit, len);
     }
     p.opacityUnit = v.opacityUnit > 0 ? double(v.opacityUnit) : unit;
+    // The transform's scale along the grid's axes: uniform (a similarity) when they agree.
+    double lengths[3];
+    for (int axis = 0; axis < 3; ++axis)
+      lengths[axis] = std::sqrt(double(m.m[axis][0]) * m.m[axis][0] + double(m.m[axis][1]) * m.m[axis][1] +
+                                double(m.m[axis][2]) * m.m[axis][2]);
+    const double lo = std::min({lengths[0], lengths[1], lengths[2]}),
+                 hi = std::max({lengths[0], lengths[1], lengths[2]});
+    p.stepOpacity.clear();
+    if (hi - lo <= 1e-6 * hi) {
+      const double exponent = p.stepOwn * hi / p.opacityUnit;
+      const size_t entries = p.table.size() / 4;
+      p.stepOpacity.resize(entries);
+      for (size_t k = 0; k < entries; ++k) {
+        const double o = p.table[k * 4 + 3];
+        p.stepOpacity[k] = o >= 1 ? 1.0f : float(1 - std::pow(1 - o, exponent));
+      }
+    }
   }
 }
 
@@ -356,9 +373,16 @@ void VolumePass::drawTile(const raster::TileTarget& tile) {
           const float* t1 = entries > 1 ? t0 + 4 : t0;
           const float opacity = t0[3] + f * (t1[3] - t0[3]);
           if (!(opacity > 0)) continue;
-          // SPEC §12: the opacity of a sample of length l is 1 − (1 − W)^(l / unit).
-          const double length = (b - a) * worldPerS;
-          const double w = opacity >= 1 ? 1.0 : 1 - std::pow(1 - double(opacity), length / p.opacityUnit);
+          // SPEC §12: the opacity of a sample of length l is 1 − (1 − W)^(l / unit) — tabled for
+          // a full step under a uniform scale.
+          double w;
+          if (!p.stepOpacity.empty() && b - a == ds) {
+            const float* c = &p.stepOpacity[size_t(e)];
+            w = c[0] + f * ((entries > 1 ? c[1] : c[0]) - c[0]);
+          } else {
+            const double length = (b - a) * worldPerS;
+            w = opacity >= 1 ? 1.0 : 1 - std::pow(1 - double(opacity), length / p.opacityUnit);
+          }
           double color[3] = {t0[0] + f * (t1[0] - t0[0]), t0[1] + f * (t1[1] - t0[1]),
                              t0[2] + f * (t1[2] - t0[2])};
           if (object.shaded && input_.lightOn) {

@@ -76,6 +76,10 @@ class VolumePass final : public raster::TilePass {
     // The transfer function at table entry e (code e / codeScale): red, green, blue, opacity.
     std::vector<float> table;
     double codeScale = 1;      // table position of code c: c · codeScale
+    // Under a transform of uniform scale every full step has the same length in the world, so its
+    // corrected opacity 1 − (1 − W)^(l / unit) is tabled per entry (read linearly like the table);
+    // empty: not uniform, every sample corrects its own.
+    std::vector<float> stepOpacity;
     int bricks[3] = {};
     std::vector<uint8_t> emptyBrick;  // per brick (x fastest): every sample it holds transparent
     int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // the pixels its box may cover this frame, [x0, x1)
