@@ -911,12 +911,14 @@ void SceneReader::readLines(const Json& v, const std::string& where) {
 }
 
 void SceneReader::readVolumes(const Json& v, const std::string& where) {
-  expectKeys(v, where, {"step", "termination", "skipEmpty", "objects"});
+  expectKeys(v, where, {"step", "termination", "skipEmpty", "precomputedNormals", "objects"});
   VolumeSettings& settings = scene_.volumeSettings;
   if (const Json* x = find(v, "step")) settings.step = inRange(*x, member(where, "step"), 0.05f, 8);
   if (const Json* x = find(v, "termination"))
     settings.termination = inRange(*x, member(where, "termination"), 0, 0.5f);
   if (const Json* x = find(v, "skipEmpty")) settings.skipEmpty = boolean(*x, member(where, "skipEmpty"));
+  if (const Json* x = find(v, "precomputedNormals"))
+    settings.precomputedNormals = boolean(*x, member(where, "precomputedNormals"));
   const Json* objects = find(v, "objects");
   if (!objects) return;
   const std::string w = member(where, "objects");

@@ -35,22 +35,62 @@ struct Sampler {
   const scene::VolumeGrid& g;
   const double* inverseSpacing;
 
-  // The trilinear code at own-space point (x, y, z), and the cell it lies in.
-  float at(double x, double y, double z) const {
+  // The cell holding own-space point (x, y, z) (clamped to the grid): its first sample and the
+  // point's place in it.
+  struct Cell {
+    size_t base;
+    float tx, ty, tz;
+  };
+  Cell locate(double x, double y, double z) const {
     const double fx = std::clamp(x * inverseSpacing[0], 0.0, double(g.nx - 1));
     const double fy = std::clamp(y * inverseSpacing[1], 0.0, double(g.ny - 1));
     const double fz = std::clamp(z * inverseSpacing[2], 0.0, double(g.nz - 1));
     const int i = std::min(int(fx), g.nx - 2), j = std::min(int(fy), g.ny - 2),
               k = std::min(int(fz), g.nz - 2);
-    const float tx = float(fx - i), ty = float(fy - j), tz = float(fz - k);
-    const uint16_t* c = g.codes.data() + g.at(i, j, k);
-    const size_t sy = size_t(g.nx), sz = size_t(g.nx) * size_t(g.ny);
-    auto lerp = [](float a, float b, float t) { return a + t * (b - a); };
-    const float c00 = lerp(c[0], c[1], tx), c10 = lerp(c[sy], c[sy + 1], tx);
-    const float c01 = lerp(c[sz], c[sz + 1], tx), c11 = lerp(c[sz + sy], c[sz + sy + 1], tx);
-    return lerp(lerp(c00, c10, ty), lerp(c01, c11, ty), tz);
+    return {g.at(i, j, k), float(fx - i), float(fy - j), float(fz - k)};
   }
+  // The trilinear interpolation of `values` (one per sample, `stride` apart) over cell `c`.
+  template <class T>
+  float blend(const T* values, const Cell& c, size_t stride = 1) const {
+    const T* v = values + c.base * stride;
+    const size_t sx = stride, sy = size_t(g.nx) * stride, sz = size_t(g.nx) * size_t(g.ny) * stride;
+    auto lerp = [](float a, float b, float t) { return a + t * (b - a); };
+    const float c00 = lerp(float(v[0]), float(v[sx]), c.tx);
+    const float c10 = lerp(float(v[sy]), float(v[sy + sx]), c.tx);
+    const float c01 = lerp(float(v[sz]), float(v[sz + sx]), c.tx);
+    const float c11 = lerp(float(v[sz + sy]), float(v[sz + sy + sx]), c.tx);
+    return lerp(lerp(c00, c10, c.ty), lerp(c01, c11, c.ty), c.tz);
+  }
+  // The trilinear code at own-space point (x, y, z).
+  float at(double x, double y, double z) const { return blend(g.codes.data(), locate(x, y, z)); }
 };
+
+// Per sample of `g`, the direction of its value's gradient (central differences, one-sided at
+// the faces) in the grid's own space, scaled to ±127; (0, 0, 0) where the gradient vanishes.
+// Four bytes a sample (x, y, z and a pad), for VolumeSettings::precomputedNormals.
+std::vector<int8_t> sampleNormals(const scene::VolumeGrid& g) {
+  std::vector<int8_t> n(g.codes.size() * 4, 0);
+  const int size[3] = {g.nx, g.ny, g.nz};
+  const size_t step[3] = {1, size_t(g.nx), size_t(g.nx) * size_t(g.ny)};
+  const double spacing[3] = {g.spacing.x, g.spacing.y, g.spacing.z};
+  for (int k = 0; k < g.nz; ++k)
+    for (int j = 0; j < g.ny; ++j)
+      for (int i = 0; i < g.nx; ++i) {
+        const size_t at = g.at(i, j, k);
+        const int index[3] = {i, j, k};
+        double d[3], length = 0;
+        for (int a = 0; a < 3; ++a) {
+          const bool low = index[a] > 0, high = index[a] < size[a] - 1;
+          const double up = g.codes[high ? at + step[a] : at], down = g.codes[low ? at - step[a] : at];
+          d[a] = (up - down) / ((low + high) * spacing[a]);
+          length += d[a] * d[a];
+        }
+        length = std::sqrt(length);
+        if (length > 0)
+          for (int a = 0; a < 3; ++a) n[at * 4 + size_t(a)] = int8_t(std::lrint(d[a] / length * 127));
+      }
+  return n;
+}
 
 // The ray o + s·d (own space) against the box [0, e]: its entry and exit s, empty when s0 ≥ s1.
 void clipToBox(const double o[3], const double d[3], const double lo[3], const double hi[3],
@@ -110,8 +150,12 @@ void VolumePass::setVolumes(const VolumeInput& input) {
       p.grid = v.grid.get();
       p.transferKey = &v.transfer;
       p.transfer = v.transfer;
+      p.normals.clear();
       prepareTables(p);
     }
+    if (input.settings.precomputedNormals && v.shaded && p.normals.empty())
+      p.normals = sampleNormals(*v.grid);
+    if (!input.settings.precomputedNormals) p.normals.clear();
     // World → own: the inverse of the affine transform, in double.
     const Mat4& m = v.transform;
     double a[3][3], inv[3][3];
@@ -386,16 +430,23 @@ void VolumePass::drawTile(const raster::TileTarget& tile) {
           double color[3] = {t0[0] + f * (t1[0] - t0[0]), t0[1] + f * (t1[1] - t0[1]),
                              t0[2] + f * (t1[2] - t0[2])};
           if (object.shaded && input_.lightOn) {
-            // The gradient by central differences over one sample spacing, to the world by the
+            // The gradient: by central differences of the interpolated value over one sample
+            // spacing, or the samples' precomputed directions interpolated; to the world by the
             // inverse transpose (the rows of world → own, transposed).
-            const double h[3] = {g.spacing.x, g.spacing.y, g.spacing.z};
             double grad[3];
-            for (int ax = 0; ax < 3; ++ax) {
-              double up[3] = {q[0], q[1], q[2]}, down[3] = {q[0], q[1], q[2]};
-              up[ax] += h[ax], down[ax] -= h[ax];
-              grad[ax] = (double(sampler.at(up[0], up[1], up[2])) -
-                          double(sampler.at(down[0], down[1], down[2]))) /
-                         (2 * h[ax]);
+            if (!p.normals.empty()) {
+              const Sampler::Cell cell = sampler.locate(q[0], q[1], q[2]);
+              for (int ax = 0; ax < 3; ++ax)
+                grad[ax] = sampler.blend(p.normals.data() + ax, cell, 4);
+            } else {
+              const double h[3] = {g.spacing.x, g.spacing.y, g.spacing.z};
+              for (int ax = 0; ax < 3; ++ax) {
+                double up[3] = {q[0], q[1], q[2]}, down[3] = {q[0], q[1], q[2]};
+                up[ax] += h[ax], down[ax] -= h[ax];
+                grad[ax] = (double(sampler.at(up[0], up[1], up[2])) -
+                            double(sampler.at(down[0], down[1], down[2]))) /
+                           (2 * h[ax]);
+              }
             }
             Vec3d nw{p.toOwn[0][0] * grad[0] + p.toOwn[1][0] * grad[1] + p.toOwn[2][0] * grad[2],
                      p.toOwn[0][1] * grad[0] + p.toOwn[1][1] * grad[1] + p.toOwn[2][1] * grad[2],

@@ -80,6 +80,9 @@ class VolumePass final : public raster::TilePass {
     // corrected opacity 1 − (1 − W)^(l / unit) is tabled per entry (read linearly like the table);
     // empty: not uniform, every sample corrects its own.
     std::vector<float> stepOpacity;
+    // VolumeSettings::precomputedNormals: per sample its gradient's direction, 4 bytes (x, y, z,
+    // pad) of ±127; empty: the gradient is taken while traversing.
+    std::vector<int8_t> normals;
     int bricks[3] = {};
     std::vector<uint8_t> emptyBrick;  // per brick (x fastest): every sample it holds transparent
     int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // the pixels its box may cover this frame, [x0, x1)
