@@ -8,8 +8,7 @@
 
 namespace sv::scene {
 
-// BENCH.md's generators, one per kind of benchmark scene. `none`: a scene from a file. The last
-// three need features of later issues (generatorNeeds).
+// BENCH.md's generators, one per kind of benchmark scene. `none`: a scene from a file.
 enum class Generator : uint8_t {
   none,
   tris,
@@ -26,8 +25,6 @@ enum class Generator : uint8_t {
 // "freeform-one", "terrain", "volume", "lights", "city"; an error lists them.
 Result<Generator> parseGenerator(const std::string& name);
 const char* generatorName(Generator generator);  // "" for none
-// What a generator needs that is not built yet ("height fields", …), or nullptr.
-const char* generatorNeeds(Generator generator);
 
 enum class SubmitOrder { random, frontToBack, backToFront };
 
@@ -142,6 +139,17 @@ struct CityParams {
   uint64_t seed = 1;
 };
 Scene generateCity(const CityParams& params);
+
+// BENCH.md's `volume`: a size³ 8-bit grid over [−1, 1]³ of the Marschner–Lobb signal inside a
+// sphere and seeded blobs, classified so that the emptiest 70 % of its samples are transparent —
+// translucent and shaded, or `opaque` (iso-surface-like: fully opaque above the threshold); the
+// camera 3.4 units from its centre (45°), lit from the upper left.
+struct VolumeParams {
+  int size = 256;  // 8 … 512
+  bool opaque = false;
+  uint64_t seed = 1;
+};
+Scene generateVolume(const VolumeParams& params);
 
 // The Marschner–Lobb test signal (Marschner and Lobb 1994, f_M = 6, α = 1/4) on [−1, 1]³, in
 // [0, 1]: ρ = (1 − sin(πz/2) + α(1 + cos(2π f_M cos(π r / 2)))) / (2(1 + α)), r = √(x² + y²).

@@ -27,6 +27,7 @@ struct BenchCase {
   scene::TerrainParams terrain;
   scene::LightsParams lights;
   scene::CityParams city;
+  scene::VolumeParams volume;
   std::string file;
 };
 

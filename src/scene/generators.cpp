@@ -38,13 +38,4 @@ const char* generatorName(Generator generator) {
   return "";
 }
 
-const char* generatorNeeds(Generator generator) {
-  switch (generator) {
-    case Generator::volume:
-      return "voxel volumes";
-    default:
-      return nullptr;
-  }
-}
-
 }  // namespace sv::scene
