@@ -266,6 +266,8 @@ void addGeneratorOptions(CLI::App* app, GeneratorArgs& g) {
   app->add_option("--trees", g.city.trees, "city: trees")->capture_default_str();
   app->add_option("--voxels", g.volume.size, "volume: samples a side")->capture_default_str();
   app->add_flag("--opaque", g.volume.opaque, "volume: iso-surface-like (opaque above the threshold)");
+  app->add_flag("--precomputed-normals", g.volume.precomputedNormals,
+                "volume: gradient directions precomputed per sample (SPEC §11's second way)");
   app->add_option("--stars", g.stars,
                   "lights: the star catalogue (xplanet's BSC), auto (found where Debian or "
                   "scripts/lib.sh puts it) or none")

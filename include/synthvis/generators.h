@@ -147,6 +147,7 @@ Scene generateCity(const CityParams& params);
 struct VolumeParams {
   int size = 256;  // 8 … 512
   bool opaque = false;
+  bool precomputedNormals = false;  // VolumeSettings::precomputedNormals
   uint64_t seed = 1;
 };
 Scene generateVolume(const VolumeParams& params);

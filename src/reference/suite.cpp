@@ -159,7 +159,8 @@ Result<CaseScene> makeScene(const BenchCase& c, const RenderOptions& options) {
     const scene::VolumeParams& p = c.volume;
     if (p.size < 8 || p.size > 512) return Error{"", "", "volume: --voxels must be 8…512"};
     out.scene = scene::generateVolume(p);
-    out.params = {{"voxels", p.size}, {"opaque", p.opaque}, {"seed", p.seed}};
+    out.params = {{"voxels", p.size}, {"opaque", p.opaque},
+                  {"precomputed_normals", p.precomputedNormals}, {"seed", p.seed}};
     return out;
   } else if (c.generator == scene::Generator::none) {
     auto loaded = scene::loadScene(c.file);

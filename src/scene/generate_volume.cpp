@@ -141,6 +141,7 @@ Scene generateVolume(const VolumeParams& p) {
                   {1.0f, {1, 1, 0.9f}, 0.5f}};
   v.opacityUnit = spacing;
   s.volumes.push_back(std::move(v));
+  s.volumeSettings.precomputedNormals = p.precomputedNormals;
   s.cameras.push_back(detail::benchCamera({2.0f, 1.6f, 2.3f}, {0, 0, 0}, 45, 0.1f, 100));
   return s;
 }

@@ -379,7 +379,8 @@ void VolumePass::drawTile(const raster::TileTarget& tile) {
           const double a = st.s0 + double(i) * ds;
           if (!(a < end)) break;
           pc.reach(a);
-          const double b = std::min(a + ds, end), mid = 0.5 * (a + b);
+          const bool full = a + ds <= end;
+          const double b = full ? a + ds : end, mid = 0.5 * (a + b);
           const double q[3] = {st.o[0] + mid * st.dir[0], st.o[1] + mid * st.dir[1],
                                st.o[2] + mid * st.dir[2]};
           if (settings.skipEmpty) {
@@ -420,11 +421,11 @@ void VolumePass::drawTile(const raster::TileTarget& tile) {
           // SPEC §12: the opacity of a sample of length l is 1 − (1 − W)^(l / unit) — tabled for
           // a full step under a uniform scale.
           double w;
-          if (!p.stepOpacity.empty() && b - a == ds) {
+          if (!p.stepOpacity.empty() && full) {
             const float* c = &p.stepOpacity[size_t(e)];
             w = c[0] + f * ((entries > 1 ? c[1] : c[0]) - c[0]);
           } else {
-            const double length = (b - a) * worldPerS;
+            const double length = (full ? ds : b - a) * worldPerS;
             w = opacity >= 1 ? 1.0 : 1 - std::pow(1 - double(opacity), length / p.opacityUnit);
           }
           double color[3] = {t0[0] + f * (t1[0] - t0[0]), t0[1] + f * (t1[1] - t0[1]),
