@@ -266,6 +266,8 @@ void addGeneratorOptions(CLI::App* app, GeneratorArgs& g) {
   app->add_option("--trees", g.city.trees, "city: trees")->capture_default_str();
   app->add_option("--voxels", g.volume.size, "volume: samples a side")->capture_default_str();
   app->add_flag("--opaque", g.volume.opaque, "volume: iso-surface-like (opaque above the threshold)");
+  app->add_flag("--no-shell", [&g](int64_t) { g.volume.shell = false; },
+                "volume: cast through the whole box, without the free-form shell");
   app->add_flag("--precomputed-normals", g.volume.precomputedNormals,
                 "volume: gradient directions precomputed per sample (SPEC §11's second way)");
   app->add_option("--stars", g.stars,

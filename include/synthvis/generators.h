@@ -142,12 +142,15 @@ Scene generateCity(const CityParams& params);
 
 // BENCH.md's `volume`: a size³ 8-bit grid over [−1, 1]³ of the Marschner–Lobb signal inside a
 // sphere and seeded blobs, classified so that the emptiest 70 % of its samples are transparent —
-// translucent and shaded, or `opaque` (iso-surface-like: fully opaque above the threshold); the
-// camera 3.4 units from its centre (45°), lit from the upper left.
+// translucent and shaded, or `opaque` (iso-surface-like: fully opaque above the threshold) — in a
+// free-form shell: the smallest sphere about its centre holding every cell that is not
+// transparent (unless !shell); the camera 3.4 units from its centre (45°), lit from the upper
+// left.
 struct VolumeParams {
   int size = 256;  // 8 … 512
   bool opaque = false;
   bool precomputedNormals = false;  // VolumeSettings::precomputedNormals
+  bool shell = true;
   uint64_t seed = 1;
 };
 Scene generateVolume(const VolumeParams& params);

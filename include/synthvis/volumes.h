@@ -6,6 +6,7 @@
 // length).
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -75,6 +76,12 @@ struct VolumeObject {
   // Lit by the scene's light (Phong of the value's gradient), or the transfer function's colour
   // as it is.
   bool shaded = true;
+  // A bounding shell (SPEC §11–§12: a free form bounding the volume, so that rays start where it
+  // begins rather than at the box): quadrics in the volume's own space, A … K as FreeFormNode's,
+  // whose common inside (F ≥ 0) holds every sample the transfer function does not make
+  // transparent. Rays are cast only within it, on the same sample lattice, so a true shell changes
+  // no pixel. Empty: the box alone.
+  std::vector<std::array<double, 10>> shell;
 };
 
 }  // namespace sv::scene

@@ -160,7 +160,8 @@ Result<CaseScene> makeScene(const BenchCase& c, const RenderOptions& options) {
     if (p.size < 8 || p.size > 512) return Error{"", "", "volume: --voxels must be 8…512"};
     out.scene = scene::generateVolume(p);
     out.params = {{"voxels", p.size}, {"opaque", p.opaque},
-                  {"precomputed_normals", p.precomputedNormals}, {"seed", p.seed}};
+                  {"precomputed_normals", p.precomputedNormals}, {"shell", p.shell},
+                  {"seed", p.seed}};
     return out;
   } else if (c.generator == scene::Generator::none) {
     auto loaded = scene::loadScene(c.file);

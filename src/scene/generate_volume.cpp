@@ -126,6 +126,17 @@ Scene generateVolume(const VolumeParams& p) {
   while (threshold < 255 && below + histogram[size_t(threshold)] <= uint64_t(0.7 * double(g.codes.size())))
     below += histogram[size_t(threshold++)];
   const float t = float(threshold) / 255;
+  // The shell: a sphere about the centre holding every sample above the threshold, and a cell's
+  // diagonal more (a trilinear value above it lies in a cell with such a corner).
+  double reach = 0;
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i)
+        if (g.codes[g.at(i, j, k)] > threshold) {
+          const double x = -1 + 2.0 * i / (n - 1), y = -1 + 2.0 * j / (n - 1), z = -1 + 2.0 * k / (n - 1);
+          reach = std::max(reach, x * x + y * y + z * z);
+        }
+  reach = std::sqrt(reach) + std::sqrt(3.0) * spacing;
   Scene s;
   s.background = {0.02f, 0.02f, 0.03f};
   s.light.direction = {0.5f, -0.7f, -0.5f};
@@ -140,6 +151,8 @@ Scene generateVolume(const VolumeParams& p) {
     v.transfer = {{t, {0.2f, 0.4f, 1}, 0}, {std::min(1.0f, t + 0.2f), {1, 0.7f, 0.3f}, 0.15f},
                   {1.0f, {1, 1, 0.9f}, 0.5f}};
   v.opacityUnit = spacing;
+  // F = reach² − |q − (1, 1, 1)|² ≥ 0 inside, in the grid's own space [0, 2]³.
+  if (p.shell) v.shell.push_back({-1, -1, -1, 0, 0, 0, 2, 2, 2, reach * reach - 3});
   s.volumes.push_back(std::move(v));
   s.volumeSettings.precomputedNormals = p.precomputedNormals;
   s.cameras.push_back(detail::benchCamera({2.0f, 1.6f, 2.3f}, {0, 0, 0}, 45, 0.1f, 100));

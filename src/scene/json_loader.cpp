@@ -927,7 +927,8 @@ void SceneReader::readVolumes(const Json& v, const std::string& where) {
   for (size_t i = 0; i < objects->size(); ++i) {
     const Json& o = (*objects)[i];
     const std::string wo = element(w, i);
-    expectKeys(o, wo, {"name", "file", "generate", "transform", "transfer", "opacityUnit", "shaded"});
+    expectKeys(o, wo, {"name", "file", "generate", "transform", "transfer", "opacityUnit", "shaded",
+                       "shell"});
     VolumeObject vo;
     if (const Json* x = find(o, "name")) vo.name = string(*x, member(wo, "name"));
     const Json* file = find(o, "file");
@@ -997,6 +998,16 @@ void SceneReader::readVolumes(const Json& v, const std::string& where) {
     if (const Json* x = find(o, "opacityUnit"))
       vo.opacityUnit = inRange(*x, member(wo, "opacityUnit"), 0, 1e30f);
     if (const Json* x = find(o, "shaded")) vo.shaded = boolean(*x, member(wo, "shaded"));
+    if (const Json* x = find(o, "shell")) {
+      // A free form's quadric with its clips, in the volume's own space; no perturbations.
+      int quadrics = 0;
+      const FreeFormNode shell = readFreeForm(*x, member(wo, "shell"), 0, quadrics, true);
+      if (!shell.perturbations.empty())
+        fail(member(wo, "shell"), "a shell is a quadric with clips, not perturbed");
+      if (shell.clips.size() > 15) fail(member(wo, "shell"), "at most 15 clips");
+      vo.shell.push_back(shell.quadric);
+      vo.shell.insert(vo.shell.end(), shell.clips.begin(), shell.clips.end());
+    }
     scene_.volumes.push_back(std::move(vo));
   }
 }

@@ -131,6 +131,10 @@ Status validateVolumes(const Scene& scene) {
                                 k));
     }
     if (!inRange(v.opacityUnit, 0, 1e30f)) return fail(i, v.name, "opacityUnit must be ≥ 0");
+    if (v.shell.size() > 16) return fail(i, v.name, fmt::format("{} shell quadrics (at most 16)", v.shell.size()));
+    for (const auto& q : v.shell)
+      for (double c : q)
+        if (!std::isfinite(c) || std::fabs(c) > 1e30) return fail(i, v.name, "a shell coefficient is not finite");
   }
   const VolumeSettings& s = scene.volumeSettings;
   if (!inRange(s.step, 0.05f, 8) || !inRange(s.termination, 0, 0.5f))

@@ -107,6 +107,46 @@ void clipToBox(const double o[3], const double d[3], const double lo[3], const d
   }
 }
 
+// The ray o + s·d (own space) against the inside (F ≥ 0) of quadric q (A … K, SPEC §11's order):
+// [s0, s1] narrowed to the stretch between the first entry and the last exit (a conservative
+// hull where the inside is two pieces), or emptied where the ray never enters it.
+void clipToQuadric(const std::array<double, 10>& q, const double o[3], const double d[3],
+                   double& s0, double& s1) {
+  const double A = q[0], B = q[1], C = q[2], D = q[3], E = q[4], F = q[5], G = q[6], H = q[7],
+               I = q[8], K = q[9];
+  const double a = A * d[0] * d[0] + B * d[1] * d[1] + C * d[2] * d[2] + D * d[0] * d[1] +
+                   E * d[0] * d[2] + F * d[1] * d[2];
+  const double b = 2 * (A * o[0] * d[0] + B * o[1] * d[1] + C * o[2] * d[2]) +
+                   D * (o[0] * d[1] + o[1] * d[0]) + E * (o[0] * d[2] + o[2] * d[0]) +
+                   F * (o[1] * d[2] + o[2] * d[1]) + G * d[0] + H * d[1] + I * d[2];
+  const double c = A * o[0] * o[0] + B * o[1] * o[1] + C * o[2] * o[2] + D * o[0] * o[1] +
+                   E * o[0] * o[2] + F * o[1] * o[2] + G * o[0] + H * o[1] + I * o[2] + K;
+  const double scale = std::fabs(a) + std::fabs(b) + std::fabs(c);
+  if (!(scale > 0)) return;
+  if (std::fabs(a) <= 1e-12 * scale) {  // linear: b·s + c ≥ 0
+    if (std::fabs(b) <= 1e-12 * scale) {
+      if (c < 0) s0 = s1;
+      return;
+    }
+    const double root = -c / b, margin = 1e-9 * (std::fabs(root) + 1);
+    if (b > 0) s0 = std::max(s0, root - margin);
+    else s1 = std::min(s1, root + margin);
+    return;
+  }
+  const double disc = b * b - 4 * a * c;
+  if (disc < 0) {
+    if (a < 0) s0 = s1;  // wholly outside (a > 0: wholly inside)
+    return;
+  }
+  const double sq = std::sqrt(disc);
+  const double r0 = std::min((-b - sq) / (2 * a), (-b + sq) / (2 * a)),
+               r1 = std::max((-b - sq) / (2 * a), (-b + sq) / (2 * a));
+  if (a > 0) return;  // inside beyond both roots: the hull is the whole line
+  const double margin = 1e-9 * (std::fabs(r0) + std::fabs(r1) + 1);
+  s0 = std::max(s0, r0 - margin);
+  s1 = std::min(s1, r1 + margin);
+}
+
 // One pixel's compositing: the running colour and transparency, and per sample of the pixel the
 // value they had when the ray reached that sample's depth.
 struct PixelComposite {
@@ -329,16 +369,17 @@ void VolumePass::drawTile(const raster::TileTarget& tile) {
       const Vec3d d = r.direction(px + 0.5, py + 0.5);
       const double worldPerS = std::sqrt(dot(d, d));
       // Each listed volume's stretch of the ray, nearest entry first.
+      // s0, s1: the box's (the sample lattice starts at s0); from, to: within the shell.
       struct Stretch {
         const Prepared* p;
-        double s0, s1, o[3], dir[3];
+        double s0, s1, o[3], dir[3], from, to;
       };
       std::array<Stretch, 64> stretches;
       int n = 0;
       for (int v = 0; v < count; ++v) {
         const Prepared& p = *listed[size_t(v)];
         if (px < p.x0 || px >= p.x1 || py < p.y0 || py >= p.y1) continue;
-        Stretch st{&p, r.znear, r.zfar, {}, {}};
+        Stretch st{&p, r.znear, r.zfar, {}, {}, 0, 0};
         for (int a = 0; a < 3; ++a) {
           st.o[a] = p.toOwn[a][0] * r.eye.x + p.toOwn[a][1] * r.eye.y + p.toOwn[a][2] * r.eye.z +
                     p.toOwn[a][3];
@@ -346,7 +387,9 @@ void VolumePass::drawTile(const raster::TileTarget& tile) {
         }
         const double lo[3] = {0, 0, 0};
         clipToBox(st.o, st.dir, lo, p.extent, st.s0, st.s1);
-        if (st.s0 < st.s1) stretches[size_t(n++)] = st;
+        st.from = st.s0, st.to = st.s1;
+        for (const auto& q : p.object->shell) clipToQuadric(q, st.o, st.dir, st.from, st.to);
+        if (st.s0 < st.s1 && st.from < st.to) stretches[size_t(n++)] = st;
       }
       if (n == 0) continue;
       std::sort(stretches.begin(), stretches.begin() + n,
@@ -375,9 +418,12 @@ void VolumePass::drawTile(const raster::TileTarget& tile) {
         const double brickSize[3] = {kBrick * double(g.spacing.x), kBrick * double(g.spacing.y),
                                      kBrick * double(g.spacing.z)};
         // Segments [s0 + i·ds, s0 + (i + 1)·ds) ∩ [s0, end), each sampled at its middle.
-        for (int64_t i = 0;; ++i) {
+        // From the segment holding the shell's entry to the one holding its exit: the samples
+        // outside the shell are transparent (its promise), the lattice the box's.
+        const int64_t first = int64_t(std::max(0.0, std::floor((st.from - st.s0) / ds)));
+        for (int64_t i = first;; ++i) {
           const double a = st.s0 + double(i) * ds;
-          if (!(a < end)) break;
+          if (!(a < end) || a > st.to) break;
           pc.reach(a);
           const bool full = a + ds <= end;
           const double b = full ? a + ds : end, mid = 0.5 * (a + b);

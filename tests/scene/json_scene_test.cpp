@@ -145,7 +145,9 @@ TEST(JsonScene, ReadsVolumes) {
       "skipEmpty": false, "objects": [{"name": "ml", "generate": {"kind": "marschner-lobb",
       "size": 9}, "transform": {"translate": [1, 2, 3]}, "transfer": [{"value": 0.2,
       "color": [1, 0, 0], "opacity": 0}, {"value": 0.8, "opacity": 0.5}], "opacityUnit": 0.1,
-      "shaded": false}, {"generate": {"kind": "cloud", "size": 16, "seed": 7},
+      "shaded": false, "shell": {"quadric": "sphere", "center": [1, 1, 1], "radius": 1.2,
+      "clip": [{"quadric": "plane", "normal": [0, 1, 0]}]}},
+      {"generate": {"kind": "cloud", "size": 16, "seed": 7},
       "transfer": [{"value": 0, "opacity": 0.1}]}]}})");
   ASSERT_TRUE(r.ok()) << r.error().str();
   ASSERT_EQ(r->volumes.size(), 2u);
@@ -158,6 +160,9 @@ TEST(JsonScene, ReadsVolumes) {
   EXPECT_FLOAT_EQ(v.transfer[1].opacity, 0.5f);
   EXPECT_FLOAT_EQ(v.opacityUnit, 0.1f);
   EXPECT_FALSE(v.shaded);
+  ASSERT_EQ(v.shell.size(), 2u);  // the sphere and its clip
+  EXPECT_LT(v.shell[0][0], 0);  // r² − |q − c|², up to a positive factor
+  EXPECT_NEAR(v.shell[0][9] / -v.shell[0][0], 1.44 - 3, 1e-5);
   EXPECT_EQ(r->volumes[1].name, "cloud");
   EXPECT_EQ(r->volumes[1].grid->ny, 4);
   EXPECT_FLOAT_EQ(r->volumeSettings.step, 0.25f);
@@ -173,6 +178,9 @@ TEST(JsonScene, ReadsVolumes) {
   EXPECT_TRUE(contains(error(R"({"generate": {"kind": "cloud"}, "transfer": [{"value": 1},
       {"value": 0}]})"), "values must increase"));
   EXPECT_TRUE(contains(error(R"({"file": "x.nii", "transfer": [{"value": 0}]})"), "x.nii"));
+  EXPECT_TRUE(contains(error(R"({"generate": {"kind": "cloud"}, "transfer": [{"value": 0}],
+      "shell": {"quadric": "sphere", "perturbations": [{"quadric": "sphere"}]}})"),
+                       "not perturbed"));
 }
 
 TEST(JsonScene, ReadsACameraList) {
