@@ -177,7 +177,7 @@ void VolumePass::setVolumes(const VolumeInput& input) {
   for (size_t i = 0; i < objects.size(); ++i) {
     Prepared& p = volumes_[i];
     const scene::VolumeObject& v = objects[i];
-    const bool same = p.grid == v.grid.get() && p.transferKey == &v.transfer &&
+    const bool same = p.grid == v.grid.get() &&
                       p.transfer.size() == v.transfer.size() &&
                       std::equal(p.transfer.begin(), p.transfer.end(), v.transfer.begin(),
                                  [](const scene::TransferPoint& a, const scene::TransferPoint& b) {
@@ -187,8 +187,8 @@ void VolumePass::setVolumes(const VolumeInput& input) {
                                  });
     p.object = &v;
     if (!same) {
+      p.held = v.grid;
       p.grid = v.grid.get();
-      p.transferKey = &v.transfer;
       p.transfer = v.transfer;
       p.normals.clear();
       prepareTables(p);

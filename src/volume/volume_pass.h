@@ -12,6 +12,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "core/eye_rays.h"
@@ -66,8 +67,10 @@ class VolumePass final : public raster::TilePass {
   struct Prepared {
     const scene::VolumeObject* object = nullptr;
     const scene::VolumeGrid* grid = nullptr;
-    const void* transferKey = nullptr;  // what the tables were made for (the object's transfer)
-    std::vector<scene::TransferPoint> transfer;
+    // Held while its tables are: a grid freed and another made at its address would otherwise
+    // be taken for it.
+    std::shared_ptr<const scene::VolumeGrid> held;
+    std::vector<scene::TransferPoint> transfer;  // what the tables were made for
     double toOwn[3][4] = {};   // world → the volume's own space (affine rows)
     double extent[3] = {};     // the grid's box in its own space: [0, extent]
     double inverseSpacing[3] = {};

@@ -260,6 +260,25 @@ TEST(VolumePass, TheSameImageForAnyThreadCount) {
   }
 }
 
+// A renderer keeps a volume's tables from frame to frame: a scene with another grid, or another
+// transfer function, draws as a fresh renderer draws it.
+TEST(VolumePass, TablesFollowTheGridAndTransferFunction) {
+  Renderer renderer(options());
+  Image first, second;
+  for (int round = 0; round < 2; ++round) {
+    scene::Scene s = marschnerLobbScene();
+    if (round == 1) {
+      s.volumes[0].grid = std::make_shared<scene::VolumeGrid>(scene::marschnerLobbGrid(33));
+      s.volumes[0].transfer[2].opacity = 0.2f;
+    }
+    Image kept;
+    ASSERT_TRUE(renderer.render(s, kept, nullptr).ok());
+    EXPECT_EQ(kept.rgb, render(s, options()).rgb) << round;
+    (round == 0 ? first : second) = kept;
+  }
+  EXPECT_NE(first.rgb, second.rgb);
+}
+
 TEST(VolumePass, MalformedVolumesAreRefusedByName) {
   auto refused = [](scene::VolumeObject v, const char* part) {
     scene::Scene s = emptyScene();
