@@ -87,7 +87,10 @@ void mergeFarLevels(const Scene& scene, InstanceTree& tree) {
           .push_back(i);
   }
   size_t vertices = 0;
-  for (const auto& [key, members] : found) {
+  for (const auto& entry : found) {
+    // Not a structured binding: clang 14 (the libFuzzer build) refuses a lambda capturing one.
+    const CellKey& key = entry.first;
+    const std::vector<uint32_t>& members = entry.second;
     if (members.size() < 2) continue;  // nothing saved
     InstanceTree::Cell cell;
     cell.beyond = std::isinf(key.until);
