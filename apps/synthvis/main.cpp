@@ -387,9 +387,9 @@ int runBench(BenchArgs a) {
   if (a.renderer.empty()) a.renderer = a.suite.empty() ? "synthvis" : "both";
   if (a.renderer != "synthvis" && a.renderer != "gl" && a.renderer != "both" &&
       a.renderer != "sphere-trace" && a.renderer != "tessellated" &&
-      a.renderer != "full-detail")
+      a.renderer != "full-detail" && a.renderer != "vtk")
     return fail({"", "",
-                 fmt::format("unknown renderer '{}' (synthvis, gl, both, sphere-trace, "
+                 fmt::format("unknown renderer '{}' (synthvis, gl, vtk, both, sphere-trace, "
                              "tessellated or full-detail)",
                              a.renderer)});
   if (auto order = sv::scene::parseSubmitOrder(a.generator.order); !order)
@@ -431,7 +431,8 @@ int runBench(BenchArgs a) {
   settings.fog = a.fog;
   settings.channels = a.channels;
   settings.arcDegrees = a.arc;
-  settings.synthvis = a.renderer != "gl";
+  settings.synthvis = a.renderer != "gl" && a.renderer != "vtk";
+  settings.vtk = a.renderer == "vtk" || a.renderer == "both";
   settings.sphereTrace = a.renderer == "sphere-trace";
   settings.tessellated = a.renderer == "tessellated";
   settings.fullDetail = a.renderer == "full-detail";
@@ -467,6 +468,9 @@ int runBench(BenchArgs a) {
       if (k == 0 && !cr.params.contains("file"))
         fmt::print("{}: {} triangles, mean area {:.1f} px, depth complexity {:.2f}\n", cr.name,
                    cr.triangles, cr.meanArea, cr.depthComplexity);
+      if (k == 0 && cr.params.value("volumes_alone", false))
+        fmt::print("{}: the scene's volumes alone, in both renderers (VTK draws nothing else)\n",
+                   cr.name);
       fmt::print("{}\n", ref::summaryLine(cr));
       if (settings.synthvis && cr.runs[0].channelStats.empty())
         fmt::print("  synthvis last frame: {}\n", cr.runs[0].stats.summary());
@@ -861,7 +865,9 @@ int main(int argc, char** argv) {
   bench->add_flag("--gl-readback", b.glReadback,
                   "count the gl reference's read-back of the image in its frame time");
   bench->add_option("--renderer", b.renderer,
-                    "synthvis, gl (Mesa llvmpipe) or both, alternating frames; sphere-trace: "
+                    "synthvis, gl (Mesa llvmpipe), vtk (VTK's CPU volume ray caster, for "
+                    "scenes of volumes alone) or both (gl, or vtk for volumes), alternating "
+                    "frames; sphere-trace: "
                     "synthvis against its free forms marched in fixed steps (--march-steps); "
                     "tessellated: against its free forms as triangles (the gl reference always "
                     "draws those); full-detail: against every instance transformed at full "

@@ -12,6 +12,7 @@
 
 #include "core/timing.h"
 #include "reference/gl_renderer.h"
+#include "reference/vtk_volume.h"
 
 namespace sv::reference {
 namespace {
@@ -219,6 +220,17 @@ Result<CaseResult> BenchRunner::run(const BenchCase& c) {
   if (!made.value().scene.channels.empty() && impl_->gl)
     return Error{"", "",
                  "channels: the gl reference draws one view only (use --renderer synthvis)"};
+  // VTK draws volumes alone: a volume scene compared with it is timed, in both renderers, without
+  // what surrounds its volumes (the row's "volumes_alone" says so).
+  if (s.vtk && !made.value().scene.volumes.empty()) {
+    scene::Scene alone = volumesAlone(made.value().scene);
+    if (alone.triangleCount() != made.value().scene.triangleCount() ||
+        !made.value().scene.freeForms.empty() || !made.value().scene.terrains.empty() ||
+        !made.value().scene.lightPoints.empty() || !made.value().scene.lines.empty()) {
+      made.value().params["volumes_alone"] = true;
+      made.value().scene = std::move(alone);
+    }
+  }
   const scene::Scene& sc = made.value().scene;
 
   CaseResult r;
@@ -238,10 +250,18 @@ Result<CaseResult> BenchRunner::run(const BenchCase& c) {
   if (s.sphereTrace || s.tessellated || s.fullDetail)
     marcher.emplace(s.sphereTrace ? marchOptions : s.fullDetail ? fullDetailOptions : s.options);
   // Volumes have no polygon form: a gl row would leave them out, and its ratio and PSNR would
-  // compare different pictures (their baseline is VTK's ray caster, issue 33).
-  if (impl_->gl && !sc.volumes.empty())
+  // compare different pictures. Their baseline is VTK's ray caster (issue 33).
+  std::unique_ptr<VtkVolumeRenderer> vtk;
+  if (s.vtk && !sc.volumes.empty()) {
+    auto v = VtkVolumeRenderer::create(sc, s.options);
+    if (!v.ok()) return v.error();
+    vtk = std::move(v).value();
+  } else if (impl_->gl && !sc.volumes.empty()) {
     return Error{"", "", fmt::format("the gl reference does not draw volumes ({} in the scene)",
                                      sc.volumes.size())};
+  } else if (s.vtk && !s.synthvis) {
+    return Error{"", "", "the vtk reference draws volume scenes only"};
+  }
   // Free forms as triangles, for the polygon baseline and for the gl reference.
   std::optional<scene::Scene> tessellated;
   if ((!sc.freeForms.empty() || !sc.terrains.empty()) && (s.tessellated || impl_->gl)) {
@@ -291,6 +311,8 @@ Result<CaseResult> BenchRunner::run(const BenchCase& c) {
                       {},
                       {},
                       {}};
+  } else if (vtk) {
+    ref = RendererRun{"vtk", vtk->description(), {}, 0, 0, 0, {}, {}, {}};
   } else if (impl_->gl) {
     if (Status st = impl_->gl->load(polygons); !st) return st.error();
     ref = RendererRun{"gl", impl_->glDescription, {}, 0, 0, 0, {}, {}, {}};
@@ -311,6 +333,10 @@ Result<CaseResult> BenchRunner::run(const BenchCase& c) {
         return st.error();
       const double ms = msSince(t0);
       if (i >= s.warmup) ref->frameMs.push_back(ms);
+    } else if (ref && vtk) {
+      const Result<double> ms = vtk->render();  // VTK's own render call, timed by the script
+      if (!ms.ok()) return ms.error();
+      if (i >= s.warmup) ref->frameMs.push_back(ms.value());
     } else if (ref) {
       const auto t0 = Clock::now();
       if (Status st = impl_->gl->render(); !st) return st.error();
@@ -328,8 +354,11 @@ Result<CaseResult> BenchRunner::run(const BenchCase& c) {
   if (ref) {
     finish(*ref);
     if (!ref->channelStats.empty()) ref->image = mosaic(refImages);
-    if (!s.sphereTrace && !s.tessellated && !s.fullDetail)
+    if (vtk) {
+      if (Status st = vtk->readImage(ref->image); !st) return st.error();
+    } else if (!s.sphereTrace && !s.tessellated && !s.fullDetail) {
       if (Status st = impl_->gl->readImage(ref->image); !st) return st.error();
+    }
     if (!r.runs.empty()) r.psnrDb = psnr(r.runs[0].image, ref->image);
     r.runs.push_back(std::move(*ref));
   }
@@ -381,9 +410,13 @@ nlohmann::json jsonRows(const CaseResult& r, const BenchSettings& s) {
          {"warmup", s.warmup},
          {"shade", s.textured ? "textured" : "gouraud"},
          {"fog", s.fog},
-         {"hsr", run.renderer == "synthvis" ? hsrName(s.options.hsr) : "zbuffer"},
+         {"hsr", run.renderer == "synthvis" ? hsrName(s.options.hsr)
+                 : run.renderer == "vtk"    ? "ray-cast"
+                                            : "zbuffer"},
          {"texture_filter", scene::textureFilterName(s.options.textureFilter)},
-         {"aa", run.renderer == "synthvis" ? s.options.samples : std::max(1, s.referenceMsaa)},
+         {"aa", run.renderer == "synthvis" ? s.options.samples
+                : run.renderer == "vtk"    ? 1
+                                           : std::max(1, s.referenceMsaa)},
          {"filter", s.options.filter == RenderOptions::Filter::tent3 ? "tent3" : "box"},
          {"readback_timed", run.renderer == "synthvis" || s.referenceReadback},
          {"median_ms", run.medianMs},

@@ -70,6 +70,9 @@ struct BenchSettings {
   int referenceMsaa = 0;
   bool synthvis = true;   // time synthvis
   bool reference = true;  // time the gl reference (after startReference)
+  // Time, on scenes with volumes (and nothing else), VTK's CPU volume ray caster
+  // (reference/vtk_volume.h), renderer name "vtk"; other scenes take the gl reference if started.
+  bool vtk = false;
   // Time, instead of the gl reference, synthvis with free forms marched in fixed steps (options.
   // marchSteps; RenderOptions::FreeFormMethod::march) — issue 7's sphere-tracing baseline, renderer
   // name "sphere-trace".
