@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "raster/framebuffer.h"
+#include "volume/sample_kernel.h"
 
 namespace sv::volume {
 namespace {
@@ -29,41 +30,6 @@ std::array<float, 4> classify(const std::vector<scene::TransferPoint>& tf, float
   return {ca[0] + t * (cb[0] - ca[0]), ca[1] + t * (cb[1] - ca[1]), ca[2] + t * (cb[2] - ca[2]),
           ca[3] + t * (cb[3] - ca[3])};
 }
-
-// A grid read trilinearly in code units at a point of its own space (clamped to the box).
-struct Sampler {
-  const scene::VolumeGrid& g;
-  const double* inverseSpacing;
-
-  // The cell holding own-space point (x, y, z) (clamped to the grid): its first sample and the
-  // point's place in it.
-  struct Cell {
-    size_t base;
-    float tx, ty, tz;
-  };
-  Cell locate(double x, double y, double z) const {
-    const double fx = std::clamp(x * inverseSpacing[0], 0.0, double(g.nx - 1));
-    const double fy = std::clamp(y * inverseSpacing[1], 0.0, double(g.ny - 1));
-    const double fz = std::clamp(z * inverseSpacing[2], 0.0, double(g.nz - 1));
-    const int i = std::min(int(fx), g.nx - 2), j = std::min(int(fy), g.ny - 2),
-              k = std::min(int(fz), g.nz - 2);
-    return {g.at(i, j, k), float(fx - i), float(fy - j), float(fz - k)};
-  }
-  // The trilinear interpolation of `values` (one per sample, `stride` apart) over cell `c`.
-  template <class T>
-  float blend(const T* values, const Cell& c, size_t stride = 1) const {
-    const T* v = values + c.base * stride;
-    const size_t sx = stride, sy = size_t(g.nx) * stride, sz = size_t(g.nx) * size_t(g.ny) * stride;
-    auto lerp = [](float a, float b, float t) { return a + t * (b - a); };
-    const float c00 = lerp(float(v[0]), float(v[sx]), c.tx);
-    const float c10 = lerp(float(v[sy]), float(v[sy + sx]), c.tx);
-    const float c01 = lerp(float(v[sz]), float(v[sz + sx]), c.tx);
-    const float c11 = lerp(float(v[sz + sy]), float(v[sz + sy + sx]), c.tx);
-    return lerp(lerp(c00, c10, c.ty), lerp(c01, c11, c.ty), c.tz);
-  }
-  // The trilinear code at own-space point (x, y, z).
-  float at(double x, double y, double z) const { return blend(g.codes.data(), locate(x, y, z)); }
-};
 
 // Per sample of `g`, the direction of its value's gradient (central differences, one-sided at
 // the faces) in the grid's own space, scaled to ±127; (0, 0, 0) where the gradient vanishes.
@@ -157,14 +123,20 @@ struct PixelComposite {
   bool done[64];
   double snapC[64][3], snapT[64];
 
+  double next = -1e300;  // no sample not yet recorded has its surface before this depth
+
   // Records the samples whose surface lies at or before eye depth s.
   void reach(double s) {
-    for (int k = 0; k < samples; ++k)
+    if (s < next) return;
+    next = 1e300;
+    for (int k = 0; k < samples; ++k) {
       if (!done[k] && limit[k] <= s) {
         done[k] = true;
         snapC[k][0] = C[0], snapC[k][1] = C[1], snapC[k][2] = C[2];
         snapT[k] = T;
       }
+      if (!done[k]) next = std::min(next, limit[k]);
+    }
   }
 };
 
@@ -333,9 +305,33 @@ void VolumePass::prepare(const raster::PassFrame& frame) {
   input_.rays.width = frame.width;
   input_.rays.height = frame.height;
   samples_ = frame.samples;
-  for (Prepared& p : volumes_) screenBounds(p);
+  for (Prepared& p : volumes_) {
+    screenBounds(p);
+    // The sample kernel's view of the volume's tables and of the light (sample_kernel.h).
+    const scene::VolumeGrid& g = *p.grid;
+    SampleSource& k = p.source;
+    k.codes = g.codes.data();
+    k.nx = g.nx, k.ny = g.ny, k.nz = g.nz;
+    const float spacing[3] = {g.spacing.x, g.spacing.y, g.spacing.z};
+    for (int a = 0; a < 3; ++a) {
+      k.inverseSpacing[a] = float(p.inverseSpacing[a]);
+      k.spacing[a] = spacing[a];
+      for (int c = 0; c < 3; ++c) k.toWorld[c][a] = float(p.toOwn[a][c]);
+    }
+    k.table = p.table.data();
+    k.entries = int(p.table.size() / 4);
+    k.codeScale = float(p.codeScale);
+    k.stepOpacity = p.stepOpacity.empty() ? nullptr : p.stepOpacity.data();
+    k.normals = p.normals.empty() ? nullptr : p.normals.data();
+    k.shade = p.object->shaded && input_.lightOn;
+    k.toLight[0] = input_.toLight.x, k.toLight[1] = input_.toLight.y, k.toLight[2] = input_.toLight.z;
+    k.ambient = input_.ambient;
+    k.lightColor[0] = input_.lightColor.x, k.lightColor[1] = input_.lightColor.y,
+    k.lightColor[2] = input_.lightColor.z;
+  }
   const int workers = frame.pool ? frame.pool->threadCount() : 1;
   counts_.assign(size_t(workers), WorkerCounts{});
+  batches_.resize(size_t(workers));
 }
 
 void VolumePass::addStats(FrameStats& stats) const {
@@ -408,120 +404,122 @@ void VolumePass::drawTile(const raster::TileTarget& tile) {
         const Stretch& st = stretches[size_t(v)];
         const Prepared& p = *st.p;
         const scene::VolumeGrid& g = *p.grid;
-        const Sampler sampler{g, p.inverseSpacing};
         const double dirLength = std::sqrt(st.dir[0] * st.dir[0] + st.dir[1] * st.dir[1] +
                                            st.dir[2] * st.dir[2]);
         const double ds = p.stepOwn / dirLength;  // a step in s
         const double end = std::min(st.s1, farthest);
-        const scene::VolumeObject& object = *p.object;
-        const int entries = int(p.table.size() / 4);
         const double brickSize[3] = {kBrick * double(g.spacing.x), kBrick * double(g.spacing.y),
                                      kBrick * double(g.spacing.z)};
+        // The samples waiting in `batch`, in ray order: their segments' starts and lengths in s.
+        SampleBatch& batch = batches_[size_t(tile.worker)].batch;
+        double start[kBatch], length[kBatch];
+        int pending = 0;
+        // Classifies the waiting samples together (sample_kernel.h), then composites them in
+        // order: false once the ray's transparency fell below ε.
+        auto flush = [&]() -> bool {
+          classifySamples(p.source, pending, batch);
+          const int waiting = pending;
+          pending = 0;
+          for (int j = 0; j < waiting; ++j) {
+            pc.reach(start[j]);
+            ++counts.samples;
+            const float opacity = batch.opacity[j];
+            if (!(opacity > 0)) continue;
+            // SPEC §12: the opacity of a sample of length l is 1 − (1 − W)^(l / unit) — tabled
+            // for a full step under a uniform scale.
+            const bool full = length[j] == ds;
+            const double w =
+                full && p.source.stepOpacity ? double(batch.w[j])
+                : opacity >= 1               ? 1.0
+                                             : 1 - std::pow(1 - double(opacity),
+                                                            length[j] * worldPerS / p.opacityUnit);
+            double color[3] = {batch.r[j], batch.g[j], batch.b[j]};
+            if (input_.fogBeta > 0) {
+              const double mid = start[j] + 0.5 * length[j];
+              const double fog = std::exp2(-double(input_.fogBeta) * mid * worldPerS);  // SPEC §8
+              const double fc[3] = {input_.fogColor.x, input_.fogColor.y, input_.fogColor.z};
+              for (int c = 0; c < 3; ++c) color[c] = color[c] * fog + fc[c] * (1 - fog);
+            }
+            for (int c = 0; c < 3; ++c) pc.C[c] += pc.T * w * color[c];
+            pc.T *= 1 - w;
+            if (pc.T < epsilon) {
+              ++counts.terminated;
+              return false;
+            }
+          }
+          return true;
+        };
         // Segments [s0 + i·ds, s0 + (i + 1)·ds) ∩ [s0, end), each sampled at its middle.
         // From the segment holding the shell's entry to the one holding its exit: the samples
         // outside the shell are transparent (its promise), the lattice the box's.
         const int64_t first = int64_t(std::max(0.0, std::floor((st.from - st.s0) / ds)));
-        for (int64_t i = first;; ++i) {
-          const double a = st.s0 + double(i) * ds;
-          if (!(a < end) || a > st.to) break;
-          pc.reach(a);
-          const bool full = a + ds <= end;
-          const double b = full ? a + ds : end, mid = 0.5 * (a + b);
-          const double q[3] = {st.o[0] + mid * st.dir[0], st.o[1] + mid * st.dir[1],
-                               st.o[2] + mid * st.dir[2]};
-          if (settings.skipEmpty) {
-            int bi[3];
-            for (int ax = 0; ax < 3; ++ax)
-              bi[ax] = std::clamp(int(std::floor(q[ax] / brickSize[ax])), 0, p.bricks[ax] - 1);
-            if (p.emptyBrick[(size_t(bi[2]) * size_t(p.bricks[1]) + size_t(bi[1])) *
-                                 size_t(p.bricks[0]) + size_t(bi[0])]) {
-              // To the last segment whose middle is still in this brick: its samples would all be
-              // transparent (the brick holds their cells' corners).
-              double lo[3], hi[3];
-              for (int ax = 0; ax < 3; ++ax) {
-                lo[ax] = bi[ax] * brickSize[ax];
-                hi[ax] = bi[ax] == p.bricks[ax] - 1 ? 1e300 : (bi[ax] + 1) * brickSize[ax];
-                if (bi[ax] == 0) lo[ax] = -1e300;
-              }
-              double e0 = -1e300, e1 = 1e300;
-              clipToBox(st.o, st.dir, lo, hi, e0, e1);
-              // Segment j's middle is s0 + (j + ½)·ds; those with it below e1 are in the brick.
-              // (No further than the stretch's last segment.)
-              const double last = std::min(std::ceil((e1 - st.s0) / ds - 0.5) - 1,
-                                           std::ceil((end - st.s0) / ds) - 1);
-              const int64_t skipTo = std::max<int64_t>(i, int64_t(std::min(last, 1e15)));
-              counts.skipped += uint64_t(skipTo - i + 1);
-              i = skipTo;
-              continue;
-            }
-          }
-          ++counts.samples;
-          const float code = sampler.at(q[0], q[1], q[2]);
-          const double pos = code * p.codeScale;
-          const int e = std::min(int(pos), entries - 2 < 0 ? 0 : entries - 2);
-          const float f = entries > 1 ? float(pos - e) : 0.0f;
-          const float* t0 = &p.table[size_t(e) * 4];
-          const float* t1 = entries > 1 ? t0 + 4 : t0;
-          const float opacity = t0[3] + f * (t1[3] - t0[3]);
-          if (!(opacity > 0)) continue;
-          // SPEC §12: the opacity of a sample of length l is 1 − (1 − W)^(l / unit) — tabled for
-          // a full step under a uniform scale.
-          double w;
-          if (!p.stepOpacity.empty() && full) {
-            const float* c = &p.stepOpacity[size_t(e)];
-            w = c[0] + f * ((entries > 1 ? c[1] : c[0]) - c[0]);
-          } else {
-            const double length = (full ? ds : b - a) * worldPerS;
-            w = opacity >= 1 ? 1.0 : 1 - std::pow(1 - double(opacity), length / p.opacityUnit);
-          }
-          double color[3] = {t0[0] + f * (t1[0] - t0[0]), t0[1] + f * (t1[1] - t0[1]),
-                             t0[2] + f * (t1[2] - t0[2])};
-          if (object.shaded && input_.lightOn) {
-            // The gradient: by central differences of the interpolated value over one sample
-            // spacing, or the samples' precomputed directions interpolated; to the world by the
-            // inverse transpose (the rows of world → own, transposed).
-            double grad[3];
-            if (!p.normals.empty()) {
-              const Sampler::Cell cell = sampler.locate(q[0], q[1], q[2]);
-              for (int ax = 0; ax < 3; ++ax)
-                grad[ax] = sampler.blend(p.normals.data() + ax, cell, 4);
-            } else {
-              const double h[3] = {g.spacing.x, g.spacing.y, g.spacing.z};
-              for (int ax = 0; ax < 3; ++ax) {
-                double up[3] = {q[0], q[1], q[2]}, down[3] = {q[0], q[1], q[2]};
-                up[ax] += h[ax], down[ax] -= h[ax];
-                grad[ax] = (double(sampler.at(up[0], up[1], up[2])) -
-                            double(sampler.at(down[0], down[1], down[2]))) /
-                           (2 * h[ax]);
-              }
-            }
-            Vec3d nw{p.toOwn[0][0] * grad[0] + p.toOwn[1][0] * grad[1] + p.toOwn[2][0] * grad[2],
-                     p.toOwn[0][1] * grad[0] + p.toOwn[1][1] * grad[1] + p.toOwn[2][1] * grad[2],
-                     p.toOwn[0][2] * grad[0] + p.toOwn[1][2] * grad[1] + p.toOwn[2][2] * grad[2]};
-            const double len = std::sqrt(dot(nw, nw));
-            if (len > 0) {
-              // Two-sided (a volume's gradient points either way through a surface), SPEC §8's
-              // weighting with Q_diff = 1 − Q_amb.
-              const double cosine = std::fabs(dot(nw, Vec3d{input_.toLight.x, input_.toLight.y,
-                                                            input_.toLight.z})) / len;
-              const double diffuse = (1 - input_.ambient) * cosine;
-              const double lc[3] = {input_.lightColor.x, input_.lightColor.y, input_.lightColor.z};
-              for (int c = 0; c < 3; ++c) color[c] *= input_.ambient + diffuse * lc[c];
-            }
-          }
-          if (input_.fogBeta > 0) {
-            const double fog = std::exp2(-double(input_.fogBeta) * mid * worldPerS);  // SPEC §8
-            const double fc[3] = {input_.fogColor.x, input_.fogColor.y, input_.fogColor.z};
-            for (int c = 0; c < 3; ++c) color[c] = color[c] * fog + fc[c] * (1 - fog);
-          }
-          for (int c = 0; c < 3; ++c) pc.C[c] += pc.T * w * color[c];
-          pc.T *= 1 - w;
-          if (pc.T < epsilon) {
-            terminated = true;
-            ++counts.terminated;
-            break;
+        const double perS = 1 / ds;
+        const double lastSegment = std::ceil((end - st.s0) * perS) - 1;
+        // The bricks along the ray, walked from the first sample's (Amanatides and Woo's grid
+        // traversal): each the stretch of s up to its exit `next`; the outermost bricks reach to
+        // infinity (a sample clamps into them). A brick every sample of which the transfer
+        // function makes transparent is stepped over whole (its samples' cells' corners all lie in
+        // it), a brick with content sampled without looking again.
+        int bi[3], stepAxis[3];
+        double next[3], delta[3];
+        {
+          const double mid = st.s0 + (double(first) + 0.5) * ds;
+          for (int ax = 0; ax < 3; ++ax) {
+            const double q = st.o[ax] + mid * st.dir[ax];
+            // (Clamped first, the truncation is the floor.)
+            bi[ax] = int(std::clamp(q / brickSize[ax], 0.0, double(p.bricks[ax] - 1)));
+            stepAxis[ax] = st.dir[ax] > 0 ? 1 : st.dir[ax] < 0 ? -1 : 0;
+            const bool edge = stepAxis[ax] == 0 || (stepAxis[ax] > 0 && bi[ax] == p.bricks[ax] - 1) ||
+                              (stepAxis[ax] < 0 && bi[ax] == 0);
+            delta[ax] = stepAxis[ax] ? brickSize[ax] / std::fabs(st.dir[ax]) : 1e300;
+            next[ax] = edge ? 1e300
+                            : ((bi[ax] + (stepAxis[ax] > 0)) * brickSize[ax] - st.o[ax]) / st.dir[ax];
           }
         }
+        for (int64_t i = first; double(i) <= lastSegment && st.s0 + double(i) * ds <= st.to;) {
+          // Segment j's middle is s0 + (j + ½)·ds; those with it below the exit are in the brick.
+          const double exit = std::min({next[0], next[1], next[2]});
+          // (⌈x⌉ of x capped first, by truncation: the baseline target has no rounding
+          // instruction, and std::ceil is a call.)
+          const double x = std::clamp((exit - st.s0) * perS - 0.5, -1.0, lastSegment + 1);
+          const double cut = double(int64_t(x));
+          const double through = std::min((cut < x ? cut + 1 : cut) - 1, lastSegment);
+          if (through >= double(i)) {
+            const int64_t last = int64_t(std::min(through, 1e15));
+            if (settings.skipEmpty &&
+                p.emptyBrick[(size_t(bi[2]) * size_t(p.bricks[1]) + size_t(bi[1])) *
+                                 size_t(p.bricks[0]) + size_t(bi[0])]) {
+              counts.skipped += uint64_t(last - i + 1);
+            } else {
+              // Samples i … last, up to the stretch's end and the shell's exit.
+              for (int64_t j = i; j <= last; ++j) {
+                const double a = st.s0 + double(j) * ds;
+                if (!(a < end) || a > st.to) break;
+                const bool full = a + ds <= end;
+                const double b = full ? a + ds : end, middle = 0.5 * (a + b);
+                start[pending] = a;
+                length[pending] = full ? ds : b - a;
+                batch.x[pending] = float(st.o[0] + middle * st.dir[0]);
+                batch.y[pending] = float(st.o[1] + middle * st.dir[1]);
+                batch.z[pending] = float(st.o[2] + middle * st.dir[2]);
+                if (++pending == kBatch && !flush()) {
+                  terminated = true;
+                  break;
+                }
+              }
+              if (terminated) break;
+            }
+            i = last + 1;
+          }
+          // On to the next brick: across the nearest of its faces.
+          const int ax = next[0] <= next[1] ? (next[0] <= next[2] ? 0 : 2) : (next[1] <= next[2] ? 1 : 2);
+          if (next[ax] >= 1e300) break;
+          bi[ax] += stepAxis[ax];
+          const bool edge = (stepAxis[ax] > 0 && bi[ax] == p.bricks[ax] - 1) ||
+                            (stepAxis[ax] < 0 && bi[ax] == 0);
+          next[ax] = edge ? 1e300 : next[ax] + delta[ax];
+        }
+        if (!terminated && pending > 0 && !flush()) terminated = true;
       }
       // Samples the rays did not reach take the whole composite; then each over its surface.
       pc.reach(1e300);

@@ -18,6 +18,7 @@
 #include "core/eye_rays.h"
 #include "raster/tile_pass.h"
 #include "synthvis/volumes.h"
+#include "volume/sample_kernel.h"
 
 namespace sv::volume {
 
@@ -89,6 +90,7 @@ class VolumePass final : public raster::TilePass {
     int bricks[3] = {};
     std::vector<uint8_t> emptyBrick;  // per brick (x fastest): every sample it holds transparent
     int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // the pixels its box may cover this frame, [x0, x1)
+    SampleSource source;  // the above as the sample kernel reads it (set by prepare)
   };
 
  private:
@@ -102,6 +104,10 @@ class VolumePass final : public raster::TilePass {
   std::vector<Prepared> volumes_;
   int samples_ = 1;
   std::vector<WorkerCounts> counts_;
+  struct WorkerBatch {
+    SampleBatch batch;
+  };
+  std::vector<WorkerBatch> batches_;  // per worker: its ray's samples waiting to be classified
 };
 
 }  // namespace sv::volume
