@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 
 #include "raster/framebuffer.h"
 #include "volume/sample_kernel.h"
@@ -248,6 +249,7 @@ void VolumePass::prepareTables(Prepared& p) const {
   const int n[3] = {g.nx, g.ny, g.nz};
   for (int a = 0; a < 3; ++a) p.bricks[a] = (n[a] - 2) / kBrick + 1;
   p.emptyBrick.assign(size_t(p.bricks[0]) * size_t(p.bricks[1]) * size_t(p.bricks[2]), 0);
+  p.contentBricks.clear();
   for (int bz = 0; bz < p.bricks[2]; ++bz)
     for (int by = 0; by < p.bricks[1]; ++by)
       for (int bx = 0; bx < p.bricks[0]; ++bx) {
@@ -266,8 +268,10 @@ void VolumePass::prepareTables(Prepared& p) const {
         // that code's entry alone: trilinear weights of equal codes give the code exactly).
         const int first = std::max(0, int(std::floor(lo * p.codeScale)));
         const int last = std::min(entries - 1, int(std::ceil(hi * p.codeScale)));
-        p.emptyBrick[(size_t(bz) * size_t(p.bricks[1]) + size_t(by)) * size_t(p.bricks[0]) +
-                     size_t(bx)] = opaqueBefore[size_t(last) + 1] == opaqueBefore[size_t(first)];
+        const size_t index =
+            (size_t(bz) * size_t(p.bricks[1]) + size_t(by)) * size_t(p.bricks[0]) + size_t(bx);
+        p.emptyBrick[index] = opaqueBefore[size_t(last) + 1] == opaqueBefore[size_t(first)];
+        if (!p.emptyBrick[index]) p.contentBricks.push_back(uint32_t(index));
       }
 }
 
@@ -301,12 +305,73 @@ void VolumePass::screenBounds(Prepared& p) const {
   p.y1 = int(std::clamp(std::ceil(y1) + 1, 0.0, double(r.height)));
 }
 
+// Per window, the eye depths between which its rays can meet a brick with content: each such
+// brick's eight corners projected give the pixels it may cover (their bounding rectangle, a pixel
+// wider: rays pass through pixel centres) and its nearest and farthest eye depth. Every sample
+// outside those depths on the window's rays lies in transparent bricks, so starting and ending
+// the rays there changes no pixel.
+void VolumePass::windowDepths(Prepared& p) const {
+  const EyeRays& r = input_.rays;
+  p.windowNear.clear();
+  p.windowFar.clear();
+  if (!input_.settings.skipEmpty) return;
+  p.windowsX = (r.width + kWindow - 1) / kWindow;
+  const int windowsY = (r.height + kWindow - 1) / kWindow;
+  p.windowNear.assign(size_t(p.windowsX) * size_t(windowsY), std::numeric_limits<float>::infinity());
+  p.windowFar.assign(p.windowNear.size(), -std::numeric_limits<float>::infinity());
+  const Mat4& m = p.object->transform;
+  const scene::VolumeGrid& g = *p.grid;
+  const double brick[3] = {kBrick * double(g.spacing.x), kBrick * double(g.spacing.y),
+                           kBrick * double(g.spacing.z)};
+  for (const uint32_t index : p.contentBricks) {
+    const int bx = int(index % uint32_t(p.bricks[0]));
+    const int by = int(index / uint32_t(p.bricks[0]) % uint32_t(p.bricks[1]));
+    const int bz = int(index / uint32_t(p.bricks[0]) / uint32_t(p.bricks[1]));
+    const int b[3] = {bx, by, bz};
+    double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300, near = 1e300, far = -1e300;
+    for (int c = 0; c < 8; ++c) {
+      double own[3];
+      for (int a = 0; a < 3; ++a)
+        own[a] = std::min((b[a] + ((c >> a) & 1)) * brick[a], p.extent[a]);
+      const Vec3 world = m.transformPoint(Vec3{float(own[0]), float(own[1]), float(own[2])});
+      const Vec3d rel{world.x - r.eye.x, world.y - r.eye.y, world.z - r.eye.z};
+      const double depth = dot(rel, r.forward);
+      const Vec4 clip = input_.viewProjection * Vec4{world.x, world.y, world.z, 1.0f};
+      if (!(depth > 1e-6) || !(clip.w > 1e-6f * std::fabs(clip.x) + 1e-20f)) {
+        // Behind the eye: its rectangle is unbounded; the windows are not known this frame.
+        p.windowNear.clear();
+        p.windowFar.clear();
+        return;
+      }
+      const double px = (clip.x / clip.w + 1) * 0.5 * r.width;
+      const double py = (1 - clip.y / clip.w) * 0.5 * r.height;
+      x0 = std::min(x0, px), x1 = std::max(x1, px), y0 = std::min(y0, py), y1 = std::max(y1, py);
+      near = std::min(near, depth), far = std::max(far, depth);
+    }
+    // (The corners in float through the transform: a margin of a pixel and a part in 10⁴ of
+    // depth covers their rounding.)
+    const int wx0 = int(std::clamp(std::floor((x0 - 1) / kWindow), 0.0, double(p.windowsX - 1)));
+    const int wx1 = int(std::clamp(std::floor((x1 + 1) / kWindow), 0.0, double(p.windowsX - 1)));
+    const int wy0 = int(std::clamp(std::floor((y0 - 1) / kWindow), 0.0, double(windowsY - 1)));
+    const int wy1 = int(std::clamp(std::floor((y1 + 1) / kWindow), 0.0, double(windowsY - 1)));
+    if (x1 < -1 || y1 < -1 || x0 > r.width + 1 || y0 > r.height + 1) continue;
+    const float n = float(near * (1 - 1e-4) - 1e-6), f = float(far * (1 + 1e-4) + 1e-6);
+    for (int wy = wy0; wy <= wy1; ++wy)
+      for (int wx = wx0; wx <= wx1; ++wx) {
+        const size_t w = size_t(wy) * size_t(p.windowsX) + size_t(wx);
+        p.windowNear[w] = std::min(p.windowNear[w], n);
+        p.windowFar[w] = std::max(p.windowFar[w], f);
+      }
+  }
+}
+
 void VolumePass::prepare(const raster::PassFrame& frame) {
   input_.rays.width = frame.width;
   input_.rays.height = frame.height;
   samples_ = frame.samples;
   for (Prepared& p : volumes_) {
     screenBounds(p);
+    windowDepths(p);
     // The sample kernel's view of the volume's tables and of the light (sample_kernel.h).
     const scene::VolumeGrid& g = *p.grid;
     SampleSource& k = p.source;
@@ -384,6 +449,12 @@ void VolumePass::drawTile(const raster::TileTarget& tile) {
         const double lo[3] = {0, 0, 0};
         clipToBox(st.o, st.dir, lo, p.extent, st.s0, st.s1);
         st.from = st.s0, st.to = st.s1;
+        if (!p.windowNear.empty()) {
+          const size_t w = size_t(py / kWindow) * size_t(p.windowsX) + size_t(px / kWindow);
+          st.from = std::max(st.from, double(p.windowNear[w]));
+          st.to = std::min(st.to, double(p.windowFar[w]));
+          if (!(st.from < st.to)) continue;
+        }
         for (const auto& q : p.object->shell) clipToQuadric(q, st.o, st.dir, st.from, st.to);
         if (st.s0 < st.s1 && st.from < st.to) stretches[size_t(n++)] = st;
       }

@@ -60,6 +60,8 @@ class VolumePass final : public raster::TilePass {
 
   // The edge of the cubes of grid cells the empty-region map is made of.
   static constexpr int kBrick = 8;
+  // The edge, in pixels, of the screen windows whose rays share their depth interval.
+  static constexpr int kWindow = 8;
   // Entries of the transfer function's table over the grid's codes (fewer for 8-bit data: one per
   // code).
   static constexpr int kTableSize = 4096;
@@ -89,7 +91,14 @@ class VolumePass final : public raster::TilePass {
     std::vector<int8_t> normals;
     int bricks[3] = {};
     std::vector<uint8_t> emptyBrick;  // per brick (x fastest): every sample it holds transparent
+    std::vector<uint32_t> contentBricks;  // the bricks not wholly transparent, by index
     int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // the pixels its box may cover this frame, [x0, x1)
+    // SPEC §12's screen subdivision at one level: per window of kWindow² pixels this frame, the
+    // eye depths [near, far] between which its rays can meet a brick with content (its bricks'
+    // corners projected): a ray starts and ends there, and a window no such brick covers casts
+    // none. Empty: not known this frame (a brick reaches behind the eye, or skipping is off).
+    std::vector<float> windowNear, windowFar;
+    int windowsX = 0;
     SampleSource source;  // the above as the sample kernel reads it (set by prepare)
   };
 
@@ -99,6 +108,7 @@ class VolumePass final : public raster::TilePass {
   };
   void prepareTables(Prepared& p) const;
   void screenBounds(Prepared& p) const;
+  void windowDepths(Prepared& p) const;
 
   VolumeInput input_;
   std::vector<Prepared> volumes_;
