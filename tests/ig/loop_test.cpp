@@ -42,12 +42,29 @@ IgConfig config() {
 }
 
 // The frame's PNG (present/'s png: naming, one channel "0").
-Image frameImage(const fs::path& dir, uint32_t frame) {
+fs::path framePath(const fs::path& dir, uint32_t frame) {
   char name[64];
   std::snprintf(name, sizeof name, "frame-%06u-0.png", frame);
-  Result<Image> image = readPng((dir / name).string());
+  return dir / name;
+}
+Image frameImage(const fs::path& dir, uint32_t frame) {
+  Result<Image> image = readPng(framePath(dir, frame).string());
   EXPECT_TRUE(image.ok()) << image.error().str();
   return image.ok() ? image.value() : Image{};
+}
+
+// The live run's frames equal the replay's, byte for byte. A live frame its PNG writer dropped
+// (present/present.h: a busy writer drops rather than hold up the loop, as it may on a loaded
+// machine) has nothing to compare; the replay, not in real time, writes every frame.
+void expectSameFrames(const fs::path& live, const fs::path& replayed, uint32_t count) {
+  uint32_t compared = 0;
+  for (uint32_t f = 0; f < count; ++f) {
+    EXPECT_TRUE(fs::exists(framePath(replayed, f))) << "frame " << f;
+    if (!fs::exists(framePath(live, f))) continue;
+    ASSERT_EQ(frameImage(live, f).rgb, frameImage(replayed, f).rgb) << "frame " << f;
+    ++compared;
+  }
+  EXPECT_GT(compared, count / 2);
 }
 
 // A command's standard output (tshark is installed by scripts/lib.sh).
@@ -193,10 +210,7 @@ TEST(IgLoop, HostDrivenEntitiesAppearInTheNextFrameAndTheSessionReplaysBitForBit
   Result<IgRunReport> r = loop.value()->run();
   ASSERT_TRUE(r.ok()) << r.error().str();
   EXPECT_EQ(r->frames, uint64_t(expectFrame));
-  for (uint32_t f = 0; f < expectFrame; ++f) {
-    const Image a = frameImage(frames, f), b = frameImage(again, f);
-    ASSERT_EQ(a.rgb, b.rgb) << "frame " << f;
-  }
+  expectSameFrames(frames, again, expectFrame);
   fs::remove_all(frames);
   fs::remove_all(again);
 }
@@ -238,10 +252,7 @@ TEST(IgLoop, TheReplayDrawsEachFrameAtItsRecordedQuality) {
   Result<IgRunReport> r = second.value()->run();
   ASSERT_TRUE(r.ok());
   EXPECT_EQ(r->frames, 12u);
-  for (uint32_t f = 0; f < 12; ++f) {
-    const Image a = frameImage(frames, f), b = frameImage(again, f);
-    ASSERT_EQ(a.rgb, b.rgb) << "frame " << f;
-  }
+  expectSameFrames(frames, again, 12);
   fs::remove_all(frames);
   fs::remove_all(again);
 }
