@@ -27,6 +27,7 @@ HWY_INLINE VF Lerp(VF a, VF b, VF t) { return hn::Add(a, hn::Mul(t, hn::Sub(b, a
 // the scalar Sampler::locate).
 struct Cell {
   VI base;
+  VI padded;  // byte offset of the cell's first sample in the bordered codes (if they are read)
   VF tx, ty, tz;
 };
 
@@ -45,6 +46,16 @@ HWY_INLINE Cell Locate(const SampleSource& s, VF x, VF y, VF z) {
   const VI k = hn::Min(hn::ConvertTo(di, fz), hn::Set(di, s.nz - 2));
   Cell c;
   c.base = hn::Add(hn::Mul(hn::Add(hn::Mul(k, hn::Set(di, s.ny)), j), hn::Set(di, s.nx)), i);
+  if (s.padded) {
+    const VI one = hn::Set(di, 1);
+    const VI at = hn::Add(hn::Mul(hn::Add(hn::Mul(hn::Add(k, one), hn::Set(di, s.ny + 2)),
+                                          hn::Add(j, one)),
+                                  hn::Set(di, s.nx + 2)),
+                          hn::Add(i, one));
+    c.padded = hn::Add(at, at);
+  } else {
+    c.padded = hn::Zero(di);
+  }
   c.tx = hn::Sub(fx, hn::ConvertTo(df, i));
   c.ty = hn::Sub(fy, hn::ConvertTo(df, j));
   c.tz = hn::Sub(fz, hn::ConvertTo(df, k));
@@ -110,6 +121,68 @@ HWY_INLINE void Normals(const SampleSource& s, const Cell& c, VF g[3]) {
   }
 }
 
+// The value over cell `c` and its central differences (the values over the cells one sample
+// before and after it along each axis, same weights), from the bordered codes: the rows of the
+// cross about the cell read as x-pairs of 16-bit codes.
+HWY_INLINE VF CodesAndGradient(const SampleSource& s, const Cell& c, VF g[3]) {
+  const DF df;
+  const DI di;
+  const DU du;
+  const auto* base = reinterpret_cast<const int32_t*>(s.padded);
+  const int px = s.nx + 2, pxy = (s.nx + 2) * (s.ny + 2);
+  const VI mask = hn::Set(di, 0xFFFF);
+  // Row (dy, dz) at x offset dx: the codes at x = i + dx and i + dx + 1.
+  auto pair = [&](VI row, int dx, VF& lo, VF& hi) {
+    const VI v = hn::GatherOffset(di, base, hn::Add(row, hn::Set(di, 2 * dx)));
+    lo = hn::ConvertTo(df, hn::And(v, mask));
+    hi = hn::ConvertTo(df, hn::BitCast(di, hn::ShiftRight<16>(hn::BitCast(du, v))));
+  };
+  auto rowAt = [&](int dy, int dz) {  // byte offset of (i + 1, j + 1 + dy, k + 1 + dz)
+    return hn::Add(c.padded, hn::Set(di, 2 * (dy * px + dz * pxy)));
+  };
+  // Rows y ∈ {j, j + 1}, z ∈ {k, k + 1}: x from i − 1 to i + 2.
+  VF x[2][2][4];
+  for (int dz = 0; dz < 2; ++dz)
+    for (int dy = 0; dy < 2; ++dy) {
+      const VI row = rowAt(dy, dz);
+      pair(row, -1, x[dz][dy][0], x[dz][dy][1]);
+      pair(row, 1, x[dz][dy][2], x[dz][dy][3]);
+    }
+  // Rows y ∈ {j − 1, j + 2} (z ∈ {k, k + 1}) and z ∈ {k − 1, k + 2} (y ∈ {j, j + 1}): x i, i + 1.
+  VF y[2][2][2], z[2][2][2];  // [dz or dy][before/after][x]
+  for (int d = 0; d < 2; ++d) {
+    pair(rowAt(-1, d), 0, y[d][0][0], y[d][0][1]);
+    pair(rowAt(2, d), 0, y[d][1][0], y[d][1][1]);
+    pair(rowAt(d, -1), 0, z[d][0][0], z[d][0][1]);
+    pair(rowAt(d, 2), 0, z[d][1][0], z[d][1][1]);
+  }
+  // Trilinear over the cell whose x-lerped rows are r00 (y0 z0), r10 (y1 z0), r01, r11.
+  auto blend = [&](VF r00, VF r10, VF r01, VF r11) {
+    return Lerp(Lerp(r00, r10, c.ty), Lerp(r01, r11, c.ty), c.tz);
+  };
+  VF rows[2][2][3];  // x-lerped rows at x offsets −1, 0, +1 (cells i − 1, i, i + 1)
+  for (int dz = 0; dz < 2; ++dz)
+    for (int dy = 0; dy < 2; ++dy)
+      for (int o = 0; o < 3; ++o) rows[dz][dy][o] = Lerp(x[dz][dy][o], x[dz][dy][o + 1], c.tx);
+  const VF value = blend(rows[0][0][1], rows[0][1][1], rows[1][0][1], rows[1][1][1]);
+  const VF xm = blend(rows[0][0][0], rows[0][1][0], rows[1][0][0], rows[1][1][0]);
+  const VF xp = blend(rows[0][0][2], rows[0][1][2], rows[1][0][2], rows[1][1][2]);
+  // The cells one before and after along y: rows (y − 1, y) and (y + 1, y + 2).
+  const VF yBefore[2] = {Lerp(y[0][0][0], y[0][0][1], c.tx), Lerp(y[1][0][0], y[1][0][1], c.tx)};
+  const VF yAfter[2] = {Lerp(y[0][1][0], y[0][1][1], c.tx), Lerp(y[1][1][0], y[1][1][1], c.tx)};
+  const VF ym = blend(yBefore[0], rows[0][0][1], yBefore[1], rows[1][0][1]);
+  const VF yp = blend(rows[0][1][1], yAfter[0], rows[1][1][1], yAfter[1]);
+  const VF zBefore[2] = {Lerp(z[0][0][0], z[0][0][1], c.tx), Lerp(z[1][0][0], z[1][0][1], c.tx)};
+  const VF zAfter[2] = {Lerp(z[0][1][0], z[0][1][1], c.tx), Lerp(z[1][1][0], z[1][1][1], c.tx)};
+  const VF zm = blend(zBefore[0], zBefore[1], rows[0][0][1], rows[0][1][1]);
+  const VF zp = blend(rows[1][0][1], rows[1][1][1], zAfter[0], zAfter[1]);
+  const VF two = hn::Set(df, 2.0f);
+  g[0] = hn::Div(hn::Sub(xp, xm), hn::Mul(two, hn::Set(df, s.spacing[0])));
+  g[1] = hn::Div(hn::Sub(yp, ym), hn::Mul(two, hn::Set(df, s.spacing[1])));
+  g[2] = hn::Div(hn::Sub(zp, zm), hn::Mul(two, hn::Set(df, s.spacing[2])));
+  return value;
+}
+
 void ClassifySamples(const SampleSource& s, int count, SampleBatch& b) {
   const DF df;
   const DI di;
@@ -120,7 +193,9 @@ void ClassifySamples(const SampleSource& s, int count, SampleBatch& b) {
   for (size_t i = 0; i < size_t(count); i += n) {
     const VF x = hn::Load(df, b.x + i), y = hn::Load(df, b.y + i), z = hn::Load(df, b.z + i);
     const Cell cell = Locate(s, x, y, z);
-    const VF code = Codes(s, cell);
+    VF g[3];
+    const bool crossed = s.shade && !s.normals && s.padded;
+    const VF code = crossed ? CodesAndGradient(s, cell, g) : Codes(s, cell);
     // SPEC §11: the transfer function's table read linearly between the entries about the code.
     const VF pos = hn::Mul(code, hn::Set(df, s.codeScale));
     const VI e = hn::Min(hn::ConvertTo(di, pos), last);
@@ -140,10 +215,9 @@ void ClassifySamples(const SampleSource& s, int count, SampleBatch& b) {
       hn::Store(Lerp(c0, c1, f), df, b.w + i);
     }
     if (s.shade) {
-      VF g[3];
       if (s.normals) {
         Normals(s, cell, g);
-      } else {
+      } else if (!crossed) {
         // Central differences of the interpolated value over one sample spacing each way.
         const VF h[3] = {hn::Set(df, s.spacing[0]), hn::Set(df, s.spacing[1]),
                          hn::Set(df, s.spacing[2])};

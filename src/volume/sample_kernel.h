@@ -26,8 +26,14 @@ struct SampleSource {
   // caller corrects every sample itself.
   const float* stepOpacity = nullptr;
   // Per sample 4 bytes (x, y, z gradient direction of ±127, pad); null: central differences of
-  // the interpolated value (six more reads).
+  // the interpolated value, one sample spacing each way.
   const int8_t* normals = nullptr;
+  // The codes with a border of one sample on every side repeating the faces' samples,
+  // (nx + 2)·(ny + 2)·(nz + 2): the central differences read the cross of cells about a sample's
+  // cell from it (16 gathers for the value and its gradient instead of 28), the border standing
+  // for the clamping at the faces. Null (or with normals): the differences are six trilinear
+  // reads at the moved points, clamped into the box.
+  const uint16_t* padded = nullptr;
   bool shade = false;
   float toWorld[3][3] = {};  // own → world for gradients: the rows of world → own, transposed
   float toLight[3] = {0, 0, 1};  // world, unit

@@ -89,6 +89,9 @@ class VolumePass final : public raster::TilePass {
     // VolumeSettings::precomputedNormals: per sample its gradient's direction, 4 bytes (x, y, z,
     // pad) of ±127; empty: the gradient is taken while traversing.
     std::vector<int8_t> normals;
+    // Gradients taken while traversing: the codes with a one-sample border (sample_kernel.h),
+    // 2 bytes a sample; empty with precomputed normals, unlit, or beyond 2^31 bytes.
+    std::vector<uint16_t> padded;
     int bricks[3] = {};
     std::vector<uint8_t> emptyBrick;  // per brick (x fastest): every sample it holds transparent
     std::vector<uint32_t> contentBricks;  // the bricks not wholly transparent, by index

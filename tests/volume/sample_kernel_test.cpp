@@ -22,6 +22,7 @@ constexpr int kNx = 9, kNy = 7, kNz = 5;
 struct Fixture {
   std::vector<uint16_t> codes;
   std::vector<int8_t> normals;
+  std::vector<uint16_t> padded;  // the codes with a border repeating the faces
   std::vector<float> table, stepOpacity;
   SampleSource source;
 
@@ -37,6 +38,13 @@ struct Fixture {
           normals[at * 4 + 1] = int8_t(-j * 17 + 50);
           normals[at * 4 + 2] = int8_t(k * 29 - 127);
         }
+    padded.resize(size_t(kNx + 2) * (kNy + 2) * (kNz + 2));
+    for (int k = 0; k < kNz + 2; ++k)
+      for (int j = 0; j < kNy + 2; ++j)
+        for (int i = 0; i < kNx + 2; ++i)
+          padded[(size_t(k) * (kNy + 2) + size_t(j)) * (kNx + 2) + size_t(i)] =
+              codes[(size_t(std::clamp(k - 1, 0, kNz - 1)) * kNy + size_t(std::clamp(j - 1, 0, kNy - 1))) * kNx +
+                    size_t(std::clamp(i - 1, 0, kNx - 1))];
     const int entries = 64;
     table.resize(entries * 4);
     stepOpacity.resize(entries);
@@ -96,8 +104,12 @@ void positions(SampleBatch& b, int round) {
 
 TEST(SampleKernel, EveryTargetGivesTheSameBitsAndTheyAreTheScalarFormulas) {
   Fixture f;
-  for (const bool precomputed : {false, true}) {
+  // Gradients: precomputed, or central differences read from the bordered codes' cross, or at the
+  // moved points clamped into the box.
+  for (const int way : {0, 1, 2}) {
+    const bool precomputed = way == 0;
     f.source.normals = precomputed ? f.normals.data() : nullptr;
+    f.source.padded = way == 1 ? f.padded.data() : nullptr;
     for (int round = 0; round < 4; ++round) {
       SampleBatch first{};
       bool have = false;
@@ -159,7 +171,13 @@ TEST(SampleKernel, EveryTargetGivesTheSameBitsAndTheyAreTheScalarFormulas) {
             }
           }
         } else {
-          const double p[3] = {in.x[i], in.y[i], in.z[i]};
+          // The bordered codes' differences are about the sample's point clamped into the box
+          // (rays' samples lie in it; this test's also beyond it), the others' about the point.
+          const int n[3] = {kNx, kNy, kNz};
+          double p[3] = {in.x[i], in.y[i], in.z[i]};
+          if (way == 1)
+            for (int a = 0; a < 3; ++a)
+              p[a] = std::clamp(p[a], 0.0, double(n[a] - 1) * f.source.spacing[a]);
           for (int a = 0; a < 3; ++a) {
             double up[3] = {p[0], p[1], p[2]}, down[3] = {p[0], p[1], p[2]};
             up[a] += f.source.spacing[a], down[a] -= f.source.spacing[a];
