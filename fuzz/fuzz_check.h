@@ -3,6 +3,8 @@
 // with a message. A broken promise aborts, which libFuzzer and the replay driver report.
 #pragma once
 
+#include <cmath>
+#include <cstddef>
 #include <cstdio>
 #include <cstdlib>
 
@@ -36,6 +38,28 @@ inline void checkResult(const Result<Scene>& result) {
   }
   if (result.value().triangleCount() > fuzzOptions().maxTriangles) {
     std::fprintf(stderr, "triangle budget exceeded: %zu\n", result.value().triangleCount());
+    std::abort();
+  }
+}
+
+// What the volume targets check of parseVolume's result: a read grid keeps the promises of
+// synthvis/volumes.h (sides 2 … kMaxVolumeSide, as many codes as samples and no more than
+// `maxSamples`, a positive finite scale and spacing), and a failure carries a message.
+inline void checkVolume(const Result<VolumeGrid>& r, size_t maxSamples) {
+  if (!r.ok()) {
+    if (r.error().message.empty()) std::abort();
+    return;
+  }
+  const VolumeGrid& g = r.value();
+  const bool ok = g.nx >= 2 && g.ny >= 2 && g.nz >= 2 && g.nx <= kMaxVolumeSide &&
+                  g.ny <= kMaxVolumeSide && g.nz <= kMaxVolumeSide &&
+                  g.codes.size() == size_t(g.nx) * size_t(g.ny) * size_t(g.nz) &&
+                  g.codes.size() <= maxSamples && g.scale > 0 && std::isfinite(g.scale) &&
+                  std::isfinite(g.offset) && g.spacing.x > 0 && g.spacing.y > 0 &&
+                  g.spacing.z > 0 && isFinite(g.spacing);
+  if (!ok) {
+    std::fprintf(stderr, "bad grid: %d × %d × %d, %zu codes, scale %g\n", g.nx, g.ny, g.nz,
+                 g.codes.size(), double(g.scale));
     std::abort();
   }
 }

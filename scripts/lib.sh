@@ -8,12 +8,14 @@ SV_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 # libgl1-mesa-dri); python3 is for scripts/quality and scripts/bench-masking; clang and its runtime
 # (libclang-rt-14-dev) build the libFuzzer targets (scripts/fuzz, and scripts/test builds them);
 # libgdal-dev is the terrain loaders' reader of DEM rasters (GeoTIFF, SRTM .hgt, …); openscenegraph's
-# osgconv is the OpenFlight tests' independent peer (it writes and reads .flt); python3-vtk9 is VTK's
-# CPU volume ray caster, the volumes' baseline (bench/vtk_volume.py, under xvfb-run).
+# osgconv is the OpenFlight tests' independent peer (it writes and reads .flt); libopenvdb-dev is the
+# volume loader's reader of OpenVDB files (and the tests' writer of them); python3-vtk9 is VTK's CPU
+# volume ray caster, the volumes' baseline (bench/vtk_volume.py, under xvfb-run).
 SV_PACKAGES=(cmake g++ ninja-build pkg-config libgtest-dev libgmock-dev libbenchmark-dev
   libhwy-dev libtinygltf-dev libtinyobjloader-dev libstb-dev libpng-dev zlib1g-dev libturbojpeg0-dev libdraco-dev libassimp-dev nlohmann-json3-dev
   libcli11-dev libfmt-dev libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri python3
-  clang libclang-rt-14-dev libgdal-dev libsdl2-dev xvfb xauth x11-apps tshark openscenegraph libmeshoptimizer-dev python3-vtk9)
+  clang libclang-rt-14-dev libgdal-dev libsdl2-dev xvfb xauth x11-apps tshark openscenegraph libmeshoptimizer-dev
+  libopenvdb-dev python3-vtk9)
 
 sv_install_packages() {
   local missing=()

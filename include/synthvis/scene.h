@@ -452,15 +452,20 @@ struct LoadOptions {
 Result<Scene> loadScene(const std::string& path, const LoadOptions& options);
 // A volume file (docs/scene-format.md "Volumes"): NIfTI-1 (.nii, .nii.gz: one volume, unsigned
 // or signed 8-, 16- or 32-bit, float or double, scl_slope and scl_inter applied, the voxel sizes
-// as its spacing) or NRRD (.nrrd, or .nhdr with a detached data file; 3 dimensions, raw or gzip,
-// spacings or space directions' lengths). Orientation (qform, sform, space origin) is not
-// applied: the volume's own space is index × spacing, placed by the scene. Every size is checked
-// before allocating; the error names the file and the problem. parseVolume reads `bytes`, the
-// whole file, named `path` (whose directory a detached data file is found in, unless
-// !followReferences).
+// as its spacing), NRRD (.nrrd, or .nhdr with a detached data file; 3 dimensions, raw or gzip,
+// spacings or space directions' lengths) or OpenVDB (.vdb, recognized by its magic: the grid
+// named "density", else the first float, double or int32 grid by name, densified over its active
+// voxels' bounding box; a linear transform's voxel size as the spacing; read by the OpenVDB
+// library in a child process with a time and a memory limit, since that reader is not hardened).
+// Orientation (qform, sform, space origin, an OpenVDB transform's rotation and translation) is
+// not applied: the volume's own space is index × spacing, placed by the scene. Every size is
+// checked before allocating; the error names the file and the problem. parseVolume reads
+// `bytes`, the whole file, named `path` (whose directory a detached data file is found in, unless
+// !followReferences), and refuses a grid of more than `maxSamples` (at most kMaxVolumeSamples): a
+// short OpenVDB file may describe a large grid.
 Result<VolumeGrid> loadVolume(const std::string& path);
 Result<VolumeGrid> parseVolume(const std::string& bytes, const std::string& path,
-                               bool followReferences);
+                               bool followReferences, size_t maxSamples = kMaxVolumeSamples);
 Result<Scene> parseJsonScene(const std::string& text, const std::string& path,
                              const LoadOptions& options);
 // In-memory variants of loadGltf and loadObj: `path` names the input in errors and is the base

@@ -1,5 +1,6 @@
-// Volume files (SPEC §11 voxel arrays; docs/scene-format.md "Volumes"): NIfTI-1 (.nii, .nii.gz)
-// and NRRD (.nrrd with its data attached, .nhdr with a detached data file; raw or gzip encoding).
+// Volume files (SPEC §11 voxel arrays; docs/scene-format.md "Volumes"): NIfTI-1 (.nii, .nii.gz),
+// NRRD (.nrrd with its data attached, .nhdr with a detached data file; raw or gzip encoding) and
+// OpenVDB (.vdb, through the OpenVDB library in a child process: scene/openvdb_loader.h).
 // Every size in a header is checked against the limits before anything is allocated, a truncated
 // file is named as such, and 8- and 16-bit data keep their exact values.
 #include <zlib.h>
@@ -13,6 +14,7 @@
 #include <sstream>
 
 #include "scene/loader_common.h"
+#include "scene/openvdb_loader.h"
 #include "synthvis/scene.h"
 
 namespace sv::scene {
@@ -98,12 +100,12 @@ size_t sizeOf(Type t) {
 }
 
 // The grid of nx × ny × nz samples, checked against the limits (before any allocation).
-VolumeGrid sizedGrid(int64_t nx, int64_t ny, int64_t nz) {
+VolumeGrid sizedGrid(int64_t nx, int64_t ny, int64_t nz, size_t maxSamples) {
   for (int64_t n : {nx, ny, nz})
     if (n < 2 || n > kMaxVolumeSide)
       fail(fmt::format("{} × {} × {} samples: each side must be 2 … {}", nx, ny, nz, kMaxVolumeSide));
-  if (uint64_t(nx) * uint64_t(ny) * uint64_t(nz) > kMaxVolumeSamples)
-    fail(fmt::format("{} × {} × {} samples: more than {}", nx, ny, nz, kMaxVolumeSamples));
+  if (uint64_t(nx) * uint64_t(ny) * uint64_t(nz) > maxSamples)
+    fail(fmt::format("{} × {} × {} samples: more than {}", nx, ny, nz, maxSamples));
   VolumeGrid g;
   g.nx = int(nx), g.ny = int(ny), g.nz = int(nz);
   return g;
@@ -184,7 +186,7 @@ bool gzipped(const std::string& bytes) {
   return bytes.size() >= 2 && uint8_t(bytes[0]) == 0x1f && uint8_t(bytes[1]) == 0x8b;
 }
 
-VolumeGrid nifti(const std::string& bytes) {
+VolumeGrid nifti(const std::string& bytes, size_t maxSamples) {
   Source in(bytes, 0, gzipped(bytes));
   unsigned char h[348];
   in.read(h, sizeof h, "the NIfTI-1 header");
@@ -214,7 +216,7 @@ VolumeGrid nifti(const std::string& bytes) {
   if (dim[0] < 3 || dim[0] > 7) fail(fmt::format("dim[0] is {}: a volume has 3 dimensions", dim[0]));
   for (int i = 4; i <= dim[0]; ++i)
     if (dim[i] > 1) fail(fmt::format("a series of {} volumes (dim[{}]): only single volumes are read", dim[i], i));
-  VolumeGrid g = sizedGrid(dim[1], dim[2], dim[3]);
+  VolumeGrid g = sizedGrid(dim[1], dim[2], dim[3], maxSamples);
   const int16_t datatype = field(int16_t{}, 70);
   Type type;
   switch (datatype) {
@@ -242,7 +244,8 @@ std::string trim(const std::string& s) {
   return a == std::string::npos ? "" : s.substr(a, b - a + 1);
 }
 
-VolumeGrid nrrd(const std::string& bytes, const std::string& path, bool followReferences) {
+VolumeGrid nrrd(const std::string& bytes, const std::string& path, bool followReferences,
+                size_t maxSamples) {
   if (bytes.compare(0, 7, "NRRD000") != 0 || bytes.size() < 8) fail("not a NRRD file (no 'NRRD000x' magic)");
   // The header: lines up to the first empty one.
   size_t at = bytes.find('\n');
@@ -271,7 +274,7 @@ VolumeGrid nrrd(const std::string& bytes, const std::string& path, bool followRe
   std::istringstream sizeText(*sizes);
   int64_t n[3] = {0, 0, 0};
   if (!(sizeText >> n[0] >> n[1] >> n[2])) fail(fmt::format("sizes '{}' are not three integers", *sizes));
-  VolumeGrid g = sizedGrid(n[0], n[1], n[2]);
+  VolumeGrid g = sizedGrid(n[0], n[1], n[2], maxSamples);
   const std::string* typeName = get("type");
   if (!typeName) fail("no 'type' field");
   static const std::pair<const char*, Type> kTypes[] = {
@@ -345,15 +348,48 @@ VolumeGrid nrrd(const std::string& bytes, const std::string& path, bool followRe
   return g;
 }
 
+// An OpenVDB file: the child densifies its grid (SPEC §11: a sparse volume becomes the dense
+// voxel array the volume pass casts), this side checks the size before any sample is read and
+// builds the grid as a NIfTI file's samples of the same type. The grid's own index space is kept:
+// sample (0, 0, 0) is the active voxels' least corner; its transform gives only the spacing.
+VolumeGrid openVdb(const std::string& bytes, size_t maxSamples) {
+  VolumeGrid g;
+  detail::VdbGrid shape;
+  std::string samples;
+  const std::string problem = detail::readOpenVdb(
+      bytes, maxSamples,
+      [&g, maxSamples](const detail::VdbGrid& s) {
+        try {
+          g = sizedGrid(s.nx, s.ny, s.nz, maxSamples);
+        } catch (const VolumeProblem& p) {
+          return fmt::format("grid '{}': {}", s.name, p.message);
+        }
+        return std::string();
+      },
+      shape, samples);
+  if (!problem.empty()) fail(problem);
+  const Type type = shape.type == detail::VdbGrid::Type::f64   ? Type::f64
+                    : shape.type == detail::VdbGrid::Type::i32 ? Type::i32
+                                                               : Type::f32;
+  Source in(samples, 0, false);
+  readSamples(g, in, type, std::endian::native == std::endian::big);
+  g.spacing = {spacingOf(shape.spacing[0]), spacingOf(shape.spacing[1]),
+               spacingOf(shape.spacing[2])};
+  return g;
+}
+
 }  // namespace
 
 Result<VolumeGrid> parseVolume(const std::string& bytes, const std::string& path,
-                               bool followReferences) {
+                               bool followReferences, size_t maxSamples) {
   const std::string ext = detail::lowerExtension(path);
+  maxSamples = std::min(maxSamples, kMaxVolumeSamples);
   try {
-    if (bytes.compare(0, 4, "NRRD") == 0) return nrrd(bytes, path, followReferences);
+    if (bytes.compare(0, 4, "NRRD") == 0) return nrrd(bytes, path, followReferences, maxSamples);
     if (ext == ".nrrd" || ext == ".nhdr") fail("not a NRRD file (no 'NRRD000x' magic)");
-    return nifti(bytes);
+    if (detail::isOpenVdb(bytes)) return openVdb(bytes, maxSamples);
+    if (ext == ".vdb") fail("not an OpenVDB file (no 'VDB ' magic)");
+    return nifti(bytes, maxSamples);
   } catch (const VolumeProblem& p) {
     return Error{path, "", p.message};
   } catch (const std::bad_alloc&) {

@@ -2,13 +2,22 @@
 // values, signed data offset, wider and float data quantized over their range, scl_slope applied,
 // either byte order, gzip; sizes checked before allocating, truncation and unsupported variants
 // named; the real Colin 27 head of Debian's mricron-data when scripts/lib.sh has unpacked it.
+// OpenVDB files written here by OpenVDB itself: densified over their active voxels with the
+// grid's values (background elsewhere), the chosen grid, the spacing; broken and unreadable ones
+// refused by name.
 #include <gtest/gtest.h>
 
+#include <openvdb/io/File.h>
+#include <openvdb/openvdb.h>
+#include <openvdb/tools/LevelSetSphere.h>
+#include <openvdb/tools/LevelSetUtil.h>
 #include <zlib.h>
 
+#include <chrono>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include "synthvis/scene.h"
 
@@ -176,6 +185,173 @@ TEST(VolumeFiles, BadFilesAreRefusedByNameBeforeAllocating) {
   refused("NRRD0004\ntype: uchar", "d.nrrd", "no end");
   refused("NRRD0004\ntype: uchar\n", "d.nrrd", "dimension is missing");
   refused("P6 3 4 255\n", "d.nrrd", "not a NRRD");
+}
+
+// The bytes of an OpenVDB file of `grids` as io::File writes it (with its grid offsets, compressed
+// as OpenVDB chooses).
+std::string vdbBytes(const openvdb::GridCPtrVec& grids, const openvdb::MetaMap& meta = {}) {
+  openvdb::initialize();
+  const std::string path = (std::filesystem::temp_directory_path() / "sv_volume_test.vdb").string();
+  openvdb::io::File(path).write(grids, meta);
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  std::filesystem::remove(path);
+  return bytes.str();
+}
+
+// A float grid of background 0 and voxel size 0.5 whose active voxels are the box
+// [2, 5] × [−1, 1] × [10, 12], valued 1 + i + 10·j + 100·k, but for (3, 0, 11), inactive (0).
+openvdb::FloatGrid::Ptr boxGrid(const std::string& name) {
+  openvdb::FloatGrid::Ptr g = openvdb::FloatGrid::create(0.0f);
+  g->setName(name);
+  g->setTransform(openvdb::math::Transform::createLinearTransform(0.5));
+  for (int k = 10; k <= 12; ++k)
+    for (int j = -1; j <= 1; ++j)
+      for (int i = 2; i <= 5; ++i) g->tree().setValueOn({i, j, k}, float(1 + i + 10 * j + 100 * k));
+  g->tree().setValueOff({3, 0, 11}, 0.0f);
+  return g;
+}
+
+TEST(VolumeFiles, OpenVdbGridIsDensifiedOverItsActiveVoxels) {
+  // "density" is chosen over an earlier scalar grid and a vector grid.
+  openvdb::FloatGrid::Ptr other = openvdb::FloatGrid::create(7.0f);
+  other->setName("aaa");
+  other->tree().setValueOn({0, 0, 0}, 8.0f);
+  openvdb::Vec3SGrid::Ptr velocity = openvdb::Vec3SGrid::create();
+  velocity->setName("vel");
+  velocity->tree().setValueOn({1, 2, 3}, openvdb::Vec3s(1, 0, 0));
+  const std::string bytes = vdbBytes({other, boxGrid("density"), velocity});
+  // Through a file, as a scene names it.
+  const auto dir = std::filesystem::temp_directory_path() / "sv_volume_vdb_test";
+  std::filesystem::create_directories(dir);
+  std::ofstream((dir / "box.vdb").string(), std::ios::binary) << bytes;
+  Result<VolumeGrid> g = loadVolume((dir / "box.vdb").string());
+  std::filesystem::remove_all(dir);
+  ASSERT_TRUE(g.ok()) << g.error().str();
+  EXPECT_EQ(g->nx, 4);
+  EXPECT_EQ(g->ny, 3);
+  EXPECT_EQ(g->nz, 3);
+  EXPECT_EQ(g->spacing.x, 0.5f);
+  EXPECT_EQ(g->spacing.z, 0.5f);
+  // Sample (0, 0, 0) is the least active voxel, (2, −1, 10); floats are quantized over their
+  // range 0 … 1226.
+  const double step = 1226.0 / 65535;
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 4; ++i) {
+        const bool off = i == 1 && j == 1 && k == 1;
+        const double want = off ? 0 : 1 + (i + 2) + 10 * (j - 1) + 100 * (k + 10);
+        EXPECT_NEAR(g->value(g->codes[g->at(i, j, k)]), want, step / 2 + 1e-3) << i << j << k;
+      }
+  // In memory, with parseVolume: the same grid.
+  Result<VolumeGrid> m = parseVolume(bytes, "box.vdb", false);
+  ASSERT_TRUE(m.ok()) << m.error().str();
+  EXPECT_EQ(m->codes, g->codes);
+}
+
+TEST(VolumeFiles, OpenVdbFogSphereDoubleAndIntegerGrids) {
+  // A level set sphere (built on OpenVDB's threads, before the reader's fork) as a fog volume:
+  // 1 inside, 0 (the background) outside its narrow band, on the sphere's voxels of 0.25.
+  openvdb::FloatGrid::Ptr sphere = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(
+      2.0f, openvdb::Vec3f(1, 0, 0), 0.25f);
+  openvdb::tools::sdfToFogVolume(*sphere);
+  sphere->setName("cloud");
+  openvdb::CoordBBox box = sphere->evalActiveVoxelBoundingBox();
+  Result<VolumeGrid> g = parseVolume(vdbBytes({sphere}), "sphere.vdb", false);
+  ASSERT_TRUE(g.ok()) << g.error().str();
+  EXPECT_EQ(g->nx, box.dim().x());
+  EXPECT_EQ(g->ny, box.dim().y());
+  EXPECT_EQ(g->nz, box.dim().z());
+  EXPECT_EQ(g->spacing.y, 0.25f);
+  EXPECT_NEAR(g->value(g->codes[g->at(g->nx / 2, g->ny / 2, g->nz / 2)]), 1, 1e-4);  // the centre
+  EXPECT_EQ(g->value(g->codes[g->at(0, 0, 0)]), 0);  // a corner of the box, outside the sphere
+  // A double grid with a non-uniform (linear) scale; an int32 grid's values.
+  openvdb::DoubleGrid::Ptr wide = openvdb::DoubleGrid::create(-1.0);
+  openvdb::Mat4R scale = openvdb::Mat4R::identity();
+  scale.preScale(openvdb::Vec3d(0.5, 1, 2));
+  scale.postTranslate(openvdb::Vec3d(3, 4, 5));
+  wide->setTransform(openvdb::math::Transform::createLinearTransform(scale));
+  for (int i = 0; i < 3; ++i) wide->tree().setValueOn({i, i, i}, 0.125 * i);
+  Result<VolumeGrid> d = parseVolume(vdbBytes({wide}), "double.vdb", false);
+  ASSERT_TRUE(d.ok()) << d.error().str();
+  EXPECT_EQ(d->nx, 3);
+  EXPECT_EQ(d->spacing.x, 0.5f);
+  EXPECT_EQ(d->spacing.y, 1.0f);
+  EXPECT_EQ(d->spacing.z, 2.0f);
+  EXPECT_NEAR(d->value(d->codes[d->at(2, 2, 2)]), 0.25, 1e-4);
+  EXPECT_NEAR(d->value(d->codes[d->at(0, 2, 1)]), -1, 1e-4);  // the background between them
+  openvdb::Int32Grid::Ptr counts = openvdb::Int32Grid::create(0);
+  counts->tree().setValueOn({0, 0, 0}, 65535);
+  counts->tree().setValueOn({1, 0, 0}, 1000);  // a sheet one voxel thick: widened to 2 samples
+  Result<VolumeGrid> c = parseVolume(vdbBytes({counts}), "int.vdb", false);
+  ASSERT_TRUE(c.ok()) << c.error().str();
+  EXPECT_EQ(c->nx, 2);
+  EXPECT_EQ(c->ny, 2);
+  EXPECT_EQ(c->nz, 2);
+  EXPECT_EQ(c->value(c->codes[c->at(0, 0, 0)]), 65535.0f);
+  EXPECT_EQ(c->value(c->codes[c->at(1, 0, 0)]), 1000.0f);
+  EXPECT_EQ(c->value(c->codes[c->at(1, 1, 1)]), 0.0f);
+}
+
+TEST(VolumeFiles, BadOpenVdbFilesAreRefusedByName) {
+  auto refused = [](const std::string& bytes, const std::string& name, const std::string& part,
+                    size_t maxSamples = kMaxVolumeSamples) {
+    const auto start = std::chrono::steady_clock::now();
+    Result<VolumeGrid> g = parseVolume(bytes, name, false, maxSamples);
+    ASSERT_FALSE(g.ok()) << part;
+    EXPECT_NE(g.error().str().find(part), std::string::npos) << g.error().str();
+    EXPECT_EQ(g.error().str().rfind(name + ": ", 0), 0u) << g.error().str();
+    EXPECT_EQ(g.error().str().find('\n'), std::string::npos) << g.error().str();
+    // Refused in well under the child's time limit: nothing was densified.
+    EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(4)) << part;
+  };
+  const std::string box = vdbBytes({boxGrid("density")});
+  // Truncated: OpenVDB's own exception, or (its header's reads are unchecked) no grid found.
+  refused(box.substr(0, box.size() / 2), "half.vdb", "OpenVDB: ");
+  refused(box.substr(0, 40), "header.vdb", "OpenVDB finds no grid in it");
+  std::string garbage = box.substr(0, 8);
+  for (int i = 0; i < 4000; ++i) garbage += char((i * 7919) >> 3);
+  refused(garbage, "garbage.vdb", "OpenVDB finds no grid in it");
+  refused("P6 3 4 255\n", "image.vdb", "not an OpenVDB file");
+  // Two voxels 100 000 apart: a box far beyond the limits, refused from its size alone (and the
+  // grid's name kept to one line).
+  openvdb::FloatGrid::Ptr far = openvdb::FloatGrid::create(0.0f);
+  far->setName("far\naway");
+  far->tree().setValueOn({0, 0, 0}, 1.0f);
+  far->tree().setValueOn({100000, 0, 0}, 1.0f);
+  refused(vdbBytes({far}), "far.vdb",
+          "grid 'far?away': 100001 × 2 × 2 samples: each side must be 2");
+  openvdb::FloatGrid::Ptr large = openvdb::FloatGrid::create(0.0f);
+  large->tree().setValueOn({0, 0, 0}, 1.0f);
+  large->tree().setValueOn({2047, 2047, 2047}, 1.0f);
+  refused(vdbBytes({large}), "large.vdb", "2048 × 2048 × 2048 samples: more than");
+  refused(box, "budget.vdb", "4 × 3 × 3 samples: more than 20", 20);
+  openvdb::Vec3SGrid::Ptr velocity = openvdb::Vec3SGrid::create();
+  velocity->setName("vel");
+  velocity->tree().setValueOn({1, 2, 3}, openvdb::Vec3s(1, 0, 0));
+  refused(vdbBytes({velocity}), "vectors.vdb",
+          "no scalar grid (float, double or int32): it holds 'vel' (vec3s)");
+  openvdb::FloatGrid::Ptr empty = openvdb::FloatGrid::create(0.0f);
+  empty->setName("nothing");
+  refused(vdbBytes({empty}), "empty.vdb", "grid 'nothing' has no active voxels");
+  openvdb::FloatGrid::Ptr frustum = boxGrid("f");
+  frustum->setTransform(openvdb::math::Transform::createFrustumTransform(
+      openvdb::BBoxd(openvdb::Vec3d(0, 0, 0), openvdb::Vec3d(10, 10, 10)), 0.5, 2));
+  refused(vdbBytes({frustum}), "frustum.vdb", "grid 'f' has a non-linear transform");
+  // A file-level string claiming 3.75 GiB: OpenVDB allocates it, and meets the reader's memory
+  // limit (1/4 GiB for so small a budget).
+  openvdb::MetaMap meta;
+  meta.insertMeta("note", openvdb::StringMetadata("synthvis-note"));
+  std::string hungry = vdbBytes({boxGrid("density")}, meta);
+  const uint32_t huge = 0xF0000000u;
+  ASSERT_NE(hungry.find("synthvis-note"), std::string::npos);
+  std::memcpy(&hungry[hungry.find("synthvis-note") - 4], &huge, 4);
+  refused(hungry, "hungry.vdb", "out of memory", 1000);
+  Result<VolumeGrid> missing = loadVolume("/nonexistent/cloud.vdb");
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.error().str().find("/nonexistent/cloud.vdb: cannot open"), std::string::npos)
+      << missing.error().str();
 }
 
 TEST(VolumeFiles, TheColin27HeadOfDebiansMricronData) {
