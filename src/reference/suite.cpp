@@ -222,14 +222,9 @@ Result<CaseResult> BenchRunner::run(const BenchCase& c) {
                  "channels: the gl reference draws one view only (use --renderer synthvis)"};
   // VTK draws volumes alone: a volume scene compared with it is timed, in both renderers, without
   // what surrounds its volumes (the row's "volumes_alone" says so).
-  if (s.vtk && !made.value().scene.volumes.empty()) {
-    scene::Scene alone = volumesAlone(made.value().scene);
-    if (alone.triangleCount() != made.value().scene.triangleCount() ||
-        !made.value().scene.freeForms.empty() || !made.value().scene.terrains.empty() ||
-        !made.value().scene.lightPoints.empty() || !made.value().scene.lines.empty()) {
-      made.value().params["volumes_alone"] = true;
-      made.value().scene = std::move(alone);
-    }
+  if (s.vtk && !made.value().scene.volumes.empty() && !besideVolumes(made.value().scene).empty()) {
+    made.value().params["volumes_alone"] = true;
+    made.value().scene = volumesAlone(made.value().scene);
   }
   const scene::Scene& sc = made.value().scene;
 

@@ -48,11 +48,7 @@ std::string lastLine(const fs::path& path) {
 // Why `scene` is not one the script can draw as synthvis does, or "".
 std::string unsupported(const scene::Scene& s) {
   if (s.volumes.empty()) return "the scene has no volumes";
-  if (s.triangleCount() > 0) return fmt::format("the scene also has {} triangles", s.triangleCount());
-  if (!s.freeForms.empty()) return "the scene also has free forms";
-  if (!s.terrains.empty()) return "the scene also has terrain";
-  if (!s.lightPoints.empty()) return "the scene also has light points";
-  if (!s.lines.empty()) return "the scene also has lines";
+  if (std::string beside = besideVolumes(s); !beside.empty()) return "the scene also has " + beside;
   if (!s.channels.empty()) return "the scene has channels";
   if (s.fog.enabled) return "the scene has fog";
   return "";
@@ -60,10 +56,20 @@ std::string unsupported(const scene::Scene& s) {
 
 }  // namespace
 
+std::string besideVolumes(const scene::Scene& s) {
+  if (s.triangleCount() > 0) return fmt::format("{} triangles", s.triangleCount());
+  if (!s.freeForms.empty()) return "free forms";
+  if (!s.terrains.empty()) return "terrain";
+  if (!s.lightPoints.empty()) return "light points";
+  if (!s.lines.empty()) return "lines";
+  return "";
+}
+
 scene::Scene volumesAlone(const scene::Scene& s) {
   scene::Scene v;
   v.background = s.background;
   v.cameras = s.cameras;
+  v.channels = s.channels;
   v.light = s.light;
   v.fog = s.fog;
   v.volumes = s.volumes;

@@ -15,9 +15,11 @@
 
 namespace sv::reference {
 
-// What of `scene` VTK draws: its volumes with their settings, the background, cameras and light,
-// without the polygons, free forms, terrain, light points and lines around them (the bench times
-// both renderers on this when it compares a volume scene with VTK, and says so).
+// What `scene` holds beside its volumes that VTK does not draw (e.g. "38 triangles"), or "".
+std::string besideVolumes(const scene::Scene& scene);
+// What of `scene` VTK draws: its volumes with their settings, the background, cameras, channels
+// and light, without the polygons, free forms, terrain, light points and lines around them (the
+// bench times both renderers on this when it compares a volume scene with VTK, and says so).
 scene::Scene volumesAlone(const scene::Scene& scene);
 
 class VtkVolumeRenderer {

@@ -299,34 +299,50 @@ void VolumePass::prepareTables(Prepared& p) const {
       }
 }
 
+namespace {
+
+// The pixels and eye depths an own-space box [lo, hi] of a volume placed by `m` may cover: the
+// bounding rectangle and depth range of its corners projected. False when a corner lies behind
+// the eye (the rectangle is unbounded).
+struct Footprint {
+  double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300, near = 1e300, far = -1e300;
+};
+bool footprint(const Mat4& m, const VolumeInput& in, const double lo[3], const double hi[3],
+               Footprint& f) {
+  const EyeRays& r = in.rays;
+  for (int c = 0; c < 8; ++c) {
+    const Vec3 own{float((c & 1) ? hi[0] : lo[0]), float((c & 2) ? hi[1] : lo[1]),
+                   float((c & 4) ? hi[2] : lo[2])};
+    const Vec3 world = m.transformPoint(own);
+    const Vec3d rel{world.x - r.eye.x, world.y - r.eye.y, world.z - r.eye.z};
+    const double depth = dot(rel, r.forward);
+    const Vec4 clip = in.viewProjection * Vec4{world.x, world.y, world.z, 1.0f};
+    if (!(depth > 1e-6) || !(clip.w > 1e-6f * std::fabs(clip.x) + 1e-20f)) return false;
+    const double px = (clip.x / clip.w + 1) * 0.5 * r.width;
+    const double py = (1 - clip.y / clip.w) * 0.5 * r.height;
+    f.x0 = std::min(f.x0, px), f.x1 = std::max(f.x1, px);
+    f.y0 = std::min(f.y0, py), f.y1 = std::max(f.y1, py);
+    f.near = std::min(f.near, depth), f.far = std::max(f.far, depth);
+  }
+  return true;
+}
+
+}  // namespace
+
 // The pixels the volume's box may cover: its corners projected, or the whole raster when one lies
 // behind the eye.
 void VolumePass::screenBounds(Prepared& p) const {
-  const Mat4& m = p.object->transform;
   const EyeRays& r = input_.rays;
-  double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
-  bool behind = false;
-  for (int c = 0; c < 8; ++c) {
-    const Vec3 own{c & 1 ? float(p.extent[0]) : 0.0f, c & 2 ? float(p.extent[1]) : 0.0f,
-                   c & 4 ? float(p.extent[2]) : 0.0f};
-    const Vec3 world = m.transformPoint(own);
-    const Vec4 clip = input_.viewProjection * Vec4{world.x, world.y, world.z, 1.0f};
-    if (!(clip.w > 1e-6f * std::fabs(clip.x) + 1e-20f)) {
-      behind = true;
-      break;
-    }
-    const double px = (clip.x / clip.w + 1) * 0.5 * r.width;
-    const double py = (1 - clip.y / clip.w) * 0.5 * r.height;
-    x0 = std::min(x0, px), x1 = std::max(x1, px), y0 = std::min(y0, py), y1 = std::max(y1, py);
-  }
-  if (behind) {
+  const double lo[3] = {0, 0, 0};
+  Footprint f;
+  if (!footprint(p.object->transform, input_, lo, p.extent, f)) {
     p.x0 = p.y0 = 0, p.x1 = r.width, p.y1 = r.height;
     return;
   }
-  p.x0 = int(std::clamp(std::floor(x0) - 1, 0.0, double(r.width)));
-  p.y0 = int(std::clamp(std::floor(y0) - 1, 0.0, double(r.height)));
-  p.x1 = int(std::clamp(std::ceil(x1) + 1, 0.0, double(r.width)));
-  p.y1 = int(std::clamp(std::ceil(y1) + 1, 0.0, double(r.height)));
+  p.x0 = int(std::clamp(std::floor(f.x0) - 1, 0.0, double(r.width)));
+  p.y0 = int(std::clamp(std::floor(f.y0) - 1, 0.0, double(r.height)));
+  p.x1 = int(std::clamp(std::ceil(f.x1) + 1, 0.0, double(r.width)));
+  p.y1 = int(std::clamp(std::ceil(f.y1) + 1, 0.0, double(r.height)));
 }
 
 // Per window, the eye depths between which its rays can meet a brick with content: each such
@@ -343,7 +359,6 @@ void VolumePass::windowDepths(Prepared& p) const {
   const int windowsY = (r.height + kWindow - 1) / kWindow;
   p.windowNear.assign(size_t(p.windowsX) * size_t(windowsY), std::numeric_limits<float>::infinity());
   p.windowFar.assign(p.windowNear.size(), -std::numeric_limits<float>::infinity());
-  const Mat4& m = p.object->transform;
   const scene::VolumeGrid& g = *p.grid;
   const double brick[3] = {kBrick * double(g.spacing.x), kBrick * double(g.spacing.y),
                            kBrick * double(g.spacing.z)};
@@ -352,26 +367,17 @@ void VolumePass::windowDepths(Prepared& p) const {
     const int by = int(index / uint32_t(p.bricks[0]) % uint32_t(p.bricks[1]));
     const int bz = int(index / uint32_t(p.bricks[0]) / uint32_t(p.bricks[1]));
     const int b[3] = {bx, by, bz};
-    double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300, near = 1e300, far = -1e300;
-    for (int c = 0; c < 8; ++c) {
-      double own[3];
-      for (int a = 0; a < 3; ++a)
-        own[a] = std::min((b[a] + ((c >> a) & 1)) * brick[a], p.extent[a]);
-      const Vec3 world = m.transformPoint(Vec3{float(own[0]), float(own[1]), float(own[2])});
-      const Vec3d rel{world.x - r.eye.x, world.y - r.eye.y, world.z - r.eye.z};
-      const double depth = dot(rel, r.forward);
-      const Vec4 clip = input_.viewProjection * Vec4{world.x, world.y, world.z, 1.0f};
-      if (!(depth > 1e-6) || !(clip.w > 1e-6f * std::fabs(clip.x) + 1e-20f)) {
-        // Behind the eye: its rectangle is unbounded; the windows are not known this frame.
-        p.windowNear.clear();
-        p.windowFar.clear();
-        return;
-      }
-      const double px = (clip.x / clip.w + 1) * 0.5 * r.width;
-      const double py = (1 - clip.y / clip.w) * 0.5 * r.height;
-      x0 = std::min(x0, px), x1 = std::max(x1, px), y0 = std::min(y0, py), y1 = std::max(y1, py);
-      near = std::min(near, depth), far = std::max(far, depth);
+    double lo[3], hi[3];
+    for (int a = 0; a < 3; ++a)
+      lo[a] = std::min(b[a] * brick[a], p.extent[a]), hi[a] = std::min((b[a] + 1) * brick[a], p.extent[a]);
+    Footprint fp;
+    if (!footprint(p.object->transform, input_, lo, hi, fp)) {
+      // Behind the eye: its rectangle is unbounded; the windows are not known this frame.
+      p.windowNear.clear();
+      p.windowFar.clear();
+      return;
     }
+    const double x0 = fp.x0, y0 = fp.y0, x1 = fp.x1, y1 = fp.y1, near = fp.near, far = fp.far;
     // (The corners in float through the transform: a margin of a pixel and a part in 10⁴ of
     // depth covers their rounding.)
     const int wx0 = int(std::clamp(std::floor((x0 - 1) / kWindow), 0.0, double(p.windowsX - 1)));
