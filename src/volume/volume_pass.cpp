@@ -471,6 +471,11 @@ void VolumePass::drawTile(const raster::TileTarget& tile) {
       for (int v = 0; v < count; ++v) {
         const Prepared& p = *listed[size_t(v)];
         if (px < p.x0 || px >= p.x1 || py < p.y0 || py >= p.y1) continue;
+        // The window's depth interval (windowDepths); empty where no brick with content shows.
+        const size_t w = p.windowNear.empty()
+                             ? 0
+                             : size_t(py / kWindow) * size_t(p.windowsX) + size_t(px / kWindow);
+        if (!p.windowNear.empty() && !(p.windowNear[w] < p.windowFar[w])) continue;
         Stretch st{&p, r.znear, r.zfar, {}, {}, 0, 0};
         for (int a = 0; a < 3; ++a) {
           st.o[a] = p.toOwn[a][0] * r.eye.x + p.toOwn[a][1] * r.eye.y + p.toOwn[a][2] * r.eye.z +
@@ -481,7 +486,6 @@ void VolumePass::drawTile(const raster::TileTarget& tile) {
         clipToBox(st.o, st.dir, lo, p.extent, st.s0, st.s1);
         st.from = st.s0, st.to = st.s1;
         if (!p.windowNear.empty()) {
-          const size_t w = size_t(py / kWindow) * size_t(p.windowsX) + size_t(px / kWindow);
           st.from = std::max(st.from, double(p.windowNear[w]));
           st.to = std::min(st.to, double(p.windowFar[w]));
           if (!(st.from < st.to)) continue;
