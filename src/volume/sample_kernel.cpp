@@ -1,5 +1,6 @@
 // classifySamples (sample_kernel.h): trilinear codes from 32-bit gathers (a cell's two samples
-// along x are adjacent 16-bit codes, so four gathers read its eight corners), the transfer
+// along x are adjacent 16-bit codes, so four gathers read its eight corners; in the bordered 8-bit
+// codes one read holds a row's four), the transfer
 // function's table read linearly, the step-corrected opacity, the gradient (precomputed per sample
 // or by central differences) and its two-sided Phong weighting, in lanes.
 #undef HWY_TARGET_INCLUDE
@@ -27,7 +28,7 @@ HWY_INLINE VF Lerp(VF a, VF b, VF t) { return hn::Add(a, hn::Mul(t, hn::Sub(b, a
 // the scalar Sampler::locate).
 struct Cell {
   VI base;
-  VI padded;  // byte offset of the cell's first sample in the bordered codes (if they are read)
+  VI padded;  // byte offset of the cell's first sample in the bordered codes read (8- or 16-bit)
   VF tx, ty, tz;
 };
 
@@ -46,13 +47,13 @@ HWY_INLINE Cell Locate(const SampleSource& s, VF x, VF y, VF z) {
   const VI k = hn::Min(hn::ConvertTo(di, fz), hn::Set(di, s.nz - 2));
   Cell c;
   c.base = hn::Add(hn::Mul(hn::Add(hn::Mul(k, hn::Set(di, s.ny)), j), hn::Set(di, s.nx)), i);
-  if (s.padded) {
+  if (s.padded8 || s.padded) {
     const VI one = hn::Set(di, 1);
     const VI at = hn::Add(hn::Mul(hn::Add(hn::Mul(hn::Add(k, one), hn::Set(di, s.ny + 2)),
                                           hn::Add(j, one)),
                                   hn::Set(di, s.nx + 2)),
                           hn::Add(i, one));
-    c.padded = hn::Add(at, at);
+    c.padded = s.padded8 ? at : hn::Add(at, at);
   } else {
     c.padded = hn::Zero(di);
   }
@@ -121,66 +122,111 @@ HWY_INLINE void Normals(const SampleSource& s, const Cell& c, VF g[3]) {
   }
 }
 
-// The value over cell `c` and its central differences (the values over the cells one sample
-// before and after it along each axis, same weights), from the bordered codes: the rows of the
-// cross about the cell read as x-pairs of 16-bit codes.
-HWY_INLINE VF CodesAndGradient(const SampleSource& s, const Cell& c, VF g[3]) {
+// The rows of the cross of cells about a sample's cell in the bordered codes: along x, the codes at
+// x = i − 1 … i + 2 of the rows y ∈ {j, j + 1}, z ∈ {k, k + 1} — the cell and its neighbours before
+// and after along x.
+struct CrossRows {
+  VF x[2][2][4];  // [dz][dy][x − i + 1]
+};
+
+// Byte offset in the bordered codes of (i + 1 + dx, j + 1 + dy, k + 1 + dz) — the cell's own
+// sample (i, j, k) moved by (dx, dy, dz) — for codes of T.
+template <typename T>
+HWY_INLINE VI CrossAt(const SampleSource& s, const Cell& c, int dx, int dy, int dz) {
+  const DI di;
+  const int px = s.nx + 2, pxy = (s.nx + 2) * (s.ny + 2);
+  return hn::Add(c.padded, hn::Set(di, int(sizeof(T)) * (dx + dy * px + dz * pxy)));
+}
+
+// The codes at a point and its x neighbour from one 32-bit read at its byte offset.
+HWY_INLINE void PairAt(const uint16_t* codes, VI offset, VF& lo, VF& hi) {
   const DF df;
   const DI di;
   const DU du;
-  const auto* base = reinterpret_cast<const int32_t*>(s.padded);
-  const int px = s.nx + 2, pxy = (s.nx + 2) * (s.ny + 2);
-  const VI mask = hn::Set(di, 0xFFFF);
-  // Row (dy, dz) at x offset dx: the codes at x = i + dx and i + dx + 1.
-  auto pair = [&](VI row, int dx, VF& lo, VF& hi) {
-    const VI v = hn::GatherOffset(di, base, hn::Add(row, hn::Set(di, 2 * dx)));
-    lo = hn::ConvertTo(df, hn::And(v, mask));
-    hi = hn::ConvertTo(df, hn::BitCast(di, hn::ShiftRight<16>(hn::BitCast(du, v))));
-  };
-  auto rowAt = [&](int dy, int dz) {  // byte offset of (i + 1, j + 1 + dy, k + 1 + dz)
-    return hn::Add(c.padded, hn::Set(di, 2 * (dy * px + dz * pxy)));
-  };
-  // Rows y ∈ {j, j + 1}, z ∈ {k, k + 1}: x from i − 1 to i + 2.
-  VF x[2][2][4];
+  const VI v = hn::GatherOffset(di, reinterpret_cast<const int32_t*>(codes), offset);
+  lo = hn::ConvertTo(df, hn::And(v, hn::Set(di, 0xFFFF)));
+  hi = hn::ConvertTo(df, hn::BitCast(di, hn::ShiftRight<16>(hn::BitCast(du, v))));
+}
+HWY_INLINE void PairAt(const uint8_t* codes, VI offset, VF& lo, VF& hi) {
+  const DF df;
+  const DI di;
+  const VI v = hn::GatherOffset(di, reinterpret_cast<const int32_t*>(codes), offset);
+  const VI mask = hn::Set(di, 0xFF);
+  lo = hn::ConvertTo(df, hn::And(v, mask));
+  hi = hn::ConvertTo(df, hn::And(hn::ShiftRight<8>(v), mask));
+}
+
+// The four codes of a cross row, x = i − 1 … i + 2: two pair reads of 16-bit codes, one read of
+// 8-bit ones.
+HWY_INLINE void RowAt(const SampleSource& s, const uint16_t* codes, const Cell& c, int dy, int dz,
+                      VF row[4]) {
+  PairAt(codes, CrossAt<uint16_t>(s, c, -1, dy, dz), row[0], row[1]);
+  PairAt(codes, CrossAt<uint16_t>(s, c, 1, dy, dz), row[2], row[3]);
+}
+HWY_INLINE void RowAt(const SampleSource& s, const uint8_t* codes, const Cell& c, int dy, int dz,
+                      VF row[4]) {
+  const DF df;
+  const DI di;
+  const DU du;
+  const VI v = hn::GatherOffset(di, reinterpret_cast<const int32_t*>(codes),
+                                CrossAt<uint8_t>(s, c, -1, dy, dz));
+  const VI mask = hn::Set(di, 0xFF);
+  row[0] = hn::ConvertTo(df, hn::And(v, mask));
+  row[1] = hn::ConvertTo(df, hn::And(hn::ShiftRight<8>(v), mask));
+  row[2] = hn::ConvertTo(df, hn::And(hn::ShiftRight<16>(v), mask));
+  row[3] = hn::ConvertTo(df, hn::BitCast(di, hn::ShiftRight<24>(hn::BitCast(du, v))));
+}
+
+// Trilinear over the cell whose x-lerped rows are r00 (y0 z0), r10 (y1 z0), r01, r11.
+HWY_INLINE VF Blend(const Cell& c, VF r00, VF r10, VF r01, VF r11) {
+  return Lerp(Lerp(r00, r10, c.ty), Lerp(r01, r11, c.ty), c.tz);
+}
+
+// The value over cell `c` from the cross's x rows (read into `rows`).
+template <typename T>
+HWY_INLINE VF CrossValue(const SampleSource& s, const T* codes, const Cell& c, CrossRows& rows) {
   for (int dz = 0; dz < 2; ++dz)
-    for (int dy = 0; dy < 2; ++dy) {
-      const VI row = rowAt(dy, dz);
-      pair(row, -1, x[dz][dy][0], x[dz][dy][1]);
-      pair(row, 1, x[dz][dy][2], x[dz][dy][3]);
-    }
-  // Rows y ∈ {j − 1, j + 2} (z ∈ {k, k + 1}) and z ∈ {k − 1, k + 2} (y ∈ {j, j + 1}): x i, i + 1.
+    for (int dy = 0; dy < 2; ++dy) RowAt(s, codes, c, dy, dz, rows.x[dz][dy]);
+  VF mid[2][2];
+  for (int dz = 0; dz < 2; ++dz)
+    for (int dy = 0; dy < 2; ++dy) mid[dz][dy] = Lerp(rows.x[dz][dy][1], rows.x[dz][dy][2], c.tx);
+  return Blend(c, mid[0][0], mid[0][1], mid[1][0], mid[1][1]);
+}
+
+// The central differences about cell `c` (the values over the cells one sample before and after it
+// along each axis, same weights): x from the cross's x rows, y and z from its other eight rows
+// (y ∈ {j − 1, j + 2} with z ∈ {k, k + 1}, z ∈ {k − 1, k + 2} with y ∈ {j, j + 1}; x i, i + 1).
+template <typename T>
+HWY_INLINE void CrossGradient(const SampleSource& s, const T* codes, const Cell& c,
+                              const CrossRows& cross, VF g[3]) {
+  const DF df;
   VF y[2][2][2], z[2][2][2];  // [dz or dy][before/after][x]
   for (int d = 0; d < 2; ++d) {
-    pair(rowAt(-1, d), 0, y[d][0][0], y[d][0][1]);
-    pair(rowAt(2, d), 0, y[d][1][0], y[d][1][1]);
-    pair(rowAt(d, -1), 0, z[d][0][0], z[d][0][1]);
-    pair(rowAt(d, 2), 0, z[d][1][0], z[d][1][1]);
+    PairAt(codes, CrossAt<T>(s, c, 0, -1, d), y[d][0][0], y[d][0][1]);
+    PairAt(codes, CrossAt<T>(s, c, 0, 2, d), y[d][1][0], y[d][1][1]);
+    PairAt(codes, CrossAt<T>(s, c, 0, d, -1), z[d][0][0], z[d][0][1]);
+    PairAt(codes, CrossAt<T>(s, c, 0, d, 2), z[d][1][0], z[d][1][1]);
   }
-  // Trilinear over the cell whose x-lerped rows are r00 (y0 z0), r10 (y1 z0), r01, r11.
-  auto blend = [&](VF r00, VF r10, VF r01, VF r11) {
-    return Lerp(Lerp(r00, r10, c.ty), Lerp(r01, r11, c.ty), c.tz);
-  };
   VF rows[2][2][3];  // x-lerped rows at x offsets −1, 0, +1 (cells i − 1, i, i + 1)
   for (int dz = 0; dz < 2; ++dz)
     for (int dy = 0; dy < 2; ++dy)
-      for (int o = 0; o < 3; ++o) rows[dz][dy][o] = Lerp(x[dz][dy][o], x[dz][dy][o + 1], c.tx);
-  const VF value = blend(rows[0][0][1], rows[0][1][1], rows[1][0][1], rows[1][1][1]);
-  const VF xm = blend(rows[0][0][0], rows[0][1][0], rows[1][0][0], rows[1][1][0]);
-  const VF xp = blend(rows[0][0][2], rows[0][1][2], rows[1][0][2], rows[1][1][2]);
+      for (int o = 0; o < 3; ++o)
+        rows[dz][dy][o] = Lerp(cross.x[dz][dy][o], cross.x[dz][dy][o + 1], c.tx);
+  const VF xm = Blend(c, rows[0][0][0], rows[0][1][0], rows[1][0][0], rows[1][1][0]);
+  const VF xp = Blend(c, rows[0][0][2], rows[0][1][2], rows[1][0][2], rows[1][1][2]);
   // The cells one before and after along y: rows (y − 1, y) and (y + 1, y + 2).
   const VF yBefore[2] = {Lerp(y[0][0][0], y[0][0][1], c.tx), Lerp(y[1][0][0], y[1][0][1], c.tx)};
   const VF yAfter[2] = {Lerp(y[0][1][0], y[0][1][1], c.tx), Lerp(y[1][1][0], y[1][1][1], c.tx)};
-  const VF ym = blend(yBefore[0], rows[0][0][1], yBefore[1], rows[1][0][1]);
-  const VF yp = blend(rows[0][1][1], yAfter[0], rows[1][1][1], yAfter[1]);
+  const VF ym = Blend(c, yBefore[0], rows[0][0][1], yBefore[1], rows[1][0][1]);
+  const VF yp = Blend(c, rows[0][1][1], yAfter[0], rows[1][1][1], yAfter[1]);
   const VF zBefore[2] = {Lerp(z[0][0][0], z[0][0][1], c.tx), Lerp(z[1][0][0], z[1][0][1], c.tx)};
   const VF zAfter[2] = {Lerp(z[0][1][0], z[0][1][1], c.tx), Lerp(z[1][1][0], z[1][1][1], c.tx)};
-  const VF zm = blend(zBefore[0], zBefore[1], rows[0][0][1], rows[0][1][1]);
-  const VF zp = blend(rows[1][0][1], rows[1][1][1], zAfter[0], zAfter[1]);
+  const VF zm = Blend(c, zBefore[0], zBefore[1], rows[0][0][1], rows[0][1][1]);
+  const VF zp = Blend(c, rows[1][0][1], rows[1][1][1], zAfter[0], zAfter[1]);
   const VF two = hn::Set(df, 2.0f);
   g[0] = hn::Div(hn::Sub(xp, xm), hn::Mul(two, hn::Set(df, s.spacing[0])));
   g[1] = hn::Div(hn::Sub(yp, ym), hn::Mul(two, hn::Set(df, s.spacing[1])));
   g[2] = hn::Div(hn::Sub(zp, zm), hn::Mul(two, hn::Set(df, s.spacing[2])));
-  return value;
 }
 
 void ClassifySamples(const SampleSource& s, int count, SampleBatch& b) {
@@ -194,8 +240,11 @@ void ClassifySamples(const SampleSource& s, int count, SampleBatch& b) {
     const VF x = hn::Load(df, b.x + i), y = hn::Load(df, b.y + i), z = hn::Load(df, b.z + i);
     const Cell cell = Locate(s, x, y, z);
     VF g[3];
-    const bool crossed = s.shade && !s.normals && s.padded;
-    const VF code = crossed ? CodesAndGradient(s, cell, g) : Codes(s, cell);
+    const bool crossed = s.shade && !s.normals && (s.padded8 || s.padded);
+    CrossRows cross;
+    const VF code = !crossed  ? Codes(s, cell)
+                    : s.padded8 ? CrossValue(s, s.padded8, cell, cross)
+                                : CrossValue(s, s.padded, cell, cross);
     // SPEC §11: the transfer function's table read linearly between the entries about the code.
     const VF pos = hn::Mul(code, hn::Set(df, s.codeScale));
     const VI e = hn::Min(hn::ConvertTo(di, pos), last);
@@ -214,10 +263,17 @@ void ClassifySamples(const SampleSource& s, int count, SampleBatch& b) {
       const VF c1 = two ? hn::GatherIndex(df, s.stepOpacity, hn::Add(e, hn::Set(di, 1))) : c0;
       hn::Store(Lerp(c0, c1, f), df, b.w + i);
     }
-    if (s.shade) {
+    // Transparent samples are not composited: their colour is zero, and where the whole vector is
+    // transparent neither the gradient nor the weighting is taken (the same bits in every lane
+    // whatever the vector's width).
+    const auto transparent = hn::Not(hn::Gt(channel[3], hn::Zero(df)));
+    if (s.shade && !hn::AllTrue(df, transparent)) {
       if (s.normals) {
         Normals(s, cell, g);
-      } else if (!crossed) {
+      } else if (crossed) {
+        if (s.padded8) CrossGradient(s, s.padded8, cell, cross, g);
+        else CrossGradient(s, s.padded, cell, cross, g);
+      } else {
         // Central differences of the interpolated value over one sample spacing each way.
         const VF h[3] = {hn::Set(df, s.spacing[0]), hn::Set(df, s.spacing[1]),
                          hn::Set(df, s.spacing[2])};
@@ -251,9 +307,9 @@ void ClassifySamples(const SampleSource& s, int count, SampleBatch& b) {
         channel[c] = hn::IfThenElse(lit, hn::Mul(channel[c], weight), channel[c]);
       }
     }
-    hn::Store(channel[0], df, b.r + i);
-    hn::Store(channel[1], df, b.g + i);
-    hn::Store(channel[2], df, b.b + i);
+    hn::Store(hn::IfThenZeroElse(transparent, channel[0]), df, b.r + i);
+    hn::Store(hn::IfThenZeroElse(transparent, channel[1]), df, b.g + i);
+    hn::Store(hn::IfThenZeroElse(transparent, channel[2]), df, b.b + i);
   }
 }
 

@@ -34,6 +34,10 @@ struct SampleSource {
   // for the clamping at the faces. Null (or with normals): the differences are six trilinear
   // reads at the moved points, clamped into the box.
   const uint16_t* padded = nullptr;
+  // The same bordered codes a byte each, when every code is below 256 (8-bit data): half the
+  // memory, and a row's four codes about the cell in one 32-bit gather (twelve gathers for the
+  // value and its gradient). Read instead of `padded` when given; 4 bytes of slack at the end.
+  const uint8_t* padded8 = nullptr;
   bool shade = false;
   float toWorld[3][3] = {};  // own → world for gradients: the rows of world → own, transposed
   float toLight[3] = {0, 0, 1};  // world, unit
@@ -52,7 +56,9 @@ struct SampleBatch {
   alignas(64) float r[kBatch], g[kBatch], b[kBatch];  // shaded colour
 };
 
-// Classifies and shades samples [0, count) of `batch` (count ≤ kBatch).
+// Classifies and shades samples [0, count) of `batch` (count ≤ kBatch). A sample the transfer
+// function makes wholly transparent gets colour (0, 0, 0) (its gradient is not taken where a whole
+// vector of samples is transparent).
 void classifySamples(const SampleSource& source, int count, SampleBatch& batch);
 
 }  // namespace sv::volume

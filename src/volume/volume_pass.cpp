@@ -62,19 +62,21 @@ std::vector<int8_t> sampleNormals(const scene::VolumeGrid& g) {
 
 // The codes of `g` with a border of one sample on every side repeating the faces' samples (the
 // sample kernel's central differences read the border where the moved point would be clamped into
-// the box); empty when its bytes would not fit the kernel's 32-bit gather offsets.
-std::vector<uint16_t> borderedCodes(const scene::VolumeGrid& g) {
+// the box), as T (uint8_t only where every code fits), with 4 bytes of slack after them for the
+// kernel's 32-bit reads; empty when its bytes would not fit the kernel's 32-bit gather offsets.
+template <typename T>
+std::vector<T> borderedCodes(const scene::VolumeGrid& g) {
   const size_t px = size_t(g.nx) + 2, py = size_t(g.ny) + 2, pz = size_t(g.nz) + 2;
-  if (px * py * pz * 2 + 16 > size_t(INT32_MAX)) return {};
-  std::vector<uint16_t> out(px * py * pz);
+  if (px * py * pz * sizeof(T) + 16 > size_t(INT32_MAX)) return {};
+  std::vector<T> out(px * py * pz + 4 / sizeof(T));
   for (size_t k = 0; k < pz; ++k)
     for (size_t j = 0; j < py; ++j) {
       const int sk = std::clamp(int(k) - 1, 0, g.nz - 1), sj = std::clamp(int(j) - 1, 0, g.ny - 1);
       const uint16_t* row = g.codes.data() + g.at(0, sj, sk);
-      uint16_t* to = out.data() + (k * py + j) * px;
-      to[0] = row[0];
-      std::copy(row, row + g.nx, to + 1);
-      to[px - 1] = row[g.nx - 1];
+      T* to = out.data() + (k * py + j) * px;
+      to[0] = T(row[0]);
+      std::transform(row, row + g.nx, to + 1, [](uint16_t c) { return T(c); });
+      to[px - 1] = T(row[g.nx - 1]);
     }
   return out;
 }
@@ -185,14 +187,20 @@ void VolumePass::setVolumes(const VolumeInput& input) {
       p.transfer = v.transfer;
       p.normals.clear();
       p.padded.clear();
+      p.padded8.clear();
       prepareTables(p);
     }
     if (input.settings.precomputedNormals && v.shaded && p.normals.empty())
       p.normals = sampleNormals(*v.grid);
     if (!input.settings.precomputedNormals) p.normals.clear();
-    if (!input.settings.precomputedNormals && v.shaded && p.padded.empty())
-      p.padded = borderedCodes(*v.grid);
-    if (input.settings.precomputedNormals || !v.shaded) p.padded.clear();
+    if (!input.settings.precomputedNormals && v.shaded && p.padded.empty() && p.padded8.empty()) {
+      const auto& codes = v.grid->codes;
+      if (std::all_of(codes.begin(), codes.end(), [](uint16_t c) { return c < 256; }))
+        p.padded8 = borderedCodes<uint8_t>(*v.grid);
+      else
+        p.padded = borderedCodes<uint16_t>(*v.grid);
+    }
+    if (input.settings.precomputedNormals || !v.shaded) p.padded.clear(), p.padded8.clear();
     // World → own: the inverse of the affine transform, in double.
     const Mat4& m = v.transform;
     double a[3][3], inv[3][3];
@@ -419,6 +427,7 @@ void VolumePass::prepare(const raster::PassFrame& frame) {
     k.stepOpacity = p.stepOpacity.empty() ? nullptr : p.stepOpacity.data();
     k.normals = p.normals.empty() ? nullptr : p.normals.data();
     k.padded = p.padded.empty() ? nullptr : p.padded.data();
+    k.padded8 = p.padded8.empty() ? nullptr : p.padded8.data();
     k.shade = p.object->shaded && input_.lightOn;
     k.toLight[0] = input_.toLight.x, k.toLight[1] = input_.toLight.y, k.toLight[2] = input_.toLight.z;
     k.ambient = input_.ambient;

@@ -92,6 +92,7 @@ class VolumePass final : public raster::TilePass {
     // Gradients taken while traversing: the codes with a one-sample border (sample_kernel.h),
     // 2 bytes a sample; empty with precomputed normals, unlit, or beyond 2^31 bytes.
     std::vector<uint16_t> padded;
+    std::vector<uint8_t> padded8;  // the same a byte a sample, instead, where every code fits
     int bricks[3] = {};
     std::vector<uint8_t> emptyBrick;  // per brick (x fastest): every sample it holds transparent
     std::vector<uint32_t> contentBricks;  // the bricks not wholly transparent, by index

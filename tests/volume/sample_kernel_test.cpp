@@ -23,17 +23,19 @@ struct Fixture {
   std::vector<uint16_t> codes;
   std::vector<int8_t> normals;
   std::vector<uint16_t> padded;  // the codes with a border repeating the faces
+  std::vector<uint8_t> padded8;  // the same a byte each (the codes are below 256), 4 bytes slack
   std::vector<float> table, stepOpacity;
   SampleSource source;
 
-  Fixture() {
+  // Codes below `codes` (256: they fit the bordered 8-bit codes).
+  explicit Fixture(int codeRange = 4096) {
     codes.resize(kNx * kNy * kNz);
     normals.resize(codes.size() * 4);
     for (int k = 0; k < kNz; ++k)
       for (int j = 0; j < kNy; ++j)
         for (int i = 0; i < kNx; ++i) {
           const size_t at = (size_t(k) * kNy + size_t(j)) * kNx + size_t(i);
-          codes[at] = uint16_t((i * 37 + j * j * 11 + k * 1000 + (i * j * k) % 13) % 4096);
+          codes[at] = uint16_t((i * 37 + j * j * 11 + k * 1000 + (i * j * k) % 13) % codeRange);
           normals[at * 4 + 0] = int8_t(i * 13 - 60);
           normals[at * 4 + 1] = int8_t(-j * 17 + 50);
           normals[at * 4 + 2] = int8_t(k * 29 - 127);
@@ -45,6 +47,8 @@ struct Fixture {
           padded[(size_t(k) * (kNy + 2) + size_t(j)) * (kNx + 2) + size_t(i)] =
               codes[(size_t(std::clamp(k - 1, 0, kNz - 1)) * kNy + size_t(std::clamp(j - 1, 0, kNy - 1))) * kNx +
                     size_t(std::clamp(i - 1, 0, kNx - 1))];
+    padded8.assign(padded.size() + 4, 0);
+    for (size_t i = 0; i < padded.size(); ++i) padded8[i] = uint8_t(padded[i]);
     const int entries = 64;
     table.resize(entries * 4);
     stepOpacity.resize(entries);
@@ -61,7 +65,7 @@ struct Fixture {
     for (int a = 0; a < 3; ++a) source.spacing[a] = spacing[a], source.inverseSpacing[a] = 1 / spacing[a];
     source.table = table.data();
     source.entries = entries;
-    source.codeScale = 63.0f / 4095.0f;
+    source.codeScale = 63.0f / float(codeRange - 1);
     source.stepOpacity = stepOpacity.data();
     source.shade = true;
     const float m[3][3] = {{0.8f, 0.1f, 0}, {-0.2f, 1.1f, 0.3f}, {0, 0.4f, 0.9f}};
@@ -102,14 +106,18 @@ void positions(SampleBatch& b, int round) {
   b.x[3] = float((kNx - 1) * 0.5), b.y[3] = float(kNy - 1), b.z[3] = float((kNz - 1) * 2);
 }
 
+// Every target, every way of taking the gradient, and 8-bit codes as well as 16-bit ones.
 TEST(SampleKernel, EveryTargetGivesTheSameBitsAndTheyAreTheScalarFormulas) {
-  Fixture f;
-  // Gradients: precomputed, or central differences read from the bordered codes' cross, or at the
-  // moved points clamped into the box.
-  for (const int way : {0, 1, 2}) {
+  for (const int range : {4096, 256}) {
+  Fixture f(range);
+  // Gradients: precomputed, or central differences read from the bordered codes' cross (16-bit,
+  // or 8-bit where they fit), or at the moved points clamped into the box.
+  for (const int way : {0, 1, 2, 3}) {
+    if (way == 3 && range > 256) continue;
     const bool precomputed = way == 0;
     f.source.normals = precomputed ? f.normals.data() : nullptr;
     f.source.padded = way == 1 ? f.padded.data() : nullptr;
+    f.source.padded8 = way == 3 ? f.padded8.data() : nullptr;
     for (int round = 0; round < 4; ++round) {
       SampleBatch first{};
       bool have = false;
@@ -175,7 +183,7 @@ TEST(SampleKernel, EveryTargetGivesTheSameBitsAndTheyAreTheScalarFormulas) {
           // (rays' samples lie in it; this test's also beyond it), the others' about the point.
           const int n[3] = {kNx, kNy, kNz};
           double p[3] = {in.x[i], in.y[i], in.z[i]};
-          if (way == 1)
+          if (way == 1 || way == 3)
             for (int a = 0; a < 3; ++a)
               p[a] = std::clamp(p[a], 0.0, double(n[a] - 1) * f.source.spacing[a]);
           for (int a = 0; a < 3; ++a) {
@@ -199,11 +207,63 @@ TEST(SampleKernel, EveryTargetGivesTheSameBitsAndTheyAreTheScalarFormulas) {
           const double lit = len2 > 0 ? base * (f.source.ambient + (1 - f.source.ambient) * cosine *
                                                                        f.source.lightColor[ch])
                                       : base;
-          EXPECT_NEAR(out[ch], lit, 2e-3) << "sample " << i << " channel " << ch;
+          // A transparent sample is not composited: its colour is zero.
+          EXPECT_NEAR(out[ch], first.opacity[i] > 0 ? lit : 0.0, 2e-3)
+              << "sample " << i << " channel " << ch;
         }
       }
     }
   }
+  }
+}
+
+// The bordered 8-bit codes give the bits the 16-bit ones give, on the samples of whole vectors of
+// transparent samples too (their gradients are skipped alike).
+TEST(SampleKernel, EightBitCodesGiveTheSixteenBitCodesBits) {
+  Fixture f(256);
+  int transparent = 0, total = 0;
+  for (int round = 0; round < 4; ++round) {
+    SampleBatch wide{}, narrow{};
+    positions(wide, round);
+    positions(narrow, round);
+    f.source.padded = f.padded.data(), f.source.padded8 = nullptr;
+    classifySamples(f.source, kBatch, wide);
+    f.source.padded = nullptr, f.source.padded8 = f.padded8.data();
+    classifySamples(f.source, kBatch, narrow);
+    for (int i = 0; i < kBatch; ++i) {
+      ++total;
+      transparent += !(wide.opacity[i] > 0);
+      EXPECT_EQ(std::memcmp(&wide.opacity[i], &narrow.opacity[i], 4), 0) << i;
+      EXPECT_EQ(std::memcmp(&wide.r[i], &narrow.r[i], 4), 0) << i;
+      EXPECT_EQ(std::memcmp(&wide.g[i], &narrow.g[i], 4), 0) << i;
+      EXPECT_EQ(std::memcmp(&wide.b[i], &narrow.b[i], 4), 0) << i;
+    }
+  }
+  // Both kinds of sample are there.
+  EXPECT_GT(transparent, 0);
+  EXPECT_LT(transparent, total);
+  // A batch wholly transparent (one transparent sample's position in every lane): no gradient is
+  // taken, and the colours are zero on every target.
+  SampleBatch probe{};
+  positions(probe, 0);
+  classifySamples(f.source, kBatch, probe);
+  int at = 0;
+  while (at < kBatch && probe.opacity[at] > 0) ++at;
+  ASSERT_LT(at, kBatch);
+  for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
+    hwy::SetSupportedTargetsForTest(target);
+    SampleBatch b{};
+    for (int i = 0; i < kBatch; ++i) b.x[i] = probe.x[at], b.y[i] = probe.y[at], b.z[i] = probe.z[at];
+    for (int i = 0; i < kBatch; ++i) b.r[i] = b.g[i] = b.b[i] = -1;
+    classifySamples(f.source, kBatch, b);
+    for (int i = 0; i < kBatch; ++i) {
+      EXPECT_EQ(b.opacity[i], 0.0f) << hwy::TargetName(target);
+      EXPECT_EQ(b.r[i], 0.0f) << hwy::TargetName(target);
+      EXPECT_EQ(b.g[i], 0.0f) << hwy::TargetName(target);
+      EXPECT_EQ(b.b[i], 0.0f) << hwy::TargetName(target);
+    }
+  }
+  hwy::SetSupportedTargetsForTest(0);
 }
 
 }  // namespace
