@@ -214,6 +214,27 @@ std::string text(const tinyxml2::XMLElement* e, const char* name, const std::str
   return c ? std::string(trimmed(c->GetText())) : fallback;
 }
 
+// What is wrong with a frustum, or nothing: the reader's and the writer's one rule.
+std::string frustumProblem(const MpcdiFrustum& f) {
+  const Orientation& o = f.orientation;
+  const Window& w = f.window;
+  for (double a : {o.yawDegrees, o.pitchDegrees, o.rollDegrees})
+    if (!std::isfinite(a)) return "frustum: yaw, pitch and roll must be finite";
+  for (double a : {w.leftDegrees, w.rightDegrees, w.downDegrees, w.upDegrees})
+    if (!(a > -90 && a < 90)) return "frustum angles must be in (−90, 90) degrees";
+  if (!(w.leftDegrees < w.rightDegrees) || !(w.downDegrees < w.upDegrees))
+    return "frustum: leftAngle must be less than rightAngle, downAngle less than upAngle";
+  return {};
+}
+
+// Whether a region's place lies within its buffer (to a millionth, for sizes written as decimals).
+bool withinBuffer(const MpcdiRegion& r) {
+  return r.x >= 0 && r.y >= 0 && r.xSize > 0 && r.ySize > 0 && r.x + r.xSize <= 1 + 1e-6 &&
+         r.y + r.ySize <= 1 + 1e-6;
+}
+constexpr const char* kOutsideBuffer =
+    "the region must lie within its buffer (x, y ≥ 0, sizes > 0, x + xsize and y + ysize ≤ 1)";
+
 // The element's id attribute, which must be present, not empty, and not among `seen`.
 std::string uniqueId(const tinyxml2::XMLElement* e, std::set<std::string>& seen) {
   const char* id = attribute(e, "id");
@@ -231,11 +252,7 @@ MpcdiFrustum readFrustum(const tinyxml2::XMLElement* e) {
   f.window.rightDegrees = numberText(e, "rightAngle");
   f.window.downDegrees = numberText(e, "downAngle");
   f.window.upDegrees = numberText(e, "upAngle");
-  const Window& w = f.window;
-  for (double a : {w.leftDegrees, w.rightDegrees, w.downDegrees, w.upDegrees})
-    if (!(a > -90 && a < 90)) fail(lineOf(e), "frustum angles must be in (−90, 90) degrees");
-  if (!(w.leftDegrees < w.rightDegrees) || !(w.downDegrees < w.upDegrees))
-    fail(lineOf(e), "frustum: leftAngle must be less than rightAngle, downAngle less than upAngle");
+  if (const std::string problem = frustumProblem(f); !problem.empty()) fail(lineOf(e), problem);
   return f;
 }
 
@@ -362,10 +379,7 @@ Mpcdi readArchive(const std::string& bytes, const MpcdiLimits& limits) {
       r.y = numberAttribute(e, "y");
       r.xSize = numberAttribute(e, "xsize");
       r.ySize = numberAttribute(e, "ysize");
-      if (!(r.x >= 0 && r.y >= 0 && r.xSize > 0 && r.ySize > 0 && r.x + r.xSize <= 1 + 1e-6 &&
-            r.y + r.ySize <= 1 + 1e-6))
-        fail(lineOf(e), "the region must lie within its buffer (x, y ≥ 0, sizes > 0, x + xsize and "
-                        "y + ysize ≤ 1)");
+      if (!withinBuffer(r)) fail(lineOf(e), kOutsideBuffer);
       if (const tinyxml2::XMLElement* f = child(e, "frustum")) r.frustum = readFrustum(f);
       else if (m.profile == MpcdiProfile::simulation3d)
         fail(lineOf(e), fmt::format("region '{}' has no <frustum> (the 3d profile needs one)", r.id));
@@ -462,7 +476,18 @@ std::string writeArchive(const Mpcdi& m) {
   x += "  <display>\n";
   std::string files = "  <files>\n";
   std::set<std::string> ids, names;
+  size_t regions = 0;
+  for (const MpcdiBuffer& b : m.buffers) regions += b.regions.size();
+  if (regions > size_t(MpcdiLimits{}.maxRegions))
+    fail(kXml, fmt::format("{} regions, more than {}", regions, MpcdiLimits{}.maxRegions));
+  std::set<std::string> bufferIds;
   for (const MpcdiBuffer& b : m.buffers) {
+    if (b.id.empty() || !bufferIds.insert(b.id).second)
+      fail(kXml, fmt::format("buffer id '{}' is empty or not unique", b.id));
+    if (b.xResolution < 0 || b.yResolution < 0 || b.xResolution > MpcdiLimits{}.maxSide ||
+        b.yResolution > MpcdiLimits{}.maxSide)
+      fail(kXml, fmt::format("buffer '{}': resolution {} × {} out of range", b.id, b.xResolution,
+                             b.yResolution));
     x += fmt::format("    <buffer id=\"{}\"", escaped(b.id));
     if (b.xResolution > 0) x += fmt::format(" Xresolution=\"{}\"", b.xResolution);
     if (b.yResolution > 0) x += fmt::format(" Yresolution=\"{}\"", b.yResolution);
@@ -472,6 +497,20 @@ std::string writeArchive(const Mpcdi& m) {
         fail(kXml, fmt::format("region id '{}' is empty or not unique", r.id));
       if (m.profile == MpcdiProfile::simulation3d && !r.frustum)
         fail(kXml, fmt::format("region '{}' needs a frustum in the 3d profile", r.id));
+      const MpcdiLimits limits;
+      if (r.xResolution < 1 || r.yResolution < 1 || r.xResolution > limits.maxSide ||
+          r.yResolution > limits.maxSide)
+        fail(kXml, fmt::format("region '{}': {} × {} pixels, each side must be 1 … {}", r.id,
+                               r.xResolution, r.yResolution, limits.maxSide));
+      if (!withinBuffer(r)) fail(kXml, fmt::format("region '{}': {}", r.id, kOutsideBuffer));
+      if (r.frustum)
+        if (const std::string problem = frustumProblem(*r.frustum); !problem.empty())
+          fail(kXml, fmt::format("region '{}': {}", r.id, problem));
+      if (r.coordinateFrame)
+        for (const double* v : {r.coordinateFrame->pos, r.coordinateFrame->yaw,
+                                r.coordinateFrame->pitch, r.coordinateFrame->roll})
+          if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]))
+            fail(kXml, fmt::format("region '{}': coordinateFrame values must be finite", r.id));
       x += fmt::format(
           "      <region id=\"{}\" Xresolution=\"{}\" Yresolution=\"{}\" x=\"{}\" y=\"{}\" "
           "xsize=\"{}\" ysize=\"{}\">\n",

@@ -483,6 +483,59 @@ TEST(MpcdiErrors, WriterRefusesWhatTheReaderWould) {
       << r.error().str();
 }
 
+TEST(MpcdiErrors, WriterRefusesBadRegions) {
+  const struct {
+    void (*spoil)(MpcdiRegion&);
+    std::string error;
+  } cases[] = {
+      {[](MpcdiRegion& r) { r.xResolution = 0; },
+       "region 'region0': 0 × 20 pixels, each side must be 1 … 16384"},
+      {[](MpcdiRegion& r) { r.xSize = 0.8; },  // 0.25 + 0.8 > 1
+       "region 'region0': the region must lie within its buffer (x, y ≥ 0, sizes > 0, x + xsize "
+       "and y + ysize ≤ 1)"},
+      {[](MpcdiRegion& r) { r.frustum->window.leftDegrees = 20; },
+       "region 'region0': frustum: leftAngle must be less than rightAngle, downAngle less than "
+       "upAngle"},
+      {[](MpcdiRegion& r) { r.frustum->orientation.yawDegrees = NAN; },
+       "region 'region0': frustum: yaw, pitch and roll must be finite"},
+  };
+  for (const auto& c : cases) {
+    Mpcdi m = sample3d();
+    m.buffers[0].regions[0].x = 0.25;
+    c.spoil(m.buffers[0].regions[0]);
+    Result<std::string> r = encodeMpcdi(m, "out.mpcdi");
+    ASSERT_FALSE(r.ok());
+    EXPECT_EQ(r.error().str(), "out.mpcdi:mpcdi.xml: " + c.error);
+  }
+}
+
+TEST(Mpcdi2d, ContentMapHoldsTheWarpAtEachPixelCentre) {
+  // A per-pixel 4 × 2 warp: each pixel's content coordinate is its own sample; the invalid
+  // sample's pixel alone is invalid (a per-pixel warp has no neighbours weighing in).
+  MpcdiRegion r;
+  r.xResolution = 4;
+  r.yResolution = 2;
+  r.warp.width = 4;
+  r.warp.height = 2;
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 4; ++x)
+      for (float v : {0.1f * x, 0.3f + 0.5f * y, 0.0f}) r.warp.values.push_back(v);
+  r.warp.values[3 * 5] = r.warp.values[3 * 5 + 1] = kNaN;  // pixel (1, 1)
+  const ContentMap c = contentMap(r);
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 4; ++x) {
+      const size_t i = size_t(y) * 4 + size_t(x);
+      if (x == 1 && y == 1) {
+        EXPECT_FALSE(c.valid[i]);
+        continue;
+      }
+      ASSERT_TRUE(c.valid[i]) << x << " " << y;
+      EXPECT_EQ(c.uv[i], (Vec2{r.warp.values[i * 3], r.warp.values[i * 3 + 1]}));
+    }
+  // The 2d profile has no frustum: no directions.
+  EXPECT_FALSE(directionMap(r).ok());
+}
+
 // ---------------------------------------------------------------------------------------------
 // The 3d profile against the analytic geometry.
 
