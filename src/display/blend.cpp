@@ -47,7 +47,7 @@ void applyBlend(const BlendWeights& w, uint16_t* rgb) {
     const float a = w.alpha[i], b = w.beta[i] * 65535.0f;
     for (int c = 0; c < 3; ++c) {
       const float v = float(rgb[i * 3 + size_t(c)]) * a + b;
-      rgb[i * 3 + size_t(c)] = uint16_t(std::min(65535.0f, std::nearbyint(v)));
+      rgb[i * 3 + size_t(c)] = uint16_t(std::clamp(std::nearbyint(v), 0.0f, 65535.0f));
     }
   }
 }

@@ -25,7 +25,7 @@ struct BlendWeights {
 BlendWeights blendWeights(const MpcdiRegion& region);
 
 // Blends a frame of linear 16-bit RGB (3 values a pixel, rows top first, the size of `weights`):
-// each value becomes round(value·alpha + beta·65535), at most 65535. Beta lifts the black level
+// each value becomes round(value·alpha + beta·65535), within 0 … 65535. Beta lifts the black level
 // of a pixel (to match the overlaps', where two projectors' black adds).
 void applyBlend(const BlendWeights& weights, uint16_t* rgb);
 

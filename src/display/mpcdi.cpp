@@ -758,6 +758,7 @@ MpcdiRegion regionFromGeometry(const DisplayGeometry& g, const MpcdiFrustum& fru
       if (!(bz < 0)) continue;  // behind the frustum's eye
       const double u = (bx / -bz - t.left) / (t.right - t.left);
       const double w = (t.up - by / -bz) / (t.up - t.down);
+      if (!(std::fabs(u) < 1e6 && std::fabs(w) < 1e6)) continue;  // at the frustum's horizon
       float* s = r.warp.values.data() + (size_t(j) * size_t(warpWidth) + size_t(i)) * 3;
       s[0] = float(u);
       s[1] = float(w);

@@ -144,7 +144,7 @@ Result<DirectionMap> directionMap(const MpcdiRegion& region);
 // A 3d-profile region for a projector of `geometry` drawn from `frustum` (the image generator's
 // view): a w × h warp (sample centres as above) holding where each sample's screen point lies in
 // the frustum's image, NaN where the projector misses the screen or the point is behind the
-// frustum's eye. No blend maps.
+// frustum's eye or at its horizon (beyond 10^6 image widths). No blend maps.
 MpcdiRegion regionFromGeometry(const DisplayGeometry& geometry, const MpcdiFrustum& frustum,
                                int warpWidth, int warpHeight, const std::string& id);
 

@@ -68,6 +68,15 @@ TEST(Blend, AppliedInLinearLight) {
   EXPECT_EQ(rgb[4], uint16_t(std::nearbyint(4 * 0.25f + 0.1f * 65535)));
   EXPECT_EQ(rgb[6], 65535);  // clamped
   EXPECT_EQ(rgb[8], uint16_t(std::nearbyint(1 + 0.5f * 65535)));
+  // A negative weight (a hand-made BlendWeights) gives black, not a wrapped value.
+  BlendWeights negative;
+  negative.width = negative.height = 1;
+  negative.alpha = {-0.5f};
+  negative.beta = {0};
+  uint16_t one[3] = {1000, 2000, 3000};
+  applyBlend(negative, one);
+  EXPECT_EQ(one[0], 0);
+  EXPECT_EQ(one[2], 0);
 }
 
 // Where projector `p` shows eye-frame point `q`: its pinhole inverted (independent of
