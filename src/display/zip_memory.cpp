@@ -122,8 +122,11 @@ std::string ZipReader::read(const std::string& entry, uint64_t maxBytes) {
   if (unzOpenCurrentFile(zip_) != UNZ_OK) throw Problem{entry, "cannot open the entry's data"};
   // Step 2: inflate piece by piece, checking the running total against the declared size (a
   // lying directory cannot make the output grow past it).
+  // Reserved up to what the archive's bytes can inflate to (deflate expands at most 1032:1), so
+  // that a small archive declaring a large entry allocates no more than its data makes.
   std::string out;
-  out.reserve(size_t(info.uncompressed_size));
+  out.reserve(size_t(std::min<uint64_t>(info.uncompressed_size,
+                                        uint64_t(stream_->in->size()) * 1032 + 1024)));
   char piece[1 << 16];
   for (;;) {
     const int n = unzReadCurrentFile(zip_, piece, sizeof piece);
