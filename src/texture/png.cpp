@@ -221,10 +221,10 @@ Status writePngGrey16(const std::string& path, int width, int height, const uint
   return {};
 }
 
-Result<std::vector<uint8_t>> encodePngGrey16(const std::string& name, int width, int height,
-                                             const uint16_t* samples) {
-  png_image png = header(width, height, 1);
-  png.format = PNG_FORMAT_LINEAR_Y;
+namespace {
+// One greyscale image (the format set in `png`) to PNG bytes in memory.
+Result<std::vector<uint8_t>> encodeGrey(png_image& png, const std::string& name,
+                                        const void* samples) {
   png_alloc_size_t bytes = 0;
   if (!png_image_write_to_memory(&png, nullptr, &bytes, 0, samples, 0, nullptr))
     return writeFailed(png, name, "cannot encode PNG");
@@ -233,6 +233,21 @@ Result<std::vector<uint8_t>> encodePngGrey16(const std::string& name, int width,
     return writeFailed(png, name, "cannot encode PNG");
   out.resize(bytes);
   return out;
+}
+}  // namespace
+
+Result<std::vector<uint8_t>> encodePngGrey16(const std::string& name, int width, int height,
+                                             const uint16_t* samples) {
+  png_image png = header(width, height, 1);
+  png.format = PNG_FORMAT_LINEAR_Y;
+  return encodeGrey(png, name, samples);
+}
+
+Result<std::vector<uint8_t>> encodePngGrey8(const std::string& name, int width, int height,
+                                            const uint8_t* samples) {
+  png_image png = header(width, height, 1);
+  png.format = PNG_FORMAT_GRAY;
+  return encodeGrey(png, name, samples);
 }
 
 }  // namespace sv::texture

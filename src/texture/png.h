@@ -61,5 +61,9 @@ Result<std::vector<uint8_t>> encodePng(const std::string& name, int width, int h
 Status writePngGrey16(const std::string& path, int width, int height, const uint16_t* samples);
 Result<std::vector<uint8_t>> encodePngGrey16(const std::string& name, int width, int height,
                                              const uint16_t* samples);
+// The same with 8-bit samples (an 8-bit greyscale PNG; readPngGrey gives the same codes back: it
+// ignores the sRGB chunk libpng writes).
+Result<std::vector<uint8_t>> encodePngGrey8(const std::string& name, int width, int height,
+                                            const uint8_t* samples);
 
 }  // namespace sv::texture

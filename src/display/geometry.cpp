@@ -1,0 +1,204 @@
+// Display geometry: projector rays against a cylinder or sphere, seen from the eye.
+// Based on: SPEC §12 (distortion correction: a table of unit vectors per display, recomputed when
+// the eye or projector moves); issue 34 item 1. The ray–quadric intersections are the textbook
+// quadratic (e.g. Pharr, Jakob & Humphreys, PBRT 4th ed., §6.2 for spheres, §6.3 for cylinders),
+// solved in double with the cancellation-free form of the roots.
+#include "display/geometry.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace sv::display {
+namespace {
+
+constexpr double kToRadians = std::numbers::pi / 180;
+constexpr double kToDegrees = 180 / std::numbers::pi;
+
+struct D3 {
+  double x, y, z;
+};
+D3 toD3(Vec3 v) { return {v.x, v.y, v.z}; }
+
+// Row-major 3×3 products.
+Rotation multiply(const Rotation& a, const Rotation& b) {
+  Rotation r{};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      r.m[i][j] = a.m[i][0] * b.m[0][j] + a.m[i][1] * b.m[1][j] + a.m[i][2] * b.m[2][j];
+  return r;
+}
+// Right-handed turns about +x, +y, +z.
+Rotation aboutX(double a) {
+  const double c = std::cos(a), s = std::sin(a);
+  return {{{1, 0, 0}, {0, c, -s}, {0, s, c}}};
+}
+Rotation aboutY(double a) {
+  const double c = std::cos(a), s = std::sin(a);
+  return {{{c, 0, s}, {0, 1, 0}, {-s, 0, c}}};
+}
+Rotation aboutZ(double a) {
+  const double c = std::cos(a), s = std::sin(a);
+  return {{{c, -s, 0}, {s, c, 0}, {0, 0, 1}}};
+}
+
+// The smallest t > 0 at which o + t·d lies on the screen's surface and within its extent, or a
+// negative number. Roots of a·t² + b·t + c = 0 by q = −(b + sign(b)·√disc)/2, t = q/a and c/q,
+// which avoids the cancellation of the schoolbook formula when b² ≫ 4ac.
+double hitScreen(const Screen& s, D3 o, D3 d) {
+  const D3 rel{o.x - s.centre.x, o.y - s.centre.y, o.z - s.centre.z};
+  const bool sphere = s.shape == ScreenShape::sphere;
+  const double a = d.x * d.x + d.z * d.z + (sphere ? d.y * d.y : 0);
+  const double b = 2 * (rel.x * d.x + rel.z * d.z + (sphere ? rel.y * d.y : 0));
+  const double c = rel.x * rel.x + rel.z * rel.z + (sphere ? rel.y * rel.y : 0) - s.radius * s.radius;
+  if (!(a > 1e-300)) return -1;  // a vertical ray never meets the cylinder's wall
+  const double disc = b * b - 4 * a * c;
+  if (!(disc >= 0)) return -1;
+  const double q = -0.5 * (b + std::copysign(std::sqrt(disc), b));
+  double t0 = q / a, t1 = q != 0 ? c / q : t0;
+  if (t0 > t1) std::swap(t0, t1);
+  for (double t : {t0, t1}) {
+    if (!(t > 1e-9)) continue;
+    const D3 p{rel.x + t * d.x, rel.y + t * d.y, rel.z + t * d.z};
+    const double azimuth = std::atan2(p.x, -p.z) * kToDegrees;
+    if (azimuth < s.minAzimuthDegrees || azimuth > s.maxAzimuthDegrees) continue;
+    if (sphere) {
+      const double elevation = std::atan2(p.y, std::hypot(p.x, p.z)) * kToDegrees;
+      if (elevation < s.minElevationDegrees || elevation > s.maxElevationDegrees) continue;
+    } else if (p.y < s.minHeight || p.y > s.maxHeight) {
+      continue;
+    }
+    return t;
+  }
+  return -1;
+}
+
+D3 rayOf(const Projector& p, double px, double py) {
+  // The image plane at distance 1 along the body's −z: the window's tangents at the image edges,
+  // linear in between (a pinhole lens).
+  const WindowTangents t = tangentsOf(p.lens);
+  const double x = t.left + (px / p.width) * (t.right - t.left);
+  const double y = t.up - (py / p.height) * (t.up - t.down);
+  const Rotation r = rotationOf(p.orientation);
+  const double v[3] = {x, y, -1};
+  D3 out{};
+  double* o[3] = {&out.x, &out.y, &out.z};
+  for (int i = 0; i < 3; ++i) *o[i] = r.m[i][0] * v[0] + r.m[i][1] * v[1] + r.m[i][2] * v[2];
+  const double len = std::sqrt(out.x * out.x + out.y * out.y + out.z * out.z);
+  return {out.x / len, out.y / len, out.z / len};
+}
+
+}  // namespace
+
+WindowTangents tangentsOf(const Window& w) {
+  return {std::tan(w.leftDegrees * kToRadians), std::tan(w.rightDegrees * kToRadians),
+          std::tan(w.downDegrees * kToRadians), std::tan(w.upDegrees * kToRadians)};
+}
+
+Vec3 Rotation::apply(double x, double y, double z) const {
+  return {float(m[0][0] * x + m[0][1] * y + m[0][2] * z),
+          float(m[1][0] * x + m[1][1] * y + m[1][2] * z),
+          float(m[2][0] * x + m[2][1] * y + m[2][2] * z)};
+}
+
+Rotation rotationOf(const Orientation& o) {
+  // As render::channelCamera: yaw right is a turn about −y, pitch up about +x, roll right (the
+  // image's up leaning to +x) about −z, composed heading · pitch · bank.
+  return multiply(multiply(aboutY(-o.yawDegrees * kToRadians), aboutX(o.pitchDegrees * kToRadians)),
+                  aboutZ(-o.rollDegrees * kToRadians));
+}
+
+Vec3 projectorRay(const Projector& projector, double px, double py) {
+  const D3 d = rayOf(projector, px, py);
+  return {float(d.x), float(d.y), float(d.z)};
+}
+
+PixelView viewOfPixel(const DisplayGeometry& g, double px, double py) {
+  const D3 o = toD3(g.projector.position);
+  const D3 d = rayOf(g.projector, px, py);
+  const double t = hitScreen(g.screen, o, d);
+  if (t < 0) return {};
+  const D3 p{o.x + t * d.x, o.y + t * d.y, o.z + t * d.z};
+  const D3 e{p.x - g.eye.x, p.y - g.eye.y, p.z - g.eye.z};
+  const double len = std::sqrt(e.x * e.x + e.y * e.y + e.z * e.z);
+  if (!(len > 0)) return {};  // the eye on the screen sees no direction
+  PixelView v;
+  v.valid = true;
+  v.screenPoint = {float(p.x), float(p.y), float(p.z)};
+  v.direction = {float(e.x / len), float(e.y / len), float(e.z / len)};
+  return v;
+}
+
+DirectionMap directionMap(const DisplayGeometry& g) {
+  DirectionMap map;
+  map.width = g.projector.width;
+  map.height = g.projector.height;
+  const size_t n = size_t(map.width) * size_t(map.height);
+  map.directions.assign(n, Vec3{});
+  map.valid.assign(n, 0);
+  for (int y = 0; y < map.height; ++y)
+    for (int x = 0; x < map.width; ++x) {
+      const PixelView v = viewOfPixel(g, x + 0.5, y + 0.5);
+      const size_t i = size_t(y) * size_t(map.width) + size_t(x);
+      map.directions[i] = v.direction;
+      map.valid[i] = v.valid;
+    }
+  return map;
+}
+
+CylinderRig threeProjectorCylinder(double radius, double overlapDegrees, int width, int height,
+                                   double projectorHeight, double projectorBehind) {
+  CylinderRig rig;
+  rig.screen.shape = ScreenShape::cylinder;
+  rig.screen.radius = radius;
+  // A degree of screen beyond the outer projectors' edges, which land on ±(90 + overlap/2): an
+  // edge ray then meets the screen whatever its rounding.
+  rig.screen.minAzimuthDegrees = -91 - overlapDegrees / 2;
+  rig.screen.maxAzimuthDegrees = 91 + overlapDegrees / 2;
+  rig.screen.minHeight = -1.2;
+  rig.screen.maxHeight = 1.2;
+  // Heading, seen from the projectors' foot (0, ·, b), of the screen's azimuth φ: the point
+  // (r sin φ, ·, −r cos φ) lies along (r sin φ, −(r cos φ + b)) — heading atan2(r sin φ, r cos φ + b).
+  // With no pitch or roll a lens column of tangent tx heads exactly yaw + atan(tx), so the
+  // window's left and right angles put the image's side edges on the chosen azimuths.
+  const double r = radius, b = projectorBehind;
+  auto heading = [&](double azimuthDegrees) {
+    const double phi = azimuthDegrees * kToRadians;
+    return std::atan2(r * std::sin(phi), r * std::cos(phi) + b) * kToDegrees;
+  };
+  for (int i = 0; i < 3; ++i) {
+    const double centre = -60 + 60 * i, half = 30 + overlapDegrees / 2;
+    Projector p;
+    p.position = {0, float(projectorHeight), float(b)};
+    p.width = width;
+    p.height = height;
+    p.orientation.yawDegrees = heading(centre);
+    p.lens.leftDegrees = heading(centre - half) - p.orientation.yawDegrees;
+    p.lens.rightDegrees = heading(centre + half) - p.orientation.yawDegrees;
+    // Vertically: a ray of tangents (tx, ty) rises ty per unit of its direction's −z, and travels
+    // D(tx)/√(1+tx²) of those before the wall, D the horizontal distance to the wall along its
+    // heading. The top row must stay under the screen's top at every column: tan(up) is the least
+    // (top − h)·√(1+tx²)/D over the columns (sampled, with 2% of the height to spare), and
+    // likewise tan(down) at the bottom.
+    const WindowTangents lens = tangentsOf(p.lens);
+    const double tl = lens.left, tr = lens.right;
+    double tanUp = 1e9, tanDown = -1e9;
+    constexpr int kColumns = 512;
+    for (int k = 0; k <= kColumns; ++k) {
+      const double tx = tl + (tr - tl) * k / kColumns;
+      const double phiHeading = (p.orientation.yawDegrees + std::atan(tx) * kToDegrees) * kToRadians;
+      // The wall along that heading from (0, b): |(0, b) + s·(sin h, −cos h)| = r.
+      const double bh = -b * std::cos(phiHeading);
+      const double s = -bh + std::sqrt(bh * bh - (b * b - r * r));
+      const double scale = std::sqrt(1 + tx * tx) / s;
+      tanUp = std::min(tanUp, (0.98 * rig.screen.maxHeight - projectorHeight) * scale);
+      tanDown = std::max(tanDown, (0.98 * rig.screen.minHeight - projectorHeight) * scale);
+    }
+    p.lens.upDegrees = std::atan(tanUp) * kToDegrees;
+    p.lens.downDegrees = std::atan(tanDown) * kToDegrees;
+    rig.projectors.push_back(p);
+  }
+  return rig;
+}
+
+}  // namespace sv::display
