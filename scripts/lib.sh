@@ -76,11 +76,12 @@ sv_data() {
 }
 
 # sv_build DIR [cmake args...]: configure (once) and build everything in DIR.
+# sv_build DIR CMAKE_ARGS...: configure DIR and build it all, or only SV_BUILD_TARGET if set.
 sv_build() {
   local dir="$1"
   shift
   cmake -S "$SV_ROOT" -B "$dir" -G Ninja "$@" >/dev/null
-  cmake --build "$dir" --parallel "$(nproc)"
+  cmake --build "$dir" --parallel "$(nproc)" --target "${SV_BUILD_TARGET:-all}"
 }
 
 # The libFuzzer build (fuzz/README.md): clang, every synthvis library instrumented, no tests or
