@@ -13,6 +13,8 @@
 #include <limits>
 #include <numbers>
 
+#include <unistd.h>
+
 #include "display/mpcdi.h"
 #include "texture/png.h"
 
@@ -21,8 +23,10 @@ namespace {
 
 const float kNaN = std::numeric_limits<float>::quiet_NaN();
 
+// A file of this process's own: ctest runs the tests of one executable as parallel processes.
 std::string tempPath(const char* name) {
-  return (std::filesystem::temp_directory_path() / name).string();
+  return (std::filesystem::temp_directory_path() /
+          (std::to_string(::getpid()) + "_" + name)).string();
 }
 
 // Bit-exact float comparison (NaN payloads and −0 included).
