@@ -69,7 +69,7 @@ std::string pointList(int n, int leftOut) {
 // "collinear") name the problem.
 template <int N>
 Result<std::array<Point<N>, N + 1>> unitFrame(const std::array<Point<N>, N + 1>& p,
-                                                const char* side, const char* dependent) {
+                                              const char* side, const char* dependent) {
   std::array<Point<N>, N + 1> u{};
   for (int i = 0; i <= N; ++i) {
     double len2 = 0;
@@ -91,11 +91,11 @@ Result<std::array<Point<N>, N + 1>> unitFrame(const std::array<Point<N>, N + 1>&
       if (i != leftOut) cols[size_t(k++)] = u[size_t(i)];
     const double independence = std::fabs(determinant<N>(cols));
     if (!(independence > kMinPointIndependence))
-      return Error{"", "",
-                   fmt::format("{} points {} are {} (normalized determinant {:.3g}, at most {:g}): "
-                               "no unique projective map fixes them",
-                               side, pointList(N, leftOut), dependent, independence,
-                               kMinPointIndependence)};
+      return Error{
+          "", "",
+          fmt::format("{} points {} are {} (normalized determinant {:.3g}, at most {:g}): "
+                      "no unique projective map fixes them",
+                      side, pointList(N, leftOut), dependent, independence, kMinPointIndependence)};
   }
   return u;
 }

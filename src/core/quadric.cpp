@@ -2,11 +2,11 @@
 // transform of a quadric's matrix, the five-point projective map, interval bounds.
 #include "core/quadric.h"
 
-#include "core/projective.h"
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
+
+#include "core/projective.h"
 
 namespace sv {
 

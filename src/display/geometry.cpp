@@ -5,11 +5,11 @@
 // solved in double with the cancellation-free form of the roots.
 #include "display/geometry.h"
 
-#include "core/quadric.h"
-
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+
+#include "core/quadric.h"
 
 namespace sv::display {
 namespace {

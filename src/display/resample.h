@@ -70,9 +70,9 @@ Orientation meanOrientation(const DirectionMap& display);
 // holding every valid direction of `display` (rounded up to whole pixels about its middle),
 // widened by `marginPixels` flat pixels on each side, at the resolution whose tangent step is the
 // display's finest angular pixel — every flat pixel then subtends at most that angle (a pixel of
-// tangent step δ at tangent (t, s) subtends δ·√(1 + s²)/(1 + t² + s²) ≤ δ). Fails when a valid direction points behind or beside the
-// orientation (no flat window holds it), when the display has no valid pixel or no two valid
-// neighbours, or when a side would exceed `maxSide` pixels.
+// tangent step δ at tangent (t, s) subtends δ·√(1 + s²)/(1 + t² + s²) ≤ δ). Fails when a valid
+// direction points behind or beside the orientation (no flat window holds it), when the display
+// has no valid pixel or no two valid neighbours, or when a side would exceed `maxSide` pixels.
 Result<FlatView> coveringFlatView(const DirectionMap& display, const Orientation& orientation,
                                   int marginPixels = 2, int maxSide = 8192);
 

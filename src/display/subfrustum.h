@@ -31,8 +31,8 @@ DirectionTable directionTable(const DisplayGeometry& geometry);  // analytic, in
 DirectionTable directionTable(const DirectionMap& map);          // widened from float
 
 struct SubFrustumOptions {
-  double boundPixels = 0.1;  // the residual a cell must reach, display pixels
-  int minCellSize = 4;       // cells are not split below this many pixels a side
+  double boundPixels = 0.1;          // the residual a cell must reach, display pixels
+  int minCellSize = 4;               // cells are not split below this many pixels a side
   double znear = 0.1, zfar = 10000;  // the depth range of each cell's projection, metres
 };
 
@@ -51,14 +51,14 @@ struct SubFrustumCell {
   double residualPixels = 0;   // max over the cell's valid pixel centres, see planSubFrusta
   double residualRadians = 0;  // likewise, as an angle
   int64_t validPixels = 0;
-  bool fitted = true;          // false: fewer than four valid pixels with no three collinear
+  bool fitted = true;  // false: fewer than four valid pixels with no three collinear
 };
 
 struct SubFrustumPlan {
   int width = 0, height = 0;
-  std::vector<SubFrustumCell> cells;  // in quadtree order
+  std::vector<SubFrustumCell> cells;                     // in quadtree order
   double maxResidualPixels = 0, maxResidualRadians = 0;  // over the fitted cells
-  int cellsAboveBound = 0;    // fitted cells at the minimum size still above the bound
+  int cellsAboveBound = 0;     // fitted cells at the minimum size still above the bound
   int64_t unfittedPixels = 0;  // valid pixels in cells without a map
 };
 
@@ -81,11 +81,11 @@ std::optional<PixelPoint> mapDirection(const SubFrustumCell& cell, Vec3d d);
 // The unit direction the map shows at display pixel (px, py).
 Vec3d mapPixel(const SubFrustumCell& cell, double px, double py);
 
-// An asymmetric frustum (channelCamera's orientation + window) that covers a cell: looking along
-// the cell's axis, x along its rows, its window the tangent box of the map's rectangle corners
-// widened by the cell's angular residual — so it holds both what the map draws and the exact
-// directions of the cell's pixels. (A homography has one degree of freedom more than such a
-// camera — skew — so the cell is drawn with `projection`, and the frustum serves culling.)
+// An asymmetric frustum (channelCamera's orientation + window) that covers a fitted cell:
+// looking along the cell's axis, x along its rows, its window the tangent box of the map's
+// rectangle corners widened by the cell's angular residual — so it holds both what the map draws
+// and the exact directions of the cell's pixels. (A homography has one degree of freedom more than
+// such a camera — skew — so the cell is drawn with `projection`, and the frustum serves culling.)
 struct CellFrustum {
   Orientation orientation;
   Window window;

@@ -11,7 +11,9 @@
 namespace sv {
 namespace {
 
-double norm(const Vec4d& v) { return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + v[3] * v[3]); }
+double norm(const Vec4d& v) {
+  return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + v[3] * v[3]);
+}
 double norm(Vec3d v) { return std::sqrt(dot(v, v)); }
 
 // Largest |C − R| over the entries, relative to R's largest entry.

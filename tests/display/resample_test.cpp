@@ -56,7 +56,8 @@ void set(DirectionMap& m, int x, int y, Vec3 d) {
 DirectionMap shiftedMap(const FlatView& v, int x0, int x1, int y0, int y1, double dx, double dy) {
   DirectionMap m = emptyMap(x1 - x0, y1 - y0);
   for (int j = y0; j < y1; ++j)
-    for (int i = x0; i < x1; ++i) set(m, i - x0, j - y0, directionAt(v, i + dx + 0.5, j + dy + 0.5));
+    for (int i = x0; i < x1; ++i)
+      set(m, i - x0, j - y0, directionAt(v, i + dx + 0.5, j + dy + 0.5));
   return m;
 }
 
@@ -96,7 +97,8 @@ TEST(Resample, UnitFloatDirectionsOfATurnedViewReproduceTheImageWithinRounding) 
   for (ResampleFilter f : {ResampleFilter::bilinear, ResampleFilter::bicubic}) {
     const ResampledImage out = resampleFlatImage(v, flat.data(), display, f);
     int worst = 0;
-    for (size_t i = 0; i < flat.size(); ++i) worst = std::max(worst, std::abs(out.rgb[i] - flat[i]));
+    for (size_t i = 0; i < flat.size(); ++i)
+      worst = std::max(worst, std::abs(out.rgb[i] - flat[i]));
     std::printf("%s, turned view, unit float directions: largest difference %d codes\n",
                 f == ResampleFilter::bilinear ? "bilinear" : "bicubic", worst);
     EXPECT_LE(worst, 2);
@@ -133,7 +135,9 @@ TEST(Resample, BicubicReproducesAQuadraticWhichBilinearDoesNot) {
   // half-pixel shifts is a whole code everywhere; bilinear's chords lie above the parabolas by
   // 4/4 + 4/4 codes there.
   const FlatView v = dyadicView();
-  auto quad = [](double x, double y) { return 4 * (x - 20) * (x - 20) + 4 * (y - 14) * (y - 14) + 1000; };
+  auto quad = [](double x, double y) {
+    return 4 * (x - 20) * (x - 20) + 4 * (y - 14) * (y - 14) + 1000;
+  };
   const std::vector<uint16_t> flat = image(v, [&](int i, int j, int) { return quad(i, j); });
   const DirectionMap display = shiftedMap(v, 2, v.width - 3, 2, v.height - 3, 0.5, 0.5);
   int cubicWorst = 0, linearWorst = 0;
@@ -153,7 +157,8 @@ TEST(Resample, BicubicReproducesAQuadraticWhichBilinearDoesNot) {
 
 // The 10 %–90 % rise of a profile sampled at positions `x`, in the positions' unit (linear
 // interpolation between samples).
-double riseWidth(const std::vector<double>& x, const std::vector<double>& value, double lo, double hi) {
+double riseWidth(const std::vector<double>& x, const std::vector<double>& value, double lo,
+                 double hi) {
   auto crossing = [&](double level) {
     for (size_t i = 1; i < value.size(); ++i)
       if (value[i - 1] < level && value[i] >= level)
@@ -184,11 +189,13 @@ TEST(Resample, BicubicIsSharperThanBilinearOnAStep) {
     for (int k = 0; k < kSamples; ++k) value[size_t(k)] = out.rgb[size_t(k) * 3];
     width[int(f)] = riseWidth(x, value, 16384, 49152);
     for (int k = 1; k < kSamples; ++k)
-      slope[int(f)] = std::max(slope[int(f)], (value[size_t(k)] - value[size_t(k) - 1]) * 16 / 32768);
+      slope[int(f)] =
+          std::max(slope[int(f)], (value[size_t(k)] - value[size_t(k) - 1]) * 16 / 32768);
   }
-  std::printf("step edge: 10-90%% rise bilinear %.3f flat pixels, bicubic %.3f (%.0f%%); steepest "
-              "slope bilinear %.3f, bicubic %.3f steps per pixel\n",
-              width[0], width[1], 100 * width[1] / width[0], slope[0], slope[1]);
+  std::printf(
+      "step edge: 10-90%% rise bilinear %.3f flat pixels, bicubic %.3f (%.0f%%); steepest "
+      "slope bilinear %.3f, bicubic %.3f steps per pixel\n",
+      width[0], width[1], 100 * width[1] / width[0], slope[0], slope[1]);
   EXPECT_NEAR(width[0], 0.8, 0.01);  // the tent's rise: 0.1 to 0.9 of a pixel
   EXPECT_NEAR(slope[0], 1, 0.01);    // and its slope, one step per pixel
   // Catmull–Rom's slope midway between the step's samples is 5/4 of a step per pixel.
@@ -200,10 +207,10 @@ TEST(Resample, DirectionsOffTheFlatImageAreBlackAndCounted) {
   const FlatView v = dyadicView();
   const std::vector<uint16_t> flat = image(v, [](int, int, int) { return 30000; });
   DirectionMap display = emptyMap(6, 1);
-  set(display, 0, 0, directionAt(v, 10, 10));    // inside
-  set(display, 1, 0, directionAt(v, -0.01, 5));  // just left of the image
-  set(display, 2, 0, directionAt(v, 5, 32.01));  // just below
-  set(display, 3, 0, Vec3{0.1f, 0, 1});          // behind the camera
+  set(display, 0, 0, directionAt(v, 10, 10));         // inside
+  set(display, 1, 0, directionAt(v, -0.01, 5));       // just left of the image
+  set(display, 2, 0, directionAt(v, 5, 32.01));       // just below
+  set(display, 3, 0, Vec3{0.1f, 0, 1});               // behind the camera
   set(display, 4, 0, directionAt(v, 47.999, 0.001));  // by the top-right corner: inside
   // Pixel 5 stays invalid.
   for (ResampleFilter f : {ResampleFilter::bilinear, ResampleFilter::bicubic}) {
@@ -212,7 +219,8 @@ TEST(Resample, DirectionsOffTheFlatImageAreBlackAndCounted) {
     EXPECT_EQ(out.invalid, 1);
     for (int k = 0; k < 6; ++k) {
       const bool lit = k == 0 || k == 4;
-      for (int c = 0; c < 3; ++c) EXPECT_EQ(out.rgb[size_t(k) * 3 + size_t(c)], lit ? 30000 : 0) << k;
+      for (int c = 0; c < 3; ++c)
+        EXPECT_EQ(out.rgb[size_t(k) * 3 + size_t(c)], lit ? 30000 : 0) << k;
     }
   }
 }
@@ -253,10 +261,11 @@ TEST(Resample, CoveringFlatViewHoldsEveryDirectionOfTheCylinderRig) {
     // Resampled through it, no pixel is outside.
     const std::vector<uint16_t> flat(size_t(v.width) * size_t(v.height) * 3, 1000);
     EXPECT_EQ(resampleFlatImage(v, flat.data(), display, ResampleFilter::bicubic).outside, 0);
-    std::printf("projector %d (320 x 200): flat view %d x %d, window [%.2f, %.2f] x [%.2f, %.2f] "
-                "deg, yaw %.2f pitch %.2f, finest display pixel %.3g rad\n",
-                i, v.width, v.height, v.window.leftDegrees, v.window.rightDegrees,
-                v.window.downDegrees, v.window.upDegrees, o.yawDegrees, o.pitchDegrees, finest);
+    std::printf(
+        "projector %d (320 x 200): flat view %d x %d, window [%.2f, %.2f] x [%.2f, %.2f] "
+        "deg, yaw %.2f pitch %.2f, finest display pixel %.3g rad\n",
+        i, v.width, v.height, v.window.leftDegrees, v.window.rightDegrees, v.window.downDegrees,
+        v.window.upDegrees, o.yawDegrees, o.pitchDegrees, finest);
   }
 }
 

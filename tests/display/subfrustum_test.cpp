@@ -119,10 +119,10 @@ TEST(SubFrustum, TheCylinderRigsProjectorsReachTheBound) {
     expectTiling(plan, t);
     size_t smallest = 1 << 30;
     for (const SubFrustumCell& c : plan.cells) smallest = std::min(smallest, size_t(c.x1 - c.x0));
-    std::printf("projector %d (1280 x 800): %zu cells (narrowest %zu px), max residual %.4f px = "
-                "%.3g rad, planned in %.1f ms\n",
-                i, plan.cells.size(), smallest, plan.maxResidualPixels, plan.maxResidualRadians,
-                ms);
+    std::printf(
+        "projector %d (1280 x 800): %zu cells (narrowest %zu px), max residual %.4f px = "
+        "%.3g rad, planned in %.1f ms\n",
+        i, plan.cells.size(), smallest, plan.maxResidualPixels, plan.maxResidualRadians, ms);
   }
   // A tighter bound needs more cells.
   const DirectionTable t = directionTable(rig.geometry(0));
@@ -151,10 +151,11 @@ TEST(SubFrustum, ReportedResidualIsTheTrueMaximumByBruteForce) {
     worst.radians = std::max(worst.radians, r.radians);
   }
   EXPECT_NEAR(plan.maxResidualPixels, worst.pixels, 1e-9 + 1e-6 * worst.pixels);
-  std::printf("320 x 200 at 0.02 px: %zu cells, reported %.6f px / %.4g rad, brute force %.6f px "
-              "/ %.4g rad\n",
-              plan.cells.size(), plan.maxResidualPixels, plan.maxResidualRadians, worst.pixels,
-              worst.radians);
+  std::printf(
+      "320 x 200 at 0.02 px: %zu cells, reported %.6f px / %.4g rad, brute force %.6f px "
+      "/ %.4g rad\n",
+      plan.cells.size(), plan.maxResidualPixels, plan.maxResidualRadians, worst.pixels,
+      worst.radians);
 }
 
 TEST(SubFrustum, ProjectionIsTheFivePointMapOfItsCorners) {
@@ -211,7 +212,8 @@ TEST(SubFrustum, EachCellsFrustumCoversItsPixels) {
         const std::optional<FlatPoint> p = flatPointOf(v, Vec3{float(d.x), float(d.y), float(d.z)});
         ASSERT_TRUE(p);
         EXPECT_TRUE(p->x >= 0 && p->x <= 1 && p->y >= 0 && p->y <= 1)
-            << "cell " << c.x0 << "," << c.y0 << " pixel " << x << "," << y << ": " << p->x << ", " << p->y;
+            << "cell " << c.x0 << "," << c.y0 << " pixel " << x << "," << y << ": " << p->x << ", "
+            << p->y;
       }
     // And it is tight: the window is within a pixel or so of the cell's angular size.
     const double width = (f.window.rightDegrees - f.window.leftDegrees) * kToRadians;
@@ -248,9 +250,10 @@ TEST(SubFrustum, PartlyInvalidDisplayKeepsOnlyCellsWithValidPixels) {
   for (const SubFrustumCell& c : plan.cells)
     partly += c.validPixels < int64_t(c.x1 - c.x0) * (c.y1 - c.y0);
   EXPECT_GT(partly, 0);
-  std::printf("partly invalid 320 x 200 (%lld invalid pixels): %zu cells, %d partly valid, max "
-              "residual %.4f px\n",
-              static_cast<long long>(invalid), plan.cells.size(), partly, plan.maxResidualPixels);
+  std::printf(
+      "partly invalid 320 x 200 (%lld invalid pixels): %zu cells, %d partly valid, max "
+      "residual %.4f px\n",
+      static_cast<long long>(invalid), plan.cells.size(), partly, plan.maxResidualPixels);
 }
 
 TEST(SubFrustum, MovingTheEyeChangesTheMapsAndThePlanIsRecomputed) {
@@ -280,11 +283,12 @@ TEST(SubFrustum, MovingTheEyeChangesTheMapsAndThePlanIsRecomputed) {
         stale = std::max(stale, p ? std::hypot(p->x - (x + 0.5), p->y - (y + 0.5)) : 1e9);
       }
   EXPECT_GT(stale, 10);
-  std::printf("1920 x 1080 projector: directions %.1f ms, plan %.1f ms (%zu cells, max %.4f px); "
-              "eye moved: directions + plan %.1f ms (%zu cells, max %.4f px); the old maps miss "
-              "by up to %.1f px\n",
-              tableMs, planMs, before.cells.size(), before.maxResidualPixels, movedMs,
-              after.cells.size(), after.maxResidualPixels, stale);
+  std::printf(
+      "1920 x 1080 projector: directions %.1f ms, plan %.1f ms (%zu cells, max %.4f px); "
+      "eye moved: directions + plan %.1f ms (%zu cells, max %.4f px); the old maps miss "
+      "by up to %.1f px\n",
+      tableMs, planMs, before.cells.size(), before.maxResidualPixels, movedMs, after.cells.size(),
+      after.maxResidualPixels, stale);
 }
 
 }  // namespace
