@@ -6,6 +6,8 @@
 #include <cmath>
 #include <limits>
 
+#include "core/projective.h"
+
 namespace sv {
 
 Vec3d normalize(Vec3d v) {
@@ -79,28 +81,6 @@ Vec3d Mat4d::transformPoint(Vec3d p) const {
 
 namespace {
 
-// The matrix whose columns are the homogeneous points p[0…3] scaled so that their sum is p[4]'s.
-std::optional<Mat4d> basisTo(const std::array<Vec3d, 5>& p) {
-  Mat4d cols;
-  for (int j = 0; j < 4; ++j) {
-    cols.m[0][j] = p[size_t(j)].x;
-    cols.m[1][j] = p[size_t(j)].y;
-    cols.m[2][j] = p[size_t(j)].z;
-    cols.m[3][j] = 1;
-  }
-  const std::optional<Mat4d> inv = cols.inverse();  // singular: p[0…3] coplanar
-  if (!inv) return std::nullopt;
-  const Vec4d lambda = *inv * Vec4d{{p[4].x, p[4].y, p[4].z, 1}};
-  // λ_j = 0: p[4] lies in the plane of the other three of p[0…3] — four coplanar.
-  double largest = 0;
-  for (int j = 0; j < 4; ++j) largest = std::max(largest, std::fabs(lambda[j]));
-  for (int j = 0; j < 4; ++j)
-    if (!(std::fabs(lambda[j]) > 1e-12 * largest)) return std::nullopt;
-  for (int i = 0; i < 4; ++i)
-    for (int j = 0; j < 4; ++j) cols.m[i][j] *= lambda[j];
-  return cols;
-}
-
 // S += w·v·vᵀ: quadric forms are sums of squared linear forms v·(p, 1).
 void addSquare(Mat4d& s, const double v[4], double w) {
   for (int i = 0; i < 4; ++i)
@@ -135,11 +115,14 @@ void axisForm(Vec3d a, Vec3d u, double v[4]) {
 
 std::optional<Mat4d> projectiveFromFivePoints(const std::array<Vec3d, 5>& src,
                                               const std::array<Vec3d, 5>& dst) {
-  const std::optional<Mat4d> a = basisTo(src), b = basisTo(dst);
-  if (!a || !b) return std::nullopt;
-  const std::optional<Mat4d> aInv = a->inverse();
-  if (!aInv) return std::nullopt;
-  return *b * *aInv;
+  std::array<Vec4d, 5> m, p;
+  for (size_t i = 0; i < 5; ++i) {
+    m[i] = Vec4d{{src[i].x, src[i].y, src[i].z, 1}};
+    p[i] = Vec4d{{dst[i].x, dst[i].y, dst[i].z, 1}};
+  }
+  Result<Mat4d> c = solveProjectiveMap(m, p);
+  if (!c.ok()) return std::nullopt;
+  return c.value();
 }
 
 Quadric Quadric::sphere(Vec3d centre, double radius) {

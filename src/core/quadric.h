@@ -54,9 +54,8 @@ struct Mat4d {
 };
 
 // The projective map of space taking src[i] to dst[i] for i = 0…4 (SPEC §12: (C)(M^i) = r_i·(P^i),
-// r_5 = 1). Nothing when four of either five are coplanar (no unique map exists).
-// Method: the map B·A⁻¹ where A takes the four unit points e_1…e_4 to the homogeneous src[0…3]
-// scaled so that e_1 + … + e_4 goes to src[4], and B likewise for dst.
+// r_5 = 1), for affine points (w = 1). Nothing when four of either five are coplanar (no unique map
+// exists). solveProjectiveMap (core/projective.h) with homogeneous points and the refusal's reason.
 std::optional<Mat4d> projectiveFromFivePoints(const std::array<Vec3d, 5>& src,
                                               const std::array<Vec3d, 5>& dst);
 

@@ -9,6 +9,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "core/quadric.h"
+
 namespace sv::display {
 namespace {
 
@@ -108,25 +110,63 @@ Rotation rotationOf(const Orientation& o) {
                   aboutZ(-o.rollDegrees * kToRadians));
 }
 
+Orientation orientationOf(const Rotation& r) {
+  // rotationOf(yaw, pitch, roll) = Ry(−yaw)·Rx(pitch)·Rz(−roll) looks along its third column
+  // negated, (sin yaw · cos pitch, sin pitch, −cos yaw · cos pitch); what remains after the first
+  // two turns, (Ry(−yaw)·Rx(pitch))ᵀ·r = Rz(−roll), holds the roll in its first column
+  // (cos roll, −sin roll, 0).
+  const double fx = -r.m[0][2], fy = -r.m[1][2], fz = -r.m[2][2];
+  Orientation o;
+  o.pitchDegrees = std::asin(std::clamp(fy, -1.0, 1.0)) * kToDegrees;
+  o.yawDegrees = (std::fabs(fx) + std::fabs(fz) > 1e-12 ? std::atan2(fx, -fz) : 0) * kToDegrees;
+  const Rotation base = rotationOf({o.yawDegrees, o.pitchDegrees, 0});
+  double c0 = 0, c1 = 0;  // (baseᵀ·r)[0][0] and [1][0]
+  for (int k = 0; k < 3; ++k) {
+    c0 += base.m[k][0] * r.m[k][0];
+    c1 += base.m[k][1] * r.m[k][0];
+  }
+  o.rollDegrees = std::atan2(-c1, c0) * kToDegrees;
+  return o;
+}
+
 Vec3 projectorRay(const Projector& projector, double px, double py) {
   const D3 d = rayOf(projector, px, py);
   return {float(d.x), float(d.y), float(d.z)};
 }
 
-PixelView viewOfPixel(const DisplayGeometry& g, double px, double py) {
+namespace {
+
+// The screen point pixel (px, py) lights and the unit direction in which the eye sees it, in
+// double; false when the pixel misses the screen or the eye sits on the screen point.
+bool traceView(const DisplayGeometry& g, double px, double py, D3& point, D3& direction) {
   const D3 o = toD3(g.projector.position);
   const D3 d = rayOf(g.projector, px, py);
   const double t = hitScreen(g.screen, o, d);
-  if (t < 0) return {};
-  const D3 p{o.x + t * d.x, o.y + t * d.y, o.z + t * d.z};
-  const D3 e{p.x - g.eye.x, p.y - g.eye.y, p.z - g.eye.z};
+  if (t < 0) return false;
+  point = {o.x + t * d.x, o.y + t * d.y, o.z + t * d.z};
+  const D3 e{point.x - g.eye.x, point.y - g.eye.y, point.z - g.eye.z};
   const double len = std::sqrt(e.x * e.x + e.y * e.y + e.z * e.z);
-  if (!(len > 0)) return {};  // the eye on the screen sees no direction
+  if (!(len > 0)) return false;  // the eye on the screen sees no direction
+  direction = {e.x / len, e.y / len, e.z / len};
+  return true;
+}
+
+}  // namespace
+
+PixelView viewOfPixel(const DisplayGeometry& g, double px, double py) {
+  D3 p{}, e{};
+  if (!traceView(g, px, py, p, e)) return {};
   PixelView v;
   v.valid = true;
   v.screenPoint = {float(p.x), float(p.y), float(p.z)};
-  v.direction = {float(e.x / len), float(e.y / len), float(e.z / len)};
+  v.direction = {float(e.x), float(e.y), float(e.z)};
   return v;
+}
+
+std::optional<Vec3d> viewDirection(const DisplayGeometry& g, double px, double py) {
+  D3 p{}, e{};
+  if (!traceView(g, px, py, p, e)) return std::nullopt;
+  return Vec3d{e.x, e.y, e.z};
 }
 
 DirectionMap directionMap(const DisplayGeometry& g) {

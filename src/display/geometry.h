@@ -9,9 +9,15 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "synthvis/math.h"
+
+namespace sv {
+struct Vec3d;  // core/quadric.h (not included here: its normalize overloads would make a braced
+               // normalize({…}) ambiguous for this header's users)
+}  // namespace sv
 
 namespace sv::display {
 
@@ -76,6 +82,10 @@ struct PixelView {
 };
 PixelView viewOfPixel(const DisplayGeometry& geometry, double px, double py);
 
+// viewOfPixel's direction in double, before its rounding to float (nothing when the pixel is
+// invalid): for the sub-frustum maps, whose residuals are measured far below float's 6e-8.
+std::optional<Vec3d> viewDirection(const DisplayGeometry& geometry, double px, double py);
+
 // The unit ray leaving a projector through its pixel (px, py), in the eye frame.
 Vec3 projectorRay(const Projector& projector, double px, double py);
 
@@ -86,6 +96,9 @@ struct Rotation {
   Vec3 apply(double x, double y, double z) const;
 };
 Rotation rotationOf(const Orientation& o);
+// The orientation of a rotation (orthonormal, determinant 1): rotationOf(orientationOf(r)) is r.
+// Pitch within [−90, 90]; at ±90 (looking straight up or down) yaw is taken as 0.
+Orientation orientationOf(const Rotation& r);
 
 // The view of every pixel centre of a display: directions (unit, eye frame) row by row from the
 // top, and whether each is valid (an invalid pixel's direction is zero).
