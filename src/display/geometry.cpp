@@ -75,13 +75,21 @@ double hitScreen(const Screen& s, D3 o, D3 d) {
   return -1;
 }
 
-D3 rayOf(const Projector& p, double px, double py) {
+// What every ray of a projector shares: its lens's tangents and its rotation (six trigonometric
+// calls, made once per table rather than once per pixel).
+struct ProjectorFrame {
+  WindowTangents t;
+  Rotation r;
+};
+ProjectorFrame frameOf(const Projector& p) { return {tangentsOf(p.lens), rotationOf(p.orientation)}; }
+
+D3 rayOf(const Projector& p, const ProjectorFrame& f, double px, double py) {
   // The image plane at distance 1 along the body's −z: the window's tangents at the image edges,
   // linear in between (a pinhole lens).
-  const WindowTangents t = tangentsOf(p.lens);
+  const WindowTangents& t = f.t;
   const double x = t.left + (px / p.width) * (t.right - t.left);
   const double y = t.up - (py / p.height) * (t.up - t.down);
-  const Rotation r = rotationOf(p.orientation);
+  const Rotation& r = f.r;
   const double v[3] = {x, y, -1};
   D3 out{};
   double* o[3] = {&out.x, &out.y, &out.z};
@@ -130,7 +138,7 @@ Orientation orientationOf(const Rotation& r) {
 }
 
 Vec3 projectorRay(const Projector& projector, double px, double py) {
-  const D3 d = rayOf(projector, px, py);
+  const D3 d = rayOf(projector, frameOf(projector), px, py);
   return {float(d.x), float(d.y), float(d.z)};
 }
 
@@ -138,9 +146,10 @@ namespace {
 
 // The screen point pixel (px, py) lights and the unit direction in which the eye sees it, in
 // double; false when the pixel misses the screen or the eye sits on the screen point.
-bool traceView(const DisplayGeometry& g, double px, double py, D3& point, D3& direction) {
+bool traceView(const DisplayGeometry& g, const ProjectorFrame& f, double px, double py, D3& point,
+               D3& direction) {
   const D3 o = toD3(g.projector.position);
-  const D3 d = rayOf(g.projector, px, py);
+  const D3 d = rayOf(g.projector, f, px, py);
   const double t = hitScreen(g.screen, o, d);
   if (t < 0) return false;
   point = {o.x + t * d.x, o.y + t * d.y, o.z + t * d.z};
@@ -155,7 +164,7 @@ bool traceView(const DisplayGeometry& g, double px, double py, D3& point, D3& di
 
 PixelView viewOfPixel(const DisplayGeometry& g, double px, double py) {
   D3 p{}, e{};
-  if (!traceView(g, px, py, p, e)) return {};
+  if (!traceView(g, frameOf(g.projector), px, py, p, e)) return {};
   PixelView v;
   v.valid = true;
   v.screenPoint = {float(p.x), float(p.y), float(p.z)};
@@ -165,24 +174,32 @@ PixelView viewOfPixel(const DisplayGeometry& g, double px, double py) {
 
 std::optional<Vec3d> viewDirection(const DisplayGeometry& g, double px, double py) {
   D3 p{}, e{};
-  if (!traceView(g, px, py, p, e)) return std::nullopt;
+  if (!traceView(g, frameOf(g.projector), px, py, p, e)) return std::nullopt;
   return Vec3d{e.x, e.y, e.z};
+}
+
+void viewDirections(const DisplayGeometry& g, std::vector<Vec3d>& directions,
+                    std::vector<uint8_t>& valid) {
+  const int w = g.projector.width, h = g.projector.height;
+  directions.assign(size_t(w) * size_t(h), Vec3d{});
+  valid.assign(directions.size(), 0);
+  const ProjectorFrame frame = frameOf(g.projector);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      D3 p{}, e{};
+      const size_t i = size_t(y) * size_t(w) + size_t(x);
+      if (traceView(g, frame, x + 0.5, y + 0.5, p, e)) directions[i] = {e.x, e.y, e.z}, valid[i] = 1;
+    }
 }
 
 DirectionMap directionMap(const DisplayGeometry& g) {
   DirectionMap map;
   map.width = g.projector.width;
   map.height = g.projector.height;
-  const size_t n = size_t(map.width) * size_t(map.height);
-  map.directions.assign(n, Vec3{});
-  map.valid.assign(n, 0);
-  for (int y = 0; y < map.height; ++y)
-    for (int x = 0; x < map.width; ++x) {
-      const PixelView v = viewOfPixel(g, x + 0.5, y + 0.5);
-      const size_t i = size_t(y) * size_t(map.width) + size_t(x);
-      map.directions[i] = v.direction;
-      map.valid[i] = v.valid;
-    }
+  std::vector<Vec3d> exact;
+  viewDirections(g, exact, map.valid);
+  map.directions.reserve(exact.size());
+  for (const Vec3d& d : exact) map.directions.push_back({float(d.x), float(d.y), float(d.z)});
   return map;
 }
 

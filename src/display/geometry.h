@@ -85,6 +85,11 @@ PixelView viewOfPixel(const DisplayGeometry& geometry, double px, double py);
 // viewOfPixel's direction in double, before its rounding to float (nothing when the pixel is
 // invalid): for the sub-frustum maps, whose residuals are measured far below float's 6e-8.
 std::optional<Vec3d> viewDirection(const DisplayGeometry& geometry, double px, double py);
+// viewDirection at every pixel centre, row by row from the top (x fastest); (0, 0, 0) and valid 0
+// where the pixel misses the screen. The projector's rotation and lens are made once, not per
+// pixel.
+void viewDirections(const DisplayGeometry& geometry, std::vector<Vec3d>& directions,
+                    std::vector<uint8_t>& valid);
 
 // The unit ray leaving a projector through its pixel (px, py), in the eye frame.
 Vec3 projectorRay(const Projector& projector, double px, double py);

@@ -149,14 +149,7 @@ DirectionTable directionTable(const DisplayGeometry& geometry) {
   DirectionTable t;
   t.width = geometry.projector.width;
   t.height = geometry.projector.height;
-  t.directions.assign(size_t(t.width) * size_t(t.height), Vec3d{});
-  t.valid.assign(size_t(t.width) * size_t(t.height), 0);
-  for (int y = 0; y < t.height; ++y)
-    for (int x = 0; x < t.width; ++x)
-      if (const std::optional<Vec3d> d = viewDirection(geometry, x + 0.5, y + 0.5)) {
-        t.directions[t.index(x, y)] = *d;
-        t.valid[t.index(x, y)] = 1;
-      }
+  viewDirections(geometry, t.directions, t.valid);
   return t;
 }
 
