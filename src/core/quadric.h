@@ -33,6 +33,12 @@ struct Vec3d {
 };
 inline double dot(Vec3d a, Vec3d b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 Vec3d normalize(Vec3d v);  // v unchanged when it has zero length
+inline Vec3d cross(Vec3d a, Vec3d b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+// The angle between a and b, radians: atan2(|a × b|, a · b), accurate at small angles, where acos
+// of the dot product is not.
+double angleBetween(Vec3d a, Vec3d b);
 
 struct Vec4d {
   double v[4] = {0, 0, 0, 0};

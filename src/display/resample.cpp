@@ -4,6 +4,8 @@
 // a = −1/2 — the Catmull–Rom spline's weights.
 #include "display/resample.h"
 
+#include "core/quadric.h"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -111,13 +113,6 @@ void resampleAll(const FlatView& view, const uint16_t* flatRgb, const DirectionM
     }
 }
 
-double angleBetween(Vec3 a, Vec3 b) {
-  // atan2(|a × b|, a · b): accurate at small angles, where acos of the dot product is not.
-  const double ax = a.x, ay = a.y, az = a.z, bx = b.x, by = b.y, bz = b.z;
-  const double cx = ay * bz - az * by, cy = az * bx - ax * bz, cz = ax * by - ay * bx;
-  return std::atan2(std::sqrt(cx * cx + cy * cy + cz * cz), ax * bx + ay * by + az * bz);
-}
-
 }  // namespace
 
 std::optional<FlatPoint> flatPointOf(const FlatView& view, Vec3 direction) {
@@ -145,7 +140,8 @@ double finestAngularPixel(const DirectionMap& display) {
       if (!display.isValid(x, y)) continue;
       for (const auto& [nx, ny] : {std::pair{x + 1, y}, std::pair{x, y + 1}}) {
         if (nx >= display.width || ny >= display.height || !display.isValid(nx, ny)) continue;
-        const double a = angleBetween(display.direction(x, y), display.direction(nx, ny));
+        const Vec3 p = display.direction(x, y), q = display.direction(nx, ny);
+        const double a = angleBetween(Vec3d{p.x, p.y, p.z}, Vec3d{q.x, q.y, q.z});
         if (!any || a < finest) finest = a;
         any = true;
       }

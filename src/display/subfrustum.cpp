@@ -18,6 +18,8 @@
 // centre, H the cell's homography, (u, v, w) = H·d.
 #include "display/subfrustum.h"
 
+#include "core/quadric.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -27,15 +29,6 @@ namespace sv::display {
 namespace {
 
 constexpr double kToDegrees = 180 / std::numbers::pi;
-
-Vec3d cross(Vec3d a, Vec3d b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-double angleBetween(Vec3d a, Vec3d b) {
-  // atan2(|a × b|, a · b): accurate at the small angles residuals are.
-  const Vec3d c = cross(a, b);
-  return std::atan2(std::sqrt(dot(c, c)), dot(a, b));
-}
 
 // Valid pixels per rectangle in O(1): counts[(y)(w + 1) + x] = valid pixels in [0, x) × [0, y).
 struct ValidCounts {

@@ -9,10 +9,6 @@ namespace {
 
 bool inside(double v) { return v >= 0; }
 
-Vec3d cross(Vec3d a, Vec3d b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-
 Interval boundOf(const FreeForm& f, const Box& b) {
   return f.bound({b[0].x, b[1].x}, {b[0].y, b[1].y}, {b[0].z, b[1].z});
 }

@@ -15,10 +15,6 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kDirectCells = 8;
 
 double length(Vec3d v) { return std::sqrt(dot(v, v)); }
-Vec3d cross(Vec3d a, Vec3d b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-
 }  // namespace
 
 Caster::Caster(const HeightField& field, const Pyramid& pyramid, Interpolation interp,
