@@ -9,6 +9,8 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "support/temp_dir.h"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -31,11 +33,7 @@ CliRun run(const std::string& args, const std::string& environment = "") {
   return r;
 }
 
-fs::path tempDir() {
-  fs::path d = fs::temp_directory_path() / "sv_cli_test";
-  fs::create_directories(d);
-  return d;
-}
+fs::path tempDir() { return sv::tests::processTemp().dir(); }
 
 std::string write(const std::string& name, const std::string& content) {
   const fs::path p = tempDir() / name;

@@ -10,11 +10,12 @@
 #include <iterator>
 
 #include "cigi/session.h"
+#include "support/temp_dir.h"
 
 namespace sv::cigi {
 namespace {
 
-std::string tempPath(const std::string& name) { return testing::TempDir() + "cigi_" + name; }
+std::string tempPath(const std::string& name) { return sv::tests::processTemp().path(name); }
 
 std::vector<uint8_t> fileBytes(const std::string& path) {
   std::ifstream f(path, std::ios::binary);

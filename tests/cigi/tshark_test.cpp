@@ -25,6 +25,7 @@
 
 #include "cigi/pcap.h"
 #include "cigi/session.h"
+#include "support/temp_dir.h"
 
 namespace sv::cigi {
 namespace {
@@ -324,7 +325,7 @@ std::vector<CapturedDatagram> conformanceSession() {
 }
 
 TEST_F(CigiTshark, ASessionCaptureDecodesWithNoMalformedPacketOrExpertError) {
-  const std::string capture = testing::TempDir() + "cigi_conformance.pcap";
+  const std::string capture = sv::tests::processTemp().path("conformance.pcap");
   ASSERT_TRUE(writePcap(capture, conformanceSession()).ok());
   int status = 0;
   // Every frame must be CIGI; then none may be malformed or carry an error (the IPv4 header
@@ -347,7 +348,7 @@ TEST_F(CigiTshark, ASessionCaptureDecodesWithNoMalformedPacketOrExpertError) {
 
 TEST_F(CigiTshark, TheMalformedCheckSeesATruncatedPacket) {
   // The check above must be able to fail: a datagram whose last packet is cut short.
-  const std::string capture = testing::TempDir() + "cigi_truncated.pcap";
+  const std::string capture = sv::tests::processTemp().path("truncated.pcap");
   auto bytes = writeDatagram(test::hostPackets());
   bytes.resize(bytes.size() - 8);
   ASSERT_TRUE(writePcap(capture, std::vector<CapturedDatagram>{{1, true, bytes}}).ok());
@@ -360,7 +361,7 @@ TEST_F(CigiTshark, TheMalformedCheckSeesATruncatedPacket) {
 }
 
 TEST_F(CigiTshark, EveryPacketTypeDecodesToTheFieldsSentInBothByteOrders) {
-  const std::string capture = testing::TempDir() + "cigi_fields.pcap";
+  const std::string capture = sv::tests::processTemp().path("fields.pcap");
   ASSERT_TRUE(writePcap(capture, conformanceSession()).ok());
   const Expected frames[4] = {hostExpectations(true), igExpectations(true),
                               hostExpectations(false), igExpectations(false)};

@@ -13,9 +13,9 @@
 #include <limits>
 #include <numbers>
 
-#include <unistd.h>
 
 #include "display/mpcdi.h"
+#include "support/temp_dir.h"
 #include "texture/png.h"
 
 namespace sv::display {
@@ -23,11 +23,8 @@ namespace {
 
 const float kNaN = std::numeric_limits<float>::quiet_NaN();
 
-// A file of this process's own: ctest runs the tests of one executable as parallel processes.
-std::string tempPath(const char* name) {
-  return (std::filesystem::temp_directory_path() /
-          (std::to_string(::getpid()) + "_" + name)).string();
-}
+// A file in this process's own directory (support/temp_dir.h).
+std::string tempPath(const char* name) { return sv::tests::processTemp().path(name); }
 
 // Bit-exact float comparison (NaN payloads and −0 included).
 bool sameBits(const std::vector<float>& a, const std::vector<float>& b) {

@@ -8,14 +8,13 @@
 
 #include "output/resolve.h"
 #include "raster/framebuffer.h"
+#include "support/temp_dir.h"
 #include "synthvis/image.h"
 
 namespace sv {
 namespace {
 
-std::string tempPath(const char* name) {
-  return (std::filesystem::temp_directory_path() / name).string();
-}
+std::string tempPath(const char* name) { return sv::tests::processTemp().path(name); }
 
 Image gradient(int w, int h) {
   Image img{w, h, std::vector<uint8_t>(size_t(w) * h * 3)};

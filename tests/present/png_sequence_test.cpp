@@ -7,6 +7,7 @@
 #include "present/async_writer.h"
 #include "present/present.h"
 #include "present/test_patterns.h"
+#include "support/temp_dir.h"
 
 namespace sv::present {
 namespace {
@@ -19,7 +20,7 @@ TEST(PresentPngSequence, FileNamesCarryFrameAndChannel) {
 }
 
 TEST(PresentPngSequence, WrittenFilesReadBackEqual) {
-  const auto dir = std::filesystem::temp_directory_path() / "sv_present_png" / "nested";
+  const auto dir = sv::tests::processTemp().dir() / "png" / "nested";
   std::filesystem::remove_all(dir.parent_path());
   auto presenter = makePresenter("png:" + dir.string(), 60);
   ASSERT_TRUE(presenter.ok()) << presenter.error().str();

@@ -8,6 +8,7 @@
 
 #include "present/present.h"
 #include "present/y4m.h"
+#include "support/temp_dir.h"
 
 namespace sv::present {
 namespace {
@@ -107,7 +108,7 @@ std::string readFile(const std::filesystem::path& path) {
 }
 
 TEST(PresentY4m, StreamOfTwoChannelsIsTheirMosaicFrameByFrame) {
-  const auto path = std::filesystem::temp_directory_path() / "sv_present_stream.y4m";
+  const auto path = sv::tests::processTemp().dir() / "stream.y4m";
   {
     auto presenter = makePresenter("y4m:" + path.string(), 30);
     ASSERT_TRUE(presenter.ok()) << presenter.error().str();

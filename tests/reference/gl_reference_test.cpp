@@ -10,6 +10,7 @@
 #include "reference/gl_renderer.h"
 #include "reference/suite.h"
 #include "small_settings.h"
+#include "support/temp_dir.h"
 
 namespace sv::reference {
 namespace {
@@ -52,7 +53,7 @@ TEST(GlReference, DrawsWhatSynthvisDraws) {
     EXPECT_GE(r->psnrDb, 40.0);
   }
   // A lit scene with cameras, culling and the background: the demo scene through a file.
-  const std::string demo = (std::filesystem::temp_directory_path() / "sv_suite_demo.glb").string();
+  const std::string demo = sv::tests::processTemp().path("suite_demo.glb");
   ASSERT_TRUE(scene::saveGltf(scene::demoScene(), demo).ok());
   BenchCase file;
   file.name = "demo";

@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #include "small_settings.h"
+#include "support/temp_dir.h"
 
 namespace sv::reference {
 namespace {
@@ -77,7 +78,7 @@ TEST(Html, WritesPageImagesAndPlots) {
   c.tris.count = 100;
   auto r = runner.run(c);
   ASSERT_TRUE(r.ok());
-  const auto dir = std::filesystem::temp_directory_path() / "sv_suite_html";
+  const auto dir = sv::tests::processTemp().dir() / "suite_html";
   std::filesystem::remove_all(dir);
   ASSERT_TRUE(writeHtml(dir.string(), {r.value()}, s, "").ok());
   for (const char* f : {"index.html", "ratio.svg", "time-triangles.svg", "time-area.svg",

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "support/temp_dir.h"
 #include "synthvis/generators.h"
 #include "synthvis/scene.h"
 #include "texture/texture.h"
@@ -12,7 +13,7 @@ namespace sv::scene {
 namespace {
 
 std::string tempPath(const std::string& name) {
-  return (std::filesystem::temp_directory_path() / ("sv_gltf_writer_" + name)).string();
+  return sv::tests::processTemp().path(name);
 }
 
 void expectSameScene(const Scene& a, const Scene& b) {

@@ -14,38 +14,12 @@
 #include <string>
 #include <vector>
 
+#include "support/temp_dir.h"
 #include "synthvis/scene.h"
 
 namespace sv::scene::testing {
 
-// A fresh directory under the system temp directory, removed with everything in it at scope exit.
-class TempDir {
- public:
-  TempDir() {
-    std::random_device random;
-    path_ = std::filesystem::temp_directory_path() /
-            ("synthvis_scene_test_" + std::to_string(random()) + std::to_string(random()));
-    std::filesystem::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    std::filesystem::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-
-  // Writes `bytes` to `name` inside the directory and returns the file's path.
-  std::string write(const std::string& name, const std::string& bytes) const {
-    std::filesystem::path p = path_ / name;
-    std::filesystem::create_directories(p.parent_path());
-    std::ofstream(p, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
-    return p.string();
-  }
-  std::string path(const std::string& name) const { return (path_ / name).string(); }
-
- private:
-  std::filesystem::path path_;
-};
+using sv::tests::TempDir;
 
 inline std::string readText(const std::string& path) {
   std::ifstream in(path, std::ios::binary);

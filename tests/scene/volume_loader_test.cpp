@@ -19,6 +19,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "support/temp_dir.h"
 #include "synthvis/scene.h"
 
 namespace sv::scene {
@@ -137,15 +138,14 @@ TEST(VolumeFiles, NrrdAttachedDetachedAndGzip) {
   EXPECT_EQ(z->spacing.z, 2.0f);
   for (int i = 0; i < 60; ++i) EXPECT_EQ(z->value(z->codes[size_t(i)]), float(i - 30));
   // Detached: a .nhdr naming its raw file beside it.
-  const auto dir = std::filesystem::temp_directory_path() / "sv_volume_test";
-  std::filesystem::create_directories(dir);
+  const sv::tests::TempDir temp;
+  const std::filesystem::path& dir = temp.dir();
   std::ofstream((dir / "d.raw").string(), std::ios::binary) << data;
   std::ofstream((dir / "d.nhdr").string(), std::ios::binary)
       << "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 3 4 5\nencoding: raw\ndata file: d.raw\n";
   Result<VolumeGrid> d = loadVolume((dir / "d.nhdr").string());
   ASSERT_TRUE(d.ok()) << d.error().str();
   EXPECT_EQ(d->codes, g->codes);
-  std::filesystem::remove_all(dir);
 }
 
 TEST(VolumeFiles, BadFilesAreRefusedByNameBeforeAllocating) {
@@ -191,7 +191,7 @@ TEST(VolumeFiles, BadFilesAreRefusedByNameBeforeAllocating) {
 // as OpenVDB chooses).
 std::string vdbBytes(const openvdb::GridCPtrVec& grids, const openvdb::MetaMap& meta = {}) {
   openvdb::initialize();
-  const std::string path = (std::filesystem::temp_directory_path() / "sv_volume_test.vdb").string();
+  const std::string path = sv::tests::processTemp().path("grids.vdb");
   openvdb::io::File(path).write(grids, meta);
   std::ifstream in(path, std::ios::binary);
   std::ostringstream bytes;
@@ -223,11 +223,8 @@ TEST(VolumeFiles, OpenVdbGridIsDensifiedOverItsActiveVoxels) {
   velocity->tree().setValueOn({1, 2, 3}, openvdb::Vec3s(1, 0, 0));
   const std::string bytes = vdbBytes({other, boxGrid("density"), velocity});
   // Through a file, as a scene names it.
-  const auto dir = std::filesystem::temp_directory_path() / "sv_volume_vdb_test";
-  std::filesystem::create_directories(dir);
-  std::ofstream((dir / "box.vdb").string(), std::ios::binary) << bytes;
-  Result<VolumeGrid> g = loadVolume((dir / "box.vdb").string());
-  std::filesystem::remove_all(dir);
+  const sv::tests::TempDir dir;
+  Result<VolumeGrid> g = loadVolume(dir.write("box.vdb", bytes));
   ASSERT_TRUE(g.ok()) << g.error().str();
   EXPECT_EQ(g->nx, 4);
   EXPECT_EQ(g->ny, 3);

@@ -1,0 +1,56 @@
+// Temporary files for tests. ctest runs every test as a process of its own, two or more at a
+// time, and two suites (Release, sanitizers) may share a machine: a fixed name under /tmp is
+// shared between them, and one test's cleanup once deleted another's file while it was read
+// (CI of stop 47: "not an OpenVDB file"). Every test file therefore lives in a directory of its
+// process's own.
+#pragma once
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+
+// Not `sv::testing`: inside namespace sv that name would hide GoogleTest's ::testing.
+namespace sv::tests {
+
+// A fresh directory under the system temp directory, named by the process and a random number,
+// removed with everything in it at scope exit.
+class TempDir {
+ public:
+  TempDir() {
+    std::random_device random;
+    path_ = std::filesystem::temp_directory_path() /
+            ("synthvis-test-" + std::to_string(::getpid()) + "-" + std::to_string(random()));
+    std::filesystem::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+
+  const std::filesystem::path& dir() const { return path_; }
+  std::string path(const std::string& name) const { return (path_ / name).string(); }
+
+  // Writes `bytes` to `name` inside the directory (making its folders) and returns its path.
+  std::string write(const std::string& name, const std::string& bytes) const {
+    const std::filesystem::path p = path_ / name;
+    std::filesystem::create_directories(p.parent_path());
+    std::ofstream(p, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
+    return p.string();
+  }
+
+ private:
+  std::filesystem::path path_;
+};
+
+// The running process's own directory: made on first use, removed when the process exits.
+inline const TempDir& processTemp() {
+  static const TempDir dir;
+  return dir;
+}
+
+}  // namespace sv::tests
