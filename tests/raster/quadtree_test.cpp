@@ -2,6 +2,8 @@
 // near plane, bad vertices, and pixel-for-pixel equality with a brute-force reference.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -297,6 +299,16 @@ TEST(Determinism, ManyBatchesGiveTheOneBatchFrame) {
     EXPECT_TRUE(one == test::renderQuadtree(p, s, 2)) << "batches of " << batch;
   }
   EXPECT_TRUE(one == test::renderReference(p, gouraudSettings(w, h)));
+}
+
+// scripts/test runs the kernels' tests a second time with SV_TEST_SIMD_TARGET=scalar
+// (support/test_main.cpp): then the scalar fallback is the only target the kernels dispatch to.
+TEST(Determinism, TheScalarPathIsTheOnlyTargetWhenAsked) {
+  const char* target = std::getenv("SV_TEST_SIMD_TARGET");
+  if (!target || !*target) GTEST_SKIP() << "SV_TEST_SIMD_TARGET is not set";
+  EXPECT_EQ(hwy::SupportedTargets(), int64_t(HWY_BASELINE_SCALAR))
+      << hwy::TargetName(hwy::SupportedTargets());
+  EXPECT_EQ(hwy::SupportedAndGeneratedTargets(), std::vector<int64_t>{HWY_BASELINE_SCALAR});
 }
 
 TEST(Determinism, EverySimdTargetGivesTheScalarTargetsFrame) {
