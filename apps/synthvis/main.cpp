@@ -41,8 +41,10 @@
 #include <optional>
 #include <numbers>
 
+#include "display/mpcdi.h"
 #include "reference/ground_truth.h"
 #include "reference/suite.h"
+#include "render/correction.h"
 #include "synthvis/generators.h"
 #include "synthvis/image.h"
 #include "synthvis/render.h"
@@ -95,6 +97,13 @@ struct RenderArgs {
   float arc = 0;
   std::string mosaic;
   std::optional<double> time;  // the scene's simulation time, seconds (light points' blinking)
+  // A curved-screen display (issue 34, docs/display.md): "cylinder3" (the demo rig, projectors of
+  // --width × --height) or an MPCDI file; the correction; the simulated viewer's panorama; the rig
+  // written as MPCDI.
+  std::string display;
+  std::string correction = "subfrusta";
+  std::string viewer;
+  std::string writeMpcdi;
   sv::RenderOptions options;
 };
 
@@ -160,6 +169,61 @@ int renderChannels(const RenderArgs& a, const sv::scene::Scene& scene, sv::Rende
   return 0;
 }
 
+// --display: every projector's pre-distorted, blended frame as OUT-<projector>.png with a line
+// each, the viewer's panorama and the rig's MPCDI file if asked for.
+int renderDisplay(const RenderArgs& a, const sv::scene::Scene& scene, const sv::RenderOptions& o) {
+  const auto correction = sv::render::parseCorrection(a.correction);
+  if (!correction) return fail(correction.error());
+  sv::render::DisplaySetup display;
+  if (a.display == "cylinder3") {
+    display = sv::render::cylinderDisplay(o.width, o.height);
+  } else {
+    auto read = sv::render::mpcdiDisplay(a.display);
+    if (!read) return fail(read.error());
+    display = std::move(read).value();
+  }
+  if (!a.writeMpcdi.empty()) {
+    auto m = sv::render::mpcdiOf(display);
+    if (!m) return fail(m.error());
+    if (sv::Status s = sv::display::writeMpcdi(a.writeMpcdi, m.value()); !s) return fail(s.error());
+    fmt::print("{}: the display as MPCDI (3d profile, {} regions)\n", a.writeMpcdi,
+               display.projectors.size());
+  }
+  sv::render::CorrectionRenderer renderer(o);
+  sv::render::DisplayFrame frame;
+  if (sv::Status s = sv::render::renderDisplay(renderer, scene, o, display, correction.value(), frame);
+      !s) {
+    sv::Error e = s.error();
+    if (e.file.empty()) e.file = a.scene.empty() ? "<demo scene>" : a.scene;
+    return fail(e);
+  }
+  double totalMs = 0;
+  for (size_t i = 0; i < frame.images.size(); ++i) {
+    const std::string path = withSuffix(a.output, display.projectors[i].name);
+    if (sv::Status s = sv::writeImage(frame.images[i], path); !s) return fail(s.error());
+    const sv::render::CorrectionStats& c = frame.correction[i];
+    const std::string how =
+        correction.value() == sv::render::Correction::subFrusta
+            ? fmt::format("{} sub-frusta, residual <= {:.3f} px, plan {:.1f} ms", c.cells,
+                          c.maxResidualPixels, c.planMs)
+            : fmt::format("flat {}x{} resampled {} in {:.1f} ms", c.flatWidth, c.flatHeight,
+                          a.correction, c.resampleMs);
+    fmt::print("{}: {}x{} | {} | {}\n", path, frame.images[i].width, frame.images[i].height, how,
+               frame.stats[i].summary());
+    totalMs += frame.stats[i].totalMs;
+  }
+  fmt::print("frame: {} projectors, {:.2f} ms\n", frame.images.size(), totalMs);
+  if (!a.viewer.empty()) {
+    auto image = sv::render::viewerImage(display, frame, sv::display::PanoramaView{},
+                                         renderer.gamma());
+    if (!image) return fail(image.error());
+    if (sv::Status s = sv::writeImage(image.value(), a.viewer); !s) return fail(s.error());
+    fmt::print("{}: the viewer's view of the screen, azimuth -100 … 100°, elevation -25 … 25°\n",
+               a.viewer);
+  }
+  return 0;
+}
+
 int runRender(const RenderArgs& a) {
   sv::RenderOptions o = a.options;
   o.cullBackFaces = !a.noCull;
@@ -213,6 +277,13 @@ int runRender(const RenderArgs& a) {
     if (!scene.channels.empty() && !a.scene.empty()) e.file = a.scene;  // its channels conflict
     return fail(e);
   }
+  if (!a.display.empty()) {
+    if (!scene.channels.empty() || a.channels > 0)
+      return fail({"", "", "--display draws the scene camera's view: not with channels"});
+    return renderDisplay(a, scene, o);
+  }
+  if (!a.viewer.empty() || !a.writeMpcdi.empty())
+    return fail({"", "", "--viewer and --write-mpcdi need --display"});
   sv::Renderer renderer(o);
   if (!scene.channels.empty()) return renderChannels(a, scene, renderer);
   if (!a.mosaic.empty())
@@ -387,10 +458,10 @@ int runBench(BenchArgs a) {
   if (a.renderer.empty()) a.renderer = a.suite.empty() ? "synthvis" : "both";
   if (a.renderer != "synthvis" && a.renderer != "gl" && a.renderer != "both" &&
       a.renderer != "sphere-trace" && a.renderer != "tessellated" &&
-      a.renderer != "full-detail" && a.renderer != "vtk")
+      a.renderer != "full-detail" && a.renderer != "vtk" && a.renderer != "display")
     return fail({"", "",
                  fmt::format("unknown renderer '{}' (synthvis, gl, vtk, both, sphere-trace, "
-                             "tessellated or full-detail)",
+                             "tessellated, full-detail or display)",
                              a.renderer)});
   if (auto order = sv::scene::parseSubmitOrder(a.generator.order); !order)
     return fail(order.error());
@@ -436,6 +507,7 @@ int runBench(BenchArgs a) {
   settings.sphereTrace = a.renderer == "sphere-trace";
   settings.tessellated = a.renderer == "tessellated";
   settings.fullDetail = a.renderer == "full-detail";
+  settings.display = a.renderer == "display";
   settings.reference = a.renderer == "gl" || a.renderer == "both";
   ref::BenchRunner runner(settings);
   if (settings.reference) {
@@ -803,6 +875,19 @@ void addRenderOptions(CLI::App* render, RenderArgs& r) {
                      "horizontal field of view)");
   render->add_option("--mosaic", r.mosaic,
                      "a scene with channels: also write them side by side into this image");
+  render->add_option("--display", r.display,
+                     "a curved-screen display: cylinder3 (three projectors of --width x --height "
+                     "on a cylinder around the eye) or an MPCDI file (3d profile); each "
+                     "projector's pre-distorted, edge-blended image is written as OUT-<name>.png");
+  render
+      ->add_option("--correction", r.correction,
+                   "--display: subfrusta (the seeds' sub-frustum projective maps, no "
+                   "resampling), or a flat view resampled bilinear or bicubic")
+      ->capture_default_str();
+  render->add_option("--viewer", r.viewer,
+                     "--display cylinder3: write the simulated viewer's view of the screen here");
+  render->add_option("--write-mpcdi", r.writeMpcdi,
+                     "--display cylinder3: write the rig as an MPCDI file (3d profile) here");
 }
 
 }  // namespace
@@ -871,7 +956,9 @@ int main(int argc, char** argv) {
                     "synthvis against its free forms marched in fixed steps (--march-steps); "
                     "tessellated: against its free forms as triangles (the gl reference always "
                     "draws those); full-detail: against every instance transformed at full "
-                    "detail (no instance culling, no levels of detail); "
+                    "detail (no instance culling, no levels of detail); display: the unwarped "
+                    "view against the centre projector of --display cylinder3 pre-distorted "
+                    "through sub-frusta (subfrusta) and by a flat view resampled (resampled); "
                     "default: synthvis for a scene, both for a suite");
   bench
       ->add_option("--march-steps", b.options.marchSteps,

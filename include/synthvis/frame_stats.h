@@ -72,6 +72,10 @@ struct FrameStats {
   uint64_t culled() const {
     return culledFacing + culledOutside + culledDegenerate + culledInvalid + culledOccluded;
   }
+  // Adds another view's counts and times to this one's (the views of one frame: a display's
+  // sub-frustum cells); the grounds' memory and load time, the scene's in every view, are the
+  // larger of the two.
+  FrameStats& operator+=(const FrameStats& o);
   // One line: triangles in / culled / drawn, windows per level, milliseconds.
   std::string summary() const;
   std::string lodSummary() const;  // the summary's levels-of-detail part ("" without any)

@@ -3,6 +3,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+
 namespace sv {
 
 // " | LOD 0:n 1:m …, dissolving d, beyond b" when some instance has levels of detail.
@@ -15,6 +17,35 @@ std::string FrameStats::lodSummary() const {
   s += fmt::format(", dissolving {}, beyond {}", lodDissolving, lodBeyond);
   if (mergedCells) s += fmt::format(", merged {} in {} cells", mergedInstances, mergedCells);
   return s;
+}
+
+FrameStats& FrameStats::operator+=(const FrameStats& o) {
+  trianglesIn += o.trianglesIn;
+  culledFacing += o.culledFacing, culledOutside += o.culledOutside;
+  culledDegenerate += o.culledDegenerate, culledInvalid += o.culledInvalid;
+  culledOccluded += o.culledOccluded, drawn += o.drawn, culledInstances += o.culledInstances;
+  for (int i = 0; i < kLodLevels; ++i) lodDrawn[i] += o.lodDrawn[i];
+  lodDissolving += o.lodDissolving, lodBeyond += o.lodBeyond;
+  mergedCells += o.mergedCells, mergedInstances += o.mergedInstances;
+  for (int i = 0; i < 6; ++i) windows[i] += o.windows[i];
+  fullWindows += o.fullWindows, partialBlocks += o.partialBlocks, fragments += o.fragments;
+  hiddenFragments += o.hiddenFragments, hybridWoken += o.hybridWoken;
+  shadedByList += o.shadedByList, shadedByScan += o.shadedByScan;
+  occludedWindows += o.occludedWindows, occludedTriangles += o.occludedTriangles;
+  occludedObjects += o.occludedObjects;
+  freeForms += o.freeForms, freeFormCells += o.freeFormCells;
+  freeFormMaskedCells += o.freeFormMaskedCells, freeFormBounds += o.freeFormBounds;
+  freeFormRays += o.freeFormRays, freeFormHits += o.freeFormHits;
+  terrains += o.terrains, terrainWindows += o.terrainWindows, terrainSteps += o.terrainSteps;
+  terrainRays += o.terrainRays, terrainHits += o.terrainHits;
+  terrainBytes = std::max(terrainBytes, o.terrainBytes);  // the scene's, in every view alike
+  terrainLoadMs = std::max(terrainLoadMs, o.terrainLoadMs);
+  lightPoints += o.lightPoints, lightsDrawn += o.lightsDrawn, lightsMs += o.lightsMs;
+  lines += o.lines, linesDrawn += o.linesDrawn, linesMs += o.linesMs;
+  volumes += o.volumes, volumeRays += o.volumeRays, volumeSamples += o.volumeSamples;
+  volumeSkipped += o.volumeSkipped, volumeTerminated += o.volumeTerminated;
+  vertexMs += o.vertexMs, setupMs += o.setupMs, rasterMs += o.rasterMs, totalMs += o.totalMs;
+  return *this;
 }
 
 std::string FrameStats::summary() const {

@@ -162,6 +162,13 @@ bool traceView(const DisplayGeometry& g, const ProjectorFrame& f, double px, dou
 
 }  // namespace
 
+std::optional<Vec3d> screenPoint(const Screen& screen, Vec3d origin, Vec3d direction) {
+  const double t =
+      hitScreen(screen, {origin.x, origin.y, origin.z}, {direction.x, direction.y, direction.z});
+  if (t < 0) return std::nullopt;
+  return origin + direction * t;
+}
+
 PixelView viewOfPixel(const DisplayGeometry& g, double px, double py) {
   D3 p{}, e{};
   if (!traceView(g, frameOf(g.projector), px, py, p, e)) return {};

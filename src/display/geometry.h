@@ -75,6 +75,10 @@ struct DisplayGeometry {
 
 // What pixel (px, py) shows. `valid` is false when the pixel's ray misses the screen (beyond its
 // extent, or no intersection in front of the projector); the other members are then zero.
+// Where the ray from `origin` along `direction` (any length) first meets the screen within its
+// extent, in front of the origin; nothing when it misses.
+std::optional<Vec3d> screenPoint(const Screen& screen, Vec3d origin, Vec3d direction);
+
 struct PixelView {
   bool valid = false;
   Vec3 screenPoint;  // where the ray from the projector first meets the screen

@@ -89,25 +89,6 @@ bool fitMap(const DirectionTable& t, const int px[4], const int py[4], Mat3d& h)
   return true;
 }
 
-// glFrustum's rows for the cell's rectangle: see SubFrustumCell::projection.
-Mat4d projectionOf(const SubFrustumCell& c, double n, double f) {
-  const auto& a = c.map.m[0];
-  const auto& b = c.map.m[1];
-  const auto& w = c.map.m[2];
-  const double sx = 2.0 / (c.x1 - c.x0), sy = 2.0 / (c.y1 - c.y0);
-  Mat4d p;
-  for (size_t k = 0; k < 3; ++k) {
-    // NDC x = sx·(u/w − x0) − 1; NDC y = 1 − sy·(v/w − y0); the w row is the axis.
-    p.m[0][k] = sx * a[k] - (sx * c.x0 + 1) * w[k];
-    p.m[1][k] = -sy * b[k] + (1 + sy * c.y0) * w[k];
-    p.m[2][k] = (f + n) / (f - n) * w[k];
-    p.m[3][k] = w[k];
-  }
-  p.m[0][3] = p.m[1][3] = p.m[3][3] = 0;
-  p.m[2][3] = -2 * f * n / (f - n);
-  return p;
-}
-
 // Step 3: the residuals at every valid pixel centre. With `stopAbove` set, returns as soon as one
 // pixel's error exceeds it (the cell will be split: its exact maximum is not needed).
 void measure(const DirectionTable& t, SubFrustumCell& c, const Mat3d& inverse,
@@ -137,6 +118,24 @@ SubFrustumCell rectangle(int x0, int y0, int x1, int y1) {
 }
 
 }  // namespace
+
+Mat4d cellProjection(const SubFrustumCell& c, double n, double f) {
+  const auto& a = c.map.m[0];
+  const auto& b = c.map.m[1];
+  const auto& w = c.map.m[2];
+  const double sx = 2.0 / (c.x1 - c.x0), sy = 2.0 / (c.y1 - c.y0);
+  Mat4d p;
+  for (size_t k = 0; k < 3; ++k) {
+    // NDC x = sx·(u/w − x0) − 1; NDC y = 1 − sy·(v/w − y0); the w row is the axis.
+    p.m[0][k] = sx * a[k] - (sx * c.x0 + 1) * w[k];
+    p.m[1][k] = -sy * b[k] + (1 + sy * c.y0) * w[k];
+    p.m[2][k] = (f + n) / (f - n) * w[k];
+    p.m[3][k] = w[k];
+  }
+  p.m[0][3] = p.m[1][3] = p.m[3][3] = 0;
+  p.m[2][3] = -2 * f * n / (f - n);
+  return p;
+}
 
 DirectionTable directionTable(const DisplayGeometry& geometry) {
   DirectionTable t;
@@ -182,7 +181,7 @@ SubFrustumPlan planSubFrusta(const DirectionTable& display, const SubFrustumOpti
     if (c.fitted) {
       measure(display, c, *inverse, canSplit ? std::optional<double>(o.boundPixels) : std::nullopt);
       if (!canSplit || c.residualPixels <= o.boundPixels) {
-        c.projection = projectionOf(c, o.znear, o.zfar);
+        c.projection = cellProjection(c, o.znear, o.zfar);
         plan.maxResidualPixels = std::max(plan.maxResidualPixels, c.residualPixels);
         plan.maxResidualRadians = std::max(plan.maxResidualRadians, c.residualRadians);
         plan.cellsAboveBound += c.residualPixels > o.boundPixels;

@@ -73,6 +73,10 @@ struct SubFrustumPlan {
 // exactly one cell, and no cell holds only invalid pixels.
 SubFrustumPlan planSubFrusta(const DirectionTable& display, const SubFrustumOptions& options = {});
 
+// SubFrustumCell::projection of a fitted cell for the depth range [znear, zfar] (glFrustum's depth
+// row with the cell's axis depth): a camera's own range, where it differs from the plan's.
+Mat4d cellProjection(const SubFrustumCell& cell, double znear, double zfar);
+
 // Where direction d shows under a cell's map (continuous display pixel), or nothing behind it.
 struct PixelPoint {
   double x, y;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/eye_rays.h"
 #include "core/timing.h"
 #include "lights/light_laws.h"
 #include "lights/splat_blocks.h"
@@ -88,7 +89,7 @@ bool LightPass::projectPoint(const scene::LightPoint& p, Splat& s) const {
   const float invW = 1 / c.w;
   s.x = (c.x * invW + 1) * 0.5f * float(frame_.width);
   s.y = (1 - c.y * invW) * 0.5f * float(frame_.height);
-  s.eyeDepth = -eye.z;
+  s.eyeDepth = c.w;  // −eye.z for a window, bit for bit; a sub-frustum cell's axis depth
   const Vec3 toEye = eye_ - p.position;
   const float d = length(toEye);
   if (!(d > 0)) return false;
@@ -151,7 +152,7 @@ void LightPass::prepare(const raster::PassFrame& frame) {
   lobeTangents_.clear();
   for (const scene::LightAppearance& a : in_.appearances)
     lobeTangents_.push_back(lobeTangents(a.horizontalLobe, a.verticalLobe));
-  m22_ = in_.projection.m[2][2];
+  m22_ = float(depthP22(in_.projection));  // m[2][2] for a window
   m32_ = in_.projection.m[3][2];
   zfar_ = m32_ / (1 + m22_);
   const size_t stars = in_.stars ? in_.stars->stars.size() : 0;

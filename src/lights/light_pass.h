@@ -39,7 +39,7 @@ struct LightInput {
 // One light as the frame draws it.
 struct Splat {
   float x = 0, y = 0;     // raster position, pixels (pixel centres at i + ½)
-  float eyeDepth = 0;     // the light's depth along the view axis (s > 0); 0 for a star
+  float eyeDepth = 0;     // the light's depth along the view axis, clip w (s > 0); 0 for a star
   float radius = 1;       // the kernel's, pixels (light_laws.h: splatRadius)
   float rgb[3] = {};      // Φ · colour · 65535 / Σw: a weight-1 pixel's 16-bit addition
   float frontDepth = 1;   // the window depth depthBias in front of the light (a star: 1)

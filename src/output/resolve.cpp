@@ -224,6 +224,16 @@ void tentFilterRows(const LinearImage& linear, const GammaTable& gamma, int rowB
     }
 }
 
+void encodeRows(const LinearImage& linear, const GammaTable& gamma, int rowBegin, int rowEnd,
+                Image& image) {
+  const size_t n = size_t(linear.width) * 3;
+  for (int y = rowBegin; y < rowEnd; ++y) {
+    const uint16_t* src = &linear.rgb[size_t(y) * n];
+    uint8_t* out = image.pixel(0, y);
+    for (size_t i = 0; i < n; ++i) out[i] = gamma.table[src[i]];
+  }
+}
+
 void resolveTile(const uint16_t* color, int tileX, int tileY, int factor, const GammaTable& gamma,
                  Image& image) {
   SV_CHECK(factor == 1 || factor == 2 || factor == 4 || factor == 8 || factor == 16);

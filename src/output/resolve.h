@@ -74,6 +74,12 @@ void resolveTileLinear(const uint16_t* color, const int32_t* sums, int tileX, in
 void tentFilterRows(const LinearImage& linear, const GammaTable& gamma, int rowBegin, int rowEnd,
                     Image& image);
 
+// The gamma table alone over rows [rowBegin, rowEnd) of a linear frame (one composed of views in
+// linear light: distortion correction's cells, edge blending), into `image` (sized by
+// prepareImage).
+void encodeRows(const LinearImage& linear, const GammaTable& gamma, int rowBegin, int rowEnd,
+                Image& image);
+
 // Debug views: the red channel holds a small number per pixel, shown in false colour. `count`
 // (raster::ShadeMode::overdraw): black for 0, then blue, cyan, green, yellow, red for 1, 2, 3,
 // 4, ≥5 triangles covering the pixel. `level` (ShadeMode::levels, and the occupancy view): black

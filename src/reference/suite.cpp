@@ -11,6 +11,8 @@
 #include <optional>
 
 #include "core/timing.h"
+#include "render/correction.h"
+#include "render/view_renderer.h"
 #include "reference/gl_renderer.h"
 #include "reference/vtk_volume.h"
 
@@ -201,6 +203,70 @@ Status BenchRunner::startReference() {
   return {};
 }
 
+namespace {
+
+// BenchSettings::display: the unwarped view, method (a) and method (b), frame by frame.
+Status runDisplayBench(const scene::Scene& sc, const BenchSettings& s, CaseResult& r) {
+  if (!sc.channels.empty()) return Error{"", "", "display: the scene's camera view, not channels"};
+  const render::DisplaySetup display = render::cylinderDisplay(s.options.width, s.options.height);
+  const render::ProjectorSetup& centre = display.projectors[1];
+  Renderer unwarped(s.options);
+  render::CorrectionRenderer warped(s.options);
+  const Result<render::FrameCamera> base = render::chooseCamera(sc, s.options);
+  if (!base.ok()) return base.error();
+  display::SubFrustumOptions so;
+  so.znear = base.value().camera.znear;
+  so.zfar = base.value().camera.zfar;
+  const auto t0 = Clock::now();
+  const display::SubFrustumPlan plan = display::planSubFrusta(centre.table, so);
+  const double planMs = msSince(t0);
+  RendererRun flat{"synthvis", "synthvis, the unwarped view", {}, 0, 0, 0, {}, {}, {}};
+  RendererRun a{"subfrusta",
+                fmt::format("synthvis through {} sub-frusta (residual ≤ {:.3f} px; the plan took "
+                            "{:.1f} ms, once)",
+                            plan.cells.size(), plan.maxResidualPixels, planMs),
+                {}, 0, 0, 0, {}, {}, {}};
+  RendererRun b{"resampled", "synthvis, a flat view with margin resampled bilinear",
+                {}, 0, 0, 0, {}, {}, {}};
+  render::DisplayFrame frameA, frameB;
+  for (int i = 0; i < s.warmup + s.frames; ++i) {
+    auto t = Clock::now();
+    if (Status st = unwarped.render(sc, flat.image, &flat.stats); !st) return st;
+    if (i >= s.warmup) flat.frameMs.push_back(msSince(t));
+    for (auto [run, correction, frame] :
+         {std::tuple{&a, render::Correction::subFrusta, &frameA},
+          std::tuple{&b, render::Correction::bilinear, &frameB}}) {
+      render::CorrectedView view;
+      view.table = &centre.table;
+      view.plan = correction == render::Correction::subFrusta ? &plan : nullptr;
+      view.eye = display.eye;
+      view.correction = correction;
+      frame->linear.resize(1);
+      frame->images.resize(1);
+      run->stats = {};
+      render::CorrectionStats cs;
+      t = Clock::now();
+      if (Status st = render::renderCorrected(warped, sc, s.options, base.value(), view,
+                                              frame->linear[0], run->stats, cs);
+          !st)
+        return st;
+      output::prepareImage(centre.table.width, centre.table.height, run->image);
+      output::encodeRows(frame->linear[0], warped.gamma(), 0, centre.table.height, run->image);
+      if (i >= s.warmup) run->frameMs.push_back(msSince(t));
+    }
+  }
+  for (RendererRun* run : {&flat, &a, &b}) {
+    finish(*run);
+    r.runs.push_back(std::move(*run));
+  }
+  r.psnrDb = psnr(r.runs[1].image, r.runs[2].image);  // method (a) against method (b)
+  r.params["display"] = "cylinder3, centre projector";
+  r.params["subfrusta_cells"] = plan.cells.size();
+  return {};
+}
+
+}  // namespace
+
 Result<CaseResult> BenchRunner::run(const BenchCase& c) {
   const BenchSettings& s = impl_->settings;
   if (s.frames < 1 || s.frames > 100000 || s.warmup < 0 || s.warmup > 100000)
@@ -234,6 +300,12 @@ Result<CaseResult> BenchRunner::run(const BenchCase& c) {
   r.triangles = sc.triangleCount();
   r.meanArea = made.value().meanArea;
   r.depthComplexity = made.value().depthComplexity;
+  if (s.display) {
+    if (impl_->gl || s.vtk)
+      return Error{"", "", "display: the warped views are measured against synthvis unwarped"};
+    if (Status st = runDisplayBench(sc, s, r); !st) return st.error();
+    return r;
+  }
   std::optional<RendererRun> ours, ref;
   if (s.synthvis) ours = RendererRun{"synthvis", "synthvis", {}, 0, 0, 0, {}, {}, {}};
   Renderer renderer(s.options);
@@ -449,6 +521,9 @@ std::string summaryLine(const CaseResult& r) {
     line += fmt::format(
         "  ratio {:5.2f}x  psnr {}", r.runs[1].medianMs / r.runs[0].medianMs,
         std::isinf(r.psnrDb) ? std::string("identical") : fmt::format("{:.1f} dB", r.psnrDb));
+  for (size_t k = 2; k < r.runs.size(); ++k)
+    line += fmt::format("  {} ratio {:5.2f}x", r.runs[k].renderer,
+                        r.runs[k].medianMs / r.runs[0].medianMs);
   return line;
 }
 

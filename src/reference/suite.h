@@ -97,6 +97,13 @@ struct BenchSettings {
   // all channels (Renderer::renderChannels). 0: the classic single view. synthvis only.
   int channels = 0;
   float arcDegrees = 150;
+  // Issue 34's benchmark: instead of a reference renderer, the scene's view on the centre
+  // projector (options.width × options.height) of the demo's curved-screen display
+  // (render::cylinderDisplay) — pre-distorted through sub-frusta (method (a), renderer name
+  // "subfrusta", the plan made once as for a fixed eye) and by a flat view with margin resampled
+  // bilinear (method (b), "resampled"), each frame beside the unwarped view ("synthvis"). synthvis
+  // only.
+  bool display = false;
 };
 
 // Renders, per case, warm-up frames then timed frames, alternating synthvis and the reference

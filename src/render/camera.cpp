@@ -7,6 +7,7 @@
 #include <limits>
 #include <numbers>
 
+#include "core/check.h"
 #include "terrain/ground.h"
 
 namespace sv::render {
@@ -135,6 +136,20 @@ Result<FrameCamera> channelCamera(const scene::Scene& scene, const RenderOptions
   f.projection = Mat4::frustum(float(n * f.tanLeft), float(n * f.tanRight), float(n * f.tanBottom),
                                float(n * f.tanTop), f.camera.znear, f.camera.zfar);
   return f;
+}
+
+EyeRays eyeRays(const FrameCamera& camera) {
+  const double znear = camera.camera.znear, zfar = camera.camera.zfar;
+  if (camera.projective) {
+    // A sub-frustum's projection is invertible by construction (its homography is fitted on four
+    // rays with no three coplanar, display/subfrustum.h).
+    std::optional<EyeRays> rays =
+        EyeRays::ofProjection(camera.view, camera.projection, znear, zfar);
+    SV_CHECK(rays.has_value());
+    return *rays;
+  }
+  return EyeRays::of(camera.view, camera.projection, camera.tanLeft, camera.tanRight,
+                     camera.tanBottom, camera.tanTop, znear, zfar);
 }
 
 }  // namespace sv::render

@@ -1,6 +1,7 @@
 // The frame's camera (SPEC §1 stage 2): the scene's, or one that frames a scene without cameras.
 #pragma once
 
+#include "core/eye_rays.h"
 #include "synthvis/render.h"
 
 namespace sv::render {
@@ -14,7 +15,15 @@ struct FrameCamera {
   // Symmetric for the classic view; a channel's may be asymmetric (SPEC §9). Whatever needs rays
   // or pixel sizes (terrain, free-form tessellation) reads these, never the camera's yfov.
   double tanLeft = -1, tanRight = 1, tanBottom = -1, tanTop = 1;
+  // The projection is not a window but a sub-frustum's projective map (SPEC §12, distortion
+  // correction: render/warped.h): rays come from its inverse (eyeRays), and the window above is
+  // the display channel's whole, for what is chosen per frame rather than per pixel (levels of
+  // detail), so that every cell of a display chooses alike.
+  bool projective = false;
 };
+
+// The camera's rays through its raster (the terrain and volume passes').
+EyeRays eyeRays(const FrameCamera& camera);
 
 // The camera `options.camera` of the scene (an error names one that does not exist), or for a
 // scene without cameras one that frames its bounds; its window is yfov high, aspect

@@ -45,9 +45,7 @@ std::vector<raster::TilePass*> FramePasses::compose(const scene::Scene& scene,
     volume::VolumeInput in;
     in.volumes = &scene.volumes;
     in.settings = scene.volumeSettings;
-    in.rays = EyeRays::of(camera.view, camera.projection, camera.tanLeft, camera.tanRight,
-                          camera.tanBottom, camera.tanTop, camera.camera.znear,
-                          camera.camera.zfar);
+    in.rays = eyeRays(camera);
     in.viewProjection = camera.projection * camera.view;
     in.lightOn = scene.light.enabled;
     in.toLight = normalize(scene.light.direction * -1.0f);

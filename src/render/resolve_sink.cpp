@@ -7,9 +7,10 @@
 namespace sv::render {
 
 ResolveSink::ResolveSink(const RenderOptions& options, const output::GammaTable& gamma,
-                         output::LinearImage& linear, Image& image)
-    : options_(options), gamma_(gamma), linear_(linear), image_(image) {
-  if (options.filter == RenderOptions::Filter::tent3) linear.resize(options.width, options.height);
+                         output::LinearImage& linear, Image& image, bool linearOut)
+    : options_(options), gamma_(gamma), linear_(linear), image_(image), linearOut_(linearOut) {
+  if (linearOut || options.filter == RenderOptions::Filter::tent3)
+    linear.resize(options.width, options.height);
 }
 
 bool ResolveSink::takesColorSums() const {
@@ -19,7 +20,7 @@ bool ResolveSink::takesColorSums() const {
 TileSink ResolveSink::finishTile(int tilesX) {
   const RenderOptions& o = options_;
   const int k = o.supersample;
-  if (o.debugView != RenderOptions::DebugView::none) {
+  if (o.debugView != RenderOptions::DebugView::none && !linearOut_) {
     const output::DebugPalette palette = o.debugView == RenderOptions::DebugView::overdraw
                                              ? output::DebugPalette::count
                                              : output::DebugPalette::level;
@@ -27,7 +28,7 @@ TileSink ResolveSink::finishTile(int tilesX) {
       output::resolveDebugTile(color, tile % tilesX, tile / tilesX, palette, image_);
     };
   }
-  if (o.filter == RenderOptions::Filter::tent3)
+  if (linearOut_ || o.filter == RenderOptions::Filter::tent3)
     return [this, tilesX, k](int tile, const float*, const uint16_t* color, const int32_t* sums) {
       output::resolveTileLinear(color, sums, tile % tilesX, tile / tilesX, k, options_.samples,
                                 linear_);
@@ -43,7 +44,7 @@ TileSink ResolveSink::finishTile(int tilesX) {
 }
 
 double ResolveSink::finish(core::ThreadPool& pool) {
-  if (options_.filter != RenderOptions::Filter::tent3) return 0;
+  if (linearOut_ || options_.filter != RenderOptions::Filter::tent3) return 0;
   const auto t0 = core::Clock::now();
   constexpr int kBand = 16;  // rows per task
   const int height = options_.height;

@@ -14,9 +14,11 @@ namespace sv::render {
 class ResolveSink {
  public:
   // `linear` (the tent filter's frame) and `image` are kept by reference for the frame; the image
-  // must be sized by output::prepareImage before the first tile.
+  // must be sized by output::prepareImage before the first tile. With `linearOut`, every tile is
+  // box-resolved into `linear` and nothing else is done (no filter, no gamma, `image` untouched):
+  // a caller that composes views in linear light (render/warped.h) takes it from there.
   ResolveSink(const RenderOptions& options, const output::GammaTable& gamma,
-              output::LinearImage& linear, Image& image);
+              output::LinearImage& linear, Image& image, bool linearOut = false);
   // The sinks finishTile hands out refer to this object: it stays where it is.
   ResolveSink(const ResolveSink&) = delete;
   ResolveSink& operator=(const ResolveSink&) = delete;
@@ -35,6 +37,7 @@ class ResolveSink {
   const output::GammaTable& gamma_;
   output::LinearImage& linear_;
   Image& image_;
+  bool linearOut_;
 };
 
 }  // namespace sv::render

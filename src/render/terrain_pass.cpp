@@ -135,8 +135,7 @@ void TerrainPass::setTerrains(const scene::Scene& scene, const FrameCamera& came
   environment_ = &shading.environment;
   groundBytes_ = 0;
   loadMs_ = 0;
-  rays_ = EyeRays::of(camera.view, camera.projection, camera.tanLeft, camera.tanRight,
-                      camera.tanBottom, camera.tanTop, camera.camera.znear, camera.camera.zfar);
+  rays_ = eyeRays(camera);
   const bool lights = shading.environment.lightOn || !shading.environment.points.empty();
   for (const scene::Terrain& t : scene.terrains) {
     if (!t.ground) continue;
@@ -161,7 +160,7 @@ void TerrainPass::setTerrains(const scene::Scene& scene, const FrameCamera& came
     d.ramp = t.ramp.empty() ? defaultRamp(f.offset, f.offset + 65535 * f.scale) : t.ramp;
     // A pixel's width per unit eye depth, in grid steps (at the view's centre: the level of
     // detail needs no more), or 0 for the exact surface everywhere.
-    d.pixel = options.terrainLod ? 2 * rays_.halfY / (options.height * options.supersample) /
+    d.pixel = options.terrainLod ? 2 * rays_.halfSpanY() / (options.height * options.supersample) /
                                        std::min(f.spacingU, f.spacingV)
                                  : 0.0;
     groundBytes_ += t.ground->bytes();

@@ -323,7 +323,7 @@ bool footprint(const Mat4& m, const VolumeInput& in, const double lo[3], const d
                    float((c & 4) ? hi[2] : lo[2])};
     const Vec3 world = m.transformPoint(own);
     const Vec3d rel{world.x - r.eye.x, world.y - r.eye.y, world.z - r.eye.z};
-    const double depth = dot(rel, r.forward);
+    const double depth = dot(rel, r.axis);
     const Vec4 clip = in.viewProjection * Vec4{world.x, world.y, world.z, 1.0f};
     if (!(depth > 1e-6) || !(clip.w > 1e-6f * std::fabs(clip.x) + 1e-20f)) return false;
     const double px = (clip.x / clip.w + 1) * 0.5 * r.width;

@@ -148,6 +148,33 @@ TEST(Cli, RenderWritesAnImageAndAStatisticsLinePerChannelAndTheMosaic) {
                      "channels[0].frustum: left (5) must be less than right (-5)");
 }
 
+// Issue 34: --display cylinder3 writes each projector's pre-distorted image, the viewer's
+// panorama and the rig as MPCDI, which --display then reads back; misuse is a one-line error.
+TEST(Cli, RenderDisplayWritesEachProjectorTheViewerAndAnMpcdiFileThatReadsBack) {
+  const fs::path dir = tempDir() / "display";
+  fs::create_directories(dir);
+  const std::string out = (dir / "p.png").string(), viewer = (dir / "viewer.png").string(),
+                    mpcdi = (dir / "rig.mpcdi").string();
+  CliRun r = run("render -o " + out + " --width 96 --height 60 --threads 2 --display cylinder3 " +
+                 "--viewer " + viewer + " --write-mpcdi " + mpcdi);
+  ASSERT_EQ(r.status, 0) << r.out;
+  for (const char* name : {"p-left.png", "p-centre.png", "p-right.png", "viewer.png", "rig.mpcdi"})
+    EXPECT_TRUE(fs::exists(dir / name)) << name;
+  EXPECT_NE(r.out.find("p-centre.png: 96x60 | "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("sub-frusta, residual <= "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("frame: 3 projectors"), std::string::npos) << r.out;
+  r = run("render -o " + (dir / "m.png").string() + " --threads 2 --display " + mpcdi +
+          " --correction bicubic");
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("m-centre.png: 96x60 | flat "), std::string::npos) << r.out;
+  expectOneLineError(run("render -o " + out + " --display " + (dir / "none.mpcdi").string()),
+                     "none.mpcdi", "");
+  expectOneLineError(run("render -o " + out + " --display cylinder3 --correction sharp"), "",
+                     "correction 'sharp': expected subfrusta, bilinear or bicubic");
+  expectOneLineError(run("render -o " + out + " --viewer " + viewer), "",
+                     "--viewer and --write-mpcdi need --display");
+}
+
 TEST(Cli, BenchChannelsTimesTheWholeFrameAndWritesTheChannelsField) {
   const std::string json = (tempDir() / "bench_channels.json").string();
   const CliRun r =

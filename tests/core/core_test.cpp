@@ -4,11 +4,13 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <vector>
 
 #include "core/check.h"
 #include "core/streaming.h"
 #include "core/thread_pool.h"
+#include "synthvis/frame_stats.h"
 #include "synthvis/math.h"
 
 namespace sv {
@@ -127,6 +129,24 @@ TEST(Check, AParallelForInsideAParallelForIsRefused) {
   core::ThreadPool pool(2);
   EXPECT_DEATH(pool.parallelFor(8, [&](size_t, int) { pool.parallelFor(8, [](size_t, int) {}); }),
                "check failed: job_ == nullptr");
+}
+
+// Summing the views of a frame (a display's cells) adds every field: a record whose every 8-byte
+// field holds the bit pattern 1 (the integer 1, or the smallest double) added to zeros gives it
+// back — a field that operator+= missed would stay zero.
+TEST(FrameStats, SummingAddsEveryField) {
+  static_assert(sizeof(FrameStats) % 8 == 0);
+  FrameStats one;
+  std::vector<uint64_t> ones(sizeof(FrameStats) / 8, 1);
+  std::memcpy(static_cast<void*>(&one), ones.data(), sizeof(FrameStats));
+  FrameStats sum;
+  sum += one;
+  EXPECT_EQ(std::memcmp(static_cast<const void*>(&sum), static_cast<const void*>(&one),
+                        sizeof(FrameStats)),
+            0);
+  sum += one;
+  EXPECT_EQ(sum.trianglesIn, 2u);
+  EXPECT_EQ(sum.volumeTerminated, 2u);
 }
 
 }  // namespace

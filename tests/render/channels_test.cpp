@@ -12,6 +12,7 @@
 #include "render/camera.h"
 #include "render/shading_tables.h"
 #include "render/terrain_pass.h"
+#include "support/test_scenes.h"
 #include "synthvis/generators.h"
 #include "synthvis/render.h"
 #include "synthvis/terrain.h"
@@ -21,16 +22,7 @@ namespace {
 
 // The camera at the origin looking down −z, no light, black background.
 scene::Scene emptyScene() {
-  scene::Scene s;
-  scene::Camera cam;
-  cam.position = {0, 0, 0};
-  cam.target = {0, 0, -1};
-  cam.yfovDegrees = 60;
-  cam.znear = 0.1f;
-  cam.zfar = 100;
-  s.cameras.push_back(cam);
-  s.light.enabled = false;
-  s.background = {0, 0, 0};
+  scene::Scene s = tests::emptyScene();
   s.materials.push_back({});
   s.materials[0].unlit = true;
   s.materials[0].doubleSided = true;

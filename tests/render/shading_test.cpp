@@ -7,6 +7,7 @@
 #include <cmath>
 #include <memory>
 
+#include "support/test_scenes.h"
 #include "synthvis/render.h"
 #include "texture/texture.h"
 
@@ -26,19 +27,7 @@ double srgbToLinear(int byte) {
 }
 
 // A scene with the camera at the origin looking down −z (60° yfov), no light, black background.
-scene::Scene emptyScene() {
-  scene::Scene s;
-  scene::Camera cam;
-  cam.position = {0, 0, 0};
-  cam.target = {0, 0, -1};
-  cam.yfovDegrees = 60;
-  cam.znear = 0.1f;
-  cam.zfar = 100;
-  s.cameras.push_back(cam);
-  s.light.enabled = false;
-  s.background = {0, 0, 0};
-  return s;
-}
+scene::Scene emptyScene() { return tests::emptyScene(); }
 
 // A quad o + s·e1 + t·e2, s, t ∈ [0, 1], with uv = (s, t), drawn with `material`.
 void addQuad(scene::Scene& s, Vec3 o, Vec3 e1, Vec3 e2, int material, Vec4 color = {1, 1, 1, 1}) {

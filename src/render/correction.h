@@ -1,0 +1,113 @@
+// One projector's frame of a curved-screen display (issue 34): the scene pre-distorted for the
+// projector's pixels, by method (a) — the seeds' sub-frusta, each cell drawn through its own
+// projective map (render/warped.h, no resampling) — or method (b), the industry's — a flat view
+// with a margin rendered and resampled through the display mapping (display/resample.h) — then
+// edge-blended, all in linear light before the gamma table.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "display/blend.h"
+#include "display/mpcdi.h"
+#include "display/resample.h"
+#include "display/subfrustum.h"
+#include "display/viewer.h"
+#include "render/warped.h"
+
+namespace sv::render {
+
+enum class Correction : uint8_t { subFrusta, bilinear, bicubic };
+// "subfrusta", "bilinear", "bicubic" (the CLI's --correction).
+Result<Correction> parseCorrection(const std::string& text);
+
+struct CorrectionStats {
+  double planMs =
+      0;  // (a): the sub-frustum plan (once per display mapping, or per frame when the eye moves)
+  double renderMs = 0;    // (a): the cells; (b): the flat view
+  double resampleMs = 0;  // (b)
+  double blendMs = 0;
+  int cells = 0;                      // (a)
+  double maxResidualPixels = 0;       // (a)
+  int flatWidth = 0, flatHeight = 0;  // (b): the flat view with its margin
+  int64_t outside = 0;                // (b): valid pixels the flat view missed (black)
+};
+
+// What a display's frames are drawn with, kept from frame to frame: the cells' renderers (method
+// (a)) and a view renderer for the flat view (method (b)), each made on first use with the
+// options' threads, and the gamma table.
+class CorrectionRenderer {
+ public:
+  explicit CorrectionRenderer(const RenderOptions& options);
+  SubFrustumRenderer& cells();
+  ViewRenderer& flat();
+  const output::GammaTable& gamma() const { return gamma_; }
+
+ private:
+  RenderOptions options_;
+  output::GammaTable gamma_;
+  std::optional<SubFrustumRenderer> cells_;
+  std::optional<ViewRenderer> flat_;
+};
+
+// A projector's display mapping and how it is corrected. `plan` (method (a)) is made from `table`
+// when not given.
+struct CorrectedView {
+  const display::DirectionTable* table = nullptr;
+  const display::SubFrustumPlan* plan = nullptr;
+  const display::BlendWeights* blend = nullptr;  // nothing: no edge blending
+  Vec3d eye{0, 0, 0};                            // the display's eye in the camera's eye frame
+  Correction correction = Correction::subFrusta;
+  int marginPixels = 2;  // (b): the flat view's margin
+};
+
+// The projector's frame in linear light (`out`, the table's size; o.width and o.height are not
+// used), for the scene seen from `base`'s eyepoint.
+Status renderCorrected(CorrectionRenderer& renderer, const scene::Scene& scene,
+                       const RenderOptions& o, const FrameCamera& base, const CorrectedView& view,
+                       output::LinearImage& out, FrameStats& stats, CorrectionStats& cs);
+
+// A display of projectors: each one's name, display mapping and blend weights — the demo rig's
+// (analytic) or an MPCDI file's — and the rig's geometry when it is known (for the viewer).
+struct ProjectorSetup {
+  std::string name;
+  display::DirectionTable table;
+  std::optional<display::BlendWeights> blend;
+};
+struct DisplaySetup {
+  std::vector<ProjectorSetup> projectors;
+  std::optional<display::CylinderRig> rig;
+  Vec3d eye{0, 0, 0};  // the display's eye in the camera's eye frame
+};
+// Issue 34's demo: display::threeProjectorCylinder with projectors of width × height and
+// `overlapDegrees` of overlap, the exact directions (in double) and the rig's alpha maps
+// (display::cylinderAlphaMaps, 16-bit at half the projectors' resolution).
+DisplaySetup cylinderDisplay(int width, int height, double overlapDegrees = 10);
+// An MPCDI file's regions (3d profile: each region's frustum and warp give its directions; its
+// alpha and beta maps its blend), named by their ids.
+Result<DisplaySetup> mpcdiDisplay(const std::string& path);
+// The rig of a cylinderDisplay as an MPCDI file (3d profile, level 2): a buffer with a region per
+// projector, its frustum the projector's covering flat view, a per-pixel warp, its alpha map.
+Result<display::Mpcdi> mpcdiOf(const DisplaySetup& display, double overlapDegrees = 10);
+
+// Every projector's frame of the display (renderCorrected), in linear light and through the
+// gamma table (the tent filter's too, when `o` asks for it).
+struct DisplayFrame {
+  std::vector<output::LinearImage> linear;
+  std::vector<Image> images;
+  std::vector<FrameStats> stats;
+  std::vector<CorrectionStats> correction;
+};
+Status renderDisplay(CorrectionRenderer& renderer, const scene::Scene& scene,
+                     const RenderOptions& o, const DisplaySetup& display, Correction correction,
+                     DisplayFrame& frame);
+// The simulated viewer's view of a rendered display (display::viewerPanorama over the rig's
+// screen, from its eye), through the gamma table. Fails for a display without a known rig.
+Result<Image> viewerImage(const DisplaySetup& display, const DisplayFrame& frame,
+                          const display::PanoramaView& view, const output::GammaTable& gamma);
+
+// The table's directions as floats (a display::DirectionMap: what method (b) resamples through).
+display::DirectionMap directionMapOf(const display::DirectionTable& table);
+
+}  // namespace sv::render

@@ -1,0 +1,67 @@
+#include "render/view_renderer.h"
+
+#include <algorithm>
+#include <thread>
+
+#include "core/timing.h"
+#include "render/frame_settings.h"
+#include "render/resolve_sink.h"
+
+namespace sv::render {
+namespace {
+
+int resolveThreads(int requested) {
+  if (requested > 0) return requested;
+  return std::clamp(int(std::thread::hardware_concurrency()), 1, kMaxThreads);
+}
+
+}  // namespace
+
+ViewRenderer::ViewRenderer(const RenderOptions& o)
+    : frame_(resolveThreads(o.threads)),
+      gamma_(o.gamma == 0 ? output::GammaTable::srgb() : output::GammaTable::power(o.gamma)) {}
+
+Status ViewRenderer::render(const scene::Scene& scene, const RenderOptions& o,
+                            const FrameCamera& camera, Image& image, FrameStats& stats) {
+  return run(scene, o, camera, image, linear_, false, stats);
+}
+
+Status ViewRenderer::renderLinear(const scene::Scene& scene, const RenderOptions& o,
+                                  const FrameCamera& camera, output::LinearImage& out,
+                                  FrameStats& stats) {
+  return run(scene, o, camera, unused_, out, true, stats);
+}
+
+Status ViewRenderer::run(const scene::Scene& scene, const RenderOptions& o,
+                         const FrameCamera& camera, Image& image, output::LinearImage& linear,
+                         bool linearOut, FrameStats& stats) {
+  const auto start = core::Clock::now();
+  // Stage 2: the shading stage's tables in the camera's eye space.
+  buildShading(scene, o, camera.view, shading_);
+  const bool pixelShading = shading_.any && o.debugView == RenderOptions::DebugView::none;
+
+  // Stage 3: every instance's vertices to clip space, in draw order.
+  const auto t0 = core::Clock::now();
+  if (Status s = buildDrawPackets(scene, o, camera, pixelShading ? &shading_ : nullptr,
+                                  frame_.pool(), packets_);
+      !s)
+    return s;
+  stats.vertexMs = core::msSince(t0);
+
+  // Stages 3–5: setup and the tiles, with the frame's passes, each tile resolved when finished.
+  Result<FrameSettings> settings = makeFrameSettings(o, scene.background, shading_.environment,
+                                                     pixelShading, packets_.indices.size() / 3);
+  if (!settings.ok()) return settings.error();
+  FrameSettings& fs = settings.value();
+  ResolveSink sink(o, gamma_, linear, image, linearOut);
+  fs.finishTile = sink.finishTile((fs.width + raster::kTileSize - 1) >> raster::kTileLog2);
+  fs.colorSums = sink.takesColorSums();
+  fs.passes = passes_.compose(scene, o, camera, shading_);
+  if (!linearOut) output::prepareImage(o.width, o.height, image);
+  frame_.render(packets_, fs, stats);
+  stats.rasterMs += sink.finish(frame_.pool());
+  stats.totalMs = core::msSince(start);
+  return {};
+}
+
+}  // namespace sv::render

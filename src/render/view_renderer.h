@@ -1,0 +1,49 @@
+// One view of a frame, from the scene and a camera to the resolved image (SPEC §1 stages 2–5):
+// what a Renderer keeps from frame to frame — its threads, tables and buffers — and the one
+// function that wires a view through them (STYLE.md habit 1). Renderer draws the classic view and
+// each display channel with it; distortion correction (render/warped.h) each sub-frustum cell.
+#pragma once
+
+#include "core/thread_pool.h"
+#include "output/resolve.h"
+#include "render/camera.h"
+#include "render/draw_packets.h"
+#include "render/frame_renderer.h"
+#include "render/passes.h"
+#include "render/shading_tables.h"
+#include "synthvis/frame_stats.h"
+#include "synthvis/render.h"
+
+namespace sv::render {
+
+class ViewRenderer {
+ public:
+  explicit ViewRenderer(const RenderOptions& options);  // threads and gamma from `options`
+
+  // One view: the shading tables in the camera's eye space, every instance's vertices to clip
+  // space, setup and the tiles with the frame's passes, each tile resolved into `image` as it is
+  // finished. `o` is the renderer's options at this view's size; adds to `stats`.
+  Status render(const scene::Scene& scene, const RenderOptions& o, const FrameCamera& camera,
+                Image& image, FrameStats& stats);
+  // The same view box-resolved into linear light (`out`, sized to the view; no filter, no gamma
+  // table): for a caller that composes views before the gamma table.
+  Status renderLinear(const scene::Scene& scene, const RenderOptions& o, const FrameCamera& camera,
+                      output::LinearImage& out, FrameStats& stats);
+
+  core::ThreadPool& pool() { return frame_.pool(); }
+  const output::GammaTable& gamma() const { return gamma_; }
+
+ private:
+  Status run(const scene::Scene& scene, const RenderOptions& o, const FrameCamera& camera,
+             Image& image, output::LinearImage& linear, bool linearOut, FrameStats& stats);
+
+  FrameRenderer frame_;
+  output::GammaTable gamma_;
+  ShadingTables shading_;
+  DrawPackets packets_;
+  output::LinearImage linear_;  // the box-resolved frame, for the tent filter
+  FramePasses passes_;
+  Image unused_;  // the image argument of a linear view's resolve, never written
+};
+
+}  // namespace sv::render

@@ -1,0 +1,63 @@
+// Distortion correction the seeds' way (SPEC §12; issue 34, method (a)): a display channel drawn
+// through a plan of sub-frusta (display/subfrustum.h), each cell a view of its own whose
+// projection is the cell's projective map — so the geometry lands pre-distorted on the display's
+// own pixels, with no resampling. Every primitive goes through the cell's camera: polygons and
+// lines and light points by its matrix, free forms by the projective map of the view volume onto
+// the cube (which a cell's projection is), terrain and volumes by the rays of its inverse
+// (core/eye_rays.h).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "core/quadric.h"
+#include "core/thread_pool.h"
+#include "display/subfrustum.h"
+#include "output/resolve.h"
+#include "render/camera.h"
+#include "render/view_renderer.h"
+
+namespace sv::render {
+
+// The camera of one cell: `base`'s view moved to the display's eye (`eye`, in `base`'s eye frame,
+// the origin of the plan's directions), the cell's projection with the camera's depth range, the
+// base window kept for what a frame chooses once (levels of detail: every cell chooses as the
+// channel would).
+FrameCamera cellCamera(const FrameCamera& base, const display::SubFrustumCell& cell, Vec3d eye);
+
+struct SubFrustumStats {
+  int cells = 0;               // cells drawn (the plan's fitted ones)
+  int64_t unfittedPixels = 0;  // valid pixels of cells without a map: black
+  double maxResidualPixels = 0;
+};
+
+// Draws a display's cells on a pool's threads, a cell to a worker at a time, each worker with a
+// single-threaded view renderer of its own: a cell's raster is a tile or two, too small to share
+// among threads, and the cells are many. Kept from frame to frame (the renderers' buffers).
+class SubFrustumRenderer {
+ public:
+  explicit SubFrustumRenderer(const RenderOptions& options);  // the options' threads and gamma
+
+  // Draws the channel seen by `base` through `plan`: every fitted cell at its own size (o.width ×
+  // o.height are the plan's; each cell's raster is its rectangle, supersampled and anti-aliased
+  // as `o` says) into its rectangle of `out` (linear light, the box resolve — no filter, no
+  // gamma). Each display pixel is drawn once, by the one cell that holds it, at its own pixel
+  // centre and samples, so abutting cells neither crack nor overlap. Pixels that `valid` (one
+  // byte a display pixel, or empty: all) marks invalid, and those of unfitted cells, are black.
+  // `stats` gets the cells' counts summed. Identical bytes for any thread count.
+  Status render(const scene::Scene& scene, const RenderOptions& o, const FrameCamera& base,
+                Vec3d eye, const display::SubFrustumPlan& plan, const std::vector<uint8_t>& valid,
+                output::LinearImage& out, FrameStats& stats, SubFrustumStats* cellStats = nullptr);
+
+  const output::GammaTable& gamma() const { return workers_[0]->gamma(); }
+
+ private:
+  core::ThreadPool pool_;
+  std::vector<std::unique_ptr<ViewRenderer>> workers_;  // one per pool worker, one thread each
+  std::vector<output::LinearImage> cellImages_;         // one per worker
+  std::vector<FrameStats> cellStats_;                   // one per cell, this frame
+  std::vector<Status> cellErrors_;                      // likewise
+};
+
+}  // namespace sv::render

@@ -1,0 +1,321 @@
+// Distortion correction the seeds' way (SPEC §12; issue 34 method (a), render/warped.h): a display
+// drawn through its sub-frustum plan, every cell a view of its own. A flat display (one cell) draws
+// the channel's own image, for polygons, terrain, free forms and volumes alike; on the cylinder
+// rig, stripes bounded by planes through the eye land on every pixel as the exact display mapping
+// says; every valid pixel is drawn (no crack), invalid ones are black; any thread count gives the
+// same bytes.
+#include "render/warped.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "display/geometry.h"
+#include "display/subfrustum.h"
+#include "render/camera.h"
+#include "render/correction.h"
+#include "render/view_renderer.h"
+#include "support/test_scenes.h"
+#include "synthvis/generators.h"
+#include "synthvis/render.h"
+
+namespace sv {
+namespace {
+
+constexpr double kToRadians = std::numbers::pi / 180;
+
+// The direction table of a pinhole camera turned by `o` with window `w`: a flat display.
+display::DirectionTable pinholeTable(const display::Orientation& o, const display::Window& w,
+                                     int width, int height) {
+  const display::Rotation r = display::rotationOf(o);
+  const double l = std::tan(w.leftDegrees * kToRadians), rt = std::tan(w.rightDegrees * kToRadians);
+  const double d = std::tan(w.downDegrees * kToRadians), u = std::tan(w.upDegrees * kToRadians);
+  display::DirectionTable t;
+  t.width = width;
+  t.height = height;
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const double bx = l + (x + 0.5) / width * (rt - l), by = u - (y + 0.5) / height * (u - d);
+      const Vec3d v{r.m[0][0] * bx + r.m[0][1] * by - r.m[0][2],
+                    r.m[1][0] * bx + r.m[1][1] * by - r.m[1][2],
+                    r.m[2][0] * bx + r.m[2][1] * by - r.m[2][2]};
+      t.directions.push_back(normalize(v));
+      t.valid.push_back(1);
+    }
+  return t;
+}
+
+// The display through `plan`, gamma-encoded, with the renderer's default camera of `scene`.
+Image renderWarped(const scene::Scene& scene, RenderOptions o, const display::SubFrustumPlan& plan,
+                   const std::vector<uint8_t>& valid, render::SubFrustumStats* cellStats = nullptr,
+                   FrameStats* statsOut = nullptr) {
+  o.width = plan.width;
+  o.height = plan.height;
+  render::SubFrustumRenderer renderer(o);
+  const Result<render::FrameCamera> base = render::chooseCamera(scene, o);
+  EXPECT_TRUE(base.ok());
+  output::LinearImage linear;
+  FrameStats stats;
+  const Status s =
+      renderer.render(scene, o, base.value(), {0, 0, 0}, plan, valid, linear, stats, cellStats);
+  EXPECT_TRUE(s.ok()) << s.error().str();
+  Image image;
+  output::prepareImage(o.width, o.height, image);
+  output::encodeRows(linear, renderer.gamma(), 0, o.height, image);
+  if (statsOut) *statsOut = stats;
+  return image;
+}
+
+struct Difference {
+  int differing = 0;  // pixels with any channel differing
+  int maxCode = 0;    // the largest difference of a channel, 8-bit codes
+};
+Difference compare(const Image& a, const Image& b) {
+  Difference d;
+  for (int y = 0; y < a.height; ++y)
+    for (int x = 0; x < a.width; ++x) {
+      int m = 0;
+      for (int c = 0; c < 3; ++c) m = std::max(m, std::abs(a.pixel(x, y)[c] - b.pixel(x, y)[c]));
+      d.differing += m > 0;
+      d.maxCode = std::max(d.maxCode, m);
+    }
+  return d;
+}
+
+scene::Scene smallTerrain() {
+  scene::TerrainParams p;
+  p.size = 129;
+  return scene::generateTerrain(p).value();
+}
+
+TEST(SubFrusta, AFlatDisplayDrawsTheChannelsImage) {
+  // One cell whose map is the channel's pinhole: the same image as the channel, but for pixels
+  // where the two projections' float roundings put an edge on different sides of a sample.
+  const display::Orientation o{20, -5, 3};
+  const display::Window w{-25, 30, -18, 15};
+  const int width = 160, height = 112;
+  const display::SubFrustumPlan plan = display::planSubFrusta(pinholeTable(o, w, width, height));
+  ASSERT_EQ(plan.cells.size(), 1u);
+  scene::VolumeParams vp;
+  const std::vector<std::pair<const char*, scene::Scene>> scenes = {
+      {"demo", scene::demoScene()},
+      {"terrain", smallTerrain()},
+      {"free forms", scene::generateFreeFormOne()},
+      {"volume", scene::generateVolume(vp)}};
+  for (const auto& [name, s] : scenes) {
+    RenderOptions opt;
+    opt.threads = 2;
+    opt.samples = 4;
+    scene::Scene channelScene = s;
+    scene::Channel c;
+    c.width = width;
+    c.height = height;
+    c.yawDegrees = float(o.yawDegrees), c.pitchDegrees = float(o.pitchDegrees);
+    c.rollDegrees = float(o.rollDegrees);
+    c.frustum = scene::ChannelFrustum{float(w.leftDegrees), float(w.rightDegrees),
+                                      float(w.downDegrees), float(w.upDegrees)};
+    channelScene.channels = {c};
+    std::vector<Image> channel;
+    ASSERT_TRUE(Renderer(opt).renderChannels(channelScene, channel));
+    const Image warped = renderWarped(s, opt, plan, {});
+    const Difference d = compare(channel[0], warped);
+    EXPECT_LE(d.differing, width * height / 100) << name;  // under 1 %
+    EXPECT_LE(d.maxCode, 96) << name;
+    std::printf("%s: %d of %d pixels differ, by up to %d codes\n", name, d.differing,
+                width * height, d.maxCode);
+  }
+}
+
+// Vertical stripes 6° wide around the eye on a cylinder of radius 2, alternately white and black;
+// their edges lie in planes through the eye, so what a direction shows depends on its azimuth alone.
+scene::Scene stripes() {
+  // The camera at the origin looking down −z: the display's eye frame is its eye space.
+  scene::Scene s = tests::emptyScene(200, {0.5f, 0, 0});
+  s.materials.resize(2);
+  s.materials[0].unlit = s.materials[1].unlit = true;
+  s.materials[0].doubleSided = s.materials[1].doubleSided = true;
+  s.materials[0].baseColor = {1, 1, 1};
+  s.materials[1].baseColor = {0, 0, 0};
+  for (int k = 0; k < 60; ++k) {
+    const double a0 = (k * 6 - 180) * kToRadians, a1 = ((k + 1) * 6 - 180) * kToRadians;
+    const auto at = [](double a, float y) {
+      return Vec3{float(2 * std::sin(a)), y, float(-2 * std::cos(a))};
+    };
+    scene::Mesh m;
+    m.positions = {at(a0, -3), at(a1, -3), at(a1, 3), at(a0, 3)};
+    m.indices = {0, 1, 2, 0, 2, 3};
+    m.material = k % 2;
+    s.meshes.push_back(m);
+    s.instances.push_back({int(s.meshes.size()) - 1, Mat4{}});
+  }
+  return s;
+}
+
+TEST(SubFrusta, StripesOnTheCylinderRigLandWhereTheDisplayMappingSays) {
+  const display::CylinderRig rig = display::threeProjectorCylinder(3, 10, 320, 200);
+  const scene::Scene s = stripes();
+  RenderOptions o;
+  o.threads = 2;
+  for (int p = 0; p < 3; ++p) {
+    const display::DirectionTable table = display::directionTable(rig.geometry(p));
+    const display::SubFrustumPlan plan = display::planSubFrusta(table);
+    render::SubFrustumStats cs;
+    const Image image = renderWarped(s, o, plan, table.valid, &cs);
+    EXPECT_EQ(cs.cells, int(plan.cells.size()));
+    // A pixel centre's exact direction decides its stripe, unless the map's error (its residual,
+    // at most 0.1 px) and the vertices' rounding could move the edge across it: pixels whose
+    // direction lies within a pixel's angle of an edge are left out.
+    const double pixelAngle =
+        1.4 *
+        (rig.projectors[size_t(p)].lens.rightDegrees - rig.projectors[size_t(p)].lens.leftDegrees) /
+        320 * kToRadians;
+    int checked = 0, wrong = 0;
+    for (int y = 0; y < table.height; ++y)
+      for (int x = 0; x < table.width; ++x) {
+        const size_t i = table.index(x, y);
+        const uint8_t* px = image.pixel(x, y);
+        if (!table.valid[i]) {
+          EXPECT_TRUE(px[0] == 0 && px[1] == 0 && px[2] == 0) << x << "," << y;
+          continue;
+        }
+        const Vec3d d = table.directions[i];
+        const double azimuth = std::atan2(d.x, -d.z) / kToRadians;  // from −z toward +x
+        const double k = (azimuth + 180) / 6;
+        const double toEdge =
+            std::abs(k - std::round(k)) * 6 * kToRadians * std::sqrt(d.x * d.x + d.z * d.z);
+        if (toEdge < pixelAngle) continue;
+        const bool white = int(std::floor(k)) % 2 == 0;
+        ++checked;
+        wrong += white ? !(px[0] == 255 && px[1] == 255 && px[2] == 255)
+                       : !(px[0] == 0 && px[1] == 0 && px[2] == 0);
+      }
+    EXPECT_EQ(wrong, 0) << "projector " << p;
+    EXPECT_GT(checked, 320 * 200 / 2) << "projector " << p;
+  }
+}
+
+TEST(SubFrusta, EveryValidPixelIsDrawnOnceInAnyThreadCount) {
+  // A white box around the eye, anti-aliased: every valid pixel's samples all white (a crack
+  // between cells would let the background through), invalid pixels black.
+  scene::Scene s = tests::emptyScene(200, {0, 0, 1});
+  s.materials.resize(1);
+  s.materials[0].unlit = true;
+  s.materials[0].doubleSided = true;
+  scene::Mesh box;
+  for (int i = 0; i < 8; ++i)
+    box.positions.push_back(
+        {(i & 1) ? 10.0f : -10.0f, (i & 2) ? 10.0f : -10.0f, (i & 4) ? 10.0f : -10.0f});
+  box.indices = {0, 1, 3, 0, 3, 2, 4, 6, 7, 4, 7, 5, 0, 4, 5, 0, 5, 1,
+                 2, 3, 7, 2, 7, 6, 0, 2, 6, 0, 6, 4, 1, 5, 7, 1, 7, 3};
+  box.material = 0;
+  s.meshes.push_back(box);
+  s.instances.push_back({0, Mat4{}});
+  display::CylinderRig rig = display::threeProjectorCylinder(3, 10, 256, 160);
+  rig.screen.maxHeight = 0.8;  // cut the screen: the projector's top rows miss it
+  const display::DirectionTable table = display::directionTable(rig.geometry(1));
+  const display::SubFrustumPlan plan = display::planSubFrusta(table);
+  int invalid = 0;
+  RenderOptions o;
+  o.samples = 4;
+  std::vector<Image> images;
+  for (int threads : {1, 2, 5}) {
+    o.threads = threads;
+    images.push_back(renderWarped(s, o, plan, table.valid));
+  }
+  for (int y = 0; y < table.height; ++y)
+    for (int x = 0; x < table.width; ++x) {
+      const uint8_t* px = images[0].pixel(x, y);
+      const bool valid = table.valid[table.index(x, y)] != 0;
+      invalid += !valid;
+      const int want = valid ? 255 : 0;
+      ASSERT_TRUE(px[0] == want && px[1] == want && px[2] == want) << x << "," << y;
+    }
+  EXPECT_GT(invalid, 0);
+  EXPECT_EQ(images[0].rgb, images[1].rgb);
+  EXPECT_EQ(images[0].rgb, images[2].rgb);
+}
+
+}  // namespace
+}  // namespace sv
+
+namespace sv {
+namespace {
+
+// The edge-spread function of a display: for every valid pixel within 3 px of a stripe edge (the
+// stripes() scene), its signed distance to the edge in display pixels along the row (positive on
+// the white side) and its linear value (0 black … 1 white); averaged in bins of 0.05 px, the 10 %
+// and 90 % crossings give the edge's rise in pixels.
+double edgeRise(const display::DirectionTable& t, const output::LinearImage& image) {
+  constexpr int kBins = 120;  // −3 … 3 px
+  std::vector<double> sum(kBins, 0), count(kBins, 0);
+  for (int y = 0; y < t.height; ++y)
+    for (int x = 1; x + 1 < t.width; ++x) {
+      const size_t i = t.index(x, y);
+      if (!t.valid[i] || !t.valid[i - 1] || !t.valid[i + 1]) continue;
+      const Vec3d d = t.directions[i];
+      const double azimuth = std::atan2(d.x, -d.z) / kToRadians;
+      const int k = int(std::lround((azimuth + 180) / 6));  // the nearest edge: stripes k−1 | k
+      const double e = (k * 6 - 180) * kToRadians;
+      // The edge's plane through the eye, its normal toward stripe k (increasing azimuth).
+      Vec3d n{std::cos(e), 0, std::sin(e)};
+      if (k % 2 != 0) n = n * -1.0;  // stripe k black: toward stripe k − 1, the white one
+      const double s = dot(d, n);
+      const double g = 0.5 * (dot(t.directions[i + 1], n) - dot(t.directions[i - 1], n));
+      if (!(std::abs(g) > 0)) continue;
+      const double px = s / std::abs(g);
+      const int bin = int(std::floor((px + 3) / 6 * kBins));
+      if (bin < 0 || bin >= kBins) continue;
+      sum[size_t(bin)] += image.rgb[3 * i] / 65535.0;
+      count[size_t(bin)] += 1;
+    }
+  auto crossing = [&](double level) {
+    double prev = 0, prevX = -3;
+    for (int b = 0; b < kBins; ++b) {
+      if (count[size_t(b)] == 0) continue;
+      const double v = sum[size_t(b)] / count[size_t(b)], x = -3 + (b + 0.5) * 6 / kBins;
+      if (v >= level) return prevX + (level - prev) / (v - prev) * (x - prevX);
+      prev = v, prevX = x;
+    }
+    return 3.0;
+  };
+  return crossing(0.9) - crossing(0.1);
+}
+
+TEST(SubFrusta, AreSharperThanAFlatViewResampled) {
+  // docs/quality.md, "Distortion correction": the rig's centre projector, 16 samples a pixel, the
+  // same scene through method (a) and through method (b)'s flat view (its own 16 samples a flat
+  // pixel, at the display's finest angular pixel) resampled bilinear and bicubic.
+  const display::CylinderRig rig = display::threeProjectorCylinder(3, 10, 640, 400);
+  const display::DirectionTable table = display::directionTable(rig.geometry(1));
+  const scene::Scene s = stripes();
+  RenderOptions o;
+  o.threads = 2;
+  o.samples = 16;
+  render::CorrectionRenderer renderer(o);
+  const Result<render::FrameCamera> base = render::chooseCamera(s, o);
+  ASSERT_TRUE(base.ok());
+  double rise[3];
+  for (int m = 0; m < 3; ++m) {
+    render::CorrectedView view;
+    view.table = &table;
+    view.correction = m == 0   ? render::Correction::subFrusta
+                      : m == 1 ? render::Correction::bilinear
+                               : render::Correction::bicubic;
+    output::LinearImage out;
+    FrameStats stats;
+    render::CorrectionStats cs;
+    ASSERT_TRUE(render::renderCorrected(renderer, s, o, base.value(), view, out, stats, cs));
+    rise[m] = edgeRise(table, out);
+  }
+  std::printf(
+      "10-90 %% edge rise: sub-frusta %.3f px, resampled bilinear %.3f px, bicubic %.3f px\n",
+      rise[0], rise[1], rise[2]);
+  EXPECT_LT(rise[0], 1.0);
+  EXPECT_LT(rise[0] * 1.15, rise[1]);
+  EXPECT_LT(rise[0], rise[2]);
+}
+
+}  // namespace
+}  // namespace sv
