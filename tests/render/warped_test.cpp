@@ -50,7 +50,7 @@ display::DirectionTable pinholeTable(const display::Orientation& o, const displa
 // The display through `plan`, gamma-encoded, with the renderer's default camera of `scene`.
 Image renderWarped(const scene::Scene& scene, RenderOptions o, const display::SubFrustumPlan& plan,
                    const std::vector<uint8_t>& valid, render::SubFrustumStats* cellStats = nullptr,
-                   FrameStats* statsOut = nullptr) {
+                   FrameStats* statsOut = nullptr, Vec3d eye = {0, 0, 0}) {
   o.width = plan.width;
   o.height = plan.height;
   render::SubFrustumRenderer renderer(o);
@@ -59,7 +59,7 @@ Image renderWarped(const scene::Scene& scene, RenderOptions o, const display::Su
   output::LinearImage linear;
   FrameStats stats;
   const Status s =
-      renderer.render(scene, o, base.value(), {0, 0, 0}, plan, valid, linear, stats, cellStats);
+      renderer.render(scene, o, base.value(), eye, plan, valid, linear, stats, cellStats);
   EXPECT_TRUE(s.ok()) << s.error().str();
   Image image;
   output::prepareImage(o.width, o.height, image);
@@ -153,46 +153,75 @@ scene::Scene stripes() {
   return s;
 }
 
+// The stripe (stripes()'s facet k, between the vertical edges at azimuths 6k − 180° and 6k − 174°
+// on the radius-2 circle) that the ray from `eye` along `d` meets, and the sine of the angle from d
+// to the nearer of that facet's two edge planes (each through the eye and an edge).
+struct StripeHit {
+  int k = -1;
+  double toEdge = 0;
+};
+StripeHit stripeOf(Vec3d eye, Vec3d d) {
+  const auto corner = [](int k) {
+    const double a = (k * 6 - 180) * kToRadians;
+    return Vec3d{2 * std::sin(a), 0, -2 * std::cos(a)};
+  };
+  for (int k = 0; k < 60; ++k) {
+    const Vec3d p = corner(k), q = corner(k + 1), e = q - p;
+    // eye + t·d = p + u·e in the xz plane.
+    const double det = d.x * -e.z - d.z * -e.x;
+    if (std::abs(det) < 1e-15) continue;
+    const double rx = p.x - eye.x, rz = p.z - eye.z;
+    const double t = (rx * -e.z - rz * -e.x) / det, u = (d.x * rz - d.z * rx) / det;
+    if (!(t > 0) || u < 0 || u > 1) continue;
+    double toEdge = 1;
+    for (const Vec3d& c : {p, q}) {
+      const Vec3d n = normalize(cross(c - eye, Vec3d{0, 1, 0}));
+      toEdge = std::min(toEdge, std::abs(dot(normalize(d), n)));
+    }
+    return {k, toEdge};
+  }
+  return {};
+}
+
 TEST(SubFrusta, StripesOnTheCylinderRigLandWhereTheDisplayMappingSays) {
-  const display::CylinderRig rig = display::threeProjectorCylinder(3, 10, 320, 200);
-  const scene::Scene s = stripes();
-  RenderOptions o;
-  o.threads = 2;
-  for (int p = 0; p < 3; ++p) {
-    const display::DirectionTable table = display::directionTable(rig.geometry(p));
-    const display::SubFrustumPlan plan = display::planSubFrusta(table);
-    render::SubFrustumStats cs;
-    const Image image = renderWarped(s, o, plan, table.valid, &cs);
-    EXPECT_EQ(cs.cells, int(plan.cells.size()));
-    // A pixel centre's exact direction decides its stripe, unless the map's error (its residual,
-    // at most 0.1 px) and the vertices' rounding could move the edge across it: pixels whose
-    // direction lies within a pixel's angle of an edge are left out.
-    const double pixelAngle =
-        1.4 *
-        (rig.projectors[size_t(p)].lens.rightDegrees - rig.projectors[size_t(p)].lens.leftDegrees) /
-        320 * kToRadians;
-    int checked = 0, wrong = 0;
-    for (int y = 0; y < table.height; ++y)
-      for (int x = 0; x < table.width; ++x) {
-        const size_t i = table.index(x, y);
-        const uint8_t* px = image.pixel(x, y);
-        if (!table.valid[i]) {
-          EXPECT_TRUE(px[0] == 0 && px[1] == 0 && px[2] == 0) << x << "," << y;
-          continue;
+  // The eye at the rig's centre, then moved as a tracked head moves (dynamic correction: a new
+  // direction table, a new plan, the cells' cameras moved to the new eye).
+  for (const Vec3 eye : {Vec3{0, 0, 0}, Vec3{0.3f, 0.1f, -0.2f}}) {
+    display::CylinderRig rig = display::threeProjectorCylinder(3, 10, 320, 200);
+    rig.eye = eye;
+    const Vec3d eyed{eye.x, eye.y, eye.z};
+    const scene::Scene s = stripes();
+    RenderOptions o;
+    o.threads = 2;
+    for (int p = 0; p < 3; ++p) {
+      const display::DirectionTable table = display::directionTable(rig.geometry(p));
+      const display::SubFrustumPlan plan = display::planSubFrusta(table);
+      render::SubFrustumStats cs;
+      const Image image = renderWarped(s, o, plan, table.valid, &cs, nullptr, eyed);
+      EXPECT_EQ(cs.cells, int(plan.cells.size()));
+      // A pixel centre's exact direction decides its stripe, unless the map's error (its
+      // residual, at most 0.1 px) and the vertices' rounding could move the edge across it:
+      // pixels whose direction lies within 1.4 pixel angles of an edge are left out.
+      const display::Window& lens = rig.projectors[size_t(p)].lens;
+      const double pixelAngle = 1.4 * (lens.rightDegrees - lens.leftDegrees) / 320 * kToRadians;
+      int checked = 0, wrong = 0;
+      for (int y = 0; y < table.height; ++y)
+        for (int x = 0; x < table.width; ++x) {
+          const size_t i = table.index(x, y);
+          const uint8_t* px = image.pixel(x, y);
+          if (!table.valid[i]) {
+            EXPECT_TRUE(px[0] == 0 && px[1] == 0 && px[2] == 0) << x << "," << y;
+            continue;
+          }
+          const StripeHit hit = stripeOf(eyed, table.directions[i]);
+          if (hit.k < 0 || hit.toEdge < pixelAngle) continue;
+          ++checked;
+          wrong += hit.k % 2 == 0 ? !(px[0] == 255 && px[1] == 255 && px[2] == 255)
+                                  : !(px[0] == 0 && px[1] == 0 && px[2] == 0);
         }
-        const Vec3d d = table.directions[i];
-        const double azimuth = std::atan2(d.x, -d.z) / kToRadians;  // from −z toward +x
-        const double k = (azimuth + 180) / 6;
-        const double toEdge =
-            std::abs(k - std::round(k)) * 6 * kToRadians * std::sqrt(d.x * d.x + d.z * d.z);
-        if (toEdge < pixelAngle) continue;
-        const bool white = int(std::floor(k)) % 2 == 0;
-        ++checked;
-        wrong += white ? !(px[0] == 255 && px[1] == 255 && px[2] == 255)
-                       : !(px[0] == 0 && px[1] == 0 && px[2] == 0);
-      }
-    EXPECT_EQ(wrong, 0) << "projector " << p;
-    EXPECT_GT(checked, 320 * 200 / 2) << "projector " << p;
+      EXPECT_EQ(wrong, 0) << "projector " << p << ", eye " << eye.x;
+      EXPECT_GT(checked, 320 * 200 / 2) << "projector " << p << ", eye " << eye.x;
+    }
   }
 }
 
