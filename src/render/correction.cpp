@@ -16,9 +16,7 @@ Result<Correction> parseCorrection(const std::string& text) {
 }
 
 CorrectionRenderer::CorrectionRenderer(const RenderOptions& options)
-    : options_(options),
-      gamma_(options.gamma == 0 ? output::GammaTable::srgb()
-                                : output::GammaTable::power(options.gamma)) {}
+    : options_(options), gamma_(gammaTableOf(options)) {}
 
 SubFrustumRenderer& CorrectionRenderer::cells() {
   if (!cells_) cells_.emplace(options_);
@@ -126,10 +124,6 @@ Status renderCorrected(CorrectionRenderer& renderer, const scene::Scene& scene,
   return {};
 }
 
-}  // namespace sv::render
-
-namespace sv::render {
-
 DisplaySetup cylinderDisplay(int width, int height, double overlapDegrees) {
   DisplaySetup d;
   d.rig = display::threeProjectorCylinder(3, overlapDegrees, width, height);
@@ -141,10 +135,11 @@ DisplaySetup cylinderDisplay(int width, int height, double overlapDegrees) {
     ProjectorSetup p;
     p.name = names[i];
     p.table = display::directionTable(d.rig->geometry(int(i)));
+    p.alpha = alpha[i];
     display::MpcdiRegion region;
     region.xResolution = width;
     region.yResolution = height;
-    region.alpha = alpha[i];
+    region.alpha = p.alpha;
     p.blend = display::blendWeights(region);
     d.projectors.push_back(std::move(p));
   }
@@ -177,16 +172,13 @@ Result<DisplaySetup> mpcdiDisplay(const std::string& path) {
   return d;
 }
 
-Result<display::Mpcdi> mpcdiOf(const DisplaySetup& d, double overlapDegrees) {
+Result<display::Mpcdi> mpcdiOf(const DisplaySetup& d) {
   if (!d.rig) return Error{"", "", "only an analytic rig can be written as MPCDI"};
   const display::CylinderRig& rig = *d.rig;
   display::Mpcdi m;
   m.level = 2;  // a warp per pixel
   display::MpcdiBuffer buffer;
   buffer.id = "display";
-  const std::vector<display::BlendMap> alpha =
-      display::cylinderAlphaMaps(rig, overlapDegrees, std::max(1, rig.projectors[0].width / 2),
-                                 std::max(1, rig.projectors[0].height / 2));
   for (size_t i = 0; i < rig.projectors.size(); ++i) {
     const display::Projector& pr = rig.projectors[i];
     const display::DirectionMap map = directionMapOf(d.projectors[i].table);
@@ -196,7 +188,7 @@ Result<display::Mpcdi> mpcdiOf(const DisplaySetup& d, double overlapDegrees) {
     display::MpcdiRegion r =
         display::regionFromGeometry(rig.geometry(int(i)), {flat->orientation, flat->window},
                                     pr.width, pr.height, d.projectors[i].name);
-    r.alpha = alpha[i];
+    r.alpha = d.projectors[i].alpha;
     buffer.xResolution += pr.width;
     buffer.yResolution = std::max(buffer.yResolution, pr.height);
     buffer.regions.push_back(std::move(r));

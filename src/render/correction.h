@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "display/blend.h"
@@ -23,8 +24,8 @@ enum class Correction : uint8_t { subFrusta, bilinear, bicubic };
 Result<Correction> parseCorrection(const std::string& text);
 
 struct CorrectionStats {
-  double planMs =
-      0;  // (a): the sub-frustum plan (once per display mapping, or per frame when the eye moves)
+  // (a): the sub-frustum plan (once per display mapping, or per frame when the eye moves).
+  double planMs = 0;
   double renderMs = 0;    // (a): the cells; (b): the flat view
   double resampleMs = 0;  // (b)
   double blendMs = 0;
@@ -73,6 +74,7 @@ Status renderCorrected(CorrectionRenderer& renderer, const scene::Scene& scene,
 struct ProjectorSetup {
   std::string name;
   display::DirectionTable table;
+  std::optional<display::BlendMap> alpha;  // the alpha map `blend` comes from, when known
   std::optional<display::BlendWeights> blend;
 };
 struct DisplaySetup {
@@ -89,7 +91,7 @@ DisplaySetup cylinderDisplay(int width, int height, double overlapDegrees = 10);
 Result<DisplaySetup> mpcdiDisplay(const std::string& path);
 // The rig of a cylinderDisplay as an MPCDI file (3d profile, level 2): a buffer with a region per
 // projector, its frustum the projector's covering flat view, a per-pixel warp, its alpha map.
-Result<display::Mpcdi> mpcdiOf(const DisplaySetup& display, double overlapDegrees = 10);
+Result<display::Mpcdi> mpcdiOf(const DisplaySetup& display);
 
 // Every projector's frame of the display (renderCorrected), in linear light and through the
 // gamma table (the tent filter's too, when `o` asks for it).

@@ -8,18 +8,18 @@
 #include "render/resolve_sink.h"
 
 namespace sv::render {
-namespace {
 
 int resolveThreads(int requested) {
   if (requested > 0) return requested;
   return std::clamp(int(std::thread::hardware_concurrency()), 1, kMaxThreads);
 }
 
-}  // namespace
+output::GammaTable gammaTableOf(const RenderOptions& o) {
+  return o.gamma == 0 ? output::GammaTable::srgb() : output::GammaTable::power(o.gamma);
+}
 
 ViewRenderer::ViewRenderer(const RenderOptions& o)
-    : frame_(resolveThreads(o.threads)),
-      gamma_(o.gamma == 0 ? output::GammaTable::srgb() : output::GammaTable::power(o.gamma)) {}
+    : frame_(resolveThreads(o.threads)), gamma_(gammaTableOf(o)) {}
 
 Status ViewRenderer::render(const scene::Scene& scene, const RenderOptions& o,
                             const FrameCamera& camera, Image& image, FrameStats& stats) {

@@ -16,6 +16,12 @@
 
 namespace sv::render {
 
+// The worker threads a renderer runs: `requested`, or for 0 one per hardware thread (at most
+// kMaxThreads).
+int resolveThreads(int requested);
+// The options' transfer function as the resolve's look-up table: sRGB, or the display gamma.
+output::GammaTable gammaTableOf(const RenderOptions& options);
+
 class ViewRenderer {
  public:
   explicit ViewRenderer(const RenderOptions& options);  // threads and gamma from `options`

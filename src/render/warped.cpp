@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cstring>
-#include <thread>
 
 namespace sv::render {
 
@@ -20,9 +19,7 @@ FrameCamera cellCamera(const FrameCamera& base, const display::SubFrustumCell& c
 }
 
 SubFrustumRenderer::SubFrustumRenderer(const RenderOptions& options)
-    : pool_(options.threads > 0
-                ? options.threads
-                : std::clamp(int(std::thread::hardware_concurrency()), 1, kMaxThreads)) {
+    : pool_(resolveThreads(options.threads)) {
   RenderOptions single = options;
   single.threads = 1;
   for (int i = 0; i < pool_.threadCount(); ++i)
