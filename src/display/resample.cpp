@@ -4,13 +4,14 @@
 // a = −1/2 — the Catmull–Rom spline's weights.
 #include "display/resample.h"
 
-#include "core/quadric.h"
-
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
+
+#include "core/quadric.h"
 
 namespace sv::display {
 namespace {
@@ -51,24 +52,25 @@ struct FlatProjection {
 // −1, 0, 1, 2 from the one left of the point, at fraction f ∈ [0, 1) past it. They sum to one
 // for every f (the t³, t² and t terms cancel), so constants and, with the symmetry, lines and
 // quadratics are reproduced.
-void cubicWeights(double f, double w[4]) {
-  const double f2 = f * f, f3 = f2 * f;
-  w[0] = -0.5 * f3 + f2 - 0.5 * f;
-  w[1] = 1.5 * f3 - 2.5 * f2 + 1;
-  w[2] = -1.5 * f3 + 2 * f2 + 0.5 * f;
-  w[3] = 0.5 * f3 - 0.5 * f2;
+void cubicWeights(float f, float w[4]) {
+  const float f2 = f * f, f3 = f2 * f;
+  w[0] = -0.5f * f3 + f2 - 0.5f * f;
+  w[1] = 1.5f * f3 - 2.5f * f2 + 1;
+  w[2] = -1.5f * f3 + 2 * f2 + 0.5f * f;
+  w[3] = 0.5f * f3 - 0.5f * f2;
 }
 
-// The filtered RGB at continuous flat pixel p (inside [0, W] × [0, H]), rounded and clamped.
-// Sample centres at +0.5: the sample left of p is floor(p − 0.5); samples beyond the image's
-// edge repeat the edge.
+// The filtered RGB at continuous flat pixel (px, py) (inside [0, W] × [0, H]), rounded and
+// clamped. Sample centres at +0.5: the sample left of p is floor(p − 0.5); samples beyond the
+// image's edge repeat the edge. In float: a sum of 16-bit codes carries 24 bits, and the warp's
+// points are floats already.
 template <ResampleFilter kFilter>
-void sample(const uint16_t* rgb, int w, int h, FlatPoint p, uint16_t* out) {
+void sample(const uint16_t* rgb, int w, int h, float px, float py, uint16_t* out) {
   constexpr int kTaps = kFilter == ResampleFilter::bilinear ? 2 : 4;
   constexpr int kFirst = kFilter == ResampleFilter::bilinear ? 0 : -1;
-  const double u = p.x - 0.5, v = p.y - 0.5;
-  const double iu = std::floor(u), iv = std::floor(v);
-  double wx[4], wy[4];
+  const float u = px - 0.5f, v = py - 0.5f;
+  const float iu = std::floor(u), iv = std::floor(v);
+  float wx[4], wy[4];
   if constexpr (kFilter == ResampleFilter::bilinear) {
     wx[0] = 1 - (u - iu), wx[1] = u - iu;
     wy[0] = 1 - (v - iv), wy[1] = v - iv;
@@ -81,36 +83,31 @@ void sample(const uint16_t* rgb, int w, int h, FlatPoint p, uint16_t* out) {
     xs[k] = std::clamp(int(iu) + kFirst + k, 0, w - 1);
     ys[k] = std::clamp(int(iv) + kFirst + k, 0, h - 1);
   }
-  double sum[3] = {0, 0, 0};
+  float sum[3] = {0, 0, 0};
   for (int j = 0; j < kTaps; ++j) {
     const uint16_t* row = rgb + size_t(ys[j]) * size_t(w) * 3;
-    double line[3] = {0, 0, 0};
+    float line[3] = {0, 0, 0};
     for (int i = 0; i < kTaps; ++i)
-      for (int c = 0; c < 3; ++c) line[c] += wx[i] * row[size_t(xs[i]) * 3 + size_t(c)];
+      for (int c = 0; c < 3; ++c) line[c] += wx[i] * float(row[size_t(xs[i]) * 3 + size_t(c)]);
     for (int c = 0; c < 3; ++c) sum[c] += wy[j] * line[c];
   }
-  for (int c = 0; c < 3; ++c) out[c] = uint16_t(std::clamp(std::lround(sum[c]), 0L, 65535L));
+  // Round half up, after the clamp (the cubic's overshoot is negative or past 65535).
+  for (int c = 0; c < 3; ++c) out[c] = uint16_t(std::clamp(sum[c], 0.0f, 65535.0f) + 0.5f);
 }
 
 template <ResampleFilter kFilter>
-void resampleAll(const FlatView& view, const uint16_t* flatRgb, const DirectionMap& display,
-                 ResampledImage& image) {
-  const FlatProjection project(view);
-  for (int y = 0; y < display.height; ++y)
-    for (int x = 0; x < display.width; ++x) {
-      uint16_t* out = image.rgb.data() + (size_t(y) * size_t(display.width) + size_t(x)) * 3;
-      if (!display.isValid(x, y)) {
-        ++image.invalid;
-        continue;
-      }
-      const std::optional<FlatPoint> p = project(display.direction(x, y));
-      // Inside the image's rectangle (a NaN fails every comparison, so lands outside).
-      if (!p || !(p->x >= 0 && p->x <= view.width && p->y >= 0 && p->y <= view.height)) {
-        ++image.outside;
-        continue;
-      }
-      sample<kFilter>(flatRgb, view.width, view.height, *p, out);
+void resampleRowsWith(const ResampleWarp& warp, const uint16_t* flatRgb, int y0, int y1,
+                      uint16_t* rgb) {
+  const FlatView& v = warp.view;
+  const size_t w = size_t(warp.width);
+  for (size_t i = size_t(y0) * w; i < size_t(y1) * w; ++i) {
+    uint16_t* out = rgb + 3 * i;
+    if (!warp.lands(i)) {
+      out[0] = out[1] = out[2] = 0;
+      continue;
     }
+    sample<kFilter>(flatRgb, v.width, v.height, warp.points[2 * i], warp.points[2 * i + 1], out);
+  }
 }
 
 }  // namespace
@@ -119,16 +116,51 @@ std::optional<FlatPoint> flatPointOf(const FlatView& view, Vec3 direction) {
   return FlatProjection(view)(direction);
 }
 
+ResampleWarp resampleWarp(const FlatView& view, const DirectionMap& display) {
+  ResampleWarp warp;
+  warp.view = view;
+  warp.width = display.width;
+  warp.height = display.height;
+  warp.points.assign(size_t(display.width) * size_t(display.height) * 2,
+                     std::numeric_limits<float>::quiet_NaN());
+  const FlatProjection project(view);
+  for (int y = 0; y < display.height; ++y)
+    for (int x = 0; x < display.width; ++x) {
+      if (!display.isValid(x, y)) {
+        ++warp.invalid;
+        continue;
+      }
+      const std::optional<FlatPoint> p = project(display.direction(x, y));
+      // Inside the image's rectangle (a NaN fails every comparison, so lands outside).
+      if (!p || !(p->x >= 0 && p->x <= view.width && p->y >= 0 && p->y <= view.height)) {
+        ++warp.outside;
+        continue;
+      }
+      const size_t i = size_t(y) * size_t(display.width) + size_t(x);
+      warp.points[2 * i] = float(p->x);
+      warp.points[2 * i + 1] = float(p->y);
+    }
+  return warp;
+}
+
+void resampleRows(const ResampleWarp& warp, const uint16_t* flatRgb, ResampleFilter filter, int y0,
+                  int y1, uint16_t* rgb) {
+  if (filter == ResampleFilter::bilinear)
+    resampleRowsWith<ResampleFilter::bilinear>(warp, flatRgb, y0, y1, rgb);
+  else
+    resampleRowsWith<ResampleFilter::bicubic>(warp, flatRgb, y0, y1, rgb);
+}
+
 ResampledImage resampleFlatImage(const FlatView& view, const uint16_t* flatRgb,
                                  const DirectionMap& display, ResampleFilter filter) {
+  const ResampleWarp warp = resampleWarp(view, display);
   ResampledImage image;
   image.width = display.width;
   image.height = display.height;
-  image.rgb.assign(size_t(display.width) * size_t(display.height) * 3, 0);
-  if (filter == ResampleFilter::bilinear)
-    resampleAll<ResampleFilter::bilinear>(view, flatRgb, display, image);
-  else
-    resampleAll<ResampleFilter::bicubic>(view, flatRgb, display, image);
+  image.rgb.resize(size_t(display.width) * size_t(display.height) * 3);
+  resampleRows(warp, flatRgb, filter, 0, display.height, image.rgb.data());
+  image.outside = warp.outside;
+  image.invalid = warp.invalid;
   return image;
 }
 

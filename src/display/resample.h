@@ -47,13 +47,33 @@ struct ResampledImage {
   int64_t invalid = 0;        // display pixels with no direction (the map's invalid ones): black
 };
 
-// The display image of `display`'s size from a flat image: linear-light 16-bit RGB (3 values a
-// pixel, rows top first) of view.width × view.height pixels. A display pixel whose direction
-// lands inside the flat image's rectangle [0, W] × [0, H] gets the filtered value there — flat
-// samples beyond the image's edge repeat its edge (clamp to edge), so a margin of 2 flat pixels
-// keeps the bicubic footprint inside — rounded to the nearest code and clamped to 0 … 65535 (the
-// cubic overshoots at edges). Other valid pixels are black and counted in `outside`; invalid
-// ones are black and counted in `invalid`. Directions need not be unit length.
+// The warp of method (b) — a simulator's warp map: where each display pixel's direction lands in
+// the flat image (flatPointOf), worked out once per display mapping and flat view, then read by
+// every frame's resampling. A valid pixel lands when its point lies inside the flat image's
+// rectangle [0, W] × [0, H]; other valid pixels are `outside`, pixels without a direction
+// `invalid`. Directions need not be unit length.
+struct ResampleWarp {
+  FlatView view;
+  int width = 0, height = 0;  // the display's
+  // Two floats a display pixel, rows top first: the flat point's x and y, or NaN where the pixel
+  // does not land (then black).
+  std::vector<float> points;
+  int64_t outside = 0, invalid = 0;
+  bool lands(size_t pixel) const { return points[2 * pixel] == points[2 * pixel]; }
+};
+ResampleWarp resampleWarp(const FlatView& view, const DirectionMap& display);
+
+// Rows [y0, y1) of the display image through `warp` from a flat image (linear-light 16-bit RGB,
+// 3 values a pixel, rows top first, warp.view's size) into `rgb` (the whole display image's
+// buffer, the same layout): a landing pixel gets the filtered value at its point — flat samples
+// beyond the image's edge repeat its edge (clamp to edge), so a margin of 2 flat pixels keeps the
+// bicubic footprint inside — rounded to the nearest code and clamped to 0 … 65535 (the cubic
+// overshoots at edges); the others black. Row bands may run in parallel.
+void resampleRows(const ResampleWarp& warp, const uint16_t* flatRgb, ResampleFilter filter, int y0,
+                  int y1, uint16_t* rgb);
+
+// The display image of `display`'s size from a flat image of view.width × view.height pixels:
+// resampleRows over every row of resampleWarp(view, display), with its counts.
 ResampledImage resampleFlatImage(const FlatView& view, const uint16_t* flatRgb,
                                  const DirectionMap& display, ResampleFilter filter);
 

@@ -54,14 +54,15 @@ ResampledImage viewerPanorama(const Screen& screen, Vec3 eye,
                                  float(points[i].y - p.position.y),
                                  float(points[i].z - p.position.z)};
     const FlatView flat{p.orientation, p.lens, p.width, p.height};
-    const ResampledImage light = resampleFlatImage(flat, images[k], towards, filter);
+    const ResampleWarp warp = resampleWarp(flat, towards);
+    std::vector<uint16_t> light(3 * n);
+    resampleRows(warp, images[k], filter, 0, h, light.data());
     for (size_t i = 0; i < n; ++i) {
       if (!seen[i]) continue;
-      const std::optional<FlatPoint> f = flatPointOf(flat, towards.directions[i]);
-      if (f && f->x >= 0 && f->x <= p.width && f->y >= 0 && f->y <= p.height) lit[i] = 1;
+      if (warp.lands(i)) lit[i] = 1;
       for (size_t c = 0; c < 3; ++c)  // black where this projector does not reach
-        out.rgb[3 * i + c] = uint16_t(
-            std::min<uint32_t>(65535, uint32_t(out.rgb[3 * i + c]) + light.rgb[3 * i + c]));
+        out.rgb[3 * i + c] =
+            uint16_t(std::min<uint32_t>(65535, uint32_t(out.rgb[3 * i + c]) + light[3 * i + c]));
     }
   }
   for (size_t i = 0; i < n; ++i) {

@@ -133,40 +133,8 @@ void resolveTile(const uint16_t* color, int tileX, int tileY, const GammaTable& 
 
 namespace {
 
-// Calls sink(x, y, mean) for every pixel of an N-sample tile inside the image, mean[ch] being the
-// rounded mean of its samples (linear, 16-bit). Sums run over a block's sample planes, 16 pixels
-// at a time (vectorized by the compiler).
-template <class Sink>
-void forEachSampleMean(const uint16_t* color, const int32_t* sums, int tileX, int tileY,
-                       int samples, int width, int height, Sink sink) {
-  using namespace raster;
-  const int x0 = tileX * kTileSize, y0 = tileY * kTileSize;
-  const int w = std::min(kTileSize, width - x0), h = std::min(kTileSize, height - y0);
-  const uint32_t half = uint32_t(samples) / 2;
-  const int shift = std::countr_zero(unsigned(samples));  // samples is a power of two
-  for (int by = 0; by < h; by += kBlockSize)
-    for (int bx = 0; bx < w; bx += kBlockSize) {
-      const size_t b = size_t((by >> kBlockLog2) * kBlocksPerTileSide + (bx >> kBlockLog2));
-      uint32_t sum[kColorPerBlock] = {};
-      if (sums) {
-        std::copy_n(sums + b * kColorPerBlock, kColorPerBlock, sum);
-      } else {
-        const uint16_t* block = color + b * samples * kColorPerBlock;
-        for (int s = 0; s < samples; ++s)
-          for (int i = 0; i < kColorPerBlock; ++i) sum[i] += block[s * kColorPerBlock + i];
-      }
-      for (int py = 0; py < std::min(kBlockSize, h - by); ++py)
-        for (int px = 0; px < std::min(kBlockSize, w - bx); ++px) {
-          const int p = py * kBlockSize + px;
-          const uint16_t mean[3] = {uint16_t((sum[p] + half) >> shift),
-                                    uint16_t((sum[kBlockPixels + p] + half) >> shift),
-                                    uint16_t((sum[2 * kBlockPixels + p] + half) >> shift)};
-          sink(x0 + bx + px, y0 + by + py, mean);
-        }
-    }
-}
-
-// The same for a raster `factor` times larger than the image (supersampling).
+// Calls sink(x, y, mean) for every image pixel of a tile of a raster `factor` times larger than
+// the image (supersampling), mean[ch] being the rounded mean of its samples (linear, 16-bit).
 template <class Sink>
 void forEachBlockMean(const uint16_t* color, int tileX, int tileY, int factor, int width,
                       int height, Sink sink) {
@@ -200,7 +168,7 @@ void resolveTileLinear(const uint16_t* color, const int32_t* sums, int tileX, in
   if (factor > 1)
     forEachBlockMean(color, tileX, tileY, factor, linear.width, linear.height, store);
   else
-    forEachSampleMean(color, sums, tileX, tileY, samples, linear.width, linear.height, store);
+    resolveSampleTileLinear(color, sums, tileX, tileY, samples, linear);
 }
 
 void tentFilterRows(const LinearImage& linear, const GammaTable& gamma, int rowBegin, int rowEnd,

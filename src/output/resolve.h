@@ -67,6 +67,9 @@ struct LinearImage {
 // samples per pixel (one of the two is 1); `sums` as resolveSampleTile.
 void resolveTileLinear(const uint16_t* color, const int32_t* sums, int tileX, int tileY, int factor,
                        int samples, LinearImage& linear);
+// Its case of factor 1 (samples 1, 4, 8, 16 or 64), in SIMD lanes as resolveSampleTile.
+void resolveSampleTileLinear(const uint16_t* color, const int32_t* sums, int tileX, int tileY,
+                             int samples, LinearImage& linear);
 
 // The 3×3 triangle (tent) filter of seed 002 (SPEC §5) over the box-resolved frame, weights
 // [1 2 1]ᵀ[1 2 1] / 16 in linear light, edges clamped; then gamma. Writes rows [rowBegin, rowEnd)

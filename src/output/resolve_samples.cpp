@@ -29,22 +29,19 @@ HWY_INLINE void StoreBlockRow(uint8_t* HWY_RESTRICT dst, const uint16_t* HWY_RES
   }
 }
 
-void ResolveSampleTile(const uint16_t* color, const int32_t* sums, int tileX, int tileY,
-                       int samples, const GammaTable& gamma, Image& image) {
+// The means of a tile's pixels, a row of blocks at a time (every block's, then the `rows` image
+// rows of that block row handed to writeRows(by, rows, blocksX, mean)): in lanes, from the sample
+// planes or from the sums.
+template <class WriteRows>
+HWY_INLINE void ForEachMeanBlockRow(const uint16_t* color, const int32_t* sums, int w, int h,
+                                    int samples, WriteRows&& writeRows) {
   using namespace raster;
   const hn::CappedTag<int32_t, kBlockPixels> d32;
   const hn::Rebind<uint16_t, decltype(d32)> d16;
   const size_t n = hn::Lanes(d32);
-  const int x0 = tileX * kTileSize, y0 = tileY * kTileSize;
-  const int w = std::min(kTileSize, image.width - x0), h = std::min(kTileSize, image.height - y0);
   const int shift = std::countr_zero(unsigned(samples));  // samples is a power of two
   const auto half = hn::Set(d32, samples / 2);
-  uint8_t* const rgb = image.rgb.data();
-  const size_t stride = size_t(image.width) * 3;
-  // A row of blocks at a time: the means of all its blocks, then its four image rows left to right
-  // (writing block by block, four rows at once, was slower: the image rows fill sequentially).
   alignas(64) uint16_t mean[kBlocksPerTileSide][kColorPerBlock];
-  alignas(64) uint8_t row[3 * kTileSize];  // an image row, written out whole (writeImageRow)
   const int blocksX = (w + kBlockSize - 1) / kBlockSize;
   for (int by = 0; by < h; by += kBlockSize) {
     for (int b = 0; b < blocksX; ++b) {
@@ -66,14 +63,61 @@ void ResolveSampleTile(const uint16_t* color, const int32_t* sums, int tileX, in
                   mean[b] + i);
       }
     }
-    const int rows = std::min(kBlockSize, h - by);
-    for (int py = 0; py < rows; ++py) {
-      for (int b = 0; b < blocksX; ++b)
-        StoreBlockRow(row + 3 * kBlockSize * b, mean[b] + py * kBlockSize,
-                      std::min(kBlockSize, w - b * kBlockSize), gamma.table.data());
-      writeImageRow(row, 3 * w, rgb + size_t(y0 + by + py) * stride + size_t(x0) * 3);
-    }
+    writeRows(by, std::min(kBlockSize, h - by), blocksX, mean);
   }
+}
+
+void ResolveSampleTile(const uint16_t* color, const int32_t* sums, int tileX, int tileY,
+                       int samples, const GammaTable& gamma, Image& image) {
+  using namespace raster;
+  const int x0 = tileX * kTileSize, y0 = tileY * kTileSize;
+  const int w = std::min(kTileSize, image.width - x0), h = std::min(kTileSize, image.height - y0);
+  uint8_t* const rgb = image.rgb.data();
+  const size_t stride = size_t(image.width) * 3;
+  // Each block row's image rows left to right (writing block by block, four rows at once, was
+  // slower: the image rows fill sequentially).
+  alignas(64) uint8_t row[3 * kTileSize];  // an image row, written out whole (writeImageRow)
+  ForEachMeanBlockRow(
+      color, sums, w, h, samples,
+      [&](int by, int rows, int blocksX, const uint16_t(*mean)[kColorPerBlock]) {
+        for (int py = 0; py < rows; ++py) {
+          for (int b = 0; b < blocksX; ++b)
+            StoreBlockRow(row + 3 * kBlockSize * b, mean[b] + py * kBlockSize,
+                          std::min(kBlockSize, w - b * kBlockSize), gamma.table.data());
+          writeImageRow(row, 3 * w, rgb + size_t(y0 + by + py) * stride + size_t(x0) * 3);
+        }
+      });
+  finishImageRows();
+}
+
+// The same means into a linear-light image, interleaved RGB, no table; its rows written whole
+// (writeImageRow) for the same reason as the image's.
+void ResolveSampleTileLinear(const uint16_t* color, const int32_t* sums, int tileX, int tileY,
+                             int samples, LinearImage& linear) {
+  using namespace raster;
+  const int x0 = tileX * kTileSize, y0 = tileY * kTileSize;
+  const int w = std::min(kTileSize, linear.width - x0);
+  const int h = std::min(kTileSize, linear.height - y0);
+  uint16_t* const rgb = linear.rgb.data();
+  const size_t stride = size_t(linear.width) * 3;
+  alignas(64) uint16_t row[3 * kTileSize];
+  ForEachMeanBlockRow(
+      color, sums, w, h, samples,
+      [&](int by, int rows, int blocksX, const uint16_t(*mean)[kColorPerBlock]) {
+        for (int py = 0; py < rows; ++py) {
+          uint16_t* HWY_RESTRICT dst = row;
+          for (int b = 0; b < blocksX; ++b) {
+            const uint16_t* HWY_RESTRICT m = mean[b] + py * kBlockSize;
+            const int cols = std::min(kBlockSize, w - b * kBlockSize);
+            for (int p = 0; p < cols; ++p, dst += 3) {
+              dst[0] = m[p];
+              dst[1] = m[kBlockPixels + p];
+              dst[2] = m[2 * kBlockPixels + p];
+            }
+          }
+          std::copy_n(row, 3 * w, rgb + size_t(y0 + by + py) * stride + size_t(x0) * 3);
+        }
+      });
   finishImageRows();
 }
 
@@ -84,11 +128,18 @@ HWY_AFTER_NAMESPACE();
 #if HWY_ONCE
 namespace sv::output {
 HWY_EXPORT(ResolveSampleTile);
+HWY_EXPORT(ResolveSampleTileLinear);
 
 void resolveSampleTile(const uint16_t* color, const int32_t* sums, int tileX, int tileY,
                        int samples, const GammaTable& gamma, Image& image) {
   SV_CHECK(samples == 4 || samples == 8 || samples == 16 || samples == 64);
   HWY_DYNAMIC_DISPATCH(ResolveSampleTile)(color, sums, tileX, tileY, samples, gamma, image);
+}
+
+void resolveSampleTileLinear(const uint16_t* color, const int32_t* sums, int tileX, int tileY,
+                             int samples, LinearImage& linear) {
+  SV_CHECK(samples == 1 || samples == 4 || samples == 8 || samples == 16 || samples == 64);
+  HWY_DYNAMIC_DISPATCH(ResolveSampleTileLinear)(color, sums, tileX, tileY, samples, linear);
 }
 }  // namespace sv::output
 #endif

@@ -226,7 +226,14 @@ Status runDisplayBench(const scene::Scene& sc, const BenchSettings& s, CaseResul
                             "{:.1f} ms, once)",
                             plan.cells.size(), plan.maxResidualPixels, planMs),
                 {}, 0, 0, 0, {}, {}, {}};
-  RendererRun b{"resampled", "synthvis, a flat view with margin resampled bilinear",
+  const auto t1 = Clock::now();
+  const Result<display::ResampleWarp> warp = render::resampleWarpOf(centre.table);
+  if (!warp.ok()) return warp.error();
+  const double warpMs = msSince(t1);
+  RendererRun b{"resampled",
+                fmt::format("synthvis, a flat view of {} × {} with margin resampled bilinear (the "
+                            "warp took {:.1f} ms, once)",
+                            warp.value().view.width, warp.value().view.height, warpMs),
                 {}, 0, 0, 0, {}, {}, {}};
   render::DisplayFrame frameA, frameB;
   for (int i = 0; i < s.warmup + s.frames; ++i) {
@@ -238,7 +245,8 @@ Status runDisplayBench(const scene::Scene& sc, const BenchSettings& s, CaseResul
           std::tuple{&b, render::Correction::bilinear, &frameB}}) {
       render::CorrectedView view;
       view.table = &centre.table;
-      view.plan = correction == render::Correction::subFrusta ? &plan : nullptr;
+      view.plan = &plan;
+      view.warp = &warp.value();
       view.eye = display.eye;
       view.correction = correction;
       frame->linear.resize(1);

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+
 #include "core/check.h"
 #include "core/timing.h"
 
@@ -71,14 +73,23 @@ Status renderCorrected(CorrectionRenderer& renderer, const scene::Scene& scene,
     cs.cells = fs.cells;
     cs.maxResidualPixels = fs.maxResidualPixels;
   } else {
-    // Method (b): the flat view that covers every direction with a margin, looking along their
-    // mean, at the display's finest angular pixel; rendered as a channel from the eye, then
-    // resampled through the display mapping.
-    const display::DirectionMap map = directionMapOf(table);
-    const Result<display::FlatView> flat =
-        display::coveringFlatView(map, display::meanOrientation(map), view.marginPixels);
-    if (!flat.ok()) return flat.error();
-    const display::FlatView& f = flat.value();
+    // Method (b): the flat view rendered as a channel from the eye, then resampled through the
+    // warp, in row bands on the flat renderer's threads.
+    std::optional<display::ResampleWarp> own;
+    const display::ResampleWarp* warp = view.warp;
+    if (!warp) {
+      const auto t0 = core::Clock::now();
+      Result<display::ResampleWarp> made = resampleWarpOf(table, view.marginPixels);
+      if (!made.ok()) return made.error();
+      own = std::move(made).value();
+      warp = &*own;
+      cs.warpMs = core::msSince(t0);
+    }
+    if (warp->width != table.width || warp->height != table.height)
+      return Error{"", "",
+                   fmt::format("a warp of {} × {} pixels for a projector of {} × {}", warp->width,
+                               warp->height, table.width, table.height)};
+    const display::FlatView& f = warp->view;
     scene::Channel c;
     c.width = f.width;
     c.height = f.height;
@@ -95,22 +106,26 @@ Status renderCorrected(CorrectionRenderer& renderer, const scene::Scene& scene,
     const Result<FrameCamera> camera = channelCamera(scene, fo, c);
     if (!camera.ok()) return camera.error();
     const auto t1 = core::Clock::now();
-    output::LinearImage flatImage;
-    if (Status s = renderer.flat().renderLinear(scene, fo, camera.value(), flatImage, stats); !s)
+    ViewRenderer& flat = renderer.flat();
+    if (Status s = flat.renderLinear(scene, fo, camera.value(), renderer.flatImage(), stats); !s)
       return s;
     cs.renderMs = core::msSince(t1);
     const auto t2 = core::Clock::now();
-    display::ResampledImage r = display::resampleFlatImage(f, flatImage.rgb.data(), map,
-                                                           view.correction == Correction::bicubic
-                                                               ? display::ResampleFilter::bicubic
-                                                               : display::ResampleFilter::bilinear);
+    out.resize(table.width, table.height);
+    const display::ResampleFilter filter = view.correction == Correction::bicubic
+                                               ? display::ResampleFilter::bicubic
+                                               : display::ResampleFilter::bilinear;
+    constexpr int kBand = 16;  // rows per task
+    const uint16_t* flatRgb = renderer.flatImage().rgb.data();
+    flat.pool().parallelFor(size_t((table.height + kBand - 1) / kBand), [&](size_t band, int) {
+      const int y0 = int(band) * kBand;
+      display::resampleRows(*warp, flatRgb, filter, y0, std::min(table.height, y0 + kBand),
+                            out.rgb.data());
+    });
     cs.resampleMs = core::msSince(t2);
     cs.flatWidth = f.width;
     cs.flatHeight = f.height;
-    cs.outside = r.outside;
-    out.width = r.width;
-    out.height = r.height;
-    out.rgb = std::move(r.rgb);
+    cs.outside = warp->outside;
   }
   if (view.blend) {
     if (view.blend->width != table.width || view.blend->height != table.height)
@@ -122,6 +137,15 @@ Status renderCorrected(CorrectionRenderer& renderer, const scene::Scene& scene,
     cs.blendMs = core::msSince(t3);
   }
   return {};
+}
+
+Result<display::ResampleWarp> resampleWarpOf(const display::DirectionTable& table,
+                                             int marginPixels) {
+  const display::DirectionMap map = directionMapOf(table);
+  const Result<display::FlatView> flat =
+      display::coveringFlatView(map, display::meanOrientation(map), marginPixels);
+  if (!flat.ok()) return flat.error();
+  return display::resampleWarp(flat.value(), map);
 }
 
 DisplaySetup cylinderDisplay(int width, int height, double overlapDegrees) {

@@ -26,6 +26,7 @@ Result<Correction> parseCorrection(const std::string& text);
 struct CorrectionStats {
   // (a): the sub-frustum plan (once per display mapping, or per frame when the eye moves).
   double planMs = 0;
+  double warpMs = 0;      // (b): the warp, likewise
   double renderMs = 0;    // (a): the cells; (b): the flat view
   double resampleMs = 0;  // (b)
   double blendMs = 0;
@@ -43,6 +44,7 @@ class CorrectionRenderer {
   explicit CorrectionRenderer(const RenderOptions& options);
   SubFrustumRenderer& cells();
   ViewRenderer& flat();
+  output::LinearImage& flatImage() { return flatImage_; }  // (b): the flat view's
   const output::GammaTable& gamma() const { return gamma_; }
 
  private:
@@ -50,18 +52,27 @@ class CorrectionRenderer {
   output::GammaTable gamma_;
   std::optional<SubFrustumRenderer> cells_;
   std::optional<ViewRenderer> flat_;
+  output::LinearImage flatImage_;
 };
 
-// A projector's display mapping and how it is corrected. `plan` (method (a)) is made from `table`
-// when not given.
+// A projector's display mapping and how it is corrected. `plan` (method (a)) and `warp` (method
+// (b)) are made from `table` when not given: both depend on the mapping alone, so a caller
+// drawing frame after frame makes them once (and again when the mapping changes).
 struct CorrectedView {
   const display::DirectionTable* table = nullptr;
   const display::SubFrustumPlan* plan = nullptr;
+  const display::ResampleWarp* warp = nullptr;
   const display::BlendWeights* blend = nullptr;  // nothing: no edge blending
   Vec3d eye{0, 0, 0};                            // the display's eye in the camera's eye frame
   Correction correction = Correction::subFrusta;
-  int marginPixels = 2;  // (b): the flat view's margin
+  int marginPixels = 2;  // (b): the flat view's margin, when the warp is made here
 };
+
+// Method (b)'s warp for a display mapping: the flat view that covers every direction with a
+// margin of `marginPixels`, looking along their mean, at the display's finest angular pixel
+// (display::coveringFlatView), and where each display pixel lands in it.
+Result<display::ResampleWarp> resampleWarpOf(const display::DirectionTable& table,
+                                             int marginPixels = 2);
 
 // The projector's frame in linear light (`out`, the table's size; o.width and o.height are not
 // used), for the scene seen from `base`'s eyepoint.
