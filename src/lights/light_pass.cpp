@@ -24,7 +24,32 @@ constexpr size_t kChunk = 4096;
 // A light adds less than half a 16-bit step to every pixel below this: not drawn.
 constexpr float kDarkest = 0.5f;
 
+// The equatorial x, y and z axes in the world at the input's time (light_laws.h: starDirection).
+void starAxesOf(const LightInput& in, Vec3 axes[3]) {
+  const scene::StarField& f = *in.stars;
+  axes[0] = starDirection({1, 0, 0}, f.latitude, f.siderealTime, in.time);
+  axes[1] = starDirection({0, 1, 0}, f.latitude, f.siderealTime, in.time);
+  axes[2] = starDirection({0, 0, 1}, f.latitude, f.siderealTime, in.time);
+}
+
+// A star's direction in the world from its equatorial direction.
+Vec3 starWorld(const Vec3 axes[3], Vec3 e) { return axes[0] * e.x + axes[1] * e.y + axes[2] * e.z; }
+
 }  // namespace
+
+void lightEyePositions(const LightInput& in, std::vector<Vec4>& out) {
+  out.clear();
+  out.reserve(in.points.size() + (in.stars ? in.stars->stars.size() : 0));
+  for (const scene::LightPoint& p : in.points)
+    out.push_back(in.view * Vec4{p.position.x, p.position.y, p.position.z, 1});
+  if (!in.stars) return;
+  Vec3 axes[3];
+  starAxesOf(in, axes);
+  for (const scene::Star& star : in.stars->stars) {
+    const Vec3 w = starWorld(axes, star.direction);
+    out.push_back(in.view * Vec4{w.x, w.y, w.z, 0});
+  }
+}
 
 void LightPass::setLights(const LightInput& input) { in_ = input; }
 
@@ -96,16 +121,14 @@ bool LightPass::projectPoint(const scene::LightPoint& p, Splat& s) const {
   const Vec3 color = appearanceColor(a, lobeAxis(a, p.phase, in_.time), toEye * (1 / d),
                                      lobeTangents_[p.appearance]);
   const float transmission = fogTransmission(in_.fogBeta, in_.settings.punchThrough, d);
-  const float energy =
-      screenEnergy(in_.settings.exposure, a.intensity * dim, transmission, d);
+  const float energy = screenEnergy(in_.settings.exposure, a.intensity * dim, transmission, d);
   return finishSplat(energy, color, s);
 }
 
 bool LightPass::projectStar(const scene::Star& star, Splat& s) const {
   const scene::StarField& f = *in_.stars;
   if (star.magnitude > f.limit) return false;
-  const Vec3 e = star.direction;
-  const Vec3 w = starAxes_[0] * e.x + starAxes_[1] * e.y + starAxes_[2] * e.z;
+  const Vec3 w = starWorld(starAxes_, star.direction);
   const Vec4 eye = in_.view * Vec4{w.x, w.y, w.z, 0};  // a direction: at infinity
   const Vec4 c = in_.projection * eye;
   if (!(c.w > 0)) return false;
@@ -120,10 +143,11 @@ bool LightPass::projectStar(const scene::Star& star, Splat& s) const {
 void LightPass::projectRange(size_t begin, size_t end, std::vector<Splat>& out) const {
   out.clear();
   const size_t points = in_.points.size();
-  for (size_t i = begin; i < end; ++i) {
+  for (size_t k = begin; k < end; ++k) {
+    const size_t i = in_.subset ? (*in_.subset)[k] : k;
     Splat s;
-    const bool drawn = i < points ? projectPoint(in_.points[i], s)
-                                  : projectStar(in_.stars->stars[i - points], s);
+    const bool drawn =
+        i < points ? projectPoint(in_.points[i], s) : projectStar(in_.stars->stars[i - points], s);
     if (drawn) out.push_back(s);
   }
 }
@@ -156,13 +180,8 @@ void LightPass::prepare(const raster::PassFrame& frame) {
   m32_ = in_.projection.m[3][2];
   zfar_ = m32_ / (1 + m22_);
   const size_t stars = in_.stars ? in_.stars->stars.size() : 0;
-  if (stars) {
-    const scene::StarField& f = *in_.stars;
-    starAxes_[0] = starDirection({1, 0, 0}, f.latitude, f.siderealTime, in_.time);
-    starAxes_[1] = starDirection({0, 1, 0}, f.latitude, f.siderealTime, in_.time);
-    starAxes_[2] = starDirection({0, 0, 1}, f.latitude, f.siderealTime, in_.time);
-  }
-  const size_t total = in_.points.size() + stars;
+  if (stars) starAxesOf(in_, starAxes_);
+  const size_t total = in_.subset ? in_.subset->size() : in_.points.size() + stars;
   candidates_ = total;
   // Chunks of a size fixed by the light count alone (never the thread count), at most 64 of them,
   // so that the per-chunk tile counts stay small.

@@ -30,19 +30,29 @@ struct LightInput {
   std::span<const scene::LightGroup> groups;
   scene::LightSettings settings;
   const scene::StarField* stars = nullptr;
-  double time = 0;   // seconds
-  Mat4 view;         // world → eye
-  Mat4 projection;   // eye → clip (OpenGL conventions: depth row −m22 + m32 / s)
+  double time = 0;    // seconds
+  Mat4 view;          // world → eye
+  Mat4 projection;    // eye → clip (OpenGL conventions: depth row −m22 + m32 / s)
   float fogBeta = 0;  // the scene's fog β, 0 without fog
+  // Only these lights, when the caller has culled them for the view (indices into the points,
+  // then the stars, ascending; it must outlive the frame): a sub-frustum cell's (render/warped.h).
+  // Nothing: every light. The frame is the same as with every light as long as the subset holds
+  // every light whose splat reaches the view.
+  const std::vector<uint32_t>* subset = nullptr;
 };
+
+// The eye-frame positions of `in`'s lights under in.view, in the pass's order (the points, then
+// the stars): (x, y, z, 1) for a point, (x, y, z, 0) — a direction, at infinity — for a star. For a
+// caller culling lights for many views at once (LightInput::subset).
+void lightEyePositions(const LightInput& in, std::vector<Vec4>& out);
 
 // One light as the frame draws it.
 struct Splat {
-  float x = 0, y = 0;     // raster position, pixels (pixel centres at i + ½)
-  float eyeDepth = 0;     // the light's depth along the view axis, clip w (s > 0); 0 for a star
-  float radius = 1;       // the kernel's, pixels (light_laws.h: splatRadius)
-  float rgb[3] = {};      // Φ · colour · 65535 / Σw: a weight-1 pixel's 16-bit addition
-  float frontDepth = 1;   // the window depth depthBias in front of the light (a star: 1)
+  float x = 0, y = 0;    // raster position, pixels (pixel centres at i + ½)
+  float eyeDepth = 0;    // the light's depth along the view axis, clip w (s > 0); 0 for a star
+  float radius = 1;      // the kernel's, pixels (light_laws.h: splatRadius)
+  float rgb[3] = {};     // Φ · colour · 65535 / Σw: a weight-1 pixel's 16-bit addition
+  float frontDepth = 1;  // the window depth depthBias in front of the light (a star: 1)
   // The kernel's pixel centres: columns firstX … firstX + spanX − 1, rows likewise. A splat of at
   // most kKeptSpan a side keeps its axis weights (worked out once, for the weight sum, and read
   // again by every tile it reaches); a larger one's are worked out again where it is drawn.
@@ -65,7 +75,7 @@ class LightPass final : public raster::TilePass {
   std::vector<Splat> splats() const;
 
  private:
-  // Lights [begin, end) of the input (stars after the points) into `out`.
+  // Lights [begin, end) of the input (stars after the points), or of its subset, into `out`.
   void projectRange(size_t begin, size_t end, std::vector<Splat>& out) const;
   bool projectPoint(const scene::LightPoint& p, Splat& s) const;
   bool projectStar(const scene::Star& star, Splat& s) const;
@@ -81,7 +91,7 @@ class LightPass final : public raster::TilePass {
   raster::PassFrame frame_;
   float m22_ = 0, m32_ = 1, zfar_ = 1;  // the projection's depth row, its far plane
   Vec3 eye_;
-  Vec3 starAxes_[3];  // equatorial x, y, z in world at this frame's time
+  Vec3 starAxes_[3];                        // equatorial x, y, z in world at this frame's time
   std::vector<LobeTangents> lobeTangents_;  // per appearance, this frame
   std::vector<std::vector<Splat>> chunks_;  // the drawn splats, chunk by chunk, in light order
   int tilesX_ = 0;

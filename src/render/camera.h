@@ -1,6 +1,9 @@
 // The frame's camera (SPEC §1 stage 2): the scene's, or one that frames a scene without cameras.
 #pragma once
 
+#include <cstdint>
+#include <vector>
+
 #include "core/eye_rays.h"
 #include "synthvis/render.h"
 
@@ -20,6 +23,9 @@ struct FrameCamera {
   // the display channel's whole, for what is chosen per frame rather than per pixel (levels of
   // detail), so that every cell of a display chooses alike.
   bool projective = false;
+  // The lights this view can show, when its caller culled them for it (lights::LightInput::subset:
+  // a sub-frustum cell's, culled for every cell at once); nothing: every light.
+  const std::vector<uint32_t>* lightSubset = nullptr;
 };
 
 // The camera's rays through its raster (the terrain and volume passes').

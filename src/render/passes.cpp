@@ -15,6 +15,7 @@ lights::LightInput lightInput(const scene::Scene& scene, const FrameCamera& came
   in.view = camera.view;
   in.projection = camera.projection;
   in.fogBeta = scene.fog.enabled ? scene.fog.beta : 0.0f;
+  in.subset = camera.lightSubset;
   return in;
 }
 

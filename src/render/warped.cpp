@@ -3,7 +3,14 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
+#include <numbers>
+#include <optional>
+#include <utility>
+
+#include "lights/light_laws.h"
+#include "render/passes.h"
 
 namespace sv::render {
 
@@ -16,6 +23,74 @@ FrameCamera cellCamera(const FrameCamera& base, const display::SubFrustumCell& c
     for (size_t k = 0; k < 4; ++k) c.projection.m[k][r] = float(p.m[r][k]);
   c.projective = true;
   return c;
+}
+
+namespace {
+
+// Cells per group of the light cull: consecutive cells of the plan's quadtree order lie together,
+// so a group's directions fit a narrow cone.
+constexpr size_t kCullGroup = 16;
+
+}  // namespace
+
+void SubFrustumRenderer::cullLights(const scene::Scene& scene, const FrameCamera& base, Vec3d eye,
+                                    const display::SubFrustumPlan& plan) {
+  std::vector<Vec4> positions;
+  lights::lightEyePositions(lightInput(scene, base), positions);
+  lightDirections_.resize(positions.size());
+  for (size_t l = 0; l < positions.size(); ++l) {
+    const Vec4& p = positions[l];
+    const Vec3d d{p.x - eye.x * p.w, p.y - eye.y * p.w, p.z - eye.z * p.w};
+    const double len = std::sqrt(dot(d, d));
+    lightDirections_[l] = len > 0 ? d * (1 / len) : Vec3d{0, 0, 0};  // at the eye: never drawn
+  }
+  // A splat reaches no pixel farther than its kernel radius from its centre (light_laws.h); a
+  // pixel more covers the difference between the pass's float projection and the map's double.
+  const scene::LightSettings& ls = scene.lightSettings;
+  const double reach = lights::splatRadius(std::max(ls.minSize, ls.maxSize)) + 1;
+  const size_t n = plan.cells.size();
+  cellLights_.resize(n);
+  pool_.parallelFor((n + kCullGroup - 1) / kCullGroup, [&](size_t g, int) {
+    const size_t c0 = g * kCullGroup, c1 = std::min(n, c0 + kCullGroup);
+    // The group's cone from the eye: about the mean of its cells' corner directions, out to the
+    // farthest corner (a cell's directions form a convex spherical quadrilateral, inside the cap
+    // of its corners), widened by `reach` pixels at twice the coarsest pixel angle at a cell's
+    // centre (a cell's pixel angle varies by far less across it).
+    std::vector<Vec3d> corners;
+    double pixelAngle = 0;
+    for (size_t i = c0; i < c1; ++i) {
+      cellLights_[i].clear();
+      const display::SubFrustumCell& c = plan.cells[i];
+      if (!c.fitted) continue;
+      for (const auto& [x, y] : {std::pair{c.x0, c.y0}, std::pair{c.x1, c.y0},
+                                 std::pair{c.x0, c.y1}, std::pair{c.x1, c.y1}})
+        corners.push_back(display::mapPixel(c, x, y));
+      const double cx = 0.5 * (c.x0 + c.x1), cy = 0.5 * (c.y0 + c.y1);
+      const Vec3d centre = display::mapPixel(c, cx, cy);
+      pixelAngle = std::max({pixelAngle, angleBetween(centre, display::mapPixel(c, cx + 1, cy)),
+                             angleBetween(centre, display::mapPixel(c, cx, cy + 1))});
+    }
+    if (corners.empty()) return;
+    Vec3d axis{0, 0, 0};
+    for (const Vec3d& d : corners) axis = axis + d;
+    axis = axis * (1 / std::sqrt(dot(axis, axis)));
+    double half = 0;
+    for (const Vec3d& d : corners) half = std::max(half, angleBetween(axis, d));
+    half += 2 * reach * pixelAngle;
+    const double cosHalf = half < std::numbers::pi ? std::cos(half) : -2;
+    for (uint32_t l = 0; l < lightDirections_.size(); ++l) {
+      const Vec3d d = lightDirections_[l];
+      if (dot(d, axis) < cosHalf || dot(d, d) == 0) continue;
+      for (size_t i = c0; i < c1; ++i) {
+        const display::SubFrustumCell& c = plan.cells[i];
+        if (!c.fitted) continue;
+        const std::optional<display::PixelPoint> p = display::mapDirection(c, d);
+        if (p && p->x >= c.x0 - reach && p->x <= c.x1 + reach && p->y >= c.y0 - reach &&
+            p->y <= c.y1 + reach)
+          cellLights_[i].push_back(l);
+      }
+    }
+  });
 }
 
 SubFrustumRenderer::SubFrustumRenderer(const RenderOptions& options)
@@ -45,6 +120,8 @@ Status SubFrustumRenderer::render(const scene::Scene& scene, const RenderOptions
   const size_t n = plan.cells.size();
   cellStats_.assign(n, FrameStats{});
   cellErrors_.assign(n, Status{});
+  const bool lights = !scene.lightPoints.empty() || !scene.stars.stars.empty();
+  if (lights) cullLights(scene, base, eye, plan);
   // Each cell writes its own rectangle of `out`: the workers never write the same pixel.
   pool_.parallelFor(n, [&](size_t i, int worker) {
     const display::SubFrustumCell& cell = plan.cells[i];
@@ -53,8 +130,10 @@ Status SubFrustumRenderer::render(const scene::Scene& scene, const RenderOptions
     co.width = cell.x1 - cell.x0;
     co.height = cell.y1 - cell.y0;
     output::LinearImage& image = cellImages_[size_t(worker)];
-    cellErrors_[i] = workers_[size_t(worker)]->renderLinear(scene, co, cellCamera(base, cell, eye),
-                                                            image, cellStats_[i]);
+    FrameCamera camera = cellCamera(base, cell, eye);
+    if (lights) camera.lightSubset = &cellLights_[i];
+    cellErrors_[i] =
+        workers_[size_t(worker)]->renderLinear(scene, co, camera, image, cellStats_[i]);
     if (!cellErrors_[i]) return;
     for (int y = 0; y < co.height; ++y)
       std::memcpy(&out.rgb[(size_t(cell.y0 + y) * size_t(o.width) + size_t(cell.x0)) * 3],

@@ -53,11 +53,18 @@ class SubFrustumRenderer {
   const output::GammaTable& gamma() const { return workers_[0]->gamma(); }
 
  private:
+  // cellLights_ for this frame: every light whose splat can reach a cell, for each cell — culled
+  // once for all of them, not by each cell's light pass over every light.
+  void cullLights(const scene::Scene& scene, const FrameCamera& base, Vec3d eye,
+                  const display::SubFrustumPlan& plan);
+
   core::ThreadPool pool_;
   std::vector<std::unique_ptr<ViewRenderer>> workers_;  // one per pool worker, one thread each
   std::vector<output::LinearImage> cellImages_;         // one per worker
   std::vector<FrameStats> cellStats_;                   // one per cell, this frame
   std::vector<Status> cellErrors_;                      // likewise
+  std::vector<std::vector<uint32_t>> cellLights_;       // likewise (cullLights)
+  std::vector<Vec3d> lightDirections_;  // unit, from the display's eye; 0 for a light at the eye
 };
 
 }  // namespace sv::render
