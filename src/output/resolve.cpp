@@ -161,14 +161,16 @@ void forEachBlockMean(const uint16_t* color, int tileX, int tileY, int factor, i
 }  // namespace
 
 void resolveTileLinear(const uint16_t* color, const int32_t* sums, int tileX, int tileY, int factor,
-                       int samples, LinearImage& linear) {
+                       int samples, const LinearTarget& t) {
+  LinearImage& image = *t.image;
   auto store = [&](int x, int y, const uint16_t* mean) {
-    std::copy_n(mean, 3, linear.rgb.data() + (size_t(y) * size_t(linear.width) + size_t(x)) * 3);
+    std::copy_n(mean, 3,
+                image.rgb.data() + (size_t(t.y + y) * size_t(image.width) + size_t(t.x + x)) * 3);
   };
   if (factor > 1)
-    forEachBlockMean(color, tileX, tileY, factor, linear.width, linear.height, store);
+    forEachBlockMean(color, tileX, tileY, factor, t.width, t.height, store);
   else
-    resolveSampleTileLinear(color, sums, tileX, tileY, samples, linear);
+    resolveSampleTileLinear(color, sums, tileX, tileY, samples, t);
 }
 
 void tentFilterRows(const LinearImage& linear, const GammaTable& gamma, int rowBegin, int rowEnd,

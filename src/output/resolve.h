@@ -62,14 +62,25 @@ struct LinearImage {
   }
 };
 
-// Box-resolves one tile into `linear` (sized for the image) instead of the display image, for any
-// of the layouts above: `factor` × `factor` pixels per image pixel (supersampling) or `samples`
-// samples per pixel (one of the two is 1); `sums` as resolveSampleTile.
+// Where a view's box-resolved tiles go in linear light: the view's width × height pixels, its
+// pixel (0, 0) at (x, y) of `image` (sized already, holding the rectangle) — the whole image for
+// the tent filter's frame, a rectangle of a display for a sub-frustum cell (render/warped.h).
+struct LinearTarget {
+  LinearImage* image = nullptr;
+  int x = 0, y = 0, width = 0, height = 0;
+};
+inline LinearTarget wholeOf(LinearImage& image) {
+  return {&image, 0, 0, image.width, image.height};
+}
+
+// Box-resolves one tile of a view into its target instead of the display image, for any of the
+// layouts above: `factor` × `factor` pixels per image pixel (supersampling) or `samples` samples
+// per pixel (one of the two is 1); `sums` as resolveSampleTile.
 void resolveTileLinear(const uint16_t* color, const int32_t* sums, int tileX, int tileY, int factor,
-                       int samples, LinearImage& linear);
+                       int samples, const LinearTarget& target);
 // Its case of factor 1 (samples 1, 4, 8, 16 or 64), in SIMD lanes as resolveSampleTile.
 void resolveSampleTileLinear(const uint16_t* color, const int32_t* sums, int tileX, int tileY,
-                             int samples, LinearImage& linear);
+                             int samples, const LinearTarget& target);
 
 // The 3×3 triangle (tent) filter of seed 002 (SPEC §5) over the box-resolved frame, weights
 // [1 2 1]ᵀ[1 2 1] / 16 in linear light, edges clamped; then gamma. Writes rows [rowBegin, rowEnd)

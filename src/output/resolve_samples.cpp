@@ -93,31 +93,31 @@ void ResolveSampleTile(const uint16_t* color, const int32_t* sums, int tileX, in
 // The same means into a linear-light image, interleaved RGB, no table; its rows written whole
 // (writeImageRow) for the same reason as the image's.
 void ResolveSampleTileLinear(const uint16_t* color, const int32_t* sums, int tileX, int tileY,
-                             int samples, LinearImage& linear) {
+                             int samples, const LinearTarget& t) {
   using namespace raster;
-  const int x0 = tileX * kTileSize, y0 = tileY * kTileSize;
-  const int w = std::min(kTileSize, linear.width - x0);
-  const int h = std::min(kTileSize, linear.height - y0);
-  uint16_t* const rgb = linear.rgb.data();
-  const size_t stride = size_t(linear.width) * 3;
+  const int w = std::min(kTileSize, t.width - tileX * kTileSize);
+  const int h = std::min(kTileSize, t.height - tileY * kTileSize);
+  const int x0 = t.x + tileX * kTileSize, y0 = t.y + tileY * kTileSize;  // in the image
+  uint16_t* const rgb = t.image->rgb.data();
+  const size_t stride = size_t(t.image->width) * 3;
   alignas(64) uint16_t row[3 * kTileSize];
-  ForEachMeanBlockRow(
-      color, sums, w, h, samples,
-      [&](int by, int rows, int blocksX, const uint16_t(*mean)[kColorPerBlock]) {
-        for (int py = 0; py < rows; ++py) {
-          uint16_t* HWY_RESTRICT dst = row;
-          for (int b = 0; b < blocksX; ++b) {
-            const uint16_t* HWY_RESTRICT m = mean[b] + py * kBlockSize;
-            const int cols = std::min(kBlockSize, w - b * kBlockSize);
-            for (int p = 0; p < cols; ++p, dst += 3) {
-              dst[0] = m[p];
-              dst[1] = m[kBlockPixels + p];
-              dst[2] = m[2 * kBlockPixels + p];
-            }
-          }
-          std::copy_n(row, 3 * w, rgb + size_t(y0 + by + py) * stride + size_t(x0) * 3);
-        }
-      });
+  ForEachMeanBlockRow(color, sums, w, h, samples,
+                      [&](int by, int rows, int blocksX, const uint16_t(*mean)[kColorPerBlock]) {
+                        for (int py = 0; py < rows; ++py) {
+                          uint16_t* HWY_RESTRICT dst = row;
+                          for (int b = 0; b < blocksX; ++b) {
+                            const uint16_t* HWY_RESTRICT m = mean[b] + py * kBlockSize;
+                            const int cols = std::min(kBlockSize, w - b * kBlockSize);
+                            for (int p = 0; p < cols; ++p, dst += 3) {
+                              dst[0] = m[p];
+                              dst[1] = m[kBlockPixels + p];
+                              dst[2] = m[2 * kBlockPixels + p];
+                            }
+                          }
+                          std::copy_n(row, 3 * w,
+                                      rgb + size_t(y0 + by + py) * stride + size_t(x0) * 3);
+                        }
+                      });
   finishImageRows();
 }
 
@@ -137,9 +137,9 @@ void resolveSampleTile(const uint16_t* color, const int32_t* sums, int tileX, in
 }
 
 void resolveSampleTileLinear(const uint16_t* color, const int32_t* sums, int tileX, int tileY,
-                             int samples, LinearImage& linear) {
+                             int samples, const LinearTarget& target) {
   SV_CHECK(samples == 1 || samples == 4 || samples == 8 || samples == 16 || samples == 64);
-  HWY_DYNAMIC_DISPATCH(ResolveSampleTileLinear)(color, sums, tileX, tileY, samples, linear);
+  HWY_DYNAMIC_DISPATCH(ResolveSampleTileLinear)(color, sums, tileX, tileY, samples, target);
 }
 }  // namespace sv::output
 #endif

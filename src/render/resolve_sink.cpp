@@ -7,10 +7,19 @@
 namespace sv::render {
 
 ResolveSink::ResolveSink(const RenderOptions& options, const output::GammaTable& gamma,
-                         output::LinearImage& linear, Image& image, bool linearOut)
-    : options_(options), gamma_(gamma), linear_(linear), image_(image), linearOut_(linearOut) {
-  if (linearOut || options.filter == RenderOptions::Filter::tent3)
+                         output::LinearImage& linear, Image& image,
+                         const output::LinearTarget* linearOut)
+    : options_(options),
+      gamma_(gamma),
+      linear_(linear),
+      image_(image),
+      linearOut_(linearOut != nullptr) {
+  if (linearOut) {
+    target_ = *linearOut;
+  } else if (options.filter == RenderOptions::Filter::tent3) {
     linear.resize(options.width, options.height);
+    target_ = output::wholeOf(linear);
+  }
 }
 
 bool ResolveSink::takesColorSums() const {
@@ -31,7 +40,7 @@ TileSink ResolveSink::finishTile(int tilesX) {
   if (linearOut_ || o.filter == RenderOptions::Filter::tent3)
     return [this, tilesX, k](int tile, const float*, const uint16_t* color, const int32_t* sums) {
       output::resolveTileLinear(color, sums, tile % tilesX, tile / tilesX, k, options_.samples,
-                                linear_);
+                                target_);
     };
   if (o.samples > 1)
     return [this, tilesX](int tile, const float*, const uint16_t* color, const int32_t* sums) {

@@ -15,10 +15,12 @@ class ResolveSink {
  public:
   // `linear` (the tent filter's frame) and `image` are kept by reference for the frame; the image
   // must be sized by output::prepareImage before the first tile. With `linearOut`, every tile is
-  // box-resolved into `linear` and nothing else is done (no filter, no gamma, `image` untouched):
-  // a caller that composes views in linear light (render/warped.h) takes it from there.
+  // box-resolved into that target and nothing else is done (no filter, no gamma, `linear` and
+  // `image` untouched): a caller that composes views in linear light (render/warped.h) takes it
+  // from there.
   ResolveSink(const RenderOptions& options, const output::GammaTable& gamma,
-              output::LinearImage& linear, Image& image, bool linearOut = false);
+              output::LinearImage& linear, Image& image,
+              const output::LinearTarget* linearOut = nullptr);
   // The sinks finishTile hands out refer to this object: it stays where it is.
   ResolveSink(const ResolveSink&) = delete;
   ResolveSink& operator=(const ResolveSink&) = delete;
@@ -38,6 +40,7 @@ class ResolveSink {
   output::LinearImage& linear_;
   Image& image_;
   bool linearOut_;
+  output::LinearTarget target_;  // where linear tiles go: linearOut's, or the whole of `linear`
 };
 
 }  // namespace sv::render

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <thread>
 
+#include "core/check.h"
 #include "core/timing.h"
 #include "render/frame_settings.h"
 #include "render/resolve_sink.h"
@@ -23,18 +24,29 @@ ViewRenderer::ViewRenderer(const RenderOptions& o)
 
 Status ViewRenderer::render(const scene::Scene& scene, const RenderOptions& o,
                             const FrameCamera& camera, Image& image, FrameStats& stats) {
-  return run(scene, o, camera, image, linear_, false, stats);
+  return run(scene, o, camera, image, nullptr, stats);
 }
 
 Status ViewRenderer::renderLinear(const scene::Scene& scene, const RenderOptions& o,
                                   const FrameCamera& camera, output::LinearImage& out,
                                   FrameStats& stats) {
-  return run(scene, o, camera, unused_, out, true, stats);
+  out.resize(o.width, o.height);
+  const output::LinearTarget target = output::wholeOf(out);
+  return run(scene, o, camera, unused_, &target, stats);
+}
+
+Status ViewRenderer::renderLinear(const scene::Scene& scene, const RenderOptions& o,
+                                  const FrameCamera& camera, const output::LinearTarget& target,
+                                  FrameStats& stats) {
+  SV_CHECK(target.width == o.width && target.height == o.height && target.x >= 0 && target.y >= 0 &&
+           target.x + target.width <= target.image->width &&
+           target.y + target.height <= target.image->height);
+  return run(scene, o, camera, unused_, &target, stats);
 }
 
 Status ViewRenderer::run(const scene::Scene& scene, const RenderOptions& o,
-                         const FrameCamera& camera, Image& image, output::LinearImage& linear,
-                         bool linearOut, FrameStats& stats) {
+                         const FrameCamera& camera, Image& image,
+                         const output::LinearTarget* linearOut, FrameStats& stats) {
   const auto start = core::Clock::now();
   // Stage 2: the shading stage's tables in the camera's eye space.
   buildShading(scene, o, camera.view, shading_);
@@ -53,7 +65,7 @@ Status ViewRenderer::run(const scene::Scene& scene, const RenderOptions& o,
                                                      pixelShading, packets_.indices.size() / 3);
   if (!settings.ok()) return settings.error();
   FrameSettings& fs = settings.value();
-  ResolveSink sink(o, gamma_, linear, image, linearOut);
+  ResolveSink sink(o, gamma_, linear_, image, linearOut);
   fs.finishTile = sink.finishTile((fs.width + raster::kTileSize - 1) >> raster::kTileLog2);
   fs.colorSums = sink.takesColorSums();
   fs.passes = passes_.compose(scene, o, camera, shading_);

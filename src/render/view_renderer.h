@@ -35,13 +35,17 @@ class ViewRenderer {
   // table): for a caller that composes views before the gamma table.
   Status renderLinear(const scene::Scene& scene, const RenderOptions& o, const FrameCamera& camera,
                       output::LinearImage& out, FrameStats& stats);
+  // The same into a rectangle of a larger linear image (target.width × target.height must be the
+  // view's o.width × o.height): a sub-frustum cell straight into its display's frame.
+  Status renderLinear(const scene::Scene& scene, const RenderOptions& o, const FrameCamera& camera,
+                      const output::LinearTarget& target, FrameStats& stats);
 
   core::ThreadPool& pool() { return frame_.pool(); }
   const output::GammaTable& gamma() const { return gamma_; }
 
  private:
   Status run(const scene::Scene& scene, const RenderOptions& o, const FrameCamera& camera,
-             Image& image, output::LinearImage& linear, bool linearOut, FrameStats& stats);
+             Image& image, const output::LinearTarget* linearOut, FrameStats& stats);
 
   FrameRenderer frame_;
   output::GammaTable gamma_;

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <numbers>
 #include <optional>
 #include <utility>
@@ -99,7 +98,6 @@ SubFrustumRenderer::SubFrustumRenderer(const RenderOptions& options)
   single.threads = 1;
   for (int i = 0; i < pool_.threadCount(); ++i)
     workers_.push_back(std::make_unique<ViewRenderer>(single));
-  cellImages_.resize(size_t(pool_.threadCount()));
 }
 
 Status SubFrustumRenderer::render(const scene::Scene& scene, const RenderOptions& o,
@@ -122,22 +120,19 @@ Status SubFrustumRenderer::render(const scene::Scene& scene, const RenderOptions
   cellErrors_.assign(n, Status{});
   const bool lights = !scene.lightPoints.empty() || !scene.stars.stars.empty();
   if (lights) cullLights(scene, base, eye, plan);
-  // Each cell writes its own rectangle of `out`: the workers never write the same pixel.
+  // Each cell resolves straight into its own rectangle of `out`: the workers never write the same
+  // pixel.
   pool_.parallelFor(n, [&](size_t i, int worker) {
     const display::SubFrustumCell& cell = plan.cells[i];
     if (!cell.fitted) return;
     RenderOptions co = o;
     co.width = cell.x1 - cell.x0;
     co.height = cell.y1 - cell.y0;
-    output::LinearImage& image = cellImages_[size_t(worker)];
     FrameCamera camera = cellCamera(base, cell, eye);
     if (lights) camera.lightSubset = &cellLights_[i];
-    cellErrors_[i] =
-        workers_[size_t(worker)]->renderLinear(scene, co, camera, image, cellStats_[i]);
-    if (!cellErrors_[i]) return;
-    for (int y = 0; y < co.height; ++y)
-      std::memcpy(&out.rgb[(size_t(cell.y0 + y) * size_t(o.width) + size_t(cell.x0)) * 3],
-                  &image.rgb[size_t(y) * size_t(co.width) * 3], size_t(co.width) * 6);
+    cellErrors_[i] = workers_[size_t(worker)]->renderLinear(
+        scene, co, camera, output::LinearTarget{&out, cell.x0, cell.y0, co.width, co.height},
+        cellStats_[i]);
   });
   SubFrustumStats counts;
   counts.unfittedPixels = plan.unfittedPixels;

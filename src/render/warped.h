@@ -60,7 +60,6 @@ class SubFrustumRenderer {
 
   core::ThreadPool pool_;
   std::vector<std::unique_ptr<ViewRenderer>> workers_;  // one per pool worker, one thread each
-  std::vector<output::LinearImage> cellImages_;         // one per worker
   std::vector<FrameStats> cellStats_;                   // one per cell, this frame
   std::vector<Status> cellErrors_;                      // likewise
   std::vector<std::vector<uint32_t>> cellLights_;       // likewise (cullLights)
