@@ -258,8 +258,7 @@ Status runDisplayBench(const scene::Scene& sc, const BenchSettings& s, CaseResul
                                               frame->linear[0], run->stats, cs);
           !st)
         return st;
-      output::prepareImage(centre.table.width, centre.table.height, run->image);
-      output::encodeRows(frame->linear[0], warped.gamma(), 0, centre.table.height, run->image);
+      warped.encode(frame->linear[0], s.options, run->image);
       if (i >= s.warmup) run->frameMs.push_back(msSince(t));
     }
   }

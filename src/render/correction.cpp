@@ -18,7 +18,20 @@ Result<Correction> parseCorrection(const std::string& text) {
 }
 
 CorrectionRenderer::CorrectionRenderer(const RenderOptions& options)
-    : options_(options), gamma_(gammaTableOf(options)) {}
+    : options_(options), gamma_(gammaTableOf(options)), pool_(resolveThreads(options.threads)) {}
+
+void CorrectionRenderer::encode(const output::LinearImage& linear, const RenderOptions& o,
+                                Image& image) {
+  output::prepareImage(linear.width, linear.height, image);
+  constexpr int kBand = 16;  // rows per task
+  pool_.parallelFor(size_t((linear.height + kBand - 1) / kBand), [&](size_t band, int) {
+    const int y0 = int(band) * kBand, y1 = std::min(linear.height, y0 + kBand);
+    if (o.filter == RenderOptions::Filter::tent3)
+      output::tentFilterRows(linear, gamma_, y0, y1, image);
+    else
+      output::encodeRows(linear, gamma_, y0, y1, image);
+  });
+}
 
 SubFrustumRenderer& CorrectionRenderer::cells() {
   if (!cells_) cells_.emplace(options_);
@@ -117,7 +130,7 @@ Status renderCorrected(CorrectionRenderer& renderer, const scene::Scene& scene,
                                                : display::ResampleFilter::bilinear;
     constexpr int kBand = 16;  // rows per task
     const uint16_t* flatRgb = renderer.flatImage().rgb.data();
-    flat.pool().parallelFor(size_t((table.height + kBand - 1) / kBand), [&](size_t band, int) {
+    renderer.pool().parallelFor(size_t((table.height + kBand - 1) / kBand), [&](size_t band, int) {
       const int y0 = int(band) * kBand;
       display::resampleRows(*warp, flatRgb, filter, y0, std::min(table.height, y0 + kBand),
                             out.rgb.data());
@@ -256,11 +269,7 @@ Status renderDisplay(CorrectionRenderer& renderer, const scene::Scene& scene,
       return e;
     }
     const output::LinearImage& linear = frame.linear[i];
-    output::prepareImage(linear.width, linear.height, frame.images[i]);
-    if (o.filter == RenderOptions::Filter::tent3)
-      output::tentFilterRows(linear, renderer.gamma(), 0, linear.height, frame.images[i]);
-    else
-      output::encodeRows(linear, renderer.gamma(), 0, linear.height, frame.images[i]);
+    renderer.encode(linear, o, frame.images[i]);
     frame.stats[i].totalMs = core::msSince(start);
   }
   return {};

@@ -38,7 +38,8 @@ struct CorrectionStats {
 
 // What a display's frames are drawn with, kept from frame to frame: the cells' renderers (method
 // (a)) and a view renderer for the flat view (method (b)), each made on first use with the
-// options' threads, and the gamma table.
+// options' threads; the gamma table; threads for the work on whole display frames (resampling,
+// the gamma table).
 class CorrectionRenderer {
  public:
   explicit CorrectionRenderer(const RenderOptions& options);
@@ -46,10 +47,16 @@ class CorrectionRenderer {
   ViewRenderer& flat();
   output::LinearImage& flatImage() { return flatImage_; }  // (b): the flat view's
   const output::GammaTable& gamma() const { return gamma_; }
+  core::ThreadPool& pool() { return pool_; }
+
+  // A projector's frame from linear light to `image`: the tent filter when `o` asks for it, else
+  // the gamma table alone, in bands of rows on the threads.
+  void encode(const output::LinearImage& linear, const RenderOptions& o, Image& image);
 
  private:
   RenderOptions options_;
   output::GammaTable gamma_;
+  core::ThreadPool pool_;
   std::optional<SubFrustumRenderer> cells_;
   std::optional<ViewRenderer> flat_;
   output::LinearImage flatImage_;
