@@ -26,9 +26,49 @@ FrameCamera cellCamera(const FrameCamera& base, const display::SubFrustumCell& c
 
 namespace {
 
-// Cells per group of the light cull: consecutive cells of the plan's quadtree order lie together,
-// so a group's directions fit a narrow cone.
-constexpr size_t kCullGroup = 16;
+// The light cull's hierarchy: groups of kCullGroup consecutive cells, and of kCullGroups such
+// groups — consecutive cells of the plan's quadtree order lie together, so their directions fit
+// a narrow cone.
+constexpr size_t kCullGroup = 16, kCullGroups = 4;
+
+// A cone from the eye: unit axis, cosine of the half angle (−2: every direction).
+struct Cone {
+  Vec3d axis;
+  double cosHalf = -2;
+  bool empty = true;  // no fitted cell
+};
+
+// The cone of cells [c0, c1) of the plan: about the mean of their corner directions, out to the
+// farthest corner (a cell's directions form a convex spherical quadrilateral, inside the cap of
+// its corners), widened by `reach` pixels at twice the coarsest pixel angle at a cell's centre (a
+// cell's pixel angle varies by far less across it).
+Cone coneOf(const display::SubFrustumPlan& plan, size_t c0, size_t c1, double reach) {
+  std::vector<Vec3d> corners;
+  double pixelAngle = 0;
+  for (size_t i = c0; i < c1; ++i) {
+    const display::SubFrustumCell& c = plan.cells[i];
+    if (!c.fitted) continue;
+    for (const auto& [x, y] : {std::pair{c.x0, c.y0}, std::pair{c.x1, c.y0}, std::pair{c.x0, c.y1},
+                               std::pair{c.x1, c.y1}})
+      corners.push_back(display::mapPixel(c, x, y));
+    const double cx = 0.5 * (c.x0 + c.x1), cy = 0.5 * (c.y0 + c.y1);
+    const Vec3d centre = display::mapPixel(c, cx, cy);
+    pixelAngle = std::max({pixelAngle, angleBetween(centre, display::mapPixel(c, cx + 1, cy)),
+                           angleBetween(centre, display::mapPixel(c, cx, cy + 1))});
+  }
+  Cone cone;
+  if (corners.empty()) return cone;
+  cone.empty = false;
+  for (const Vec3d& d : corners) cone.axis = cone.axis + d;
+  const double len = std::sqrt(dot(cone.axis, cone.axis));
+  if (!(len > 0)) return cone;  // corners all around: every direction
+  cone.axis = cone.axis * (1 / len);
+  double half = 0;
+  for (const Vec3d& d : corners) half = std::max(half, angleBetween(cone.axis, d));
+  half += 2 * reach * pixelAngle;
+  if (half < std::numbers::pi) cone.cosHalf = std::cos(half);
+  return cone;
+}
 
 }  // namespace
 
@@ -36,57 +76,45 @@ void SubFrustumRenderer::cullLights(const scene::Scene& scene, const FrameCamera
                                     const display::SubFrustumPlan& plan) {
   std::vector<Vec4> positions;
   lights::lightEyePositions(lightInput(scene, base), positions);
-  lightDirections_.resize(positions.size());
+  lightDirections_.clear();
   for (size_t l = 0; l < positions.size(); ++l) {
     const Vec4& p = positions[l];
     const Vec3d d{p.x - eye.x * p.w, p.y - eye.y * p.w, p.z - eye.z * p.w};
     const double len = std::sqrt(dot(d, d));
-    lightDirections_[l] = len > 0 ? d * (1 / len) : Vec3d{0, 0, 0};  // at the eye: never drawn
+    if (len > 0) lightDirections_.push_back({d * (1 / len), uint32_t(l)});  // at the eye: never
   }
   // A splat reaches no pixel farther than its kernel radius from its centre (light_laws.h); a
   // pixel more covers the difference between the pass's float projection and the map's double.
   const scene::LightSettings& ls = scene.lightSettings;
   const double reach = lights::splatRadius(std::max(ls.minSize, ls.maxSize)) + 1;
   const size_t n = plan.cells.size();
+  const size_t span = kCullGroup * kCullGroups;
   cellLights_.resize(n);
-  pool_.parallelFor((n + kCullGroup - 1) / kCullGroup, [&](size_t g, int) {
-    const size_t c0 = g * kCullGroup, c1 = std::min(n, c0 + kCullGroup);
-    // The group's cone from the eye: about the mean of its cells' corner directions, out to the
-    // farthest corner (a cell's directions form a convex spherical quadrilateral, inside the cap
-    // of its corners), widened by `reach` pixels at twice the coarsest pixel angle at a cell's
-    // centre (a cell's pixel angle varies by far less across it).
-    std::vector<Vec3d> corners;
-    double pixelAngle = 0;
-    for (size_t i = c0; i < c1; ++i) {
-      cellLights_[i].clear();
-      const display::SubFrustumCell& c = plan.cells[i];
-      if (!c.fitted) continue;
-      for (const auto& [x, y] : {std::pair{c.x0, c.y0}, std::pair{c.x1, c.y0},
-                                 std::pair{c.x0, c.y1}, std::pair{c.x1, c.y1}})
-        corners.push_back(display::mapPixel(c, x, y));
-      const double cx = 0.5 * (c.x0 + c.x1), cy = 0.5 * (c.y0 + c.y1);
-      const Vec3d centre = display::mapPixel(c, cx, cy);
-      pixelAngle = std::max({pixelAngle, angleBetween(centre, display::mapPixel(c, cx + 1, cy)),
-                             angleBetween(centre, display::mapPixel(c, cx, cy + 1))});
-    }
-    if (corners.empty()) return;
-    Vec3d axis{0, 0, 0};
-    for (const Vec3d& d : corners) axis = axis + d;
-    axis = axis * (1 / std::sqrt(dot(axis, axis)));
-    double half = 0;
-    for (const Vec3d& d : corners) half = std::max(half, angleBetween(axis, d));
-    half += 2 * reach * pixelAngle;
-    const double cosHalf = half < std::numbers::pi ? std::cos(half) : -2;
-    for (uint32_t l = 0; l < lightDirections_.size(); ++l) {
-      const Vec3d d = lightDirections_[l];
-      if (dot(d, axis) < cosHalf || dot(d, d) == 0) continue;
+  for (std::vector<uint32_t>& list : cellLights_) list.clear();
+  // Lights in light order through each level, so every cell's list comes out ascending.
+  pool_.parallelFor((n + span - 1) / span, [&](size_t top, int) {
+    const size_t t0 = top * span, t1 = std::min(n, t0 + span);
+    const Cone outer = coneOf(plan, t0, t1, reach);
+    if (outer.empty) return;
+    std::vector<const LightDirection*> inOuter, inGroup;
+    for (const LightDirection& l : lightDirections_)
+      if (dot(l.direction, outer.axis) >= outer.cosHalf) inOuter.push_back(&l);
+    for (size_t c0 = t0; c0 < t1; c0 += kCullGroup) {
+      const size_t c1 = std::min(t1, c0 + kCullGroup);
+      const Cone group = coneOf(plan, c0, c1, reach);
+      if (group.empty) continue;
+      inGroup.clear();
+      for (const LightDirection* l : inOuter)
+        if (dot(l->direction, group.axis) >= group.cosHalf) inGroup.push_back(l);
       for (size_t i = c0; i < c1; ++i) {
         const display::SubFrustumCell& c = plan.cells[i];
         if (!c.fitted) continue;
-        const std::optional<display::PixelPoint> p = display::mapDirection(c, d);
-        if (p && p->x >= c.x0 - reach && p->x <= c.x1 + reach && p->y >= c.y0 - reach &&
-            p->y <= c.y1 + reach)
-          cellLights_[i].push_back(l);
+        for (const LightDirection* l : inGroup) {
+          const std::optional<display::PixelPoint> p = display::mapDirection(c, l->direction);
+          if (p && p->x >= c.x0 - reach && p->x <= c.x1 + reach && p->y >= c.y0 - reach &&
+              p->y <= c.y1 + reach)
+            cellLights_[i].push_back(l->index);
+        }
       }
     }
   });

@@ -63,7 +63,11 @@ class SubFrustumRenderer {
   std::vector<FrameStats> cellStats_;                   // one per cell, this frame
   std::vector<Status> cellErrors_;                      // likewise
   std::vector<std::vector<uint32_t>> cellLights_;       // likewise (cullLights)
-  std::vector<Vec3d> lightDirections_;  // unit, from the display's eye; 0 for a light at the eye
+  struct LightDirection {
+    Vec3d direction;  // unit, from the display's eye
+    uint32_t index;   // the light's (LightInput::subset)
+  };
+  std::vector<LightDirection> lightDirections_;  // this frame's, but for a light at the eye
 };
 
 }  // namespace sv::render
