@@ -142,8 +142,15 @@ Status SubFrustumRenderer::render(const scene::Scene& scene, const RenderOptions
   if (!valid.empty() && valid.size() != size_t(o.width) * size_t(o.height))
     return Error{"", "", "the display's valid-pixel mask does not match its size"};
   out.resize(o.width, o.height);
-  std::fill(out.rgb.begin(), out.rgb.end(), uint16_t(0));
   const size_t n = plan.cells.size();
+  // Every pixel is written: a fitted cell's by its view; an unfitted cell's, and one that is
+  // invalid, black. Pixels outside every cell are invalid (the plan's cells hold every valid one):
+  // without a mask to say so, the frame starts black.
+  int64_t covered = 0;
+  for (const display::SubFrustumCell& c : plan.cells)
+    covered += int64_t(c.x1 - c.x0) * int64_t(c.y1 - c.y0);
+  if (valid.empty() && covered != int64_t(o.width) * int64_t(o.height))
+    std::fill(out.rgb.begin(), out.rgb.end(), uint16_t(0));
   cellStats_.assign(n, FrameStats{});
   cellErrors_.assign(n, Status{});
   const bool lights = !scene.lightPoints.empty() || !scene.stars.stars.empty();
@@ -152,7 +159,12 @@ Status SubFrustumRenderer::render(const scene::Scene& scene, const RenderOptions
   // pixel.
   pool_.parallelFor(n, [&](size_t i, int worker) {
     const display::SubFrustumCell& cell = plan.cells[i];
-    if (!cell.fitted) return;
+    if (!cell.fitted) {
+      for (int y = cell.y0; y < cell.y1; ++y)
+        std::fill_n(&out.rgb[(size_t(y) * size_t(o.width) + size_t(cell.x0)) * 3],
+                    size_t(cell.x1 - cell.x0) * 3, uint16_t(0));
+      return;
+    }
     RenderOptions co = o;
     co.width = cell.x1 - cell.x0;
     co.height = cell.y1 - cell.y0;
