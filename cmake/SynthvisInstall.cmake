@@ -7,7 +7,7 @@
 include(CMakePackageConfigHelpers)
 
 set(SV_INSTALLED_STAGES sv_core sv_texture sv_terrain sv_scene sv_geometry sv_shade sv_raster sv_freeform
-    sv_lights sv_lines sv_volume sv_display
+    sv_lights sv_lines sv_segments sv_volume sv_display
     sv_output sv_render)
 foreach(lib IN LISTS SV_INSTALLED_STAGES)
   string(REPLACE "sv_" "" stage ${lib})
@@ -27,7 +27,7 @@ install(FILES ${PROJECT_BINARY_DIR}/synthvisConfig.cmake
 # pkg-config: the libraries in link order (each before what it uses); the dependencies' own .pc
 # files in Requires, since the libraries are static.
 set(SV_PC_LIBS "")
-foreach(lib sv_render sv_display sv_output sv_volume sv_lines sv_lights sv_freeform sv_raster sv_shade sv_geometry sv_scene sv_terrain sv_texture
+foreach(lib sv_render sv_display sv_output sv_volume sv_segments sv_lines sv_lights sv_freeform sv_raster sv_shade sv_geometry sv_scene sv_terrain sv_texture
             sv_core)
   string(APPEND SV_PC_LIBS " -l${lib}")
 endforeach()
