@@ -87,6 +87,7 @@ struct RenderArgs {
   std::string filter = "box";
   std::string textureFilter = "trilinear";
   std::string hsr = "zbuffer";
+  std::string pipeline = "tiles";
   std::string freeform = "raycast";
   std::string terrainFilter = "scene";
   bool noCull = false;
@@ -237,6 +238,9 @@ int runRender(const RenderArgs& a) {
   auto hsr = sv::parseHsr(a.hsr);
   if (!hsr) return fail(hsr.error());
   o.hsr = hsr.value();
+  auto pipeline = sv::parsePipeline(a.pipeline);
+  if (!pipeline) return fail(pipeline.error());
+  o.pipeline = pipeline.value();
   if (a.freeform != "raycast" && a.freeform != "march")
     return fail(
         {"", "", fmt::format("unknown free-form method '{}' (raycast or march)", a.freeform)});
@@ -458,10 +462,11 @@ int runBench(BenchArgs a) {
   if (a.renderer.empty()) a.renderer = a.suite.empty() ? "synthvis" : "both";
   if (a.renderer != "synthvis" && a.renderer != "gl" && a.renderer != "both" &&
       a.renderer != "sphere-trace" && a.renderer != "tessellated" &&
-      a.renderer != "full-detail" && a.renderer != "vtk" && a.renderer != "display")
+      a.renderer != "full-detail" && a.renderer != "vtk" && a.renderer != "display" &&
+      a.renderer != "segments")
     return fail({"", "",
                  fmt::format("unknown renderer '{}' (synthvis, gl, vtk, both, sphere-trace, "
-                             "tessellated, full-detail or display)",
+                             "tessellated, full-detail, display or segments)",
                              a.renderer)});
   if (auto order = sv::scene::parseSubmitOrder(a.generator.order); !order)
     return fail(order.error());
@@ -508,6 +513,7 @@ int runBench(BenchArgs a) {
   settings.tessellated = a.renderer == "tessellated";
   settings.fullDetail = a.renderer == "full-detail";
   settings.display = a.renderer == "display";
+  settings.pipelines = a.renderer == "segments";
   settings.reference = a.renderer == "gl" || a.renderer == "both";
   ref::BenchRunner runner(settings);
   if (settings.reference) {
@@ -848,6 +854,12 @@ void addRenderOptions(CLI::App* render, RenderArgs& r) {
                    "priority, nearest first) or hybrid (masking with depth: any order)")
       ->capture_default_str();
   render
+      ->add_option("--pipeline", r.pipeline,
+                   "rasterization: tiles (recursive subdivision, masks, masking) or segments "
+                   "(seed 002's scan-line segments, priority X-sort into RUN codes; polygons with "
+                   "vertex colours, one sample per pixel, priority order)")
+      ->capture_default_str();
+  render
       ->add_option("--texture-filter", r.textureFilter,
                    "texture sampling for materials that do not choose: point, nearest, tri3, "
                    "bilinear, trilinear3, trilinear or aniso")
@@ -959,6 +971,8 @@ int main(int argc, char** argv) {
                     "detail (no instance culling, no levels of detail); display: the unwarped "
                     "view against the centre projector of --display cylinder3 pre-distorted "
                     "through sub-frusta (subfrusta) and by a flat view resampled (resampled); "
+                    "segments: the tile pipeline under priority masking against seed 002's "
+                    "segment pipeline (one sample, vertex colours); "
                     "default: synthvis for a scene, both for a suite");
   bench
       ->add_option("--march-steps", b.options.marchSteps,

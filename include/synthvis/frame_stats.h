@@ -61,6 +61,9 @@ struct FrameStats {
   // within the far plane and near the screen), and the line pass's time (its preparation plus the
   // busiest worker's tile work).
   uint64_t lines = 0, linesDrawn = 0;
+  // The segment pipeline (SPEC §10, RenderOptions::Pipeline::segments): segments sorted, and RUN
+  // codes read (a run per change of the visible segment along a line).
+  uint64_t segments = 0, segmentRuns = 0;
   double linesMs = 0;
   // Volumes (the volume pass): volumes in the frame, pixels whose ray met one, samples classified,
   // samples stepped over in empty regions, and rays ended by their transparency (early ray

@@ -68,6 +68,13 @@ struct RenderOptions {
   // hybrid — masking combined with depth bounds per window, the Z-buffer's image for any order,
   // fastest when the order is roughly front to back.
   enum class Hsr { zbuffer, priority, hybrid } hsr = Hsr::zbuffer;
+  // The rasterization pipeline: the tiles (recursive 2×2 subdivision, masks, masking and the
+  // passes), or seed 002's segment pipeline (SPEC §10) — each scan line's segments in priority
+  // order, sorted by overwrite into RUN codes, each run shaded along it. The segment pipeline's
+  // visibility is priority (the scene's triangles in the order Hsr::priority draws them, whatever
+  // `hsr` says); so far it draws polygons with vertex colours at one sample per pixel (issue 35):
+  // a scene or options needing more are refused.
+  enum class Pipeline { tiles, segments } pipeline = Pipeline::tiles;
   // How free forms (Scene::freeForms) are drawn: multi-level ray casting (SPEC §12), or — the
   // baseline it is measured against — every pixel marched front to back in `marchSteps` equal
   // steps of depth (in the cube the view volume is mapped onto), its first sign change bisected.
@@ -97,6 +104,10 @@ struct RenderOptions {
 // interpolated surface's normals and the draped image's texture coordinates (or the colour ramp
 // as vertex colours).
 Result<scene::Scene> tessellatedScene(const scene::Scene& scene, const RenderOptions& options);
+
+// By name, as the CLI's --pipeline writes them: "tiles", "segments".
+Result<RenderOptions::Pipeline> parsePipeline(const std::string& text);
+const char* pipelineName(RenderOptions::Pipeline pipeline);
 
 // By name, as the CLI's --hsr writes them: "zbuffer", "priority", "hybrid".
 Result<RenderOptions::Hsr> parseHsr(const std::string& text);

@@ -42,6 +42,7 @@ FrameStats& FrameStats::operator+=(const FrameStats& o) {
   terrainLoadMs = std::max(terrainLoadMs, o.terrainLoadMs);
   lightPoints += o.lightPoints, lightsDrawn += o.lightsDrawn, lightsMs += o.lightsMs;
   lines += o.lines, linesDrawn += o.linesDrawn, linesMs += o.linesMs;
+  segments += o.segments, segmentRuns += o.segmentRuns;
   volumes += o.volumes, volumeRays += o.volumeRays, volumeSamples += o.volumeSamples;
   volumeSkipped += o.volumeSkipped, volumeTerminated += o.volumeTerminated;
   vertexMs += o.vertexMs, setupMs += o.setupMs, rasterMs += o.rasterMs, totalMs += o.totalMs;
@@ -85,6 +86,8 @@ std::string FrameStats::summary() const {
                       : std::string()) +
          (lines ? fmt::format(" | lines {}: drawn {}, {:.2f} ms", lines, linesDrawn, linesMs)
                 : std::string()) +
+         (segments ? fmt::format(" | segments {}: runs {}", segments, segmentRuns)
+                   : std::string()) +
          (volumes ? fmt::format(" | volumes {}: rays {}, samples {}, skipped {}, terminated {}",
                                 volumes, volumeRays, volumeSamples, volumeSkipped,
                                 volumeTerminated)

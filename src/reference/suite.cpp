@@ -272,6 +272,40 @@ Status runDisplayBench(const scene::Scene& sc, const BenchSettings& s, CaseResul
   return {};
 }
 
+// BenchSettings::pipelines: the tile pipeline under priority masking and the segment pipeline,
+// frame by frame.
+Status runPipelinesBench(const scene::Scene& sc, const BenchSettings& s, CaseResult& r) {
+  if (!sc.channels.empty()) return Error{"", "", "segments: the scene's camera view, not channels"};
+  RenderOptions tileOptions = s.options, segmentOptions = s.options;
+  tileOptions.hsr = RenderOptions::Hsr::priority;
+  tileOptions.pipeline = RenderOptions::Pipeline::tiles;
+  segmentOptions.pipeline = RenderOptions::Pipeline::segments;
+  if (Status st = validate(segmentOptions); !st) return st;
+  Renderer tiles(tileOptions), segments(segmentOptions);
+  RendererRun a{"synthvis", "synthvis, the tile pipeline under priority masking",
+                {}, 0, 0, 0, {}, {}, {}};
+  RendererRun b{"segments", "synthvis, seed 002's segment pipeline", {}, 0, 0, 0, {}, {}, {}};
+  for (int i = 0; i < s.warmup + s.frames; ++i) {
+    for (auto [run, renderer] : {std::pair{&a, &tiles}, std::pair{&b, &segments}}) {
+      run->stats = {};
+      const auto t = Clock::now();
+      if (Status st = renderer->render(sc, run->image, &run->stats); !st) return st;
+      if (i >= s.warmup) run->frameMs.push_back(msSince(t));
+    }
+  }
+  for (RendererRun* run : {&a, &b}) {
+    finish(*run);
+    r.runs.push_back(std::move(*run));
+  }
+  const FrameStats& st = r.runs[1].stats;
+  r.psnrDb = psnr(r.runs[0].image, r.runs[1].image);
+  r.params["pipeline"] = "segments against tiles (priority masking)";
+  r.params["segments_per_frame"] = st.segments;
+  r.params["runs_per_frame"] = st.segmentRuns;
+  r.params["segments_per_second"] = double(st.segments) / (r.runs[1].medianMs / 1000);
+  return {};
+}
+
 }  // namespace
 
 Result<CaseResult> BenchRunner::run(const BenchCase& c) {
@@ -311,6 +345,12 @@ Result<CaseResult> BenchRunner::run(const BenchCase& c) {
     if (impl_->gl || s.vtk)
       return Error{"", "", "display: the warped views are measured against synthvis unwarped"};
     if (Status st = runDisplayBench(sc, s, r); !st) return st.error();
+    return r;
+  }
+  if (s.pipelines) {
+    if (impl_->gl || s.vtk)
+      return Error{"", "", "segments: the segment pipeline is measured against the tile pipeline"};
+    if (Status st = runPipelinesBench(sc, s, r); !st) return st.error();
     return r;
   }
   std::optional<RendererRun> ours, ref;

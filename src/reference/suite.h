@@ -104,6 +104,11 @@ struct BenchSettings {
   // bilinear (method (b), "resampled"), each frame beside the unwarped view ("synthvis"). synthvis
   // only.
   bool display = false;
+  // Issue 35's benchmark: instead of a reference renderer, the segment pipeline
+  // (RenderOptions::Pipeline::segments, renderer name "segments") beside the tile pipeline under
+  // priority masking ("synthvis") — the same visibility — frame by frame; the case's params give
+  // the segment pipeline's segments and runs a frame and its segments per second. synthvis only.
+  bool pipelines = false;
 };
 
 // Renders, per case, warm-up frames then timed frames, alternating synthvis and the reference

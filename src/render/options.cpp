@@ -44,7 +44,26 @@ Status validate(const RenderOptions& o) {
     return Error{"", "", fmt::format("LOD scale {} is out of range (1e-6…1e6)", o.lodScale)};
   if (o.gamma != 0 && !(o.gamma >= 0.5 && o.gamma <= 5))
     return Error{"", "", fmt::format("gamma {} is out of range (0.5…5, or 0 for sRGB)", o.gamma)};
+  if (o.pipeline == RenderOptions::Pipeline::segments) {
+    if (o.samples != 1 || o.supersample != 1)
+      return Error{"", "",
+                   "the segment pipeline draws one sample per pixel so far (its recipient–donor "
+                   "anti-aliasing is not built): drop --aa and --supersample"};
+    if (o.filter != RenderOptions::Filter::box)
+      return Error{"", "", "the segment pipeline has no tent filter yet: drop --filter tent3"};
+    if (debug) return Error{"", "", "the debug views show the tile pipeline"};
+  }
   return {};
+}
+
+Result<RenderOptions::Pipeline> parsePipeline(const std::string& text) {
+  if (text == "tiles") return RenderOptions::Pipeline::tiles;
+  if (text == "segments") return RenderOptions::Pipeline::segments;
+  return Error{"", "", fmt::format("unknown pipeline '{}' (tiles or segments)", text)};
+}
+
+const char* pipelineName(RenderOptions::Pipeline pipeline) {
+  return pipeline == RenderOptions::Pipeline::segments ? "segments" : "tiles";
 }
 
 Result<RenderOptions::Hsr> parseHsr(const std::string& text) {

@@ -34,7 +34,8 @@ constexpr int kBand = 16;
 }  // namespace
 
 void SegmentRenderer::render(const DrawPackets& packets, const SegmentSettings& s,
-                             const output::GammaTable& gamma, Image& image, SegmentStats& stats) {
+                             const output::GammaTable& gamma, core::ThreadPool& pool, Image& image,
+                             FrameStats& stats) {
   const auto t0 = core::Clock::now();
   output::prepareImage(s.width, s.height, image);
   geometry::Viewport vp;
@@ -42,10 +43,10 @@ void SegmentRenderer::render(const DrawPackets& packets, const SegmentSettings& 
   vp.height = s.height;
   // Setup, in parallel chunks, every triangle with its call's culling: the tile pipeline's records.
   const size_t n = packets.indices.size() / 3;
-  std::vector<geometry::TriangleSetup> all(n);
-  drawn_.assign(n, 0);
+  all_.resize(n);
+  outcome_.resize(n);
   constexpr size_t kChunk = 4096;
-  pool_.parallelFor((n + kChunk - 1) / kChunk, [&](size_t c, int) {
+  pool.parallelFor((n + kChunk - 1) / kChunk, [&](size_t c, int) {
     const size_t end = std::min(n, (c + 1) * kChunk);
     size_t call = 0;
     for (size_t tri = c * kChunk; tri < end; ++tri) {
@@ -55,14 +56,23 @@ void SegmentRenderer::render(const DrawPackets& packets, const SegmentSettings& 
       const geometry::CullMode cull =
           call < packets.calls.size() ? packets.calls[call].cull : geometry::CullMode::none;
       const uint32_t* i = &packets.indices[tri * 3];
-      drawn_[tri] = geometry::setupTriangle(packets.vertices[i[0]], packets.vertices[i[1]],
-                                            packets.vertices[i[2]], vp, cull,
-                                            all[tri]) == geometry::SetupOutcome::drawn;
+      outcome_[tri] =
+          uint8_t(geometry::setupTriangle(packets.vertices[i[0]], packets.vertices[i[1]],
+                                          packets.vertices[i[2]], vp, cull, all_[tri]));
     }
   });
   setups_.clear();
-  for (size_t tri = 0; tri < n; ++tri)
-    if (drawn_[tri]) setups_.push_back(all[tri]);
+  uint64_t counts[5] = {};
+  for (size_t tri = 0; tri < n; ++tri) {
+    ++counts[outcome_[tri]];
+    if (outcome_[tri] == uint8_t(geometry::SetupOutcome::drawn)) setups_.push_back(all_[tri]);
+  }
+  stats.trianglesIn += n;
+  stats.drawn += counts[int(geometry::SetupOutcome::drawn)];
+  stats.culledFacing += counts[int(geometry::SetupOutcome::culledFacing)];
+  stats.culledOutside += counts[int(geometry::SetupOutcome::culledOutside)];
+  stats.culledDegenerate += counts[int(geometry::SetupOutcome::culledDegenerate)];
+  stats.culledInvalid += counts[int(geometry::SetupOutcome::culledInvalid)];
   // The drawn triangles bucketed by their first row, priority order kept within a row.
   const size_t m = setups_.size();
   firstRow_.assign(size_t(s.height) + 1, 0);
@@ -73,7 +83,6 @@ void SegmentRenderer::render(const DrawPackets& packets, const SegmentSettings& 
     std::vector<uint32_t> next(firstRow_.begin(), firstRow_.end() - 1);
     for (uint32_t k = 0; k < m; ++k) byRow_[next[size_t(setups_[k].minY)]++] = k;
   }
-  stats.triangles += m;
   stats.setupMs += core::msSince(t0);
 
   const auto t1 = core::Clock::now();
@@ -82,8 +91,11 @@ void SegmentRenderer::render(const DrawPackets& packets, const SegmentSettings& 
     clear[c] = uint16_t(std::lround(std::clamp(s.clearColor[c], 0.0f, 1.0f) * 65535.0f));
   const uint32_t background = uint32_t(m);  // no triangle's number
   const int bands = (s.height + kBand - 1) / kBand;
-  std::vector<SegmentStats> bandStats(static_cast<size_t>(bands));
-  pool_.parallelFor(size_t(bands), [&](size_t band, int) {
+  struct Counts {
+    uint64_t segments = 0, runs = 0;
+  };
+  std::vector<Counts> bandCounts(static_cast<size_t>(bands));
+  pool.parallelFor(size_t(bands), [&](size_t band, int) {
     const int y0 = int(band) * kBand, y1 = std::min(s.height, y0 + kBand);
     segments::XSorter sorter(s.width);
     std::vector<segments::Run> runs;
@@ -93,7 +105,7 @@ void SegmentRenderer::render(const DrawPackets& packets, const SegmentSettings& 
     for (uint32_t k = 0; k < firstRow_[size_t(y0)]; ++k)
       if (setups_[byRow_[k]].maxY >= y0) active.push_back(byRow_[k]);
     std::sort(active.begin(), active.end());
-    SegmentStats& st = bandStats[band];
+    Counts& st = bandCounts[band];
     for (int y = y0; y < y1; ++y) {
       const auto first = byRow_.begin() + firstRow_[size_t(y)];
       const auto last = byRow_.begin() + firstRow_[size_t(y) + 1];
@@ -126,17 +138,16 @@ void SegmentRenderer::render(const DrawPackets& packets, const SegmentSettings& 
         for (int x = xa; x < xb; ++x) {
           const float w = 1.0f / planeAt(t.invW, x, y, t.minX, t.minY);
           for (int c = 0; c < 3; ++c)
-            row[3 * x + c] =
-                gamma.table[unitToCode(planeAt(*planes[c], x, y, t.minX, t.minY) * w)];
+            row[3 * x + c] = gamma.table[unitToCode(planeAt(*planes[c], x, y, t.minX, t.minY) * w)];
         }
       }
     }
   });
-  for (const SegmentStats& b : bandStats) {
+  for (const Counts& b : bandCounts) {
     stats.segments += b.segments;
-    stats.runs += b.runs;
+    stats.segmentRuns += b.runs;
   }
-  stats.linesMs += core::msSince(t1);
+  stats.rasterMs += core::msSince(t1);
 }
 
 }  // namespace sv::render

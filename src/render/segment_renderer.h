@@ -18,6 +18,7 @@
 #include "output/resolve.h"
 #include "render/draw_packets.h"
 #include "segments/x_sort.h"
+#include "synthvis/frame_stats.h"
 
 namespace sv::render {
 
@@ -26,28 +27,20 @@ struct SegmentSettings {
   float clearColor[3] = {0, 0, 0};  // linear
 };
 
-struct SegmentStats {
-  uint64_t triangles = 0;  // set up and drawn (the rest culled as the tile pipeline culls them)
-  uint64_t segments = 0;   // non-empty segments sorted
-  uint64_t runs = 0;       // RUN codes read (a run per change of the visible segment)
-  double setupMs = 0, linesMs = 0;
-};
-
 class SegmentRenderer {
  public:
-  explicit SegmentRenderer(int threads) : pool_(threads) {}
-
   // The frame of `packets` (vertex colours: the Gouraud shading of the tile pipeline's
-  // ShadeMode::gouraud) into `image` (sized here), through `gamma`.
+  // ShadeMode::gouraud) into `image` (sized here), through `gamma`, on `pool`'s threads; adds the
+  // triangles' outcomes (culled as the tile pipeline culls them), the segments and runs, and the
+  // times (setup; the lines as rasterMs) to `stats`.
   void render(const DrawPackets& packets, const SegmentSettings& settings,
-              const output::GammaTable& gamma, Image& image, SegmentStats& stats);
-
-  core::ThreadPool& pool() { return pool_; }
+              const output::GammaTable& gamma, core::ThreadPool& pool, Image& image,
+              FrameStats& stats);
 
  private:
-  core::ThreadPool pool_;
+  std::vector<geometry::TriangleSetup> all_;     // every packet triangle's record
+  std::vector<uint8_t> outcome_;                 // per packet triangle: its SetupOutcome
   std::vector<geometry::TriangleSetup> setups_;  // the drawn triangles', in priority order
-  std::vector<uint8_t> drawn_;                   // per packet triangle: set up and drawn
   std::vector<uint32_t> firstRow_;               // per row: its first starting triangle in byRow_
   std::vector<uint32_t> byRow_;                  // drawn triangles by first row, priority within
 };

@@ -1,5 +1,7 @@
 #include "render/view_renderer.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <thread>
 
@@ -48,6 +50,13 @@ Status ViewRenderer::run(const scene::Scene& scene, const RenderOptions& o,
                          const FrameCamera& camera, Image& image,
                          const output::LinearTarget* linearOut, FrameStats& stats) {
   const auto start = core::Clock::now();
+  if (o.pipeline == RenderOptions::Pipeline::segments) {
+    if (linearOut)
+      return Error{"", "", "the segment pipeline draws images, not views in linear light"};
+    if (Status s = runSegments(scene, o, camera, image, stats); !s) return s;
+    stats.totalMs = core::msSince(start);
+    return {};
+  }
   // Stage 2: the shading stage's tables in the camera's eye space.
   buildShading(scene, o, camera.view, shading_);
   const bool pixelShading = shading_.any && o.debugView == RenderOptions::DebugView::none;
@@ -73,6 +82,41 @@ Status ViewRenderer::run(const scene::Scene& scene, const RenderOptions& o,
   frame_.render(packets_, fs, stats);
   stats.rasterMs += sink.finish(frame_.pool());
   stats.totalMs = core::msSince(start);
+  return {};
+}
+
+Status ViewRenderer::runSegments(const scene::Scene& scene, const RenderOptions& o,
+                                 const FrameCamera& camera, Image& image, FrameStats& stats) {
+  // What the segment pipeline does not draw yet (issue 35) is refused, not dropped.
+  const char* missing = !scene.freeForms.empty()                                   ? "free forms"
+                        : !scene.terrains.empty()                                  ? "terrain"
+                        : !scene.volumes.empty()                                   ? "volumes"
+                        : !scene.lines.empty()                                     ? "lines"
+                        : !scene.lightPoints.empty() || !scene.stars.stars.empty() ? "light points"
+                                                                                   : nullptr;
+  if (missing)
+    return Error{
+        "", "",
+        fmt::format("the segment pipeline draws polygons only so far: the scene has {}", missing)};
+  buildShading(scene, o, camera.view, shading_);
+  if (shading_.any)
+    return Error{"", "",
+                 "the segment pipeline draws vertex colours only so far: the scene's materials "
+                 "need pixel shading (lighting, texture or fog)"};
+  // Stage 3: every instance's vertices to clip space, in the priority order masking draws in.
+  RenderOptions po = o;
+  po.hsr = RenderOptions::Hsr::priority;
+  const auto t0 = core::Clock::now();
+  if (Status s = buildDrawPackets(scene, po, camera, nullptr, frame_.pool(), packets_); !s)
+    return s;
+  stats.vertexMs = core::msSince(t0);
+  SegmentSettings ss;
+  ss.width = o.width;
+  ss.height = o.height;
+  ss.clearColor[0] = scene.background.x;
+  ss.clearColor[1] = scene.background.y;
+  ss.clearColor[2] = scene.background.z;
+  segments_.render(packets_, ss, gamma_, frame_.pool(), image, stats);
   return {};
 }
 

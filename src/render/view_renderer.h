@@ -10,6 +10,7 @@
 #include "render/draw_packets.h"
 #include "render/frame_renderer.h"
 #include "render/passes.h"
+#include "render/segment_renderer.h"
 #include "render/shading_tables.h"
 #include "synthvis/frame_stats.h"
 #include "synthvis/render.h"
@@ -44,10 +45,14 @@ class ViewRenderer {
   const output::GammaTable& gamma() const { return gamma_; }
 
  private:
+  // The segment pipeline's view (RenderOptions::Pipeline::segments) into `image`.
+  Status runSegments(const scene::Scene& scene, const RenderOptions& o, const FrameCamera& camera,
+                     Image& image, FrameStats& stats);
   Status run(const scene::Scene& scene, const RenderOptions& o, const FrameCamera& camera,
              Image& image, const output::LinearTarget* linearOut, FrameStats& stats);
 
   FrameRenderer frame_;
+  SegmentRenderer segments_;
   output::GammaTable gamma_;
   ShadingTables shading_;
   DrawPackets packets_;

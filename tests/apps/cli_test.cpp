@@ -59,6 +59,35 @@ TEST(Cli, RendersTheDemoSceneAndPrintsOneStatsLine) {
   EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
 }
 
+TEST(Cli, TheSegmentPipelineDrawsThePriorityImageAndRefusesWhatItCannotDraw) {
+  // --pipeline segments on a scene of vertex colours: the bytes of the tile pipeline under
+  // priority masking; on the airport (light points) and with --aa: a one-line error.
+  const std::string scene = std::string(SV_SOURCE_DIR) + "/scenes/mixed.json";
+  const std::string seg = (tempDir() / "segments.png").string();
+  const std::string tiles = (tempDir() / "tiles.png").string();
+  const CliRun a =
+      run("render " + scene + " -o " + seg + " --width 160 --height 96 --pipeline segments");
+  EXPECT_EQ(a.status, 0) << a.out;
+  EXPECT_NE(a.out.find("segments "), std::string::npos) << a.out;
+  const CliRun b =
+      run("render " + scene + " -o " + tiles + " --width 160 --height 96 --hsr priority");
+  EXPECT_EQ(b.status, 0) << b.out;
+  std::ifstream fa(seg, std::ios::binary), fb(tiles, std::ios::binary);
+  const std::string bytesA((std::istreambuf_iterator<char>(fa)), {});
+  const std::string bytesB((std::istreambuf_iterator<char>(fb)), {});
+  EXPECT_FALSE(bytesA.empty());
+  EXPECT_EQ(bytesA, bytesB);
+  const std::string airport = std::string(SV_SOURCE_DIR) + "/scenes/airport.json";
+  expectOneLineError(run("render " + airport + " -o " + seg + " --pipeline segments"), airport,
+                     "light points");
+  const CliRun aa = run("render " + scene + " -o " + seg + " --pipeline segments --aa 4");
+  EXPECT_EQ(aa.status, 1) << aa.out;
+  EXPECT_NE(aa.out.find("one sample per pixel"), std::string::npos) << aa.out;
+  const CliRun bad = run("render " + scene + " -o " + seg + " --pipeline scanlines");
+  EXPECT_EQ(bad.status, 1) << bad.out;
+  EXPECT_NE(bad.out.find("tiles or segments"), std::string::npos) << bad.out;
+}
+
 TEST(Cli, TruncatedJsonNamesFileAndPosition) {
   const std::string f =
       write("trunc.json", "{\"synthvis\": 1, \"objects\": [ {\"primitive\": \"box\"");
@@ -213,8 +242,10 @@ TEST(Cli, RenderTimeBlinksLightsAndBenchLightsWritesItsCounts) {
   expectOneLineError(run("render " + scene + " -o " + on + " --time nan"), "--time",
                      "not a finite number");
   const std::string json = (tempDir() / "bench_lights.json").string();
-  const CliRun c = run("bench lights --lights 3000 --stars none --width 160 --height 120 "
-                       "--frames 1 --warmup 0 --json " + json);
+  const CliRun c =
+      run("bench lights --lights 3000 --stars none --width 160 --height 120 "
+          "--frames 1 --warmup 0 --json " +
+          json);
   ASSERT_EQ(c.status, 0) << c.out;
   std::ifstream f(json);
   const nlohmann::json row = nlohmann::json::parse(f);

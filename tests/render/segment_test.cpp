@@ -2,11 +2,10 @@
 // drawn by both — the tiles under priority masking at one sample, resolved through the same gamma
 // table — give the same bytes, for ordinary and wild triangles (behind the eye, beyond the near
 // and far planes, huge), and any thread count gives the same image.
-#include "render/segment_renderer.h"
-
 #include <gtest/gtest.h>
 
 #include "output/resolve.h"
+#include "render/segment_renderer.h"
 #include "support/raster_harness.h"
 
 namespace sv {
@@ -30,12 +29,13 @@ TEST(SegmentPipeline, DrawsTheTilePipelinesPriorityMaskedImageByteForByte) {
       ss.height = h;
       std::copy_n(fs.clearColor, 3, ss.clearColor);
       std::vector<Image> images;
-      render::SegmentStats stats;
+      FrameStats stats;
       for (int threads : {1, 2, 5}) {
-        render::SegmentRenderer r(threads);
+        render::SegmentRenderer r;
+        core::ThreadPool pool(threads);
         images.emplace_back();
         stats = {};
-        r.render(p, ss, gamma, images.back(), stats);
+        r.render(p, ss, gamma, pool, images.back(), stats);
       }
       int differing = 0, drawn = 0;
       for (int y = 0; y < h; ++y)
@@ -47,7 +47,9 @@ TEST(SegmentPipeline, DrawsTheTilePipelinesPriorityMaskedImageByteForByte) {
       EXPECT_EQ(differing, 0) << "seed " << seed << (wild ? " wild" : "");
       EXPECT_GT(drawn, w * h);  // most pixels covered (counted once per channel)
       EXPECT_GT(stats.segments, 5000u);
-      EXPECT_GT(stats.runs, uint64_t(h));
+      EXPECT_GT(stats.segmentRuns, uint64_t(h));
+      EXPECT_EQ(stats.trianglesIn, 300u);
+      EXPECT_GT(stats.drawn, 100u);
       EXPECT_EQ(images[0].rgb, images[1].rgb);
       EXPECT_EQ(images[0].rgb, images[2].rgb);
     }
