@@ -50,6 +50,16 @@ FrameStats& FrameStats::operator+=(const FrameStats& o) {
 }
 
 std::string FrameStats::summary() const {
+  // A segment-pipeline frame (RenderOptions::Pipeline::segments) has no windows, fragments or
+  // tiles to report: its triangles, its segments and runs, and its times.
+  if (segments)
+    return fmt::format("triangles in {} / culled {} (facing {}, outside {}, degenerate {}, invalid "
+                       "{}) / drawn {} | segments {}: runs {} | {:.2f} ms (vertex {:.2f}, setup "
+                       "{:.2f}, lines {:.2f})",
+                       trianglesIn, culled(), culledFacing, culledOutside, culledDegenerate,
+                       culledInvalid, drawn, segments, segmentRuns, totalMs, vertexMs, setupMs,
+                       rasterMs) +
+           lodSummary();
   return fmt::format(
              "triangles in {} / culled {} (facing {}, outside {}{}, degenerate {}, invalid {}{}) / "
              "drawn {} "
@@ -86,8 +96,7 @@ std::string FrameStats::summary() const {
                       : std::string()) +
          (lines ? fmt::format(" | lines {}: drawn {}, {:.2f} ms", lines, linesDrawn, linesMs)
                 : std::string()) +
-         (segments ? fmt::format(" | segments {}: runs {}", segments, segmentRuns)
-                   : std::string()) +
+
          (volumes ? fmt::format(" | volumes {}: rays {}, samples {}, skipped {}, terminated {}",
                                 volumes, volumeRays, volumeSamples, volumeSkipped,
                                 volumeTerminated)
