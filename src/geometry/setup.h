@@ -79,6 +79,18 @@ struct Plane {
   float c0, dx, dy;
 };
 
+// A plane's value at the centre of pixel (x, y) of a triangle whose box starts at (minX, minY), in
+// the tile kernel's float operations and order (raster/kernel_common-inl.h, blockBases): the 4×4
+// block's base (c0 + dx·X) + dy·Y at its top-left pixel, plus the lane's offset dx·lx + dy·ly.
+// The scalar form, for what must match the kernel bit for bit: the brute-force reference
+// (tests/support) and the segment pipeline (render/segment_renderer.cpp).
+inline float planeAtPixel(const Plane& p, int x, int y, int minX, int minY) {
+  const float bx = float((x & ~3) - minX), by = float((y & ~3) - minY);
+  const float base = (p.c0 + p.dx * bx) + p.dy * by;
+  const float offset = p.dx * float(x & 3) + p.dy * float(y & 3);
+  return base + offset;
+}
+
 enum class CullMode : uint8_t { none, back, front };
 
 struct Viewport {

@@ -90,8 +90,8 @@ void ResolveSampleTile(const uint16_t* color, const int32_t* sums, int tileX, in
   finishImageRows();
 }
 
-// The same means into a linear-light image, interleaved RGB, no table; its rows written whole
-// (writeImageRow) for the same reason as the image's.
+// The same means into a linear-light image, interleaved RGB, no table; each row gathered, then
+// copied whole (plainly: a sub-frustum cell's rows are short and start anywhere).
 void ResolveSampleTileLinear(const uint16_t* color, const int32_t* sums, int tileX, int tileY,
                              int samples, const LinearTarget& t) {
   using namespace raster;
@@ -118,7 +118,6 @@ void ResolveSampleTileLinear(const uint16_t* color, const int32_t* sums, int til
                                       rgb + size_t(y0 + by + py) * stride + size_t(x0) * 3);
                         }
                       });
-  finishImageRows();
 }
 
 }  // namespace HWY_NAMESPACE

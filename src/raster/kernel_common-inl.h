@@ -100,8 +100,9 @@ HWY_INLINE void addToSums(DI di, VI count, const VI* c, const int32_t* clear, in
 
 // Parameters are evaluated per 4×4 block as base + offset: base = (c0 + dx·X) + dy·Y at the block's
 // top-left pixel (X, Y relative to the plane's origin), offset = dx·lx + dy·ly per lane, computed
-// once per triangle. Every target, and the scalar reference in tests/support, computes exactly
-// these float operations in this order, which is what makes them bit-identical.
+// once per triangle. Every target, and the scalar form geometry::planeAtPixel (the reference in
+// tests/support, the segment pipeline), computes exactly these float operations in this order,
+// which is what makes them bit-identical.
 enum PlaneIndex { kDepth, kInvW, kRed, kGreen, kBlue, kPlaneCount };
 
 struct PlaneLanes {

@@ -12,15 +12,6 @@
 namespace sv::render {
 namespace {
 
-// A plane's value at the centre of pixel (x, y), in the tile kernel's float operations and order
-// (raster/kernel_common-inl.h: the 4×4 block's base, then the lane's offset).
-float planeAt(const geometry::Plane& p, int x, int y, int minX, int minY) {
-  const float bx = float((x & ~3) - minX), by = float((y & ~3) - minY);
-  const float base = (p.c0 + p.dx * bx) + p.dy * by;
-  const float offset = p.dx * float(x & 3) + p.dy * float(y & 3);
-  return base + offset;
-}
-
 // 0 … 1 to a 16-bit code, rounded to nearest even as the kernel's magic-number conversion does;
 // NaN to 0, as its Max(v, 0).
 uint16_t unitToCode(float v) {
@@ -136,9 +127,10 @@ void SegmentRenderer::render(const DrawPackets& packets, const SegmentSettings& 
         const geometry::TriangleSetup& t = setups_[runs[r].segment];
         const geometry::Plane* planes[3] = {&t.red, &t.green, &t.blue};
         for (int x = xa; x < xb; ++x) {
-          const float w = 1.0f / planeAt(t.invW, x, y, t.minX, t.minY);
+          const float w = 1.0f / geometry::planeAtPixel(t.invW, x, y, t.minX, t.minY);
           for (int c = 0; c < 3; ++c)
-            row[3 * x + c] = gamma.table[unitToCode(planeAt(*planes[c], x, y, t.minX, t.minY) * w)];
+            row[3 * x + c] = gamma.table[unitToCode(
+                geometry::planeAtPixel(*planes[c], x, y, t.minX, t.minY) * w)];
         }
       }
     }

@@ -117,17 +117,6 @@ std::vector<uint16_t> renderResolved(const render::DrawPackets& p, const render:
   return rgb;
 }
 
-namespace {
-// The kernel's evaluation order (blockBases, raster/kernel_common-inl.h): per 4×4 block a base at its top-left pixel,
-// plus a per-lane offset.
-float evalPlane(const geometry::Plane& p, int x, int y, int minX, int minY) {
-  const float bx = float((x & ~3) - minX), by = float((y & ~3) - minY);
-  const float base = (p.c0 + p.dx * bx) + p.dy * by;
-  const float offset = p.dx * float(x & 3) + p.dy * float(y & 3);
-  return base + offset;
-}
-}  // namespace
-
 uint16_t Frame::resolved(int x, int y, int ch) const {
   uint32_t sum = 0;
   for (int k = 0; k < samples; ++k) sum += channel(x, y, ch, k);
@@ -188,7 +177,7 @@ Frame renderReference(const render::DrawPackets& p, const render::FrameSettings&
           ++f.color[i * 3];
           continue;
         }
-        const float zCentre = evalPlane(t.depth, x, y, t.minX, t.minY);
+        const float zCentre = geometry::planeAtPixel(t.depth, x, y, t.minX, t.minY);
         // Colour at the centre, or with anti-aliasing for a partly covered pixel at the centroid
         // of its covered samples: (Σ offsets in 1/256 px) · (1 / (count · 256)).
         float cx = 0, cy = 0;
@@ -205,14 +194,17 @@ Frame renderReference(const render::DrawPackets& p, const render::FrameSettings&
           cy = float(sy) * scale;
         }
         auto at = [&](const geometry::Plane& plane) {
-          return evalPlane(plane, x, y, t.minX, t.minY) + (plane.dx * cx + plane.dy * cy);
+          return geometry::planeAtPixel(plane, x, y, t.minX, t.minY) +
+                 (plane.dx * cx + plane.dy * cy);
         };
-        const float invW = n > 1 ? at(t.invW) : evalPlane(t.invW, x, y, t.minX, t.minY);
+        const float invW =
+            n > 1 ? at(t.invW) : geometry::planeAtPixel(t.invW, x, y, t.minX, t.minY);
         const float w = 1.0f / (n > 1 ? std::max(invW, 1e-30f) : invW);
         uint16_t c16[3];
         const geometry::Plane* planes[3] = {&t.red, &t.green, &t.blue};
         for (int ch = 0; ch < 3; ++ch) {
-          const float v = n > 1 ? at(*planes[ch]) : evalPlane(*planes[ch], x, y, t.minX, t.minY);
+          const float v =
+              n > 1 ? at(*planes[ch]) : geometry::planeAtPixel(*planes[ch], x, y, t.minX, t.minY);
           // NaN → 0, as the kernels' Max(v·w, 0) gives on every SIMD target (it returns the
           // other operand); std::max returns its first operand when the two are unordered.
           const float c = std::min(std::max(0.0f, v * w), 1.0f);
