@@ -387,6 +387,7 @@ struct BenchArgs {
   bool glReadback = false;
   int channels = 0;  // BENCH.md --channels N (SPEC §9)
   float arc = 150;   // … abutting in this arc, degrees
+  std::string pipeline = "tiles";  // segments: as --renderer segments
   sv::RenderOptions options{.width = 1920, .height = 1080, .threads = 2};
 };
 
@@ -455,6 +456,15 @@ int runBench(BenchArgs a) {
     return fail(h.error());
   else
     a.options.hsr = h.value();
+  auto pipeline = sv::parsePipeline(a.pipeline);
+  if (!pipeline) return fail(pipeline.error());
+  if (pipeline.value() == sv::RenderOptions::Pipeline::segments) {
+    if (!a.renderer.empty() && a.renderer != "segments")
+      return fail({"", "", "--pipeline segments is measured against the tiles: drop --renderer"});
+    a.renderer = "segments";
+  }
+  // The segment pipeline's options are checked as the segment renderer's.
+  if (a.renderer == "segments") a.options.pipeline = sv::RenderOptions::Pipeline::segments;
   if (sv::Status s = sv::validate(a.options); !s) return fail(s.error());
   if (sv::Status s = checkBenchChannels(a.channels, a.arc); !s) return fail(s.error());
   if (a.scene.empty() == a.suite.empty())
@@ -811,6 +821,25 @@ int runTerrainQuery(const std::string& scenePath, const std::vector<double>& at,
 }
 
 // The `render` subcommand's options, into `r`.
+// The segment pipeline's video channel (RenderOptions::SegmentChannel), for render and bench.
+void addSegmentChannelOptions(CLI::App* app, sv::RenderOptions& o) {
+  app->add_flag("--donor", o.segmentChannel.donor,
+                "segment pipeline: the recipient-donor anti-aliasing filter (seed 002's 1x1 box)");
+  app->add_flag("--interlaced", o.segmentChannel.interlaced,
+                "segment pipeline: two fields a frame, even lines then odd");
+  app->add_option("--segment-rate", o.segmentChannel.wordsPerLine,
+                  "segment pipeline: the geometry stage's rate in segment words per line period "
+                  "(overload protection repeats lines it cannot deliver in time; 0 = unlimited)")
+      ->capture_default_str();
+  app->add_option("--critical-lines", o.segmentChannel.criticalLines,
+                  "segment pipeline: lines buffered ahead of the display below which a line is "
+                  "repeated")
+      ->capture_default_str();
+  app->add_option("--fifo-words", o.segmentChannel.fifoWords,
+                  "segment pipeline: the FIFO's capacity in segment words")
+      ->capture_default_str();
+}
+
 void addRenderOptions(CLI::App* render, RenderArgs& r) {
   render->add_option("scene", r.scene,
                      "scene file (.json, .gltf, .glb, .obj); default: built-in demo");
@@ -857,8 +886,9 @@ void addRenderOptions(CLI::App* render, RenderArgs& r) {
       ->add_option("--pipeline", r.pipeline,
                    "rasterization: tiles (recursive subdivision, masks, masking) or segments "
                    "(seed 002's scan-line segments, priority X-sort into RUN codes; polygons with "
-                   "vertex colours, one sample per pixel, priority order)")
+                   "vertex colours, priority order)")
       ->capture_default_str();
+  addSegmentChannelOptions(render, r.options);
   render
       ->add_option("--texture-filter", r.textureFilter,
                    "texture sampling for materials that do not choose: point, nearest, tri3, "
@@ -924,6 +954,10 @@ int main(int argc, char** argv) {
                    "generated scenes: gouraud, or textured (BENCH.md's 1024x1024 texture)")
       ->capture_default_str();
   bench->add_flag("--fog", b.fog, "generated scenes: BENCH.md's fog (haze, beta 0.1 per unit)");
+  bench->add_option("--pipeline", b.pipeline,
+                    "tiles, or segments: the same as --renderer segments")
+      ->capture_default_str();
+  addSegmentChannelOptions(bench, b.options);
   bench->add_option("--hsr", b.hsr, "hidden surfaces: zbuffer, priority or hybrid")
       ->capture_default_str();
   bench

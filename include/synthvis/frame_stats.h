@@ -62,8 +62,9 @@ struct FrameStats {
   // busiest worker's tile work).
   uint64_t lines = 0, linesDrawn = 0;
   // The segment pipeline (SPEC §10, RenderOptions::Pipeline::segments): segments sorted, and RUN
-  // codes read (a run per change of the visible segment along a line).
-  uint64_t segments = 0, segmentRuns = 0;
+  // codes read (a run per change of the visible segment along a line), and lines the overload
+  // protection repeated instead of drawing (RenderOptions::SegmentChannel).
+  uint64_t segments = 0, segmentRuns = 0, repeatedLines = 0;
   double linesMs = 0;
   // Volumes (the volume pass): volumes in the frame, pixels whose ray met one, samples classified,
   // samples stepped over in empty regions, and rays ended by their transparency (early ray

@@ -72,9 +72,24 @@ struct RenderOptions {
   // passes), or seed 002's segment pipeline (SPEC §10) — each scan line's segments in priority
   // order, sorted by overwrite into RUN codes, each run shaded along it. The segment pipeline's
   // visibility is priority (the scene's triangles in the order Hsr::priority draws them, whatever
-  // `hsr` says); so far it draws polygons with vertex colours at one sample per pixel (issue 35):
-  // a scene or options needing more are refused.
+  // `hsr` says); it draws polygons with vertex colours (issue 35): a scene or options needing more
+  // are refused. Its anti-aliasing is its own (SegmentChannel::donor, `filter` tent3).
   enum class Pipeline { tiles, segments } pipeline = Pipeline::tiles;
+  // The segment pipeline's video channel (SPEC §10, §5, §9), for Pipeline::segments only.
+  struct SegmentChannel {
+    // The recipient–donor 1×1 filter: a pixel an edge of its visible triangle crosses is that
+    // triangle's colour times the area it covers plus a neighbour's across the edge for the rest.
+    bool donor = false;
+    // Two fields a frame (the even lines, then the odd), each through the channel on its own clock.
+    bool interlaced = false;
+    // Overload protection on a model clock counted in segment words (docs/ARCHITECTURE.md): the
+    // geometry stage's rate in words per line period (0: unlimited, no line is ever repeated), the
+    // lines that must be buffered ahead of the display before a line is drawn, and the FIFO's
+    // capacity in words (seed 002: 4096). A line that would come late is repeated instead.
+    int64_t wordsPerLine = 0;
+    int criticalLines = 2;
+    int fifoWords = 4096;
+  } segmentChannel = {};
   // How free forms (Scene::freeForms) are drawn: multi-level ray casting (SPEC §12), or — the
   // baseline it is measured against — every pixel marched front to back in `marchSteps` equal
   // steps of depth (in the cube the view volume is mapped onto), its first sign change bisected.

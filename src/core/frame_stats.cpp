@@ -42,7 +42,7 @@ FrameStats& FrameStats::operator+=(const FrameStats& o) {
   terrainLoadMs = std::max(terrainLoadMs, o.terrainLoadMs);
   lightPoints += o.lightPoints, lightsDrawn += o.lightsDrawn, lightsMs += o.lightsMs;
   lines += o.lines, linesDrawn += o.linesDrawn, linesMs += o.linesMs;
-  segments += o.segments, segmentRuns += o.segmentRuns;
+  segments += o.segments, segmentRuns += o.segmentRuns, repeatedLines += o.repeatedLines;
   volumes += o.volumes, volumeRays += o.volumeRays, volumeSamples += o.volumeSamples;
   volumeSkipped += o.volumeSkipped, volumeTerminated += o.volumeTerminated;
   vertexMs += o.vertexMs, setupMs += o.setupMs, rasterMs += o.rasterMs, totalMs += o.totalMs;
@@ -52,13 +52,13 @@ FrameStats& FrameStats::operator+=(const FrameStats& o) {
 std::string FrameStats::summary() const {
   // A segment-pipeline frame (RenderOptions::Pipeline::segments) has no windows, fragments or
   // tiles to report: its triangles, its segments and runs, and its times.
-  if (segments)
+  if (segments || repeatedLines)
     return fmt::format("triangles in {} / culled {} (facing {}, outside {}, degenerate {}, invalid "
-                       "{}) / drawn {} | segments {}: runs {} | {:.2f} ms (vertex {:.2f}, setup "
-                       "{:.2f}, lines {:.2f})",
+                       "{}) / drawn {} | segments {}: runs {}, lines repeated {} | {:.2f} ms "
+                       "(vertex {:.2f}, setup {:.2f}, lines {:.2f})",
                        trianglesIn, culled(), culledFacing, culledOutside, culledDegenerate,
-                       culledInvalid, drawn, segments, segmentRuns, totalMs, vertexMs, setupMs,
-                       rasterMs) +
+                       culledInvalid, drawn, segments, segmentRuns, repeatedLines, totalMs,
+                       vertexMs, setupMs, rasterMs) +
            lodSummary();
   return fmt::format(
              "triangles in {} / culled {} (facing {}, outside {}{}, degenerate {}, invalid {}{}) / "

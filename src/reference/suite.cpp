@@ -279,6 +279,7 @@ Status runPipelinesBench(const scene::Scene& sc, const BenchSettings& s, CaseRes
   RenderOptions tileOptions = s.options, segmentOptions = s.options;
   tileOptions.hsr = RenderOptions::Hsr::priority;
   tileOptions.pipeline = RenderOptions::Pipeline::tiles;
+  tileOptions.segmentChannel = {};
   segmentOptions.pipeline = RenderOptions::Pipeline::segments;
   if (Status st = validate(segmentOptions); !st) return st;
   Renderer tiles(tileOptions), segments(segmentOptions);
@@ -303,6 +304,11 @@ Status runPipelinesBench(const scene::Scene& sc, const BenchSettings& s, CaseRes
   r.params["segments_per_frame"] = st.segments;
   r.params["runs_per_frame"] = st.segmentRuns;
   r.params["segments_per_second"] = double(st.segments) / (r.runs[1].medianMs / 1000);
+  // Overload protection (RenderOptions::SegmentChannel): the lines repeated in the last frame,
+  // and their share of the frame's lines.
+  r.params["segment_words_per_line"] = s.options.segmentChannel.wordsPerLine;
+  r.params["repeated_lines"] = st.repeatedLines;
+  r.params["repeated_share"] = double(st.repeatedLines) / double(s.options.height);
   return {};
 }
 

@@ -44,15 +44,30 @@ Status validate(const RenderOptions& o) {
     return Error{"", "", fmt::format("LOD scale {} is out of range (1e-6…1e6)", o.lodScale)};
   if (o.gamma != 0 && !(o.gamma >= 0.5 && o.gamma <= 5))
     return Error{"", "", fmt::format("gamma {} is out of range (0.5…5, or 0 for sRGB)", o.gamma)};
+  const RenderOptions::SegmentChannel& sc = o.segmentChannel;
   if (o.pipeline == RenderOptions::Pipeline::segments) {
     if (o.samples != 1 || o.supersample != 1)
       return Error{"", "",
-                   "the segment pipeline draws one sample per pixel so far (its recipient–donor "
-                   "anti-aliasing is not built): drop --aa and --supersample"};
-    if (o.filter != RenderOptions::Filter::box)
-      return Error{"", "", "the segment pipeline has no tent filter yet: drop --filter tent3"};
+                   "the segment pipeline samples pixel centres; its anti-aliasing is the "
+                   "recipient–donor filter (--donor) and --filter tent3: drop --aa and "
+                   "--supersample"};
     if (debug) return Error{"", "", "the debug views show the tile pipeline"};
+  } else if (sc.donor || sc.interlaced || sc.wordsPerLine != 0) {
+    return Error{"", "",
+                 "the recipient–donor filter, interlaced fields and the segment rate belong to the "
+                 "segment pipeline: add --pipeline segments"};
   }
+  if (sc.wordsPerLine < 0 || sc.wordsPerLine > 1000000000)
+    return Error{"", "",
+                 fmt::format("{} segment words per line is out of range (0…1e9, 0 = unlimited)",
+                             sc.wordsPerLine)};
+  if (sc.criticalLines < 1 || sc.criticalLines > 1024)
+    return Error{"", "",
+                 fmt::format("{} critical lines is out of range (1…1024)", sc.criticalLines)};
+  if (sc.fifoWords < 16 || sc.fifoWords > (1 << 24))
+    return Error{"", "",
+                 fmt::format("a FIFO of {} segment words is out of range (16…16777216)",
+                             sc.fifoWords)};
   return {};
 }
 

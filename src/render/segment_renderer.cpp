@@ -1,12 +1,20 @@
-// Based on: SPEC §10 (seed 002: segments of each scan line in priority order, the priority X-sort
-// by overwrite, RUN codes, per-pixel interpolation along the run, the gamma tables), §8 (Gouraud
-// colour), §2 (the perspective-correct colour as colour/w ÷ 1/w, as the tile kernel computes it).
+// Based on: SPEC §10 (seed 002: segments of each scan line in priority order, a FIFO of segment
+// words between the geometry and the sorter, the priority X-sort by overwrite, RUN codes, the line
+// repeat of the overload protection, per-pixel interpolation along the run, the gamma tables),
+// §5 (the recipient–donor 1×1 filter, the 3×3 triangle filter), §8 (Gouraud colour), §2 (the
+// perspective-correct colour as colour/w ÷ 1/w, as the tile kernel computes it), §9 (interlaced
+// fields as an option).
 #include "render/segment_renderer.h"
 
 #include <algorithm>
+#include <atomic>
+#include <bit>
 #include <cmath>
+#include <thread>
+#include <type_traits>
 
 #include "core/timing.h"
+#include "segments/recipient_donor.h"
 #include "segments/segments.h"
 
 namespace sv::render {
@@ -19,16 +27,241 @@ uint16_t unitToCode(float v) {
   return uint16_t(std::nearbyint(c * 65535.0f));
 }
 
-// Rows per task: a band's sorter and active list are its own.
-constexpr int kBand = 16;
+using Word = SegmentRenderer::Word;
+
+// The FIFO between the two stages' threads: a ring of segment words, one writer, one reader. A
+// stage that finds it full (or empty) yields its core to the other.
+class WordRing {
+ public:
+  explicit WordRing(size_t capacity) : words_(std::bit_ceil(capacity)), mask_(words_.size() - 1) {}
+
+  void push(const Word* w, size_t n) {
+    size_t head = head_.load(std::memory_order_relaxed);
+    while (n > 0) {
+      const size_t room = words_.size() - (head - tail_.load(std::memory_order_acquire));
+      if (room == 0) {
+        std::this_thread::yield();
+        continue;
+      }
+      const size_t k = std::min(room, n);
+      for (size_t j = 0; j < k; ++j) words_[(head + j) & mask_] = w[j];
+      head += k;
+      head_.store(head, std::memory_order_release);
+      w += k;
+      n -= k;
+    }
+  }
+  // The words of the next line into `line`, up to and including its end-of-line or repeat word.
+  void popLine(std::vector<Word>& line) {
+    line.clear();
+    size_t tail = tail_.load(std::memory_order_relaxed);
+    for (;;) {
+      const size_t head = head_.load(std::memory_order_acquire);
+      if (head == tail) {
+        std::this_thread::yield();
+        continue;
+      }
+      while (tail != head) {
+        const Word w = words_[tail++ & mask_];
+        line.push_back(w);
+        if (w.segment >= SegmentRenderer::kRepeatLine) {
+          tail_.store(tail, std::memory_order_release);
+          return;
+        }
+      }
+      tail_.store(tail, std::memory_order_release);
+    }
+  }
+
+ private:
+  std::vector<Word> words_;
+  size_t mask_;
+  alignas(64) std::atomic<size_t> head_{0};  // words written
+  alignas(64) std::atomic<size_t> tail_{0};  // words read
+};
+
+// The ring holds the channel's FIFO, at least 1024 words (fewer only cost the threads more waits).
+constexpr size_t kMinRing = 1024;
+
+// Per pixel: the donor direction code of (dx, dy), and "none".
+int8_t donorCode(int dx, int dy) { return int8_t((dy + 1) * 3 + (dx + 1)); }
+constexpr int8_t kNoDonor = 4;
 
 }  // namespace
+
+struct SegmentRenderer::Field {
+  const SegmentSettings* s;
+  int first, step, lines;  // line i is row first + i·step
+  bool linear;             // drawn into linear_ (for the filters), not straight into the image
+  uint32_t background;     // the sorter's background segment: no drawn triangle's number
+  segments::ChannelClock* clock;
+  int row(int i) const { return first + i * step; }
+};
+
+void SegmentRenderer::produceLine(const Field& f, int line, std::vector<Word>& words) {
+  words.clear();
+  const int y = f.row(line);
+  // The triangles starting in rows (mergedRow_, y] join the active list, in priority order; those
+  // that end above y leave it.
+  incoming_.clear();
+  for (int r = mergedRow_ + 1; r <= y; ++r)
+    incoming_.insert(incoming_.end(), byRow_.begin() + firstRow_[size_t(r)],
+                     byRow_.begin() + firstRow_[size_t(r) + 1]);
+  mergedRow_ = std::max(mergedRow_, y);
+  std::sort(incoming_.begin(), incoming_.end());
+  merged_.clear();
+  std::merge(active_.begin(), active_.end(), incoming_.begin(), incoming_.end(),
+             std::back_inserter(merged_));
+  active_.clear();
+  for (uint32_t k : merged_)
+    if (lastRow_[k] >= y) active_.push_back(k);
+  if (!f.clock->startLine(line)) {
+    words.push_back({kRepeatLine, y, y});
+    return;
+  }
+  // Increasing priority: the last triangle first, so the first one's segment is written last.
+  for (auto it = active_.rbegin(); it != active_.rend(); ++it) {
+    const segments::Segment seg = segments::segmentOf(setups_[*it], y, f.s->width);
+    if (!seg.empty()) words.push_back({*it, seg.xl, seg.xr});
+  }
+  words.push_back({kEndOfLine, y, y});
+  if (!f.clock->finishLine(line, int64_t(words.size()))) {
+    words.clear();
+    words.push_back({kRepeatLine, y, y});
+  }
+}
+
+void SegmentRenderer::sortLine(const Field& f, int y, const Word* words, size_t count,
+                               segments::XSorter& sorter, std::vector<segments::Run>& runs,
+                               FrameStats& stats) {
+  const int width = f.s->width;
+  sorter.clear(f.background);
+  for (size_t i = 0; i + 1 < count; ++i) sorter.add(words[i].segment, words[i].xl, words[i].xr);
+  stats.segments += count - 1;
+  sorter.runs(runs);
+  stats.segmentRuns += runs.size();
+  uint8_t* bytes = f.linear ? nullptr : image_->pixel(0, y);
+  uint16_t* codes = f.linear ? &linear_.rgb[size_t(y) * size_t(width) * 3] : nullptr;
+  float* area = f.s->donor ? &area_[size_t(y) * size_t(width)] : nullptr;
+  int8_t* donor = f.s->donor ? &donor_[size_t(y) * size_t(width)] : nullptr;
+  for (size_t r = 0; r < runs.size(); ++r) {
+    const int xa = runs[r].x, xb = r + 1 < runs.size() ? runs[r + 1].x : width;
+    if (runs[r].segment == f.background) {
+      for (int x = xa; x < xb; ++x)
+        for (int c = 0; c < 3; ++c) {
+          if (bytes) bytes[3 * x + c] = gamma_->table[clear_[c]];
+          if (codes) codes[3 * x + c] = clear_[c];
+        }
+      if (area) {
+        std::fill(area + xa, area + xb, 1.0f);
+        std::fill(donor + xa, donor + xb, kNoDonor);
+      }
+      continue;
+    }
+    // Along the run: colour/w and 1/w at each pixel centre, the colour their ratio.
+    const geometry::TriangleSetup& t = setups_[runs[r].segment];
+    const geometry::Plane* planes[3] = {&t.red, &t.green, &t.blue};
+    for (int x = xa; x < xb; ++x) {
+      const float w = 1.0f / geometry::planeAtPixel(t.invW, x, y, t.minX, t.minY);
+      for (int c = 0; c < 3; ++c) {
+        const uint16_t code =
+            unitToCode(geometry::planeAtPixel(*planes[c], x, y, t.minX, t.minY) * w);
+        if (bytes) bytes[3 * x + c] = gamma_->table[code];
+        if (codes) codes[3 * x + c] = code;
+      }
+      if (area) {
+        const segments::Recipient rec = segments::recipientOf(t, x, y);
+        area[x] = rec.area;
+        donor[x] = donorCode(rec.dx, rec.dy);
+      }
+    }
+  }
+}
+
+void SegmentRenderer::repeatLine(const Field& f, int y) {
+  // Progressive, and the first field: the line above in the field (the seed's line repeat); the
+  // second field: the mean of its neighbours in the first. The top line has none: background.
+  const int width = f.s->width, h = f.s->height;
+  const bool second = f.step == 2 && f.first == 1;
+  const int a = second ? y - 1 : y - f.step, below = second && y + 1 < h ? y + 1 : -1;
+  const size_t n = size_t(width) * 3;
+  const auto blend = [&](auto row, auto clearOf) {
+    using T = std::remove_pointer_t<decltype(row(0))>;
+    T* dst = row(y);
+    if (a < 0) {
+      for (size_t i = 0; i < n; ++i) dst[i] = clearOf(i % 3);
+    } else if (below < 0) {
+      std::copy(row(a), row(a) + n, dst);
+    } else {
+      const T *p = row(a), *q = row(below);
+      for (size_t i = 0; i < n; ++i) dst[i] = T((uint32_t(p[i]) + q[i] + 1) / 2);
+    }
+  };
+  if (f.linear) {
+    blend([&](int r) { return &linear_.rgb[size_t(r) * n]; }, [&](size_t c) { return clear_[c]; });
+    if (f.s->donor) {
+      std::fill_n(&area_[size_t(y) * size_t(width)], width, 1.0f);
+      std::fill_n(&donor_[size_t(y) * size_t(width)], width, kNoDonor);
+    }
+  } else {
+    blend([&](int r) { return image_->pixel(0, r); },
+          [&](size_t c) { return gamma_->table[clear_[c]]; });
+  }
+}
+
+void SegmentRenderer::runField(const Field& f, core::ThreadPool& pool, FrameStats& stats) {
+  active_.clear();
+  mergedRow_ = -1;
+  const auto sortWords = [&](int line, const std::vector<Word>& words, segments::XSorter& sorter,
+                             std::vector<segments::Run>& runs) {
+    const int y = f.row(line);
+    if (words.back().segment == kRepeatLine) {
+      repeatLine(f, y);
+      ++stats.repeatedLines;
+    } else {
+      sortLine(f, y, words.data(), words.size(), sorter, runs, stats);
+    }
+  };
+  if (pool.threadCount() < 2 || f.lines < 2) {
+    // One thread: a line through both stages at a time.
+    segments::XSorter sorter(f.s->width);
+    std::vector<segments::Run> runs;
+    std::vector<Word> words;
+    for (int i = 0; i < f.lines; ++i) {
+      produceLine(f, i, words);
+      sortWords(i, words, sorter, runs);
+    }
+    return;
+  }
+  // Two threads: the geometry stage writes each line's words into the ring, the sorter stage reads
+  // them line by line (parallelFor's two items run on two workers: neither waits for the other to
+  // finish, only for words or room).
+  WordRing ring(std::max<size_t>(kMinRing, size_t(f.s->timing.fifoWords)));
+  pool.parallelFor(2, [&](size_t stage, int) {
+    std::vector<Word> words;
+    if (stage == 0) {
+      for (int i = 0; i < f.lines; ++i) {
+        produceLine(f, i, words);
+        ring.push(words.data(), words.size());
+      }
+      return;
+    }
+    segments::XSorter sorter(f.s->width);
+    std::vector<segments::Run> runs;
+    for (int i = 0; i < f.lines; ++i) {
+      ring.popLine(words);
+      sortWords(i, words, sorter, runs);
+    }
+  });
+}
 
 void SegmentRenderer::render(const DrawPackets& packets, const SegmentSettings& s,
                              const output::GammaTable& gamma, core::ThreadPool& pool, Image& image,
                              FrameStats& stats) {
   const auto t0 = core::Clock::now();
   output::prepareImage(s.width, s.height, image);
+  image_ = &image;
+  gamma_ = &gamma;
   geometry::Viewport vp;
   vp.width = s.width;
   vp.height = s.height;
@@ -67,7 +300,11 @@ void SegmentRenderer::render(const DrawPackets& packets, const SegmentSettings& 
   // The drawn triangles bucketed by their first row, priority order kept within a row.
   const size_t m = setups_.size();
   firstRow_.assign(size_t(s.height) + 1, 0);
-  for (const geometry::TriangleSetup& t : setups_) ++firstRow_[size_t(t.minY) + 1];
+  lastRow_.resize(m);
+  for (size_t k = 0; k < m; ++k) {
+    ++firstRow_[size_t(setups_[k].minY) + 1];
+    lastRow_[k] = setups_[k].maxY;
+  }
   for (int y = 0; y < s.height; ++y) firstRow_[size_t(y) + 1] += firstRow_[size_t(y)];
   byRow_.resize(m);
   {
@@ -77,67 +314,56 @@ void SegmentRenderer::render(const DrawPackets& packets, const SegmentSettings& 
   stats.setupMs += core::msSince(t0);
 
   const auto t1 = core::Clock::now();
-  uint16_t clear[3];
   for (int c = 0; c < 3; ++c)
-    clear[c] = uint16_t(std::lround(std::clamp(s.clearColor[c], 0.0f, 1.0f) * 65535.0f));
-  const uint32_t background = uint32_t(m);  // no triangle's number
-  const int bands = (s.height + kBand - 1) / kBand;
-  struct Counts {
-    uint64_t segments = 0, runs = 0;
-  };
-  std::vector<Counts> bandCounts(static_cast<size_t>(bands));
-  pool.parallelFor(size_t(bands), [&](size_t band, int) {
-    const int y0 = int(band) * kBand, y1 = std::min(s.height, y0 + kBand);
-    segments::XSorter sorter(s.width);
-    std::vector<segments::Run> runs;
-    // The triangles that reach row y0 but start above it, then those starting in each row: the
-    // active list, in priority order (ascending number).
-    std::vector<uint32_t> active, merged;
-    for (uint32_t k = 0; k < firstRow_[size_t(y0)]; ++k)
-      if (setups_[byRow_[k]].maxY >= y0) active.push_back(byRow_[k]);
-    std::sort(active.begin(), active.end());
-    Counts& st = bandCounts[band];
-    for (int y = y0; y < y1; ++y) {
-      const auto first = byRow_.begin() + firstRow_[size_t(y)];
-      const auto last = byRow_.begin() + firstRow_[size_t(y) + 1];
-      merged.clear();
-      std::merge(active.begin(), active.end(), first, last, std::back_inserter(merged));
-      active.clear();
-      for (uint32_t k : merged)
-        if (setups_[k].maxY >= y) active.push_back(k);
-      // Increasing priority: the last triangle first, so the first one's segment is written last.
-      sorter.clear(background);
-      for (auto it = active.rbegin(); it != active.rend(); ++it) {
-        const segments::Segment seg = segments::segmentOf(setups_[*it], y, s.width);
-        if (seg.empty()) continue;
-        sorter.add(*it, seg.xl, seg.xr);
-        ++st.segments;
-      }
-      sorter.runs(runs);
-      st.runs += runs.size();
-      uint8_t* row = image.pixel(0, y);
-      for (size_t r = 0; r < runs.size(); ++r) {
-        const int xa = runs[r].x, xb = r + 1 < runs.size() ? runs[r + 1].x : s.width;
-        if (runs[r].segment == background) {
-          for (int x = xa; x < xb; ++x)
-            for (int c = 0; c < 3; ++c) row[3 * x + c] = gamma.table[clear[c]];
-          continue;
-        }
-        // Along the run: colour/w and 1/w at each pixel centre, the colour their ratio.
-        const geometry::TriangleSetup& t = setups_[runs[r].segment];
-        const geometry::Plane* planes[3] = {&t.red, &t.green, &t.blue};
-        for (int x = xa; x < xb; ++x) {
-          const float w = 1.0f / geometry::planeAtPixel(t.invW, x, y, t.minX, t.minY);
-          for (int c = 0; c < 3; ++c)
-            row[3 * x + c] = gamma.table[unitToCode(
-                geometry::planeAtPixel(*planes[c], x, y, t.minX, t.minY) * w)];
-        }
-      }
+    clear_[c] = uint16_t(std::lround(std::clamp(s.clearColor[c], 0.0f, 1.0f) * 65535.0f));
+  const bool linear = s.donor || s.tent;
+  if (linear) linear_.resize(s.width, s.height);
+  if (s.donor) {
+    area_.resize(size_t(s.width) * size_t(s.height));
+    donor_.resize(area_.size());
+  }
+  const int fields = s.interlaced ? 2 : 1;
+  for (int field = 0; field < fields; ++field) {
+    Field f{&s, field, fields, (s.height - field + fields - 1) / fields, linear, uint32_t(m),
+            nullptr};
+    segments::ChannelClock clock(s.timing, f.lines);
+    f.clock = &clock;
+    runField(f, pool, stats);
+  }
+  if (linear) {
+    // The recipient–donor filter: each boundary pixel C_R·S + C_D·(1 − S), C_D its donor's colour
+    // as the sorter left it (the recipient colours, not the filtered ones).
+    const output::LinearImage* source = &linear_;
+    constexpr int kRows = 16;
+    const size_t bands = size_t((s.height + kRows - 1) / kRows);
+    if (s.donor) {
+      filtered_.resize(s.width, s.height);
+      pool.parallelFor(bands, [&](size_t band, int) {
+        const int y0 = int(band) * kRows, y1 = std::min(s.height, y0 + kRows);
+        for (int y = y0; y < y1; ++y)
+          for (int x = 0; x < s.width; ++x) {
+            const size_t i = size_t(y) * size_t(s.width) + size_t(x);
+            const float a = area_[i];
+            const int dx = donor_[i] % 3 - 1, dy = donor_[i] / 3 - 1;
+            const int nx = x + dx, ny = y + dy;
+            const bool blend = a < 1 && nx >= 0 && nx < s.width && ny >= 0 && ny < s.height;
+            const size_t j = blend ? size_t(ny) * size_t(s.width) + size_t(nx) : i;
+            for (int c = 0; c < 3; ++c) {
+              const float v = float(linear_.rgb[3 * i + size_t(c)]) * a +
+                              float(linear_.rgb[3 * j + size_t(c)]) * (1 - a);
+              filtered_.rgb[3 * i + size_t(c)] = blend ? uint16_t(v + 0.5f) : linear_.rgb[3 * i + size_t(c)];
+            }
+          }
+      });
+      source = &filtered_;
     }
-  });
-  for (const Counts& b : bandCounts) {
-    stats.segments += b.segments;
-    stats.segmentRuns += b.runs;
+    pool.parallelFor(bands, [&](size_t band, int) {
+      const int y0 = int(band) * kRows, y1 = std::min(s.height, y0 + kRows);
+      if (s.tent)
+        output::tentFilterRows(*source, gamma, y0, y1, image);
+      else
+        output::encodeRows(*source, gamma, y0, y1, image);
+    });
   }
   stats.rasterMs += core::msSince(t1);
 }

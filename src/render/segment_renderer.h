@@ -1,13 +1,20 @@
 // Seed 002's segment pipeline (SPEC §10; issue 35) for a frame's draw packets: no frame buffer of
-// depths — each scan line's segments, in priority order, sorted by overwrite into RUN codes
-// (segments/x_sort.h), then each run's pixels shaded along it and put through the gamma table.
+// depths — each scan line's segments, in priority order, sent as segment words through a FIFO to a
+// sorter that sorts them by overwrite into RUN codes (segments/x_sort.h), each run's pixels shaded
+// along it; then the video channel's filters (the recipient–donor 1×1 filter, the 3×3 triangle
+// filter, SPEC §5) and the gamma table.
+//
+// Two stages, as the seed's channel: the geometry stage (the lines' active triangles, their
+// segments) and the sorter stage (X-sort, runs, pixels), on two threads with a bounded ring of
+// segment words between them — or on one thread, a line at a time, when the pool has one. The
+// channel's overload protection (segments/channel_clock.h) decides on a model clock counted in
+// segment words which lines are repeated, so the image is the same bytes for any thread count.
 //
 // Visibility is priority: the packets' triangle order, first in front — the order the tile
 // pipeline's priority masking draws in (buildDrawPackets under Hsr::priority), so at one sample per
 // pixel the two pipelines show the same triangle at every pixel (tests/render/segment_test.cpp).
 // The colour is the tile kernel's perspective-correct Gouraud colour, the same float operations,
-// so the images agree byte for byte. Rows go in bands to the pool's threads, each band with its
-// own sorter: the same bytes for any thread count.
+// so without the filters the images agree byte for byte.
 #pragma once
 
 #include <cstdint>
@@ -17,6 +24,7 @@
 #include "geometry/setup.h"
 #include "output/resolve.h"
 #include "render/draw_packets.h"
+#include "segments/channel_clock.h"
 #include "segments/x_sort.h"
 #include "synthvis/frame_stats.h"
 
@@ -25,24 +33,58 @@ namespace sv::render {
 struct SegmentSettings {
   int width = 0, height = 0;
   float clearColor[3] = {0, 0, 0};  // linear
+  segments::ChannelTiming timing;   // the overload protection's model clock
+  // Two fields a frame, the even lines then the odd ones, each through the channel on its own
+  // clock; a repeated line of the second field is the mean of its neighbours in the first.
+  bool interlaced = false;
+  bool donor = false;  // the recipient–donor 1×1 filter (segments/recipient_donor.h)
+  bool tent = false;   // the 3×3 triangle filter [1 2 1]ᵀ[1 2 1]/16 after it
 };
 
 class SegmentRenderer {
  public:
   // The frame of `packets` (vertex colours: the Gouraud shading of the tile pipeline's
   // ShadeMode::gouraud) into `image` (sized here), through `gamma`, on `pool`'s threads; adds the
-  // triangles' outcomes (culled as the tile pipeline culls them), the segments and runs, and the
-  // times (setup; the lines as rasterMs) to `stats`.
+  // triangles' outcomes (culled as the tile pipeline culls them), the segments, runs and repeated
+  // lines, and the times (setup; the lines and filters as rasterMs) to `stats`.
   void render(const DrawPackets& packets, const SegmentSettings& settings,
               const output::GammaTable& gamma, core::ThreadPool& pool, Image& image,
               FrameStats& stats);
 
+  // One segment word of the FIFO: a segment (the drawn triangle's number and its pixels [xl, xr))
+  // or, with `segment` kEndOfLine or kRepeatLine, the end of a line or the line-repeat flag.
+  struct Word {
+    uint32_t segment;
+    int32_t xl, xr;
+  };
+  static constexpr uint32_t kEndOfLine = ~0u, kRepeatLine = ~0u - 1;
+
  private:
+  struct Field;
+  void runField(const Field& field, core::ThreadPool& pool, FrameStats& stats);
+  void produceLine(const Field& field, int line, std::vector<Word>& words);
+  void sortLine(const Field& field, int y, const Word* words, size_t count,
+                segments::XSorter& sorter, std::vector<segments::Run>& runs, FrameStats& stats);
+  void repeatLine(const Field& field, int y);
+
   std::vector<geometry::TriangleSetup> all_;     // every packet triangle's record
   std::vector<uint8_t> outcome_;                 // per packet triangle: its SetupOutcome
   std::vector<geometry::TriangleSetup> setups_;  // the drawn triangles', in priority order
+  std::vector<int16_t> lastRow_;                 // per drawn triangle: its last row (maxY)
   std::vector<uint32_t> firstRow_;               // per row: its first starting triangle in byRow_
   std::vector<uint32_t> byRow_;                  // drawn triangles by first row, priority within
+  // The geometry stage's active list (drawn triangles reaching the line, in priority order) and the
+  // last row whose starting triangles it has taken in.
+  std::vector<uint32_t> active_, incoming_, merged_;
+  int mergedRow_ = -1;
+  // With a filter: the frame in linear light (the recipients' colours), each pixel's recipient
+  // area and donor direction, and the donor-filtered frame.
+  output::LinearImage linear_, filtered_;
+  std::vector<float> area_;
+  std::vector<int8_t> donor_;  // (dy + 1)·3 + (dx + 1)
+  Image* image_ = nullptr;
+  const output::GammaTable* gamma_ = nullptr;
+  uint16_t clear_[3] = {};
 };
 
 }  // namespace sv::render

@@ -116,6 +116,12 @@ Status ViewRenderer::runSegments(const scene::Scene& scene, const RenderOptions&
   ss.clearColor[0] = scene.background.x;
   ss.clearColor[1] = scene.background.y;
   ss.clearColor[2] = scene.background.z;
+  ss.timing.wordsPerLine = o.segmentChannel.wordsPerLine;
+  ss.timing.criticalLines = o.segmentChannel.criticalLines;
+  ss.timing.fifoWords = o.segmentChannel.fifoWords;
+  ss.interlaced = o.segmentChannel.interlaced;
+  ss.donor = o.segmentChannel.donor;
+  ss.tent = o.filter == RenderOptions::Filter::tent3;
   segments_.render(packets_, ss, gamma_, frame_.pool(), image, stats);
   return {};
 }

@@ -82,7 +82,22 @@ TEST(Cli, TheSegmentPipelineDrawsThePriorityImageAndRefusesWhatItCannotDraw) {
                      "light points");
   const CliRun aa = run("render " + scene + " -o " + seg + " --pipeline segments --aa 4");
   EXPECT_EQ(aa.status, 1) << aa.out;
-  EXPECT_NE(aa.out.find("one sample per pixel"), std::string::npos) << aa.out;
+  EXPECT_NE(aa.out.find("--donor"), std::string::npos) << aa.out;
+  // The channel's options: the filters, fields and a throttled rate draw a complete frame, whose
+  // statistics say how many lines were repeated; without --pipeline segments they are refused.
+  const CliRun ch = run("render " + scene + " -o " + seg +
+                        " --width 160 --height 96 --pipeline segments --donor --filter tent3 "
+                        "--interlaced --segment-rate 8 --critical-lines 3 --fifo-words 256");
+  EXPECT_EQ(ch.status, 0) << ch.out;
+  EXPECT_NE(ch.out.find("lines repeated "), std::string::npos) << ch.out;
+  EXPECT_EQ(ch.out.find("lines repeated 0 "), std::string::npos) << ch.out;
+  const CliRun tiled = run("render " + scene + " -o " + seg + " --donor");
+  EXPECT_EQ(tiled.status, 1) << tiled.out;
+  EXPECT_NE(tiled.out.find("--pipeline segments"), std::string::npos) << tiled.out;
+  const CliRun fifo =
+      run("render " + scene + " -o " + seg + " --pipeline segments --fifo-words 3");
+  EXPECT_EQ(fifo.status, 1) << fifo.out;
+  EXPECT_NE(fifo.out.find("FIFO of 3"), std::string::npos) << fifo.out;
   const CliRun bad = run("render " + scene + " -o " + seg + " --pipeline scanlines");
   EXPECT_EQ(bad.status, 1) << bad.out;
   EXPECT_NE(bad.out.find("tiles or segments"), std::string::npos) << bad.out;

@@ -1,12 +1,17 @@
 // The segment pipeline (render/segment_renderer.h) against the tile pipeline: a frame's packets
 // drawn by both — the tiles under priority masking at one sample, resolved through the same gamma
 // table — give the same bytes, for ordinary and wild triangles (behind the eye, beyond the near
-// and far planes, huge), and any thread count gives the same image.
+// and far planes, huge), and any thread count gives the same image; with the 3×3 triangle filter
+// too. The channel: lines repeated under a throttled geometry stage, the frame still complete;
+// interlaced fields; the recipient–donor filter on a single edge against its area formula.
 #include <gtest/gtest.h>
 
 #include "output/resolve.h"
 #include "render/segment_renderer.h"
 #include "support/raster_harness.h"
+#include "segments/recipient_donor.h"
+
+#include <cmath>
 
 namespace sv {
 namespace {
@@ -53,6 +58,147 @@ TEST(SegmentPipeline, DrawsTheTilePipelinesPriorityMaskedImageByteForByte) {
       EXPECT_EQ(images[0].rgb, images[1].rgb);
       EXPECT_EQ(images[0].rgb, images[2].rgb);
     }
+}
+
+
+// Renders `p` with `ss` on 1, 2 and 5 threads; expects the same image from all; returns it.
+Image renderAll(const render::DrawPackets& p, const render::SegmentSettings& ss,
+                const output::GammaTable& gamma, FrameStats& stats) {
+  std::vector<Image> images;
+  for (int threads : {1, 2, 5}) {
+    render::SegmentRenderer r;
+    core::ThreadPool pool(threads);
+    images.emplace_back();
+    stats = {};
+    r.render(p, ss, gamma, pool, images.back(), stats);
+  }
+  EXPECT_EQ(images[0].rgb, images[1].rgb);
+  EXPECT_EQ(images[0].rgb, images[2].rgb);
+  return images[0];
+}
+
+bool sameRow(const Image& a, int ya, const Image& b, int yb) {
+  return std::equal(a.pixel(0, ya), a.pixel(0, ya) + 3 * a.width, b.pixel(0, yb));
+}
+
+TEST(SegmentPipeline, WithTheTentFilterDrawsTheTilePipelinesFilteredImage) {
+  const output::GammaTable gamma = output::GammaTable::srgb();
+  const int w = 200, h = 120;
+  const render::DrawPackets p = test::randomScene(w, h, 300, 31, false);
+  render::FrameSettings fs;
+  fs.width = w;
+  fs.height = h;
+  fs.masking = raster::Masking::priority;
+  const test::Frame tiles = test::renderQuadtree(p, fs);
+  output::LinearImage linear;
+  linear.resize(w, h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 3; ++c)
+        linear.rgb[(size_t(y) * w + size_t(x)) * 3 + size_t(c)] = tiles.channel(x, y, c);
+  Image expected;
+  output::prepareImage(w, h, expected);
+  output::tentFilterRows(linear, gamma, 0, h, expected);
+  render::SegmentSettings ss;
+  ss.width = w;
+  ss.height = h;
+  ss.tent = true;
+  FrameStats stats;
+  EXPECT_EQ(renderAll(p, ss, gamma, stats).rgb, expected.rgb);
+}
+
+TEST(SegmentPipeline, AThrottledGeometryStageRepeatsLinesAndTheFrameIsComplete) {
+  // Under a rate below the frame's mean segment words per line, some lines are repeated: each row
+  // is the unthrottled frame's row, or (progressive) a copy of the row above it — or (interlaced,
+  // second field) the mean of its neighbours. The same lines for any thread count.
+  const output::GammaTable gamma = output::GammaTable::srgb();
+  const int w = 240, h = 160;
+  const render::DrawPackets p = test::randomScene(w, h, 600, 41, false);
+  render::SegmentSettings ss;
+  ss.width = w;
+  ss.height = h;
+  ss.clearColor[1] = 0.2f;
+  FrameStats full;
+  const Image exact = renderAll(p, ss, gamma, full);
+  EXPECT_EQ(full.repeatedLines, 0u);
+  const double mean = double(full.segments + uint64_t(h)) / h;  // words a line, ends included
+  ss.interlaced = true;
+  FrameStats fields;
+  EXPECT_EQ(renderAll(p, ss, gamma, fields).rgb, exact.rgb);  // unthrottled: the same frame
+  for (bool interlaced : {false, true}) {
+    ss.interlaced = interlaced;
+    ss.timing.wordsPerLine = int64_t(mean * 0.7);
+    FrameStats stats;
+    const Image img = renderAll(p, ss, gamma, stats);
+    EXPECT_GT(stats.repeatedLines, uint64_t(h) / 10) << interlaced;
+    EXPECT_LT(stats.repeatedLines, uint64_t(h) * 3 / 4) << interlaced;
+    uint64_t repeats = 0;
+    for (int y = 0; y < h; ++y) {
+      if (sameRow(img, y, exact, y)) continue;
+      ++repeats;
+      if (!interlaced || y % 2 == 0) {
+        const int above = y - (interlaced ? 2 : 1);
+        if (above >= 0)
+          EXPECT_TRUE(sameRow(img, y, img, above)) << interlaced << " row " << y;
+        else
+          EXPECT_EQ(img.pixel(0, y)[1], gamma.table[uint16_t(std::lround(0.2 * 65535))]);
+      } else {
+        const int below = y + 1 < h ? y + 1 : y - 1;
+        for (int i = 0; i < 3 * w; ++i)
+          EXPECT_EQ(img.pixel(0, y)[i],
+                    (img.pixel(0, y - 1)[i] + img.pixel(0, below)[i] + 1) / 2)
+              << "row " << y;
+      }
+    }
+    // Rows that differ were repeated (a repeated row may happen to equal the exact one).
+    EXPECT_LE(repeats, stats.repeatedLines) << interlaced;
+    EXPECT_GT(repeats, stats.repeatedLines / 2) << interlaced;
+  }
+}
+
+TEST(SegmentPipeline, TheRecipientDonorFilterWeighsABoundaryPixelByItsArea) {
+  // A white triangle on black whose one edge crosses the raster, in linear output (gamma 1): a
+  // pixel whose centre the triangle covers shows the area of it inside the edge (the donor across
+  // the edge is black); one whose centre it misses stays black — the seed's stated limit. (On the
+  // raster's border a donor beyond it leaves the pixel whole: the border is not checked.)
+  const output::GammaTable gamma = output::GammaTable::power(1.0);
+  const int w = 96, h = 64;
+  for (double angle : {0.1, 0.7, 1.3, 2.2, 3.9, 5.5}) {
+    const double cx = 47.3, cy = 31.8, c = std::cos(angle), s = std::sin(angle);
+    const double px = cx - 500 * c, py = cy - 500 * s, qx = cx + 500 * c, qy = cy + 500 * s;
+    const double rx = cx - 500 * s, ry = cy + 500 * c;
+    const auto clip = [&](double x, double y) {
+      return geometry::ClipVertex{float(2 * x / w - 1), float(1 - 2 * y / h), 0.5f, 1, 1, 1, 1, 1};
+    };
+    render::DrawPackets p;
+    test::addTriangle(p, clip(px, py), clip(qx, qy), clip(rx, ry));
+    render::SegmentSettings ss;
+    ss.width = w;
+    ss.height = h;
+    ss.donor = true;
+    FrameStats stats;
+    const Image img = renderAll(p, ss, gamma, stats);
+    // The inward unit normal (toward r).
+    double nx = -(qy - py), ny = qx - px;
+    const double len = std::hypot(nx, ny);
+    nx /= len, ny /= len;
+    if (nx * (rx - px) + ny * (ry - py) < 0) nx = -nx, ny = -ny;
+    int boundary = 0;
+    for (int y = 1; y + 1 < h; ++y)
+      for (int x = 1; x + 1 < w; ++x) {
+        const double d = nx * (x + 0.5 - px) + ny * (y + 0.5 - py);
+        if (std::fabs(d) < 0.01) continue;  // a centre within snapping of the edge
+        const double area = segments::halfPlaneArea(nx, ny, d);
+        const int v = img.pixel(x, y)[0];
+        if (d > 0) {
+          EXPECT_NEAR(v, 255 * area, 2.0) << angle << " at " << x << "," << y;
+          boundary += area < 1;
+        } else {
+          EXPECT_EQ(v, 0) << angle << " at " << x << "," << y;
+        }
+      }
+    EXPECT_GT(boundary, 30) << angle;
+  }
 }
 
 }  // namespace
