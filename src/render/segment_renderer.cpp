@@ -83,10 +83,6 @@ class WordRing {
 // The ring holds the channel's FIFO, at least 1024 words (fewer only cost the threads more waits).
 constexpr size_t kMinRing = 1024;
 
-// Per pixel: the donor direction code of (dx, dy), and "none".
-int8_t donorCode(int dx, int dy) { return int8_t((dy + 1) * 3 + (dx + 1)); }
-constexpr int8_t kNoDonor = 4;
-
 }  // namespace
 
 struct SegmentRenderer::Field {
@@ -142,20 +138,16 @@ void SegmentRenderer::sortLine(const Field& f, int y, const Word* words, size_t 
   stats.segmentRuns += runs.size();
   uint8_t* bytes = f.linear ? nullptr : image_->pixel(0, y);
   uint16_t* codes = f.linear ? &linear_.rgb[size_t(y) * size_t(width) * 3] : nullptr;
-  float* area = f.s->donor ? &area_[size_t(y) * size_t(width)] : nullptr;
-  int8_t* donor = f.s->donor ? &donor_[size_t(y) * size_t(width)] : nullptr;
+  uint32_t* visible = f.s->donor ? &visible_[size_t(y) * size_t(width)] : nullptr;
   for (size_t r = 0; r < runs.size(); ++r) {
     const int xa = runs[r].x, xb = r + 1 < runs.size() ? runs[r + 1].x : width;
+    if (visible) std::fill(visible + xa, visible + xb, runs[r].segment);
     if (runs[r].segment == f.background) {
       for (int x = xa; x < xb; ++x)
         for (int c = 0; c < 3; ++c) {
           if (bytes) bytes[3 * x + c] = gamma_->table[clear_[c]];
           if (codes) codes[3 * x + c] = clear_[c];
         }
-      if (area) {
-        std::fill(area + xa, area + xb, 1.0f);
-        std::fill(donor + xa, donor + xb, kNoDonor);
-      }
       continue;
     }
     // Along the run: colour/w and 1/w at each pixel centre, the colour their ratio.
@@ -168,11 +160,6 @@ void SegmentRenderer::sortLine(const Field& f, int y, const Word* words, size_t 
             unitToCode(geometry::planeAtPixel(*planes[c], x, y, t.minX, t.minY) * w);
         if (bytes) bytes[3 * x + c] = gamma_->table[code];
         if (codes) codes[3 * x + c] = code;
-      }
-      if (area) {
-        const segments::Recipient rec = segments::recipientOf(t, x, y);
-        area[x] = rec.area;
-        donor[x] = donorCode(rec.dx, rec.dy);
       }
     }
   }
@@ -199,10 +186,7 @@ void SegmentRenderer::repeatLine(const Field& f, int y) {
   };
   if (f.linear) {
     blend([&](int r) { return &linear_.rgb[size_t(r) * n]; }, [&](size_t c) { return clear_[c]; });
-    if (f.s->donor) {
-      std::fill_n(&area_[size_t(y) * size_t(width)], width, 1.0f);
-      std::fill_n(&donor_[size_t(y) * size_t(width)], width, kNoDonor);
-    }
+    if (f.s->donor) std::fill_n(&visible_[size_t(y) * size_t(width)], width, f.background + 1);
   } else {
     blend([&](int r) { return image_->pixel(0, r); },
           [&](size_t c) { return gamma_->table[clear_[c]]; });
@@ -319,8 +303,7 @@ void SegmentRenderer::render(const DrawPackets& packets, const SegmentSettings& 
   const bool linear = s.donor || s.tent;
   if (linear) linear_.resize(s.width, s.height);
   if (s.donor) {
-    area_.resize(size_t(s.width) * size_t(s.height));
-    donor_.resize(area_.size());
+    visible_.resize(size_t(s.width) * size_t(s.height));
   }
   const int fields = s.interlaced ? 2 : 1;
   for (int field = 0; field < fields; ++field) {
@@ -331,29 +314,24 @@ void SegmentRenderer::render(const DrawPackets& packets, const SegmentSettings& 
     runField(f, pool, stats);
   }
   if (linear) {
-    // The recipient–donor filter: each boundary pixel C_R·S + C_D·(1 − S), C_D its donor's colour
-    // as the sorter left it (the recipient colours, not the filtered ones).
+    // The recipient–donor filter (segments/recipient_donor.h) over the colours and visible
+    // triangles the sorter left, then the tent filter or the gamma table alone.
     const output::LinearImage* source = &linear_;
     constexpr int kRows = 16;
     const size_t bands = size_t((s.height + kRows - 1) / kRows);
     if (s.donor) {
       filtered_.resize(s.width, s.height);
+      segments::SortedFrame sorted;
+      sorted.width = s.width;
+      sorted.height = s.height;
+      sorted.visible = visible_.data();
+      sorted.background = uint32_t(m);
+      sorted.unsorted = uint32_t(m) + 1;
+      sorted.setups = setups_.data();
+      sorted.rgb = linear_.rgb.data();
       pool.parallelFor(bands, [&](size_t band, int) {
         const int y0 = int(band) * kRows, y1 = std::min(s.height, y0 + kRows);
-        for (int y = y0; y < y1; ++y)
-          for (int x = 0; x < s.width; ++x) {
-            const size_t i = size_t(y) * size_t(s.width) + size_t(x);
-            const float a = area_[i];
-            const int dx = donor_[i] % 3 - 1, dy = donor_[i] / 3 - 1;
-            const int nx = x + dx, ny = y + dy;
-            const bool blend = a < 1 && nx >= 0 && nx < s.width && ny >= 0 && ny < s.height;
-            const size_t j = blend ? size_t(ny) * size_t(s.width) + size_t(nx) : i;
-            for (int c = 0; c < 3; ++c) {
-              const float v = float(linear_.rgb[3 * i + size_t(c)]) * a +
-                              float(linear_.rgb[3 * j + size_t(c)]) * (1 - a);
-              filtered_.rgb[3 * i + size_t(c)] = blend ? uint16_t(v + 0.5f) : linear_.rgb[3 * i + size_t(c)];
-            }
-          }
+        segments::recipientDonorRows(sorted, y0, y1, filtered_.rgb.data());
       });
       source = &filtered_;
     }

@@ -77,11 +77,11 @@ class SegmentRenderer {
   // last row whose starting triangles it has taken in.
   std::vector<uint32_t> active_, incoming_, merged_;
   int mergedRow_ = -1;
-  // With a filter: the frame in linear light (the recipients' colours), each pixel's recipient
-  // area and donor direction, and the donor-filtered frame.
+  // With a filter: the frame in linear light as the sorter left it, the triangle visible at each
+  // pixel (for the recipient–donor filter: the drawn triangle's number, the background's m, a
+  // repeated line's m + 1), and the donor-filtered frame.
   output::LinearImage linear_, filtered_;
-  std::vector<float> area_;
-  std::vector<int8_t> donor_;  // (dy + 1)·3 + (dx + 1)
+  std::vector<uint32_t> visible_;
   Image* image_ = nullptr;
   const output::GammaTable* gamma_ = nullptr;
   uint16_t clear_[3] = {};

@@ -50,3 +50,56 @@ Recipient recipientOf(const geometry::TriangleSetup& t, int x, int y) {
 }
 
 }  // namespace sv::segments
+
+namespace sv::segments {
+
+void recipientDonorRows(const SortedFrame& f, int rowBegin, int rowEnd, uint16_t* out) {
+  const size_t w = size_t(f.width);
+  for (int y = rowBegin; y < rowEnd; ++y)
+    for (int x = 0; x < f.width; ++x) {
+      const size_t i = size_t(y) * w + size_t(x);
+      const uint32_t r = f.visible[i];
+      float cut = 0;
+      int dx = 0, dy = 0;
+      if (r != f.unsorted) {
+        if (r != f.background) {
+          const Recipient own = recipientOf(f.setups[r], x, y);
+          cut = 1 - own.area;
+          dx = own.dx;
+          dy = own.dy;
+        }
+        // The triangles other than the recipient shown at the neighbours: the area each covers of
+        // this pixel, those in front of the recipient cutting it off.
+        uint32_t seen[8];
+        int n = 0;
+        float front = 0, others = 0, most = 0;
+        int mx = 0, my = 0;
+        for (int ny = std::max(y - 1, 0); ny <= std::min(y + 1, f.height - 1); ++ny)
+          for (int nx = std::max(x - 1, 0); nx <= std::min(x + 1, f.width - 1); ++nx) {
+            const uint32_t t = f.visible[size_t(ny) * w + size_t(nx)];
+            if (t == r || t >= f.background || std::find(seen, seen + n, t) != seen + n) continue;
+            seen[n++] = t;
+            const float a = recipientOf(f.setups[t], x, y).area;
+            others += a;
+            if (t < r) front += a;
+            if (a > most) most = a, mx = nx - x, my = ny - y;
+          }
+        cut = std::min(std::max(cut, front), 1.0f);
+        // The donor: the neighbouring triangle that covers the most of the pixel, unless more of
+        // the cut-off part is claimed by none of them — then the neighbour across the recipient's
+        // edge (the background, or what lies behind).
+        if (most > 0 && (most >= cut - others || (dx == 0 && dy == 0))) dx = mx, dy = my;
+      }
+      const size_t j = size_t(y + dy) * w + size_t(x + dx);
+      const bool blend = cut > 0 && (dx != 0 || dy != 0) && x + dx >= 0 && x + dx < f.width &&
+                         y + dy >= 0 && y + dy < f.height && f.visible[j] != f.unsorted;
+      for (int c = 0; c < 3; ++c) {
+        const uint16_t own = f.rgb[3 * i + size_t(c)];
+        out[3 * i + size_t(c)] =
+            blend ? uint16_t(float(own) * (1 - cut) + float(f.rgb[3 * j + size_t(c)]) * cut + 0.5f)
+                  : own;
+      }
+    }
+}
+
+}  // namespace sv::segments
