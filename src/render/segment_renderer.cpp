@@ -20,11 +20,13 @@
 namespace sv::render {
 namespace {
 
-// 0 … 1 to a 16-bit code, rounded to nearest even as the kernel's magic-number conversion does;
+// 0 … 1 to a 16-bit code, rounded to nearest even as the kernel's magic-number conversion does
+// (the same conversion: adding and taking away 1.5·2^23 leaves the float rounded to an integer);
 // NaN to 0, as its Max(v, 0).
 uint16_t unitToCode(float v) {
-  const float c = std::min(std::max(0.0f, v), 1.0f);
-  return uint16_t(std::nearbyint(c * 65535.0f));
+  constexpr float kMagic = 12582912.0f;
+  const float c = std::min(std::max(0.0f, v), 1.0f) * 65535.0f;
+  return uint16_t((c + kMagic) - kMagic);
 }
 
 using Word = SegmentRenderer::Word;
@@ -51,9 +53,10 @@ class WordRing {
       n -= k;
     }
   }
-  // The words of the next line into `line`, up to and including its end-of-line or repeat word.
-  void popLine(std::vector<Word>& line) {
-    line.clear();
+  // Calls fn(word) for each word of the next line, up to and including its end-of-line or repeat
+  // word, as they arrive (no copy: the sorter reads the ring).
+  template <class Fn>
+  void popLine(Fn&& fn) {
     size_t tail = tail_.load(std::memory_order_relaxed);
     for (;;) {
       const size_t head = head_.load(std::memory_order_acquire);
@@ -63,7 +66,7 @@ class WordRing {
       }
       while (tail != head) {
         const Word w = words_[tail++ & mask_];
-        line.push_back(w);
+        fn(w);
         if (w.segment >= SegmentRenderer::kRepeatLine) {
           tail_.store(tail, std::memory_order_release);
           return;
@@ -127,22 +130,25 @@ void SegmentRenderer::produceLine(const Field& f, int line, std::vector<Word>& w
   }
 }
 
-void SegmentRenderer::sortLine(const Field& f, int y, const Word* words, size_t count,
-                               segments::XSorter& sorter, std::vector<segments::Run>& runs,
-                               FrameStats& stats) {
-  const int width = f.s->width;
-  sorter.clear(f.background);
-  for (size_t i = 0; i + 1 < count; ++i) sorter.add(words[i].segment, words[i].xl, words[i].xr);
-  stats.segments += count - 1;
+void SegmentRenderer::finishLine(int y, const segments::XSorter& sorter,
+                                 std::vector<segments::Run>& runs, FrameStats& stats) {
   sorter.runs(runs);
   stats.segmentRuns += runs.size();
-  uint8_t* bytes = f.linear ? nullptr : image_->pixel(0, y);
-  uint16_t* codes = f.linear ? &linear_.rgb[size_t(y) * size_t(width) * 3] : nullptr;
-  uint32_t* visible = f.s->donor ? &visible_[size_t(y) * size_t(width)] : nullptr;
-  for (size_t r = 0; r < runs.size(); ++r) {
-    const int xa = runs[r].x, xb = r + 1 < runs.size() ? runs[r + 1].x : width;
+  rowRuns_[size_t(y)] = {uint32_t(runStore_.size()), uint32_t(runStore_.size() + runs.size())};
+  runStore_.insert(runStore_.end(), runs.begin(), runs.end());
+}
+
+void SegmentRenderer::shadeRow(const SegmentSettings& s, bool linear, uint32_t background, int y) {
+  const int width = s.width;
+  const segments::Run* runs = runStore_.data() + rowRuns_[size_t(y)].begin;
+  const size_t n = rowRuns_[size_t(y)].end - rowRuns_[size_t(y)].begin;
+  uint8_t* bytes = linear ? nullptr : image_->pixel(0, y);
+  uint16_t* codes = linear ? &linear_.rgb[size_t(y) * size_t(width) * 3] : nullptr;
+  uint32_t* visible = s.donor ? &visible_[size_t(y) * size_t(width)] : nullptr;
+  for (size_t r = 0; r < n; ++r) {
+    const int xa = runs[r].x, xb = r + 1 < n ? runs[r + 1].x : width;
     if (visible) std::fill(visible + xa, visible + xb, runs[r].segment);
-    if (runs[r].segment == f.background) {
+    if (runs[r].segment == background) {
       for (int x = xa; x < xb; ++x)
         for (int c = 0; c < 3; ++c) {
           if (bytes) bytes[3 * x + c] = gamma_->table[clear_[c]];
@@ -196,24 +202,35 @@ void SegmentRenderer::repeatLine(const Field& f, int y) {
 void SegmentRenderer::runField(const Field& f, core::ThreadPool& pool, FrameStats& stats) {
   active_.clear();
   mergedRow_ = -1;
-  const auto sortWords = [&](int line, const std::vector<Word>& words, segments::XSorter& sorter,
-                             std::vector<segments::Run>& runs) {
+  // The sorter stage, word by word: a line's segments into the sorter, its end into RUN codes.
+  struct Sorting {
+    segments::XSorter sorter;
+    std::vector<segments::Run> runs;
+    bool started = false;
+  };
+  const auto sortWord = [&](int line, const Word& w, Sorting& st) {
+    if (!st.started) st.sorter.clear(f.background), st.started = true;
+    if (w.segment < kRepeatLine) {
+      st.sorter.add(w.segment, w.xl, w.xr);
+      ++stats.segments;
+      return;
+    }
     const int y = f.row(line);
-    if (words.back().segment == kRepeatLine) {
-      repeatLine(f, y);
+    st.started = false;
+    if (w.segment == kRepeatLine) {
+      rowRuns_[size_t(y)] = {kRepeated, kRepeated};
       ++stats.repeatedLines;
     } else {
-      sortLine(f, y, words.data(), words.size(), sorter, runs, stats);
+      finishLine(y, st.sorter, st.runs, stats);
     }
   };
   if (pool.threadCount() < 2 || f.lines < 2) {
     // One thread: a line through both stages at a time.
-    segments::XSorter sorter(f.s->width);
-    std::vector<segments::Run> runs;
+    Sorting st{segments::XSorter(f.s->width), {}, false};
     std::vector<Word> words;
     for (int i = 0; i < f.lines; ++i) {
       produceLine(f, i, words);
-      sortWords(i, words, sorter, runs);
+      for (const Word& w : words) sortWord(i, w, st);
     }
     return;
   }
@@ -230,12 +247,8 @@ void SegmentRenderer::runField(const Field& f, core::ThreadPool& pool, FrameStat
       }
       return;
     }
-    segments::XSorter sorter(f.s->width);
-    std::vector<segments::Run> runs;
-    for (int i = 0; i < f.lines; ++i) {
-      ring.popLine(words);
-      sortWords(i, words, sorter, runs);
-    }
+    Sorting st{segments::XSorter(f.s->width), {}, false};
+    for (int i = 0; i < f.lines; ++i) ring.popLine([&](const Word& w) { sortWord(i, w, st); });
   });
 }
 
@@ -306,19 +319,34 @@ void SegmentRenderer::render(const DrawPackets& packets, const SegmentSettings& 
     visible_.resize(size_t(s.width) * size_t(s.height));
   }
   const int fields = s.interlaced ? 2 : 1;
+  rowRuns_.assign(size_t(s.height), {});
+  runStore_.clear();
+  std::vector<Field> fieldsOf;
   for (int field = 0; field < fields; ++field) {
     Field f{&s, field, fields, (s.height - field + fields - 1) / fields, linear, uint32_t(m),
             nullptr};
     segments::ChannelClock clock(s.timing, f.lines);
     f.clock = &clock;
     runField(f, pool, stats);
+    f.clock = nullptr;
+    fieldsOf.push_back(f);
   }
+  // The pixels of every sorted line, in bands of rows on the pool's threads; then the repeated
+  // lines, field by field from the top, each from lines already there.
+  constexpr int kRows = 16;
+  const size_t bands = size_t((s.height + kRows - 1) / kRows);
+  pool.parallelFor(bands, [&](size_t band, int) {
+    const int y0 = int(band) * kRows, y1 = std::min(s.height, y0 + kRows);
+    for (int y = y0; y < y1; ++y)
+      if (rowRuns_[size_t(y)].begin != kRepeated) shadeRow(s, linear, uint32_t(m), y);
+  });
+  for (const Field& f : fieldsOf)
+    for (int i = 0; i < f.lines; ++i)
+      if (rowRuns_[size_t(f.row(i))].begin == kRepeated) repeatLine(f, f.row(i));
   if (linear) {
     // The recipient–donor filter (segments/recipient_donor.h) over the colours and visible
     // triangles the sorter left, then the tent filter or the gamma table alone.
     const output::LinearImage* source = &linear_;
-    constexpr int kRows = 16;
-    const size_t bands = size_t((s.height + kRows - 1) / kRows);
     if (s.donor) {
       filtered_.resize(s.width, s.height);
       segments::SortedFrame sorted;

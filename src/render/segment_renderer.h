@@ -1,14 +1,16 @@
 // Seed 002's segment pipeline (SPEC §10; issue 35) for a frame's draw packets: no frame buffer of
 // depths — each scan line's segments, in priority order, sent as segment words through a FIFO to a
-// sorter that sorts them by overwrite into RUN codes (segments/x_sort.h), each run's pixels shaded
-// along it; then the video channel's filters (the recipient–donor 1×1 filter, the 3×3 triangle
+// sorter that sorts them by overwrite into RUN codes (segments/x_sort.h); then each run's pixels
+// shaded along it, the video channel's filters (the recipient–donor 1×1 filter, the 3×3 triangle
 // filter, SPEC §5) and the gamma table.
 //
 // Two stages, as the seed's channel: the geometry stage (the lines' active triangles, their
-// segments) and the sorter stage (X-sort, runs, pixels), on two threads with a bounded ring of
+// segments) and the sorter stage (X-sort into RUN codes), on two threads with a bounded ring of
 // segment words between them — or on one thread, a line at a time, when the pool has one. The
-// channel's overload protection (segments/channel_clock.h) decides on a model clock counted in
-// segment words which lines are repeated, so the image is the same bytes for any thread count.
+// pixels of the sorted lines are then shaded in bands of rows on all the pool's threads (shading
+// them in the sorter stage left it the slower of the two: docs/performance.md). The channel's
+// overload protection (segments/channel_clock.h) decides on a model clock counted in segment
+// words which lines are repeated, so the image is the same bytes for any thread count.
 //
 // Visibility is priority: the packets' triangle order, first in front — the order the tile
 // pipeline's priority masking draws in (buildDrawPackets under Hsr::priority), so at one sample per
@@ -63,8 +65,9 @@ class SegmentRenderer {
   struct Field;
   void runField(const Field& field, core::ThreadPool& pool, FrameStats& stats);
   void produceLine(const Field& field, int line, std::vector<Word>& words);
-  void sortLine(const Field& field, int y, const Word* words, size_t count,
-                segments::XSorter& sorter, std::vector<segments::Run>& runs, FrameStats& stats);
+  void finishLine(int y, const segments::XSorter& sorter, std::vector<segments::Run>& runs,
+                  FrameStats& stats);
+  void shadeRow(const SegmentSettings& settings, bool linear, uint32_t background, int y);
   void repeatLine(const Field& field, int y);
 
   std::vector<geometry::TriangleSetup> all_;     // every packet triangle's record
@@ -77,6 +80,14 @@ class SegmentRenderer {
   // last row whose starting triangles it has taken in.
   std::vector<uint32_t> active_, incoming_, merged_;
   int mergedRow_ = -1;
+  // The sorter stage's output: each row's RUN codes, [begin, end) in runStore_ (kRepeated: the
+  // line is repeated), shaded once the fields are sorted.
+  struct RowRuns {
+    uint32_t begin = 0, end = 0;
+  };
+  static constexpr uint32_t kRepeated = ~0u;
+  std::vector<RowRuns> rowRuns_;
+  std::vector<segments::Run> runStore_;
   // With a filter: the frame in linear light as the sorter left it, the triangle visible at each
   // pixel (for the recipient–donor filter: the drawn triangle's number, the background's m, a
   // repeated line's m + 1), and the donor-filtered frame.

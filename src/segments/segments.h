@@ -12,12 +12,9 @@
 namespace sv::segments {
 
 // The pixels [xl, xr) of one row that a triangle covers (the seed's X_L … X_R − 1), empty when
-// xl ≥ xr, and the continuous ends of its span on the row's centre line — where its edges cross
-// y + ½ — for the recipient–donor filter, which weighs a boundary pixel by the part of it the
-// segment covers.
+// xl ≥ xr.
 struct Segment {
   int32_t xl = 0, xr = 0;
-  float exactLeft = 0, exactRight = 0;
   bool empty() const { return xl >= xr; }
 };
 

@@ -21,9 +21,10 @@ void XSorter::add(uint32_t segment, int xl, int xr) {
   xr = std::min(xr, width());
   if (xl >= xr) return;
   // X_L: number and mark; X_L+1 … X_R−1: number, mark cleared; X_R: mark only.
-  words_[size_t(xl)] = segment | kMark;
-  std::fill(words_.begin() + xl + 1, words_.begin() + xr, segment);
-  words_[size_t(xr)] |= kMark;
+  uint32_t* w = words_.data();
+  w[xl] = segment | kMark;
+  for (int x = xl + 1; x < xr; ++x) w[x] = segment;
+  w[xr] |= kMark;
 }
 
 void XSorter::runs(std::vector<Run>& out) const {
