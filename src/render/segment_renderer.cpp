@@ -15,19 +15,11 @@
 
 #include "core/timing.h"
 #include "segments/recipient_donor.h"
+#include "segments/run_shading.h"
 #include "segments/segments.h"
 
 namespace sv::render {
 namespace {
-
-// 0 … 1 to a 16-bit code, rounded to nearest even as the kernel's magic-number conversion does
-// (the same conversion: adding and taking away 1.5·2^23 leaves the float rounded to an integer);
-// NaN to 0, as its Max(v, 0).
-uint16_t unitToCode(float v) {
-  constexpr float kMagic = 12582912.0f;
-  const float c = std::min(std::max(0.0f, v), 1.0f) * 65535.0f;
-  return uint16_t((c + kMagic) - kMagic);
-}
 
 using Word = SegmentRenderer::Word;
 
@@ -100,28 +92,52 @@ struct SegmentRenderer::Field {
 void SegmentRenderer::produceLine(const Field& f, int line, std::vector<Word>& words) {
   words.clear();
   const int y = f.row(line);
-  // The triangles starting in rows (mergedRow_, y] join the active list, in priority order; those
-  // that end above y leave it.
+  // The triangles starting in rows (mergedRow_, y] join the active list, in priority order, each
+  // with a walker from row y (three-edge triangles; the others are cut by segmentOf); those that
+  // end above y leave it, their walkers' slots freed.
   incoming_.clear();
   for (int r = mergedRow_ + 1; r <= y; ++r)
-    incoming_.insert(incoming_.end(), byRow_.begin() + firstRow_[size_t(r)],
-                     byRow_.begin() + firstRow_[size_t(r) + 1]);
+    for (uint32_t i = firstRow_[size_t(r)]; i < firstRow_[size_t(r) + 1]; ++i) {
+      const uint32_t k = byRow_[i];
+      const geometry::TriangleSetup& t = setups_[k];
+      if (t.maxY < y) continue;
+      uint32_t slot = kNoWalker;
+      if (segments::SegmentWalker::fits(t)) {
+        if (freeSlots_.empty()) {
+          freeSlots_.push_back(uint32_t(walkers_.size()));
+          walkers_.emplace_back();
+        }
+        slot = freeSlots_.back();
+        freeSlots_.pop_back();
+        walkers_[slot] = segments::SegmentWalker(t, y, f.s->width, f.step);
+      }
+      incoming_.push_back({k, slot, t.maxY});
+    }
   mergedRow_ = std::max(mergedRow_, y);
-  std::sort(incoming_.begin(), incoming_.end());
+  const auto byNumber = [](const Active& a, const Active& b) { return a.number < b.number; };
+  std::sort(incoming_.begin(), incoming_.end(), byNumber);
   merged_.clear();
   std::merge(active_.begin(), active_.end(), incoming_.begin(), incoming_.end(),
-             std::back_inserter(merged_));
+             std::back_inserter(merged_), byNumber);
   active_.clear();
-  for (uint32_t k : merged_)
-    if (lastRow_[k] >= y) active_.push_back(k);
-  if (!f.clock->startLine(line)) {
+  for (const Active& a : merged_) {
+    if (a.lastRow >= y)
+      active_.push_back(a);
+    else if (a.slot != kNoWalker)
+      freeSlots_.push_back(a.slot);
+  }
+  const bool repeat = !f.clock->startLine(line);
+  // Increasing priority: the last triangle first, so the first one's segment is written last.
+  // (A repeated line's walkers still step on.)
+  for (auto it = active_.rbegin(); it != active_.rend(); ++it) {
+    const segments::Segment seg = it->slot != kNoWalker
+                                      ? walkers_[it->slot].next()
+                                      : segments::segmentOf(setups_[it->number], y, f.s->width);
+    if (!seg.empty() && !repeat) words.push_back({it->number, seg.xl, seg.xr});
+  }
+  if (repeat) {
     words.push_back({kRepeatLine, y, y});
     return;
-  }
-  // Increasing priority: the last triangle first, so the first one's segment is written last.
-  for (auto it = active_.rbegin(); it != active_.rend(); ++it) {
-    const segments::Segment seg = segments::segmentOf(setups_[*it], y, f.s->width);
-    if (!seg.empty()) words.push_back({*it, seg.xl, seg.xr});
   }
   words.push_back({kEndOfLine, y, y});
   if (!f.clock->finishLine(line, int64_t(words.size()))) {
@@ -138,36 +154,27 @@ void SegmentRenderer::finishLine(int y, const segments::XSorter& sorter,
   runStore_.insert(runStore_.end(), runs.begin(), runs.end());
 }
 
-void SegmentRenderer::shadeRow(const SegmentSettings& s, bool linear, uint32_t background, int y) {
+void SegmentRenderer::shadeRow(const SegmentSettings& s, bool linear, uint32_t background, int y,
+                               std::vector<uint16_t>& buffer) {
   const int width = s.width;
   const segments::Run* runs = runStore_.data() + rowRuns_[size_t(y)].begin;
   const size_t n = rowRuns_[size_t(y)].end - rowRuns_[size_t(y)].begin;
-  uint8_t* bytes = linear ? nullptr : image_->pixel(0, y);
-  uint16_t* codes = linear ? &linear_.rgb[size_t(y) * size_t(width) * 3] : nullptr;
+  // Linear codes into the frame (for the filters) or a row buffer (then the gamma table).
+  buffer.resize(size_t(width) * 3);
+  uint16_t* codes = linear ? &linear_.rgb[size_t(y) * size_t(width) * 3] : buffer.data();
   uint32_t* visible = s.donor ? &visible_[size_t(y) * size_t(width)] : nullptr;
   for (size_t r = 0; r < n; ++r) {
     const int xa = runs[r].x, xb = r + 1 < n ? runs[r + 1].x : width;
     if (visible) std::fill(visible + xa, visible + xb, runs[r].segment);
     if (runs[r].segment == background) {
-      for (int x = xa; x < xb; ++x)
-        for (int c = 0; c < 3; ++c) {
-          if (bytes) bytes[3 * x + c] = gamma_->table[clear_[c]];
-          if (codes) codes[3 * x + c] = clear_[c];
-        }
+      for (int x = xa; x < xb; ++x) std::copy_n(clear_, 3, codes + 3 * x);
       continue;
     }
-    // Along the run: colour/w and 1/w at each pixel centre, the colour their ratio.
-    const geometry::TriangleSetup& t = setups_[runs[r].segment];
-    const geometry::Plane* planes[3] = {&t.red, &t.green, &t.blue};
-    for (int x = xa; x < xb; ++x) {
-      const float w = 1.0f / geometry::planeAtPixel(t.invW, x, y, t.minX, t.minY);
-      for (int c = 0; c < 3; ++c) {
-        const uint16_t code =
-            unitToCode(geometry::planeAtPixel(*planes[c], x, y, t.minX, t.minY) * w);
-        if (bytes) bytes[3 * x + c] = gamma_->table[code];
-        if (codes) codes[3 * x + c] = code;
-      }
-    }
+    segments::shadeRun(setups_[runs[r].segment], y, xa, xb, codes + 3 * xa);
+  }
+  if (!linear) {
+    uint8_t* bytes = image_->pixel(0, y);
+    for (size_t i = 0; i < size_t(width) * 3; ++i) bytes[i] = gamma_->table[codes[i]];
   }
 }
 
@@ -201,6 +208,8 @@ void SegmentRenderer::repeatLine(const Field& f, int y) {
 
 void SegmentRenderer::runField(const Field& f, core::ThreadPool& pool, FrameStats& stats) {
   active_.clear();
+  walkers_.clear();
+  freeSlots_.clear();
   mergedRow_ = -1;
   // The sorter stage, word by word: a line's segments into the sorter, its end into RUN codes.
   struct Sorting {
@@ -297,11 +306,7 @@ void SegmentRenderer::render(const DrawPackets& packets, const SegmentSettings& 
   // The drawn triangles bucketed by their first row, priority order kept within a row.
   const size_t m = setups_.size();
   firstRow_.assign(size_t(s.height) + 1, 0);
-  lastRow_.resize(m);
-  for (size_t k = 0; k < m; ++k) {
-    ++firstRow_[size_t(setups_[k].minY) + 1];
-    lastRow_[k] = setups_[k].maxY;
-  }
+  for (size_t k = 0; k < m; ++k) ++firstRow_[size_t(setups_[k].minY) + 1];
   for (int y = 0; y < s.height; ++y) firstRow_[size_t(y) + 1] += firstRow_[size_t(y)];
   byRow_.resize(m);
   {
@@ -335,10 +340,12 @@ void SegmentRenderer::render(const DrawPackets& packets, const SegmentSettings& 
   // lines, field by field from the top, each from lines already there.
   constexpr int kRows = 16;
   const size_t bands = size_t((s.height + kRows - 1) / kRows);
-  pool.parallelFor(bands, [&](size_t band, int) {
+  rowBuffers_.resize(size_t(pool.threadCount()));
+  pool.parallelFor(bands, [&](size_t band, int worker) {
     const int y0 = int(band) * kRows, y1 = std::min(s.height, y0 + kRows);
     for (int y = y0; y < y1; ++y)
-      if (rowRuns_[size_t(y)].begin != kRepeated) shadeRow(s, linear, uint32_t(m), y);
+      if (rowRuns_[size_t(y)].begin != kRepeated)
+        shadeRow(s, linear, uint32_t(m), y, rowBuffers_[size_t(worker)]);
   });
   for (const Field& f : fieldsOf)
     for (int i = 0; i < f.lines; ++i)

@@ -27,6 +27,7 @@
 #include "output/resolve.h"
 #include "render/draw_packets.h"
 #include "segments/channel_clock.h"
+#include "segments/segments.h"
 #include "segments/x_sort.h"
 #include "synthvis/frame_stats.h"
 
@@ -67,18 +68,26 @@ class SegmentRenderer {
   void produceLine(const Field& field, int line, std::vector<Word>& words);
   void finishLine(int y, const segments::XSorter& sorter, std::vector<segments::Run>& runs,
                   FrameStats& stats);
-  void shadeRow(const SegmentSettings& settings, bool linear, uint32_t background, int y);
+  void shadeRow(const SegmentSettings& settings, bool linear, uint32_t background, int y,
+                std::vector<uint16_t>& buffer);
   void repeatLine(const Field& field, int y);
 
   std::vector<geometry::TriangleSetup> all_;     // every packet triangle's record
   std::vector<uint8_t> outcome_;                 // per packet triangle: its SetupOutcome
   std::vector<geometry::TriangleSetup> setups_;  // the drawn triangles', in priority order
-  std::vector<int16_t> lastRow_;                 // per drawn triangle: its last row (maxY)
   std::vector<uint32_t> firstRow_;               // per row: its first starting triangle in byRow_
   std::vector<uint32_t> byRow_;                  // drawn triangles by first row, priority within
   // The geometry stage's active list (drawn triangles reaching the line, in priority order) and the
   // last row whose starting triangles it has taken in.
-  std::vector<uint32_t> active_, incoming_, merged_;
+  struct Active {
+    uint32_t number;  // the drawn triangle's
+    uint32_t slot;    // its walker in walkers_, or kNoWalker
+    int32_t lastRow;
+  };
+  static constexpr uint32_t kNoWalker = ~0u;
+  std::vector<Active> active_, incoming_, merged_;
+  std::vector<segments::SegmentWalker> walkers_;
+  std::vector<uint32_t> freeSlots_;
   int mergedRow_ = -1;
   // The sorter stage's output: each row's RUN codes, [begin, end) in runStore_ (kRepeated: the
   // line is repeated), shaded once the fields are sorted.
@@ -87,6 +96,7 @@ class SegmentRenderer {
   };
   static constexpr uint32_t kRepeated = ~0u;
   std::vector<RowRuns> rowRuns_;
+  std::vector<std::vector<uint16_t>> rowBuffers_;  // per worker: a row's codes before the gamma table
   std::vector<segments::Run> runStore_;
   // With a filter: the frame in linear light as the sorter left it, the triangle visible at each
   // pixel (for the recipient–donor filter: the drawn triangle's number, the background's m, a
