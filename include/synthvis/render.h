@@ -72,8 +72,8 @@ struct RenderOptions {
   // passes), or seed 002's segment pipeline (SPEC §10) — each scan line's segments in priority
   // order, sorted by overwrite into RUN codes, each run shaded along it. The segment pipeline's
   // visibility is priority (the scene's triangles in the order Hsr::priority draws them, whatever
-  // `hsr` says); it draws polygons with vertex colours (issue 35): a scene or options needing more
-  // are refused. Its anti-aliasing is its own (SegmentChannel::donor, `filter` tent3).
+  // `hsr` says); it draws polygons with vertex colours, and fog (issue 35): a scene or options
+  // needing more are refused. Its anti-aliasing is its own (SegmentChannel::donor, `filter` tent3).
   enum class Pipeline { tiles, segments } pipeline = Pipeline::tiles;
   // The segment pipeline's video channel (SPEC §10, §5, §9), for Pipeline::segments only.
   struct SegmentChannel {

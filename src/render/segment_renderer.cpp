@@ -170,7 +170,20 @@ void SegmentRenderer::shadeRow(const SegmentSettings& s, bool linear, uint32_t b
       for (int x = xa; x < xb; ++x) std::copy_n(clear_, 3, codes + 3 * x);
       continue;
     }
-    segments::shadeRun(setups_[runs[r].segment], y, xa, xb, codes + 3 * xa);
+    const geometry::TriangleSetup& t = setups_[runs[r].segment];
+    segments::shadeRun(t, y, xa, xb, codes + 3 * xa);
+    if (s.fog) {
+      const double ry = s.tanTop - (s.tanTop - s.tanBottom) * (y + 0.5) / s.height;
+      for (int x = xa; x < xb; ++x) {
+        const double rx = s.tanLeft + (s.tanRight - s.tanLeft) * (x + 0.5) / s.width;
+        const double w = 1.0 / double(geometry::planeAtPixel(t.invW, x, y, t.minX, t.minY));
+        const float f = std::exp2(-s.fogBeta * float(w * std::sqrt(rx * rx + ry * ry + 1)));
+        for (int c = 0; c < 3; ++c) {
+          const float v = float(codes[3 * x + c]) * f + s.fogColor[c] * 65535.0f * (1 - f);
+          codes[3 * x + c] = uint16_t(std::clamp(v, 0.0f, 65535.0f) + 0.5f);
+        }
+      }
+    }
   }
   if (!linear) {
     uint8_t* bytes = image_->pixel(0, y);

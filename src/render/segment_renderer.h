@@ -40,6 +40,14 @@ struct SegmentSettings {
   // Two fields a frame, the even lines then the odd ones, each through the channel on its own
   // clock; a repeated line of the second field is the mean of its neighbours in the first.
   bool interlaced = false;
+  // Fog (SPEC §8, seed 002): C = C_c·2^(−β·r) + C_F·(1 − 2^(−β·r)) per pixel of a surface, r the
+  // eye's distance to the pixel's point — its eye depth w (1 ÷ the 1/w plane) times the length of
+  // its ray at unit depth through the view window tanLeft … tanTop (a perspective projection's
+  // clip w is the eye depth).
+  bool fog = false;
+  float fogColor[3] = {0, 0, 0};  // linear
+  float fogBeta = 0;
+  double tanLeft = -1, tanRight = 1, tanBottom = -1, tanTop = 1;
   bool donor = false;  // the recipient–donor 1×1 filter (segments/recipient_donor.h)
   bool tent = false;   // the 3×3 triangle filter [1 2 1]ᵀ[1 2 1]/16 after it
 };

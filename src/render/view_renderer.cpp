@@ -98,11 +98,19 @@ Status ViewRenderer::runSegments(const scene::Scene& scene, const RenderOptions&
     return Error{
         "", "",
         fmt::format("the segment pipeline draws polygons only so far: the scene has {}", missing)};
-  buildShading(scene, o, camera.view, shading_);
-  if (shading_.any)
+  // Vertex colours, and fog along the run; not the materials' pixel shading.
+  bool materials = false;
+  for (const scene::Material& mat : scene.materials) materials |= mat.needsPixelShading();
+  if (o.lod)
+    for (const scene::LodGroup& g : scene.lodGroups) materials |= g.fade > 0;
+  if (materials)
     return Error{"", "",
-                 "the segment pipeline draws vertex colours only so far: the scene's materials "
-                 "need pixel shading (lighting, texture or fog)"};
+                 "the segment pipeline draws vertex colours (and fog): the scene's materials "
+                 "need pixel shading (lighting per pixel, texture, translucency or a dissolving "
+                 "level of detail)"};
+  const bool fog = scene.fog.enabled && scene.fog.beta > 0;
+  if (fog && camera.projective)
+    return Error{"", "", "the segment pipeline's fog needs a view window, not a sub-frustum"};
   // Stage 3: every instance's vertices to clip space, in the priority order masking draws in.
   RenderOptions po = o;
   po.hsr = RenderOptions::Hsr::priority;
@@ -121,6 +129,15 @@ Status ViewRenderer::runSegments(const scene::Scene& scene, const RenderOptions&
   ss.timing.fifoWords = o.segmentChannel.fifoWords;
   ss.interlaced = o.segmentChannel.interlaced;
   ss.donor = o.segmentChannel.donor;
+  ss.fog = fog;
+  ss.fogColor[0] = scene.fog.color.x;
+  ss.fogColor[1] = scene.fog.color.y;
+  ss.fogColor[2] = scene.fog.color.z;
+  ss.fogBeta = scene.fog.beta;
+  ss.tanLeft = camera.tanLeft;
+  ss.tanRight = camera.tanRight;
+  ss.tanBottom = camera.tanBottom;
+  ss.tanTop = camera.tanTop;
   ss.tent = o.filter == RenderOptions::Filter::tent3;
   segments_.render(packets_, ss, gamma_, frame_.pool(), image, stats);
   return {};

@@ -103,6 +103,49 @@ TEST(Cli, TheSegmentPipelineDrawsThePriorityImageAndRefusesWhatItCannotDraw) {
   EXPECT_NE(bad.out.find("tiles or segments"), std::string::npos) << bad.out;
 }
 
+TEST(Cli, TheSegmentPipelinesFogIsTheTilePipelines) {
+  // A fogged ground and boxes of plain colours: the segment pipeline's fog (the range from the
+  // 1/w plane and the view window) against the tile pipeline's (the eye position interpolated):
+  // the same image but for rounding.
+  const auto text = [](const std::string& beta) {
+    return R"({"synthvis": 1, "background": [0.6, 0.7, 0.8],
+      "camera": {"position": [0, 2, 0], "target": [0, 1.5, -40], "yfov": 45, "near": 0.5,
+                 "far": 2000},
+      "fog": {"color": [0.6, 0.7, 0.8], "beta": )" +
+           beta + R"(},
+      "objects": [
+        {"primitive": "box", "size": 3, "color": [0.8, 0.2, 0.1],
+         "transform": {"translate": [2, 1.5, -20]}},
+        {"primitive": "box", "size": 6, "color": [0.1, 0.6, 0.2],
+         "transform": {"translate": [-6, 3, -70]}},
+        {"primitive": "checker", "size": [400, 400], "color": [0.3, 0.3, 0.3]}]})";
+  };
+  const std::string scene = write("fogged.json", text("0.02"));
+  const std::string clearScene = write("unfogged.json", text("0"));
+  const std::string seg = (tempDir() / "fog-segments.png").string();
+  const std::string tiles = (tempDir() / "fog-tiles.png").string();
+  const CliRun a = run("render " + scene + " -o " + seg + " --width 320 --height 180 --pipeline segments");
+  ASSERT_EQ(a.status, 0) << a.out;
+  const CliRun b = run("render " + scene + " -o " + tiles + " --width 320 --height 180 --hsr priority");
+  ASSERT_EQ(b.status, 0) << b.out;
+  const CliRun c = run("compare " + seg + " " + tiles);
+  ASSERT_EQ(c.status, 0) << c.out;
+  const size_t at = c.out.find("PSNR ");
+  ASSERT_NE(at, std::string::npos) << c.out;
+  const std::string psnr = c.out.substr(at + 5, c.out.find(' ', at + 5) - at - 5);
+  EXPECT_TRUE(psnr == "inf" || std::stod(psnr) > 50) << c.out;
+  // And the fog did something: without it the frame is far from the fogged one.
+  const std::string clear = (tempDir() / "fog-clear.png").string();
+  ASSERT_EQ(
+      run("render " + clearScene + " -o " + clear + " --width 320 --height 180 --pipeline segments")
+          .status,
+      0);
+  const CliRun d = run("compare " + seg + " " + clear);
+  const size_t at2 = d.out.find("PSNR ");
+  ASSERT_NE(at2, std::string::npos) << d.out;
+  EXPECT_LT(std::stod(d.out.substr(at2 + 5)), 30) << d.out;
+}
+
 TEST(Cli, TruncatedJsonNamesFileAndPosition) {
   const std::string f =
       write("trunc.json", "{\"synthvis\": 1, \"objects\": [ {\"primitive\": \"box\"");
