@@ -92,26 +92,13 @@ struct SegmentRenderer::Field {
 void SegmentRenderer::produceLine(const Field& f, int line, std::vector<Word>& words) {
   words.clear();
   const int y = f.row(line);
-  // The triangles starting in rows (mergedRow_, y] join the active list, in priority order, each
-  // with a walker from row y (three-edge triangles; the others are cut by segmentOf); those that
-  // end above y leave it, their walkers' slots freed.
+  // The triangles starting in rows (mergedRow_, y] join the active list, in priority order; those
+  // that end above y leave it.
   incoming_.clear();
   for (int r = mergedRow_ + 1; r <= y; ++r)
     for (uint32_t i = firstRow_[size_t(r)]; i < firstRow_[size_t(r) + 1]; ++i) {
       const uint32_t k = byRow_[i];
-      const geometry::TriangleSetup& t = setups_[k];
-      if (t.maxY < y) continue;
-      uint32_t slot = kNoWalker;
-      if (segments::SegmentWalker::fits(t)) {
-        if (freeSlots_.empty()) {
-          freeSlots_.push_back(uint32_t(walkers_.size()));
-          walkers_.emplace_back();
-        }
-        slot = freeSlots_.back();
-        freeSlots_.pop_back();
-        walkers_[slot] = segments::SegmentWalker(t, y, f.s->width, f.step);
-      }
-      incoming_.push_back({k, slot, t.maxY});
+      if (setups_[k].maxY >= y) incoming_.push_back({k, setups_[k].maxY});
     }
   mergedRow_ = std::max(mergedRow_, y);
   const auto byNumber = [](const Active& a, const Active& b) { return a.number < b.number; };
@@ -120,24 +107,17 @@ void SegmentRenderer::produceLine(const Field& f, int line, std::vector<Word>& w
   std::merge(active_.begin(), active_.end(), incoming_.begin(), incoming_.end(),
              std::back_inserter(merged_), byNumber);
   active_.clear();
-  for (const Active& a : merged_) {
-    if (a.lastRow >= y)
-      active_.push_back(a);
-    else if (a.slot != kNoWalker)
-      freeSlots_.push_back(a.slot);
-  }
+  for (const Active& a : merged_)
+    if (a.lastRow >= y) active_.push_back(a);
   const bool repeat = !f.clock->startLine(line);
-  // Increasing priority: the last triangle first, so the first one's segment is written last.
-  // (A repeated line's walkers still step on.)
-  for (auto it = active_.rbegin(); it != active_.rend(); ++it) {
-    const segments::Segment seg = it->slot != kNoWalker
-                                      ? walkers_[it->slot].next()
-                                      : segments::segmentOf(setups_[it->number], y, f.s->width);
-    if (!seg.empty() && !repeat) words.push_back({it->number, seg.xl, seg.xr});
-  }
   if (repeat) {
     words.push_back({kRepeatLine, y, y});
     return;
+  }
+  // Increasing priority: the last triangle first, so the first one's segment is written last.
+  for (auto it = active_.rbegin(); it != active_.rend(); ++it) {
+    const segments::Segment seg = segments::segmentOf(setups_[it->number], y, f.s->width);
+    if (!seg.empty()) words.push_back({it->number, seg.xl, seg.xr});
   }
   words.push_back({kEndOfLine, y, y});
   if (!f.clock->finishLine(line, int64_t(words.size()))) {
@@ -221,8 +201,6 @@ void SegmentRenderer::repeatLine(const Field& f, int y) {
 
 void SegmentRenderer::runField(const Field& f, core::ThreadPool& pool, FrameStats& stats) {
   active_.clear();
-  walkers_.clear();
-  freeSlots_.clear();
   mergedRow_ = -1;
   // The sorter stage, word by word: a line's segments into the sorter, its end into RUN codes.
   struct Sorting {

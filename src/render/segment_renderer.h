@@ -27,7 +27,6 @@
 #include "output/resolve.h"
 #include "render/draw_packets.h"
 #include "segments/channel_clock.h"
-#include "segments/segments.h"
 #include "segments/x_sort.h"
 #include "synthvis/frame_stats.h"
 
@@ -89,13 +88,9 @@ class SegmentRenderer {
   // last row whose starting triangles it has taken in.
   struct Active {
     uint32_t number;  // the drawn triangle's
-    uint32_t slot;    // its walker in walkers_, or kNoWalker
-    int32_t lastRow;
+    int32_t lastRow;  // its maxY, kept here: the list is filtered every row
   };
-  static constexpr uint32_t kNoWalker = ~0u;
   std::vector<Active> active_, incoming_, merged_;
-  std::vector<segments::SegmentWalker> walkers_;
-  std::vector<uint32_t> freeSlots_;
   int mergedRow_ = -1;
   // The sorter stage's output: each row's RUN codes, [begin, end) in runStore_ (kRepeated: the
   // line is repeated), shaded once the fields are sorted.

@@ -23,34 +23,4 @@ struct Segment {
 // same integers), within the record's bounding box and [0, width). Empty off the box's rows.
 Segment segmentOf(const geometry::TriangleSetup& t, int y, int width);
 
-// A triangle's segments row after row without a division per edge and row: each edge's bound is
-// stepped from the row before as a quotient and remainder (the crossing moves by stepY/stepX a row),
-// exactly — the same segments as segmentOf. For triangles of three edges (those clipped by the near
-// or far plane have more: segmentOf cuts theirs). 80 bytes, kept by the geometry stage for each
-// active triangle instead of reading its 160-byte setup record every row.
-class SegmentWalker {
- public:
-  static bool fits(const geometry::TriangleSetup& t) { return t.edgeCount == 3; }
-  SegmentWalker() = default;
-  // At row y of a raster `width` pixels wide, stepping `rowStep` rows at a time (2: one field of
-  // an interlaced frame).
-  SegmentWalker(const geometry::TriangleSetup& t, int y, int width, int rowStep = 1);
-  // The segment of the current row, then on to the next.
-  Segment next();
-
- private:
-  // One edge: a left bound ⌈−k/a⌉ (a > 0), a right bound ⌊k/−a⌋ (a < 0), both as q with
-  // remainder r ∈ [0, d) and per row q += dq, r += dr (carrying); or (a = 0) the row wholly in or
-  // out as k ≥ 0, k += its step.
-  struct Edge {
-    int64_t q;
-    int32_t dq;
-    uint32_t r, dr, d;
-  };
-  static void carry(Edge& w, int carry);
-  Edge edges_[3] = {};
-  int16_t lo_ = 0, hi_ = -1;  // the box's columns within the raster
-  uint8_t kinds_ = 0;         // 2 bits an edge: 0 left, 1 right, 2 horizontal
-};
-
 }  // namespace sv::segments

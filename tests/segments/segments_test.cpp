@@ -1,8 +1,7 @@
 // Segments cut from setup records (segments/segments.h): a row's segment holds exactly the pixel
 // centres every edge function admits — the tile pipeline's point-sampled coverage — for ordinary
 // and wild triangles (vertices behind the eye, beyond the near and far planes, huge); its ends lie
-// where the edges cross the row's centre line; and a walker stepping the edges row by row cuts the
-// same segments.
+// where the edges cross the row's centre line.
 #include "segments/segments.h"
 
 #include <gtest/gtest.h>
@@ -78,42 +77,6 @@ TEST(Segments, EndsAreThePixelCentresInsideWhereTheEdgesCrossTheRow) {
     ++checked;
   }
   EXPECT_GT(checked, 95);
-}
-
-TEST(Segments, AWalkerSteppingRowByRowCutsTheSegmentsSegmentOfCuts) {
-  // Every three-edge triangle of random scenes, ordinary and wild, from its first row and from a
-  // row inside, one row and two rows (a field) at a time.
-  const int w = 300, h = 200;
-  geometry::Viewport vp;
-  vp.width = w;
-  vp.height = h;
-  int64_t rows = 0;
-  for (bool wild : {false, true})
-    for (unsigned seed : {5u, 6u, 7u}) {
-      const render::DrawPackets p = test::randomScene(w, h, 300, seed, wild);
-      for (size_t tri = 0; tri < p.indices.size() / 3; ++tri) {
-        geometry::TriangleSetup t;
-        const uint32_t* i = &p.indices[tri * 3];
-        if (geometry::setupTriangle(p.vertices[i[0]], p.vertices[i[1]], p.vertices[i[2]], vp,
-                                    geometry::CullMode::none, t) != geometry::SetupOutcome::drawn ||
-            !segments::SegmentWalker::fits(t))
-          continue;
-        for (int step : {1, 2})
-          for (int start : {int(t.minY), (t.minY + t.maxY) / 2}) {
-            segments::SegmentWalker walker(t, start, w, step);
-            for (int y = start; y <= t.maxY; y += step) {
-              const segments::Segment a = walker.next(), b = segments::segmentOf(t, y, w);
-              ASSERT_EQ(a.empty(), b.empty()) << "triangle " << tri << " row " << y;
-              if (!b.empty()) {
-                ASSERT_EQ(a.xl, b.xl) << "triangle " << tri << " row " << y;
-                ASSERT_EQ(a.xr, b.xr) << "triangle " << tri << " row " << y;
-              }
-              ++rows;
-            }
-          }
-      }
-    }
-  EXPECT_GT(rows, 20000);
 }
 
 }  // namespace
