@@ -565,6 +565,13 @@ int runBench(BenchArgs a) {
       for (size_t c = 0; c < cr.runs[0].channelStats.size(); ++c)
         fmt::print("  synthvis last frame, channel {}: {}\n", c,
                    cr.runs[0].channelStats[c].summary());
+      if (settings.pipelines && cr.runs.size() > 1)
+        fmt::print("  segments last frame: {}\n"
+                   "  segments: {:.1f} M/s, lines repeated {} ({:.1f} %)\n",
+                   cr.runs[1].stats.summary(),
+                   cr.params.value("segments_per_second", 0.0) / 1e6,
+                   cr.params.value("repeated_lines", uint64_t(0)),
+                   100 * cr.params.value("repeated_share", 0.0));
       for (auto& row : ref::jsonRows(cr, settings)) {
         if (a.repeat > 1) row["repeat"] = k + 1;
         rows.push_back(row);
