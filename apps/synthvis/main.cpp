@@ -53,6 +53,7 @@
 #include "terrain/height_field.h"
 #include "ig/config.h"
 #include "ig/host.h"
+#include "cluster/cluster.h"
 #include "ig/loop.h"
 #include "prep/prep.h"
 
@@ -754,19 +755,32 @@ int runCompare(const std::string& imagePath, const std::string& referencePath,
 
 // `synthvis terrain SCENE --height X,Y,Z | --los X,Y,Z,X,Y,Z`: the host's queries (synthvis/terrain.h).
 // synthvis ig: the real-time loop a host drives (docs/ig.md).
-int runIg(const std::string& configPath, const sv::ig::IgRunOptions& options) {
+int runIg(const std::string& configPath, sv::ig::IgRunOptions options) {
   // A y4m reader that goes away is the presenter's closed(), not the end of the process.
   std::signal(SIGPIPE, SIG_IGN);
+  // Under mpirun, one rank of the IG (docs/cluster.md); an error on any rank ends the whole job,
+  // named, rather than leaving the others waiting for it.
+  sv::Result<std::unique_ptr<sv::cluster::Cluster>> cluster = sv::cluster::Cluster::join();
+  if (!cluster) return fail(cluster.error());
+  sv::cluster::Cluster& job = *cluster.value();
+  options.cluster = &job;
+  const auto failJob = [&](sv::Error e) {
+    if (e.file.empty()) e.file = configPath;
+    if (job.size() > 1) job.abort(fmt::format("{}: {}", job.name(job.rank()), e.str()));
+    return fail(e);
+  };
   sv::Result<sv::ig::IgConfig> config = sv::ig::loadIgConfig(configPath);
-  if (!config) return fail(config.error());
+  if (!config) return failJob(config.error());
   sv::Result<std::unique_ptr<sv::ig::IgLoop>> loop = sv::ig::IgLoop::create(config.value(), options);
-  if (!loop) return fail(loop.error());
-  if (options.replay.empty())
-    fmt::print(stderr, "synthvis ig: {} at {:.0f} Hz, listening on UDP {}\n", configPath,
-               config->rate, loop.value()->port());
+  if (!loop) return failJob(loop.error());
+  if (options.replay.empty() && job.rank() == 0)
+    fmt::print(stderr, "synthvis ig: {} at {:.0f} Hz, listening on UDP {}{}\n", configPath,
+               config->rate, loop.value()->port(),
+               job.size() > 1 ? fmt::format(", {} ranks", job.size()) : std::string());
   sv::Result<sv::ig::IgRunReport> report = loop.value()->run();
-  if (!report) return fail(report.error());
-  fmt::print(stderr, "{}\n", report->summary());
+  if (!report) return failJob(report.error());
+  fmt::print(stderr, "{}{}\n", job.size() > 1 ? job.name(job.rank()) + ": " : std::string(),
+             report->summary());
   return 0;
 }
 

@@ -46,7 +46,7 @@ std::string directoryOf(const std::string& path) {
 IgConfig read(const Json& root, const std::string& path) {
   known(root, "configuration",
         {"synthvis-ig", "scene", "rate", "channels", "width", "height", "models", "origin", "port",
-         "host", "render", "deadline", "maxEntities"});
+         "host", "render", "deadline", "maxEntities", "cluster"});
   IgConfig c;
   if (!root.contains("synthvis-ig") || root["synthvis-ig"] != 1)
     bad("\"synthvis-ig\": 1 expected (the configuration format's version)");
@@ -130,12 +130,60 @@ IgConfig read(const Json& root, const std::string& path) {
   if (root.contains("deadline")) c.deadline = number(root["deadline"], "deadline", 0.1, 1);
   if (root.contains("maxEntities"))
     c.maxEntities = uint16_t(integer(root["maxEntities"], "maxEntities", 1, 65535));
+  if (const auto it = root.find("cluster"); it != root.end()) {
+    known(*it, "cluster", {"ranks", "timeout"});
+    if (it->contains("ranks")) {
+      const Json& ranks = (*it)["ranks"];
+      if (!ranks.is_array() || ranks.empty() || ranks.size() > 4096)
+        bad("cluster.ranks: an array of 1 … 4096 arrays of channel indices expected");
+      for (size_t r = 0; r < ranks.size(); ++r) {
+        if (!ranks[r].is_array()) bad(fmt::format("cluster.ranks[{}]: an array of channel indices expected", r));
+        std::vector<int> channels;
+        for (size_t k = 0; k < ranks[r].size(); ++k)
+          channels.push_back(integer(ranks[r][k], fmt::format("cluster.ranks[{}][{}]", r, k).c_str(), 0,
+                                     int(scene::kMaxChannels) - 1));
+        c.ranks.push_back(std::move(channels));
+      }
+    }
+    if (it->contains("timeout")) c.rankTimeout = number((*it)["timeout"], "cluster.timeout", 0.1, 3600);
+  }
   c.render.width = c.width;
   c.render.height = c.height;
   return c;
 }
 
 }  // namespace
+
+Result<std::vector<std::vector<int>>> channelsByRank(const IgConfig& config, int channelCount,
+                                                    int ranks) {
+  std::vector<std::vector<int>> out(static_cast<size_t>(ranks));
+  if (config.ranks.empty()) {
+    if (ranks > channelCount)
+      return Error{"", "",
+                   fmt::format("{} ranks for {} channels: a rank would draw nothing (give "
+                               "cluster.ranks, or fewer ranks)",
+                               ranks, channelCount)};
+    for (int i = 0; i < channelCount; ++i) out[size_t(i % ranks)].push_back(i);
+    return out;
+  }
+  if (int(config.ranks.size()) != ranks)
+    return Error{"", "",
+                 fmt::format("cluster.ranks assigns channels to {} ranks, the job has {}",
+                             config.ranks.size(), ranks)};
+  std::vector<int> owner(size_t(channelCount), -1);
+  for (int r = 0; r < ranks; ++r)
+    for (int i : config.ranks[size_t(r)]) {
+      if (i >= channelCount)
+        return Error{"", "", fmt::format("cluster.ranks[{}]: channel {} does not exist ({} channels)", r, i, channelCount)};
+      if (owner[size_t(i)] >= 0)
+        return Error{"", "", fmt::format("cluster.ranks: channel {} is assigned to rank {} and rank {}", i, owner[size_t(i)], r)};
+      owner[size_t(i)] = r;
+    }
+  for (int i = 0; i < channelCount; ++i)
+    if (owner[size_t(i)] < 0)
+      return Error{"", "", fmt::format("cluster.ranks: channel {} is assigned to no rank", i)};
+  return config.ranks;
+}
 
 Result<IgConfig> parseIgConfig(const std::string& text, const std::string& path) {
   return parseJsonInput<IgConfig>(text, path, [&](const Json& root) { return read(root, path); });

@@ -30,7 +30,18 @@ struct IgConfig {
   RenderOptions render;       // threads, anti-aliasing, filters: full quality
   double deadline = 0.9;      // the share of a frame period a frame may take (overload.h)
   uint16_t maxEntities = 1024;  // entity IDs 0 … maxEntities − 1
+  // Under mpirun (docs/cluster.md): the channels each rank draws, by channel index — rank r draws
+  // ranks[r]; empty: channel i on rank i mod N. And how long rank 0 waits at the frame lock for a
+  // rank before it ends the job, naming it.
+  std::vector<std::vector<int>> ranks;
+  double rankTimeout = 5;
 };
+
+// The channels each of `ranks` processes draws under `config` with `channelCount` channels: the
+// configuration's assignment, checked (every channel on exactly one rank, as many ranks as the
+// job has), or channel i on rank i mod ranks — an error when there are more ranks than channels.
+Result<std::vector<std::vector<int>>> channelsByRank(const IgConfig& config, int channelCount,
+                                                    int ranks);
 
 // Reads a configuration file; errors name the file and the field.
 Result<IgConfig> loadIgConfig(const std::string& path);

@@ -18,6 +18,7 @@
 #include "ig/overload.h"
 #include "ig/udp.h"
 #include "ig/world.h"
+#include "cluster/cluster.h"
 #include "present/overlay.h"
 #include "present/present.h"
 #include "present/test_patterns.h"
@@ -60,6 +61,42 @@ void replicate(const Image& image, int r, int width, int height, Image& out) {
   }
 }
 
+// A frame's input as rank 0 broadcasts it (docs/cluster.md): whether the replay has ended, the
+// recorded quality level, and the host's datagrams — little-endian u8, i32, u32 count, then each
+// as a u32 length and its bytes.
+void packInput(bool ended, int level, const std::vector<std::vector<uint8_t>>& datagrams,
+               std::vector<uint8_t>& out) {
+  out.clear();
+  const auto u32 = [&](uint32_t v) {
+    for (int i = 0; i < 4; ++i) out.push_back(uint8_t(v >> (8 * i)));
+  };
+  out.push_back(ended ? 1 : 0);
+  u32(uint32_t(level));
+  u32(uint32_t(datagrams.size()));
+  for (const std::vector<uint8_t>& d : datagrams) {
+    u32(uint32_t(d.size()));
+    out.insert(out.end(), d.begin(), d.end());
+  }
+}
+
+void unpackInput(const std::vector<uint8_t>& in, bool& ended, int& level,
+                 std::vector<std::vector<uint8_t>>& datagrams) {
+  size_t at = 0;
+  const auto u32 = [&] {
+    uint32_t v = 0;
+    for (int i = 0; i < 4; ++i) v |= uint32_t(in[at++]) << (8 * i);
+    return v;
+  };
+  ended = in[at++] != 0;
+  level = int(int32_t(u32()));
+  datagrams.resize(u32());
+  for (std::vector<uint8_t>& d : datagrams) {
+    const uint32_t n = u32();
+    d.assign(in.begin() + long(at), in.begin() + long(at + n));
+    at += n;
+  }
+}
+
 }  // namespace
 
 struct IgLoop::Impl {
@@ -79,6 +116,10 @@ struct IgLoop::Impl {
   bool ownsStatus = false;
   std::map<int, std::unique_ptr<Renderer>> renderers;  // by quality level
   bool loggedMalformed = false;
+  // The job (docs/cluster.md): this rank's channels (all of them in a job of one).
+  cluster::Cluster* cluster = nullptr;
+  int rank = 0, ranks = 1;
+  std::vector<int> mine;
 
   ~Impl() {
     if (ownsStatus && status) std::fclose(status);
@@ -143,7 +184,15 @@ Result<std::unique_ptr<IgLoop>> IgLoop::create(const IgConfig& config,
   Result<IgWorld> world = IgWorld::load(config);
   if (!world) return world.error();
   m.world.emplace(std::move(world.value()));
-  if (!options.replay.empty()) {
+  m.cluster = options.cluster;
+  if (m.cluster) m.rank = m.cluster->rank(), m.ranks = m.cluster->size();
+  Result<std::vector<std::vector<int>>> byRank =
+      channelsByRank(config, int(m.world->channels().size()), m.ranks);
+  if (!byRank) return byRank.error();
+  m.mine = byRank.value()[size_t(m.rank)];
+  if (m.rank != 0) {
+    // Rank 0 alone hears the host; the others take its datagrams from the broadcast.
+  } else if (!options.replay.empty()) {
     Result<std::vector<cigi::CapturedDatagram>> r = cigi::readPcap(options.replay);
     if (!r) return r.error();
     m.replay = std::move(r.value());
@@ -157,7 +206,7 @@ Result<std::unique_ptr<IgLoop>> IgLoop::create(const IgConfig& config,
       m.hostKnown = true;
     }
   }
-  if (!options.record.empty()) {
+  if (!options.record.empty() && m.rank == 0) {
     if (Status s = m.recorder.open(options.record); !s) return s.error();
     m.recording = true;
   }
@@ -171,8 +220,11 @@ Result<std::unique_ptr<IgLoop>> IgLoop::create(const IgConfig& config,
   if (options.status == "-") {
     m.status = stdout;
   } else if (!options.status.empty()) {
-    m.status = std::fopen(options.status.c_str(), "w");
-    if (!m.status) return Error{options.status, "", "cannot write the status stream"};
+    // Each rank its own stream: FILE.rankR in a job of several.
+    const std::string path =
+        m.ranks > 1 ? fmt::format("{}.rank{}", options.status, m.rank) : options.status;
+    m.status = std::fopen(path.c_str(), "w");
+    if (!m.status) return Error{path, "", "cannot write the status stream"};
     m.ownsStatus = true;
   }
   return loop;
@@ -196,6 +248,13 @@ Result<IgRunReport> IgLoop::run() {
   std::vector<Image> images, enlarged;
   std::vector<FrameStats> stats;
   std::vector<std::string> names;
+  std::vector<Image> mineShown;
+  std::vector<uint8_t> input;
+  // In a job of several, this rank's channels only.
+  const std::vector<int>* only = m.ranks > 1 ? &m.mine : nullptr;
+  const auto drawn = [&](size_t c) {
+    return !only || std::find(only->begin(), only->end(), int(c)) != only->end();
+  };
   // Before the clock starts, the first frame at every quality level: once each to make the
   // renderers' threads and buffers and touch their memory (so the first timed frame is not the
   // slowest), then three rounds over all levels, whose median per level is the governor's
@@ -211,12 +270,15 @@ Result<IgRunReport> IgLoop::run() {
         works[size_t(level)] = work(world.frameScene(0));
         const scene::Scene& first = world.atQuality(q.stars, q.replication);
         const Clock::time_point warm = Clock::now();
-        if (Status s = m.rendererFor(level, q.options).renderChannels(first, images, &stats); !s)
+        if (Status s =
+                m.rendererFor(level, q.options).renderChannels(first, images, &stats, only);
+            !s)
           return s.error();
         if (q.replication > 1) {  // the enlargements' memory too
           enlarged.resize(images.size());
           for (size_t c = 0; c < images.size(); ++c)
-            replicate(images[c], q.replication, world.channels()[c].width,
+            if (drawn(c))
+              replicate(images[c], q.replication, world.channels()[c].width,
                       world.channels()[c].height, enlarged[c]);
         }
         if (round > 0) times[size_t(level)].push_back(msBetween(warm, Clock::now()));
@@ -241,7 +303,12 @@ Result<IgRunReport> IgLoop::run() {
 
     // 1. The host's datagrams, applied in the order they came.
     int recordedLevel = -1;
-    m.hostDatagrams(frame, incoming, replayEnded, recordedLevel);
+    if (m.rank == 0) m.hostDatagrams(frame, incoming, replayEnded, recordedLevel);
+    if (m.ranks > 1) {  // rank 0's input to every rank: the state changes alike everywhere
+      if (m.rank == 0) packInput(replayEnded, recordedLevel, incoming, input);
+      m.cluster->broadcast(input);
+      unpackInput(input, replayEnded, recordedLevel, incoming);
+    }
     if (replayEnded && incoming.empty()) break;
     replies.clear();
     world.setFrame(frame);
@@ -280,10 +347,14 @@ Result<IgRunReport> IgLoop::run() {
     sof.igStatus = uint8_t(level);
     sof.timestampValid = true;
     sof.timestamp = uint32_t(std::llround(msBetween(t0, start) * 100));  // 10 µs ticks
-    replies.insert(replies.begin(), sof);
-    const std::vector<uint8_t> answer = cigi::writeDatagram(replies);
-    if (m.network && m.hostKnown) m.socket.send(answer, m.host);
-    if (m.recording) (void)m.recorder.add({msBetween(t0, start) / 1000, false, answer});
+    // In a job of several it goes after the frame lock, once every rank has drawn the frame.
+    const auto answerHost = [&] {
+      replies.insert(replies.begin(), sof);
+      const std::vector<uint8_t> answer = cigi::writeDatagram(replies);
+      if (m.network && m.hostKnown) m.socket.send(answer, m.host);
+      if (m.recording) (void)m.recorder.add({msBetween(t0, start) / 1000, false, answer});
+    };
+    if (m.ranks == 1) answerHost();
 
     // 4. The frame.
     const QualityLevel& q = governor.at(level);
@@ -297,21 +368,22 @@ Result<IgRunReport> IgLoop::run() {
       stats.assign(images.size(), FrameStats{});
     } else {
       Renderer& renderer = m.rendererFor(level, q.options);
-      if (Status s = renderer.renderChannels(scene, images, &stats); !s) return s.error();
+      if (Status s = renderer.renderChannels(scene, images, &stats, only); !s) return s.error();
     }
     // What is shown: the images, or with replication their enlargements.
     std::vector<Image>* shown = &images;
     if (q.replication > 1) {
       enlarged.resize(images.size());
       for (size_t c = 0; c < images.size(); ++c)
-        replicate(images[c], q.replication, world.channels()[c].width,
+        if (drawn(c))
+          replicate(images[c], q.replication, world.channels()[c].width,
                   world.channels()[c].height, enlarged[c]);
       shown = &enlarged;
     }
     const double renderMs = msBetween(renderStart, Clock::now());
     names.clear();
     for (const scene::Channel& c : scene.channels) names.push_back(c.name);
-    if (m.options.overlay && !shown->empty()) {
+    if (m.options.overlay && !shown->empty() && drawn(0)) {
       double vertex = 0, setup = 0, raster = 0, lights = 0;
       for (const FrameStats& s : stats) {
         vertex += s.vertexMs;
@@ -329,6 +401,23 @@ Result<IgRunReport> IgLoop::run() {
                       world.activeEntities(), world.counts().datagrams, world.counts().malformed,
                       report.missed)};
       present::drawOverlay((*shown)[0], lines, std::max(1, (*shown)[0].height / 360));
+    }
+    if (m.ranks > 1) {
+      // The frame lock: presented together, or the job ends naming the rank that did not come.
+      Result<int> worst = m.cluster->frameLock({frame, level}, m.config.rankTimeout);
+      if (!worst) m.cluster->abort(worst.error().str());
+      sof.igStatus = uint8_t(worst.value());
+      if (m.rank == 0) answerHost();
+      // This rank's channels, by their names (an unnamed one by its index in the whole set).
+      mineShown.clear();
+      std::vector<std::string> mineNames;
+      for (int c : m.mine) {
+        mineShown.push_back((*shown)[size_t(c)]);
+        mineNames.push_back(names[size_t(c)].empty() ? fmt::format("channel{}", c)
+                                                     : names[size_t(c)]);
+      }
+      names = std::move(mineNames);
+      shown = &mineShown;
     }
     if (Status s = m.presenter->present({frame, *shown, names}); !s) return s.error();
     // Not bound to a rate, the loop waits for the writer instead of letting it drop frames.
@@ -354,10 +443,12 @@ Result<IgRunReport> IgLoop::run() {
     }
     if (m.status) {
       std::fprintf(m.status,
-                   "{\"frame\":%u,\"ms\":%.3f,\"renderMs\":%.3f,\"budgetMs\":%.3f,\"level\":%d,"
+                   "{\"frame\":%u,\"rank\":%d,\"time\":%.6f,\"ms\":%.3f,\"renderMs\":%.3f,"
+                   "\"budgetMs\":%.3f,\"level\":%d,"
                    "\"entities\":%zu,\"datagrams\":%llu,\"malformed\":%llu,\"rejected\":%llu,"
                    "\"missed\":%llu}\n",
-                   frame, ms, renderMs, governor.budgetMs(), level, world.activeEntities(),
+                   frame, m.rank, frame / m.config.rate, ms, renderMs, governor.budgetMs(), level,
+                   world.activeEntities(),
                    (unsigned long long)world.counts().datagrams,
                    (unsigned long long)world.counts().malformed,
                    (unsigned long long)world.counts().rejected,

@@ -17,6 +17,10 @@
 #include "ig/config.h"
 #include "synthvis/result.h"
 
+namespace sv::cluster {
+class Cluster;
+}
+
 namespace sv::ig {
 
 struct IgRunOptions {
@@ -29,6 +33,12 @@ struct IgRunOptions {
   std::string testPattern;      // grid, bars or wedges: every channel shows it instead of the scene
   bool realtime = true;         // false: frames as fast as they render (replays, tests)
   bool governor = true;         // overload protection on
+  // Under mpirun, the job this process is a rank of (docs/cluster.md): rank 0 alone speaks to
+  // the host (or reads the replay) and broadcasts each frame's datagrams; every rank draws and
+  // presents its channels (IgConfig::ranks); the frame lock releases them together, and Start of
+  // Frame goes to the host after it, with the worst quality level of all ranks. Null, or a job
+  // of one: this process is the whole IG.
+  cluster::Cluster* cluster = nullptr;
 };
 
 // What a run did.

@@ -3,6 +3,8 @@
 // draw packets → setup and tiles, with the frame's passes → resolve).
 #include <fmt/format.h>
 
+#include <algorithm>
+
 #include "core/timing.h"
 #include "render/camera.h"
 #include "render/view_renderer.h"
@@ -42,7 +44,7 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
 // its own image at its own size; the scene's draw order, tables and passes are rebuilt per channel
 // from its camera.
 Status Renderer::renderChannels(const scene::Scene& scene, std::vector<Image>& images,
-                                std::vector<FrameStats>* statsOut) {
+                                std::vector<FrameStats>* statsOut, const std::vector<int>* only) {
   Impl& m = *impl_;
   if (scene.channels.empty()) {  // the classic view (render validates)
     images.resize(1);
@@ -57,6 +59,7 @@ Status Renderer::renderChannels(const scene::Scene& scene, std::vector<Image>& i
   images.resize(n);
   std::vector<FrameStats> stats(n);
   for (size_t i = 0; i < n; ++i) {
+    if (only && std::find(only->begin(), only->end(), int(i)) == only->end()) continue;
     const scene::Channel& channel = scene.channels[i];
     RenderOptions o = m.options;
     o.width = channel.width;

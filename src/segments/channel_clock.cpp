@@ -9,7 +9,8 @@
 
 namespace sv::segments {
 
-ChannelClock::ChannelClock(const ChannelTiming& timing, int lines) : timing_(timing), lines_(lines) {
+ChannelClock::ChannelClock(const ChannelTiming& timing, int lines)
+    : timing_(timing), lines_(lines) {
   SV_CHECK(timing.wordsPerLine >= 0 && timing.criticalLines >= 1 && timing.fifoWords >= 1);
   SV_CHECK(lines >= 0);
 }

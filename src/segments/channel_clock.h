@@ -17,9 +17,9 @@
 namespace sv::segments {
 
 struct ChannelTiming {
-  int64_t wordsPerLine = 0;   // the geometry stage's rate; 0 = unlimited (no line is repeated)
-  int criticalLines = 2;      // fewer lines buffered than this before a line: it is repeated
-  int64_t fifoWords = 4096;   // the FIFO's capacity in segment words (seed 002: 4096)
+  int64_t wordsPerLine = 0;  // the geometry stage's rate; 0 = unlimited (no line is repeated)
+  int criticalLines = 2;     // fewer lines buffered than this before a line: it is repeated
+  int64_t fifoWords = 4096;  // the FIFO's capacity in segment words (seed 002: 4096)
 };
 
 class ChannelClock {

@@ -13,7 +13,8 @@ double halfPlaneArea(double nx, double ny, double d) {
   // With p ≥ q the larger and smaller of |nx|, |ny|: the line crosses the square's two sides
   // across p while |d| ≤ (p − q)/2 (area linear in d), cuts a corner triangle of legs
   // t/q and t/p while (p − q)/2 < |d| < (p + q)/2, t = (p + q)/2 − |d|, and misses beyond.
-  const double p = std::max(std::fabs(nx), std::fabs(ny)), q = std::min(std::fabs(nx), std::fabs(ny));
+  const double p = std::max(std::fabs(nx), std::fabs(ny)),
+               q = std::min(std::fabs(nx), std::fabs(ny));
   const double half = 0.5 * (p + q), a = std::fabs(d);
   if (a >= half) return d > 0 ? 1.0 : 0.0;
   if (a <= 0.5 * (p - q)) return 0.5 + d / p;

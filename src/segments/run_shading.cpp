@@ -3,11 +3,12 @@
 // float operations in the same order per pixel, here a row's pixels in lanes.
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "segments/run_shading.cpp"
+#include "segments/run_shading.h"
+
 #include <algorithm>
 
 #include "hwy/foreach_target.h"  // IWYU pragma: keep
 #include "hwy/highway.h"
-#include "segments/run_shading.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace sv::segments {

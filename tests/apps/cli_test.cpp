@@ -1,36 +1,23 @@
 // The command-line tool as a user meets it: malformed input gives one clear line naming the file
 // and the problem, and a non-zero exit — never a crash.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
-#include <array>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "support/shell.h"
 #include "support/temp_dir.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-struct CliRun {
-  int status = -1;
-  std::string out;  // stdout and stderr together
-};
+using CliRun = sv::tests::ShellRun;
 
 CliRun run(const std::string& args, const std::string& environment = "") {
-  CliRun r;
-  const std::string cmd = environment + std::string(SV_CLI) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return r;
-  std::array<char, 4096> buf;
-  size_t n;
-  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), n);
-  const int st = pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
-  return r;
+  return sv::tests::shell(environment + std::string(SV_CLI) + " " + args);
 }
 
 fs::path tempDir() { return sv::tests::processTemp().dir(); }

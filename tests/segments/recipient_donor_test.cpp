@@ -70,8 +70,8 @@ TEST(RecipientDonor, ABoundaryPixelsAreaAndDonorComeFromTheEdgeCrossingIt) {
     const P q{cx + 400 * std::cos(a), cy + 400 * std::sin(a)};
     const P r{cx - 400 * std::sin(a), cy + 400 * std::cos(a)};
     const auto clip = [&](P v) {
-      return geometry::ClipVertex{float(2 * v.x / w - 1), float(1 - 2 * v.y / h), 0.5f, 1, 1, 1,
-                                  1, 1};
+      return geometry::ClipVertex{
+          float(2 * v.x / w - 1), float(1 - 2 * v.y / h), 0.5f, 1, 1, 1, 1, 1};
     };
     geometry::TriangleSetup t;
     ASSERT_EQ(geometry::setupTriangle(clip(p), clip(q), clip(r), vp, geometry::CullMode::none, t),

@@ -1,0 +1,60 @@
+// Several processes as one image generator (issue 36, docs/cluster.md): the ranks of an MPI job
+// started by `mpirun -n N synthvis ig CONFIG`. Rank 0 speaks to the host and broadcasts each
+// frame's input; every rank draws its channels; the frame lock releases them together. Started
+// without mpirun, a process is a cluster of one and never initializes MPI (whose start-up costs
+// half a second and a helper process).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "synthvis/result.h"
+
+namespace sv::cluster {
+
+// True when this process was started by mpirun (Open MPI's or PMIx's environment is set).
+bool launchedByMpi();
+
+// What a rank reports when it has drawn a frame: the frame's number and the quality level its own
+// overload protection chose (ig/overload.h).
+struct FrameDone {
+  uint32_t frame = 0;
+  int32_t level = 0;
+};
+
+class Cluster {
+ public:
+  // Joins the MPI job when launchedByMpi(), else a cluster of this process alone.
+  static Result<std::unique_ptr<Cluster>> join();
+  ~Cluster();
+  Cluster(const Cluster&) = delete;
+  Cluster& operator=(const Cluster&) = delete;
+
+  int rank() const { return rank_; }
+  int size() const { return size_; }
+  // Rank r's name: "rank r on HOST".
+  std::string name(int rank) const;
+
+  // Rank 0's `bytes` to every rank (the others' are replaced).
+  void broadcast(std::vector<uint8_t>& bytes);
+
+  // The frame lock (a software swap lock): every rank reports `done`; rank 0 waits for all of
+  // them at most `timeoutSeconds`, then releases them together with the worst level reported
+  // (the result, on every rank). A rank that has not answered in time is named in the error
+  // (rank 0's); the caller ends the job (abort) — never a hang.
+  Result<int> frameLock(const FrameDone& done, double timeoutSeconds);
+
+  // Ends the whole job at once with `message` on standard error and exit status 3 (MPI_Abort);
+  // a cluster of one exits the process.
+  [[noreturn]] void abort(const std::string& message);
+
+ private:
+  Cluster() = default;
+  bool mpi_ = false;
+  int rank_ = 0, size_ = 1;
+  std::vector<std::string> hosts_;  // by rank
+};
+
+}  // namespace sv::cluster
