@@ -154,8 +154,8 @@ class Renderer {
   // shared among all the renderer's threads. A scene without channels gives the one classic image.
   // Identical bytes for any thread count; a channel with no turn, offset or frustum of its own at
   // the options' size gives render()'s image.
-  // With `only`, just those channels (indices into scene.channels; the others' images and
-  // statistics are left as they are): one process's share of a cluster's channels.
+  // With `only`, just those channels (indices into scene.channels; the others' images are left
+  // as they are, their statistics zero): one process's share of a cluster's channels.
   Status renderChannels(const scene::Scene& scene, std::vector<Image>& images,
                         std::vector<FrameStats>* stats = nullptr,
                         const std::vector<int>* only = nullptr);

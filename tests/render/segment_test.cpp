@@ -61,6 +61,22 @@ TEST(SegmentPipeline, DrawsTheTilePipelinesPriorityMaskedImageByteForByte) {
 }
 
 
+// The segment pipeline's settings for a w × h frame, and the tile pipeline's under priority
+// masking — the two drawn side by side.
+render::SegmentSettings segmentSettings(int w, int h) {
+  render::SegmentSettings ss;
+  ss.width = w;
+  ss.height = h;
+  return ss;
+}
+render::FrameSettings prioritySettings(int w, int h) {
+  render::FrameSettings fs;
+  fs.width = w;
+  fs.height = h;
+  fs.masking = raster::Masking::priority;
+  return fs;
+}
+
 // Renders `p` with `ss` on 1, 2 and 5 threads; expects the same image from all; returns it.
 Image renderAll(const render::DrawPackets& p, const render::SegmentSettings& ss,
                 const output::GammaTable& gamma, FrameStats& stats) {
@@ -85,11 +101,7 @@ TEST(SegmentPipeline, WithTheTentFilterDrawsTheTilePipelinesFilteredImage) {
   const output::GammaTable gamma = output::GammaTable::srgb();
   const int w = 200, h = 120;
   const render::DrawPackets p = test::randomScene(w, h, 300, 31, false);
-  render::FrameSettings fs;
-  fs.width = w;
-  fs.height = h;
-  fs.masking = raster::Masking::priority;
-  const test::Frame tiles = test::renderQuadtree(p, fs);
+  const test::Frame tiles = test::renderQuadtree(p, prioritySettings(w, h));
   output::LinearImage linear;
   linear.resize(w, h);
   for (int y = 0; y < h; ++y)
@@ -99,9 +111,7 @@ TEST(SegmentPipeline, WithTheTentFilterDrawsTheTilePipelinesFilteredImage) {
   Image expected;
   output::prepareImage(w, h, expected);
   output::tentFilterRows(linear, gamma, 0, h, expected);
-  render::SegmentSettings ss;
-  ss.width = w;
-  ss.height = h;
+  render::SegmentSettings ss = segmentSettings(w, h);
   ss.tent = true;
   FrameStats stats;
   EXPECT_EQ(renderAll(p, ss, gamma, stats).rgb, expected.rgb);
@@ -114,9 +124,7 @@ TEST(SegmentPipeline, AThrottledGeometryStageRepeatsLinesAndTheFrameIsComplete) 
   const output::GammaTable gamma = output::GammaTable::srgb();
   const int w = 240, h = 160;
   const render::DrawPackets p = test::randomScene(w, h, 600, 41, false);
-  render::SegmentSettings ss;
-  ss.width = w;
-  ss.height = h;
+  render::SegmentSettings ss = segmentSettings(w, h);
   ss.clearColor[1] = 0.2f;
   FrameStats full;
   const Image exact = renderAll(p, ss, gamma, full);
@@ -173,9 +181,7 @@ TEST(SegmentPipeline, TheRecipientDonorFilterWeighsABoundaryPixelByItsArea) {
     };
     render::DrawPackets p;
     test::addTriangle(p, clip(px, py), clip(qx, qy), clip(rx, ry));
-    render::SegmentSettings ss;
-    ss.width = w;
-    ss.height = h;
+    render::SegmentSettings ss = segmentSettings(w, h);
     ss.donor = true;
     FrameStats stats;
     const Image img = renderAll(p, ss, gamma, stats);
