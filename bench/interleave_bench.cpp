@@ -16,6 +16,7 @@
 #include <thread>
 
 #include "bench_scenes.h"
+#include "core/check.h"
 #include "raster/binner.h"
 #include "raster/framebuffer.h"
 #include "raster/rasterizer.h"
@@ -36,7 +37,7 @@ void BM_Tiles(benchmark::State& state) {
   FrameStats stats;
   for (auto _ : state) {
     stats = {};
-    fr.render(packets, fs, stats);
+    SV_CHECK(fr.render(packets, fs, stats).ok());
   }
   state.counters["triangles/s"] = benchmark::Counter(
       double(packets.indices.size() / 3) * state.iterations(), benchmark::Counter::kIsRate);

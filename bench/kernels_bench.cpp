@@ -18,6 +18,7 @@
 #include <random>
 
 #include "bench_scenes.h"
+#include "core/check.h"
 #include "output/resolve.h"
 #include "raster/coverage_masks.h"
 #include "raster/framebuffer.h"
@@ -214,7 +215,7 @@ void BM_FrameTris(benchmark::State& state) {
   fs.samples = int(state.range(2));
   for (auto _ : state) {
     FrameStats stats;
-    fr.render(packets, fs, stats);
+    SV_CHECK(fr.render(packets, fs, stats).ok());
   }
   state.counters["triangles/s"] = benchmark::Counter(
       double(packets.indices.size() / 3) * state.iterations(), benchmark::Counter::kIsRate);

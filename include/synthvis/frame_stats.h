@@ -65,6 +65,11 @@ struct FrameStats {
   // codes read (a run per change of the visible segment along a line), and lines the overload
   // protection repeated instead of drawing (RenderOptions::SegmentChannel).
   uint64_t segments = 0, segmentRuns = 0, repeatedLines = 0;
+  // A channel shared by several processes (synthvis/tile_share.h): the bytes this process sent
+  // or received for it (its tiles to part 0, the light points' depth probes), and the time that
+  // took, waiting for the other parts included.
+  uint64_t shareBytes = 0;
+  double shareMs = 0;
   double linesMs = 0;
   // Volumes (the volume pass): volumes in the frame, pixels whose ray met one, samples classified,
   // samples stepped over in empty regions, and rays ended by their transparency (early ray

@@ -10,6 +10,7 @@
 #include "synthvis/image.h"
 #include "synthvis/result.h"
 #include "synthvis/scene.h"
+#include "synthvis/tile_share.h"
 
 namespace sv {
 
@@ -138,6 +139,14 @@ Result<Mat4> viewProjection(const scene::Scene& scene, const RenderOptions& opti
 // lighting and fog ranges are computed.
 Result<Mat4> viewMatrix(const scene::Scene& scene, const RenderOptions& options);
 
+// One process's share of a display channel in a job of several (issue 36, docs/cluster.md): the
+// channel (an index into scene.channels), and which of its tiles this process draws — all of them
+// unless `tiles` is shared.
+struct ChannelShare {
+  int channel = 0;
+  TileShare tiles;
+};
+
 // Renders scenes; keeps its threads and buffers from frame to frame.
 class Renderer {
  public:
@@ -154,11 +163,13 @@ class Renderer {
   // shared among all the renderer's threads. A scene without channels gives the one classic image.
   // Identical bytes for any thread count; a channel with no turn, offset or frustum of its own at
   // the options' size gives render()'s image.
-  // With `only`, just those channels (indices into scene.channels; the others' images are left
-  // as they are, their statistics zero): one process's share of a cluster's channels.
+  // With `only`, just those channels, ascending (the others' images are left as they are, their
+  // statistics zero): one process's share of a cluster's channels. A channel shared by several
+  // processes is drawn in part, and assembled in part 0's image (the other parts' images hold
+  // their own tiles alone); every part renders its shared channels in the same order.
   Status renderChannels(const scene::Scene& scene, std::vector<Image>& images,
                         std::vector<FrameStats>* stats = nullptr,
-                        const std::vector<int>* only = nullptr);
+                        const std::vector<ChannelShare>* only = nullptr);
 
   const RenderOptions& options() const;
 

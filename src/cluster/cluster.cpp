@@ -5,7 +5,9 @@
 #include <fmt/format.h>
 #include <mpi.h>
 
+#include <algorithm>
 #include <chrono>
+#include <functional>
 #include <cstdio>
 #include <cstdlib>
 #include <thread>
@@ -13,7 +15,109 @@
 namespace sv::cluster {
 namespace {
 
-constexpr int kTagDone = 1, kTagGo = 2;
+constexpr int kTagDone = 1, kTagGo = 2, kTagTiles = 3, kTagValues = 4, kTagMax = 5;
+using SteadyClock = std::chrono::steady_clock;
+
+SteadyClock::time_point after(double seconds) {
+  return SteadyClock::now() +
+         std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>(seconds));
+}
+
+// Polls `requests` until every one is complete, or fails at `deadline` naming those that are
+// not (who(i) names request i's peer). Polling, not MPI_Waitall: MPI itself never times out, and
+// a hung peer must end the job, not stall it.
+Status waitAll(std::vector<MPI_Request>& requests, SteadyClock::time_point deadline,
+               double seconds, const std::function<std::string(size_t)>& who) {
+  for (;;) {
+    int done = 0;
+    MPI_Testall(int(requests.size()), requests.data(), &done, MPI_STATUSES_IGNORE);
+    if (done) return {};
+    if (SteadyClock::now() > deadline) break;
+    std::this_thread::sleep_for(std::chrono::microseconds(50));
+  }
+  std::string missing;
+  for (size_t i = 0; i < requests.size(); ++i) {
+    int flag = 0;
+    if (requests[i] != MPI_REQUEST_NULL) MPI_Test(&requests[i], &flag, MPI_STATUS_IGNORE);
+    if (requests[i] != MPI_REQUEST_NULL && !flag) {
+      const std::string name = who(i);
+      if (missing.find(name) == std::string::npos)
+        missing += (missing.empty() ? "" : ", ") + name;
+    }
+  }
+  return Error{"", "", fmt::format("no answer within {:g} s from {}", seconds, missing)};
+}
+
+Status tooLarge(size_t bytes) {
+  return Error{"", "", fmt::format("a message of {} bytes is beyond MPI's int counts", bytes)};
+}
+
+// The parts of one shared channel over their own communicator (part p = its rank p).
+class MpiExchange final : public TileExchange {
+ public:
+  MpiExchange(MPI_Comm comm, std::vector<int> ranks, int part, double timeout,
+              const Cluster& cluster)
+      : comm_(comm), ranks_(std::move(ranks)), part_(part), timeout_(timeout), cluster_(cluster) {}
+  ~MpiExchange() override { MPI_Comm_free(&comm_); }
+
+  Status gather(const std::vector<uint8_t>& mine,
+                std::vector<std::vector<uint8_t>>& all) override {
+    if (mine.size() > size_t(INT32_MAX)) return tooLarge(mine.size());
+    std::vector<MPI_Request> requests;
+    if (part_ != 0) {
+      requests.assign(1, MPI_REQUEST_NULL);
+      MPI_Isend(mine.data(), int(mine.size()), MPI_BYTE, 0, kTagTiles, comm_, &requests[0]);
+      return waitAll(requests, after(2 * timeout_), 2 * timeout_, [&](size_t) { return name(0); });
+    }
+    all[0] = mine;
+    requests.assign(all.size() - 1, MPI_REQUEST_NULL);
+    for (size_t p = 1; p < all.size(); ++p) {
+      if (all[p].size() > size_t(INT32_MAX)) return tooLarge(all[p].size());
+      MPI_Irecv(all[p].data(), int(all[p].size()), MPI_BYTE, int(p), kTagTiles, comm_,
+                &requests[p - 1]);
+    }
+    return waitAll(requests, after(timeout_), timeout_, [&](size_t i) { return name(int(i) + 1); });
+  }
+
+  Status maxAll(std::vector<float>& values) override {
+    if (values.size() > size_t(INT32_MAX)) return tooLarge(values.size() * sizeof(float));
+    const int n = int(values.size());
+    std::vector<MPI_Request> requests;
+    if (part_ != 0) {
+      requests.assign(2, MPI_REQUEST_NULL);
+      MPI_Isend(values.data(), n, MPI_FLOAT, 0, kTagValues, comm_, &requests[0]);
+      std::vector<float> result(values.size());
+      MPI_Irecv(result.data(), n, MPI_FLOAT, 0, kTagMax, comm_, &requests[1]);
+      if (Status s =
+              waitAll(requests, after(2 * timeout_), 2 * timeout_, [&](size_t) { return name(0); });
+          !s)
+        return s;
+      values = std::move(result);
+      return {};
+    }
+    const size_t parts = ranks_.size();
+    std::vector<std::vector<float>> theirs(parts, std::vector<float>(values.size()));
+    requests.assign(parts - 1, MPI_REQUEST_NULL);
+    for (size_t p = 1; p < parts; ++p)
+      MPI_Irecv(theirs[p].data(), n, MPI_FLOAT, int(p), kTagValues, comm_, &requests[p - 1]);
+    const auto who = [&](size_t i) { return name(int(i) + 1); };
+    if (Status s = waitAll(requests, after(timeout_), timeout_, who); !s) return s;
+    for (size_t p = 1; p < parts; ++p)
+      for (size_t i = 0; i < values.size(); ++i) values[i] = std::max(values[i], theirs[p][i]);
+    for (size_t p = 1; p < parts; ++p)
+      MPI_Isend(values.data(), n, MPI_FLOAT, int(p), kTagMax, comm_, &requests[p - 1]);
+    return waitAll(requests, after(timeout_), timeout_, who);
+  }
+
+ private:
+  std::string name(int part) const { return cluster_.name(ranks_[size_t(part)]); }
+
+  MPI_Comm comm_;
+  std::vector<int> ranks_;  // world ranks, by part
+  int part_;
+  double timeout_;
+  const Cluster& cluster_;
+};
 
 }  // namespace
 
@@ -56,17 +160,51 @@ std::string Cluster::name(int rank) const {
                      rank >= 0 && rank < int(hosts_.size()) ? hosts_[size_t(rank)] : "?");
 }
 
-void Cluster::broadcast(std::vector<uint8_t>& bytes) {
-  if (size_ == 1) return;
+Status Cluster::broadcast(std::vector<uint8_t>& bytes, double timeoutSeconds) {
+  if (size_ == 1) return {};
+  // Polled, as every wait of the job: a rank 0 that hangs is named, not waited for forever.
+  const double wait = rank_ == 0 ? timeoutSeconds : 2 * timeoutSeconds;
+  const auto deadline = after(wait);
+  const auto who = [&](size_t) {
+    return rank_ == 0 ? std::string("some rank (the frame's input was not taken)") : name(0);
+  };
   uint64_t n = bytes.size();
-  MPI_Bcast(&n, 1, MPI_UINT64_T, 0, MPI_COMM_WORLD);
+  std::vector<MPI_Request> request(1, MPI_REQUEST_NULL);
+  MPI_Ibcast(&n, 1, MPI_UINT64_T, 0, MPI_COMM_WORLD, &request[0]);
+  if (Status s = waitAll(request, deadline, wait, who); !s) return s;
   bytes.resize(size_t(n));
   // In pieces below 2^31 bytes (MPI counts are int).
   for (uint64_t at = 0; at < n;) {
     const int piece = int(std::min<uint64_t>(n - at, 1u << 30));
-    MPI_Bcast(bytes.data() + at, piece, MPI_BYTE, 0, MPI_COMM_WORLD);
+    MPI_Ibcast(bytes.data() + at, piece, MPI_BYTE, 0, MPI_COMM_WORLD, &request[0]);
+    if (Status s = waitAll(request, deadline, wait, who); !s) return s;
     at += uint64_t(piece);
   }
+  return {};
+}
+
+Result<int> Cluster::agreeMax(int value, double timeoutSeconds) {
+  if (size_ == 1) return value;
+  int32_t mine = value, result = value;
+  std::vector<MPI_Request> request(1, MPI_REQUEST_NULL);
+  MPI_Iallreduce(&mine, &result, 1, MPI_INT32_T, MPI_MAX, MPI_COMM_WORLD, &request[0]);
+  if (Status s = waitAll(request, after(2 * timeoutSeconds), 2 * timeoutSeconds,
+                         [&](size_t) { return std::string("some rank (no quality level came)"); });
+      !s)
+    return s.error();
+  return int(result);
+}
+
+std::unique_ptr<TileExchange> Cluster::shareGroup(const std::vector<int>& ranks,
+                                                  double timeoutSeconds) {
+  const auto at = std::find(ranks.begin(), ranks.end(), rank_);
+  if (!mpi_) return nullptr;
+  MPI_Comm comm = MPI_COMM_NULL;
+  MPI_Comm_split(MPI_COMM_WORLD, at == ranks.end() ? MPI_UNDEFINED : 0,
+                 at == ranks.end() ? 0 : int(at - ranks.begin()), &comm);
+  if (at == ranks.end()) return nullptr;
+  return std::make_unique<MpiExchange>(comm, ranks, int(at - ranks.begin()), timeoutSeconds,
+                                       *this);
 }
 
 Result<int> Cluster::frameLock(const FrameDone& done, double timeoutSeconds) {
@@ -74,8 +212,13 @@ Result<int> Cluster::frameLock(const FrameDone& done, double timeoutSeconds) {
   int32_t worst = done.level;
   if (rank_ != 0) {
     const int32_t message[2] = {int32_t(done.frame), done.level};
-    MPI_Send(message, 2, MPI_INT32_T, 0, kTagDone, MPI_COMM_WORLD);
-    MPI_Recv(&worst, 1, MPI_INT32_T, 0, kTagGo, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    std::vector<MPI_Request> requests(2, MPI_REQUEST_NULL);
+    MPI_Isend(message, 2, MPI_INT32_T, 0, kTagDone, MPI_COMM_WORLD, &requests[0]);
+    MPI_Irecv(&worst, 1, MPI_INT32_T, 0, kTagGo, MPI_COMM_WORLD, &requests[1]);
+    if (Status s = waitAll(requests, after(2 * timeoutSeconds), 2 * timeoutSeconds,
+                           [&](size_t) { return name(0); });
+        !s)
+      return Error{"", "", fmt::format("frame {}: {}", done.frame, s.error().message)};
     return int(worst);
   }
   // Rank 0: one receive a rank, polled until all have come or the time is up.

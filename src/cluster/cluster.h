@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "synthvis/result.h"
+#include "synthvis/tile_share.h"
 
 namespace sv::cluster {
 
@@ -37,13 +38,25 @@ class Cluster {
   // Rank r's name: "rank r on HOST".
   std::string name(int rank) const;
 
-  // Rank 0's `bytes` to every rank (the others' are replaced).
-  void broadcast(std::vector<uint8_t>& bytes);
+  // Rank 0's `bytes` to every rank (the others' are replaced). A rank that waits longer than
+  // `timeoutSeconds` for rank 0 gets an error naming it.
+  Status broadcast(std::vector<uint8_t>& bytes, double timeoutSeconds);
+
+  // The largest of every rank's `value`, on every rank (the quality level all ranks draw at when
+  // they share channels: a shared channel's parts must draw alike).
+  Result<int> agreeMax(int value, double timeoutSeconds);
+
+  // The parts of one shared channel (synthvis/tile_share.h): `ranks`, in part order, exchanging
+  // over their own communicator. Every rank of the job calls it, for the same groups in the same
+  // order (the communicator's creation is collective); a rank not in `ranks` gets nullptr. A part
+  // that does not answer within `timeoutSeconds` is named in the exchange's error.
+  std::unique_ptr<TileExchange> shareGroup(const std::vector<int>& ranks, double timeoutSeconds);
 
   // The frame lock (a software swap lock): every rank reports `done`; rank 0 waits for all of
   // them at most `timeoutSeconds`, then releases them together with the worst level reported
   // (the result, on every rank). A rank that has not answered in time is named in the error
-  // (rank 0's); the caller ends the job (abort) — never a hang.
+  // (rank 0's; the others wait twice as long for rank 0, then name it); the caller ends the job
+  // (abort) — never a hang.
   Result<int> frameLock(const FrameDone& done, double timeoutSeconds);
 
   // Ends the whole job at once with `message` on standard error and exit status 3 (MPI_Abort);

@@ -43,6 +43,7 @@ FrameStats& FrameStats::operator+=(const FrameStats& o) {
   lightPoints += o.lightPoints, lightsDrawn += o.lightsDrawn, lightsMs += o.lightsMs;
   lines += o.lines, linesDrawn += o.linesDrawn, linesMs += o.linesMs;
   segments += o.segments, segmentRuns += o.segmentRuns, repeatedLines += o.repeatedLines;
+  shareBytes += o.shareBytes, shareMs += o.shareMs;
   volumes += o.volumes, volumeRays += o.volumeRays, volumeSamples += o.volumeSamples;
   volumeSkipped += o.volumeSkipped, volumeTerminated += o.volumeTerminated;
   vertexMs += o.vertexMs, setupMs += o.setupMs, rasterMs += o.rasterMs, totalMs += o.totalMs;
@@ -96,7 +97,8 @@ std::string FrameStats::summary() const {
                       : std::string()) +
          (lines ? fmt::format(" | lines {}: drawn {}, {:.2f} ms", lines, linesDrawn, linesMs)
                 : std::string()) +
-
+         (shareBytes ? fmt::format(" | shared: {} bytes exchanged, {:.2f} ms", shareBytes, shareMs)
+                     : std::string()) +
          (volumes ? fmt::format(" | volumes {}: rays {}, samples {}, skipped {}, terminated {}",
                                 volumes, volumeRays, volumeSamples, volumeSkipped,
                                 volumeTerminated)

@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
 
@@ -131,7 +132,7 @@ IgConfig read(const Json& root, const std::string& path) {
   if (root.contains("maxEntities"))
     c.maxEntities = uint16_t(integer(root["maxEntities"], "maxEntities", 1, 65535));
   if (const auto it = root.find("cluster"); it != root.end()) {
-    known(*it, "cluster", {"ranks", "timeout"});
+    known(*it, "cluster", {"ranks", "timeout", "split"});
     if (it->contains("ranks")) {
       const Json& ranks = (*it)["ranks"];
       if (!ranks.is_array() || ranks.empty() || ranks.size() > 4096)
@@ -146,6 +147,26 @@ IgConfig read(const Json& root, const std::string& path) {
       }
     }
     if (it->contains("timeout")) c.rankTimeout = number((*it)["timeout"], "cluster.timeout", 0.1, 3600);
+    if (it->contains("split")) {
+      const Json& split = (*it)["split"];
+      if (!split.is_array() || split.size() > scene::kMaxChannels)
+        bad("cluster.split: an array of {\"channel\": C, \"ranks\": [R, …]} expected");
+      for (size_t k = 0; k < split.size(); ++k) {
+        const std::string at = fmt::format("cluster.split[{}]", k);
+        if (!split[k].is_object()) bad(at + ": an object {\"channel\": C, \"ranks\": [R, …]} expected");
+        known(split[k], at.c_str(), {"channel", "ranks"});
+        IgConfig::Split one;
+        if (!split[k].contains("channel")) bad(at + ".channel: missing");
+        one.channel = integer(split[k]["channel"], (at + ".channel").c_str(), 0,
+                              int(scene::kMaxChannels) - 1);
+        const Json* ranks = split[k].contains("ranks") ? &split[k]["ranks"] : nullptr;
+        if (!ranks || !ranks->is_array() || ranks->empty() || ranks->size() > 4096)
+          bad(at + ".ranks: an array of 1 … 4096 rank numbers expected");
+        for (size_t r = 0; r < ranks->size(); ++r)
+          one.ranks.push_back(integer((*ranks)[r], fmt::format("{}.ranks[{}]", at, r).c_str(), 0, 4095));
+        c.splits.push_back(std::move(one));
+      }
+    }
   }
   c.render.width = c.width;
   c.render.height = c.height;
@@ -154,35 +175,75 @@ IgConfig read(const Json& root, const std::string& path) {
 
 }  // namespace
 
-Result<std::vector<std::vector<int>>> channelsByRank(const IgConfig& config, int channelCount,
-                                                    int ranks) {
-  std::vector<std::vector<int>> out(static_cast<size_t>(ranks));
-  if (config.ranks.empty()) {
-    if (ranks > channelCount)
-      return Error{"", "",
-                   fmt::format("{} ranks for {} channels: a rank would draw nothing (give "
-                               "cluster.ranks, or fewer ranks)",
-                               ranks, channelCount)};
-    for (int i = 0; i < channelCount; ++i) out[size_t(i % ranks)].push_back(i);
-    return out;
-  }
-  if (int(config.ranks.size()) != ranks)
-    return Error{"", "",
-                 fmt::format("cluster.ranks assigns channels to {} ranks, the job has {}",
-                             config.ranks.size(), ranks)};
-  std::vector<int> owner(size_t(channelCount), -1);
-  for (int r = 0; r < ranks; ++r)
-    for (int i : config.ranks[size_t(r)]) {
-      if (i >= channelCount)
-        return Error{"", "", fmt::format("cluster.ranks[{}]: channel {} does not exist ({} channels)", r, i, channelCount)};
-      if (owner[size_t(i)] >= 0)
-        return Error{"", "", fmt::format("cluster.ranks: channel {} is assigned to rank {} and rank {}", i, owner[size_t(i)], r)};
-      owner[size_t(i)] = r;
+Result<std::vector<std::vector<ChannelShare>>> channelsByRank(const IgConfig& config,
+                                                             int channelCount, int ranks) {
+  std::vector<std::vector<ChannelShare>> out(static_cast<size_t>(ranks));
+  // Who draws each channel: a rank (assigned or dealt), or the split's ranks.
+  std::vector<std::string> owner(static_cast<size_t>(channelCount));
+  std::vector<const IgConfig::Split*> splitOf(size_t(channelCount), nullptr);
+  for (size_t k = 0; k < config.splits.size(); ++k) {
+    const IgConfig::Split& split = config.splits[k];
+    if (split.channel >= channelCount)
+      return Error{"", "", fmt::format("cluster.split[{}]: channel {} does not exist ({} channels)",
+                                       k, split.channel, channelCount)};
+    if (splitOf[size_t(split.channel)])
+      return Error{"", "", fmt::format("cluster.split: channel {} is split twice", split.channel)};
+    for (size_t i = 0; i < split.ranks.size(); ++i) {
+      if (split.ranks[i] >= ranks)
+        return Error{"", "", fmt::format("cluster.split[{}]: rank {} does not exist (the job has {})",
+                                         k, split.ranks[i], ranks)};
+      if (std::find(split.ranks.begin(), split.ranks.begin() + long(i), split.ranks[i]) !=
+          split.ranks.begin() + long(i))
+        return Error{"", "", fmt::format("cluster.split[{}]: rank {} is listed twice", k,
+                                         split.ranks[i])};
     }
-  for (int i = 0; i < channelCount; ++i)
-    if (owner[size_t(i)] < 0)
-      return Error{"", "", fmt::format("cluster.ranks: channel {} is assigned to no rank", i)};
-  return config.ranks;
+    splitOf[size_t(split.channel)] = &split;
+    owner[size_t(split.channel)] = fmt::format("ranks {} (split)", fmt::join(split.ranks, ", "));
+  }
+  std::vector<std::vector<int>> whole(static_cast<size_t>(ranks));
+  if (config.ranks.empty()) {
+    int dealt = 0;
+    for (int i = 0; i < channelCount; ++i)
+      if (!splitOf[size_t(i)]) whole[size_t(dealt++ % ranks)].push_back(i);
+  } else {
+    if (int(config.ranks.size()) != ranks)
+      return Error{"", "",
+                   fmt::format("cluster.ranks assigns channels to {} ranks, the job has {}",
+                               config.ranks.size(), ranks)};
+    for (int r = 0; r < ranks; ++r)
+      for (int i : config.ranks[size_t(r)]) {
+        if (i >= channelCount)
+          return Error{"", "", fmt::format("cluster.ranks[{}]: channel {} does not exist ({} channels)", r, i, channelCount)};
+        if (!owner[size_t(i)].empty())
+          return Error{"", "", fmt::format("cluster.ranks: channel {} is assigned to {} and to rank {}", i, owner[size_t(i)], r)};
+        owner[size_t(i)] = fmt::format("rank {}", r);
+      }
+    for (int i = 0; i < channelCount; ++i)
+      if (owner[size_t(i)].empty())
+        return Error{"", "", fmt::format("cluster.ranks: channel {} is assigned to no rank", i)};
+    whole = config.ranks;
+  }
+  // By rank, in channel order (the order every part meets its shared channels in).
+  for (int i = 0; i < channelCount; ++i) {
+    if (const IgConfig::Split* split = splitOf[size_t(i)]) {
+      for (size_t p = 0; p < split->ranks.size(); ++p)
+        out[size_t(split->ranks[p])].push_back(
+            ChannelShare{i, TileShare{int(split->ranks.size()), int(p), nullptr}});
+      continue;
+    }
+    for (int r = 0; r < ranks; ++r)
+      if (std::find(whole[size_t(r)].begin(), whole[size_t(r)].end(), i) != whole[size_t(r)].end())
+        out[size_t(r)].push_back(ChannelShare{i, {}});
+  }
+  for (int r = 0; r < ranks; ++r)
+    if (out[size_t(r)].empty())
+      return Error{"", "",
+                   config.ranks.empty() && config.splits.empty()
+                       ? fmt::format("{} ranks for {} channels: a rank would draw nothing (give "
+                                     "cluster.ranks or cluster.split, or fewer ranks)",
+                                     ranks, channelCount)
+                       : fmt::format("cluster: rank {} draws nothing", r)};
+  return out;
 }
 
 Result<IgConfig> parseIgConfig(const std::string& text, const std::string& path) {

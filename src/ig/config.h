@@ -35,13 +35,23 @@ struct IgConfig {
   // rank before it ends the job, naming it.
   std::vector<std::vector<int>> ranks;
   double rankTimeout = 5;
+  // Channels drawn by several ranks together (synthvis/tile_share.h): each split channel's tiles
+  // dealt to its ranks, the first of which assembles and presents it.
+  struct Split {
+    int channel = 0;
+    std::vector<int> ranks;
+  };
+  std::vector<Split> splits;
 };
 
-// The channels each of `ranks` processes draws under `config` with `channelCount` channels: the
-// configuration's assignment, checked (every channel on exactly one rank, as many ranks as the
-// job has), or channel i on rank i mod ranks — an error when there are more ranks than channels.
-Result<std::vector<std::vector<int>>> channelsByRank(const IgConfig& config, int channelCount,
-                                                    int ranks);
+// What each of `ranks` processes draws under `config` with `channelCount` channels, by rank, in
+// channel order: whole channels — the configuration's assignment, or the channels not split
+// dealt round the ranks (the j-th on rank j mod ranks) — and its parts of split channels (their
+// exchange left for the caller). Errors: a channel on no rank or on two (assigned twice, or
+// assigned and split), an index beyond the channels or the ranks, an assignment for another
+// number of ranks, and a rank left with nothing to draw.
+Result<std::vector<std::vector<ChannelShare>>> channelsByRank(const IgConfig& config,
+                                                             int channelCount, int ranks);
 
 // Reads a configuration file; errors name the file and the field.
 Result<IgConfig> loadIgConfig(const std::string& path);

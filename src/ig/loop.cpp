@@ -119,7 +119,9 @@ struct IgLoop::Impl {
   // The job (docs/cluster.md): this rank's channels (all of them in a job of one).
   cluster::Cluster* cluster = nullptr;
   int rank = 0, ranks = 1;
-  std::vector<int> mine;
+  std::vector<ChannelShare> mine;  // in channel order
+  std::vector<std::unique_ptr<TileExchange>> exchanges;  // this rank's split channels'
+  bool splits = false;  // some channel is drawn by several ranks
 
   ~Impl() {
     if (ownsStatus && status) std::fclose(status);
@@ -186,10 +188,23 @@ Result<std::unique_ptr<IgLoop>> IgLoop::create(const IgConfig& config,
   m.world.emplace(std::move(world.value()));
   m.cluster = options.cluster;
   if (m.cluster) m.rank = m.cluster->rank(), m.ranks = m.cluster->size();
-  Result<std::vector<std::vector<int>>> byRank =
+  Result<std::vector<std::vector<ChannelShare>>> byRank =
       channelsByRank(config, int(m.world->channels().size()), m.ranks);
   if (!byRank) return byRank.error();
   m.mine = byRank.value()[size_t(m.rank)];
+  // Every rank makes every split's group, in channel order (a collective step); each keeps its
+  // own parts' exchanges.
+  std::vector<IgConfig::Split> splits = config.splits;
+  std::sort(splits.begin(), splits.end(),
+            [](const auto& a, const auto& b) { return a.channel < b.channel; });
+  for (const IgConfig::Split& split : splits) {
+    if (split.ranks.size() < 2 || !m.cluster) continue;
+    m.splits = true;
+    std::unique_ptr<TileExchange> e = m.cluster->shareGroup(split.ranks, config.rankTimeout);
+    for (ChannelShare& c : m.mine)
+      if (c.channel == split.channel) c.tiles.exchange = e.get();
+    if (e) m.exchanges.push_back(std::move(e));
+  }
   if (m.rank != 0) {
     // Rank 0 alone hears the host; the others take its datagrams from the broadcast.
   } else if (!options.replay.empty()) {
@@ -250,10 +265,13 @@ Result<IgRunReport> IgLoop::run() {
   std::vector<std::string> names;
   std::vector<Image> mineShown;
   std::vector<uint8_t> input;
-  // In a job of several, this rank's channels only.
-  const std::vector<int>* only = m.ranks > 1 ? &m.mine : nullptr;
+  // In a job of several, this rank's channels only, whole or its part; it presents those it
+  // draws whole and the shared ones it assembles (part 0).
+  const std::vector<ChannelShare>* only = m.ranks > 1 ? &m.mine : nullptr;
   const auto drawn = [&](size_t c) {
-    return !only || std::find(only->begin(), only->end(), int(c)) != only->end();
+    return !only || std::any_of(only->begin(), only->end(), [&](const ChannelShare& s) {
+             return s.channel == int(c) && s.tiles.part == 0;
+           });
   };
   // Before the clock starts, the first frame at every quality level: once each to make the
   // renderers' threads and buffers and touch their memory (so the first timed frame is not the
@@ -306,7 +324,8 @@ Result<IgRunReport> IgLoop::run() {
     if (m.rank == 0) m.hostDatagrams(frame, incoming, replayEnded, recordedLevel);
     if (m.ranks > 1) {  // rank 0's input to every rank: the state changes alike everywhere
       if (m.rank == 0) packInput(replayEnded, recordedLevel, incoming, input);
-      m.cluster->broadcast(input);
+      if (Status s = m.cluster->broadcast(input, m.config.rankTimeout); !s)
+        m.cluster->abort(fmt::format("frame {}: {}", frame, s.error().message));
       unpackInput(input, replayEnded, recordedLevel, incoming);
     }
     if (replayEnded && incoming.empty()) break;
@@ -337,6 +356,13 @@ Result<IgRunReport> IgLoop::run() {
     int level = m.options.governor && !pattern ? governor.choose(frameWork) : 0;
     if (!m.options.replay.empty())
       level = recordedLevel >= 0 && recordedLevel < governor.levels() ? recordedLevel : 0;
+    // The parts of a shared channel must draw it alike: with splits, every rank draws at the
+    // worst level any rank chose.
+    if (m.splits) {
+      Result<int> worst = m.cluster->agreeMax(level, m.config.rankTimeout);
+      if (!worst) m.cluster->abort(fmt::format("frame {}: {}", frame, worst.error().message));
+      level = worst.value();
+    }
 
     // 3. Start of Frame and the answers, at once: the host sends its next frame on it. The IG
     // status is the quality level (0: full quality; docs/ig.md).
@@ -368,7 +394,10 @@ Result<IgRunReport> IgLoop::run() {
       stats.assign(images.size(), FrameStats{});
     } else {
       Renderer& renderer = m.rendererFor(level, q.options);
-      if (Status s = renderer.renderChannels(scene, images, &stats, only); !s) return s.error();
+      if (Status s = renderer.renderChannels(scene, images, &stats, only); !s) {
+        if (m.splits) m.cluster->abort(fmt::format("frame {}: {}", frame, s.error().message));
+        return s.error();
+      }
     }
     // What is shown: the images, or with replication their enlargements.
     std::vector<Image>* shown = &images;
@@ -411,7 +440,9 @@ Result<IgRunReport> IgLoop::run() {
       // This rank's channels, by their names (an unnamed one by its index in the whole set).
       mineShown.clear();
       std::vector<std::string> mineNames;
-      for (int c : m.mine) {
+      for (const ChannelShare& share : m.mine) {
+        const int c = share.channel;
+        if (!drawn(size_t(c))) continue;  // a part the channel's part 0 shows
         mineShown.push_back((*shown)[size_t(c)]);
         mineNames.push_back(names[size_t(c)].empty() ? fmt::format("channel{}", c)
                                                      : names[size_t(c)]);
@@ -442,12 +473,16 @@ Result<IgRunReport> IgLoop::run() {
       while (slot < end) slot += period;
     }
     if (m.status) {
+      uint64_t shareBytes = 0;
+      double shareMs = 0;
+      for (const FrameStats& st : stats) shareBytes += st.shareBytes, shareMs += st.shareMs;
       std::fprintf(m.status,
                    "{\"frame\":%u,\"rank\":%d,\"time\":%.6f,\"ms\":%.3f,\"renderMs\":%.3f,"
-                   "\"budgetMs\":%.3f,\"level\":%d,"
+                   "\"shareBytes\":%llu,\"shareMs\":%.3f,\"budgetMs\":%.3f,\"level\":%d,"
                    "\"entities\":%zu,\"datagrams\":%llu,\"malformed\":%llu,\"rejected\":%llu,"
                    "\"missed\":%llu}\n",
-                   frame, m.rank, frame / m.config.rate, ms, renderMs, governor.budgetMs(), level,
+                   frame, m.rank, frame / m.config.rate, ms, renderMs,
+                   (unsigned long long)shareBytes, shareMs, governor.budgetMs(), level,
                    world.activeEntities(),
                    (unsigned long long)world.counts().datagrams,
                    (unsigned long long)world.counts().malformed,

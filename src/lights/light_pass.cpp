@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/eye_rays.h"
 #include "core/timing.h"
@@ -148,7 +149,10 @@ void LightPass::projectRange(size_t begin, size_t end, std::vector<Splat>& out) 
     Splat s;
     const bool drawn =
         i < points ? projectPoint(in_.points[i], s) : projectStar(in_.stars->stars[i - points], s);
-    if (drawn) out.push_back(s);
+    if (drawn) {
+      s.light = uint32_t(k);
+      out.push_back(s);
+    }
   }
 }
 
@@ -166,6 +170,8 @@ void LightPass::forTiles(const Splat& s, F&& f) const {
 void LightPass::prepare(const raster::PassFrame& frame) {
   const auto t0 = core::Clock::now();
   frame_ = frame;
+  exchangeMs_ = 0;
+  probes_.clear();
   const Mat4& v = in_.view;
   // The eye: view = [R t], eye = −Rᵀ t.
   for (int j = 0; j < 3; ++j) {
@@ -214,13 +220,28 @@ std::vector<Splat> LightPass::splats() const {
 // is behind it (but within a pixel of a silhouette a light behind shows). A star is seen only
 // where nothing was drawn.
 float LightPass::visibility(const Splat& s) const {
+  if (frame_.share.shared()) {
+    // The probes exchange() fetched, in the order it stored them.
+    const float* probe = &probes_[probeAt_[s.light]];
+    const int cx = std::clamp(floorToInt(s.x), 0, frame_.width - 1);
+    const int cy = std::clamp(floorToInt(s.y), 0, frame_.height - 1);
+    return visibilityFrom(s, [&](int x, int y, int k) {
+      if (x == cx && y == cy) return probe[k];
+      const int neighbour = (y - cy + 1) * 3 + (x - cx + 1);  // 0 … 8, the centre 4
+      return probe[frame_.samples + neighbour - (neighbour > 4)];
+    });
+  }
+  return visibilityFrom(s, [&](int x, int y, int k) {
+    const int tile = (y >> kTileLog2) * tilesX_ + (x >> kTileLog2);
+    return frame_.frame->tileDepth(tile)[FrameBuffer::depthOffset(x, y, frame_.samples, k)];
+  });
+}
+
+template <class DepthAt>
+float LightPass::visibilityFrom(const Splat& s, DepthAt&& depthAt) const {
   const int cx = std::clamp(floorToInt(s.x), 0, frame_.width - 1);
   const int cy = std::clamp(floorToInt(s.y), 0, frame_.height - 1);
   const int n = frame_.samples;
-  auto depthAt = [&](int x, int y, int k) {
-    const int tile = (y >> kTileLog2) * tilesX_ + (x >> kTileLog2);
-    return frame_.frame->tileDepth(tile)[FrameBuffer::depthOffset(x, y, n, k)];
-  };
   int visible = 0;
   if (s.eyeDepth == 0) {
     for (int k = 0; k < n; ++k) visible += !(depthAt(cx, cy, k) < 1.0f);
@@ -242,6 +263,43 @@ float LightPass::visibility(const Splat& s) const {
   const float limit = s.eyeDepth - in_.settings.depthBias - spread;
   for (int k = 0; k < n; ++k) visible += !(eyeDepthOf(depthAt(cx, cy, k)) < limit);
   return float(visible) / float(n);
+}
+
+// SPEC §3.4, issue 36: a part of a shared frame has drawn only its own tiles, and a light's
+// visibility reads the depth around its centre, which another part may have drawn. Every part
+// fills the probes it drew and leaves the others at −∞; their maximum is the whole frame's.
+Status LightPass::exchange() {
+  if (!frame_.share.shared()) return {};
+  const auto t0 = core::Clock::now();
+  const int n = frame_.samples;
+  const size_t stride = size_t(n + kNeighbourProbes);
+  size_t drawn = 0;
+  for (const std::vector<Splat>& c : chunks_) drawn += c.size();
+  probes_.assign(drawn * stride, -std::numeric_limits<float>::infinity());
+  probeAt_.assign(size_t(candidates_), 0);
+  const auto depthAt = [&](int x, int y, int k, float& out) {
+    if (x < 0 || y < 0 || x >= frame_.width || y >= frame_.height) return;
+    const int tx = x >> kTileLog2, ty = y >> kTileLog2;
+    if (!frame_.share.owns(tx, ty)) return;
+    out = frame_.frame->tileDepth(ty * tilesX_ + tx)[FrameBuffer::depthOffset(x, y, n, k)];
+  };
+  size_t slot = 0;
+  for (const std::vector<Splat>& c : chunks_)
+    for (const Splat& s : c) {
+      float* probe = &probes_[slot * stride];
+      probeAt_[s.light] = uint32_t(slot * stride);
+      ++slot;
+      const int cx = std::clamp(floorToInt(s.x), 0, frame_.width - 1);
+      const int cy = std::clamp(floorToInt(s.y), 0, frame_.height - 1);
+      for (int k = 0; k < n; ++k) depthAt(cx, cy, k, probe[k]);
+      int at = n;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx)
+          if (dx != 0 || dy != 0) depthAt(cx + dx, cy + dy, 0, probe[at++]);
+    }
+  const Status s = frame_.share.exchange->maxAll(probes_);
+  exchangeMs_ = core::msSince(t0);
+  return s;
 }
 
 void LightPass::drawTile(const raster::TileTarget& tile) {
@@ -293,7 +351,10 @@ void LightPass::addStats(FrameStats& stats) const {
   uint64_t drawn = 0;
   for (const std::vector<Splat>& c : chunks_) drawn += c.size();
   stats.lightsDrawn += drawn;
-  stats.lightsMs += prepareMs_ + *std::max_element(workerMs_.begin(), workerMs_.end());
+  stats.lightsMs +=
+      prepareMs_ + exchangeMs_ + *std::max_element(workerMs_.begin(), workerMs_.end());
+  stats.shareMs += exchangeMs_;
+  stats.shareBytes += probes_.size() * sizeof(float);
 }
 
 }  // namespace sv::lights

@@ -60,6 +60,7 @@ struct Splat {
   int firstX = 0, firstY = 0;
   int spanX = 0, spanY = 0;
   float kx[kKeptSpan] = {}, ky[kKeptSpan] = {};
+  uint32_t light = 0;  // its place among the frame's candidates (points, then stars, or subset)
 };
 
 class LightPass final : public raster::TilePass {
@@ -68,6 +69,9 @@ class LightPass final : public raster::TilePass {
 
   raster::PassStage stage() const override { return raster::PassStage::lights; }
   void prepare(const raster::PassFrame& frame) override;
+  // In a shared frame (PassFrame::share): the depths every splat's visibility reads — its centre
+  // pixel's samples and the first sample of the eight around it — from the parts that drew them.
+  Status exchange() override;
   void drawTile(const raster::TileTarget& tile) override;
   void addStats(FrameStats& stats) const override;
 
@@ -83,8 +87,15 @@ class LightPass final : public raster::TilePass {
   // Calls f(tile index) for every tile the splat's kernel square reaches.
   template <class F>
   void forTiles(const Splat& s, F&& f) const;
-  // The fraction of the centre pixel's samples that do not hide splat `s`.
+  // The fraction of the centre pixel's samples that do not hide splat `s`, from the frame's
+  // depth (or, in a shared frame, the exchanged probes).
   float visibility(const Splat& s) const;
+  // The same from depthAt(x, y, sample) (in the frame: 0 ≤ x < width, 0 ≤ y < height).
+  template <class DepthAt>
+  float visibilityFrom(const Splat& s, DepthAt&& depthAt) const;
+  // A shared frame's probes per splat: the centre pixel's n samples, then these (the eight
+  // neighbours' first samples).
+  static constexpr int kNeighbourProbes = 8;
   float eyeDepthOf(float windowDepth) const;
 
   LightInput in_;
@@ -98,8 +109,12 @@ class LightPass final : public raster::TilePass {
   size_t tiles_ = 0;
   raster::TileLists<Splat> tileSplats_;  // every tile's splats, in light order
   std::vector<double> workerMs_;
-  double prepareMs_ = 0;
+  double prepareMs_ = 0, exchangeMs_ = 0;
   uint64_t candidates_ = 0;
+  // A shared frame's probes (exchange): per drawn splat, in light order, its centre pixel's
+  // samples then its neighbours' first samples; where each candidate's start (slot × stride).
+  std::vector<float> probes_;
+  std::vector<uint32_t> probeAt_;
 };
 
 }  // namespace sv::lights

@@ -12,6 +12,8 @@
 #include "core/thread_pool.h"
 #include "raster/coverage_masks.h"
 #include "synthvis/frame_stats.h"
+#include "synthvis/result.h"
+#include "synthvis/tile_share.h"
 
 namespace sv::raster {
 
@@ -32,6 +34,9 @@ struct PassFrame {
   // passes are done, so its depth is final when drawTile is called, and a pass may read any
   // tile's depth (a light's centre may lie in the next tile); it still writes only its own tile.
   const class FrameBuffer* frame = nullptr;
+  // A frame shared by several processes (synthvis/tile_share.h): drawTile is called for this
+  // part's tiles only, and the others' samples are never drawn here.
+  TileShare share = {};
 };
 
 // One tile's shared buffers, as raster/framebuffer.h lays them out: `samples` depth and colour
@@ -57,6 +62,10 @@ class TilePass {
   virtual PassStage stage() const = 0;
   // Once per frame, before any tile, on the frame's thread (may run work on frame.pool).
   virtual void prepare(const PassFrame& frame) = 0;
+  // In a shared frame, for passes of stage lights: once this part's tiles are drawn, before
+  // drawTile — where a pass that reads beyond its tile fetches what the other parts drew
+  // (PassFrame::share's exchange). Every part calls it for the same passes in the same order.
+  virtual Status exchange() { return {}; }
   // Draws the pass into one tile, once per tile and frame, on worker `tile.worker`.
   virtual void drawTile(const TileTarget& tile) = 0;
   // Once per frame, after every tile: adds what the pass did to the frame's statistics.

@@ -553,7 +553,7 @@ Status GlRenderer::loadLights(const scene::Scene& scene) {
   pass.setLights(in);
   core::ThreadPool pool(1);
   const int w = g.options.width, h = g.options.height;
-  pass.prepare(raster::PassFrame{w, h, 1, nullptr, &pool, nullptr});
+  pass.prepare(raster::PassFrame{w, h, 1, nullptr, &pool, nullptr, {}});
   const float m22 = in.projection.m[2][2], m32 = in.projection.m[3][2];
   std::vector<float> data;
   const std::vector<lights::Splat> splats = pass.splats();

@@ -36,13 +36,14 @@ struct CallCursor {
 };
 
 // Object-space culling before setup (SPEC §4, seed 004): whether the object bounded by `bound`
-// lies in occupied windows of every tile it reaches — the occupancy earlier batches left.
+// lies in occupied windows of every tile it reaches — the occupancy earlier batches left — of
+// those this part draws (`share`).
 bool hiddenInFrame(const geometry::ObjectBound& bound, const std::vector<raster::Occupancy>& tiles,
-                   int tilesX, raster::Masking masking) {
+                   int tilesX, raster::Masking masking, const TileShare& share) {
   if (bound.minX > bound.maxX || bound.minY > bound.maxY) return false;  // off screen: setup culls
   for (int ty = bound.minY >> raster::kTileLog2; ty <= bound.maxY >> raster::kTileLog2; ++ty)
     for (int tx = bound.minX >> raster::kTileLog2; tx <= bound.maxX >> raster::kTileLog2; ++tx)
-      if (!raster::objectHidden(tiles[size_t(ty * tilesX + tx)], bound, tx, ty, masking))
+      if (share.owns(tx, ty) && !raster::objectHidden(tiles[size_t(ty * tilesX + tx)], bound, tx, ty, masking))
         return false;
   return true;
 }
@@ -154,7 +155,7 @@ void FrameRenderer::preparePasses(const FrameSettings& settings, const Frame& f)
   afterOpaque_.clear();
   afterTranslucent_.clear();
   const raster::PassFrame frame{settings.width, settings.height, f.samples, f.coverage, &pool_,
-                                f.wholeFrame ? &fb_ : nullptr};
+                                f.wholeFrame ? &fb_ : nullptr, settings.share};
   for (raster::PassStage stage :
        {raster::PassStage::surfaces, raster::PassStage::volumes, raster::PassStage::lights})
     for (raster::TilePass* pass : settings.passes) {
@@ -164,10 +165,13 @@ void FrameRenderer::preparePasses(const FrameSettings& settings, const Frame& f)
     }
 }
 
-void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& settings,
-                           FrameStats& stats) {
+Status FrameRenderer::render(const DrawPackets& packets, const FrameSettings& settings,
+                             FrameStats& stats) {
   const Frame f = frameOf(packets, settings);
   prepareBuffers(packets, f);
+  drawnTiles_.clear();
+  for (int tile = 0; tile < f.tiles; ++tile)
+    if (settings.share.owns(tile % f.tilesX, tile / f.tilesX)) drawnTiles_.push_back(tile);
   preparePasses(settings, f);
   const Traversal& t = packets.traversal;
   stats.trianglesIn += f.triangles + t.culledTriangles;
@@ -194,15 +198,20 @@ void FrameRenderer::render(const DrawPackets& packets, const FrameSettings& sett
     stats.rasterMs += core::msSince(t0);
   }
   if (f.lights) {
+    // A shared frame's lights read depth the other parts drew (TilePass::exchange).
+    if (settings.share.shared())
+      for (raster::TilePass* pass : afterTranslucent_)
+        if (Status s = pass->exchange(); !s) return s;
     const auto t0 = core::Clock::now();
-    pool_.parallelFor(size_t(f.tiles), [&](size_t tile, int worker) {
-      finishTile(settings, int(tile), fb_.tileDepth(int(tile)), fb_.tileColor(int(tile)), nullptr,
-                 worker);
+    pool_.parallelFor(drawnTiles_.size(), [&](size_t i, int worker) {
+      const int tile = drawnTiles_[i];
+      finishTile(settings, tile, fb_.tileDepth(tile), fb_.tileColor(tile), nullptr, worker);
     });
     stats.rasterMs += core::msSince(t0);
   }
   addTileStats(stats);
   for (const raster::TilePass* pass : settings.passes) pass->addStats(stats);
+  return {};
 }
 
 void FrameRenderer::setUpBatch(const DrawPackets& packets, const FrameSettings& settings,
@@ -243,7 +252,8 @@ FrameRenderer::SetupCounts FrameRenderer::setUpChunk(const DrawPackets& packets,
                                 ? uint32_t(call - packets.calls.data())
                                 : raster::kNoObject;
     if (object != raster::kNoObject && f.wholeFrame && !batch.first &&
-        hiddenInFrame(objects_[object], frameOccupancy_, f.tilesX, settings.masking)) {
+        hiddenInFrame(objects_[object], frameOccupancy_, f.tilesX, settings.masking,
+                      settings.share)) {
       c.occluded += runEnd - tri;
       tri = runEnd;
       continue;
@@ -290,8 +300,8 @@ FrameRenderer::SetupCounts FrameRenderer::setUpChunk(const DrawPackets& packets,
 }
 
 void FrameRenderer::drawTiles(const FrameSettings& settings, const Frame& f, const Batch& batch) {
-  pool_.parallelFor(size_t(f.tiles), [&](size_t tile, int worker) {
-    drawTile(settings, f, batch, int(tile), worker);
+  pool_.parallelFor(drawnTiles_.size(), [&](size_t i, int worker) {
+    drawTile(settings, f, batch, drawnTiles_[i], worker);
   });
 }
 

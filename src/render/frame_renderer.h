@@ -56,14 +56,18 @@ struct FrameSettings {
   // once the tile's opaque triangles are in, lights once every tile is drawn (the frame then
   // kept whole), before finishTile — and its statistics added to the frame's.
   std::vector<raster::TilePass*> passes;
+  // A frame shared by several processes (synthvis/tile_share.h): only this part's tiles are
+  // drawn and handed to finishTile; setup and binning still see the whole frame.
+  TileShare share;
 };
 
 class FrameRenderer {
  public:
   explicit FrameRenderer(int threads) : pool_(threads) {}
 
-  // Draws `packets`, handing every finished tile to settings.finishTile; adds to `stats`.
-  void render(const DrawPackets& packets, const FrameSettings& settings, FrameStats& stats);
+  // Draws `packets`, handing every finished tile (of this part, in a shared frame) to
+  // settings.finishTile; adds to `stats`. Fails only when a shared frame's exchange does.
+  Status render(const DrawPackets& packets, const FrameSettings& settings, FrameStats& stats);
 
   core::ThreadPool& pool() { return pool_; }
 
@@ -122,6 +126,7 @@ class FrameRenderer {
   std::vector<raster::RasterStats> tileStats_;
   std::vector<SetupCounts> chunkCounts_;  // the batch's, per chunk
   std::vector<uint8_t> opaqueDone_;       // per tile: the afterOpaque passes have run
+  std::vector<int> drawnTiles_;           // the tiles this part draws (every tile unshared)
   // FrameSettings::passes by stage: those that run once a tile's opaque triangles are in, and
   // those after its last triangle.
   std::vector<raster::TilePass*> afterOpaque_, afterTranslucent_;

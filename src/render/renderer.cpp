@@ -44,9 +44,11 @@ Status Renderer::render(const scene::Scene& scene, Image& image, FrameStats* sta
 // its own image at its own size; the scene's draw order, tables and passes are rebuilt per channel
 // from its camera.
 Status Renderer::renderChannels(const scene::Scene& scene, std::vector<Image>& images,
-                                std::vector<FrameStats>* statsOut, const std::vector<int>* only) {
+                                std::vector<FrameStats>* statsOut,
+                                const std::vector<ChannelShare>* only) {
   Impl& m = *impl_;
   if (scene.channels.empty()) {  // the classic view (render validates)
+    if (only) return Error{"", "", "a share of the channels needs a scene with display channels"};
     images.resize(1);
     FrameStats stats;
     if (Status s = render(scene, images[0], &stats); !s) return s;
@@ -59,7 +61,10 @@ Status Renderer::renderChannels(const scene::Scene& scene, std::vector<Image>& i
   images.resize(n);
   std::vector<FrameStats> stats(n);
   for (size_t i = 0; i < n; ++i) {
-    if (only && std::find(only->begin(), only->end(), int(i)) == only->end()) continue;
+    const auto share = only ? std::find_if(only->begin(), only->end(),
+                                           [&](const ChannelShare& c) { return c.channel == int(i); })
+                            : std::vector<ChannelShare>::const_iterator{};
+    if (only && share == only->end()) continue;
     const scene::Channel& channel = scene.channels[i];
     RenderOptions o = m.options;
     o.width = channel.width;
@@ -72,7 +77,13 @@ Status Renderer::renderChannels(const scene::Scene& scene, std::vector<Image>& i
     const auto start = core::Clock::now();
     const Result<render::FrameCamera> camera = render::channelCamera(scene, o, channel);
     if (!camera.ok()) return camera.error();
-    if (Status s = m.view.render(scene, o, camera.value(), images[i], stats[i]); !s) return s;
+    if (Status s = m.view.render(scene, o, camera.value(), images[i], stats[i],
+                                 only ? share->tiles : TileShare{});
+        !s) {
+      Error e = s.error();
+      if (only) e.message = fmt::format("channels[{}]: {}", i, e.message);
+      return e;
+    }
     stats[i].totalMs = core::msSince(start);
   }
   if (statsOut) *statsOut = std::move(stats);

@@ -9,6 +9,7 @@
 #include "core/timing.h"
 #include "render/frame_settings.h"
 #include "render/resolve_sink.h"
+#include "render/tile_gather.h"
 
 namespace sv::render {
 
@@ -25,8 +26,9 @@ ViewRenderer::ViewRenderer(const RenderOptions& o)
     : frame_(resolveThreads(o.threads)), gamma_(gammaTableOf(o)) {}
 
 Status ViewRenderer::render(const scene::Scene& scene, const RenderOptions& o,
-                            const FrameCamera& camera, Image& image, FrameStats& stats) {
-  return run(scene, o, camera, image, nullptr, stats);
+                            const FrameCamera& camera, Image& image, FrameStats& stats,
+                            const TileShare& share) {
+  return run(scene, o, camera, image, nullptr, stats, share);
 }
 
 Status ViewRenderer::renderLinear(const scene::Scene& scene, const RenderOptions& o,
@@ -34,7 +36,7 @@ Status ViewRenderer::renderLinear(const scene::Scene& scene, const RenderOptions
                                   FrameStats& stats) {
   out.resize(o.width, o.height);
   const output::LinearTarget target = output::wholeOf(out);
-  return run(scene, o, camera, unused_, &target, stats);
+  return run(scene, o, camera, unused_, &target, stats, {});
 }
 
 Status ViewRenderer::renderLinear(const scene::Scene& scene, const RenderOptions& o,
@@ -43,14 +45,19 @@ Status ViewRenderer::renderLinear(const scene::Scene& scene, const RenderOptions
   SV_CHECK(target.width == o.width && target.height == o.height && target.x >= 0 && target.y >= 0 &&
            target.x + target.width <= target.image->width &&
            target.y + target.height <= target.image->height);
-  return run(scene, o, camera, unused_, &target, stats);
+  return run(scene, o, camera, unused_, &target, stats, {});
 }
 
 Status ViewRenderer::run(const scene::Scene& scene, const RenderOptions& o,
                          const FrameCamera& camera, Image& image,
-                         const output::LinearTarget* linearOut, FrameStats& stats) {
+                         const output::LinearTarget* linearOut, FrameStats& stats,
+                         const TileShare& share) {
   const auto start = core::Clock::now();
+  SV_CHECK(!share.shared() || (!linearOut && share.exchange && share.part >= 0 &&
+                               share.part < share.parts));
   if (o.pipeline == RenderOptions::Pipeline::segments) {
+    if (share.shared())
+      return Error{"", "", "the segment pipeline draws a channel in one process, not shared"};
     if (linearOut)
       return Error{"", "", "the segment pipeline draws images, not views in linear light"};
     if (Status s = runSegments(scene, o, camera, image, stats); !s) return s;
@@ -78,8 +85,22 @@ Status ViewRenderer::run(const scene::Scene& scene, const RenderOptions& o,
   fs.finishTile = sink.finishTile((fs.width + raster::kTileSize - 1) >> raster::kTileLog2);
   fs.colorSums = sink.takesColorSums();
   fs.passes = passes_.compose(scene, o, camera, shading_);
+  fs.share = share;
   if (!linearOut) output::prepareImage(o.width, o.height, image);
-  frame_.render(packets_, fs, stats);
+  if (Status s = frame_.render(packets_, fs, stats); !s) return s;
+  if (share.shared()) {
+    // Part 0 assembles the image: the finished pixels, or for the tent filter, which reads
+    // across tile borders, the box-resolved linear ones it then filters.
+    const bool tent = o.filter == RenderOptions::Filter::tent3;
+    const SharedPixels pixels{
+        tent ? reinterpret_cast<uint8_t*>(linear_.rgb.data()) : image.rgb.data(), o.width,
+        o.height, tent ? int(3 * sizeof(uint16_t)) : 3, raster::kTileSize / o.supersample};
+    if (Status s = gatherShare(pixels, share, stats); !s) return s;
+    if (share.part != 0) {
+      stats.totalMs = core::msSince(start);
+      return {};
+    }
+  }
   stats.rasterMs += sink.finish(frame_.pool());
   stats.totalMs = core::msSince(start);
   return {};

@@ -14,6 +14,7 @@
 #include "render/shading_tables.h"
 #include "synthvis/frame_stats.h"
 #include "synthvis/render.h"
+#include "synthvis/tile_share.h"
 
 namespace sv::render {
 
@@ -29,9 +30,11 @@ class ViewRenderer {
 
   // One view: the shading tables in the camera's eye space, every instance's vertices to clip
   // space, setup and the tiles with the frame's passes, each tile resolved into `image` as it is
-  // finished. `o` is the renderer's options at this view's size; adds to `stats`.
+  // finished. `o` is the renderer's options at this view's size; adds to `stats`. With a shared
+  // `share`, only its part's tiles are drawn, and part 0's image is assembled from every part's
+  // (the other parts' hold their own tiles alone).
   Status render(const scene::Scene& scene, const RenderOptions& o, const FrameCamera& camera,
-                Image& image, FrameStats& stats);
+                Image& image, FrameStats& stats, const TileShare& share = {});
   // The same view box-resolved into linear light (`out`, sized to the view; no filter, no gamma
   // table): for a caller that composes views before the gamma table.
   Status renderLinear(const scene::Scene& scene, const RenderOptions& o, const FrameCamera& camera,
@@ -49,7 +52,8 @@ class ViewRenderer {
   Status runSegments(const scene::Scene& scene, const RenderOptions& o, const FrameCamera& camera,
                      Image& image, FrameStats& stats);
   Status run(const scene::Scene& scene, const RenderOptions& o, const FrameCamera& camera,
-             Image& image, const output::LinearTarget* linearOut, FrameStats& stats);
+             Image& image, const output::LinearTarget* linearOut, FrameStats& stats,
+             const TileShare& share);
 
   FrameRenderer frame_;
   SegmentRenderer segments_;

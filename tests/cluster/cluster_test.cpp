@@ -11,6 +11,8 @@
 #include <fstream>
 #include <sstream>
 
+#include <fmt/format.h>
+
 #include "ig/config.h"
 #include "support/shell.h"
 #include "support/temp_dir.h"
@@ -26,27 +28,76 @@ ig::IgConfig withRanks(std::vector<std::vector<int>> ranks) {
   return c;
 }
 
+// The channels each rank draws, written "c" for a whole channel and "c:p/P" for part p of P.
+using Drawn = std::vector<std::vector<std::string>>;
+Result<Drawn> drawnBy(const ig::IgConfig& config, int channels, int ranks) {
+  Result<std::vector<std::vector<ChannelShare>>> r = ig::channelsByRank(config, channels, ranks);
+  if (!r) return r.error();
+  Drawn out;
+  for (const auto& rank : r.value()) {
+    out.emplace_back();
+    for (const ChannelShare& c : rank)
+      out.back().push_back(c.tiles.shared() ? fmt::format("{}:{}/{}", c.channel, c.tiles.part,
+                                                          c.tiles.parts)
+                                            : std::to_string(c.channel));
+  }
+  return out;
+}
+
+std::string errorOf(const Result<Drawn>& x) { return x.ok() ? std::string() : x.error().message; }
+
+ig::IgConfig withSplits(std::vector<ig::IgConfig::Split> splits,
+                        std::vector<std::vector<int>> ranks = {}) {
+  ig::IgConfig c = withRanks(std::move(ranks));
+  c.splits = std::move(splits);
+  return c;
+}
+
 TEST(Cluster, ChannelsGoRoundTheRanksOrAsAssignedAndABadAssignmentIsRefused) {
-  auto r = ig::channelsByRank(ig::IgConfig{}, 5, 2);
+  auto r = drawnBy(ig::IgConfig{}, 5, 2);
   ASSERT_TRUE(r.ok());
-  EXPECT_EQ(r.value(), (std::vector<std::vector<int>>{{0, 2, 4}, {1, 3}}));
-  r = ig::channelsByRank(withRanks({{2}, {0, 1}}), 3, 2);
+  EXPECT_EQ(r.value(), (Drawn{{"0", "2", "4"}, {"1", "3"}}));
+  r = drawnBy(withRanks({{2}, {0, 1}}), 3, 2);
   ASSERT_TRUE(r.ok());
-  EXPECT_EQ(r.value(), (std::vector<std::vector<int>>{{2}, {0, 1}}));
-  const auto error = [](const Result<std::vector<std::vector<int>>>& x) {
-    return x.ok() ? std::string() : x.error().message;
-  };
-  EXPECT_NE(error(ig::channelsByRank(ig::IgConfig{}, 2, 3)).find("3 ranks for 2 channels"),
+  EXPECT_EQ(r.value(), (Drawn{{"2"}, {"0", "1"}}));
+  EXPECT_NE(errorOf(drawnBy(ig::IgConfig{}, 2, 3)).find("3 ranks for 2 channels"),
             std::string::npos);
-  EXPECT_NE(error(ig::channelsByRank(withRanks({{0}, {1}}), 2, 3)).find("the job has 3"),
+  EXPECT_NE(errorOf(drawnBy(withRanks({{0}, {1}}), 2, 3)).find("the job has 3"),
             std::string::npos);
-  EXPECT_NE(error(ig::channelsByRank(withRanks({{0, 1}, {1}}), 2, 2))
-                .find("channel 1 is assigned to rank 0 and rank 1"),
+  EXPECT_NE(errorOf(drawnBy(withRanks({{0, 1}, {1}}), 2, 2))
+                .find("channel 1 is assigned to rank 0 and to rank 1"),
             std::string::npos);
-  EXPECT_NE(error(ig::channelsByRank(withRanks({{0}, {}}), 2, 2))
-                .find("channel 1 is assigned to no rank"),
+  EXPECT_NE(errorOf(drawnBy(withRanks({{0}, {}}), 2, 2)).find("channel 1 is assigned to no rank"),
             std::string::npos);
-  EXPECT_NE(error(ig::channelsByRank(withRanks({{0}, {5}}), 2, 2)).find("channel 5 does not exist"),
+  EXPECT_NE(errorOf(drawnBy(withRanks({{0}, {5}}), 2, 2)).find("channel 5 does not exist"),
+            std::string::npos);
+}
+
+TEST(Cluster, ASplitChannelIsDealtToItsRanksInPartOrderAndABadSplitIsRefused) {
+  // Channel 1 over ranks 2, 0 (rank 2 is part 0: it assembles and shows it); the others dealt.
+  auto r = drawnBy(withSplits({{1, {2, 0}}}), 4, 3);
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r.value(), (Drawn{{"0", "1:1/2"}, {"2"}, {"1:0/2", "3"}}));
+  // One channel over every rank: nobody idle, though there are more ranks than channels.
+  r = drawnBy(withSplits({{0, {0, 1, 2}}}), 1, 3);
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r.value(), (Drawn{{"0:0/3"}, {"0:1/3"}, {"0:2/3"}}));
+  r = drawnBy(withSplits({{0, {1, 0}}}, {{1}, {}}), 2, 2);
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r.value(), (Drawn{{"0:1/2", "1"}, {"0:0/2"}}));
+  EXPECT_NE(errorOf(drawnBy(withSplits({{0, {0, 1}}}, {{0}, {1}}), 2, 2))
+                .find("channel 0 is assigned to ranks 0, 1 (split) and to rank 0"),
+            std::string::npos);
+  EXPECT_NE(errorOf(drawnBy(withSplits({{0, {0, 3}}}), 2, 2)).find("rank 3 does not exist"),
+            std::string::npos);
+  EXPECT_NE(errorOf(drawnBy(withSplits({{0, {1, 1}}}), 2, 2)).find("rank 1 is listed twice"),
+            std::string::npos);
+  EXPECT_NE(errorOf(drawnBy(withSplits({{0, {0, 1}}, {0, {1, 0}}}), 2, 2))
+                .find("channel 0 is split twice"),
+            std::string::npos);
+  EXPECT_NE(errorOf(drawnBy(withSplits({{4, {0, 1}}}), 2, 2)).find("channel 4 does not exist"),
+            std::string::npos);
+  EXPECT_NE(errorOf(drawnBy(withSplits({{0, {0, 1}}}), 2, 4)).find("rank 2 draws nothing"),
             std::string::npos);
 }
 
@@ -64,11 +115,12 @@ std::string mpirun(int ranks) {
 
 fs::path tempDir() { return tests::processTemp().dir(); }
 
-std::string config(const std::string& name, const std::string& extra) {
+std::string config(const std::string& name, const std::string& extra,
+                   const std::string& scene = "mixed.json",
+                   const std::string& channels = R"("count": 3, "arc": 120, "width": 96, "height": 72)") {
   const fs::path p = tempDir() / name;
-  std::ofstream(p) << R"({"synthvis-ig": 1, "scene": ")" << SV_SOURCE_DIR
-                   << R"(/scenes/mixed.json", "rate": 30,
-    "channels": {"count": 3, "arc": 120, "width": 96, "height": 72},
+  std::ofstream(p) << R"({"synthvis-ig": 1, "scene": ")" << SV_SOURCE_DIR << "/scenes/" << scene
+                   << R"(", "rate": 30, "channels": {)" << channels << R"(},
     "port": 0, "host": {"port": 0})"
                    << extra << "}";
   return p.string();
@@ -115,35 +167,94 @@ TEST(Cluster, ThreeRanksDrawTheChannelsOneProcessDrawsAtTheSameInstants) {
   }
 }
 
+// Every file of `one` has its twin in `other`, byte for byte; returns how many.
+int expectSameFiles(const fs::path& one, const fs::path& other) {
+  int files = 0;
+  for (const auto& e : fs::directory_iterator(one)) {
+    const fs::path twin = other / e.path().filename();
+    EXPECT_TRUE(fs::exists(twin)) << twin;
+    EXPECT_EQ(slurp(e.path()), slurp(twin)) << e.path().filename();
+    ++files;
+  }
+  return files;
+}
+
+TEST(Cluster, ASplitChannelIsTheImageOneProcessDraws) {
+  // The airport at night (light points, whose visibility reads depth across tile borders; fog),
+  // 4 samples a pixel: channel 1 split over ranks 2 and 0 (rank 2 assembles and shows it), the
+  // others on ranks 0 and 1.
+  const std::string channels = R"("count": 3, "arc": 150, "width": 200, "height": 120)";
+  const std::string render = R"(, "render": {"threads": 1, "aa": 4})";
+  const std::string whole = config("whole.json", render, "airport.json", channels);
+  const std::string split = config(
+      "split.json", render + R"(, "cluster": {"split": [{"channel": 1, "ranks": [2, 0]}]})",
+      "airport.json", channels);
+  const fs::path one = tempDir() / "split-one", three = tempDir() / "split-three";
+  const std::string args = " --frames 3 --as-fast-as-possible --no-governor --output png:";
+  const ShellRun a = shell(std::string(SV_CLI) + " ig " + whole + args + one.string());
+  ASSERT_EQ(a.status, 0) << a.out;
+  const ShellRun b = shell(mpirun(3) + SV_CLI + " ig " + split + args + three.string() +
+                           " --status " + (tempDir() / "split-status").string());
+  ASSERT_EQ(b.status, 0) << b.out;
+  EXPECT_EQ(expectSameFiles(one, three), 9);  // 3 frames × 3 channels
+  EXPECT_EQ(expectSameFiles(three, one), 9);  // and no file besides
+  // The parts' status lines say what crossed between them.
+  for (int rank : {0, 2}) {
+    std::ifstream status(tempDir() / ("split-status.rank" + std::to_string(rank)));
+    std::string line;
+    ASSERT_TRUE(std::getline(status, line));
+    EXPECT_NE(line.find("\"shareBytes\":"), std::string::npos) << line;
+    EXPECT_EQ(line.find("\"shareBytes\":0,"), std::string::npos) << line;
+  }
+}
+
 TEST(Cluster, ABadAssignmentIsRefusedAtStart) {
   const std::string cfg = config("bad.json", R"(, "cluster": {"ranks": [[0, 1], [1, 2], []]})");
   const ShellRun r = shell(mpirun(3) + SV_CLI + " ig " + cfg + " --frames 2 --as-fast-as-possible");
   EXPECT_NE(r.status, 0) << r.out;
-  EXPECT_NE(r.out.find("channel 1 is assigned to rank 0 and rank 1"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("channel 1 is assigned to rank 0 and to rank 1"), std::string::npos) << r.out;
 }
 
-TEST(Cluster, ARankThatStopsAnsweringEndsTheJobNamedWithinTheTimeout) {
-  // Rank 2 stopped (SIGSTOP) once the run is under way: rank 0's frame lock waits 1 s for it,
-  // then ends the job with an error naming it.
-  const std::string cfg = config("stop.json", R"(, "cluster": {"timeout": 1})");
-  const fs::path status = tempDir() / "stop-status";
+// Runs `config` on 3 ranks and stops (SIGSTOP) rank `stopped` once the run is under way; the
+// job's output, and the seconds it took to end.
+std::pair<ShellRun, double> runAndStop(const std::string& cfg, int stopped) {
+  const fs::path status = tempDir() / ("stop-status" + std::to_string(stopped));
   // The driver, as a script: the stopper in the background, then the job.
   const fs::path script = tempDir() / "stop.sh";
-  std::ofstream(script) << "for i in $(seq 1 400); do [ -s " << status.string()
-                        << ".rank2 ] && break; sleep 0.05; done\n"
+  std::ofstream(script) << "for i in $(seq 1 400); do [ -s " << status.string() << ".rank"
+                        << stopped << " ] && break; sleep 0.05; done\n"
                         << "for p in $(pgrep -f 'ig " << cfg << "'); do\n"
                         << "  if tr '\\0' '\\n' < /proc/$p/environ 2>/dev/null | "
-                        << "grep -qx OMPI_COMM_WORLD_RANK=2; then kill -STOP $p; fi\n"
+                        << "grep -qx OMPI_COMM_WORLD_RANK=" << stopped
+                        << "; then kill -STOP $p; fi\n"
                         << "done\n";
   const auto start = std::chrono::steady_clock::now();
   const ShellRun r =
       shell("sh -c 'sh " + script.string() + " & " + mpirun(3) + SV_CLI + " ig " + cfg +
             " --frames 100000 --no-governor --status " + status.string() + "'");
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return {r, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()};
+}
+
+TEST(Cluster, ARankThatStopsAnsweringEndsTheJobNamedWithinTheTimeout) {
+  // Rank 2 stopped: rank 0's frame lock waits 1 s for it, then ends the job naming it.
+  const auto [r, seconds] = runAndStop(config("stop.json", R"(, "cluster": {"timeout": 1})"), 2);
   EXPECT_NE(r.status, 0) << r.out;
   EXPECT_NE(r.status, 124) << "timed out: " << r.out;
   EXPECT_NE(r.out.find("no answer within 1 s from rank 2 on "), std::string::npos) << r.out;
+  EXPECT_LT(seconds, 60) << r.out;
+}
+
+TEST(Cluster, ARankZeroThatStopsAnsweringIsNamedByTheOthers) {
+  // Rank 0 stopped, with a channel split over all three ranks: the others wait twice the
+  // timeout for it (at the broadcast, the quality level, the gather or the frame lock), then
+  // end the job naming it.
+  const auto [r, seconds] = runAndStop(
+      config("stop0.json",
+             R"(, "cluster": {"timeout": 1, "split": [{"channel": 0, "ranks": [0, 1, 2]}]})"),
+      0);
+  EXPECT_NE(r.status, 0) << r.out;
+  EXPECT_NE(r.status, 124) << "timed out: " << r.out;
+  EXPECT_NE(r.out.find("no answer within 2 s from rank 0 on "), std::string::npos) << r.out;
   EXPECT_LT(seconds, 60) << r.out;
 }
 

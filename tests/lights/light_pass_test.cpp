@@ -29,7 +29,7 @@ struct BareFrame {
     }
   }
   void draw(lights::LightPass& pass) {
-    pass.prepare(raster::PassFrame{fb.width(), fb.height(), 1, nullptr, &pool, &fb});
+    pass.prepare(raster::PassFrame{fb.width(), fb.height(), 1, nullptr, &pool, &fb, {}});
     for (int t = 0; t < fb.tileCount(); ++t)
       pass.drawTile({t % fb.tilesX(), t / fb.tilesX(), fb.tileDepth(t), fb.tileColor(t), 0});
   }

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <random>
 
+#include "core/check.h"
+
 namespace sv::test {
 
 geometry::ClipVertex pixelVertex(double x, double y, int width, int height, float z, float w,
@@ -82,7 +84,7 @@ Frame renderQuadtree(const render::DrawPackets& p, const render::FrameSettings& 
       }
   };
   FrameStats local;
-  r.render(p, settings, stats ? *stats : local);
+  SV_CHECK(r.render(p, settings, stats ? *stats : local).ok());  // unshared: never fails
   return f;
 }
 
@@ -112,7 +114,7 @@ std::vector<uint16_t> renderResolved(const render::DrawPackets& p, const render:
         }
   };
   FrameStats stats;
-  r.render(p, settings, stats);
+  SV_CHECK(r.render(p, settings, stats).ok());
   if (usedSums) *usedSums = sumTiles > 0 && planeTiles == 0;  // every tile, or none
   return rgb;
 }
