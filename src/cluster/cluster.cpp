@@ -15,7 +15,8 @@
 namespace sv::cluster {
 namespace {
 
-constexpr int kTagDone = 1, kTagGo = 2, kTagTiles = 3, kTagValues = 4, kTagMax = 5;
+constexpr int kTagDone = 1, kTagGo = 2, kTagTiles = 3, kTagValues = 4, kTagMax = 5,
+              kTagLevel = 6, kTagAgreed = 7;
 using SteadyClock = std::chrono::steady_clock;
 
 SteadyClock::time_point after(double seconds) {
@@ -183,16 +184,8 @@ Status Cluster::broadcast(std::vector<uint8_t>& bytes, double timeoutSeconds) {
   return {};
 }
 
-Result<int> Cluster::agreeMax(int value, double timeoutSeconds) {
-  if (size_ == 1) return value;
-  int32_t mine = value, result = value;
-  std::vector<MPI_Request> request(1, MPI_REQUEST_NULL);
-  MPI_Iallreduce(&mine, &result, 1, MPI_INT32_T, MPI_MAX, MPI_COMM_WORLD, &request[0]);
-  if (Status s = waitAll(request, after(2 * timeoutSeconds), 2 * timeoutSeconds,
-                         [&](size_t) { return std::string("some rank (no quality level came)"); });
-      !s)
-    return s.error();
-  return int(result);
+Result<int> Cluster::agreeMax(uint32_t frame, int value, double timeoutSeconds) {
+  return worstOf({frame, value}, kTagLevel, kTagAgreed, timeoutSeconds);
 }
 
 std::unique_ptr<TileExchange> Cluster::shareGroup(const std::vector<int>& ranks,
@@ -208,57 +201,45 @@ std::unique_ptr<TileExchange> Cluster::shareGroup(const std::vector<int>& ranks,
 }
 
 Result<int> Cluster::frameLock(const FrameDone& done, double timeoutSeconds) {
+  return worstOf(done, kTagDone, kTagGo, timeoutSeconds);
+}
+
+// Every rank's (frame, value) to rank 0, the largest value back — point to point, each wait
+// polled, so that whoever does not answer is named: rank 0 names the ranks missing, the others
+// rank 0 (given twice the time, as rank 0 may itself be waiting for a slow rank).
+Result<int> Cluster::worstOf(const FrameDone& done, int tagUp, int tagDown,
+                             double timeoutSeconds) {
   if (size_ == 1) return done.level;
   int32_t worst = done.level;
   if (rank_ != 0) {
     const int32_t message[2] = {int32_t(done.frame), done.level};
     std::vector<MPI_Request> requests(2, MPI_REQUEST_NULL);
-    MPI_Isend(message, 2, MPI_INT32_T, 0, kTagDone, MPI_COMM_WORLD, &requests[0]);
-    MPI_Irecv(&worst, 1, MPI_INT32_T, 0, kTagGo, MPI_COMM_WORLD, &requests[1]);
+    MPI_Isend(message, 2, MPI_INT32_T, 0, tagUp, MPI_COMM_WORLD, &requests[0]);
+    MPI_Irecv(&worst, 1, MPI_INT32_T, 0, tagDown, MPI_COMM_WORLD, &requests[1]);
     if (Status s = waitAll(requests, after(2 * timeoutSeconds), 2 * timeoutSeconds,
                            [&](size_t) { return name(0); });
         !s)
       return Error{"", "", fmt::format("frame {}: {}", done.frame, s.error().message)};
     return int(worst);
   }
-  // Rank 0: one receive a rank, polled until all have come or the time is up.
   std::vector<int32_t> messages(size_t(size_) * 2);
-  std::vector<MPI_Request> requests(size_t(size_), MPI_REQUEST_NULL);
+  std::vector<MPI_Request> requests(size_t(size_ - 1), MPI_REQUEST_NULL);
   for (int r = 1; r < size_; ++r)
-    MPI_Irecv(&messages[size_t(r) * 2], 2, MPI_INT32_T, r, kTagDone, MPI_COMM_WORLD,
-              &requests[size_t(r)]);
-  const auto deadline =
-      std::chrono::steady_clock::now() + std::chrono::duration<double>(timeoutSeconds);
-  std::vector<bool> answered(size_t(size_), false);
-  answered[0] = true;
-  for (;;) {
-    bool all = true;
-    for (int r = 1; r < size_; ++r) {
-      if (answered[size_t(r)]) continue;
-      int flag = 0;
-      MPI_Test(&requests[size_t(r)], &flag, MPI_STATUS_IGNORE);
-      answered[size_t(r)] = flag != 0;
-      all = all && flag != 0;
-    }
-    if (all) break;
-    if (std::chrono::steady_clock::now() > deadline) {
-      std::string missing;
-      for (int r = 1; r < size_; ++r)
-        if (!answered[size_t(r)]) missing += (missing.empty() ? "" : ", ") + name(r);
-      return Error{"", "",
-                   fmt::format("frame {}: no answer within {:g} s from {}", done.frame,
-                               timeoutSeconds, missing)};
-    }
-    std::this_thread::sleep_for(std::chrono::microseconds(100));
-  }
+    MPI_Irecv(&messages[size_t(r) * 2], 2, MPI_INT32_T, r, tagUp, MPI_COMM_WORLD,
+              &requests[size_t(r - 1)]);
+  if (Status s = waitAll(requests, after(timeoutSeconds), timeoutSeconds,
+                         [&](size_t i) { return name(int(i) + 1); });
+      !s)
+    return Error{"", "", fmt::format("frame {}: {}", done.frame, s.error().message)};
   for (int r = 1; r < size_; ++r) {
     if (uint32_t(messages[size_t(r) * 2]) != done.frame)
       return Error{"", "",
-                   fmt::format("frame {}: {} finished frame {} instead", done.frame, name(r),
+                   fmt::format("frame {}: {} is at frame {} instead", done.frame, name(r),
                                messages[size_t(r) * 2])};
     worst = std::max(worst, messages[size_t(r) * 2 + 1]);
   }
-  for (int r = 1; r < size_; ++r) MPI_Send(&worst, 1, MPI_INT32_T, r, kTagGo, MPI_COMM_WORLD);
+  // Small messages: sent at once, whether or not their rank is still listening.
+  for (int r = 1; r < size_; ++r) MPI_Send(&worst, 1, MPI_INT32_T, r, tagDown, MPI_COMM_WORLD);
   return int(worst);
 }
 

@@ -44,7 +44,8 @@ class Cluster {
 
   // The largest of every rank's `value`, on every rank (the quality level all ranks draw at when
   // they share channels: a shared channel's parts must draw alike).
-  Result<int> agreeMax(int value, double timeoutSeconds);
+  // Waits as frameLock does, naming whoever does not answer.
+  Result<int> agreeMax(uint32_t frame, int value, double timeoutSeconds);
 
   // The parts of one shared channel (synthvis/tile_share.h): `ranks`, in part order, exchanging
   // over their own communicator. Every rank of the job calls it, for the same groups in the same
@@ -65,6 +66,8 @@ class Cluster {
 
  private:
   Cluster() = default;
+  // frameLock's pattern on its own pair of tags: (frame, value) up to rank 0, the worst back.
+  Result<int> worstOf(const FrameDone& done, int tagUp, int tagDown, double timeoutSeconds);
   bool mpi_ = false;
   int rank_ = 0, size_ = 1;
   std::vector<std::string> hosts_;  // by rank

@@ -359,8 +359,8 @@ Result<IgRunReport> IgLoop::run() {
     // The parts of a shared channel must draw it alike: with splits, every rank draws at the
     // worst level any rank chose.
     if (m.splits) {
-      Result<int> worst = m.cluster->agreeMax(level, m.config.rankTimeout);
-      if (!worst) m.cluster->abort(fmt::format("frame {}: {}", frame, worst.error().message));
+      Result<int> worst = m.cluster->agreeMax(frame, level, m.config.rankTimeout);
+      if (!worst) m.cluster->abort(worst.error().message);
       level = worst.value();
     }
 

@@ -11,6 +11,8 @@
 #include <fstream>
 #include <sstream>
 
+#include <unistd.h>
+
 #include <fmt/format.h>
 
 #include "ig/config.h"
@@ -206,6 +208,61 @@ TEST(Cluster, ASplitChannelIsTheImageOneProcessDraws) {
     EXPECT_NE(line.find("\"shareBytes\":"), std::string::npos) << line;
     EXPECT_EQ(line.find("\"shareBytes\":0,"), std::string::npos) << line;
   }
+}
+
+TEST(Cluster, RankZeroIsTheIgAHostDrivesAndWiresharkReadsItsSession) {
+  // The IG issue's conformance check with three ranks (one channel split over two): the host
+  // drives rank 0 over loopback UDP; the recorded session is read by Wireshark's CIGI dissector
+  // with no malformed packet, one Start of Frame per frame counting 0, 1, 2, …, the host's
+  // entity in it — and the host heard one IG, not three.
+  const int igPort = 20000 + int(::getpid() % 20000);
+  const std::string cfg = config(
+      "cigi.json",
+      fmt::format(R"(, "render": {{"threads": 1}}, "cluster": {{"split": [{{"channel": 1, "ranks": [1, 2]}}]}})"),
+      "airport.json", R"("count": 3, "arc": 150, "width": 160, "height": 96)");
+  {  // the IG listens on igPort and answers whoever drives it
+    std::ifstream in(cfg);
+    std::string text((std::istreambuf_iterator<char>(in)), {});
+    text.replace(text.find(R"("port": 0, "host": {"port": 0})"), 30,
+                 fmt::format(R"("port": {}, "host": {{"port": 0}})", igPort));
+    std::ofstream(cfg) << text;
+  }
+  const fs::path script = tempDir() / "host.json";
+  std::ofstream(script) << fmt::format(R"({{"synthvis-host": 1, "origin": {{"lat": 0, "lon": 0, "alt": 0}},
+    "ig": {{"address": "127.0.0.1", "port": {}}}, "port": 0, "rate": 30, "frames": 40,
+    "entities": [{{"id": 0, "type": 0, "path": [{{"t": 0, "north": -900, "up": 60, "pitch": -3}},
+                                                {{"t": 2, "north": -800, "up": 55, "pitch": -3}}]}}],
+    "events": [{{"t": 0.3, "hat": {{"id": 5, "north": -850, "up": 100}}}}]}})",
+                                       igPort);
+  const fs::path capture = tempDir() / "cluster-session.pcap";
+  const ShellRun r = shell("sh -c '" + mpirun(3) + SV_CLI + " ig " + cfg +
+                           " --frames 100 --no-governor --output null --record " +
+                           capture.string() + " & sleep 0.5; " + SV_CLI + " host " +
+                           script.string() + "; wait'");
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("host: 40 frames sent"), std::string::npos) << r.out;
+  // One Start of Frame a frame: the host sends a frame for each it hears, so it heard about 40 —
+  // not three times as many from three ranks.
+  unsigned sent = 0, heard = 0;
+  const size_t at = r.out.find("host: ");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  ASSERT_EQ(std::sscanf(r.out.c_str() + at, "host: %u frames sent, %u Start of Frame", &sent, &heard),
+            2)
+      << r.out;
+  EXPECT_GE(heard, 40u);
+  EXPECT_LE(heard, 42u);
+  // tshark's output alone (its warnings to standard error dropped).
+  const auto tshark = [&](const std::string& args) {
+    return tests::shell("(tshark -n -r '" + capture.string() +
+                        "' -d udp.port==8004,cigi -d udp.port==8005,cigi " + args + " 2>/dev/null)")
+        .out;
+  };
+  EXPECT_EQ(tshark("-Y '_ws.malformed || _ws.expert.severity >= error'"), "");
+  std::string counting;
+  for (int f = 0; f < 100; ++f) counting += std::to_string(f) + "\n";
+  EXPECT_EQ(tshark("-Y cigi.sof -T fields -e cigi.sof.ig_frame_number"), counting);
+  EXPECT_NE(tshark("-Y 'cigi.entity_control.entity_id == 0' -T fields -e frame.number"), "");
+  EXPECT_NE(tshark("-Y cigi.hat_hot_response -T fields -e cigi.hat_hot_response.hat_hot_id"), "");
 }
 
 TEST(Cluster, ABadAssignmentIsRefusedAtStart) {
