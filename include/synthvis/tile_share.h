@@ -16,8 +16,9 @@ namespace sv {
 class TileExchange {
  public:
   virtual ~TileExchange() = default;
-  // Every part's bytes to part 0: `all[p]`, sized by the caller to part p's byte count, receives
-  // part p's `mine` (part 0's own included); the other parts' `all` is not touched.
+  // Every other part's bytes to part 0: on part 0, `all[p]` (p ≥ 1), sized by the caller to
+  // part p's byte count, receives part p's `mine` (part 0's own `mine` and `all[0]` are not
+  // used); on the others, `all` is not touched.
   virtual Status gather(const std::vector<uint8_t>& mine,
                         std::vector<std::vector<uint8_t>>& all) = 0;
   // The element-wise maximum of every part's `values` (all of one length), on every part.

@@ -54,23 +54,23 @@ void unpackShare(const SharedPixels& image, const TileShare& share, int part,
   });
 }
 
-Status gatherShare(const SharedPixels& image, const TileShare& share, FrameStats& stats) {
+Status gatherShare(const SharedPixels& image, const TileShare& share, ShareBuffers& b,
+                   FrameStats& stats) {
   const auto t0 = core::Clock::now();
-  std::vector<uint8_t> mine;
-  packShare(image, share, share.part, mine);
-  std::vector<std::vector<uint8_t>> all;
-  if (share.part == 0) {
-    all.resize(size_t(share.parts));
-    for (int p = 0; p < share.parts; ++p) all[size_t(p)].resize(sharedBytes(image, share, p));
-  }
-  if (Status s = share.exchange->gather(mine, all); !s) return s;
-  if (share.part == 0) {
-    for (int p = 1; p < share.parts; ++p) {
-      unpackShare(image, share, p, all[size_t(p)]);
-      stats.shareBytes += all[size_t(p)].size();
-    }
+  if (share.part != 0) {
+    packShare(image, share, share.part, b.mine);
+    if (Status s = share.exchange->gather(b.mine, b.all); !s) return s;
+    stats.shareBytes += b.mine.size();
   } else {
-    stats.shareBytes += mine.size();
+    // Part 0's own tiles are in place already.
+    b.mine.clear();
+    b.all.resize(size_t(share.parts));
+    for (int p = 1; p < share.parts; ++p) b.all[size_t(p)].resize(sharedBytes(image, share, p));
+    if (Status s = share.exchange->gather(b.mine, b.all); !s) return s;
+    for (int p = 1; p < share.parts; ++p) {
+      unpackShare(image, share, p, b.all[size_t(p)]);
+      stats.shareBytes += b.all[size_t(p)].size();
+    }
   }
   stats.shareMs += core::msSince(t0);
   return {};

@@ -28,8 +28,16 @@ void packShare(const SharedPixels& image, const TileShare& share, int part,
 void unpackShare(const SharedPixels& image, const TileShare& share, int part,
                  const std::vector<uint8_t>& in);
 
+// What gatherShare keeps from frame to frame: fresh buffers of megabytes cost their page faults
+// every frame (a 1080p half frame's three took a millisecond).
+struct ShareBuffers {
+  std::vector<uint8_t> mine;
+  std::vector<std::vector<uint8_t>> all;
+};
+
 // Every part's tiles into part 0's image (the others' images keep their own tiles alone); the
 // bytes and time go to stats.shareBytes, shareMs.
-Status gatherShare(const SharedPixels& image, const TileShare& share, FrameStats& stats);
+Status gatherShare(const SharedPixels& image, const TileShare& share, ShareBuffers& buffers,
+                   FrameStats& stats);
 
 }  // namespace sv::render

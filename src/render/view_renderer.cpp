@@ -95,7 +95,7 @@ Status ViewRenderer::run(const scene::Scene& scene, const RenderOptions& o,
     const SharedPixels pixels{
         tent ? reinterpret_cast<uint8_t*>(linear_.rgb.data()) : image.rgb.data(), o.width,
         o.height, tent ? int(3 * sizeof(uint16_t)) : 3, raster::kTileSize / o.supersample};
-    if (Status s = gatherShare(pixels, share, stats); !s) return s;
+    if (Status s = gatherShare(pixels, share, shareBuffers_, stats); !s) return s;
     if (share.part != 0) {
       stats.totalMs = core::msSince(start);
       return {};

@@ -12,6 +12,7 @@
 #include "render/passes.h"
 #include "render/segment_renderer.h"
 #include "render/shading_tables.h"
+#include "render/tile_gather.h"
 #include "synthvis/frame_stats.h"
 #include "synthvis/render.h"
 #include "synthvis/tile_share.h"
@@ -63,6 +64,7 @@ class ViewRenderer {
   output::LinearImage linear_;  // the box-resolved frame, for the tent filter
   FramePasses passes_;
   Image unused_;  // the image argument of a linear view's resolve, never written
+  ShareBuffers shareBuffers_;  // a shared view's tiles on their way to part 0
 };
 
 }  // namespace sv::render
