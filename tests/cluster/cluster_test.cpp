@@ -272,9 +272,10 @@ TEST(Cluster, ABadAssignmentIsRefusedAtStart) {
   EXPECT_NE(r.out.find("channel 1 is assigned to rank 0 and to rank 1"), std::string::npos) << r.out;
 }
 
-// Runs `config` on 3 ranks and stops (SIGSTOP) rank `stopped` once the run is under way; the
-// job's output, and the seconds it took to end.
-std::pair<ShellRun, double> runAndStop(const std::string& cfg, int stopped) {
+// Runs `config` on 3 ranks and sends rank `stopped` `signal` (STOP: it stops answering; KILL: it
+// dies) once the run is under way; the job's output, and the seconds it took to end.
+std::pair<ShellRun, double> runAndStop(const std::string& cfg, int stopped,
+                                       const std::string& signal = "STOP") {
   const fs::path status = tempDir() / ("stop-status" + std::to_string(stopped));
   // The driver, as a script: the stopper in the background, then the job.
   const fs::path script = tempDir() / "stop.sh";
@@ -283,7 +284,7 @@ std::pair<ShellRun, double> runAndStop(const std::string& cfg, int stopped) {
                         << "for p in $(pgrep -f 'ig " << cfg << "'); do\n"
                         << "  if tr '\\0' '\\n' < /proc/$p/environ 2>/dev/null | "
                         << "grep -qx OMPI_COMM_WORLD_RANK=" << stopped
-                        << "; then kill -STOP $p; fi\n"
+                        << "; then kill -" << signal << " $p; fi\n"
                         << "done\n";
   const auto start = std::chrono::steady_clock::now();
   const ShellRun r =
@@ -298,6 +299,16 @@ TEST(Cluster, ARankThatStopsAnsweringEndsTheJobNamedWithinTheTimeout) {
   EXPECT_NE(r.status, 0) << r.out;
   EXPECT_NE(r.status, 124) << "timed out: " << r.out;
   EXPECT_NE(r.out.find("no answer within 1 s from rank 2 on "), std::string::npos) << r.out;
+  EXPECT_LT(seconds, 60) << r.out;
+}
+
+TEST(Cluster, ARankKilledMidRunEndsTheJobNamed) {
+  // mpirun sees the death and ends the job at once, naming the rank.
+  const auto [r, seconds] = runAndStop(config("kill.json", R"(, "cluster": {"timeout": 1})"), 1, "KILL");
+  EXPECT_NE(r.status, 0) << r.out;
+  EXPECT_NE(r.status, 124) << "timed out: " << r.out;
+  EXPECT_NE(r.out.find("rank 1"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("signal 9"), std::string::npos) << r.out;
   EXPECT_LT(seconds, 60) << r.out;
 }
 
