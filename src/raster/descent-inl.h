@@ -120,6 +120,9 @@ class TriangleRaster {
                           ? kBlockLog2
                           : std::max(kBlockLog2, int(std::bit_width(unsigned(extent - 1))) - 1);
     const int n = 1 << log2n;
+    if constexpr (kSpans) {
+      if (!occ_ && log2n > kBlockLog2) return spans(x0, y0, x1, y1);
+    }
     for (int cy = y0 >> log2n; cy <= y1 >> log2n; ++cy)
       for (int cx = x0 >> log2n; cx <= x1 >> log2n; ++cx)
         visitRoot(cx << log2n, cy << log2n, log2n, n);
@@ -173,6 +176,74 @@ class TriangleRaster {
       sampleDepth_[s] =
           t_.depth.dx * float(offsets[size_t(s)][0]) + t_.depth.dy * float(offsets[size_t(s)][1]);
       sampleDepthMax_ = std::max(sampleDepthMax_, sampleDepth_[s]);
+    }
+  }
+
+  // Triangles past the scan's extent walked as rows of 4×4 blocks (issue 37), where nothing needs
+  // the windows above a block — no masking (occupancy is kept per window), no anti-aliasing, no
+  // debug view that shows them: every block of a row of the box is classified against each edge
+  // at once, one SIMD lane a block — wholly outside an edge (dropped), inside every edge (filled),
+  // or crossed (a leaf, testing only the edges that cross it). The tests are the descent's at its
+  // last window level, so the pixels are the same, and a triangle writes a pixel once whatever
+  // order its blocks come in: the image is the descent's, bit for bit (tests/golden). What the
+  // descent spent on its branches above the blocks is saved: tris 10k × 1000 px ×0.80, textured
+  // ×0.89 (docs/performance.md, "Fill against the roofline").
+  static constexpr bool kSpans = !kAA && kOp != PixelOp::levels && kOp != PixelOp::overdraw;
+
+  // Out of line: inlined into draw, it slowed the small triangles' path beside it (×1.04–1.09).
+  HWY_NOINLINE void spans(int x0, int y0, int x1, int y1) {
+    const int bx0 = x0 >> kBlockLog2, bx1 = x1 >> kBlockLog2;
+    const int by0 = y0 >> kBlockLog2, by1 = y1 >> kBlockLog2;
+    const int columns = bx1 - bx0 + 1;  // lane j: block column bx0 + j
+    const unsigned live = (1u << columns) - 1;
+    const hn::CappedTag<T, kBlocksPerTileSide> d;
+    const size_t lanes = hn::Lanes(d);
+    const auto zero = hn::Zero(d);
+    // Per edge, each lane's offset from the row's first block, sX·4·j, within the box's blocks
+    // (whose values the descent's budget covers); lanes past them read 0, their bits dropped by
+    // `live`.
+    alignas(64) T step[kMaxEdges][kBlocksPerTileSide] = {};
+    for (int k = 0; k < E; ++k)
+      for (int j = 0; j < columns; ++j) step[k][j] = sX_[k] * T(j * kBlockSize);
+    for (int by = by0; by <= by1; ++by) {
+      const int ly = by << kBlockLog2;
+      ctx_.stats->windows[statLevel(kBlockLog2)] += uint64_t(columns);
+      T rowTl[kMaxEdges];
+      unsigned out = 0, crossed[kMaxEdges] = {};
+      for (int k = 0; k < E; ++k) {
+        const auto& e = t_.edges[k];
+        rowTl[k] = T(e.c + e.stepX() * (ctx_.originX + (bx0 << kBlockLog2)) +
+                     e.stepY() * (ctx_.originY + ly));
+        const auto base = hn::Set(d, rowTl[k]);
+        const auto dMax = hn::Set(d, maxOffset(k, T(kBlockSize - 1)));
+        const auto dMin = hn::Set(d, minOffset(k, T(kBlockSize - 1)));
+        for (size_t i = 0; i < size_t(columns); i += lanes) {
+          const auto tl = hn::Add(base, hn::LoadU(d, step[k] + i));
+          out |= laneBits(d, hn::Lt(hn::Add(tl, dMax), zero), i);
+          crossed[k] |= laneBits(d, hn::Lt(hn::Add(tl, dMin), zero), i);
+        }
+      }
+      unsigned anyCrossed = 0;
+      for (int k = 0; k < E; ++k) anyCrossed |= crossed[k];
+      const unsigned in = live & ~out;
+      // The row's full blocks first, in a tight loop (as plainFill's), then its crossed ones.
+      const unsigned full = in & ~anyCrossed;
+      if (full) {
+        ctx_.stats->fullWindows += uint64_t(std::popcount(full));
+        drawLevel_ = kBlockLog2;
+        for (unsigned b = full; b; b &= b - 1)
+          shade((bx0 + std::countr_zero(b)) << kBlockLog2, ly, 0xFFFF);
+      }
+      for (unsigned b = in & anyCrossed; b; b &= b - 1) {
+        const int j = std::countr_zero(b);
+        unsigned active = 0;
+        T tl[kMaxEdges];
+        for (int k = 0; k < E; ++k) {
+          active |= ((crossed[k] >> j) & 1u) << k;
+          tl[k] = rowTl[k] + step[k][j];
+        }
+        leaf((bx0 + j) << kBlockLog2, ly, tl, active);
+      }
     }
   }
 
@@ -253,8 +324,9 @@ class TriangleRaster {
   }
 
   // A 4×4 leaf crossed by the `active` edges: the last two levels of the subdivision unrolled —
-  // all 16 pixel centres tested at once in SIMD lanes.
-  void leaf(int lx, int ly, const T* tl, unsigned active) {
+  // all 16 pixel centres tested at once in SIMD lanes. Always inlined: called from spans too, the
+  // compiler took it out of draw's scan of small triangles (layers ×1.15, tris 100k × 10 ×1.08).
+  HWY_INLINE void leaf(int lx, int ly, const T* tl, unsigned active) {
     if constexpr (kAA) return leafSamples(lx, ly, tl, active);
     const hn::CappedTag<T, kBlockPixels> d;
     const size_t lanes = hn::Lanes(d);
