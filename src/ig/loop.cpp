@@ -225,7 +225,13 @@ Result<std::unique_ptr<IgLoop>> IgLoop::create(const IgConfig& config,
     if (Status s = m.recorder.open(options.record); !s) return s.error();
     m.recording = true;
   }
-  Result<std::unique_ptr<present::Presenter>> p = present::makePresenter(options.output, int(std::lround(config.rate)));
+  // A rank that shows nothing — only parts of split channels that another rank assembles — opens
+  // no output (a y4m stream of no channels has no frame to write).
+  const bool showsNothing =
+      m.ranks > 1 && std::none_of(m.mine.begin(), m.mine.end(),
+                                  [](const ChannelShare& c) { return c.tiles.part == 0; });
+  Result<std::unique_ptr<present::Presenter>> p =
+      present::makePresenter(showsNothing ? "null" : options.output, int(std::lround(config.rate)));
   if (!p) return p.error();
   m.presenter = std::move(p.value());
   if (!options.testPattern.empty()) {

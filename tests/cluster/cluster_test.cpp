@@ -265,6 +265,25 @@ TEST(Cluster, RankZeroIsTheIgAHostDrivesAndWiresharkReadsItsSession) {
   EXPECT_NE(tshark("-Y cigi.hat_hot_response -T fields -e cigi.hat_hot_response.hat_hot_id"), "");
 }
 
+TEST(Cluster, ARankThatShowsNothingOpensNoOutput) {
+  // One channel split over both ranks: rank 1 draws half of it and shows nothing, so only rank 0
+  // writes the y4m stream (a stream of no channels has no frame to write).
+  const std::string cfg = config("nothing.json", R"(, "cluster": {"split": [{"channel": 0, "ranks": [0, 1]}]})",
+                                 "mixed.json", R"("count": 1, "arc": 60, "width": 96, "height": 64)");
+  const fs::path y4m = tempDir() / "nothing.y4m";
+  const ShellRun r = shell(mpirun(2) + SV_CLI + " ig " + cfg +
+                           " --frames 3 --as-fast-as-possible --no-governor --output y4m:" +
+                           y4m.string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  const std::string stream = slurp(y4m);
+  size_t frames = 0;
+  for (size_t at = stream.find("FRAME\n"); at != std::string::npos;
+       at = stream.find("FRAME\n", at + 1))
+    ++frames;
+  EXPECT_EQ(frames, 3u);
+  EXPECT_EQ(stream.rfind("YUV4MPEG2 W96 H64", 0), 0u) << stream.substr(0, 40);
+}
+
 TEST(Cluster, ABadAssignmentIsRefusedAtStart) {
   const std::string cfg = config("bad.json", R"(, "cluster": {"ranks": [[0, 1], [1, 2], []]})");
   const ShellRun r = shell(mpirun(3) + SV_CLI + " ig " + cfg + " --frames 2 --as-fast-as-possible");
