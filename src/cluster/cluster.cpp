@@ -31,8 +31,8 @@ SteadyClock::time_point after(double seconds) {
 Status waitAll(std::vector<MPI_Request>& requests, SteadyClock::time_point deadline,
                double seconds, const std::function<std::string(size_t)>& who) {
   // Each test drives MPI's progress, so the first 0.3 ms — a message on its way — are polled back
-  // to back; a longer wait (a peer still drawing) sleeps 50 µs between tests: spinning longer
-  // took the core's sibling thread from a rank still drawing (a 1080p split frame 11.5 → 13.5 ms).
+  // to back; a longer wait (a peer still drawing) sleeps 50 µs between tests, so that a waiting
+  // rank does not take a core from one still drawing when there are more ranks than cores.
   const auto spinUntil = SteadyClock::now() + std::chrono::microseconds(kSpinMicroseconds);
   for (;;) {
     int done = 0;
