@@ -216,6 +216,7 @@ TEST(Cluster, RankZeroIsTheIgAHostDrivesAndWiresharkReadsItsSession) {
   // with no malformed packet, one Start of Frame per frame counting 0, 1, 2, …, the host's
   // entity in it — and the host heard one IG, not three.
   const int igPort = 20000 + int(::getpid() % 20000);
+  constexpr int kFrames = 150;  // 5 s at 30 Hz: the host's 40 frames fit after the job's start
   const std::string cfg = config(
       "cigi.json",
       fmt::format(R"(, "render": {{"threads": 1}}, "cluster": {{"split": [{{"channel": 1, "ranks": [1, 2]}}]}})"),
@@ -235,10 +236,14 @@ TEST(Cluster, RankZeroIsTheIgAHostDrivesAndWiresharkReadsItsSession) {
     "events": [{{"t": 0.3, "hat": {{"id": 5, "north": -850, "up": 100}}}}]}})",
                                        igPort);
   const fs::path capture = tempDir() / "cluster-session.pcap";
-  const ShellRun r = shell("sh -c '" + mpirun(3) + SV_CLI + " ig " + cfg +
-                           " --frames 100 --no-governor --output null --record " +
-                           capture.string() + " & sleep 0.5; " + SV_CLI + " host " +
-                           script.string() + "; wait'");
+  const fs::path status = tempDir() / "cigi-status";
+  // The host starts once rank 0 has drawn its first frame (its status line): the job's start-up
+  // takes seconds on a loaded machine, longer than the host waits for a first Start of Frame.
+  const ShellRun r = shell(
+      "sh -c '" + mpirun(3) + SV_CLI + " ig " + cfg + " --frames " + std::to_string(kFrames) +
+      " --no-governor --output null --record " + capture.string() + " --status " +
+      status.string() + " & for i in $(seq 1 400); do [ -s " + status.string() +
+      ".rank0 ] && break; sleep 0.05; done; " + SV_CLI + " host " + script.string() + "; wait'");
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_NE(r.out.find("host: 40 frames sent"), std::string::npos) << r.out;
   // One Start of Frame a frame: the host sends a frame for each it hears, so it heard about 40 —
@@ -259,7 +264,7 @@ TEST(Cluster, RankZeroIsTheIgAHostDrivesAndWiresharkReadsItsSession) {
   };
   EXPECT_EQ(tshark("-Y '_ws.malformed || _ws.expert.severity >= error'"), "");
   std::string counting;
-  for (int f = 0; f < 100; ++f) counting += std::to_string(f) + "\n";
+  for (int f = 0; f < kFrames; ++f) counting += std::to_string(f) + "\n";
   EXPECT_EQ(tshark("-Y cigi.sof -T fields -e cigi.sof.ig_frame_number"), counting);
   EXPECT_NE(tshark("-Y 'cigi.entity_control.entity_id == 0' -T fields -e frame.number"), "");
   EXPECT_NE(tshark("-Y cigi.hat_hot_response -T fields -e cigi.hat_hot_response.hat_hot_id"), "");
