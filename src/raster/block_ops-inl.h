@@ -26,44 +26,61 @@ HWY_INLINE void countBlock(uint32_t mask, uint16_t* color) {
   for (; mask; mask &= mask - 1) ++color[std::countr_zero(mask)];
 }
 
-// Depth test ("less") and Gouraud colour for the pixels of one 4×4 block set in `mask`.
-// (gx, gy) is the block's top-left pixel; `depth` and `color` point at the block's storage.
+// The pass mask of float lanes i… as a mask of as many 16-bit lanes, for masked colour stores: a
+// third of the instructions of widening, blending and narrowing each channel.
+template <class DU, class DF, class M>
+HWY_INLINE auto passMask16(DU du, DF df, M pass) {
+  uint8_t bits[8] = {};
+  hn::StoreMaskBits(df, pass, bits);
+  return hn::LoadMaskBits(du, bits);
+}
+
+// Depth test ("less") and Gouraud colour for the pixels of one 4×4 block set in `mask` (kFull:
+// all 16, untested). base[p · stride] holds plane p's value at the block's top-left pixel
+// (blockBases, or runBases for a run of blocks); `depth` and `color` point at the block's storage.
 // Returns how many of the pixels failed the depth test (hidden fragments, as every depth-testing
 // block operation here: hybrid masking wakes on them, drawLists).
-HWY_INLINE int shadeBlock(const TriangleSetup& t, const PlaneLanes& lanes, uint32_t mask, int gx,
-                          int gy, float* depth, uint16_t* color) {
+template <bool kFull = false>
+HWY_INLINE int gouraudBlock(const PlaneLanes& lanes, const float* base, size_t stride,
+                            uint32_t mask, float* depth, uint16_t* color) {
   const hn::CappedTag<float, kBlockPixels> df;
   const hn::RebindToSigned<decltype(df)> di;
   const hn::Rebind<uint16_t, decltype(df)> du;
   const size_t n = hn::Lanes(df);
-  alignas(32) float base[8];
-  blockBases(t, lanes, gx, gy, base);
   const auto maskVec = hn::Set(di, static_cast<int32_t>(mask));
   const auto one = hn::Set(df, 1.0f);
-  int hidden = 0;
+  uint32_t passed = 0;
   for (size_t i = 0; i < size_t(kBlockPixels); i += n) {
-    const auto covered = hn::TestBit(maskVec, hn::LoadU(di, kLaneBit + i));
-    if (hn::AllFalse(di, covered)) continue;
     // SPEC §4: Z-buffer — depth is a §2 parameter, linear in screen space.
-    const auto z = hn::Add(hn::Set(df, base[kDepth]), hn::LoadU(df, lanes.offset[kDepth] + i));
+    const auto z =
+        hn::Add(hn::Set(df, base[kDepth * stride]), hn::LoadU(df, lanes.offset[kDepth] + i));
     const auto zOld = hn::LoadU(df, depth + i);
-    const auto pass = hn::And(hn::RebindMask(df, covered), hn::Lt(z, zOld));
-    hidden += int(hn::CountTrue(di, covered) - hn::CountTrue(df, pass));
+    auto pass = hn::Lt(z, zOld);
+    if constexpr (!kFull)
+      pass = hn::And(hn::RebindMask(df, hn::TestBit(maskVec, hn::LoadU(di, kLaneBit + i))), pass);
     if (hn::AllFalse(df, pass)) continue;
-    hn::StoreU(hn::IfThenElse(pass, z, zOld), df, depth + i);
+    passed |= laneBits(df, pass, i);
+    hn::BlendedStore(z, pass, df, depth + i);
     // SPEC §2: perspective-correct colour = (colour/w) / (1/w).
-    const auto w =
-        hn::Div(one, hn::Add(hn::Set(df, base[kInvW]), hn::LoadU(df, lanes.offset[kInvW] + i)));
-    const auto passI = hn::RebindMask(di, pass);
+    const auto w = hn::Div(
+        one, hn::Add(hn::Set(df, base[kInvW * stride]), hn::LoadU(df, lanes.offset[kInvW] + i)));
+    const auto pass16 = passMask16(du, df, pass);
     for (int ch = 0; ch < kColorChannels; ++ch) {
-      uint16_t* dst = color + ch * kBlockPixels + i;
-      const auto old = hn::PromoteTo(di, hn::LoadU(du, dst));
-      hn::StoreU(
-          hn::DemoteTo(du, hn::IfThenElse(passI, colorLanes(df, lanes, base, ch, i, w), old)), du,
-          dst);
+      const auto cw = hn::Add(hn::Set(df, base[(kRed + ch) * stride]),
+                              hn::LoadU(df, lanes.offset[kRed + ch] + i));
+      hn::BlendedStore(hn::DemoteTo(du, colorToLanes(df, cw, w)), pass16, du,
+                       color + ch * kBlockPixels + i);
     }
   }
-  return hidden;
+  return std::popcount(mask) - std::popcount(passed);
+}
+
+// The same for the pixels of the block at (gx, gy) set in `mask`.
+HWY_INLINE int shadeBlock(const TriangleSetup& t, const PlaneLanes& lanes, uint32_t mask, int gx,
+                          int gy, float* depth, uint16_t* color) {
+  alignas(32) float base[8];
+  blockBases(t, lanes, gx, gy, base);
+  return gouraudBlock(lanes, base, 1, mask, depth, color);
 }
 
 // The centroid of each lane's covered samples relative to its pixel centre, in pixels (zero for a
@@ -188,28 +205,35 @@ HWY_INLINE int shadeBlockSamples(const TriangleSetup& t, const PlaneLanes& lanes
 // Visibility (PixelOp::visibility): the depth test alone, recording triangle `id` in the pixels it
 // wins — the SPEC §1 split of visibility from shading that the image generators of the seeds made
 // in hardware: each pixel is shaded once, by its final winner, however many triangles covered it.
-// Returns the pixels hidden by the depth test.
-HWY_INLINE int visibleBlock(const TriangleSetup& t, const PlaneLanes& lanes, uint32_t mask, int gx,
-                            int gy, uint32_t id, float* depth, uint32_t* visible) {
+// `zBase`: the depth plane at the block's top-left pixel (blockBases, runBases); kFull: all 16
+// pixels, untested. Returns the pixels hidden by the depth test.
+template <bool kFull = false>
+HWY_INLINE int visibleBlockAt(const PlaneLanes& lanes, float zBase, uint32_t mask, uint32_t id,
+                              float* depth, uint32_t* visible) {
   const hn::CappedTag<float, kBlockPixels> df;
   const hn::RebindToSigned<decltype(df)> di;
   const hn::RebindToUnsigned<decltype(df)> du;
   const size_t n = hn::Lanes(df);
-  alignas(32) float base[8];
-  blockBases(t, lanes, gx, gy, base);
   const auto maskVec = hn::Set(di, static_cast<int32_t>(mask));
   const auto idVec = hn::Set(du, id);
-  int hidden = 0;
+  uint32_t passed = 0;
   for (size_t i = 0; i < size_t(kBlockPixels); i += n) {
-    const auto covered = hn::RebindMask(df, hn::TestBit(maskVec, hn::LoadU(di, kLaneBit + i)));
-    if (hn::AllFalse(df, covered)) continue;
-    const auto z = hn::Add(hn::Set(df, base[kDepth]), hn::LoadU(df, lanes.offset[kDepth] + i));
-    const auto pass = hn::And(covered, hn::Lt(z, hn::LoadU(df, depth + i)));
-    hidden += int(hn::CountTrue(df, covered) - hn::CountTrue(df, pass));
+    const auto z = hn::Add(hn::Set(df, zBase), hn::LoadU(df, lanes.offset[kDepth] + i));
+    auto pass = hn::Lt(z, hn::LoadU(df, depth + i));
+    if constexpr (!kFull)
+      pass = hn::And(hn::RebindMask(df, hn::TestBit(maskVec, hn::LoadU(di, kLaneBit + i))), pass);
+    passed |= laneBits(df, pass, i);
     hn::BlendedStore(z, pass, df, depth + i);
     hn::BlendedStore(idVec, hn::RebindMask(du, pass), du, visible + i);
   }
-  return hidden;
+  return std::popcount(mask) - std::popcount(passed);
+}
+
+HWY_INLINE int visibleBlock(const TriangleSetup& t, const PlaneLanes& lanes, uint32_t mask, int gx,
+                            int gy, uint32_t id, float* depth, uint32_t* visible) {
+  alignas(32) float base[8];
+  blockBases(t, lanes, gx, gy, base);
+  return visibleBlockAt(lanes, base[kDepth], mask, id, depth, visible);
 }
 
 // The levels view (PixelOp::levels): the depth test, and in the pixels that pass, `level` in the

@@ -120,8 +120,11 @@ class TriangleRaster {
                           ? kBlockLog2
                           : std::max(kBlockLog2, int(std::bit_width(unsigned(extent - 1))) - 1);
     const int n = 1 << log2n;
+    // Past kSpanExtent pixels, block rows (spans) where they apply: 16 px measured best against 8
+    // (30k × 30 px ×0.97) and 4 (100k × 10 px ×1.14); 32 px had left 10k × 100 px ×0.95 behind.
+    constexpr int kSpanExtent = 16;
     if constexpr (kSpans) {
-      if (!occ_ && log2n > kBlockLog2) return spans(x0, y0, x1, y1);
+      if (!occ_ && extent > kSpanExtent) return spans(x0, y0, x1, y1);
     }
     for (int cy = y0 >> log2n; cy <= y1 >> log2n; ++cy)
       for (int cx = x0 >> log2n; cx <= x1 >> log2n; ++cx)
@@ -179,7 +182,7 @@ class TriangleRaster {
     }
   }
 
-  // Triangles past the scan's extent walked as rows of 4×4 blocks (issue 37), where nothing needs
+  // Triangles past kSpanExtent walked as rows of 4×4 blocks (issue 37), where nothing needs
   // the windows above a block — no masking (occupancy is kept per window), no anti-aliasing, no
   // debug view that shows them: every block of a row of the box is classified against each edge
   // at once, one SIMD lane a block — wholly outside an edge (dropped), inside every edge (filled),
@@ -187,7 +190,8 @@ class TriangleRaster {
   // last window level, so the pixels are the same, and a triangle writes a pixel once whatever
   // order its blocks come in: the image is the descent's, bit for bit (tests/golden). What the
   // descent spent on its branches above the blocks is saved: tris 10k × 1000 px ×0.80, textured
-  // ×0.89 (docs/performance.md, "Fill against the roofline").
+  // ×0.89 (docs/performance.md, "Fill against the roofline"). A row's planes are evaluated once
+  // for all its blocks (runBases) and its full blocks drawn in runs without a coverage test.
   static constexpr bool kSpans = !kAA && kOp != PixelOp::levels && kOp != PixelOp::overdraw;
 
   // Out of line: inlined into draw, it slowed the small triangles' path beside it (×1.04–1.09).
@@ -226,13 +230,29 @@ class TriangleRaster {
       unsigned anyCrossed = 0;
       for (int k = 0; k < E; ++k) anyCrossed |= crossed[k];
       const unsigned in = live & ~out;
-      // The row's full blocks first, in a tight loop (as plainFill's), then its crossed ones.
+      if (!in) continue;
+      // The planes' bases of the row's blocks from its first drawn one, in one vector expression
+      // each (runBases) rather than one per block.
+      const int first = std::countr_zero(in), count = std::bit_width(in) - first;
+      alignas(64) float base[kPlaneCount][kBlocksPerTileSide];
+      if constexpr (kRowBases)
+        runBases(t_, planeLanes_, ctx_.originX + ((bx0 + first) << kBlockLog2), ctx_.originY + ly,
+                 count, kOp == PixelOp::visibility ? 1 : kPlaneCount, base);
+      // The row's full blocks first, in runs (as plainFill's), then its crossed ones.
       const unsigned full = in & ~anyCrossed;
       if (full) {
         ctx_.stats->fullWindows += uint64_t(std::popcount(full));
         drawLevel_ = kBlockLog2;
-        for (unsigned b = full; b; b &= b - 1)
-          shade((bx0 + std::countr_zero(b)) << kBlockLog2, ly, 0xFFFF);
+        if constexpr (kRowBases) {
+          for (unsigned b = full; b;) {
+            const int j = std::countr_zero(b), run = std::countr_one(b >> j);
+            b &= ~(((1u << run) - 1) << j);
+            fullRun((bx0 + j) << kBlockLog2, ly, run, &base[0][j - first]);
+          }
+        } else {
+          for (unsigned b = full; b; b &= b - 1)
+            shade((bx0 + std::countr_zero(b)) << kBlockLog2, ly, 0xFFFF);
+        }
       }
       for (unsigned b = in & anyCrossed; b; b &= b - 1) {
         const int j = std::countr_zero(b);
@@ -242,9 +262,34 @@ class TriangleRaster {
           active |= ((crossed[k] >> j) & 1u) << k;
           tl[k] = rowTl[k] + step[k][j];
         }
-        leaf((bx0 + j) << kBlockLog2, ly, tl, active);
+        leaf((bx0 + j) << kBlockLog2, ly, tl, active, kRowBases ? &base[0][j - first] : nullptr);
       }
     }
+  }
+
+  // Whether spans hands the blocks their planes' bases from one evaluation per row (runBases):
+  // the operations whose block functions take them.
+  static constexpr bool kRowBases = kOp == PixelOp::gouraud || kOp == PixelOp::visibility;
+
+  // A run of `count` full blocks in a row from (lx, ly), base[p · kBlocksPerTileSide + j] holding
+  // plane p at block j's top-left pixel (runBases): each block's depth test and colour or
+  // visibility with no coverage test. The same operations per pixel as shade's, so the same image.
+  void fullRun(int lx, int ly, int count, const float* base) {
+    const size_t first = tileBlock(lx, ly);
+    int hidden = 0;
+    for (int j = 0; j < count; ++j) {
+      const size_t block = first + size_t(j);
+      if constexpr (kOp == PixelOp::visibility)
+        hidden += visibleBlockAt<true>(planeLanes_, base[j], 0xFFFF, id_,
+                                       ctx_.depth + block * kBlockPixels,
+                                       ctx_.visible + block * kBlockPixels);
+      else
+        hidden += gouraudBlock<true>(planeLanes_, base + j, kBlocksPerTileSide, 0xFFFF,
+                                     ctx_.depth + block * kBlockPixels,
+                                     ctx_.color + block * kColorPerBlock);
+    }
+    ctx_.stats->fragments += uint64_t(count) * kBlockPixels;
+    ctx_.stats->hiddenFragments += uint64_t(hidden);
   }
 
   // Classifies a root window by the coverage function of each edge, then fills, tests or splits.
@@ -326,7 +371,8 @@ class TriangleRaster {
   // A 4×4 leaf crossed by the `active` edges: the last two levels of the subdivision unrolled —
   // all 16 pixel centres tested at once in SIMD lanes. Always inlined: called from spans too, the
   // compiler took it out of draw's scan of small triangles (layers ×1.15, tris 100k × 10 ×1.08).
-  HWY_INLINE void leaf(int lx, int ly, const T* tl, unsigned active) {
+  // `base`: the planes' bases at the block, base[p · kBlocksPerTileSide] (spans), or nullptr.
+  HWY_INLINE void leaf(int lx, int ly, const T* tl, unsigned active, const float* base = nullptr) {
     if constexpr (kAA) return leafSamples(lx, ly, tl, active);
     const hn::CappedTag<T, kBlockPixels> d;
     const size_t lanes = hn::Lanes(d);
@@ -346,7 +392,7 @@ class TriangleRaster {
     if (occ_ && !ctx_.hybrid) mask &= ~occ_->pixels(lx, ly);
     if (!mask) return;
     drawLevel_ = 1;
-    shade(lx, ly, mask);
+    shade(lx, ly, mask, base);
     if (mark_) occ_->addPixels(lx, ly, mask, blockDepth(lx, ly));
   }
 
@@ -623,7 +669,8 @@ class TriangleRaster {
       }
   }
 
-  void shade(int lx, int ly, uint32_t mask) {
+  // `base`: as leaf's.
+  void shade(int lx, int ly, uint32_t mask, const float* base = nullptr) {
     ctx_.stats->fragments += std::popcount(mask);
     const size_t block = tileBlock(lx, ly);
     if constexpr (kOp == PixelOp::overdraw) {
@@ -634,8 +681,11 @@ class TriangleRaster {
                      ctx_.depth + block * kBlockPixels, ctx_.color + block * kColorPerBlock);
     } else if constexpr (kOp == PixelOp::visibility) {
       ctx_.stats->hiddenFragments +=
-          visibleBlock(t_, planeLanes_, mask, ctx_.originX + lx, ctx_.originY + ly, id_,
-                       ctx_.depth + block * kBlockPixels, ctx_.visible + block * kBlockPixels);
+          base ? visibleBlockAt(planeLanes_, base[kDepth], mask, id_,
+                                ctx_.depth + block * kBlockPixels,
+                                ctx_.visible + block * kBlockPixels)
+               : visibleBlock(t_, planeLanes_, mask, ctx_.originX + lx, ctx_.originY + ly, id_,
+                              ctx_.depth + block * kBlockPixels, ctx_.visible + block * kBlockPixels);
     } else if constexpr (kOp == PixelOp::material) {
       ctx_.stats->hiddenFragments +=
           shadeBlockMaterial(t_, planeLanes_, attributeLanes_, *attributes_, *ctx_.environment,
@@ -644,8 +694,10 @@ class TriangleRaster {
                              ctx_.visible ? ctx_.visible + block * kBlockPixels : nullptr);
     } else {
       ctx_.stats->hiddenFragments +=
-          shadeBlock(t_, planeLanes_, mask, ctx_.originX + lx, ctx_.originY + ly,
-                     ctx_.depth + block * kBlockPixels, ctx_.color + block * kColorPerBlock);
+          base ? gouraudBlock(planeLanes_, base, kBlocksPerTileSide, mask,
+                              ctx_.depth + block * kBlockPixels, ctx_.color + block * kColorPerBlock)
+               : shadeBlock(t_, planeLanes_, mask, ctx_.originX + lx, ctx_.originY + ly,
+                            ctx_.depth + block * kBlockPixels, ctx_.color + block * kColorPerBlock);
     }
   }
 

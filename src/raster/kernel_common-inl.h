@@ -167,6 +167,27 @@ HWY_INLINE void blockBases(const TriangleSetup& t, const PlaneLanes& lanes, int 
               d8, base + p);
 }
 
+// The same for a run of `count` blocks in a row from the block at (gx, gy): plane p at block j's
+// top-left pixel in base[p][j], for the first `planes` planes. Lane by lane these are blockBases'
+// float operations, so the values are the same bit for bit; a run of full blocks takes one vector
+// expression per plane instead of one per block.
+HWY_INLINE void runBases(const TriangleSetup& t, const PlaneLanes& lanes, int gx, int gy,
+                         int count, int planes, float (*base)[kBlocksPerTileSide]) {
+  const hn::CappedTag<float, kBlocksPerTileSide> df;
+  const hn::RebindToSigned<decltype(df)> di;
+  const auto by = hn::Set(df, float(gy - t.minY));
+  for (size_t i = 0; i < size_t(count); i += hn::Lanes(df)) {
+    // Block j's x, relative to the planes' origin: gx − minX + 4·j, exact in float.
+    const auto bx = hn::ConvertTo(df, hn::Add(hn::Set(di, gx - t.minX),
+                                              hn::ShiftLeft<kBlockLog2>(
+                                                  hn::LoadU(di, kLaneIndex + i))));
+    for (int p = 0; p < planes; ++p)
+      hn::Store(hn::Add(hn::Add(hn::Set(df, lanes.c0[p]), hn::Mul(hn::Set(df, lanes.dx[p]), bx)),
+                        hn::Mul(hn::Set(df, lanes.dy[p]), by)),
+                df, base[p] + i);
+  }
+}
+
 // 0…1 → 16-bit linear light in int32 lanes. Float → 16-bit by the magic-number trick: for
 // 0 ≤ v < 2^23, the float v + 2^23 holds round-to-nearest-even(v) in its low mantissa bits (no
 // range fix-ups, unlike ConvertTo).
