@@ -227,11 +227,25 @@ Result<std::unique_ptr<IgLoop>> IgLoop::create(const IgConfig& config,
   }
   // A rank that shows nothing — only parts of split channels that another rank assembles — opens
   // no output (a y4m stream of no channels has no frame to write).
-  const bool showsNothing =
-      m.ranks > 1 && std::none_of(m.mine.begin(), m.mine.end(),
-                                  [](const ChannelShare& c) { return c.tiles.part == 0; });
+  const auto shows = [](const std::vector<ChannelShare>& shares) {
+    return std::any_of(shares.begin(), shares.end(),
+                       [](const ChannelShare& c) { return c.tiles.part == 0; });
+  };
+  const bool showsNothing = m.ranks > 1 && !shows(m.mine);
+  // Where several ranks show channels, each writes its own y4m stream: PATH.rankR (ranks on one
+  // machine would otherwise write one file over each other), and a pipe would interleave them.
+  std::string output = options.output;
+  const auto showing = std::count_if(byRank.value().begin(), byRank.value().end(), shows);
+  if (showing > 1 && output.rfind("y4m:", 0) == 0) {
+    if (output == "y4m:-")
+      return Error{"", "",
+                   fmt::format("output 'y4m:-': {} ranks show channels and their streams would "
+                               "interleave on one pipe (use y4m:PATH: each rank writes PATH.rankR)",
+                               showing)};
+    output = fmt::format("{}.rank{}", output, m.rank);
+  }
   Result<std::unique_ptr<present::Presenter>> p =
-      present::makePresenter(showsNothing ? "null" : options.output, int(std::lround(config.rate)));
+      present::makePresenter(showsNothing ? "null" : output, int(std::lround(config.rate)));
   if (!p) return p.error();
   m.presenter = std::move(p.value());
   if (!options.testPattern.empty()) {

@@ -289,6 +289,28 @@ TEST(Cluster, ARankThatShowsNothingOpensNoOutput) {
   EXPECT_EQ(stream.rfind("YUV4MPEG2 W96 H64", 0), 0u) << stream.substr(0, 40);
 }
 
+TEST(Cluster, RanksShowingChannelsWriteAY4mStreamEachAndRefuseOnePipe) {
+  // Two ranks, a channel each: on one machine a shared path would be written by both at once, so
+  // each rank writes PATH.rankR, a whole stream of its own channel.
+  const std::string cfg = config("two.json", "", "mixed.json",
+                                 R"("count": 2, "arc": 90, "width": 96, "height": 64)");
+  const fs::path y4m = tempDir() / "two.y4m";
+  const std::string args = " ig " + cfg + " --frames 3 --as-fast-as-possible --no-governor";
+  const ShellRun r = shell(mpirun(2) + SV_CLI + args + " --output y4m:" + y4m.string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_FALSE(fs::exists(y4m));
+  for (int rank = 0; rank < 2; ++rank) {
+    const std::string stream = slurp(y4m.string() + ".rank" + std::to_string(rank));
+    EXPECT_EQ(stream.rfind("YUV4MPEG2 W96 H64", 0), 0u) << rank << ": " << stream.substr(0, 40);
+    EXPECT_EQ(stream.size(), stream.find('\n') + 1 + 3 * (6 + 3 * 96 * 64)) << rank;
+  }
+  const ShellRun pipe = shell(mpirun(2) + SV_CLI + args + " --output y4m:-");
+  EXPECT_NE(pipe.status, 0);
+  EXPECT_NE(pipe.out.find("2 ranks show channels and their streams would interleave"),
+            std::string::npos)
+      << pipe.out;
+}
+
 TEST(Cluster, ABadAssignmentIsRefusedAtStart) {
   const std::string cfg = config("bad.json", R"(, "cluster": {"ranks": [[0, 1], [1, 2], []]})");
   const ShellRun r = shell(mpirun(3) + SV_CLI + " ig " + cfg + " --frames 2 --as-fast-as-possible");
