@@ -392,7 +392,12 @@ class TriangleRaster {
     if (occ_ && !ctx_.hybrid) mask &= ~occ_->pixels(lx, ly);
     if (!mask) return;
     drawLevel_ = 1;
-    shade(lx, ly, mask, base);
+    if constexpr (kRowBases) {
+      if (base) shadeFromRow(lx, ly, mask, base);
+      else shade(lx, ly, mask);
+    } else {
+      shade(lx, ly, mask);
+    }
     if (mark_) occ_->addPixels(lx, ly, mask, blockDepth(lx, ly));
   }
 
@@ -669,8 +674,7 @@ class TriangleRaster {
       }
   }
 
-  // `base`: as leaf's.
-  void shade(int lx, int ly, uint32_t mask, const float* base = nullptr) {
+  void shade(int lx, int ly, uint32_t mask) {
     ctx_.stats->fragments += std::popcount(mask);
     const size_t block = tileBlock(lx, ly);
     if constexpr (kOp == PixelOp::overdraw) {
@@ -681,11 +685,8 @@ class TriangleRaster {
                      ctx_.depth + block * kBlockPixels, ctx_.color + block * kColorPerBlock);
     } else if constexpr (kOp == PixelOp::visibility) {
       ctx_.stats->hiddenFragments +=
-          base ? visibleBlockAt(planeLanes_, base[kDepth], mask, id_,
-                                ctx_.depth + block * kBlockPixels,
-                                ctx_.visible + block * kBlockPixels)
-               : visibleBlock(t_, planeLanes_, mask, ctx_.originX + lx, ctx_.originY + ly, id_,
-                              ctx_.depth + block * kBlockPixels, ctx_.visible + block * kBlockPixels);
+          visibleBlock(t_, planeLanes_, mask, ctx_.originX + lx, ctx_.originY + ly, id_,
+                       ctx_.depth + block * kBlockPixels, ctx_.visible + block * kBlockPixels);
     } else if constexpr (kOp == PixelOp::material) {
       ctx_.stats->hiddenFragments +=
           shadeBlockMaterial(t_, planeLanes_, attributeLanes_, *attributes_, *ctx_.environment,
@@ -694,11 +695,25 @@ class TriangleRaster {
                              ctx_.visible ? ctx_.visible + block * kBlockPixels : nullptr);
     } else {
       ctx_.stats->hiddenFragments +=
-          base ? gouraudBlock(planeLanes_, base, kBlocksPerTileSide, mask,
-                              ctx_.depth + block * kBlockPixels, ctx_.color + block * kColorPerBlock)
-               : shadeBlock(t_, planeLanes_, mask, ctx_.originX + lx, ctx_.originY + ly,
-                            ctx_.depth + block * kBlockPixels, ctx_.color + block * kColorPerBlock);
+          shadeBlock(t_, planeLanes_, mask, ctx_.originX + lx, ctx_.originY + ly,
+                     ctx_.depth + block * kBlockPixels, ctx_.color + block * kColorPerBlock);
     }
+  }
+
+  // shade for a crossed block of a row (spans, kRowBases), its planes' bases from the row's:
+  // base[p · kBlocksPerTileSide] (runBases). A function of its own, so that the scan's shade keeps
+  // no test for it.
+  void shadeFromRow(int lx, int ly, uint32_t mask, const float* base) {
+    ctx_.stats->fragments += std::popcount(mask);
+    const size_t block = tileBlock(lx, ly);
+    if constexpr (kOp == PixelOp::visibility)
+      ctx_.stats->hiddenFragments +=
+          visibleBlockAt(planeLanes_, base[kDepth], mask, id_, ctx_.depth + block * kBlockPixels,
+                         ctx_.visible + block * kBlockPixels);
+    else
+      ctx_.stats->hiddenFragments +=
+          gouraudBlock(planeLanes_, base, kBlocksPerTileSide, mask,
+                       ctx_.depth + block * kBlockPixels, ctx_.color + block * kColorPerBlock);
   }
 
   // `shading`: as shadeBlockSamples.
