@@ -18,6 +18,7 @@
 #include <map>
 #include <string_view>
 
+#include "scene/child_process.h"
 #include "scene/loader_common.h"
 #include "texture/texture.h"
 
@@ -25,6 +26,9 @@ namespace sv::scene::detail {
 namespace {
 
 constexpr int kTimeLimitSeconds = 120;
+// The address space the child may take beyond what it starts with: Assimp allocates what a file
+// claims, and a hostile one may claim any size.
+constexpr uint64_t kMemoryBudget = uint64_t(4) << 30;
 
 // Assimp's C entry points, looked up in the child.
 struct AssimpApi {
@@ -211,6 +215,7 @@ std::string convert(const aiScene& a, const std::string& path, const LoadOptions
 // The child: import, convert, write `out` (a .glb); on failure the reason to `report`, exit 1.
 [[noreturn]] void child(const std::string& path, const std::string& extension,
                         const LoadOptions& options, const std::string& out, int report) {
+  report = isolateChild(report, kMemoryBudget);
   auto die = [&](const std::string& why) {
     const ssize_t ignored = write(report, why.data(), std::min<size_t>(why.size(), 4000));
     (void)ignored;

@@ -8,14 +8,12 @@
 // allocates a sample.
 #include "scene/openvdb_loader.h"
 
-#include <fcntl.h>
 #include <fmt/format.h>
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 #include <poll.h>
 #include <signal.h>
 #include <sys/mman.h>
-#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -28,18 +26,9 @@
 #include <string_view>
 #include <vector>
 
+#include "scene/child_process.h"
 #include "scene/loader_common.h"
 
-#if defined(__SANITIZE_ADDRESS__)
-#define SV_OPENVDB_ASAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define SV_OPENVDB_ASAN 1
-#endif
-#endif
-#ifdef SV_OPENVDB_ASAN
-#include <sanitizer/common_interface_defs.h>
-#endif
 
 namespace sv::scene::detail {
 namespace {
@@ -93,44 +82,6 @@ void writeAll(int fd, const void* data, size_t n) {
     if (k <= 0) _exit(3);  // the parent stopped reading: it needs nothing more
     p += k, n -= size_t(k);
   }
-}
-
-// A child that behaves as a fresh process would: the parent's signal handlers (a host's crash
-// reporter, libFuzzer's and the sanitizers') must not run here and report the parent's input as
-// theirs, so a crash ends the child by its signal; no output but the pipe `out`, and no other file
-// of the parent's held open (another load's pipe would not see its end while this child lives);
-// at most `budget` more bytes of address space than it starts with. Returns the pipe's descriptor
-// (moved above 2 if the parent had closed its standard ones).
-int isolate(int out, uint64_t budget) {
-  for (int s : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT, SIGPIPE, SIGTERM, SIGINT, SIGALRM})
-    signal(s, SIG_DFL);
-#ifdef SV_OPENVDB_ASAN
-  __sanitizer_set_death_callback(nullptr);
-#endif
-  if (out <= STDERR_FILENO) out = fcntl(out, F_DUPFD, STDERR_FILENO + 1);
-  if (const int null = open("/dev/null", O_WRONLY); null >= 0) {
-    dup2(null, STDOUT_FILENO);
-    dup2(null, STDERR_FILENO);
-    close(null);
-  }
-  if (out > 3) close_range(3, unsigned(out) - 1, 0);
-  close_range(unsigned(out) + 1, ~0u, 0);
-  // The address space now (first field of /proc/self/statm, in pages) plus the budget; never
-  // above a limit already set.
-  unsigned long long pages = 0;
-  if (FILE* f = std::fopen("/proc/self/statm", "r")) {
-    if (std::fscanf(f, "%llu", &pages) != 1) pages = 0;
-    std::fclose(f);
-  }
-  rlimit limit{};
-  if (pages > 0 && getrlimit(RLIMIT_AS, &limit) == 0) {
-    const rlim_t want = rlim_t(pages * uint64_t(sysconf(_SC_PAGESIZE)) + budget);
-    if (limit.rlim_cur == RLIM_INFINITY || want < limit.rlim_cur) {
-      limit.rlim_cur = want;
-      setrlimit(RLIMIT_AS, &limit);
-    }
-  }
-  return out;
 }
 
 bool scalar(const openvdb::GridBase& g) {
@@ -230,7 +181,7 @@ void readAndSend(const std::string& bytes, int out) {
 
 [[noreturn]] void child(const std::string& bytes, size_t maxSamples, int pipeEnd) {
   const uint64_t budget = memoryBudget(bytes.size(), maxSamples);
-  const int out = isolate(pipeEnd, budget);
+  const int out = isolateChild(pipeEnd, budget);
   std::string why;
   try {
     readAndSend(bytes, out);
