@@ -82,6 +82,13 @@ struct Mat4 {
   friend bool operator==(const Mat4& a, const Mat4& b) = default;
 };
 
+// The determinant of m's upper 3×3 (an affine transform's linear part), in double.
+double linearDeterminant(const Mat4& m);
+// The inverse of an affine m (last row 0, 0, 0, 1) in double, as rows r = 0…2 of the inverse's
+// upper 3 × 4: [inverse of the upper 3×3 (its cofactors times 1/det) | −that · m's translation].
+// False, `out` untouched, when the upper 3×3 is singular (|det| ≤ 1e-30) or not finite.
+bool affineInverse(const Mat4& m, double (&out)[3][4]);
+
 inline bool isFinite(const Mat4& m) {
   for (const auto& column : m.m)
     for (float x : column)

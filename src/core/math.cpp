@@ -92,6 +92,35 @@ Vec3 Mat4::transformDirection(Vec3 d) const {
   return {r.x, r.y, r.z};
 }
 
+double linearDeterminant(const Mat4& m) {
+  const auto& t = m.m;  // column-major: t[column][row]
+  return double(t[0][0]) * (double(t[1][1]) * t[2][2] - double(t[2][1]) * t[1][2]) -
+         double(t[1][0]) * (double(t[0][1]) * t[2][2] - double(t[2][1]) * t[0][2]) +
+         double(t[2][0]) * (double(t[0][1]) * t[1][2] - double(t[1][1]) * t[0][2]);
+}
+
+bool affineInverse(const Mat4& m, double (&out)[3][4]) {
+  double a[3][3];  // row r, column c
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) a[r][c] = m.m[c][r];
+  const double det = linearDeterminant(m);
+  if (!(std::fabs(det) > 1e-30) || !std::isfinite(det)) return false;
+  const double id = 1 / det;
+  const double inv[3][3] = {
+      {(a[1][1] * a[2][2] - a[2][1] * a[1][2]) * id, (a[0][2] * a[2][1] - a[0][1] * a[2][2]) * id,
+       (a[0][1] * a[1][2] - a[0][2] * a[1][1]) * id},
+      {(a[1][2] * a[2][0] - a[1][0] * a[2][2]) * id, (a[0][0] * a[2][2] - a[0][2] * a[2][0]) * id,
+       (a[1][0] * a[0][2] - a[0][0] * a[1][2]) * id},
+      {(a[1][0] * a[2][1] - a[2][0] * a[1][1]) * id, (a[2][0] * a[0][1] - a[0][0] * a[2][1]) * id,
+       (a[0][0] * a[1][1] - a[1][0] * a[0][1]) * id}};
+  const double t[3] = {m.m[3][0], m.m[3][1], m.m[3][2]};
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) out[r][c] = inv[r][c];
+    out[r][3] = -(inv[r][0] * t[0] + inv[r][1] * t[1] + inv[r][2] * t[2]);
+  }
+  return true;
+}
+
 Mat4 Mat4::normalMatrix() const {
   // The inverse transpose of the 3×3 part equals its cofactor matrix divided by its determinant.
   auto a = [this](int r, int c) { return m[c][r]; };

@@ -213,10 +213,7 @@ Result<std::unique_ptr<VtkVolumeRenderer>> VtkVolumeRenderer::create(
     // casts in the volume's own space (under the user matrix), so its sample distance and opacity
     // unit are own lengths; synthvis's opacity unit is a world length.
     const auto& t = v.transform.m;
-    const double det = double(t[0][0]) * (double(t[1][1]) * t[2][2] - double(t[2][1]) * t[1][2]) -
-                       double(t[1][0]) * (double(t[0][1]) * t[2][2] - double(t[2][1]) * t[0][2]) +
-                       double(t[2][0]) * (double(t[0][1]) * t[1][2] - double(t[1][1]) * t[0][2]);
-    const double scale = std::cbrt(std::fabs(det));
+    const double scale = std::cbrt(std::fabs(linearDeterminant(v.transform)));
     const double smallest = std::min({g.spacing.x, g.spacing.y, g.spacing.z});
     nlohmann::json matrix = nlohmann::json::array();
     for (int row = 0; row < 4; ++row)

@@ -231,27 +231,12 @@ struct Place {
 };
 
 // The inverse of an affine matrix (last row 0, 0, 0, 1); nothing when singular.
-std::optional<Mat4> affineInverse(const Mat4& m) {
-  auto e = [&](int r, int c) { return double(m.m[c][r]); };  // row r, column c
-  double inv[3][3] = {
-      {e(1, 1) * e(2, 2) - e(1, 2) * e(2, 1), e(0, 2) * e(2, 1) - e(0, 1) * e(2, 2),
-       e(0, 1) * e(1, 2) - e(0, 2) * e(1, 1)},
-      {e(1, 2) * e(2, 0) - e(1, 0) * e(2, 2), e(0, 0) * e(2, 2) - e(0, 2) * e(2, 0),
-       e(0, 2) * e(1, 0) - e(0, 0) * e(1, 2)},
-      {e(1, 0) * e(2, 1) - e(1, 1) * e(2, 0), e(0, 1) * e(2, 0) - e(0, 0) * e(2, 1),
-       e(0, 0) * e(1, 1) - e(0, 1) * e(1, 0)}};
-  const double det = e(0, 0) * inv[0][0] + e(0, 1) * inv[1][0] + e(0, 2) * inv[2][0];
-  if (!(std::fabs(det) > 1e-30)) return std::nullopt;
+std::optional<Mat4> inverseOf(const Mat4& m) {
+  double inv[3][4];
+  if (!affineInverse(m, inv)) return std::nullopt;
   Mat4 r;
-  for (int row = 0; row < 3; ++row) {
-    double t = 0;
-    for (int c = 0; c < 3; ++c) {
-      inv[row][c] /= det;
-      r.m[c][row] = float(inv[row][c]);
-      t += inv[row][c] * e(c, 3);
-    }
-    r.m[3][row] = float(-t);
-  }
+  for (int row = 0; row < 3; ++row)
+    for (int c = 0; c < 4; ++c) r.m[c][row] = float(inv[row][c]);
   return r;
 }
 
@@ -344,7 +329,7 @@ class Reader {
     root_.m[0] = {float(metres), 0, 0, 0};
     root_.m[1] = {0, 0, float(-metres), 0};
     root_.m[2] = {0, float(metres), 0, 0};
-    rootInverse_ = *affineInverse(root_);
+    rootInverse_ = *inverseOf(root_);
   }
 
   // Step 3: the palettes — colours, materials, textures, vertices.
@@ -802,7 +787,7 @@ class Reader {
     }
     g.fade = fade;
     // The centre, given in the LOD node's space, in the mesh's own.
-    const std::optional<Mat4> back = affineInverse(sinceLod);
+    const std::optional<Mat4> back = inverseOf(sinceLod);
     const Vec3 c = back ? back->transformPoint(lod.center) : lod.center;
     g.center = isFinite(c) ? c : lod.center;
     scene_.lodGroups.push_back(std::move(g));

@@ -112,9 +112,7 @@ Status validateVolumes(const Scene& scene) {
     for (const auto& row : v.transform.m)
       for (float x : row) finite &= std::isfinite(x);
     const Mat4& m = v.transform;
-    const double det = double(m.m[0][0]) * (double(m.m[1][1]) * m.m[2][2] - double(m.m[2][1]) * m.m[1][2]) -
-                       double(m.m[1][0]) * (double(m.m[0][1]) * m.m[2][2] - double(m.m[2][1]) * m.m[0][2]) +
-                       double(m.m[2][0]) * (double(m.m[0][1]) * m.m[1][2] - double(m.m[1][1]) * m.m[0][2]);
+    const double det = linearDeterminant(m);
     if (!finite || m.m[0][3] != 0 || m.m[1][3] != 0 || m.m[2][3] != 0 || m.m[3][3] != 1 ||
         !(std::fabs(det) > 1e-30) || !std::isfinite(det))
       return fail(i, v.name, "its transform must be finite, affine and invertible");
@@ -329,10 +327,8 @@ Status validate(const Scene& scene, const std::string& file, bool vertexData) {
     const auto& m = f.transform.m;
     if (m[0][3] != 0 || m[1][3] != 0 || m[2][3] != 0 || m[3][3] != 1)
       return fail(fmt::format("{}: transform is not affine (last row must be 0, 0, 0, 1)", label));
-    const float det = m[0][0] * (m[1][1] * m[2][2] - m[2][1] * m[1][2]) -
-                      m[1][0] * (m[0][1] * m[2][2] - m[2][1] * m[0][2]) +
-                      m[2][0] * (m[0][1] * m[1][2] - m[1][1] * m[0][2]);
-    if (!(std::fabs(det) > 1e-20f)) return fail(fmt::format("{}: transform is singular", label));
+    if (!(std::fabs(linearDeterminant(f.transform)) > 1e-20))
+      return fail(fmt::format("{}: transform is singular", label));
     if (f.form.quadricCount() > kMaxFreeFormQuadrics)
       return fail(fmt::format("{}: {} quadrics (at most {})", label, f.form.quadricCount(),
                               kMaxFreeFormQuadrics));

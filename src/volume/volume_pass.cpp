@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 
+#include "core/check.h"
 #include "raster/framebuffer.h"
 #include "volume/sample_kernel.h"
 
@@ -201,29 +202,11 @@ void VolumePass::setVolumes(const VolumeInput& input) {
         p.padded = borderedCodes<uint16_t>(*v.grid);
     }
     if (input.settings.precomputedNormals || !v.shaded) p.padded.clear(), p.padded8.clear();
-    // World → own: the inverse of the affine transform, in double.
+    // World → own: the inverse of the affine transform, in double (validateVolumes has refused a
+    // singular one).
+    const bool invertible = affineInverse(v.transform, p.toOwn);
+    SV_CHECK(invertible);
     const Mat4& m = v.transform;
-    double a[3][3], inv[3][3];
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) a[r][c] = m.m[c][r];
-    const double det = a[0][0] * (a[1][1] * a[2][2] - a[2][1] * a[1][2]) -
-                       a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
-                       a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
-    const double id = 1 / det;
-    inv[0][0] = (a[1][1] * a[2][2] - a[2][1] * a[1][2]) * id;
-    inv[0][1] = (a[0][2] * a[2][1] - a[0][1] * a[2][2]) * id;
-    inv[0][2] = (a[0][1] * a[1][2] - a[0][2] * a[1][1]) * id;
-    inv[1][0] = (a[1][2] * a[2][0] - a[1][0] * a[2][2]) * id;
-    inv[1][1] = (a[0][0] * a[2][2] - a[0][2] * a[2][0]) * id;
-    inv[1][2] = (a[1][0] * a[0][2] - a[0][0] * a[1][2]) * id;
-    inv[2][0] = (a[1][0] * a[2][1] - a[2][0] * a[1][1]) * id;
-    inv[2][1] = (a[2][0] * a[0][1] - a[0][0] * a[2][1]) * id;
-    inv[2][2] = (a[0][0] * a[1][1] - a[1][0] * a[0][1]) * id;
-    const double t[3] = {m.m[3][0], m.m[3][1], m.m[3][2]};
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) p.toOwn[r][c] = inv[r][c];
-      p.toOwn[r][3] = -(inv[r][0] * t[0] + inv[r][1] * t[1] + inv[r][2] * t[2]);
-    }
     const scene::VolumeGrid& g = *v.grid;
     const Vec3 e = g.extent();
     p.extent[0] = e.x, p.extent[1] = e.y, p.extent[2] = e.z;
