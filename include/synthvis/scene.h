@@ -406,7 +406,11 @@ void buildInstanceTree(Scene& scene);
 // cells are found). Beyond a group's last level (a finite `to`), cells of half its range without
 // a mesh. Deterministic: the same cells on every run.
 inline constexpr size_t kMergeTriangles = 32, kMergeVertices = size_t(1) << 22;
-void mergeFarLevels(const Scene& scene, InstanceTree& tree);
+// `meshBounds`: meshBounds(scene).
+void mergeFarLevels(const Scene& scene, InstanceTree& tree,
+                    const std::vector<std::array<Vec3, 2>>& meshBounds);
+// Every mesh's bounds (Mesh::bounds), in mesh order.
+std::vector<std::array<Vec3, 2>> meshBounds(const Scene& scene);
 // An instance's box in its own space around every level of detail it may draw.
 std::array<Vec3, 2> instanceBounds(const Scene& scene, const Instance& instance,
                                    const std::vector<std::array<Vec3, 2>>& meshBounds);

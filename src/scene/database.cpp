@@ -600,7 +600,8 @@ Result<Scene> parseDatabase(const char* data, size_t size, const std::string& pa
     // The merged cells are not stored: made again from the valid instances, as buildInstanceTree
     // made them for the source (the same cells, so the same image). The tree was made here.
     if (scene.instanceTree)
-      mergeFarLevels(scene, *std::const_pointer_cast<InstanceTree>(scene.instanceTree));
+      mergeFarLevels(scene, *std::const_pointer_cast<InstanceTree>(scene.instanceTree),
+                     meshBounds(scene));
     return scene;
   } catch (const DbProblem& p) {
     return Error{path, "", "database: " + p.message};

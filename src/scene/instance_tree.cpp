@@ -100,19 +100,24 @@ std::array<Vec3, 2> instanceBounds(const Scene& scene, const Instance& instance,
   return box.value_or(meshBounds[size_t(instance.mesh)]);
 }
 
+std::vector<std::array<Vec3, 2>> meshBounds(const Scene& scene) {
+  std::vector<std::array<Vec3, 2>> bounds;
+  bounds.reserve(scene.meshes.size());
+  for (const Mesh& m : scene.meshes) bounds.push_back(m.bounds());
+  return bounds;
+}
+
 void buildInstanceTree(Scene& scene) {
   auto tree = std::make_shared<InstanceTree>();
   const size_t n = scene.instances.size();
   tree->instanceCount = n;
+  const std::vector<std::array<Vec3, 2>> bounds = meshBounds(scene);
   if (n > 0) {
-    std::vector<std::array<Vec3, 2>> meshBounds;
-    meshBounds.reserve(scene.meshes.size());
-    for (const Mesh& m : scene.meshes) meshBounds.push_back(m.bounds());
     std::vector<Box> boxes(n);
     std::vector<uint64_t> triangles(n);
     for (size_t i = 0; i < n; ++i) {
       const Instance& inst = scene.instances[i];
-      const auto [lo, hi] = instanceBounds(scene, inst, meshBounds);
+      const auto [lo, hi] = instanceBounds(scene, inst, bounds);
       boxes[i] = worldBox(inst.transform, lo, hi);
       triangles[i] = scene.meshes[size_t(inst.mesh)].triangleCount();
     }
@@ -126,7 +131,7 @@ void buildInstanceTree(Scene& scene) {
       Builder{boxes, triangles, *tree}.build(0, 0, uint32_t(held));
     }
   }
-  mergeFarLevels(scene, *tree);
+  mergeFarLevels(scene, *tree, bounds);
   scene.instanceTree = std::move(tree);
 }
 

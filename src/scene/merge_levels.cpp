@@ -39,12 +39,10 @@ void extend(Vec3& lo, Vec3& hi, Vec3 p) {
 
 }  // namespace
 
-void mergeFarLevels(const Scene& scene, InstanceTree& tree) {
+void mergeFarLevels(const Scene& scene, InstanceTree& tree,
+                    const std::vector<std::array<Vec3, 2>>& meshBounds) {
   tree.cells.clear();
   tree.members.clear();
-  std::vector<std::array<Vec3, 2>> meshBounds;
-  meshBounds.reserve(scene.meshes.size());
-  for (const Mesh& m : scene.meshes) meshBounds.push_back(m.bounds());
   // Each group's range centre in its instances' space, as the traversal measures ranges to it.
   std::vector<Vec3> centres;
   for (const LodGroup& g : scene.lodGroups) {

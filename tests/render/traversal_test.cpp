@@ -213,8 +213,7 @@ TEST(Traversal, TheInstanceTreeBoundsEveryInstanceOnce) {
   const scene::InstanceTree& t = *city.instanceTree;
   ASSERT_EQ(t.instanceCount, city.instances.size());
   EXPECT_EQ(std::set<uint32_t>(t.order.begin(), t.order.end()).size(), city.instances.size());
-  std::vector<std::array<Vec3, 2>> meshBounds;
-  for (const scene::Mesh& m : city.meshes) meshBounds.push_back(m.bounds());
+  const std::vector<std::array<Vec3, 2>> meshBounds = scene::meshBounds(city);
   auto inside = [](Vec3 q, const scene::InstanceTree::Node& n) {
     const float e = 1e-3f;
     return q.x >= n.lo.x - e && q.y >= n.lo.y - e && q.z >= n.lo.z - e && q.x <= n.hi.x + e &&
