@@ -8,6 +8,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "support/test_scenes.h"
 #include "synthvis/image.h"
 #include "synthvis/render.h"
 #include "synthvis/scene.h"
@@ -20,15 +21,8 @@ constexpr int kW = 200, kH = 160;
 // A camera at the origin looking down −z, 90° vertical field: at depth 10 one unit is kH/20
 // pixels. Black background, no light needed (lines are unlit).
 scene::Scene emptyScene() {
-  scene::Scene s;
-  s.background = {0, 0, 0};
-  scene::Camera cam;
-  cam.position = {0, 0, 0};
-  cam.target = {0, 0, -1};
-  cam.yfovDegrees = 90;
-  cam.znear = 0.1f;
-  cam.zfar = 1000;
-  s.cameras = {cam};
+  scene::Scene s = tests::emptyScene(1000);
+  s.cameras[0].yfovDegrees = 90;
   return s;
 }
 
