@@ -120,8 +120,9 @@ class TriangleRaster {
                           ? kBlockLog2
                           : std::max(kBlockLog2, int(std::bit_width(unsigned(extent - 1))) - 1);
     const int n = 1 << log2n;
-    // Past kSpanExtent pixels, block rows (spans) where they apply: 16 px measured best against 8
-    // (30k × 30 px ×0.97) and 4 (100k × 10 px ×1.14); 32 px had left 10k × 100 px ×0.95 behind.
+    // Past kSpanExtent pixels, block rows (spans) where they apply. From 16 px: from 8, 30k × 30 px
+    // was ×1.03 slower; from 4, 100k × 10 px ×1.14; the scan up to 32 px had left 30k × 100 px ×0.95
+    // behind (docs/performance.md, "Fill and texture against the roofline").
     constexpr int kSpanExtent = 16;
     if constexpr (kSpans) {
       if (!occ_ && extent > kSpanExtent) return spans(x0, y0, x1, y1);

@@ -205,14 +205,6 @@ HWY_INLINE auto colorToLanes(DF df, V cw, V w) {
   return unitToLanes(df, hn::Min(hn::Max(hn::Mul(cw, w), hn::Zero(df)), hn::Set(df, 1.0f)));
 }
 
-// Channel ch at the pixel centres of lanes i… .
-template <class DF, class V>
-HWY_INLINE auto colorLanes(DF df, const PlaneLanes& lanes, const float* base, int ch, size_t i,
-                           V w) {
-  const auto cw = hn::Add(hn::Set(df, base[kRed + ch]), hn::LoadU(df, lanes.offset[kRed + ch] + i));
-  return colorToLanes(df, cw, w);
-}
-
 // A bound of the triangle's depth over the pixels [gx0, gx1] × [gy0, gy1] (frame coordinates, with
 // their squares when anti-aliased: samples lie within half a pixel of the centres): the smallest
 // (upper = false) or largest value of its depth plane there, widened by more than the rounding of
