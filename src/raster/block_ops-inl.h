@@ -60,7 +60,7 @@ HWY_INLINE int gouraudBlock(const PlaneLanes& lanes, const float* base, size_t s
       pass = hn::And(hn::RebindMask(df, hn::TestBit(maskVec, hn::LoadU(di, kLaneBit + i))), pass);
     if (hn::AllFalse(df, pass)) continue;
     passed |= laneBits(df, pass, i);
-    hn::BlendedStore(z, pass, df, depth + i);
+    storeWhere(z, pass, df, depth + i);
     // SPEC §2: perspective-correct colour = (colour/w) / (1/w).
     const auto w = hn::Div(
         one, hn::Add(hn::Set(df, base[kInvW * stride]), hn::LoadU(df, lanes.offset[kInvW] + i)));
@@ -68,7 +68,7 @@ HWY_INLINE int gouraudBlock(const PlaneLanes& lanes, const float* base, size_t s
     for (int ch = 0; ch < kColorChannels; ++ch) {
       const auto cw = hn::Add(hn::Set(df, base[(kRed + ch) * stride]),
                               hn::LoadU(df, lanes.offset[kRed + ch] + i));
-      hn::BlendedStore(hn::DemoteTo(du, colorToLanes(df, cw, w)), pass16, du,
+      storeWhere(hn::DemoteTo(du, colorToLanes(df, cw, w)), pass16, du,
                        color + ch * kBlockPixels + i);
     }
   }
@@ -186,13 +186,13 @@ HWY_INLINE int shadeBlockSamples(const TriangleSetup& t, const PlaneLanes& lanes
         count = hn::Sub(count, hn::VecFromMask(di, hn::RebindMask(di, pass)));
         continue;
       }
-      hn::BlendedStore(z, pass, df, zPlane);
+      storeWhere(z, pass, df, zPlane);
       // The pass mask in 16-bit lanes (−1 stays −1 under the saturating demotion), then masked
       // stores: a third of the instructions of widening, blending and narrowing each channel.
       const auto pass16 = hn::MaskFromVec(
           hn::BitCast(du, hn::DemoteTo(d16, hn::VecFromMask(di, hn::RebindMask(di, pass)))));
       for (int ch = 0; ch < kColorChannels; ++ch)
-        hn::BlendedStore(c16[ch], pass16, du,
+        storeWhere(c16[ch], pass16, du,
                          color + size_t(s) * kColorPerBlock + ch * kBlockPixels + i);
     }
     hidden += int(hn::CountTrue(du32, hn::Ne(hn::Or(m0, m1), hn::Zero(du32))) -
@@ -223,8 +223,8 @@ HWY_INLINE int visibleBlockAt(const PlaneLanes& lanes, float zBase, uint32_t mas
     if constexpr (!kFull)
       pass = hn::And(hn::RebindMask(df, hn::TestBit(maskVec, hn::LoadU(di, kLaneBit + i))), pass);
     passed |= laneBits(df, pass, i);
-    hn::BlendedStore(z, pass, df, depth + i);
-    hn::BlendedStore(idVec, hn::RebindMask(du, pass), du, visible + i);
+    storeWhere(z, pass, df, depth + i);
+    storeWhere(idVec, hn::RebindMask(du, pass), du, visible + i);
   }
   return std::popcount(mask) - std::popcount(passed);
 }

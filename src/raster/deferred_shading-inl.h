@@ -166,7 +166,7 @@ class DeferredShader {
           }
           for (size_t i = 0; i < size_t(kBlockPixels); i += n) {
             const auto mine = hn::Eq(hn::LoadU(du, visible + i), id);
-            hn::BlendedStore(none, mine, du, visible + i);
+            storeWhere(none, mine, du, visible + i);
             take(b, entry.id, hn::Add(laneIndex(), hn::Set(di, first + int(i))), mine);
           }
         }

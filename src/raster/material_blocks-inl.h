@@ -116,7 +116,7 @@ HWY_INLINE void storeShaded(DF df, M pass, bool blend, const float (*rgba)[kBloc
                                hn::Set(df, 1.0f / 65535.0f));
       c = hn::Min(hn::Add(hn::Mul(old, keep), c), hn::Set(df, 1.0f));
     }
-    hn::BlendedStore(hn::DemoteTo(du, unitToLanes(df, c)), pass16, du, dst);
+    storeWhere(hn::DemoteTo(du, unitToLanes(df, c)), pass16, du, dst);
   }
 }
 
@@ -157,11 +157,11 @@ HWY_INLINE int shadeBlockMaterial(const TriangleSetup& t, const PlaneLanes& lane
     // Translucent surfaces are seen through: they do not hide what is drawn after them.
     if (!blend) {
       const auto z = hn::Add(hn::Set(df, base[kDepth]), hn::LoadU(df, lanes.offset[kDepth] + i));
-      hn::BlendedStore(z, pass, df, depth + i);
+      storeWhere(z, pass, df, depth + i);
       // A pixel this triangle now owns no longer waits for a deferred one (shadeVisible).
       if (visible) {
         const hn::RebindToUnsigned<decltype(df)> du;
-        hn::BlendedStore(hn::Set(du, kNoTriangle), hn::RebindMask(du, pass), du, visible + i);
+        storeWhere(hn::Set(du, kNoTriangle), hn::RebindMask(du, pass), du, visible + i);
       }
     }
     storeShaded(df, pass, blend, rgba, i, color);
@@ -282,7 +282,7 @@ HWY_INLINE void writeSamples(const TriangleSetup& t, const PlaneLanes& lanes,
           shown, hn::RebindMask(df, hn::TestBit(s < 32 ? p0 : p1, hn::Set(du32, 1u << (s & 31)))));
       if (hn::AllFalse(df, passed)) continue;
       if (!blend)
-        hn::BlendedStore(hn::Add(zPix, hn::Set(df, sampleDepth[s])), passed, df,
+        storeWhere(hn::Add(zPix, hn::Set(df, sampleDepth[s])), passed, df,
                          depth + size_t(s) * kBlockPixels + i);
       storeShaded(df, passed, blend, rgba, i, color + size_t(s) * kColorPerBlock);
     }
