@@ -539,6 +539,7 @@ int runBench(BenchArgs a) {
     }
   }
 
+  if (settings.synthvis) fmt::print("synthvis: SIMD target {}\n", ref::simdTarget());
   std::vector<ref::CaseResult> results;
   nlohmann::json rows = nlohmann::json::array();
   for (size_t i = 0; i < cases.size(); ++i) {

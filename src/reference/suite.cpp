@@ -1,6 +1,7 @@
 #include "reference/suite.h"
 
 #include <fmt/format.h>
+#include <hwy/targets.h>
 
 #include <algorithm>
 #include <cctype>
@@ -501,6 +502,11 @@ double pixelsOf(const CaseResult& r) {
 }
 }  // namespace
 
+std::string simdTarget() {
+  const std::vector<int64_t> targets = hwy::SupportedAndGeneratedTargets();
+  return targets.empty() ? "none" : hwy::TargetName(targets.front());
+}
+
 double psnr(const Image& a, const Image& b) {
   if (a.width != b.width || a.height != b.height || a.rgb.size() != b.rgb.size() || a.rgb.empty())
     return 0;
@@ -547,6 +553,7 @@ nlohmann::json jsonRows(const CaseResult& r, const BenchSettings& s) {
          {"mtri_per_s", run.medianMs > 0 ? double(r.triangles) / run.medianMs / 1e3 : 0},
          {"mpix_per_s", run.medianMs > 0 ? pixels / run.medianMs / 1e3 : 0}});
     if (run.renderer == "synthvis") {
+      row["simd"] = simdTarget();
       uint64_t drawn = run.stats.drawn;
       if (!run.channelStats.empty()) {
         drawn = 0;

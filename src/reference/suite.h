@@ -128,6 +128,10 @@ class BenchRunner {
   std::unique_ptr<Impl> impl_;
 };
 
+// The SIMD target synthvis's kernels run on here (Highway's dispatch: the best of those built that
+// this CPU supports), e.g. "AVX2" or "AVX3_ZEN4": the same scene's figures differ by target.
+std::string simdTarget();
+
 // Peak signal-to-noise ratio of two same-sized 8-bit images, dB (+∞ when equal).
 double psnr(const Image& a, const Image& b);
 

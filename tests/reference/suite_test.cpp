@@ -3,6 +3,7 @@
 #include "reference/suite.h"
 
 #include <gtest/gtest.h>
+#include <hwy/targets.h>
 
 #include <cmath>
 #include <filesystem>
@@ -63,10 +64,21 @@ TEST(BenchRunner, JsonRowsCarryBenchMdFields) {
   const nlohmann::json rows = jsonRows(r.value(), s);
   ASSERT_EQ(rows.size(), 1u);
   for (const char* key : {"scene", "renderer", "width", "height", "threads", "frames", "median_ms",
-                          "min_ms", "max_ms", "triangles", "count", "area", "realized_mean_area"})
+                          "min_ms", "max_ms", "triangles", "count", "area", "realized_mean_area",
+                          "simd"})
     EXPECT_TRUE(rows[0].contains(key)) << key;
   EXPECT_EQ(rows[0]["renderer"], "synthvis");
+  EXPECT_EQ(rows[0]["simd"], simdTarget());
   EXPECT_EQ(rows[0]["triangles"], 300);
+}
+
+// The target named is the one the kernels dispatch to: the scalar one when only it is allowed.
+TEST(Bench, NamesTheSimdTargetTheKernelsRunOn) {
+  const int64_t before = hwy::SupportedTargets();  // test_main may have narrowed it already
+  hwy::SetSupportedTargetsForTest(HWY_BASELINE_SCALAR);
+  EXPECT_EQ(simdTarget(), hwy::TargetName(HWY_BASELINE_SCALAR));
+  hwy::SetSupportedTargetsForTest(before);
+  EXPECT_NE(simdTarget(), "none");
 }
 
 TEST(Html, WritesPageImagesAndPlots) {
