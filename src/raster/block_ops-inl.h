@@ -69,7 +69,7 @@ HWY_INLINE int gouraudBlock(const PlaneLanes& lanes, const float* base, size_t s
       const auto cw = hn::Add(hn::Set(df, base[(kRed + ch) * stride]),
                               hn::LoadU(df, lanes.offset[kRed + ch] + i));
       storeWhere(hn::DemoteTo(du, colorToLanes(df, cw, w)), pass16, du,
-                       color + ch * kBlockPixels + i);
+                 color + ch * kBlockPixels + i);
     }
   }
   return std::popcount(mask) - std::popcount(passed);
@@ -192,8 +192,7 @@ HWY_INLINE int shadeBlockSamples(const TriangleSetup& t, const PlaneLanes& lanes
       const auto pass16 = hn::MaskFromVec(
           hn::BitCast(du, hn::DemoteTo(d16, hn::VecFromMask(di, hn::RebindMask(di, pass)))));
       for (int ch = 0; ch < kColorChannels; ++ch)
-        storeWhere(c16[ch], pass16, du,
-                         color + size_t(s) * kColorPerBlock + ch * kBlockPixels + i);
+        storeWhere(c16[ch], pass16, du, color + size_t(s) * kColorPerBlock + ch * kBlockPixels + i);
     }
     hidden += int(hn::CountTrue(du32, hn::Ne(hn::Or(m0, m1), hn::Zero(du32))) -
                   hn::CountTrue(df, anyPass));

@@ -283,7 +283,7 @@ HWY_INLINE void writeSamples(const TriangleSetup& t, const PlaneLanes& lanes,
       if (hn::AllFalse(df, passed)) continue;
       if (!blend)
         storeWhere(hn::Add(zPix, hn::Set(df, sampleDepth[s])), passed, df,
-                         depth + size_t(s) * kBlockPixels + i);
+                   depth + size_t(s) * kBlockPixels + i);
       storeShaded(df, passed, blend, rgba, i, color + size_t(s) * kColorPerBlock);
     }
   }

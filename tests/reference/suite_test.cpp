@@ -63,9 +63,9 @@ TEST(BenchRunner, JsonRowsCarryBenchMdFields) {
   EXPECT_NEAR(r->meanArea, 40, 2);
   const nlohmann::json rows = jsonRows(r.value(), s);
   ASSERT_EQ(rows.size(), 1u);
-  for (const char* key : {"scene", "renderer", "width", "height", "threads", "frames", "median_ms",
-                          "min_ms", "max_ms", "triangles", "count", "area", "realized_mean_area",
-                          "simd"})
+  for (const char* key :
+       {"scene", "renderer", "width", "height", "threads", "frames", "median_ms", "min_ms",
+        "max_ms", "triangles", "count", "area", "realized_mean_area", "simd"})
     EXPECT_TRUE(rows[0].contains(key)) << key;
   EXPECT_EQ(rows[0]["renderer"], "synthvis");
   EXPECT_EQ(rows[0]["simd"], simdTarget());
