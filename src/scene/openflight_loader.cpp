@@ -552,8 +552,10 @@ class Reader {
         const int32_t current = f.i32(16);
         if (masks > 0 && (current < 0 || current >= masks))
           fail(fmt::format("switch at byte {}: current mask {} of {}", r.at, current, masks));
+        // Without masks every child is drawn: one mask of all of them, current whatever the
+        // record's (then meaningless) current-mask field says.
         if (masks == 0) s.masks.push_back(std::vector<bool>(node.children.size(), true));
-        s.current = size_t(std::max(current, 0));
+        s.current = masks == 0 ? 0 : size_t(current);
         scene_.switches.push_back(std::move(s));
         const size_t sw = scene_.switches.size() - 1;
         for (size_t c = 0; c < node.children.size(); ++c) {

@@ -399,6 +399,34 @@ TEST(OpenFlight, IndexedLightPointsUseTheirPalettes) {
   EXPECT_EQ(r->warnings[1], "indexed.flt: 1 light point record animated by Morse code drawn steady");
 }
 
+// A switch without masks draws all its children, whatever its current-mask field holds (a fuzzed
+// file with 62 there loaded as a scene that failed validation).
+TEST(OpenFlight, ASwitchWithoutMasksDrawsEveryChild) {
+  FltWriter w;
+  w.header();
+  w.vertexPalette();
+  std::vector<int32_t> tri;
+  for (double x : {0.0, 1.0, 0.5}) tri.push_back(w.vertex(FltWriter::V::at(x, x == 0.5 ? 1 : 0, 0)));
+  w.push();
+  w.switchNode("sw", 62, {});
+  w.push();
+  for (const char* name : {"a", "b"}) {
+    w.object(name);
+    w.push();
+    w.polygon({}, tri);
+    w.pop();
+  }
+  w.pop();
+  w.pop();
+  Result<Scene> r = parseOpenFlight(w.bytes, "switch.flt");
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  ASSERT_EQ(r->switches.size(), 1u);
+  EXPECT_EQ(r->switches[0].current, 0u);
+  EXPECT_TRUE(validate(r.value(), "switch.flt").ok()) << validate(r.value(), "switch.flt").error().str();
+  for (const std::vector<uint32_t>& child : r->switches[0].children)
+    for (uint32_t k : child) EXPECT_TRUE(r->instances[k].visible);
+}
+
 // Malformed files: one line naming the file and the problem.
 TEST(OpenFlight, RefusesMalformedFiles) {
   auto error = [](const std::string& bytes) {
