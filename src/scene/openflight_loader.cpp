@@ -617,7 +617,8 @@ class Reader {
     // second in the xy plane); degenerate or unset (−1e8) points give the node's own axes.
     DVec x = onX - origin, xy = inXy - origin;
     DVec z = cross(x, xy), y = cross(z, x);
-    const bool valid = x.norm() > 0 && z.norm() > 0 && origin.finite() && onX.finite() &&
+    auto usable = [](const DVec& v) { return v.norm() > 0 && std::isfinite(v.norm()); };
+    const bool valid = usable(x) && usable(z) && usable(y) && origin.finite() && onX.finite() &&
                        inXy.finite();
     if (!valid) x = {1, 0, 0}, y = {0, 1, 0}, z = {0, 0, 1};
     x = x.unit(), y = y.unit(), z = z.unit();
@@ -629,6 +630,10 @@ class Reader {
     frame.m[3] = {float(origin.v[0]), float(origin.v[1]), float(origin.v[2]), 1};
     d.frame = frame;
     d.place = at.sinceDof;
+    // Points finite in double may lie beyond float's range.
+    if (!isFinite(d.frame) || !isFinite(d.place))
+      fail(fmt::format("degree of freedom at byte {}: its frame lies beyond float's range",
+                       f.at()));
     // Ranges (min, max, current, increment) in the order z, y, x, pitch, roll, yaw, scale z, y, x.
     auto read = [&](int k, int field) { return f.f64(88 + 32 * size_t(k) + 8 * size_t(field)); };
     for (int field = 0; field < 3; ++field) {

@@ -470,6 +470,28 @@ TEST(OpenFlight, RefusesMalformedFiles) {
   deep.header();
   for (int k = 0; k < 200; ++k) deep.group("g"), deep.push();
   EXPECT_TRUE(contains(error(deep.bytes), "nesting deeper than 128 levels"));
+  // A degree of freedom placed beyond float's range (finite in the file's doubles), directly or
+  // through a matrix above it: refused rather than loaded as a scene its validation fails.
+  for (bool byMatrix : {false, true}) {
+    FltWriter far;
+    far.header();
+    far.push();
+    if (byMatrix)  // two translations by 3e38 each: finite floats, their sum is not
+      for (int k = 0; k < 2; ++k) {
+        far.group("g");
+        far.matrix(FltWriter::translation(3e38f, 0, 0));
+        far.push();
+      }
+    const double at = byMatrix ? 0 : 1e300;
+    far.dof("d", {at, 0, 0}, {at + 1, 0, 0}, {at, 1, 0}, {});
+    far.push();
+    far.object("o");
+    far.pop();
+    if (byMatrix) far.pop(), far.pop();
+    far.pop();
+    EXPECT_TRUE(contains(error(far.bytes), "its frame lies beyond float's range"))
+        << error(far.bytes);
+  }
 }
 
 // --- OpenSceneGraph as the peer (its osgconv tool, Debian's openscenegraph) -------------------
