@@ -630,7 +630,8 @@ class Reader {
     frame.m[3] = {float(origin.v[0]), float(origin.v[1]), float(origin.v[2]), 1};
     d.frame = frame;
     d.place = at.sinceDof;
-    // Points finite in double may lie beyond float's range.
+    // Points finite in double, or the product of the matrices above, may lie beyond float's
+    // range: refused rather than made an infinite transform.
     if (!isFinite(d.frame) || !isFinite(d.place))
       fail(fmt::format("degree of freedom at byte {}: its frame lies beyond float's range",
                        f.at()));
