@@ -49,7 +49,8 @@ void position(const Json& o, const std::string& where, const GeoOrigin& origin, 
 }
 
 HostScript read(const Json& root) {
-  if (!root.is_object() || root.value("synthvis-host", 0) != 1)
+  // Compared as JSON, not read as an int: a version of 1e79 or "1" is refused, not converted.
+  if (!root.is_object() || !root.contains("synthvis-host") || root["synthvis-host"] != 1)
     bad("\"synthvis-host\": 1 expected (the script format's version)");
   HostScript s;
   GeoOrigin origin;

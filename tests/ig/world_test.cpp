@@ -9,6 +9,7 @@
 
 #include "ig/config.h"
 #include "ig/geo.h"
+#include "ig/host.h"
 #include "ig/overload.h"
 #include "synthvis/render.h"
 #include "synthvis/terrain.h"
@@ -70,6 +71,31 @@ TEST(IgConfig, MalformedConfigurationsGetAClearError) {
     EXPECT_NE(c.error().str().find(message), std::string::npos) << c.error().str();
     EXPECT_EQ(c.error().file, "ig.json");
   }
+}
+
+TEST(IgHost, MalformedScriptsGetAClearError) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"[", "malformed JSON"},
+      {R"({"rate": 30})", "\"synthvis-host\": 1 expected"},
+      {R"({"synthvis-host": "1"})", "\"synthvis-host\": 1 expected"},
+      {R"({"synthvis-host": 2})", "\"synthvis-host\": 1 expected"},
+      // A version beyond int's range, which a read as int would convert (fuzz find).
+      {R"({"synthvis-host": 1e79})", "\"synthvis-host\": 1 expected"},
+      {R"({"synthvis-host": 1, "rate": 0})", "script.rate"},
+      {R"({"synthvis-host": 1, "entities": [{"id": 1}]})", "entities[0].path"},
+      {R"({"synthvis-host": 1, "entities": [{"path": [{"t": 1}, {"t": 1}]}]})",
+       "times must increase"},
+      {R"({"synthvis-host": 1, "events": [{"timeOfDay": "25:00"}]})", "\"HH:MM\" expected"},
+  };
+  for (const auto& [text, message] : cases) {
+    Result<HostScript> s = parseHostScript(text, "host.json");
+    ASSERT_FALSE(s.ok()) << text;
+    EXPECT_NE(s.error().str().find(message), std::string::npos) << s.error().str();
+    EXPECT_EQ(s.error().file, "host.json");
+  }
+  Result<HostScript> s = parseHostScript(R"({"synthvis-host": 1.0, "rate": 50})", "host.json");
+  ASSERT_TRUE(s.ok()) << s.error().str();
+  EXPECT_EQ(s->rate, 50.0);
 }
 
 TEST(IgWorld, AnEntityAppearsWithItsModelAtItsPoseAndGoesWhenDestroyed) {
