@@ -30,6 +30,22 @@ double num(const Json& o, const char* key, const std::string& where, double lo, 
   return x;
 }
 
+// "HH:MM" (or "H:MM"): one or two digits each side of the colon and nothing else, so that no
+// field is read beyond int's range (which sscanf's %d leaves undefined).
+bool clockTime(const std::string& s, int& h, int& m) {
+  auto digits = [&s](size_t from, size_t to, int& v) {
+    if (to <= from || to - from > 2) return false;
+    v = 0;
+    for (size_t i = from; i < to; ++i) {
+      if (s[i] < '0' || s[i] > '9') return false;
+      v = v * 10 + (s[i] - '0');
+    }
+    return true;
+  };
+  const size_t colon = s.find(':');
+  return colon != std::string::npos && digits(0, colon, h) && digits(colon + 1, s.size(), m);
+}
+
 // A position: lat/lon/alt, or east/north/up from the script's origin.
 void position(const Json& o, const std::string& where, const GeoOrigin& origin, double& lat,
               double& lon, double& alt) {
@@ -123,8 +139,7 @@ HostScript read(const Json& root) {
       if (e.contains("timeOfDay")) {
         const Json& t = e["timeOfDay"];
         int h = -1, m = -1;
-        if (!t.is_string() || std::sscanf(t.get<std::string>().c_str(), "%d:%d", &h, &m) != 2 ||
-            h < 0 || h > 23 || m < 0 || m > 59)
+        if (!t.is_string() || !clockTime(t.get<std::string>(), h, m) || h > 23 || m > 59)
           bad(where + ".timeOfDay: \"HH:MM\" expected");
         cigi::CelestialSphereControl c;
         c.hour = uint8_t(h);

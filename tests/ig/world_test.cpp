@@ -86,6 +86,9 @@ TEST(IgHost, MalformedScriptsGetAClearError) {
       {R"({"synthvis-host": 1, "entities": [{"path": [{"t": 1}, {"t": 1}]}]})",
        "times must increase"},
       {R"({"synthvis-host": 1, "events": [{"timeOfDay": "25:00"}]})", "\"HH:MM\" expected"},
+      {R"({"synthvis-host": 1, "events": [{"timeOfDay": "99999999999:00"}]})",
+       "\"HH:MM\" expected"},
+      {R"({"synthvis-host": 1, "events": [{"timeOfDay": "6:30pm"}]})", "\"HH:MM\" expected"},
   };
   for (const auto& [text, message] : cases) {
     Result<HostScript> s = parseHostScript(text, "host.json");
@@ -93,9 +96,17 @@ TEST(IgHost, MalformedScriptsGetAClearError) {
     EXPECT_NE(s.error().str().find(message), std::string::npos) << s.error().str();
     EXPECT_EQ(s.error().file, "host.json");
   }
-  Result<HostScript> s = parseHostScript(R"({"synthvis-host": 1.0, "rate": 50})", "host.json");
+  Result<HostScript> s = parseHostScript(
+      R"({"synthvis-host": 1.0, "rate": 50, "events": [{"t": 1, "timeOfDay": "6:30"}]})",
+      "host.json");
   ASSERT_TRUE(s.ok()) << s.error().str();
   EXPECT_EQ(s->rate, 50.0);
+  ASSERT_EQ(s->events.size(), 1u);
+  ASSERT_EQ(s->events[0].packets.size(), 1u);
+  const auto* sky = std::get_if<cigi::CelestialSphereControl>(&s->events[0].packets[0]);
+  ASSERT_NE(sky, nullptr);
+  EXPECT_EQ(sky->hour, 6);
+  EXPECT_EQ(sky->minute, 30);
 }
 
 TEST(IgWorld, AnEntityAppearsWithItsModelAtItsPoseAndGoesWhenDestroyed) {
