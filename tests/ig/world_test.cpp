@@ -55,6 +55,18 @@ TEST(IgGeo, GeodeticPositionsRoundTripAndHeadingsPointTheWayTheySay) {
   EXPECT_NEAR(eulerFrame(levelFrame(), 0, 0, 90).right.y, -1, 1e-12);
 }
 
+// Each (text, message) case refused by `parse` with an error naming `file` and holding `message`.
+template <class Parse>
+void expectRefused(Parse parse, const std::vector<std::pair<std::string, std::string>>& cases,
+                   const std::string& file) {
+  for (const auto& [text, message] : cases) {
+    const auto r = parse(text, file);
+    ASSERT_FALSE(r.ok()) << text;
+    EXPECT_NE(r.error().str().find(message), std::string::npos) << r.error().str();
+    EXPECT_EQ(r.error().file, file);
+  }
+}
+
 TEST(IgConfig, MalformedConfigurationsGetAClearError) {
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"{", "malformed JSON"},
@@ -65,12 +77,7 @@ TEST(IgConfig, MalformedConfigurationsGetAClearError) {
       {R"({"synthvis-ig": 1, "scene": "a.json", "render": {"aa": 3}})", "render.aa"},
       {R"({"synthvis-ig": 1, "scene": "a.json", "colour": 1})", "unknown field \"colour\""},
   };
-  for (const auto& [text, message] : cases) {
-    Result<IgConfig> c = parseIgConfig(text, "ig.json");
-    ASSERT_FALSE(c.ok()) << text;
-    EXPECT_NE(c.error().str().find(message), std::string::npos) << c.error().str();
-    EXPECT_EQ(c.error().file, "ig.json");
-  }
+  expectRefused(parseIgConfig, cases, "ig.json");
 }
 
 TEST(IgHost, MalformedScriptsGetAClearError) {
@@ -90,12 +97,7 @@ TEST(IgHost, MalformedScriptsGetAClearError) {
        "\"HH:MM\" expected"},
       {R"({"synthvis-host": 1, "events": [{"timeOfDay": "6:30pm"}]})", "\"HH:MM\" expected"},
   };
-  for (const auto& [text, message] : cases) {
-    Result<HostScript> s = parseHostScript(text, "host.json");
-    ASSERT_FALSE(s.ok()) << text;
-    EXPECT_NE(s.error().str().find(message), std::string::npos) << s.error().str();
-    EXPECT_EQ(s.error().file, "host.json");
-  }
+  expectRefused(parseHostScript, cases, "host.json");
   Result<HostScript> s = parseHostScript(
       R"({"synthvis-host": 1.0, "rate": 50, "events": [{"t": 1, "timeOfDay": "6:30"}]})",
       "host.json");
