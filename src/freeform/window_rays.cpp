@@ -22,6 +22,7 @@
 #include <limits>
 #include <vector>
 
+#include "core/masked_store-inl.h"
 #include "freeform/freeform.h"
 #include "freeform/interval_lanes-inl.h"
 
@@ -29,6 +30,7 @@ HWY_BEFORE_NAMESPACE();
 namespace sv::freeform {
 namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
+using core::HWY_NAMESPACE::storeWhere;
 
 // The lanes' rays: per quadric (the nodes, then the clips) its b and c along z (alongZ in
 // freeform.cpp; a is the quadric's own C), and u = u0 + u1·z.
@@ -509,15 +511,17 @@ int QuadricHits(const ProjectedFreeForm::Node* nodes, const Quadric* clips, size
       if (hn::AllFalse(df, taken)) continue;
       const MD takenD =
           hn::Gt(hn::PromoteTo(d, hn::IfThenElseZero(taken, hn::Set(df, 1.0f))), hn::Zero(d));
-      hn::BlendedStore(nearer, taken, df, depth + c);
-      hn::BlendedStore(nearer, taken, df, node + c);
+      // The cell is whole and its rows are the caster's own (Caster::quadricCell): storeWhere may
+      // write every lane back.
+      storeWhere(nearer, taken, df, depth + c);
+      storeWhere(nearer, taken, df, node + c);
       if (to.object)
-        hn::BlendedStore(hn::Set(du, to.id), hn::RebindMask(du, taken), du,
-                         to.object + r * to.stride + c);
-      if (to.cubeZ) hn::BlendedStore(z, takenD, d, to.cubeZ + r * to.stride + c);
+        storeWhere(hn::Set(du, to.id), hn::RebindMask(du, taken), du,
+                   to.object + r * to.stride + c);
+      if (to.cubeZ) storeWhere(z, takenD, d, to.cubeZ + r * to.stride + c);
       if (to.active)
-        hn::BlendedStore(hn::Set(d64, to.activeBits), hn::RebindMask(d64, takenD), d64,
-                         to.active + r * to.stride + c);
+        storeWhere(hn::Set(d64, to.activeBits), hn::RebindMask(d64, takenD), d64,
+                   to.active + r * to.stride + c);
       hits += int(hn::CountTrue(d, takenD));
       // The last one taken, in raster order: the highest lane of this vector.
       uint8_t bits[8] = {};

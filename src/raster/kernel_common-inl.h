@@ -19,6 +19,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "core/masked_store-inl.h"
 #include "hwy/highway.h"
 #include "raster/framebuffer.h"
 #include "raster/rasterizer.h"
@@ -111,20 +112,7 @@ struct PlaneLanes {
   alignas(32) float c0[8], dx[8], dy[8];
 };
 
-// Stores the lanes of `v` where `m` is set; the others keep what `p` holds. Highway's BlendedStore
-// writes only those lanes, and below AVX-512 x86 has no cheap way to: AVX2 stores 16-bit lanes one
-// by one (ScalarMaskedStore: an extract, a test and a branch per lane) and 32-bit lanes by vmaskmov,
-// which AMD's cores microcode. A tile's buffers belong to the one thread drawing it, and every
-// store here is of whole lanes inside a block, so there the lanes are loaded, blended and stored
-// back: the same bytes in memory, three plain instructions.
-template <class D, class M>
-HWY_INLINE void storeWhere(hn::Vec<D> v, M m, D d, hn::TFromD<D>* HWY_RESTRICT p) {
-#if HWY_TARGET == HWY_AVX2 || HWY_TARGET == HWY_SSE4 || HWY_TARGET == HWY_SSSE3
-  hn::StoreU(hn::IfThenElse(m, v, hn::LoadU(d, p)), d, p);
-#else
-  hn::BlendedStore(v, m, d, p);
-#endif
-}
+using core::HWY_NAMESPACE::storeWhere;  // the masked store of every block operation
 
 // The lanes of `m` (at most 16: one 4×4 block's worth from lane i on) as bits, shifted to bit i.
 template <class D, class M>
