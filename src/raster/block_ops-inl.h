@@ -26,15 +26,6 @@ HWY_INLINE void countBlock(uint32_t mask, uint16_t* color) {
   for (; mask; mask &= mask - 1) ++color[std::countr_zero(mask)];
 }
 
-// The pass mask of float lanes i… as a mask of as many 16-bit lanes, for masked colour stores: a
-// third of the instructions of widening, blending and narrowing each channel.
-template <class DU, class DF, class M>
-HWY_INLINE auto passMask16(DU du, DF df, M pass) {
-  uint8_t bits[8] = {};
-  hn::StoreMaskBits(df, pass, bits);
-  return hn::LoadMaskBits(du, bits);
-}
-
 // Depth test ("less") and Gouraud colour for the pixels of one 4×4 block set in `mask` (kFull:
 // all 16, untested). base[p · stride] holds plane p's value at the block's top-left pixel
 // (blockBases, or runBases for a run of blocks); `depth` and `color` point at the block's storage.
@@ -64,7 +55,7 @@ HWY_INLINE int gouraudBlock(const PlaneLanes& lanes, const float* base, size_t s
     // SPEC §2: perspective-correct colour = (colour/w) / (1/w).
     const auto w = hn::Div(
         one, hn::Add(hn::Set(df, base[kInvW * stride]), hn::LoadU(df, lanes.offset[kInvW] + i)));
-    const auto pass16 = passMask16(du, df, pass);
+    const auto pass16 = passMask16(df, pass);
     for (int ch = 0; ch < kColorChannels; ++ch) {
       const auto cw = hn::Add(hn::Set(df, base[(kRed + ch) * stride]),
                               hn::LoadU(df, lanes.offset[kRed + ch] + i));
@@ -133,7 +124,6 @@ HWY_INLINE int shadeBlockSamples(const TriangleSetup& t, const PlaneLanes& lanes
   const hn::RebindToSigned<decltype(df)> di;
   const hn::RebindToUnsigned<decltype(df)> du32;
   const hn::Rebind<uint16_t, decltype(df)> du;
-  const hn::Rebind<int16_t, decltype(df)> d16;
   const size_t n = hn::Lanes(df);
   alignas(32) float base[8];
   blockBases(t, lanes, gx, gy, base);
@@ -187,10 +177,7 @@ HWY_INLINE int shadeBlockSamples(const TriangleSetup& t, const PlaneLanes& lanes
         continue;
       }
       storeWhere(z, pass, df, zPlane);
-      // The pass mask in 16-bit lanes (−1 stays −1 under the saturating demotion), then masked
-      // stores: a third of the instructions of widening, blending and narrowing each channel.
-      const auto pass16 = hn::MaskFromVec(
-          hn::BitCast(du, hn::DemoteTo(d16, hn::VecFromMask(di, hn::RebindMask(di, pass)))));
+      const auto pass16 = passMask16(df, pass);
       for (int ch = 0; ch < kColorChannels; ++ch)
         storeWhere(c16[ch], pass16, du, color + size_t(s) * kColorPerBlock + ch * kBlockPixels + i);
     }

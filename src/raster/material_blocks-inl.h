@@ -104,9 +104,7 @@ HWY_INLINE void storeShaded(DF df, M pass, bool blend, const float (*rgba)[kBloc
                             uint16_t* color) {
   const hn::RebindToSigned<DF> di;
   const hn::Rebind<uint16_t, DF> du;
-  const hn::Rebind<int16_t, DF> d16;
-  const auto pass16 = hn::MaskFromVec(
-      hn::BitCast(du, hn::DemoteTo(d16, hn::VecFromMask(di, hn::RebindMask(di, pass)))));
+  const auto pass16 = passMask16(df, pass);
   const auto keep = hn::Sub(hn::Set(df, 1.0f), hn::LoadU(df, rgba[3] + i));
   for (int ch = 0; ch < kColorChannels; ++ch) {
     uint16_t* dst = color + ch * kBlockPixels + i;
