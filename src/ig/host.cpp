@@ -30,11 +30,12 @@ double num(const Json& o, const char* key, const std::string& where, double lo, 
   return x;
 }
 
-// "HH:MM" (or "H:MM"): one or two digits each side of the colon and nothing else, so that no
-// field is read beyond int's range (which sscanf's %d leaves undefined).
+// "HH:MM" (or "H:MM"): one or two digits of hour and two of minute, and nothing else. So "6:5"
+// (6:05 or 6:50?) is refused, and no field is read beyond int's range (which sscanf's %d leaves
+// undefined).
 bool clockTime(const std::string& s, int& h, int& m) {
-  auto digits = [&s](size_t from, size_t to, int& v) {
-    if (to <= from || to - from > 2) return false;
+  auto digits = [&s](size_t from, size_t to, size_t least, int& v) {
+    if (to < from + least || to - from > 2) return false;
     v = 0;
     for (size_t i = from; i < to; ++i) {
       if (s[i] < '0' || s[i] > '9') return false;
@@ -43,7 +44,7 @@ bool clockTime(const std::string& s, int& h, int& m) {
     return true;
   };
   const size_t colon = s.find(':');
-  return colon != std::string::npos && digits(0, colon, h) && digits(colon + 1, s.size(), m);
+  return colon != std::string::npos && digits(0, colon, 1, h) && digits(colon + 1, s.size(), 2, m);
 }
 
 // A position: lat/lon/alt, or east/north/up from the script's origin.

@@ -96,6 +96,7 @@ TEST(IgHost, MalformedScriptsGetAClearError) {
       {R"({"synthvis-host": 1, "events": [{"timeOfDay": "99999999999:00"}]})",
        "\"HH:MM\" expected"},
       {R"({"synthvis-host": 1, "events": [{"timeOfDay": "6:30pm"}]})", "\"HH:MM\" expected"},
+      {R"({"synthvis-host": 1, "events": [{"timeOfDay": "6:5"}]})", "\"HH:MM\" expected"},
   };
   expectRefused(parseHostScript, cases, "host.json");
   Result<HostScript> s = parseHostScript(
