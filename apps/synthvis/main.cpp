@@ -36,12 +36,17 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
-#include <optional>
 #include <numbers>
+#include <optional>
 
+#include "cluster/cluster.h"
+#include "core/write_file.h"
 #include "display/mpcdi.h"
+#include "ig/config.h"
+#include "ig/host.h"
+#include "ig/loop.h"
+#include "prep/prep.h"
 #include "reference/ground_truth.h"
 #include "reference/suite.h"
 #include "render/correction.h"
@@ -51,11 +56,6 @@
 #include "synthvis/scene.h"
 #include "synthvis/terrain.h"
 #include "terrain/height_field.h"
-#include "ig/config.h"
-#include "ig/host.h"
-#include "cluster/cluster.h"
-#include "ig/loop.h"
-#include "prep/prep.h"
 
 namespace {
 
@@ -596,10 +596,9 @@ int runBench(BenchArgs a) {
         return fail(s.error());
   }
   if (!a.json.empty()) {
-    std::ofstream out(a.json);
     // One scene on one renderer: an object (BENCH.md); otherwise a list of rows.
-    out << (rows.size() == 1 ? rows[0] : rows).dump(2) << "\n";
-    if (!out) return fail({a.json, "", "cannot write"});
+    const std::string text = (rows.size() == 1 ? rows[0] : rows).dump(2) + "\n";
+    if (sv::Status s = sv::core::writeFile(a.json, {text}); !s) return fail(s.error());
   }
   if (!a.html.empty()) {
     if (sv::Status s = ref::writeHtml(a.html, results, settings, runner.referenceDescription()); !s)

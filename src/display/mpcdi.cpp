@@ -8,9 +8,9 @@
 // (Xresolution, xResolution; fileset, fileSet).
 #include "display/mpcdi.h"
 
-#include <tinyxml2.h>
-
 #include <fmt/format.h>
+#include <strings.h>
+#include <tinyxml2.h>
 
 #include <algorithm>
 #include <bit>
@@ -20,8 +20,8 @@
 #include <fstream>
 #include <numbers>
 #include <set>
-#include <strings.h>
 
+#include "core/write_file.h"
 #include "display/zip_memory.h"
 #include "texture/png.h"
 
@@ -639,10 +639,7 @@ Result<std::string> encodeMpcdi(const Mpcdi& m, const std::string& name) {
 Status writeMpcdi(const std::string& path, const Mpcdi& m) {
   Result<std::string> bytes = encodeMpcdi(m, path);
   if (!bytes.ok()) return bytes.error();
-  std::ofstream out(path, std::ios::binary);
-  if (!out || !out.write(bytes->data(), std::streamsize(bytes->size())))
-    return Error{path, "", "cannot write the file"};
-  return {};
+  return core::writeFile(path, {bytes.value()});
 }
 
 std::string encodePfm(const FloatMap& map) { return writePfm(map); }

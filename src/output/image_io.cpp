@@ -1,9 +1,7 @@
 // Image files: PNG through the one PNG codec (texture/png.h); PPM by hand.
 #include <fmt/format.h>
 
-#include <cstdio>
-#include <memory>
-
+#include "core/write_file.h"
 #include "synthvis/image.h"
 #include "texture/png.h"
 
@@ -42,13 +40,8 @@ Status writePng(const Image& image, const std::string& path) {
 
 Status writePpm(const Image& image, const std::string& path) {
   if (Status s = checkImage(image, path); !s) return s;
-  std::unique_ptr<FILE, int (*)(FILE*)> f(std::fopen(path.c_str(), "wb"), &std::fclose);
-  if (!f) return Error{path, "", "cannot open for writing"};
   const std::string header = fmt::format("P6\n{} {}\n255\n", image.width, image.height);
-  if (std::fwrite(header.data(), 1, header.size(), f.get()) != header.size() ||
-      std::fwrite(image.rgb.data(), 1, image.rgb.size(), f.get()) != image.rgb.size())
-    return Error{path, "", "write failed"};
-  return {};
+  return core::writeFile(path, {header, core::bytesOf(image.rgb.data(), image.rgb.size())});
 }
 
 namespace {

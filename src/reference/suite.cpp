@@ -7,15 +7,15 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <optional>
 
 #include "core/timing.h"
-#include "render/correction.h"
-#include "render/view_renderer.h"
+#include "core/write_file.h"
 #include "reference/gl_renderer.h"
 #include "reference/vtk_volume.h"
+#include "render/correction.h"
+#include "render/view_renderer.h"
 
 namespace sv::reference {
 namespace {
@@ -746,10 +746,7 @@ std::string fileSlug(const std::string& name) {
 }
 
 Status writeText(const std::filesystem::path& p, const std::string& text) {
-  std::ofstream out(p, std::ios::binary);
-  out << text;
-  if (!out) return Error{p.string(), "", "cannot write"};
-  return {};
+  return core::writeFile(p.string(), {text});
 }
 
 }  // namespace

@@ -3,6 +3,8 @@
 // and checksum are checked.
 // Based on: SPEC §1 (seed 004's database preparation system, whose output the image generator
 // loads as is).
+#include "scene/database.h"
+
 #include <fcntl.h>
 #include <fmt/format.h>
 #include <sys/mman.h>
@@ -20,7 +22,7 @@
 #include <span>
 #include <type_traits>
 
-#include "scene/database.h"
+#include "core/write_file.h"
 #include "scene/loader_common.h"
 #include "terrain/ground.h"
 #include "texture/texture.h"
@@ -556,16 +558,16 @@ Status saveDatabase(const Scene& scene, const std::string& path) {
   std::memcpy(header + detail::kDatabaseChecksumAt, &sum, 8);
   // Written beside the target and renamed over it: a reader never maps a half-written file.
   const std::string temporary = path + ".partial";
-  std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(temporary.c_str(), "wb"),
-                                                    &std::fclose);
-  if (!f) return Error{path, "", fmt::format("cannot write: {}", std::strerror(errno))};
-  const bool ok = std::fwrite(header, 1, kHeaderBytes, f.get()) == kHeaderBytes &&
-                  std::fwrite(payload.data(), 1, payload.size(), f.get()) == payload.size() &&
-                  std::fflush(f.get()) == 0;
-  f.reset();
-  if (!ok || std::rename(temporary.c_str(), path.c_str()) != 0) {
+  if (Status s = core::writeFile(temporary, {core::bytesOf(header, kHeaderBytes),
+                                             core::bytesOf(payload.data(), payload.size())});
+      !s) {
     std::remove(temporary.c_str());
-    return Error{path, "", fmt::format("cannot write: {}", std::strerror(errno))};
+    return Error{path, "", s.error().message};
+  }
+  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
+    const int error = errno;
+    std::remove(temporary.c_str());
+    return Error{path, "", fmt::format("cannot write: {}", std::strerror(error))};
   }
   return {};
 }

@@ -18,7 +18,9 @@
 #include <cmath>
 #include <cstring>
 #include <numbers>
+#include <sstream>
 
+#include "core/write_file.h"
 #include "synthvis/scene.h"
 #include "texture/texture.h"
 
@@ -233,11 +235,14 @@ Status saveGltf(const Scene& scene, const std::string& path) {
   model.buffers[0].uri.clear();
 
   tinygltf::TinyGLTF writer;
-  // .gltf: the buffer goes into the file as a data: URI.
-  if (!writer.WriteGltfSceneToFile(&model, path, /*embedImages=*/true, /*embedBuffers=*/true,
-                                   /*prettyPrint=*/!binary, /*writeBinary=*/binary))
-    return Error{path, "", "cannot write"};
-  return {};
+  // Into memory, then out through writeFile: tinygltf's own file writer checks neither that a .glb
+  // opened nor that it was written. The stream writer embeds the buffer (.gltf: as a data: URI)
+  // and the images.
+  std::ostringstream bytes;
+  if (!writer.WriteGltfSceneToStream(&model, bytes, /*prettyPrint=*/!binary,
+                                     /*writeBinary=*/binary))
+    return Error{path, "", "cannot encode glTF"};
+  return core::writeFile(path, {bytes.view()});
 }
 
 }  // namespace sv::scene

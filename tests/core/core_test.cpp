@@ -10,6 +10,8 @@
 #include "core/check.h"
 #include "core/streaming.h"
 #include "core/thread_pool.h"
+#include "core/write_file.h"
+#include "support/temp_dir.h"
 #include "synthvis/frame_stats.h"
 #include "synthvis/math.h"
 
@@ -147,6 +149,35 @@ TEST(FrameStats, SummingAddsEveryField) {
   sum += one;
   EXPECT_EQ(sum.trianglesIn, 2u);
   EXPECT_EQ(sum.volumeTerminated, 2u);
+}
+
+TEST(WriteFile, WritesThePartsInOrder) {
+  const std::string path = sv::tests::processTemp().path("parts.bin");
+  const uint8_t bytes[] = {0, 1, 255};
+  ASSERT_TRUE(core::writeFile(path, {"P6\n", "", core::bytesOf(bytes, sizeof bytes)}).ok());
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  ASSERT_NE(f, nullptr);
+  char back[16] = {};
+  const size_t n = std::fread(back, 1, sizeof back, f);
+  std::fclose(f);
+  EXPECT_EQ(std::string(back, n), std::string("P6\n\0\1\xff", 6));
+}
+
+TEST(WriteFile, AFileThatCannotBeMadeIsAnErrorNamingItAndTheReason) {
+  const std::string path = sv::tests::processTemp().path("no-such-folder/out.glb");
+  const Status s = core::writeFile(path, {"x"});
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.error().str(), path + ": cannot write: No such file or directory");
+}
+
+// A few bytes fit in the stream's buffer, so fwrite succeeds and only the flush meets the full
+// disk: what a writer that checks only its writes reports as success.
+TEST(WriteFile, ADiskThatFillsAtTheFlushIsAnError) {
+  const std::string path = sv::tests::fullDiskPath("full.bin");
+  if (path.empty()) GTEST_SKIP() << "no /dev/full here";
+  const Status s = core::writeFile(path, {"a few bytes"});
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.error().str(), path + ": cannot write: No space left on device");
 }
 
 }  // namespace

@@ -78,6 +78,20 @@ TEST(ImageIo, ErrorsNameTheFile) {
   EXPECT_FALSE(writeImage(gradient(2, 2), tempPath("sv_img.bmp")).ok());
 }
 
+// Both formats on a full disk: the PPM writer checked only its fwrites, which a small image's
+// bytes pass (they wait in the buffer), and reported success.
+TEST(ImageIo, AFullDiskIsAnError) {
+  for (const char* name : {"full.ppm", "full.png"}) {
+    const std::string path = sv::tests::fullDiskPath(name);
+    if (path.empty()) GTEST_SKIP() << "no /dev/full here";
+    const Status s = writeImage(gradient(2, 2), path);
+    ASSERT_FALSE(s.ok()) << name;
+    EXPECT_NE(s.error().str().find(path + ": cannot write"), std::string::npos) << s.error().str();
+    EXPECT_NE(s.error().str().find("No space left on device"), std::string::npos)
+        << s.error().str();
+  }
+}
+
 // The image reader is the texture maps' (texture/png.h): the same size limit and the same refusal
 // of a header that claims more than the file can hold, before anything is allocated.
 TEST(ImageIo, ReadsThroughTheOnePngCodecWithItsLimits) {

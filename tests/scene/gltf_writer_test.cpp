@@ -138,6 +138,20 @@ TEST(GltfWriter, LinesRoundTrip) {
   EXPECT_EQ(r->triangleCount(), s.triangleCount());
 }
 
+// tinygltf's own file writer reported success for a .glb it could not open or finish.
+TEST(GltfWriter, AFileThatCannotBeWrittenIsAnError) {
+  for (const char* name : {"full.glb", "full.gltf"}) {
+    const std::string path = sv::tests::fullDiskPath(name);
+    if (path.empty()) GTEST_SKIP() << "no /dev/full here";
+    const Status st = saveGltf(generateTris({}), path);
+    ASSERT_FALSE(st.ok()) << name;
+    EXPECT_EQ(st.error().str(), path + ": cannot write: No space left on device");
+  }
+  const Status st = saveGltf(generateTris({}), tempPath("no-such-folder/x.glb"));
+  ASSERT_FALSE(st.ok());
+  EXPECT_NE(st.error().str().find("No such file or directory"), std::string::npos);
+}
+
 TEST(GltfWriter, RefusesOtherExtensions) {
   const Status st = saveGltf(generateTris({}), tempPath("x.obj"));
   ASSERT_FALSE(st.ok());

@@ -53,4 +53,16 @@ inline const TempDir& processTemp() {
   return dir;
 }
 
+// A file that takes any open but no data: `name` in the process's directory, a link to /dev/full
+// (every write to it fails with "No space left on device" when it is flushed). Empty where there
+// is no such device; the test then skips.
+inline std::string fullDiskPath(const std::string& name) {
+  std::error_code ec;
+  if (!std::filesystem::is_character_file("/dev/full", ec)) return {};
+  const std::string path = processTemp().path(name);
+  std::filesystem::remove(path, ec);
+  std::filesystem::create_symlink("/dev/full", path, ec);
+  return ec ? std::string() : path;
+}
+
 }  // namespace sv::tests
