@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -15,10 +16,10 @@
 
 #include "cigi/cigi.h"
 #include "cigi/pcap.h"
+#include "cluster/cluster.h"
 #include "ig/overload.h"
 #include "ig/udp.h"
 #include "ig/world.h"
-#include "cluster/cluster.h"
 #include "present/overlay.h"
 #include "present/present.h"
 #include "present/test_patterns.h"
@@ -114,6 +115,7 @@ struct IgLoop::Impl {
   std::unique_ptr<present::Presenter> presenter;
   std::FILE* status = nullptr;
   bool ownsStatus = false;
+  std::string statusName;  // for the warning when it can no longer be written
   std::map<int, std::unique_ptr<Renderer>> renderers;  // by quality level
   bool loggedMalformed = false;
   // The job (docs/cluster.md): this rank's channels (all of them in a job of one).
@@ -125,6 +127,16 @@ struct IgLoop::Impl {
 
   ~Impl() {
     if (ownsStatus && status) std::fclose(status);
+  }
+
+  // A status stream that can no longer be written (a full disk, a closed pipe) is given up with
+  // one warning: it is for monitoring, and the picture the simulator waits for goes on.
+  void giveUpStatus(int error) {
+    std::fprintf(stderr,
+                 "synthvis ig: %s: cannot write the status stream: %s; no more status lines\n",
+                 statusName.c_str(), std::strerror(error));
+    if (ownsStatus) std::fclose(status);
+    status = nullptr;
   }
 
   Renderer& rendererFor(int level, const RenderOptions& quality) {
@@ -254,6 +266,7 @@ Result<std::unique_ptr<IgLoop>> IgLoop::create(const IgConfig& config,
   }
   if (options.status == "-") {
     m.status = stdout;
+    m.statusName = "standard output";
   } else if (!options.status.empty()) {
     // Each rank its own stream: FILE.rankR in a job of several.
     const std::string path =
@@ -261,6 +274,7 @@ Result<std::unique_ptr<IgLoop>> IgLoop::create(const IgConfig& config,
     m.status = std::fopen(path.c_str(), "w");
     if (!m.status) return Error{path, "", "cannot write the status stream"};
     m.ownsStatus = true;
+    m.statusName = path;
   }
   return loop;
 }
@@ -496,19 +510,19 @@ Result<IgRunReport> IgLoop::run() {
       uint64_t shareBytes = 0;
       double shareMs = 0;
       for (const FrameStats& st : stats) shareBytes += st.shareBytes, shareMs += st.shareMs;
-      std::fprintf(m.status,
-                   "{\"frame\":%u,\"rank\":%d,\"time\":%.6f,\"ms\":%.3f,\"renderMs\":%.3f,"
-                   "\"shareBytes\":%llu,\"shareMs\":%.3f,\"budgetMs\":%.3f,\"level\":%d,"
-                   "\"entities\":%zu,\"datagrams\":%llu,\"malformed\":%llu,\"rejected\":%llu,"
-                   "\"missed\":%llu}\n",
-                   frame, m.rank, frame / m.config.rate, ms, renderMs,
-                   (unsigned long long)shareBytes, shareMs, governor.budgetMs(), level,
-                   world.activeEntities(),
-                   (unsigned long long)world.counts().datagrams,
-                   (unsigned long long)world.counts().malformed,
-                   (unsigned long long)world.counts().rejected,
-                   (unsigned long long)report.missed);
-      std::fflush(m.status);
+      errno = 0;
+      const int written = std::fprintf(
+          m.status,
+          "{\"frame\":%u,\"rank\":%d,\"time\":%.6f,\"ms\":%.3f,\"renderMs\":%.3f,"
+          "\"shareBytes\":%llu,\"shareMs\":%.3f,\"budgetMs\":%.3f,\"level\":%d,"
+          "\"entities\":%zu,\"datagrams\":%llu,\"malformed\":%llu,\"rejected\":%llu,"
+          "\"missed\":%llu}\n",
+          frame, m.rank, frame / m.config.rate, ms, renderMs, (unsigned long long)shareBytes,
+          shareMs, governor.budgetMs(), level, world.activeEntities(),
+          (unsigned long long)world.counts().datagrams,
+          (unsigned long long)world.counts().malformed, (unsigned long long)world.counts().rejected,
+          (unsigned long long)report.missed);
+      if (written < 0 || std::fflush(m.status) != 0) m.giveUpStatus(errno);
     }
     if (m.presenter->closed()) break;
   }

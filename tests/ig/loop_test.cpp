@@ -20,6 +20,7 @@
 #include "cigi/pcap.h"
 #include "ig/geo.h"
 #include "ig/host.h"
+#include "support/temp_dir.h"
 #include "synthvis/image.h"
 
 namespace sv::ig {
@@ -255,6 +256,41 @@ TEST(IgLoop, TheReplayDrawsEachFrameAtItsRecordedQuality) {
   expectSameFrames(frames, again, 12);
   fs::remove_all(frames);
   fs::remove_all(again);
+}
+
+// --status: a JSON line a frame. A stream that cannot be written (here a full disk) is given up
+// with one warning, and the frames go on.
+TEST(IgLoop, TheStatusStreamHasALineAFrameAndAFullDiskEndsItNotTheLoop) {
+  IgRunOptions options;
+  options.frames = 3;
+  options.realtime = false;
+  options.status = sv::tests::processTemp().path("status.jsonl");
+  {
+    Result<std::unique_ptr<IgLoop>> loop = IgLoop::create(config(), options);
+    ASSERT_TRUE(loop.ok()) << loop.error().str();
+    ASSERT_TRUE(loop.value()->run().ok());
+  }
+  std::ifstream in(options.status);
+  std::string line;
+  uint32_t frame = 0;
+  for (; std::getline(in, line); ++frame)
+    EXPECT_EQ(line.rfind("{\"frame\":" + std::to_string(frame) + ",", 0), 0u) << line;
+  EXPECT_EQ(frame, 3u);
+
+  options.status = sv::tests::fullDiskPath("full-status.jsonl");
+  if (options.status.empty()) GTEST_SKIP() << "no /dev/full here";
+  Result<std::unique_ptr<IgLoop>> loop = IgLoop::create(config(), options);
+  ASSERT_TRUE(loop.ok()) << loop.error().str();
+  testing::internal::CaptureStderr();
+  Result<IgRunReport> r = loop.value()->run();
+  const std::string warnings = testing::internal::GetCapturedStderr();
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  EXPECT_EQ(r->frames, 3u);
+  const std::string warning = "synthvis ig: " + options.status +
+                              ": cannot write the status stream: No space left on device; no more "
+                              "status lines\n";
+  EXPECT_NE(warnings.find(warning), std::string::npos) << warnings;
+  EXPECT_EQ(warnings.find(warning), warnings.rfind(warning)) << "warned once";
 }
 
 TEST(IgLoop, BadDatagramsAreCountedAndDroppedAndTheLoopKeepsItsRate) {
