@@ -134,7 +134,7 @@ struct IgLoop::Impl {
   void giveUpStatus(int error) {
     std::fprintf(stderr,
                  "synthvis ig: %s: cannot write the status stream: %s; no more status lines\n",
-                 statusName.c_str(), std::strerror(error));
+                 statusName.c_str(), std::strerror(error ? error : EIO));
     if (ownsStatus) std::fclose(status);
     status = nullptr;
   }
