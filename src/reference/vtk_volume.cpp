@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 #include <vector>
 
+#include "core/write_file.h"
 #include "render/camera.h"
 
 #ifndef SV_VTK_SCRIPT_PATH
@@ -202,13 +203,11 @@ Result<std::unique_ptr<VtkVolumeRenderer>> VtkVolumeRenderer::create(
     const scene::VolumeObject& v = scene.volumes[i];
     const scene::VolumeGrid& g = *v.grid;
     const fs::path raw = m.dir / fmt::format("volume-{}.raw", i);
-    {
-      std::ofstream out(raw, std::ios::binary);
-      // The codes as they are in memory: little-endian on every machine synthvis builds for.
-      out.write(reinterpret_cast<const char*>(g.codes.data()),
-                std::streamsize(g.codes.size() * sizeof(uint16_t)));
-      if (!out) return Error{raw.string(), "", "vtk reference: cannot write the volume"};
-    }
+    // The codes as they are in memory: little-endian on every machine synthvis builds for.
+    if (Status s = core::writeFile(
+            raw.string(), {core::bytesOf(g.codes.data(), g.codes.size() * sizeof(uint16_t))});
+        !s)
+      return Error{raw.string(), "", "vtk reference: " + s.error().message};
     // The transform's uniform scale (the cube root of its determinant): VTK's fixed-point mapper
     // casts in the volume's own space (under the user matrix), so its sample distance and opacity
     // unit are own lengths; synthvis's opacity unit is a world length.
@@ -233,11 +232,8 @@ Result<std::unique_ptr<VtkVolumeRenderer>> VtkVolumeRenderer::create(
          {"shaded", v.shaded}});
   }
   const fs::path jobPath = m.dir / "job.json";
-  {
-    std::ofstream out(jobPath);
-    out << job.dump() << "\n";
-    if (!out) return Error{jobPath.string(), "", "vtk reference: cannot write the job"};
-  }
+  if (Status s = core::writeFile(jobPath.string(), {job.dump() + "\n"}); !s)
+    return Error{jobPath.string(), "", "vtk reference: " + s.error().message};
 
   int in[2], out[2];
   if (::pipe(in) != 0) return Error{"", "", "vtk reference: pipe failed"};
