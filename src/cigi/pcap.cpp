@@ -13,6 +13,7 @@
 #include <memory>
 
 #include "cigi/cigi.h"
+#include "core/write_file.h"
 
 namespace sv::cigi {
 namespace {
@@ -63,8 +64,9 @@ Error fileError(const std::string& file, std::string message, size_t byte = SIZE
 
 // Writes all of `bytes` and flushes, or says why not.
 Status writeAll(std::FILE* f, const std::string& path, const uint8_t* bytes, size_t n) {
+  errno = 0;
   if (std::fwrite(bytes, 1, n, f) != n || std::fflush(f) != 0) {
-    return fileError(path, fmt::format("cannot write: {}", std::strerror(errno)));
+    return fileError(path, fmt::format("cannot write: {}", core::writeFailure(errno)));
   }
   return {};
 }

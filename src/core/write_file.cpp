@@ -8,10 +8,11 @@
 
 namespace sv::core {
 
+const char* writeFailure(int error) { return std::strerror(error ? error : EIO); }
+
 Status writeFile(const std::string& path, std::initializer_list<std::string_view> parts) {
-  // (A failure that set no errno is reported as an I/O error, not as "Success".)
   auto failed = [&path](int error) {
-    return Error{path, "", fmt::format("cannot write: {}", std::strerror(error ? error : EIO))};
+    return Error{path, "", fmt::format("cannot write: {}", writeFailure(error))};
   };
   std::FILE* f = std::fopen(path.c_str(), "wb");
   if (!f) return failed(errno);

@@ -18,6 +18,10 @@ namespace sv::core {
 // failure stays.
 Status writeFile(const std::string& path, std::initializer_list<std::string_view> parts);
 
+// The system's reason for a failed write: strerror(error), or that of EIO where the failing call
+// set no errno (a short fwrite may not), so that no error ever reads "Success".
+const char* writeFailure(int error);
+
 // A part of bytes that are not chars.
 inline std::string_view bytesOf(const void* data, size_t size) {
   return {static_cast<const char*>(data), size};

@@ -17,6 +17,7 @@
 #include "cigi/cigi.h"
 #include "cigi/pcap.h"
 #include "cluster/cluster.h"
+#include "core/write_file.h"
 #include "ig/overload.h"
 #include "ig/udp.h"
 #include "ig/world.h"
@@ -134,7 +135,7 @@ struct IgLoop::Impl {
   void giveUpStatus(int error) {
     std::fprintf(stderr,
                  "synthvis ig: %s: cannot write the status stream: %s; no more status lines\n",
-                 statusName.c_str(), std::strerror(error ? error : EIO));
+                 statusName.c_str(), core::writeFailure(error));
     if (ownsStatus) std::fclose(status);
     status = nullptr;
   }

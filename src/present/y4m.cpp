@@ -11,6 +11,7 @@
 #include <cstring>
 #include <memory>
 
+#include "core/write_file.h"
 #include "present/async_writer.h"
 #include "present/outputs.h"
 
@@ -81,7 +82,7 @@ Status Y4mWriter::write(const Image& image) {
   // Flushed every frame: a player at the other end of a pipe shows it now, not a buffer later.
   if (std::fwrite(out.data(), 1, out.size(), file_) != out.size() || std::fflush(file_) != 0) {
     if (errno == EPIPE) brokenPipe_ = true;
-    return Error{name_, "", std::string("y4m: write failed: ") + std::strerror(errno)};
+    return Error{name_, "", std::string("y4m: write failed: ") + core::writeFailure(errno)};
   }
   return {};
 }

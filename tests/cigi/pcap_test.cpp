@@ -68,6 +68,20 @@ TEST(CigiPcap, TheIncrementalWriterLeavesAReadableFileAfterEachRecord) {
   }
 }
 
+// Every record is flushed, so a disk that is full fails the record (here already the file's header),
+// and the error names the file and the system's reason.
+TEST(CigiPcap, AFullDiskIsAnError) {
+  const std::string path = sv::tests::fullDiskPath("full.pcap");
+  if (path.empty()) GTEST_SKIP() << "no /dev/full here";
+  PcapWriter writer;
+  const Status s = writer.open(path);
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.error().str(), path + ": cannot write: No space left on device");
+  const Status whole = writePcap(path, session());
+  ASSERT_FALSE(whole.ok());
+  EXPECT_EQ(whole.error().str(), path + ": cannot write: No space left on device");
+}
+
 TEST(CigiPcap, FramesCarryTheSessionsAddressesPortsAndACorrectIpv4Checksum) {
   const std::string path = tempPath("frame.pcap");
   const std::vector<CapturedDatagram> one = {{5.5, true, {1, 2, 3, 4, 5, 6, 7, 8}}};

@@ -142,6 +142,21 @@ TEST(PresentY4m, StreamOfTwoChannelsIsTheirMosaicFrameByFrame) {
   std::filesystem::remove(path);
 }
 
+// Each frame is flushed (a player at the end of a pipe shows it now), so a full disk fails the
+// frame it cut short.
+TEST(PresentY4m, AFullDiskIsAnError) {
+  const std::string path = sv::tests::fullDiskPath("full.y4m");
+  if (path.empty()) GTEST_SKIP() << "no /dev/full here";
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  ASSERT_NE(f, nullptr);
+  Y4mWriter writer(f, path, 25);
+  const Status s = writer.write(solid(4, 4, 1, 2, 3));
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.error().str(), path + ": y4m: write failed: No space left on device");
+  EXPECT_FALSE(writer.brokenPipe());
+  std::fclose(f);
+}
+
 TEST(PresentY4m, FrameOfAnotherSizeIsAnError) {
   std::FILE* f = std::tmpfile();
   ASSERT_NE(f, nullptr);
