@@ -536,7 +536,10 @@ class Reader {
           fail(fmt::format("switch at byte {}: {} masks of {} words do not fit its record", r.at,
                            masks, words));
         // One flag per mask and child, for every switch placed: bounded like the nodes visited.
-        switchFlags_ += uint64_t(std::max(masks, 1)) * uint64_t(node.children.size());
+        // A mask counts as one flag at least: masks of no words are not bounded by the record's
+        // size, and each is still stored.
+        switchFlags_ +=
+            uint64_t(std::max(masks, 1)) * uint64_t(std::max<size_t>(node.children.size(), 1));
         if (switchFlags_ > kMaxVisits)
           fail(fmt::format("switches hold more than {} mask flags", kMaxVisits));
         Switch s;

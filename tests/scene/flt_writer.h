@@ -210,10 +210,14 @@ class FltWriter {
     p.f64(center[0]).f64(center[1]).f64(center[2]).f64(transition).f64(0);
     record(73, p);
   }
+  // `masks` one word each, or (a malformed record) `declaredMasks` of `words` words declared
+  // while the words written are still `masks`.
   void switchNode(const std::string& name, int32_t current,
-                  const std::vector<uint32_t>& masks /* one word each */) {
+                  const std::vector<uint32_t>& masks /* one word each */,
+                  int32_t declaredMasks = -1, int32_t words = 1) {
     Bytes p;
-    p.text(name, 8).i32(0).i32(current).i32(int32_t(masks.size())).i32(1);
+    p.text(name, 8).i32(0).i32(current);
+    p.i32(declaredMasks < 0 ? int32_t(masks.size()) : declaredMasks).i32(words);
     for (uint32_t m : masks) p.u32(m);
     record(96, p);
   }

@@ -470,6 +470,15 @@ TEST(OpenFlight, RefusesMalformedFiles) {
   deep.header();
   for (int k = 0; k < 200; ++k) deep.group("g"), deep.push();
   EXPECT_TRUE(contains(error(deep.bytes), "nesting deeper than 128 levels"));
+  // A switch of 2^25 masks of no words and no children: its record holds none of their bits, so
+  // its size did not bound them, and each placed an empty mask (a fuzzed file of 972 bytes asked
+  // for 2.7 GB). Every mask counts against the loader's bound on mask flags.
+  FltWriter masks;
+  masks.header();
+  masks.push();
+  masks.switchNode("sw", 0, {}, 1 << 25, 0);
+  masks.pop();
+  EXPECT_EQ(error(masks.bytes), "bad.flt: switches hold more than 16777216 mask flags");
   // A degree of freedom placed beyond float's range (finite in the file's doubles), directly or
   // through a matrix above it: refused rather than loaded as a scene its validation fails.
   for (bool byMatrix : {false, true}) {
