@@ -4,6 +4,7 @@
 // column-major (m[col][row], as glTF stores them) and act on column vectors: p' = M·p.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -42,10 +43,19 @@ inline bool isFinite(Vec3 a) {
   constexpr float kMax = std::numeric_limits<float>::max();
   return (std::fabs(a.x) <= kMax) & (std::fabs(a.y) <= kMax) & (std::fabs(a.z) <= kMax);
 }
-// Returns `a` scaled to unit length, or `a` unchanged when it has zero length.
+// Returns `a` scaled to unit length, or `a` unchanged when it is zero or not finite.
 inline Vec3 normalize(Vec3 a) {
-  float l = length(a);
-  return l > 0 ? a * (1.0f / l) : a;
+  constexpr float kMin = std::numeric_limits<float>::min(),
+                  kMax = std::numeric_limits<float>::max();
+  const float d = dot(a, a);
+  if (d >= kMin && d <= kMax) return a * (1.0f / std::sqrt(d));
+  // The squared length overflowed (components beyond ~1e19) or fell below float's normal range
+  // (below ~1e-19, where it loses bits and 1 / length can overflow): divided by its largest
+  // component first, the vector has a length in [1, √3].
+  const float m = std::max(std::fabs(a.x), std::max(std::fabs(a.y), std::fabs(a.z)));
+  if (!(m > 0 && m <= kMax) || !isFinite(a)) return a;
+  const Vec3 b{a.x / m, a.y / m, a.z / m};
+  return b * (1.0f / length(b));
 }
 
 // 4×4 matrix, column-major: m[c][r] is row r of column c.

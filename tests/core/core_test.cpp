@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <vector>
 
 #include "core/check.h"
@@ -64,6 +65,30 @@ TEST(Streaming, GatherCopiesWholeRecordsOrTheirPrefixInTheGivenOrder) {
   core::gatherStreaming(to.data(), from.data(), swap, 2, 8);
   EXPECT_EQ(to[0].v[2], 6u);
   EXPECT_EQ(to[1].v[0], 1u);
+}
+
+// A finite non-zero vector of any size has a unit direction: a length that overflows (1e30: its
+// square is beyond float) or underflows (1e-25) must not give a zero or infinite vector (a fuzzed
+// OpenFlight light faced 1e30-long normals and got direction 0, which validation refuses).
+TEST(Vec3, NormalizeGivesAUnitVectorForAnyFiniteNonZeroVector) {
+  for (float s : {1.0f, 1e30f, 3e38f, 1e-20f, 1e-25f, 1e-40f}) {
+    for (Vec3 v : {Vec3{s, 0, 0}, Vec3{s, -s, s}, Vec3{0, 0, -s}, Vec3{s, s * 0.5f, 0}}) {
+      const Vec3 n = normalize(v);
+      EXPECT_TRUE(isFinite(n)) << s;
+      EXPECT_NEAR(length(n), 1.0f, 1e-6f) << s;
+      EXPECT_GT(dot(n, v), 0.0f) << s;  // the same direction
+    }
+  }
+  // The common case keeps its bits: a · (1 / |a|).
+  const Vec3 a{3, -4, 12};
+  const Vec3 n = normalize(a);
+  const float inv = 1.0f / length(a);
+  EXPECT_EQ(n, (Vec3{a.x * inv, a.y * inv, a.z * inv}));
+  // Zero and non-finite vectors come back unchanged.
+  EXPECT_EQ(normalize(Vec3{0, 0, 0}), (Vec3{0, 0, 0}));
+  const float inf = std::numeric_limits<float>::infinity();
+  EXPECT_EQ(normalize(Vec3{inf, 0, 0}), (Vec3{inf, 0, 0}));
+  EXPECT_FALSE(isFinite(normalize(Vec3{std::nanf(""), 1, 0})));
 }
 
 TEST(Mat4, NormalMatrixKeepsNormalsPerpendicularUnderNonUniformScale) {
