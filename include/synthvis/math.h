@@ -52,8 +52,9 @@ inline Vec3 normalize(Vec3 a) {
   // The squared length overflowed (components beyond ~1e19) or fell below float's normal range
   // (below ~1e-19, where it loses bits and 1 / length can overflow): divided by its largest
   // component first, the vector has a length in [1, √3].
+  if (!isFinite(a)) return a;
   const float m = std::max(std::fabs(a.x), std::max(std::fabs(a.y), std::fabs(a.z)));
-  if (!(m > 0 && m <= kMax) || !isFinite(a)) return a;
+  if (m == 0) return a;
   const Vec3 b{a.x / m, a.y / m, a.z / m};
   return b * (1.0f / length(b));
 }
