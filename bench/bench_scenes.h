@@ -11,12 +11,12 @@ namespace sv::bench {
 
 inline render::DrawPackets trisPackets(int count, double area, int width = 1920,
                                        int height = 1080) {
-  scene::TrisParams p;
+  generators::TrisParams p;
   p.count = count;
   p.area = area;
   p.width = width;
   p.height = height;
-  const scene::Scene s = scene::generateTris(p);
+  const scene::Scene s = generators::generateTris(p);
   render::DrawPackets packets;
   const Mat4 vp = Mat4::perspective(60 * std::numbers::pi_v<float> / 180,
                                     float(width) / float(height), 0.1f, 100) *

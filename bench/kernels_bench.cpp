@@ -24,8 +24,8 @@
 #include "raster/framebuffer.h"
 #include "raster/rasterizer.h"
 #include "render/camera.h"
+#include "render/draw_packets.h"
 #include "render/frame_renderer.h"
-#include "render/traversal.h"
 #include "synthvis/generators.h"
 #include "texture/texture.h"
 
@@ -255,7 +255,7 @@ BENCHMARK(BM_ResolveFrame);
 // instance tree classified, every instance's level chosen; argument 1: through the tree, 0: every
 // instance tested on its own.
 void BM_TraverseCity(benchmark::State& state) {
-  scene::Scene city = scene::generateCity({});
+  scene::Scene city = generators::generateCity({});
   if (!state.range(0)) city.instanceTree.reset();
   RenderOptions o;
   o.width = 1920;
@@ -264,9 +264,10 @@ void BM_TraverseCity(benchmark::State& state) {
   std::vector<std::array<Vec3, 2>> bounds;
   for (const scene::Mesh& m : city.meshes) bounds.push_back(m.bounds());
   core::ThreadPool pool(1);
-  render::Traversal t;
+  traversal::Traversal t;
   for (auto _ : state) {
-    render::traverse(city, o, camera, bounds, pool, t);
+    traversal::traverse(city, render::traversalOptions(o), render::traversalView(camera), bounds,
+                        pool, t);
     benchmark::DoNotOptimize(t.draws.data());
   }
   state.counters["instances/s"] = benchmark::Counter(

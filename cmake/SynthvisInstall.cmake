@@ -6,9 +6,9 @@
 # itself (apps/synthvis). tests/install builds a small program against an installed copy.
 include(CMakePackageConfigHelpers)
 
-set(SV_INSTALLED_STAGES sv_core sv_texture sv_terrain sv_scene sv_geometry sv_shade sv_raster sv_freeform
-    sv_lights sv_lines sv_segments sv_volume sv_display
-    sv_output sv_render)
+set(SV_INSTALLED_STAGES sv_core sv_texture sv_scene_records sv_scene sv_formats sv_generators
+    sv_traversal sv_geometry sv_shade sv_raster sv_terrain sv_freeform sv_lights sv_lines
+    sv_segments sv_volume sv_display sv_output sv_render)
 foreach(lib IN LISTS SV_INSTALLED_STAGES)
   string(REPLACE "sv_" "" stage ${lib})
   set_target_properties(${lib} PROPERTIES EXPORT_NAME ${stage})
@@ -27,8 +27,9 @@ install(FILES ${PROJECT_BINARY_DIR}/synthvisConfig.cmake
 # pkg-config: the libraries in link order (each before what it uses); the dependencies' own .pc
 # files in Requires, since the libraries are static.
 set(SV_PC_LIBS "")
-foreach(lib sv_render sv_display sv_output sv_volume sv_segments sv_lines sv_lights sv_freeform sv_raster sv_shade sv_geometry sv_scene sv_terrain sv_texture
-            sv_core)
+foreach(lib sv_generators sv_render sv_traversal sv_display sv_output sv_volume sv_segments
+            sv_lines sv_lights sv_freeform sv_formats sv_terrain sv_raster sv_shade sv_geometry
+            sv_scene sv_texture sv_core)
   string(APPEND SV_PC_LIBS " -l${lib}")
 endforeach()
 # Relocatable: the prefix is found from the .pc file's own place, wherever --prefix put it.

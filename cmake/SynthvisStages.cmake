@@ -26,6 +26,11 @@ function(sv_publish_headers target)
   if(installed)
     install(FILES ${installed} DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}/synthvis")
   endif()
-  target_include_directories(${target} PUBLIC "$<BUILD_INTERFACE:${root}>"
-                                              "$<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>")
+  get_target_property(type ${target} TYPE)
+  set(scope PUBLIC)
+  if(type STREQUAL "INTERFACE_LIBRARY")  # header-only: its users see the root, it has no sources
+    set(scope INTERFACE)
+  endif()
+  target_include_directories(${target} ${scope} "$<BUILD_INTERFACE:${root}>"
+                                                "$<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>")
 endfunction()

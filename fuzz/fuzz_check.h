@@ -8,9 +8,12 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "synthvis/scene.h"
+#include "synthvis/formats.h"
 
-namespace sv::scene::fuzz {
+namespace sv::formats::fuzz {
+
+using scene::kMaxVolumeSide;
+using scene::VolumeGrid;
 
 // Limits for fuzzing: no file access at all, and a triangle budget small enough that the largest
 // accepted input still runs in milliseconds. The paths the targets pass name a directory that
@@ -64,4 +67,4 @@ inline void checkVolume(const Result<VolumeGrid>& r, size_t maxSamples) {
   }
 }
 
-}  // namespace sv::scene::fuzz
+}  // namespace sv::formats::fuzz

@@ -6,7 +6,7 @@
 #include "fuzz_check.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  using namespace sv::scene;
+  using namespace sv::formats;
   std::string bytes(reinterpret_cast<const char*>(data), size);
   fuzz::checkResult(
       parseOpenFlight(bytes, "/nonexistent-synthvis-fuzz/model.flt", fuzz::fuzzOptions()));

@@ -8,14 +8,15 @@
 #include <string>
 
 #include "fuzz_check.h"
+#include "synthvis/formats.h"
 #include "synthvis/render.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace sv;
   const std::string text(reinterpret_cast<const char*>(data), size);
-  const Result<scene::Scene> r = scene::parseJsonScene(
-      text, "/nonexistent-synthvis-fuzz/scene.json", scene::fuzz::fuzzOptions());
-  scene::fuzz::checkResult(r);
+  const Result<scene::Scene> r = formats::parseJsonScene(
+      text, "/nonexistent-synthvis-fuzz/scene.json", formats::fuzz::fuzzOptions());
+  formats::fuzz::checkResult(r);
   if (!r.ok() || r.value().freeForms.empty()) return 0;
   scene::Scene s = r.value();
   s.meshes.clear();

@@ -17,8 +17,8 @@
 #include <string>
 #include <vector>
 
+#include "formats/heights.h"
 #include "png_crc.h"
-#include "terrain/height_field.h"
 
 namespace {
 
@@ -33,7 +33,7 @@ void check(bool ok, const char* what) {
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  namespace tr = sv::terrain;
+  namespace tr = sv::formats;
   // GDAL's block cache, process-wide, small: inputs are small and the fuzzer's RSS limit counts it.
   static const bool configured = [] {
     CPLSetConfigOption("GDAL_CACHEMAX", "16");  // MB

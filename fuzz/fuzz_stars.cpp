@@ -8,11 +8,12 @@
 #include <cstdlib>
 #include <string_view>
 
+#include "synthvis/formats.h"
 #include "synthvis/scene.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);
-  const auto r = sv::scene::parseStarCatalog(text, "fuzz.BSC");
+  const auto r = sv::formats::parseStarCatalog(text, "fuzz.BSC");
   if (!r.ok()) {
     if (r.error().message.empty()) std::abort();
     return 0;

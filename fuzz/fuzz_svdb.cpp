@@ -6,11 +6,11 @@
 #include <cstring>
 #include <string>
 
+#include "formats/svdb.h"
 #include "fuzz_check.h"
-#include "scene/database.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  using namespace sv::scene;
+  using namespace sv::formats;
   std::string bytes(reinterpret_cast<const char*>(data), size);
   if (bytes.size() >= detail::kDatabaseHeaderBytes) {
     const uint64_t payload = bytes.size() - detail::kDatabaseHeaderBytes;

@@ -9,11 +9,12 @@
 #include <string>
 
 #include "fuzz_check.h"
+#include "synthvis/formats.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   constexpr size_t kBudget = size_t(1) << 20;
   const std::string bytes(reinterpret_cast<const char*>(data), size);
-  sv::scene::fuzz::checkVolume(
-      sv::scene::parseVolume(bytes, "/nonexistent/fuzz.vdb", false, kBudget), kBudget);
+  sv::formats::fuzz::checkVolume(
+      sv::formats::parseVolume(bytes, "/nonexistent/fuzz.vdb", false, kBudget), kBudget);
   return 0;
 }

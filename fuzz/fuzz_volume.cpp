@@ -9,13 +9,14 @@
 #include <string>
 
 #include "fuzz_check.h"
+#include "synthvis/formats.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size >= 8 && std::memcmp(data, "\x20\x42\x44\x56\0\0\0\0", 8) == 0) return 0;
   const std::string bytes(reinterpret_cast<const char*>(data), size);
   for (const char* name :
        {"/nonexistent/fuzz.nii", "/nonexistent/fuzz.nii.gz", "/nonexistent/fuzz.nrrd"})
-    sv::scene::fuzz::checkVolume(sv::scene::parseVolume(bytes, name, false),
-                                 sv::scene::kMaxVolumeSamples);
+    sv::formats::fuzz::checkVolume(sv::formats::parseVolume(bytes, name, false),
+                                   sv::scene::kMaxVolumeSamples);
   return 0;
 }

@@ -41,7 +41,7 @@
 #include <optional>
 
 #include "cluster/cluster.h"
-#include "core/write_file.h"
+#include "core/files.h"
 #include "display/mpcdi.h"
 #include "ig/config.h"
 #include "ig/host.h"
@@ -50,6 +50,7 @@
 #include "reference/ground_truth.h"
 #include "reference/suite.h"
 #include "render/correction.h"
+#include "synthvis/formats.h"
 #include "synthvis/generators.h"
 #include "synthvis/image.h"
 #include "synthvis/render.h"
@@ -67,8 +68,8 @@ int fail(const sv::Error& e) {
 // The scene at `path`, or the built-in demo scene when no path is given; what the file holds but
 // is not drawn is printed as warnings.
 sv::Result<sv::scene::Scene> loadSceneOrDemo(const std::string& path) {
-  if (path.empty()) return sv::scene::demoScene();
-  sv::Result<sv::scene::Scene> scene = sv::scene::loadScene(path);
+  if (path.empty()) return sv::formats::demoScene();
+  sv::Result<sv::scene::Scene> scene = sv::formats::loadScene(path);
   if (scene)
     for (const std::string& w : scene->warnings) fmt::print(stderr, "synthvis: warning: {}\n", w);
   return scene;
@@ -307,7 +308,7 @@ int runRender(const RenderArgs& a) {
 
 // The parameters of BENCH.md's generators, shared by `bench` and `gen`.
 struct GeneratorArgs {
-  sv::scene::TrisParams tris;
+  sv::generators::TrisParams tris;
   int layers = 4;
   std::string order = "random";
   int objects = 100;
@@ -315,8 +316,8 @@ struct GeneratorArgs {
   std::string terrainFilter = "bilinear";
   std::string stars = "auto";  // lights: the star catalogue, "auto" or "none"
   int lights = 100000;         // lights: light points per channel, stars included
-  sv::scene::CityParams city;
-  sv::scene::VolumeParams volume;
+  sv::generators::CityParams city;
+  sv::generators::VolumeParams volume;
 };
 
 // lights --stars auto: xplanet's catalogue where Debian installs it, or where scripts/lib.sh
@@ -396,9 +397,9 @@ struct BenchArgs {
 // a later feature, or an unknown one.
 sv::Result<sv::reference::BenchCase> generatorCase(const std::string& kind,
                                                    const GeneratorArgs& g) {
-  auto generator = sv::scene::parseGenerator(kind);
+  auto generator = sv::generators::parseGenerator(kind);
   if (!generator) return generator.error();
-  auto order = sv::scene::parseSubmitOrder(g.order);
+  auto order = sv::generators::parseSubmitOrder(g.order);
   if (!order) return order.error();
   sv::reference::BenchCase c;
   c.name = kind;
@@ -479,7 +480,7 @@ int runBench(BenchArgs a) {
                  fmt::format("unknown renderer '{}' (synthvis, gl, vtk, both, sphere-trace, "
                              "tessellated, full-detail, display or segments)",
                              a.renderer)});
-  if (auto order = sv::scene::parseSubmitOrder(a.generator.order); !order)
+  if (auto order = sv::generators::parseSubmitOrder(a.generator.order); !order)
     return fail(order.error());
   if (a.repeat < 1 || a.repeat > 100)
     return fail({"", "", fmt::format("--repeat {}: must be 1…100", a.repeat)});
@@ -497,7 +498,7 @@ int runBench(BenchArgs a) {
     cases = std::move(c).value();
   } else {
     ref::BenchCase c;
-    if (sv::scene::parseGenerator(a.scene).ok()) {
+    if (sv::generators::parseGenerator(a.scene).ok()) {
       auto g = generatorCase(a.scene, a.generator);
       if (!g) return fail(g.error());
       c = g.value();
@@ -630,7 +631,8 @@ int runGen(const GenArgs& a) {
   o.height = a.height;
   auto made = sv::reference::makeScene(c.value(), o);
   if (!made) return fail(made.error());
-  if (sv::Status s = sv::scene::saveGltf(made.value().scene, a.output); !s) return fail(s.error());
+  if (sv::Status s = sv::formats::saveGltf(made.value().scene, a.output); !s)
+    return fail(s.error());
   if (made.value().meanArea > 0)
     fmt::print("{}: {} {} triangles, mean area {:.1f} px at {}x{}, depth complexity {:.2f}\n",
                a.output, a.kind, made.value().scene.triangleCount(), made.value().meanArea, a.width,
@@ -658,7 +660,7 @@ int runPrep(const PrepArgs& a) {
   };
   auto t0 = Clock::now();
   sv::Result<sv::scene::Scene> loaded = sv::Error{"", "", ""};
-  if (sv::scene::parseGenerator(a.input).ok()) {
+  if (sv::generators::parseGenerator(a.input).ok()) {
     auto c = generatorCase(a.input, a.generator);
     if (!c) return fail(c.error());
     auto made = sv::reference::makeScene(c.value(), sv::RenderOptions{});
@@ -683,11 +685,11 @@ int runPrep(const PrepArgs& a) {
   if (!report) return fail(report.error());
   fmt::print("prep: prepared in {:.2f} s: {}\n", seconds(t0), report->summary());
   t0 = Clock::now();
-  if (sv::Status s = sv::scene::saveDatabase(scene, a.output); !s) return fail(s.error());
+  if (sv::Status s = sv::formats::saveDatabase(scene, a.output); !s) return fail(s.error());
   const double written = seconds(t0);
   // The load time a user of the database will see: mapped, checked, copied out.
   t0 = Clock::now();
-  auto back = sv::scene::loadDatabase(a.output);
+  auto back = sv::formats::loadDatabase(a.output);
   if (!back) return fail(back.error());
   const double load = seconds(t0);
   std::error_code ec;
@@ -817,7 +819,7 @@ int runTerrainQuery(const std::string& scenePath, const std::vector<double>& at,
                                      filterName)});
   if (at.empty() == los.empty())
     return fail({"", "", "give one query: --height X,Y,Z or --los X,Y,Z,X,Y,Z"});
-  auto loaded = sv::scene::loadScene(scenePath);
+  auto loaded = sv::formats::loadScene(scenePath);
   if (!loaded) return fail(loaded.error());
   const sv::scene::Scene& scene = loaded.value();
   if (scene.terrains.empty()) return fail({scenePath, "", "the scene has no terrain"});
@@ -1160,7 +1162,7 @@ int main(int argc, char** argv) {
   if (*render) return runRender(r);
   if (*bench) {
     // BENCH.md's freeform-one is 1024 × 1024 unless the size is given.
-    if (b.scene == sv::scene::generatorName(sv::scene::Generator::freeformOne) &&
+    if (b.scene == sv::generators::generatorName(sv::generators::Generator::freeformOne) &&
         bench->count("--width") == 0 && bench->count("--height") == 0)
       b.options.width = b.options.height = 1024;
     return runBench(b);

@@ -1,12 +1,16 @@
-// Seeded, deterministic benchmark scenes exactly as shared BENCH.md defines them.
+// Seeded, deterministic benchmark scenes exactly as shared BENCH.md defines them (src/generators,
+// beside the bench harness that runs them).
 #pragma once
 
 #include <cstdint>
 #include <string>
 
+#include "synthvis/result.h"
 #include "synthvis/scene.h"
 
-namespace sv::scene {
+namespace sv::generators {
+
+using scene::Scene;
 
 // BENCH.md's generators, one per kind of benchmark scene. `none`: a scene from a file.
 enum class Generator : uint8_t {
@@ -155,18 +159,6 @@ struct VolumeParams {
 };
 Scene generateVolume(const VolumeParams& params);
 
-// The Marschner–Lobb test signal (Marschner and Lobb 1994, f_M = 6, α = 1/4) on [−1, 1]³, in
-// [0, 1]: ρ = (1 − sin(πz/2) + α(1 + cos(2π f_M cos(π r / 2)))) / (2(1 + α)), r = √(x² + y²).
-double marschnerLobb(double x, double y, double z);
-// It sampled on a size³ grid spanning [−1, 1]³ (spacing 2/(size − 1), its own space's origin at
-// (−1, −1, −1): place it by a translation of (−1, −1, −1)), quantized to `bits` (8 or 16) — values
-// 0 … 1. size 2 … 1024.
-VolumeGrid marschnerLobbGrid(int size, int bits = 8);
-// A seeded cloud: fractal value noise (4 octaves) over a size × size/4 × size grid (x, z across,
-// y up; spacing 1), thinned toward the layer's top and bottom and cut below `cover` (0 … 1: the
-// share of the layer left empty), 8-bit densities 0 … 1. size 8 … 1024.
-VolumeGrid cloudGrid(int size, uint64_t seed, float cover = 0.55f);
-
 // The frame every generated scene shares: one instance of mesh 0 with material 0 (unlit,
 // double-sided, named `name`), the BENCH.md camera, no light, black background. No meshes yet.
 Scene benchCameraScene(const std::string& name);
@@ -177,4 +169,4 @@ void addBenchTexture(Scene& s);
 // nearest surfaces (distance 2) keep 87 % of their colour and the farthest (20) a quarter.
 void addBenchFog(Scene& s);
 
-}  // namespace sv::scene
+}  // namespace sv::generators

@@ -1,4 +1,5 @@
-// The scene database (SPEC §1, stage 1): what the loaders build and the renderer consumes.
+// The scene database (SPEC §1, stage 1): what the readers (synthvis/formats.h) and generators
+// build, and what the renderer consumes.
 //
 // A Scene is plain data: meshes (triangle lists with per-vertex attributes), materials, instances
 // placing meshes in the world, cameras, one directional light and a background colour.
@@ -13,18 +14,15 @@
 #include <string_view>
 #include <vector>
 
+#include "synthvis/height_field.h"
 #include "synthvis/light_points.h"
 #include "synthvis/lines.h"
 #include "synthvis/math.h"
-#include "synthvis/volumes.h"
 #include "synthvis/result.h"
+#include "synthvis/volumes.h"
 
 namespace sv::texture {
 class Texture;  // src/texture/texture.h: a decoded image, its MIP pyramid and wrap modes
-}
-
-namespace sv::terrain {
-struct Ground;  // src/terrain/ground.h: a height table and its min/max pyramids
 }
 
 namespace sv::scene {
@@ -250,13 +248,9 @@ struct FreeFormObject {
 // World placement: map east is +x, north is −z, height +y; the map position `origin` (metres)
 // lies at the world origin. Base: the plane y = 0, or a sphere of radius `baseRadius` through
 // the origin (centre (0, −baseRadius, 0)), heights along its radius.
-struct TerrainColorStop {
-  double height = 0;  // metres
-  Vec3 color;         // linear
-};
 struct Terrain {
   std::string name;
-  std::shared_ptr<const terrain::Ground> ground;
+  std::shared_ptr<const HeightField> heights;  // the table (synthvis/height_field.h)
   double origin[2] = {0, 0};  // map (east, north), metres, at the world origin
   double baseRadius = 0;      // 0: a plane
   bool bicubic = false;       // interpolation below the finest level (else bilinear)
@@ -418,86 +412,5 @@ std::array<Vec3, 2> instanceBounds(const Scene& scene, const Instance& instance,
 // Appends `other`'s meshes and materials to `scene`, placing each of `other`'s instances under
 // `transform`. Cameras and light of `other` are appended/ignored as documented in scene-format.md.
 void appendScene(Scene& scene, Scene other, const Mat4& transform);
-
-// Loaders. Each reads one file and returns a Scene or an Error naming the file and the problem.
-// They never crash, hang or allocate without bound on malformed input (each has a fuzz target).
-// The formats and every limit are described in docs/scene-format.md.
-// By extension: .json, .gltf, .glb, .obj, .flt, .svdb (a prepared database); any other through
-// Assimp.
-Result<Scene> loadScene(const std::string& path);
-Result<Scene> loadJsonScene(const std::string& path);
-// Parses JSON scene text; `path` names it in errors and is the base for relative mesh paths.
-Result<Scene> parseJsonScene(const std::string& text, const std::string& path);
-Result<Scene> loadGltf(const std::string& path);
-Result<Scene> loadObj(const std::string& path);
-// The star catalogue (docs/lights.md#stars): xplanet's Bright Star Catalogue format — per line
-// declination (degrees), right ascension (hours), magnitude, an optional B−V colour index, then
-// anything (a quoted name, numbers); '#' comments. Errors name the file and line.
-Result<std::vector<Star>> loadStarCatalog(const std::string& path);
-Result<std::vector<Star>> parseStarCatalog(std::string_view text, const std::string& path);
-// A star's linear colour (maximum component 1) from its B−V index: the black-body temperature
-// by Ballesteros' formula, its chromaticity by a fit of the Planckian locus.
-Vec3 starColor(float bv);
-
-// Limits and switches shared by all loaders. The defaults suit files from disk.
-struct LoadOptions {
-  // Most triangles one loaded scene may hold, counted over all instances.
-  uint64_t maxTriangles = uint64_t(1) << 26;
-  // Longest chain of scene files referencing scene files below the one being loaded.
-  int maxNesting = 8;
-  // False: never open any other file (referenced meshes, .mtl libraries, external glTF buffers
-  // and images all fail as missing). For untrusted text and fuzzing.
-  bool followReferences = true;
-  // Most texels (full-resolution images, summed over the textures of one file) a load may decode
-  // or generate: 2^28 texels hold 2 GiB with their pyramids.
-  uint64_t maxTexels = uint64_t(1) << 28;
-};
-
-Result<Scene> loadScene(const std::string& path, const LoadOptions& options);
-// A volume file (docs/scene-format.md "Volumes"): NIfTI-1 (.nii, .nii.gz: one volume, unsigned
-// or signed 8-, 16- or 32-bit, float or double, scl_slope and scl_inter applied, the voxel sizes
-// as its spacing), NRRD (.nrrd, or .nhdr with a detached data file; 3 dimensions, raw or gzip,
-// spacings or space directions' lengths) or OpenVDB (.vdb, recognized by its magic: the grid
-// named "density", else the first float, double or int32 grid by name, densified over its active
-// voxels' bounding box; a linear transform's voxel size as the spacing; read by the OpenVDB
-// library in a child process with a time and a memory limit, since that reader is not hardened).
-// Orientation (qform, sform, space origin, an OpenVDB transform's rotation and translation) is
-// not applied: the volume's own space is index × spacing, placed by the scene. Every size is
-// checked before allocating; the error names the file and the problem. parseVolume reads
-// `bytes`, the whole file, named `path` (whose directory a detached data file is found in, unless
-// !followReferences), and refuses a grid of more than `maxSamples` (at most kMaxVolumeSamples): a
-// short OpenVDB file may describe a large grid.
-Result<VolumeGrid> loadVolume(const std::string& path);
-Result<VolumeGrid> parseVolume(const std::string& bytes, const std::string& path,
-                               bool followReferences, size_t maxSamples = kMaxVolumeSamples);
-Result<Scene> parseJsonScene(const std::string& text, const std::string& path,
-                             const LoadOptions& options);
-// In-memory variants of loadGltf and loadObj: `path` names the input in errors and is the base
-// for its relative references. `bytes` may be .gltf text or .glb (recognized by its magic).
-Result<Scene> loadGltfFromMemory(const std::string& bytes, const std::string& path,
-                                 const LoadOptions& options = {});
-Result<Scene> parseObj(const std::string& text, const std::string& path,
-                       const LoadOptions& options = {});
-// OpenFlight (.flt, revisions 15.0 to 16.x; docs/scene-format.md "OpenFlight"): `bytes` the whole
-// file, `path` names it and is the base for its textures and external references.
-Result<Scene> parseOpenFlight(const std::string& bytes, const std::string& path,
-                              const LoadOptions& options = {});
-
-// The prepared database (docs/prep.md, `synthvis prep`): the scene's own arrays in one file,
-// versioned and checksummed, loaded by mapping the file. Terrain is not stored (an error).
-Status saveDatabase(const Scene& scene, const std::string& path);
-Result<Scene> loadDatabase(const std::string& path, const LoadOptions& options = {});
-// The same from bytes in memory (`path` names them in errors).
-Result<Scene> parseDatabase(const char* data, size_t size, const std::string& path,
-                            const LoadOptions& options = {});
-
-// Writes `scene` as glTF 2.0: binary for a path ending in .glb, text with the buffer embedded for
-// .gltf. loadGltf reads it back to the same meshes, materials, instances and cameras.
-Status saveGltf(const Scene& scene, const std::string& path);
-
-// The built-in demo scene (scenes/demo.json compiled into the binary).
-Scene demoScene();
-// The text of the built-in demo scene.
-const char* demoSceneJson();
 
 }  // namespace sv::scene

@@ -13,7 +13,7 @@
 #include <memory>
 
 #include "cigi/cigi.h"
-#include "core/write_file.h"
+#include "core/files.h"
 
 namespace sv::cigi {
 namespace {

@@ -21,7 +21,7 @@
 #include <numbers>
 #include <set>
 
-#include "core/write_file.h"
+#include "core/files.h"
 #include "display/zip_memory.h"
 #include "texture/png.h"
 

@@ -17,7 +17,7 @@
 #include "cigi/cigi.h"
 #include "cigi/pcap.h"
 #include "cluster/cluster.h"
-#include "core/write_file.h"
+#include "core/files.h"
 #include "ig/overload.h"
 #include "ig/udp.h"
 #include "ig/world.h"

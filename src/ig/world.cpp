@@ -9,6 +9,7 @@
 #include <cstring>
 #include <numbers>
 
+#include "synthvis/formats.h"
 #include "synthvis/terrain.h"
 
 namespace sv::ig {
@@ -29,11 +30,11 @@ float fogBetaForVisibility(float v) { return float(std::log2(20.0) / double(v));
 Result<IgWorld> IgWorld::load(const IgConfig& config) {
   IgWorld w;
   w.config_ = config;
-  Result<scene::Scene> db = scene::loadScene(config.scene);
+  Result<scene::Scene> db = formats::loadScene(config.scene);
   if (!db) return db.error();
   w.base_ = std::move(db.value());
   for (const auto& [type, file] : config.models) {
-    Result<scene::Scene> model = scene::loadScene(file);
+    Result<scene::Scene> model = formats::loadScene(file);
     if (!model) return model.error();
     if (!model->freeForms.empty() || !model->terrains.empty())
       return Error{file, "", "an entity model holds triangles only (free forms and terrain belong to the database)"};

@@ -1,6 +1,6 @@
 // The database preparation system (SPEC §1; seed 004 names it beside the image generator): what
 // `synthvis prep` does to a loaded scene before writing it as a prepared database
-// (scene::saveDatabase) — docs/prep.md.
+// (formats::saveDatabase) — docs/prep.md.
 //
 //   1. Optimize every mesh for the renderer (meshoptimizer): vertices deduplicated and put in the
 //      order the triangles first use them (vertex fetch). Triangle order is kept: the image is

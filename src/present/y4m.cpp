@@ -11,7 +11,7 @@
 #include <cstring>
 #include <memory>
 
-#include "core/write_file.h"
+#include "core/files.h"
 #include "present/async_writer.h"
 #include "present/outputs.h"
 

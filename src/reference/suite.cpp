@@ -10,12 +10,13 @@
 #include <limits>
 #include <optional>
 
+#include "core/files.h"
 #include "core/timing.h"
-#include "core/write_file.h"
 #include "reference/gl_renderer.h"
 #include "reference/vtk_volume.h"
 #include "render/correction.h"
 #include "render/view_renderer.h"
+#include "synthvis/formats.h"
 
 namespace sv::reference {
 namespace {
@@ -38,7 +39,7 @@ void finish(RendererRun& r) {
 
 BenchCase trisCase(int count, double area) {
   BenchCase c;
-  c.generator = scene::Generator::tris;
+  c.generator = generators::Generator::tris;
   c.tris.count = count;
   c.tris.area = area;
   const std::string n =
@@ -47,19 +48,19 @@ BenchCase trisCase(int count, double area) {
   return c;
 }
 
-BenchCase layersCase(int layers, scene::SubmitOrder order) {
+BenchCase layersCase(int layers, generators::SubmitOrder order) {
   BenchCase c;
-  c.generator = scene::Generator::layers;
+  c.generator = generators::Generator::layers;
   c.layers.layers = layers;
   c.layers.order = order;
-  c.name = fmt::format("layers-d{}-{}", layers, scene::submitOrderName(order));
+  c.name = fmt::format("layers-d{}-{}", layers, generators::submitOrderName(order));
   return c;
 }
 
 }  // namespace
 
 Result<std::vector<BenchCase>> suiteCases(const std::string& suite) {
-  using scene::SubmitOrder;
+  using generators::SubmitOrder;
   std::vector<BenchCase> cases;
   if (suite == "quick") {
     for (int count : {10000, 100000})
@@ -74,16 +75,17 @@ Result<std::vector<BenchCase>> suiteCases(const std::string& suite) {
            {SubmitOrder::random, SubmitOrder::frontToBack, SubmitOrder::backToFront})
         cases.push_back(layersCase(d, o));
     // Free forms (issue 7), at the suite's raster; the gl reference draws them tessellated.
-    for (const scene::Generator g : {scene::Generator::freeform, scene::Generator::freeformOne}) {
+    for (const generators::Generator g :
+         {generators::Generator::freeform, generators::Generator::freeformOne}) {
       BenchCase c;
       c.generator = g;
-      c.name = scene::generatorName(g);
+      c.name = generators::generatorName(g);
       cases.push_back(c);
     }
     // Terrain (issue 29) at 1024² heights, the size whose full-resolution grid the gl reference
     // draws (2.1 M triangles).
     BenchCase t;
-    t.generator = scene::Generator::terrain;
+    t.generator = generators::Generator::terrain;
     t.terrain.size = 1024;
     t.name = "terrain-1024";
     cases.push_back(t);
@@ -95,56 +97,56 @@ Result<std::vector<BenchCase>> suiteCases(const std::string& suite) {
 
 Result<CaseScene> makeScene(const BenchCase& c, const RenderOptions& options) {
   CaseScene out;
-  scene::TrisStats realized;
-  if (c.generator == scene::Generator::tris) {
-    scene::TrisParams t = c.tris;
+  generators::TrisStats realized;
+  if (c.generator == generators::Generator::tris) {
+    generators::TrisParams t = c.tris;
     if (t.count < 0 || t.count > 20'000'000 || !(t.area > 0 && t.area <= 1e7) || !(t.depth >= 0))
       return Error{"", "", "tris: count must be 0…2e7, area in (0, 1e7] px, depth ≥ 0"};
     t.width = options.width;
     t.height = options.height;
-    out.scene = scene::generateTris(t, &realized);
+    out.scene = generators::generateTris(t, &realized);
     out.params = {{"count", t.count},
                   {"area", t.area},
                   {"depth", t.depth},
-                  {"order", scene::submitOrderName(t.order)},
+                  {"order", generators::submitOrderName(t.order)},
                   {"seed", t.seed}};
-  } else if (c.generator == scene::Generator::layers) {
-    scene::LayersParams l = c.layers;
+  } else if (c.generator == generators::Generator::layers) {
+    generators::LayersParams l = c.layers;
     if (l.layers < 1 || l.layers > 64) return Error{"", "", "layers: D must be 1…64"};
     l.width = options.width;
     l.height = options.height;
-    out.scene = scene::generateLayers(l, &realized);
+    out.scene = generators::generateLayers(l, &realized);
     out.params = {
-        {"layers", l.layers}, {"order", scene::submitOrderName(l.order)}, {"seed", l.seed}};
-  } else if (c.generator == scene::Generator::grazing) {
-    out.scene = scene::generateGrazing(c.grazing);
+        {"layers", l.layers}, {"order", generators::submitOrderName(l.order)}, {"seed", l.seed}};
+  } else if (c.generator == generators::Generator::grazing) {
+    out.scene = generators::generateGrazing(c.grazing);
     out.params = {{"seed", c.grazing.seed}};
     return out;  // no target area or depth complexity to report
-  } else if (c.generator == scene::Generator::freeform) {
-    scene::FreeFormParams f = c.freeform;
+  } else if (c.generator == generators::Generator::freeform) {
+    generators::FreeFormParams f = c.freeform;
     if (f.count < 0 || f.count > 100000) return Error{"", "", "freeform: objects must be 0…100000"};
     f.width = options.width;
     f.height = options.height;
-    out.scene = scene::generateFreeForms(f);
+    out.scene = generators::generateFreeForms(f);
     out.params = {{"objects", f.count}, {"seed", f.seed}};
     return out;
-  } else if (c.generator == scene::Generator::freeformOne) {
-    out.scene = scene::generateFreeFormOne();
+  } else if (c.generator == generators::Generator::freeformOne) {
+    out.scene = generators::generateFreeFormOne();
     out.params = {{"objects", 1}, {"perturbations", 6}};
     return out;
-  } else if (c.generator == scene::Generator::terrain) {
-    Result<scene::Scene> t = scene::generateTerrain(c.terrain);
+  } else if (c.generator == generators::Generator::terrain) {
+    Result<scene::Scene> t = generators::generateTerrain(c.terrain);
     if (!t) return t.error();
     out.scene = std::move(t).value();
     out.params = {{"size", c.terrain.size},
                   {"seed", c.terrain.seed},
                   {"interpolation", c.terrain.bicubic ? "bicubic" : "bilinear"}};
     return out;
-  } else if (c.generator == scene::Generator::lights) {
-    scene::LightsParams l = c.lights;
+  } else if (c.generator == generators::Generator::lights) {
+    generators::LightsParams l = c.lights;
     l.width = options.width;
     l.height = options.height;
-    Result<scene::Scene> made = scene::generateLights(l);
+    Result<scene::Scene> made = generators::generateLights(l);
     if (!made) return made.error();
     out.scene = std::move(made).value();
     out.params = {{"lights", out.scene.lightPoints.size()},
@@ -152,30 +154,31 @@ Result<CaseScene> makeScene(const BenchCase& c, const RenderOptions& options) {
                   {"seed", l.seed},
                   {"layers", 1}};
     return out;
-  } else if (c.generator == scene::Generator::city) {
-    const scene::CityParams& p = c.city;
+  } else if (c.generator == generators::Generator::city) {
+    const generators::CityParams& p = c.city;
     if (p.buildings < 1 || p.buildings > 1000000 || p.trees < 0 || p.trees > 10000000)
       return Error{"", "", "city: buildings must be 1…1e6 and trees 0…1e7"};
-    out.scene = scene::generateCity(p);
+    out.scene = generators::generateCity(p);
     out.params = {{"buildings", p.buildings}, {"trees", p.trees}, {"seed", p.seed}};
     return out;
-  } else if (c.generator == scene::Generator::volume) {
-    const scene::VolumeParams& p = c.volume;
+  } else if (c.generator == generators::Generator::volume) {
+    const generators::VolumeParams& p = c.volume;
     if (p.size < 8 || p.size > 512) return Error{"", "", "volume: --voxels must be 8…512"};
-    out.scene = scene::generateVolume(p);
+    out.scene = generators::generateVolume(p);
     out.params = {{"voxels", p.size}, {"opaque", p.opaque},
                   {"precomputed_normals", p.precomputedNormals}, {"shell", p.shell},
                   {"seed", p.seed}};
     return out;
-  } else if (c.generator == scene::Generator::none) {
-    auto loaded = scene::loadScene(c.file);
+  } else if (c.generator == generators::Generator::none) {
+    auto loaded = formats::loadScene(c.file);
     if (!loaded) return loaded.error();
     out.scene = std::move(loaded).value();
     out.params = {{"file", c.file}};
     return out;
   } else {
-    return Error{"", "", fmt::format("generator '{}' is not a bench case",
-                                     scene::generatorName(c.generator))};
+    return Error{
+        "", "",
+        fmt::format("generator '{}' is not a bench case", generators::generatorName(c.generator))};
   }
   out.meanArea = realized.meanArea;
   out.depthComplexity = realized.depthComplexity;

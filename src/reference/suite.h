@@ -19,15 +19,15 @@ namespace sv::reference {
 // A scene to time: a generator with its parameters, or a scene file.
 struct BenchCase {
   std::string name;                                     // e.g. "tris-100k-a10", or the file's path
-  scene::Generator generator = scene::Generator::none;  // none: `file`
-  scene::TrisParams tris;
-  scene::LayersParams layers;
-  scene::GrazingParams grazing;
-  scene::FreeFormParams freeform;
-  scene::TerrainParams terrain;
-  scene::LightsParams lights;
-  scene::CityParams city;
-  scene::VolumeParams volume;
+  generators::Generator generator = generators::Generator::none;  // none: `file`
+  generators::TrisParams tris;
+  generators::LayersParams layers;
+  generators::GrazingParams grazing;
+  generators::FreeFormParams freeform;
+  generators::TerrainParams terrain;
+  generators::LightsParams lights;
+  generators::CityParams city;
+  generators::VolumeParams volume;
   std::string file;
 };
 
@@ -90,7 +90,7 @@ struct BenchSettings {
   // BENCH.md --shade textured: generated scenes get the bench texture (options.textureFilter
   // samples it; the reference uses GL's nearest equivalent).
   bool textured = false;
-  // BENCH.md --fog: generated scenes get the bench fog (scene::addBenchFog), in both renderers.
+  // BENCH.md --fog: generated scenes get the bench fog (generators::addBenchFog), in both renderers.
   bool fog = false;
   // BENCH.md --channels N (SPEC §9): a scene without channels of its own gets N abutting ones in
   // an arc of `arcDegrees` around its camera, each options.width × options.height; one frame is

@@ -17,7 +17,7 @@
 #include <nlohmann/json.hpp>
 #include <vector>
 
-#include "core/write_file.h"
+#include "core/files.h"
 #include "render/camera.h"
 
 #ifndef SV_VTK_SCRIPT_PATH

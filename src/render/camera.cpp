@@ -8,7 +8,7 @@
 #include <numbers>
 
 #include "core/check.h"
-#include "terrain/ground.h"
+#include "synthvis/height_field.h"
 
 namespace sv::render {
 namespace {
@@ -32,8 +32,8 @@ scene::Camera defaultCamera(const scene::Scene& s) {
   // Terrain: its footprint between its lowest and highest heights (on the plane; a sphere's
   // ground drops below it, which a default view need not mind).
   for (const scene::Terrain& t : s.terrains) {
-    if (!t.ground) continue;
-    const terrain::HeightField& f = t.ground->field;
+    if (!t.heights) continue;
+    const scene::HeightField& f = *t.heights;
     const float x0 = float(f.originU - t.origin[0]), x1 = float(f.eastU() - t.origin[0]);
     const float z0 = float(t.origin[1] - f.originV), z1 = float(t.origin[1] - f.southV());
     const float y0 = float(f.offset), y1 = float(f.offset + 65535 * f.scale);

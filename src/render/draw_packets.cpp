@@ -12,6 +12,8 @@
 namespace sv::render {
 namespace {
 
+using traversal::InstanceDraw;
+
 // The vertex stage's work, in parallel chunks each writing its own range: a range of one
 // instance's vertices, or of its indices (copied offset to the frame's vertex numbering and
 // range-checked).
@@ -143,6 +145,18 @@ const shade::MaterialShading* doorMaterial(const shade::MaterialShading* base, u
   return &p.doorMaterials.emplace_back(base, m).second;
 }
 
+}  // namespace
+
+traversal::View traversalView(const FrameCamera& camera) {
+  return {camera.view, camera.projection, camera.tanBottom, camera.tanTop};
+}
+
+traversal::Options traversalOptions(const RenderOptions& o) {
+  return {o.cullInstances, o.lod, o.lodScale, o.mergeCells && o.hsr == RenderOptions::Hsr::zbuffer};
+}
+
+namespace {
+
 // The frame's layout: one call per draw the traversal chose, opaque materials first, then
 // translucent ones (SPEC §4: blended over what is behind them), each with its vertex and index
 // jobs; `stored` gathers the attributes the calls' materials read. Sizes `p`'s vertices and
@@ -157,7 +171,7 @@ Status layOutCalls(const scene::Scene& scene, const RenderOptions& o, const Fram
       o.hsr != RenderOptions::Hsr::zbuffer && o.debugView != RenderOptions::DebugView::overdraw;
   const Mat4 viewProj = camera.projection * camera.view;
   const geometry::Viewport boundViewport{o.width * o.supersample, o.height * o.supersample};
-  traverse(scene, o, camera, boxes, pool, p.traversal);
+  traversal::traverse(scene, traversalOptions(o), traversalView(camera), boxes, pool, p.traversal);
   const std::vector<InstanceDraw>& draws = p.traversal.draws;
   const std::vector<uint32_t> order = drawOrder(scene, draws, camera.view, o.hsr, boxes, sort);
   p.doorMaterials.clear();

@@ -11,7 +11,7 @@
 #include "geometry/setup.h"
 #include "render/camera.h"
 #include "render/shading_tables.h"
-#include "render/traversal.h"
+#include "traversal/traversal.h"
 
 namespace sv::render {
 
@@ -42,7 +42,7 @@ struct DrawPackets {
   std::vector<DrawCall> calls;    // in draw order (buildDrawPackets)
   // What the traversal chose (its draws, what it culled and the levels of detail drawn), and the
   // frame's meshes' bounds.
-  Traversal traversal;
+  traversal::Traversal traversal;
   std::vector<std::array<Vec3, 2>> meshBounds;
   // The materials of dissolving draws (each a scene material's with a door), for the frame.
   std::deque<std::pair<const shade::MaterialShading*, shade::MaterialShading>> doorMaterials;
@@ -60,6 +60,11 @@ struct DrawPackets {
 Status buildDrawPackets(const scene::Scene& scene, const RenderOptions& options,
                         const FrameCamera& camera, const ShadingTables* shading,
                         core::ThreadPool& pool, DrawPackets& out);
+
+// The traversal's view and options for a frame of `camera` under `options` (merged cells only
+// under the Z-buffer: masking draws objects nearest first, which a merged cell is not).
+traversal::View traversalView(const FrameCamera& camera);
+traversal::Options traversalOptions(const RenderOptions& options);
 
 // The smallest view depth of the corners of the box [lo, hi] placed by `toEye`.
 float nearestEyeDepth(const Mat4& toEye, Vec3 lo, Vec3 hi);

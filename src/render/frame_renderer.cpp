@@ -173,7 +173,7 @@ Status FrameRenderer::render(const DrawPackets& packets, const FrameSettings& se
   for (int tile = 0; tile < f.tiles; ++tile)
     if (settings.share.owns(tile % f.tilesX, tile / f.tilesX)) drawnTiles_.push_back(tile);
   preparePasses(settings, f);
-  const Traversal& t = packets.traversal;
+  const traversal::Traversal& t = packets.traversal;
   stats.trianglesIn += f.triangles + t.culledTriangles;
   stats.culledOutside += t.culledTriangles;
   stats.culledInstances += t.culledInstances;

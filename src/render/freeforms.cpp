@@ -10,7 +10,7 @@
 
 #include "freeform/tessellate.h"
 #include "render/draw_packets.h"
-#include "render/terrain_pass.h"
+#include "render/terrains.h"
 
 namespace sv::render {
 namespace {
@@ -142,7 +142,7 @@ Result<scene::Scene> tessellatedScene(const scene::Scene& scene, const RenderOpt
   }
   out.terrains.clear();
   for (const scene::Terrain& t : scene.terrains)
-    if (t.ground) render::appendTerrainGrid(t, o, out);
+    if (t.heights) render::appendTerrainGrid(t, o, out);
   return out;
 }
 

@@ -1,6 +1,7 @@
 #include "render/passes.h"
 
 #include "render/freeforms.h"
+#include "render/terrains.h"
 
 namespace sv::render {
 
@@ -33,7 +34,8 @@ std::vector<raster::TilePass*> FramePasses::compose(const scene::Scene& scene,
     passes.push_back(&freeForms_);
   }
   if (!scene.terrains.empty()) {
-    terrains_.setTerrains(scene, camera, shading, o);
+    const EyeRays rays = eyeRays(camera);
+    terrains_.setTerrains(terrainDraws(scene, rays, shading, o), rays, shading.environment);
     passes.push_back(&terrains_);
   }
   if (!scene.lines.empty()) {

@@ -9,7 +9,7 @@
 #include "lines/line_pass.h"
 #include "render/camera.h"
 #include "render/shading_tables.h"
-#include "render/terrain_pass.h"
+#include "terrain/terrain_pass.h"
 #include "volume/volume_pass.h"
 
 namespace sv::render {
@@ -27,7 +27,7 @@ class FramePasses {
 
  private:
   freeform::FreeFormPass freeForms_;
-  TerrainPass terrains_;
+  terrain::TerrainPass terrains_;
   lines::LinePass lines_;
   volume::VolumePass volumes_;
   lights::LightPass lights_;

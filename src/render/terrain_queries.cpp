@@ -1,33 +1,20 @@
 // The host's terrain queries (synthvis/terrain.h), through terrain::Caster.
 #include <cmath>
 
+#include "render/terrains.h"
 #include "synthvis/terrain.h"
-#include "terrain/ground.h"
 
 namespace sv {
-namespace {
-
-terrain::Interpolation interpolationOf(const scene::Terrain& t, RenderOptions::TerrainFilter f) {
-  if (f == RenderOptions::TerrainFilter::bicubic ||
-      (f == RenderOptions::TerrainFilter::scene && t.bicubic))
-    return terrain::Interpolation::bicubic;
-  return terrain::Interpolation::bilinear;
-}
-
-terrain::Caster casterOf(const scene::Terrain& t, terrain::Interpolation interp) {
-  return terrain::Caster(t.ground->field, t.ground->pyramid(interp), interp,
-                         terrain::Placement{t.origin[0], t.origin[1], t.baseRadius});
-}
-
-}  // namespace
+using render::casterOf;
+using render::interpolationFor;
 
 std::optional<TerrainHeight> terrainHeight(const scene::Scene& scene, double x, double y,
                                            double z, RenderOptions::TerrainFilter filter) {
   std::optional<TerrainHeight> best;
   for (size_t i = 0; i < scene.terrains.size(); ++i) {
     const scene::Terrain& t = scene.terrains[i];
-    if (!t.ground) continue;
-    const terrain::Caster c = casterOf(t, interpolationOf(t, filter));
+    if (!t.heights) continue;
+    const terrain::Caster c = casterOf(t, interpolationFor(t, filter));
     const terrain::Caster::MapPoint m = c.toMap({x, y, z});
     const double h = c.surface(m.gx, m.gy);
     if (std::isnan(h)) continue;
@@ -43,8 +30,8 @@ std::optional<TerrainHit> lineOfSight(const scene::Scene& scene, const double fr
   const Vec3d d = Vec3d{to[0], to[1], to[2]} - a;
   for (size_t i = 0; i < scene.terrains.size(); ++i) {
     const scene::Terrain& t = scene.terrains[i];
-    if (!t.ground) continue;
-    const terrain::Caster c = casterOf(t, interpolationOf(t, filter));
+    if (!t.heights) continue;
+    const terrain::Caster c = casterOf(t, interpolationFor(t, filter));
     terrain::CastCounters counters;
     const double s = c.cast(a, d, 0, 1, counters);
     if (std::isnan(s) || (best && s >= best->fraction)) continue;

@@ -9,8 +9,8 @@
 #include <limits>
 #include <utility>
 
+#include "scene/append.h"
 #include "scene/channels.h"
-#include "scene/loader_common.h"
 
 namespace sv::scene {
 
@@ -207,11 +207,10 @@ Status validateLights(const Scene& scene) {
   return {};
 }
 
-}  // namespace
-
-Status validate(const Scene& scene, const std::string& file, bool vertexData) {
-  auto fail = [&](std::string message) { return Status(Error{file, "", std::move(message)}); };
-
+// The meshes' invariants (scene.h, Mesh); `vertexData`: also every position finite and every
+// index in range.
+Status validateMeshes(const Scene& scene, bool vertexData) {
+  auto fail = [](std::string message) { return Status(Error{"", "", std::move(message)}); };
   for (size_t i = 0; i < scene.meshes.size(); ++i) {
     const Mesh& mesh = scene.meshes[i];
     const size_t n = mesh.positions.size();
@@ -248,6 +247,12 @@ Status validate(const Scene& scene, const std::string& file, bool vertexData) {
           return fail(fmt::format("{}: positions[{}] is not finite", meshLabel(mesh, i), k));
     }
   }
+  return {};
+}
+
+// The instances' invariants (scene.h, Instance, LodGroup, InstanceTree).
+Status validateInstances(const Scene& scene) {
+  auto fail = [](std::string message) { return Status(Error{"", "", std::move(message)}); };
   for (size_t i = 0; i < scene.instances.size(); ++i) {
     const Instance& instance = scene.instances[i];
     if (instance.mesh < 0 || size_t(instance.mesh) >= scene.meshes.size())
@@ -289,6 +294,12 @@ Status validate(const Scene& scene, const std::string& file, bool vertexData) {
       from = l.to;
     }
   }
+  return {};
+}
+
+// The articulations' invariants (scene.h, Switch, Dof).
+Status validateArticulations(const Scene& scene) {
+  auto fail = [](std::string message) { return Status(Error{"", "", std::move(message)}); };
   for (size_t i = 0; i < scene.switches.size(); ++i) {
     const Switch& sw = scene.switches[i];
     for (const std::vector<uint32_t>& child : sw.children)
@@ -316,6 +327,12 @@ Status validate(const Scene& scene, const std::string& file, bool vertexData) {
                                 "articulated, or has a transform that is not finite",
                                 i, k));
   }
+  return {};
+}
+
+// The free forms' invariants (scene.h, FreeFormObject, FreeFormNode).
+Status validateFreeForms(const Scene& scene) {
+  auto fail = [](std::string message) { return Status(Error{"", "", std::move(message)}); };
   for (size_t i = 0; i < scene.freeForms.size(); ++i) {
     const FreeFormObject& f = scene.freeForms[i];
     const std::string label =
@@ -349,6 +366,13 @@ Status validate(const Scene& scene, const std::string& file, bool vertexData) {
       for (const FreeFormNode& p : n->perturbations) stack.push_back(&p);
     }
   }
+  return {};
+}
+
+// The materials', textures', fog's, lights' (validateLights) and cameras' invariants: finite,
+// and every index in range.
+Status validateLooks(const Scene& scene) {
+  auto fail = [](std::string message) { return Status(Error{"", "", std::move(message)}); };
   for (size_t i = 0; i < scene.materials.size(); ++i) {
     const Material& m = scene.materials[i];
     if (m.texture < -1 || (m.texture >= 0 && size_t(m.texture) >= scene.textures.size()))
@@ -370,15 +394,26 @@ Status validate(const Scene& scene, const std::string& file, bool vertexData) {
   for (size_t i = 0; i < scene.pointLights.size(); ++i)
     if (!isFinite(scene.pointLights[i].position) || !isFinite(scene.pointLights[i].color))
       return fail(fmt::format("pointLights[{}]: not finite", i));
-  if (Status s = validateLights(scene); !s) return Status(Error{file, "", s.error().message});
+  if (Status st = validateLights(scene); !st) return st;
   for (size_t i = 0; i < scene.cameras.size(); ++i) {
     const Camera& c = scene.cameras[i];
     if (!isFinite(c.position) || !isFinite(c.target) || !isFinite(c.up) ||
         !std::isfinite(c.yfovDegrees) || !std::isfinite(c.znear) || !std::isfinite(c.zfar))
       return fail(fmt::format("cameras[{}]: not finite", i));
   }
+  return {};
+}
+
+}  // namespace
+
+Status validate(const Scene& scene, const std::string& file, bool vertexData) {
+  // Each part's first problem, named by `file`.
+  for (const Status& s :
+       {validateMeshes(scene, vertexData), validateInstances(scene), validateArticulations(scene),
+        validateFreeForms(scene), validateLooks(scene)})
+    if (!s) return Status(Error{file, "", s.error().message});
   if (std::string problem = detail::channelsProblem(scene.channels); !problem.empty())
-    return fail(std::move(problem));
+    return Status(Error{file, "", std::move(problem)});
   return {};
 }
 

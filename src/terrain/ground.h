@@ -1,40 +1,39 @@
-// A ground as a scene holds it: the height table and, built on first use and kept, its min/max
-// pyramid for each interpolation (a scene chooses one, the CLI may choose the other).
+// A height table as the terrain stage draws it: the table (synthvis/height_field.h) and, built on
+// first use and kept with it (HeightField::derived), its min/max pyramid for each interpolation —
+// a scene chooses one, the CLI may choose the other. Readers build the scene's at load time, so
+// that no frame waits for it.
 #pragma once
 
+#include <chrono>
 #include <memory>
-#include <mutex>
 
-#include "terrain/caster.h"
+#include "terrain/pyramid.h"
 
 namespace sv::terrain {
 
-struct Ground {
-  explicit Ground(HeightField f) : field(std::move(f)) {}
-  HeightField field;
-  // Reading (or generating) the table and building the pyramid the scene asks for (loaders build
-  // it; another interpolation's is built by the first frame that asks, in that frame's time).
-  double loadMs = 0;
+// The pyramid over `interp`'s surface of `field` (thread-safe; built once per table).
+inline const Pyramid& pyramidOf(const HeightField& field, Interpolation interp) {
+  const int slot = interp == Interpolation::bicubic ? 1 : 0;
+  return field.derived.get<Pyramid>(slot, [&] { return std::make_unique<Pyramid>(field, interp); });
+}
 
-  // The pyramid over `interp`'s surface (thread-safe; built once).
-  const Pyramid& pyramid(Interpolation interp) const {
-    Slot& s = slots_[interp == Interpolation::bicubic ? 1 : 0];
-    std::call_once(s.once, [&] { s.pyramid = std::make_unique<Pyramid>(field, interp); });
-    return *s.pyramid;
-  }
-  size_t bytes() const {
-    size_t b = field.bytes();
-    for (const Slot& s : slots_)
-      if (s.pyramid) b += s.pyramid->bytes();
-    return b;
-  }
+// `field` ready for a scene (Terrain::heights): with the pyramid `interp` builds made at once —
+// part of loading, not of the first frame — and its time added to the table's loadMs.
+inline std::shared_ptr<const HeightField> prepareGround(HeightField field, Interpolation interp) {
+  auto held = std::make_shared<HeightField>(std::move(field));
+  const auto start = std::chrono::steady_clock::now();
+  pyramidOf(*held, interp);
+  held->loadMs +=
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return held;
+}
 
- private:
-  struct Slot {
-    std::once_flag once;
-    std::unique_ptr<Pyramid> pyramid;
-  };
-  mutable Slot slots_[2];
-};
+// The memory the table and the pyramids built so far hold, in bytes (statistics, after a frame).
+inline size_t groundBytes(const HeightField& field) {
+  size_t b = field.bytes();
+  for (int slot = 0; slot < scene::DerivedData::kSlots; ++slot)
+    if (const Pyramid* p = field.derived.built<Pyramid>(slot)) b += p->bytes();
+  return b;
+}
 
 }  // namespace sv::terrain

@@ -9,6 +9,7 @@
 
 #include "core/thread_pool.h"
 #include "raster/framebuffer.h"
+#include "synthvis/formats.h"
 #include "synthvis/image.h"
 #include "synthvis/render.h"
 #include "synthvis/scene.h"
@@ -280,7 +281,7 @@ TEST(LightPass, MalformedLightsAndCataloguesGetAClearError) {
       {R"({"groups": [{"name": "a"}, {"name": "a"}]})", "a second group named 'a'"},
   };
   for (const Case& c : cases) {
-    const Result<scene::Scene> r = scene::parseJsonScene(head + c.lights + "}", "t.json");
+    const Result<scene::Scene> r = formats::parseJsonScene(head + c.lights + "}", "t.json");
     ASSERT_FALSE(r.ok()) << c.lights;
     EXPECT_NE(r.error().str().find(c.message), std::string::npos) << r.error().str();
     EXPECT_EQ(r.error().str().find('\n'), std::string::npos);
@@ -297,20 +298,21 @@ TEST(LightPass, MalformedLightsAndCataloguesGetAClearError) {
       {" 10.0  5.0  1.0  9.0 \"A\"\n", "colour index 9"},
   };
   for (const auto& c : catalogues) {
-    const auto r = scene::parseStarCatalog(c.text, "BSC");
+    const auto r = formats::parseStarCatalog(c.text, "BSC");
     ASSERT_FALSE(r.ok()) << c.text;
     EXPECT_NE(r.error().str().find(c.message), std::string::npos) << r.error().str();
   }
 }
 
 TEST(LightPass, StringsArraysAndSequencesExpandAsDocumented) {
-  const Result<scene::Scene> r = scene::parseJsonScene(R"({"synthvis": 1, "lights": {
+  const Result<scene::Scene> r = formats::parseJsonScene(R"({"synthvis": 1, "lights": {
     "appearances": [{"name": "w"}, {"name": "f", "blink": {"period": 0.5, "on": 0.1}}],
     "groups": [{"name": "g", "dim": 0.5}],
     "strings": [{"appearance": "f", "group": "g", "start": [0,0,0], "end": [0,0,-90],
                  "spacing": 30, "sequence": true}],
     "arrays": [{"origin": [1,2,3], "u": [1,0,0], "v": [0,0,1], "counts": [3, 2]}],
-    "points": [{"position": [5,5,5], "appearance": 1, "phase": 0.25}]}})", "t.json");
+    "points": [{"position": [5,5,5], "appearance": 1, "phase": 0.25}]}})",
+                                                         "t.json");
   ASSERT_TRUE(r.ok()) << r.error().str();
   const scene::Scene& s = r.value();
   // Points first, then strings, then arrays.
@@ -330,7 +332,7 @@ TEST(LightPass, StringsArraysAndSequencesExpandAsDocumented) {
 
 #ifdef SV_STAR_CATALOG
 TEST(LightPass, XplanetsCatalogueReads) {
-  const auto r = scene::loadStarCatalog(SV_STAR_CATALOG);
+  const auto r = formats::loadStarCatalog(SV_STAR_CATALOG);
   ASSERT_TRUE(r.ok()) << r.error().str();
   EXPECT_GT(r.value().size(), 9000u);  // 9 110 stars in the BSC, less the novae xplanet drops
   // Sirius first: Dec −16.7161°, RA 6.7525 h, magnitude −1.46.

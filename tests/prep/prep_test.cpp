@@ -12,10 +12,11 @@
 #include <random>
 #include <string>
 
-#include "scene/flt_writer.h"
-#include "scene/primitives.h"
+#include "formats/flt_writer.h"
+#include "formats/primitives.h"
+#include "synthvis/formats.h"
 #include "synthvis/generators.h"
-#include "terrain/ground.h"
+#include "synthvis/height_field.h"
 #include "synthvis/render.h"
 #include "synthvis/scene.h"
 
@@ -49,8 +50,8 @@ void writeBytes(const std::string& path, const std::string& bytes) {
 // light points, a switch and a degree of freedom (from an OpenFlight file), channels and fog.
 scene::Scene richScene() {
   TempFile flt("every.flt");
-  writeBytes(flt.path, scene::testing::everyNodeFlt());
-  Result<scene::Scene> loaded = scene::loadScene(flt.path);
+  writeBytes(flt.path, formats::testing::everyNodeFlt());
+  Result<scene::Scene> loaded = formats::loadScene(flt.path);
   EXPECT_TRUE(loaded.ok()) << loaded.error().str();
   scene::Scene s = std::move(loaded.value());
   auto place = [&](scene::Mesh m, Mat4 at, int material) {
@@ -63,10 +64,10 @@ scene::Scene richScene() {
   red.baseColor = {0.7f, 0.1f, 0.05f, 1};
   s.materials.push_back(red);
   const int redIndex = int(s.materials.size() - 1);
-  place(scene::detail::makeSphere(1, 96, 48), Mat4::translation({0, 1, -4}), redIndex);
-  place(scene::detail::makeSphere(1, 96, 48), Mat4::translation({3, 1, -60}), redIndex);
-  place(scene::detail::makeTorus(1.5f, 0.4f, 96, 32), Mat4::translation({-3, 1, -20}), -1);
-  place(scene::detail::makeChecker(60, 200, 12, 40, {0.8f, 0.8f, 0.8f, 1}, {0.3f, 0.3f, 0.3f, 1}),
+  place(formats::detail::makeSphere(1, 96, 48), Mat4::translation({0, 1, -4}), redIndex);
+  place(formats::detail::makeSphere(1, 96, 48), Mat4::translation({3, 1, -60}), redIndex);
+  place(formats::detail::makeTorus(1.5f, 0.4f, 96, 32), Mat4::translation({-3, 1, -20}), -1);
+  place(formats::detail::makeChecker(60, 200, 12, 40, {0.8f, 0.8f, 0.8f, 1}, {0.3f, 0.3f, 0.3f, 1}),
         Mat4::translation({0, 0, -80}), -1);
   scene::Camera cam;
   cam.position = {2, 3, 8};
@@ -169,14 +170,14 @@ void expectSameScene(const scene::Scene& a, const scene::Scene& b) {
 TEST(Database, HoldsBackTheSceneItWasGiven) {
   const scene::Scene s = richScene();
   TempFile db("rich.svdb");
-  ASSERT_TRUE(scene::saveDatabase(s, db.path).ok());
-  Result<scene::Scene> back = scene::loadScene(db.path);
+  ASSERT_TRUE(formats::saveDatabase(s, db.path).ok());
+  Result<scene::Scene> back = formats::loadScene(db.path);
   ASSERT_TRUE(back.ok()) << back.error().str();
   expectSameScene(s, back.value());
   EXPECT_EQ(render(s, true), render(back.value(), true));
   // Written twice, the same bytes: nothing in the file depends on memory contents.
   TempFile again("again.svdb");
-  ASSERT_TRUE(scene::saveDatabase(back.value(), again.path).ok());
+  ASSERT_TRUE(formats::saveDatabase(back.value(), again.path).ok());
   EXPECT_EQ(readBytes(db.path), readBytes(again.path));
 }
 
@@ -188,8 +189,8 @@ TEST(Prep, RendersBitIdenticallyToItsSource) {
   EXPECT_LT(r->verticesOut, r->verticesIn);  // the primitives' seams, the faces' corners merged
   EXPECT_GE(r->groupsMade, 3u);              // the spheres' mesh, the torus, the ground
   TempFile db("prepared.svdb");
-  ASSERT_TRUE(scene::saveDatabase(prepared, db.path).ok());
-  Result<scene::Scene> loaded = scene::loadScene(db.path);
+  ASSERT_TRUE(formats::saveDatabase(prepared, db.path).ok());
+  Result<scene::Scene> loaded = formats::loadScene(db.path);
   ASSERT_TRUE(loaded.ok()) << loaded.error().str();
   // Every instance at full detail: the source's image, bit for bit.
   const std::vector<uint8_t> full = render(source, false);
@@ -209,7 +210,7 @@ TEST(Prep, RendersBitIdenticallyToItsSource) {
 
 TEST(Prep, GeneratedLevelsShrinkAndSwitchFartherOut) {
   scene::Scene s;
-  s.meshes.push_back(scene::detail::makeSphere(2, 128, 64));
+  s.meshes.push_back(formats::detail::makeSphere(2, 128, 64));
   s.instances.push_back({0, Mat4::scaling({3, 3, 3}), 0, -1});
   s.instances.push_back({0, Mat4::translation({10, 0, 0}), 0, -1});
   PrepOptions o;
@@ -232,7 +233,7 @@ TEST(Prep, GeneratedLevelsShrinkAndSwitchFartherOut) {
   EXPECT_EQ(s.instances[1].lod, 0);
   // A finer pixel error switches farther out: ranges scale as 1 / error.
   scene::Scene t;
-  t.meshes.push_back(scene::detail::makeSphere(2, 128, 64));
+  t.meshes.push_back(formats::detail::makeSphere(2, 128, 64));
   t.instances.push_back({0, Mat4::scaling({3, 3, 3}), 0, -1});
   t.instances.push_back({0, Mat4::translation({10, 0, 0}), 0, -1});
   o.pixelError = 0.5f;
@@ -243,14 +244,14 @@ TEST(Prep, GeneratedLevelsShrinkAndSwitchFartherOut) {
 
 TEST(Database, RefusesDamagedFiles) {
   scene::Scene s;
-  s.meshes.push_back(scene::detail::makeBox({1, 1, 1}));
+  s.meshes.push_back(formats::detail::makeBox({1, 1, 1}));
   s.instances.push_back({0, Mat4{}, 0, -1});
   TempFile db("box.svdb");
-  ASSERT_TRUE(scene::saveDatabase(s, db.path).ok());
+  ASSERT_TRUE(formats::saveDatabase(s, db.path).ok());
   const std::string good = readBytes(db.path);
   auto error = [&](const std::string& bytes) {
     writeBytes(db.path, bytes);
-    Result<scene::Scene> r = scene::loadScene(db.path);
+    Result<scene::Scene> r = formats::loadScene(db.path);
     return r.ok() ? std::string("(loaded)") : r.error().str().substr(db.path.size() + 2);
   };
   EXPECT_EQ(error(good), "(loaded)");
@@ -268,12 +269,12 @@ TEST(Database, RefusesDamagedFiles) {
   EXPECT_EQ(error("glTF" + good), "not a synthvis database (no SVDB header)");
   EXPECT_EQ(error(""), "not a synthvis database (empty file)");
   // A terrain whose draped image does not exist is refused on load, by name.
-  Result<scene::Scene> terrain = scene::generateTerrain({.size = 65});
+  Result<scene::Scene> terrain = generators::generateTerrain({.size = 65});
   ASSERT_TRUE(terrain.ok()) << terrain.error().str();
   terrain->terrains[0].name = "hills";
   terrain->terrains[0].image = 7;
-  ASSERT_TRUE(scene::saveDatabase(terrain.value(), db.path).ok());
-  Result<scene::Scene> bad = scene::loadScene(db.path);
+  ASSERT_TRUE(formats::saveDatabase(terrain.value(), db.path).ok());
+  Result<scene::Scene> bad = formats::loadScene(db.path);
   ASSERT_FALSE(bad.ok());
   EXPECT_EQ(bad.error().str().substr(db.path.size() + 2),
             "database: terrain 'hills': a value is not finite or out of range");
@@ -283,16 +284,17 @@ TEST(Database, RefusesDamagedFiles) {
 // is the same, for both filters.
 TEST(Database, HoldsTerrainAndDrawsItTheSame) {
   for (bool bicubic : {false, true}) {
-    Result<scene::Scene> s = scene::generateTerrain({.size = 257, .seed = 3, .bicubic = bicubic});
+    Result<scene::Scene> s =
+        generators::generateTerrain({.size = 257, .seed = 3, .bicubic = bicubic});
     ASSERT_TRUE(s.ok()) << s.error().str();
     TempFile db("terrain.svdb");
-    ASSERT_TRUE(scene::saveDatabase(s.value(), db.path).ok());
-    Result<scene::Scene> back = scene::loadScene(db.path);
+    ASSERT_TRUE(formats::saveDatabase(s.value(), db.path).ok());
+    Result<scene::Scene> back = formats::loadScene(db.path);
     ASSERT_TRUE(back.ok()) << back.error().str();
     ASSERT_EQ(back->terrains.size(), 1u);
     const scene::Terrain &a = s->terrains[0], &b = back->terrains[0];
-    EXPECT_EQ(a.ground->field.q, b.ground->field.q);
-    EXPECT_EQ(a.ground->field.spacingU, b.ground->field.spacingU);
+    EXPECT_EQ(a.heights->q, b.heights->q);
+    EXPECT_EQ(a.heights->spacingU, b.heights->spacingU);
     EXPECT_EQ(a.bicubic, b.bicubic);
     EXPECT_EQ(a.image, b.image);
     EXPECT_EQ(render(s.value(), true), render(back.value(), true)) << bicubic;

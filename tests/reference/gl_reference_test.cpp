@@ -11,6 +11,7 @@
 #include "reference/suite.h"
 #include "small_settings.h"
 #include "support/temp_dir.h"
+#include "synthvis/formats.h"
 
 namespace sv::reference {
 namespace {
@@ -27,12 +28,12 @@ TEST(GlReference, DrawsWhatSynthvisDraws) {
     GTEST_SKIP() << "the gl reference cannot start here: " << st.error().str();
   BenchCase tris;
   tris.name = "tris";
-  tris.generator = scene::Generator::tris;
+  tris.generator = generators::Generator::tris;
   tris.tris.count = 2000;
   tris.tris.area = 60;
   BenchCase layers;
   layers.name = "layers";
-  layers.generator = scene::Generator::layers;
+  layers.generator = generators::Generator::layers;
   layers.layers.layers = 3;
   for (const BenchCase& c : {tris, layers}) {
     auto r = runner.run(c);
@@ -54,7 +55,7 @@ TEST(GlReference, DrawsWhatSynthvisDraws) {
   }
   // A lit scene with cameras, culling and the background: the demo scene through a file.
   const std::string demo = sv::tests::processTemp().path("suite_demo.glb");
-  ASSERT_TRUE(scene::saveGltf(scene::demoScene(), demo).ok());
+  ASSERT_TRUE(formats::saveGltf(formats::demoScene(), demo).ok());
   BenchCase file;
   file.name = "demo";
   file.file = demo;

@@ -15,7 +15,7 @@ namespace {
 
 // A white, unlit quad over pixels x ∈ [0, right), all rows, on the BENCH.md camera at depth 2.
 scene::Scene quadScene(int width, int height, double right) {
-  scene::Scene s = scene::benchCameraScene("quad");
+  scene::Scene s = generators::benchCameraScene("quad");
   const double tanHalf = std::tan(30.0 * std::numbers::pi / 180), aspect = double(width) / height;
   auto at = [&](double px, double py) {
     const double z = 2;
@@ -59,12 +59,12 @@ TEST(GroundTruth, CoverageOfAnEdgePixelIsTheAreaInside) {
 // One sample per pixel, at its centre, is what synthvis's rasterizer computes: two independent
 // implementations agree but for pixel centres within rounding of an edge.
 TEST(GroundTruth, OneSamplePerPixelMatchesSynthvis) {
-  scene::TrisParams p;
+  generators::TrisParams p;
   p.count = 3000;
   p.area = 60;
   p.width = 320;
   p.height = 240;
-  const scene::Scene s = scene::generateTris(p);
+  const scene::Scene s = generators::generateTris(p);
   GroundTruthOptions g;
   g.options.width = 320;
   g.options.height = 240;

@@ -41,7 +41,7 @@ TEST(Suites, QuickAndFullNameBenchMdScenes) {
   bool hasLayers16 = false, hasFreeForm = false;
   for (const auto& c : full.value()) {
     hasLayers16 |= c.name == "layers-d16-b2f";
-    hasFreeForm |= c.generator == scene::Generator::freeform;
+    hasFreeForm |= c.generator == generators::Generator::freeform;
   }
   EXPECT_TRUE(hasLayers16);
   EXPECT_TRUE(hasFreeForm);
@@ -53,7 +53,7 @@ TEST(BenchRunner, JsonRowsCarryBenchMdFields) {
   BenchRunner runner(s);
   BenchCase c;
   c.name = "tris-small";
-  c.generator = scene::Generator::tris;
+  c.generator = generators::Generator::tris;
   c.tris.count = 300;
   c.tris.area = 40;
   auto r = runner.run(c);
@@ -86,7 +86,7 @@ TEST(Html, WritesPageImagesAndPlots) {
   BenchRunner runner(s);
   BenchCase c;
   c.name = "tris-html";
-  c.generator = scene::Generator::tris;
+  c.generator = generators::Generator::tris;
   c.tris.count = 100;
   auto r = runner.run(c);
   ASSERT_TRUE(r.ok());
@@ -110,7 +110,7 @@ TEST(BenchRunner, FreeFormsRunAgainstTheMarcherAndTheirTessellation) {
     BenchRunner runner(s);
     BenchCase c;
     c.name = "freeform-one";
-    c.generator = scene::Generator::freeformOne;
+    c.generator = generators::Generator::freeformOne;
     auto r = runner.run(c);
     ASSERT_TRUE(r.ok()) << r.error().str();
     ASSERT_EQ(r->runs.size(), 2u);

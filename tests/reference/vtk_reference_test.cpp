@@ -18,7 +18,7 @@ using testing::smallSettings;
 BenchCase volumeCase() {
   BenchCase c;
   c.name = "volume";
-  c.generator = scene::Generator::volume;
+  c.generator = generators::Generator::volume;
   c.volume.size = 48;
   return c;
 }
@@ -61,14 +61,14 @@ TEST(VtkReference, RefusesWhatItDoesNotDraw) {
   // A scene without volumes.
   BenchCase tris;
   tris.name = "tris";
-  tris.generator = scene::Generator::tris;
+  tris.generator = generators::Generator::tris;
   tris.tris.count = 100;
   auto r = runner.run(tris);
   ASSERT_FALSE(r.ok());
   EXPECT_NE(r.error().message.find("volume scenes only"), std::string::npos) << r.error().str();
   // A volume beside polygons.
-  scene::Scene mixed = scene::generateVolume(scene::VolumeParams{});
-  scene::Scene boxes = scene::generateTris(scene::TrisParams{});
+  scene::Scene mixed = generators::generateVolume(generators::VolumeParams{});
+  scene::Scene boxes = generators::generateTris(generators::TrisParams{});
   mixed.meshes = boxes.meshes, mixed.instances = boxes.instances, mixed.materials = boxes.materials;
   auto v = VtkVolumeRenderer::create(mixed, s.options);
   ASSERT_FALSE(v.ok());
@@ -76,7 +76,8 @@ TEST(VtkReference, RefusesWhatItDoesNotDraw) {
       << v.error().str();
   // No script.
   setenv("SV_VTK_SCRIPT", "/nonexistent/vtk_volume.py", 1);
-  auto missing = VtkVolumeRenderer::create(scene::generateVolume(scene::VolumeParams{}), s.options);
+  auto missing =
+      VtkVolumeRenderer::create(generators::generateVolume(generators::VolumeParams{}), s.options);
   unsetenv("SV_VTK_SCRIPT");
   ASSERT_FALSE(missing.ok());
   EXPECT_NE(missing.error().message.find("script is missing"), std::string::npos);

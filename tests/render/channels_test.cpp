@@ -11,8 +11,9 @@
 #include "raster/framebuffer.h"
 #include "render/camera.h"
 #include "render/shading_tables.h"
-#include "render/terrain_pass.h"
+#include "render/terrains.h"
 #include "support/test_scenes.h"
+#include "synthvis/formats.h"
 #include "synthvis/generators.h"
 #include "synthvis/render.h"
 #include "synthvis/terrain.h"
@@ -54,13 +55,13 @@ std::vector<Image> renderChannels(const scene::Scene& s, int threads,
 bool lit(const Image& im, int x, int y) { return im.pixel(x, y)[0] > 127; }
 
 scene::Scene smallTerrain() {
-  scene::TerrainParams p;
+  generators::TerrainParams p;
   p.size = 129;
-  return scene::generateTerrain(p).value();
+  return generators::generateTerrain(p).value();
 }
 
 TEST(Channels, ACentredChannelIsTheClassicViewBitForBit) {
-  for (scene::Scene s : {scene::demoScene(), smallTerrain()}) {
+  for (scene::Scene s : {formats::demoScene(), smallTerrain()}) {
     RenderOptions o;
     o.width = 160;
     o.height = 112;
@@ -177,7 +178,7 @@ TEST(Channels, StatisticsAndSizesArePerChannel) {
 }
 
 TEST(Channels, ThreeChannelsGiveTheSameBytesOnOneAndTwoThreads) {
-  for (scene::Scene s : {scene::demoScene(), smallTerrain()}) {
+  for (scene::Scene s : {formats::demoScene(), smallTerrain()}) {
     s.channels = scene::arcChannels(3, 150, 96, 64);
     s.channels[0].offset = {-0.2f, 0.1f, 0};
     s.channels[2].pitchDegrees = 8;
@@ -226,8 +227,9 @@ TEST(Channels, TerrainOnAnAsymmetricChannelMeetsTheGroundWhereTheProjectionSays)
   const render::FrameCamera camera = render::channelCamera(s, o, c).value();
   render::ShadingTables shading;
   render::buildShading(s, o, camera.view, shading);
-  render::TerrainPass pass;
-  pass.setTerrains(s, camera, shading, o);
+  terrain::TerrainPass pass;
+  const EyeRays rays = render::eyeRays(camera);
+  pass.setTerrains(render::terrainDraws(s, rays, shading, o), rays, shading.environment);
   pass.prepare(raster::PassFrame{o.width, o.height, 1, nullptr, nullptr});
   std::vector<float> depth(raster::kTileSize * raster::kTileSize, 1.0f);
   std::vector<uint16_t> color(raster::kTileSize * raster::kTileSize * 3, 0);

@@ -293,7 +293,7 @@ TEST(FreeFormRender, MarchedFormsAreShadedAsCastOnes) {
 // around the crease where that happened, the caster's hits are the first sign change a fine
 // fixed-step march finds, pixel for pixel.
 TEST(FreeFormRender, RaysGrazingACreaseFindTheFirstCrossing) {
-  const scene::Scene s = scene::generateFreeFormOne();
+  const scene::Scene s = generators::generateFreeFormOne();
   const scene::Camera& cam = s.cameras[0];
   const Mat4 m = Mat4::perspective(cam.yfovDegrees * float(M_PI) / 180, 1, cam.znear, cam.zfar) *
                  Mat4::lookAt(cam.position, cam.target, cam.up);

@@ -20,6 +20,7 @@
 
 #include "reference/ground_truth.h"
 #include "reference/suite.h"
+#include "synthvis/formats.h"
 #include "synthvis/render.h"
 
 namespace sv {
@@ -54,7 +55,7 @@ reference::BenchCase fileCase(const std::string& file) {
 reference::BenchCase generatorCase(const std::string& generator) {
   reference::BenchCase c;
   c.name = generator;
-  c.generator = scene::parseGenerator(generator).value();
+  c.generator = generators::parseGenerator(generator).value();
   c.tris.count = 3000;
   c.tris.area = 12;
   c.freeform.count = 12;
@@ -111,7 +112,7 @@ std::vector<HashCase> hashCases() {
        [](RenderOptions& o) { o.hsr = RenderOptions::Hsr::priority; });
   both("demo-hybrid", fileCase(""), [](RenderOptions& o) { o.hsr = RenderOptions::Hsr::hybrid; });
   reference::BenchCase f2b = generatorCase("layers");
-  f2b.layers.order = scene::SubmitOrder::frontToBack;
+  f2b.layers.order = generators::SubmitOrder::frontToBack;
   both("layers-f2b-priority", f2b, [](RenderOptions& o) { o.hsr = RenderOptions::Hsr::priority; });
   both(
       "layers-textured-hybrid", generatorCase("layers"),
@@ -183,8 +184,8 @@ TEST(ImageHashes, EveryImageOnEveryTargetIsTheRecordedOne) {
     reference::BenchCase shaded = c.scene;
     shaded.tris.textured = shaded.layers.textured = c.textured;
     shaded.tris.fog = shaded.layers.fog = shaded.grazing.fog = c.fog;
-    if (shaded.generator == scene::Generator::none && shaded.file.empty()) {
-      scenes.push_back(scene::demoScene());
+    if (shaded.generator == generators::Generator::none && shaded.file.empty()) {
+      scenes.push_back(formats::demoScene());
       continue;
     }
     auto made = reference::makeScene(shaded, c.options);
@@ -225,8 +226,8 @@ TEST(ImageHashes, EveryImageOnEveryTargetIsTheRecordedOne) {
   // The ground truth (`synthvis truth`) and its edge mask: scalar code, once.
   for (const char* file :
        {"", "scenes/mixed.json", "scenes/aa-edges.json", "scenes/freeform-mixed.json"}) {
-    auto loaded = *file ? scene::loadScene(std::string(SV_SOURCE_DIR) + "/" + file)
-                        : Result<scene::Scene>(scene::demoScene());
+    auto loaded = *file ? formats::loadScene(std::string(SV_SOURCE_DIR) + "/" + file)
+                        : Result<scene::Scene>(formats::demoScene());
     ASSERT_TRUE(loaded.ok()) << file;
     reference::GroundTruthOptions g{baseOptions(1), 4};
     Image edges;

@@ -11,7 +11,8 @@
 #include <numbers>
 #include <set>
 
-#include "scene/primitives.h"
+#include "formats/primitives.h"
+#include "synthvis/formats.h"
 #include "synthvis/generators.h"
 
 namespace sv {
@@ -33,7 +34,7 @@ Image renderScene(const scene::Scene& s, int w, int h, int threads, FrameStats* 
 // SV_UPDATE_GOLDEN=1 rewrites them instead of comparing.
 TEST(Render, DemoSceneMatchesItsGoldenImage) {
   const std::string golden = std::string(SV_SOURCE_DIR) + "/tests/golden/demo_128x96.png";
-  const Image img = renderScene(scene::demoScene(), 128, 96, 2);
+  const Image img = renderScene(formats::demoScene(), 128, 96, 2);
   if (std::getenv("SV_UPDATE_GOLDEN")) {
     ASSERT_TRUE(writePng(img, golden).ok());
     GTEST_SKIP() << "golden image rewritten: " << golden;
@@ -56,7 +57,7 @@ TEST(Render, DemoSceneMatchesItsGoldenImage) {
 
 TEST(Render, DemoSceneIsNotEmptyAndShowsSeveralColours) {
   FrameStats stats;
-  const Image img = renderScene(scene::demoScene(), 160, 120, 2, &stats);
+  const Image img = renderScene(formats::demoScene(), 160, 120, 2, &stats);
   EXPECT_GT(stats.drawn, 1000u);
   EXPECT_GT(stats.culledFacing, 0u);  // closed objects: their back faces
   std::set<uint32_t> colours;
@@ -66,16 +67,16 @@ TEST(Render, DemoSceneIsNotEmptyAndShowsSeveralColours) {
 }
 
 TEST(Render, DeterminismOneTwoAndEightThreadsGiveIdenticalBytes) {
-  const scene::Scene demo = scene::demoScene();
+  const scene::Scene demo = formats::demoScene();
   const Image one = renderScene(demo, 333, 201, 1);
   EXPECT_EQ(one.rgb, renderScene(demo, 333, 201, 2).rgb);
   EXPECT_EQ(one.rgb, renderScene(demo, 333, 201, 8).rgb);
-  scene::TrisParams p;
+  generators::TrisParams p;
   p.count = 20000;
   p.area = 30;
   p.width = 400;
   p.height = 300;
-  const scene::Scene tris = scene::generateTris(p);
+  const scene::Scene tris = generators::generateTris(p);
   const Image t1 = renderScene(tris, 400, 300, 1);
   EXPECT_EQ(t1.rgb, renderScene(tris, 400, 300, 2).rgb);
   EXPECT_EQ(t1.rgb, renderScene(tris, 400, 300, 8).rgb);
@@ -95,7 +96,7 @@ TEST(Render, OptionsOutOfRangeAreRejectedWithTheReason) {
   o.camera = 3;
   Renderer r(o);
   Image img;
-  EXPECT_FALSE(r.render(scene::demoScene(), img).ok());
+  EXPECT_FALSE(r.render(formats::demoScene(), img).ok());
 }
 
 // The renderer checks vertices and indices as its vertex stage reads them (not in a pass of
@@ -103,7 +104,7 @@ TEST(Render, OptionsOutOfRangeAreRejectedWithTheReason) {
 // however many vertex chunks the mesh spans, for any thread count — also where the draw order
 // reads the meshes' bounds first (priority masking).
 TEST(Render, BadVertexDataIsRefusedWithTheOffenderNamed) {
-  scene::Scene base = scene::demoScene();
+  scene::Scene base = formats::demoScene();
   ASSERT_FALSE(base.meshes.empty());
   // A mesh large enough for several vertex chunks (2^14 vertices each) and index chunks (2^16).
   scene::Mesh big;
@@ -157,24 +158,24 @@ TEST(Render, BadVertexDataIsRefusedWithTheOffenderNamed) {
 }
 
 TEST(TrisGenerator, SameSeedSameSceneAndStatisticsWithinFivePercent) {
-  scene::TrisParams p;
+  generators::TrisParams p;
   p.count = 20000;
   p.area = 100;
-  scene::TrisStats a, b;
-  const scene::Scene s1 = scene::generateTris(p, &a), s2 = scene::generateTris(p, &b);
+  generators::TrisStats a, b;
+  const scene::Scene s1 = generators::generateTris(p, &a), s2 = generators::generateTris(p, &b);
   ASSERT_EQ(s1.meshes[0].positions.size(), s2.meshes[0].positions.size());
   EXPECT_EQ(s1.meshes[0].positions[12345], s2.meshes[0].positions[12345]);
   EXPECT_NEAR(a.meanArea, 100, 5);
   p.depth = 4;
-  scene::TrisStats d;
-  scene::generateTris(p, &d);
+  generators::TrisStats d;
+  generators::generateTris(p, &d);
   EXPECT_NEAR(d.depthComplexity, 4, 0.2);
   p.seed = 2;
-  EXPECT_NE(scene::generateTris(p).meshes[0].positions[0], s1.meshes[0].positions[0]);
+  EXPECT_NE(generators::generateTris(p).meshes[0].positions[0], s1.meshes[0].positions[0]);
 }
 
 TEST(TrisGenerator, RenderedAreaMatchesTheRequestedArea) {
-  scene::TrisParams p;
+  generators::TrisParams p;
   p.count = 2000;
   p.area = 50;
   p.width = 640;
@@ -187,14 +188,14 @@ TEST(TrisGenerator, RenderedAreaMatchesTheRequestedArea) {
   Renderer r(o);
   Image img;
   FrameStats stats;
-  ASSERT_TRUE(r.render(scene::generateTris(p), img, &stats).ok());
+  ASSERT_TRUE(r.render(generators::generateTris(p), img, &stats).ok());
   EXPECT_NEAR(double(stats.fragments) / p.count, 50, 2.5);
 }
 
 // A white quad (unlit, double-sided) on black whose right edge runs down the middle of column 10
 // (x = 10.5) of a w × h image: column 9 fully covered, column 10 half, column 11 not at all.
 scene::Scene halfCoveredColumnScene(int w, int h) {
-  scene::Scene s = scene::benchCameraScene("quad");
+  scene::Scene s = generators::benchCameraScene("quad");
   const double tanHalf = std::tan(30.0 * std::numbers::pi / 180), aspect = double(w) / h;
   auto at = [&](double px, double py) {
     return Vec3{float((2 * px / w - 1) * 2 * tanHalf * aspect),
@@ -296,20 +297,20 @@ TEST(DebugViews, LevelsAndOccupancyShowTheSubdivisionAndTheMasks) {
   o.hsr = RenderOptions::Hsr::priority;
   o.debugView = RenderOptions::DebugView::levels;
   Image levels, occupancy;
-  ASSERT_TRUE(Renderer(o).render(scene::generateGrazing({}), levels).ok());
+  ASSERT_TRUE(Renderer(o).render(generators::generateGrazing({}), levels).ok());
   std::set<std::array<uint8_t, 3>> colours;
   for (size_t i = 0; i < levels.rgb.size(); i += 3)
     colours.insert({levels.rgb[i], levels.rgb[i + 1], levels.rgb[i + 2]});
   EXPECT_EQ(colours.count({0, 0, 0}), 1u) << "the sky";
   EXPECT_EQ(colours.count({128, 128, 128}), 1u) << "leaf-tested pixels along edges";
   EXPECT_GE(colours.size(), 3u) << "and pixels filled in whole windows";
-  scene::LayersParams p;
+  generators::LayersParams p;
   p.layers = 2;
-  p.order = scene::SubmitOrder::frontToBack;
+  p.order = generators::SubmitOrder::frontToBack;
   p.width = o.width;
   p.height = o.height;
   o.debugView = RenderOptions::DebugView::occupancy;
-  ASSERT_TRUE(Renderer(o).render(scene::generateLayers(p), occupancy).ok());
+  ASSERT_TRUE(Renderer(o).render(generators::generateLayers(p), occupancy).ok());
   for (size_t i = 0; i < occupancy.rgb.size(); i += 3)
     ASSERT_EQ(occupancy.rgb[i], 230) << "pixel " << i / 3 << " not in a full 64-px tile";
   o.hsr = RenderOptions::Hsr::zbuffer;
@@ -317,29 +318,29 @@ TEST(DebugViews, LevelsAndOccupancyShowTheSubdivisionAndTheMasks) {
 }
 
 TEST(LayersGenerator, SameSeedSameSceneAndStatistics) {
-  scene::LayersParams p;
+  generators::LayersParams p;
   p.layers = 3;
-  scene::TrisStats a, b;
-  const scene::Scene s1 = scene::generateLayers(p, &a), s2 = scene::generateLayers(p, &b);
+  generators::TrisStats a, b;
+  const scene::Scene s1 = generators::generateLayers(p, &a), s2 = generators::generateLayers(p, &b);
   ASSERT_EQ(s1.meshes[0].positions.size(), s2.meshes[0].positions.size());
   EXPECT_EQ(s1.meshes[0].positions, s2.meshes[0].positions);
   EXPECT_EQ(s1.meshes[0].colors, s2.meshes[0].colors);
   EXPECT_NEAR(a.meanArea, 200, 10);  // BENCH.md: mean area 200 px, within 5 %
   EXPECT_NEAR(a.depthComplexity, 3, 0.15);
   p.seed = 2;
-  EXPECT_NE(scene::generateLayers(p).meshes[0].positions, s1.meshes[0].positions);
+  EXPECT_NE(generators::generateLayers(p).meshes[0].positions, s1.meshes[0].positions);
 }
 
 // BENCH.md's layers are textured with fog: the flags add the bench texture and fog and change
 // nothing else; every layer's UVs are a linear map of the screen with 0.5–4 texels per pixel.
 TEST(LayersGenerator, TexturedAndFoggedLayersKeepTheirGeometry) {
-  scene::LayersParams p;
+  generators::LayersParams p;
   p.layers = 4;
   p.width = 640;
   p.height = 360;
-  const scene::Scene plain = scene::generateLayers(p);
+  const scene::Scene plain = generators::generateLayers(p);
   p.textured = p.fog = true;
-  const scene::Scene shaded = scene::generateLayers(p);
+  const scene::Scene shaded = generators::generateLayers(p);
   EXPECT_EQ(plain.meshes[0].positions, shaded.meshes[0].positions);
   EXPECT_EQ(plain.meshes[0].colors, shaded.meshes[0].colors);
   EXPECT_EQ(plain.meshes[0].uvs, shaded.meshes[0].uvs);
@@ -371,13 +372,13 @@ TEST(LayersGenerator, TexturedAndFoggedLayersKeepTheirGeometry) {
 // docs/quality.md) — the Z-buffer keeps the nearer by a rounding of equal depths, masking the
 // first. A translucent quad in front blends the same way over either.
 TEST(LayersGenerator, PriorityMaskingDrawsTheZBufferImageOfOrderedLayers) {
-  scene::LayersParams p;
+  generators::LayersParams p;
   p.layers = 5;
-  p.order = scene::SubmitOrder::frontToBack;
+  p.order = generators::SubmitOrder::frontToBack;
   p.width = 256;
   p.height = 160;
   p.textured = p.fog = true;
-  scene::Scene s = scene::generateLayers(p);
+  scene::Scene s = generators::generateLayers(p);
   // A translucent quad nearer than every layer (drawn after the opaque triangles).
   scene::Material glass;
   glass.name = "glass";
@@ -439,9 +440,9 @@ TEST(ObjectCulling, HiddenInstancesAreDroppedWholeWithTheZBufferImage) {
   glass.baseColor = {0.9f, 0.2f, 0.1f, 0.5f};
   glass.alphaMode = scene::AlphaMode::blend;
   s.materials = {wall, cube, glass};
-  scene::Mesh wallMesh = scene::detail::makeBox({3, 2, 0.1f});
+  scene::Mesh wallMesh = formats::detail::makeBox({3, 2, 0.1f});
   wallMesh.material = 0;
-  scene::Mesh cubeMesh = scene::detail::makeBox({0.3f, 0.3f, 0.3f});
+  scene::Mesh cubeMesh = formats::detail::makeBox({0.3f, 0.3f, 0.3f});
   cubeMesh.material = 1;
   scene::Mesh glassMesh = cubeMesh;
   glassMesh.material = 2;
@@ -488,7 +489,7 @@ TEST(ObjectCulling, InstancesOutsideTheViewAreDroppedWithTheSameImage) {
   scene::Material grey;
   grey.baseColor = {0.6f, 0.6f, 0.6f, 1};
   s.materials = {grey};
-  scene::Mesh box = scene::detail::makeBox({0.8f, 0.8f, 0.8f});
+  scene::Mesh box = formats::detail::makeBox({0.8f, 0.8f, 0.8f});
   box.material = 0;
   s.meshes = {box};
   for (int x = -12; x <= 12; ++x)
@@ -543,9 +544,9 @@ TEST(ObjectCulling, InstancesOutsideTheViewAreDroppedWithTheSameImage) {
 
 // BENCH.md: "every pixel is covered D times" — counted by the renderer, in every order.
 TEST(LayersGenerator, EveryPixelIsCoveredDTimes) {
-  for (auto order : {scene::SubmitOrder::random, scene::SubmitOrder::frontToBack,
-                     scene::SubmitOrder::backToFront}) {
-    scene::LayersParams p;
+  for (auto order : {generators::SubmitOrder::random, generators::SubmitOrder::frontToBack,
+                     generators::SubmitOrder::backToFront}) {
+    generators::LayersParams p;
     p.layers = 3;
     p.order = order;
     p.width = 320;
@@ -558,13 +559,13 @@ TEST(LayersGenerator, EveryPixelIsCoveredDTimes) {
     Renderer r(o);
     Image img;
     FrameStats stats;
-    ASSERT_TRUE(r.render(scene::generateLayers(p), img, &stats).ok());
-    EXPECT_EQ(stats.fragments, uint64_t(3) * 320 * 200) << scene::submitOrderName(order);
+    ASSERT_TRUE(r.render(generators::generateLayers(p), img, &stats).ok());
+    EXPECT_EQ(stats.fragments, uint64_t(3) * 320 * 200) << generators::submitOrderName(order);
     // The overdraw palette's colour for 3: green (40, 200, 40), at every pixel.
     size_t wrong = 0;
     for (size_t i = 0; i < img.rgb.size(); i += 3)
       wrong += !(img.rgb[i] == 40 && img.rgb[i + 1] == 200 && img.rgb[i + 2] == 40);
-    EXPECT_EQ(wrong, 0u) << scene::submitOrderName(order);
+    EXPECT_EQ(wrong, 0u) << generators::submitOrderName(order);
   }
 }
 

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "render/tile_gather.h"
+#include "synthvis/formats.h"
 #include "synthvis/render.h"
 #include "synthvis/scene.h"
 
@@ -66,7 +67,7 @@ class MemoryExchange final : public TileExchange {
 };
 
 scene::Scene load(const std::string& file, int width, int height) {
-  Result<scene::Scene> s = scene::loadScene(std::string(SV_SOURCE_DIR) + "/scenes/" + file);
+  Result<scene::Scene> s = formats::loadScene(std::string(SV_SOURCE_DIR) + "/scenes/" + file);
   EXPECT_TRUE(s.ok()) << s.error().str();
   scene::Scene scene = std::move(s.value());
   scene::Channel c;

@@ -5,10 +5,11 @@
 #include <cmath>
 #include <memory>
 
+#include "formats/heights.h"
 #include "raster/framebuffer.h"
 #include "render/camera.h"
 #include "render/shading_tables.h"
-#include "render/terrain_pass.h"
+#include "render/terrains.h"
 #include "synthvis/generators.h"
 #include "synthvis/image.h"
 #include "synthvis/render.h"
@@ -19,10 +20,10 @@ namespace sv {
 namespace {
 
 scene::Scene smallTerrain(int size, bool bicubic) {
-  scene::TerrainParams p;
+  generators::TerrainParams p;
   p.size = size;
   p.bicubic = bicubic;
-  return scene::generateTerrain(p).value();
+  return generators::generateTerrain(p).value();
 }
 
 RenderOptions smallOptions(int threads) {
@@ -40,8 +41,9 @@ TEST(TerrainRender, TheHeightQueryAgreesWithTheRenderedDepth) {
     const render::FrameCamera camera = render::chooseCamera(s, o).value();
     render::ShadingTables shading;
     render::buildShading(s, o, camera.view, shading);
-    render::TerrainPass pass;
-    pass.setTerrains(s, camera, shading, o);
+    terrain::TerrainPass pass;
+    const EyeRays rays = render::eyeRays(camera);
+    pass.setTerrains(render::terrainDraws(s, rays, shading, o), rays, shading.environment);
     pass.prepare(raster::PassFrame{o.width, o.height, 1, nullptr, nullptr});
     // One tile's buffers, cleared to the far plane.
     std::vector<float> depth(raster::kTileSize * raster::kTileSize, 1.0f);
@@ -107,12 +109,12 @@ TEST(TerrainRender, SameImageForAnyThreadCount) {
 
 TEST(TerrainRender, AMosaicOfFourTilesRendersAsTheMergedMap) {
   scene::Scene merged = smallTerrain(129, false);
-  const terrain::HeightField& f = merged.terrains[0].ground->field;
+  const scene::HeightField& f = *merged.terrains[0].heights;
   // Four tiles sharing their edge row and column, as SRTM tiles do.
-  std::vector<terrain::HeightField> tiles;
+  std::vector<scene::HeightField> tiles;
   for (int ty = 0; ty < 2; ++ty)
     for (int tx = 0; tx < 2; ++tx) {
-      terrain::HeightField t;
+      scene::HeightField t;
       t.width = t.height = 65;
       t.spacingU = f.spacingU, t.spacingV = f.spacingV;
       t.originU = f.originU + tx * 64 * f.spacingU;
@@ -123,10 +125,10 @@ TEST(TerrainRender, AMosaicOfFourTilesRendersAsTheMergedMap) {
         for (int i = 0; i < 65; ++i) t.q.push_back(f.code(tx * 64 + i, ty * 64 + j));
       tiles.push_back(std::move(t));
     }
-  Result<terrain::HeightField> m = terrain::mosaic(tiles);
+  Result<scene::HeightField> m = formats::mosaic(tiles);
   ASSERT_TRUE(m.ok()) << m.error().str();
   scene::Scene fromTiles = merged;
-  fromTiles.terrains[0].ground = std::make_shared<terrain::Ground>(std::move(m.value()));
+  fromTiles.terrains[0].heights = std::make_shared<scene::HeightField>(std::move(m.value()));
   Image a, b;
   const RenderOptions o = smallOptions(2);
   ASSERT_TRUE(Renderer(o).render(merged, a));

@@ -18,6 +18,7 @@
 #include "render/correction.h"
 #include "render/view_renderer.h"
 #include "support/test_scenes.h"
+#include "synthvis/formats.h"
 #include "synthvis/generators.h"
 #include "synthvis/render.h"
 
@@ -85,9 +86,9 @@ Difference compare(const Image& a, const Image& b) {
 }
 
 scene::Scene smallTerrain() {
-  scene::TerrainParams p;
+  generators::TerrainParams p;
   p.size = 129;
-  return scene::generateTerrain(p).value();
+  return generators::generateTerrain(p).value();
 }
 
 TEST(SubFrusta, AFlatDisplayDrawsTheChannelsImage) {
@@ -98,12 +99,12 @@ TEST(SubFrusta, AFlatDisplayDrawsTheChannelsImage) {
   const int width = 160, height = 112;
   const display::SubFrustumPlan plan = display::planSubFrusta(pinholeTable(o, w, width, height));
   ASSERT_EQ(plan.cells.size(), 1u);
-  scene::VolumeParams vp;
+  generators::VolumeParams vp;
   const std::vector<std::pair<const char*, scene::Scene>> scenes = {
-      {"demo", scene::demoScene()},
+      {"demo", formats::demoScene()},
       {"terrain", smallTerrain()},
-      {"free forms", scene::generateFreeFormOne()},
-      {"volume", scene::generateVolume(vp)}};
+      {"free forms", generators::generateFreeFormOne()},
+      {"volume", generators::generateVolume(vp)}};
   for (const auto& [name, s] : scenes) {
     RenderOptions opt;
     opt.threads = 2;

@@ -6,13 +6,12 @@
 #include <cmath>
 #include <limits>
 
-#include "scene/scene_test_util.h"
-#include "synthvis/generators.h"
+#include "support/expect.h"
 
 namespace sv::scene {
 namespace {
 
-using testing::contains;
+using sv::tests::contains;
 
 Scene oneTriangleScene() {
   Scene s;
@@ -128,25 +127,6 @@ TEST(Scene, AppendSceneOffsetsIndicesAndComposesTransforms) {
   EXPECT_EQ(s.cameras[0].target, (Vec3{10, 0, 0}));
   EXPECT_EQ(s.light.ambient, Light{}.ambient);  // the outer scene keeps its light
   EXPECT_TRUE(validate(s, "merged").ok());
-}
-
-// BENCH.md's generators are named in one place: every name parses back to its generator, an
-// unknown one is refused with the list, and those of later issues say what they need.
-TEST(Generators, NamesParseBack) {
-  for (Generator g :
-       {Generator::tris, Generator::layers, Generator::grazing, Generator::freeform,
-        Generator::freeformOne, Generator::terrain, Generator::volume, Generator::lights,
-        Generator::city}) {
-    const Result<Generator> parsed = parseGenerator(generatorName(g));
-    ASSERT_TRUE(parsed.ok()) << generatorName(g);
-    EXPECT_EQ(parsed.value(), g);
-  }
-  EXPECT_STREQ(generatorName(Generator::freeformOne), "freeform-one");
-  const Result<Generator> bad = parseGenerator("trees");
-  ASSERT_FALSE(bad.ok());
-  EXPECT_EQ(bad.error().message,
-            "unknown generator 'trees' (tris, layers, grazing, freeform, freeform-one, terrain, "
-            "volume, lights, city)");
 }
 
 }  // namespace

@@ -6,8 +6,14 @@
 #include <cmath>
 #include <random>
 
+#include "formats/heights.h"
+
 namespace sv::terrain {
 namespace {
+
+// Tables to cast over, made as the formats make them.
+using formats::generateFractal;
+using formats::quantize;
 
 const Interpolation kFilters[] = {Interpolation::bilinear, Interpolation::bicubic};
 

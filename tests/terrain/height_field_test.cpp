@@ -4,8 +4,14 @@
 
 #include <cmath>
 
+#include "formats/heights.h"
+
 namespace sv::terrain {
 namespace {
+
+// Tables to cast over, made as the formats make them.
+using formats::generateFractal;
+using formats::quantize;
 
 TEST(HeightField, BothFiltersReproduceTheTableAtGridPoints) {
   const HeightField f = generateFractal(33, 10, 500, 7).value();
@@ -46,7 +52,7 @@ TEST(HeightField, FractalIsSeededAndSpansItsRelief) {
 TEST(HeightField, QuantizeRefusesEmptyAndAbsurdTables) {
   EXPECT_FALSE(quantize({NAN, NAN, NAN, NAN}, 2, 2, "x").ok());
   EXPECT_FALSE(quantize({1, 2}, 2, 1, "x").ok());
-  EXPECT_FALSE(generateFractal(kMaxSide + 1, 1, 1, 0).ok());
+  EXPECT_FALSE(generateFractal(scene::kMaxHeightSide + 1, 1, 1, 0).ok());
   const HeightField f = quantize({1, NAN, 3, 5}, 2, 2, "x").value();
   EXPECT_NEAR(f.at(1, 0), 1, 1e-9);  // no data takes the lowest height
   EXPECT_NEAR(f.at(1, 1), 5, 1e-9);

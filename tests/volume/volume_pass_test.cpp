@@ -10,9 +10,10 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <string>
 #include <memory>
+#include <string>
 
+#include "synthvis/formats.h"
 #include "synthvis/generators.h"
 #include "synthvis/image.h"
 #include "synthvis/render.h"
@@ -86,7 +87,7 @@ scene::Scene marschnerLobbScene() {
   scene::Scene s = emptyScene();
   scene::VolumeObject v;
   v.name = "marschner-lobb";
-  v.grid = std::make_shared<scene::VolumeGrid>(scene::marschnerLobbGrid(41));
+  v.grid = std::make_shared<scene::VolumeGrid>(formats::marschnerLobbGrid(41));
   v.transform = Mat4::translation({0, 0, -14}) * Mat4::scaling({6, 6, 6}) *
                 Mat4::translation({-1, -1, -1});
   v.transfer = {{0.0f, {0.2f, 0.4f, 1}, 0}, {0.45f, {0.2f, 0.4f, 1}, 0},
@@ -225,10 +226,10 @@ TEST(VolumePass, EmptySpaceSkippingMovesNoPixel) {
   // BENCH.md's volume without its shell, 4 samples a pixel, 3 threads: the windows' depth
   // intervals (SPEC §12's screen subdivision) start and end the rays at the bricks with content
   // and cast none where no such brick shows — no pixel moves, fewer rays are cast.
-  scene::VolumeParams params;
+  generators::VolumeParams params;
   params.size = 48;
   params.shell = false;
-  scene::Scene blobs = scene::generateVolume(params);
+  scene::Scene blobs = generators::generateVolume(params);
   blobs.volumeSettings.skipEmpty = false;
   const Image whole = render(blobs, options(4, 3), &every);
   blobs.volumeSettings.skipEmpty = true;
@@ -241,12 +242,12 @@ TEST(VolumePass, EmptySpaceSkippingMovesNoPixel) {
 // samples (BENCH.md's volume, its sphere made from the data); a shell cutting the content away
 // removes it.
 TEST(VolumePass, ATrueShellChangesNoPixel) {
-  scene::VolumeParams params;
+  generators::VolumeParams params;
   params.size = 40;
-  scene::Scene shelled = scene::generateVolume(params);
+  scene::Scene shelled = generators::generateVolume(params);
   ASSERT_EQ(shelled.volumes[0].shell.size(), 1u);
   params.shell = false;
-  const scene::Scene boxed = scene::generateVolume(params);
+  const scene::Scene boxed = generators::generateVolume(params);
   EXPECT_TRUE(boxed.volumes[0].shell.empty());
   RenderOptions o = options();
   o.width = o.height = 96;
@@ -284,7 +285,7 @@ TEST(VolumePass, TablesFollowTheGridAndTransferFunction) {
   for (int round = 0; round < 2; ++round) {
     scene::Scene s = marschnerLobbScene();
     if (round == 1) {
-      s.volumes[0].grid = std::make_shared<scene::VolumeGrid>(scene::marschnerLobbGrid(33));
+      s.volumes[0].grid = std::make_shared<scene::VolumeGrid>(formats::marschnerLobbGrid(33));
       s.volumes[0].transfer[2].opacity = 0.2f;
     }
     Image kept;
@@ -344,7 +345,7 @@ TEST(VolumeQuality, MarschnerLobbAgainstItsAnalyticReference) {
   auto draw = [&](int size, int bits, bool precomputed = false) {
     scene::Scene s = marschnerLobbScene();
     s.volumeSettings.precomputedNormals = precomputed;
-    s.volumes[0].grid = std::make_shared<scene::VolumeGrid>(scene::marschnerLobbGrid(size, bits));
+    s.volumes[0].grid = std::make_shared<scene::VolumeGrid>(formats::marschnerLobbGrid(size, bits));
     s.volumes[0].transfer = {{0.0f, {1, 0.55f, 0.15f}, 0},
                              {0.46f, {1, 0.55f, 0.15f}, 0},
                              {0.5f, {1, 0.7f, 0.35f}, 0.9f},
