@@ -6,11 +6,13 @@
 # the wrong way names a file that is not there, and the build fails (tests/layering holds it).
 include(GNUInstallDirs)
 
-# sv_publish_headers(TARGET [STAGE dir] [PUBLIC_HEADERS h…]): TARGET's include root as above. The
-# public headers are installed under include/synthvis (the stage's own headers are internal and
-# stay in the source tree).
+# sv_publish_headers(TARGET [STAGE dir] [PUBLIC_HEADERS h…] [NOT_INSTALLED]): TARGET's include
+# root as above. The public headers are installed under include/synthvis (the stage's own headers
+# are internal and stay in the source tree) — unless NOT_INSTALLED: the library is not installed
+# (the IG, the bench harness, prep, the cluster: the CLI's, apps/synthvis), so neither are its
+# headers, which are public to the programs of this tree.
 function(sv_publish_headers target)
-  cmake_parse_arguments(P "" "STAGE" "PUBLIC_HEADERS" ${ARGN})
+  cmake_parse_arguments(P "NOT_INSTALLED" "STAGE" "PUBLIC_HEADERS" ${ARGN})
   set(root "${PROJECT_BINARY_DIR}/stage-include/${target}")
   file(REMOVE_RECURSE "${root}")
   file(MAKE_DIRECTORY "${root}")
@@ -23,7 +25,7 @@ function(sv_publish_headers target)
     file(CREATE_LINK "${PROJECT_SOURCE_DIR}/include/synthvis/${h}" "${root}/synthvis/${h}" SYMBOLIC)
     list(APPEND installed "${PROJECT_SOURCE_DIR}/include/synthvis/${h}")
   endforeach()
-  if(installed)
+  if(installed AND NOT P_NOT_INSTALLED)
     install(FILES ${installed} DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}/synthvis")
   endif()
   get_target_property(type ${target} TYPE)

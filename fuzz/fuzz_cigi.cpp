@@ -10,8 +10,8 @@
 #include <span>
 #include <string>
 
-#include "cigi/cigi.h"
 #include "cigi/pcap.h"
+#include "synthvis/cigi.h"
 
 namespace {
 

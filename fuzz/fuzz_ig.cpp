@@ -8,8 +8,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "ig/config.h"
-#include "ig/host.h"
+#include "synthvis/ig.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size == 0) return 0;

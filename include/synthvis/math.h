@@ -59,6 +59,34 @@ inline Vec3 normalize(Vec3 a) {
   return b * (1.0f / length(b));
 }
 
+// Vec3 in double: the one double vector type — for the free forms' and the terrain's rays, the
+// display's directions and the host's geodetic positions, where float loses what they need.
+struct Vec3d {
+  double x = 0, y = 0, z = 0;
+  friend Vec3d operator+(Vec3d a, Vec3d b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+  friend Vec3d operator-(Vec3d a, Vec3d b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+  friend Vec3d operator*(Vec3d a, double s) { return {a.x * s, a.y * s, a.z * s}; }
+  friend Vec3d operator*(double s, Vec3d a) { return a * s; }
+};
+inline double dot(Vec3d a, Vec3d b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline Vec3d cross(Vec3d a, Vec3d b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+inline double length(Vec3d v) { return std::sqrt(dot(v, v)); }
+// `v` scaled to unit length, or unchanged when it has zero length.
+inline Vec3d normalize(Vec3d v) {
+  const double l = std::sqrt(dot(v, v));
+  return l > 0 ? v * (1 / l) : v;
+}
+// The angle between a and b, radians: atan2(|a × b|, a · b), accurate at small angles, where acos
+// of the dot product is not.
+inline double angleBetween(Vec3d a, Vec3d b) {
+  const Vec3d c = cross(a, b);
+  return std::atan2(std::sqrt(dot(c, c)), dot(a, b));
+}
+inline Vec3 toFloat(Vec3d v) { return {float(v.x), float(v.y), float(v.z)}; }
+inline Vec3d toDouble(Vec3 v) { return {v.x, v.y, v.z}; }
+
 // 4×4 matrix, column-major: m[c][r] is row r of column c.
 struct Mat4 {
   std::array<std::array<float, 4>, 4> m{{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}}};

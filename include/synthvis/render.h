@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "synthvis/display.h"
 #include "synthvis/frame_stats.h"
 #include "synthvis/image.h"
 #include "synthvis/result.h"
@@ -108,6 +109,11 @@ struct RenderOptions {
   // ground is drawn from the mean pyramid's level of its size, as a texture's MIP levels are;
   // false: the table's own surface everywhere (exact, and aliased in the distance).
   bool terrainLod = true;
+  // How a curved-screen display's frames are pre-distorted (Renderer::renderDisplay; SPEC §12,
+  // docs/display.md): the seeds' sub-frusta, each drawn through its own projective map with no
+  // resampling; or a flat view with a margin, rendered and resampled bilinearly or bicubically
+  // through the display mapping (the industry's way, for comparison).
+  enum class Correction { subFrusta, bilinear, bicubic } correction = Correction::subFrusta;
 };
 
 // The scene with every free form replaced by triangles (issue 7's polygon baseline): marching
@@ -124,6 +130,13 @@ Result<scene::Scene> tessellatedScene(const scene::Scene& scene, const RenderOpt
 // By name, as the CLI's --pipeline writes them: "tiles", "segments".
 Result<RenderOptions::Pipeline> parsePipeline(const std::string& text);
 const char* pipelineName(RenderOptions::Pipeline pipeline);
+
+// By name, as the CLI's --terrain-filter writes them: "scene", "bilinear", "bicubic".
+Result<RenderOptions::TerrainFilter> parseTerrainFilter(const std::string& text);
+
+// By name, as the CLI's --correction writes them: "subfrusta", "bilinear", "bicubic".
+Result<RenderOptions::Correction> parseCorrection(const std::string& text);
+const char* correctionName(RenderOptions::Correction correction);
 
 // By name, as the CLI's --hsr writes them: "zbuffer", "priority", "hybrid".
 Result<RenderOptions::Hsr> parseHsr(const std::string& text);
@@ -170,6 +183,22 @@ class Renderer {
   Status renderChannels(const scene::Scene& scene, std::vector<Image>& images,
                         std::vector<FrameStats>* stats = nullptr,
                         const std::vector<ChannelShare>* only = nullptr);
+
+  // Renders every projector of `display` (SPEC §9, §12; docs/display.md): the scene camera's
+  // view from the display's eye, each projector's pixels in their own directions, pre-distorted
+  // as options().correction says and edge-blended in linear light before the gamma table —
+  // projector i into images[i] at its own size (the options' width and height are not used), its
+  // statistics into (*stats)[i] and its correction's into (*correction)[i]. The projectors are
+  // drawn one after another, each on all the renderer's threads; the frames in linear light are
+  // kept for viewerImage. Identical bytes for any thread count. An error names the projector.
+  Status renderDisplay(const scene::Scene& scene, const Display& display,
+                       std::vector<Image>& images, std::vector<FrameStats>* stats = nullptr,
+                       std::vector<DisplayStats>* correction = nullptr);
+  // The simulated viewer's view of the screen (docs/display.md, "The viewer"): the frames of the
+  // last renderDisplay of `display` projected onto its screen and seen from its eye, azimuth
+  // −100…100°, elevation −25…25°, through the gamma table. An error for a display whose geometry
+  // is not known (Display::hasGeometry) or that this renderer has not drawn.
+  Result<Image> viewerImage(const Display& display) const;
 
   const RenderOptions& options() const;
 

@@ -14,6 +14,7 @@
 #include <string_view>
 #include <vector>
 
+#include "synthvis/geodesy.h"
 #include "synthvis/height_field.h"
 #include "synthvis/light_points.h"
 #include "synthvis/lines.h"
@@ -333,6 +334,16 @@ struct Fog {
   float beta = 0;                 // per scene unit; the colour halves every 1/β units
 };
 
+// Where the database lies on the Earth (docs/scene-format.md, "Geodetic frame"): the geodetic
+// position of the world origin, and whether the ground curves with the Earth. Geographic height
+// tables and draped images are placed by it, and the IG places its entities by it
+// (synthvis/geodesy.h: one conversion for both).
+struct Geodetic {
+  GeoPoint origin;
+  bool curved = false;
+  GeoFrame frame() const { return GeoFrame(origin, curved); }
+};
+
 struct Scene {
   std::vector<Mesh> meshes;
   std::vector<Material> materials;
@@ -368,6 +379,9 @@ struct Scene {
   VolumeSettings volumeSettings;
   // Simulation time, seconds: what blinking, sequences and the stars' rotation are functions of.
   double time = 0;
+  // The database's place on the Earth; nothing: not stated (a geographic table is then placed by
+  // a frame at its own centre).
+  std::optional<Geodetic> geodetic;
   // What a loader read but does not draw, one line each naming the file and the part ("…: 2
   // primitives of points are not drawn"), and "nothing to draw" for a file that holds nothing
   // drawable: never a silently empty image. The CLI prints them.

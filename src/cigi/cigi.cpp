@@ -6,7 +6,7 @@
 // Decoder (wire → struct) or an Encoder (struct → wire), so reading and writing cannot drift
 // apart. The hand-built byte arrays of tests/cigi/cigi_test.cpp and the tshark check pin the
 // layouts themselves.
-#include "cigi/cigi.h"
+#include "synthvis/cigi.h"
 
 #include <fmt/format.h>
 

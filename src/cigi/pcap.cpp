@@ -12,8 +12,8 @@
 #include <cstring>
 #include <memory>
 
-#include "cigi/cigi.h"
-#include "core/files.h"
+#include "synthvis/cigi.h"
+#include "synthvis/files.h"
 
 namespace sv::cigi {
 namespace {

@@ -1,15 +1,15 @@
 // Based on: SPEC §9 (all channels of a frame show the same simulation instant), §3.4 (one picture
 // over several processors); the MPI standard's broadcast, point-to-point messages and MPI_Abort.
-#include "cluster/cluster.h"
+#include "synthvis/cluster.h"
 
 #include <fmt/format.h>
 #include <mpi.h>
 
 #include <algorithm>
 #include <chrono>
-#include <functional>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <thread>
 
 namespace sv::cluster {

@@ -1,4 +1,4 @@
-#include "core/files.h"
+#include "synthvis/files.h"
 
 #include <fmt/format.h>
 

@@ -10,16 +10,6 @@
 
 namespace sv {
 
-Vec3d normalize(Vec3d v) {
-  const double l = std::sqrt(dot(v, v));
-  return l > 0 ? v * (1 / l) : v;
-}
-
-double angleBetween(Vec3d a, Vec3d b) {
-  const Vec3d c = cross(a, b);
-  return std::atan2(std::sqrt(dot(c, c)), dot(a, b));
-}
-
 Mat4d operator*(const Mat4d& a, const Mat4d& b) {
   Mat4d r;
   for (int i = 0; i < 4; ++i)

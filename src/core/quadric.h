@@ -17,29 +17,15 @@
 #include <limits>
 #include <optional>
 
+#include "synthvis/math.h"
+
 namespace sv {
 
-// Vec3d, Vec4d and Mat4d are synthvis/math.h's Vec3, Vec4 and Mat4 in double, for the free forms'
+// Vec4d and Mat4d are synthvis/math.h's Vec4 and Mat4 in double (Vec3d is math.h's own), for the free forms'
 // arithmetic: a quadric carried into the cube by a projective map and its interval bounds lose
 // the surface in float (the map's entries span many orders of magnitude near the far plane).
 // Mat4d is row-major (m[r][c]), as SPEC §12 writes S' = M^{-T} S M^{-1} and a quadric's matrix;
 // render turns the camera's column-major Mat4 into it (render/freeforms.cpp).
-struct Vec3d {
-  double x = 0, y = 0, z = 0;
-  friend Vec3d operator+(Vec3d a, Vec3d b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-  friend Vec3d operator-(Vec3d a, Vec3d b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-  friend Vec3d operator*(Vec3d a, double s) { return {a.x * s, a.y * s, a.z * s}; }
-  friend Vec3d operator*(double s, Vec3d a) { return a * s; }
-};
-inline double dot(Vec3d a, Vec3d b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-Vec3d normalize(Vec3d v);  // v unchanged when it has zero length
-inline Vec3d cross(Vec3d a, Vec3d b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-// The angle between a and b, radians: atan2(|a × b|, a · b), accurate at small angles, where acos
-// of the dot product is not.
-double angleBetween(Vec3d a, Vec3d b);
-
 struct Vec4d {
   double v[4] = {0, 0, 0, 0};
   double& operator[](int i) { return v[i]; }

@@ -17,11 +17,6 @@ namespace {
 constexpr double kToRadians = std::numbers::pi / 180;
 constexpr double kToDegrees = 180 / std::numbers::pi;
 
-struct D3 {
-  double x, y, z;
-};
-D3 toD3(Vec3 v) { return {v.x, v.y, v.z}; }
-
 // Row-major 3×3 products.
 Rotation multiply(const Rotation& a, const Rotation& b) {
   Rotation r{};
@@ -47,8 +42,8 @@ Rotation aboutZ(double a) {
 // The smallest t > 0 at which o + t·d lies on the screen's surface and within its extent, or a
 // negative number. Roots of a·t² + b·t + c = 0 by q = −(b + sign(b)·√disc)/2, t = q/a and c/q,
 // which avoids the cancellation of the schoolbook formula when b² ≫ 4ac.
-double hitScreen(const Screen& s, D3 o, D3 d) {
-  const D3 rel{o.x - s.centre.x, o.y - s.centre.y, o.z - s.centre.z};
+double hitScreen(const Screen& s, Vec3d o, Vec3d d) {
+  const Vec3d rel{o.x - s.centre.x, o.y - s.centre.y, o.z - s.centre.z};
   const bool sphere = s.shape == ScreenShape::sphere;
   const double a = d.x * d.x + d.z * d.z + (sphere ? d.y * d.y : 0);
   const double b = 2 * (rel.x * d.x + rel.z * d.z + (sphere ? rel.y * d.y : 0));
@@ -61,7 +56,7 @@ double hitScreen(const Screen& s, D3 o, D3 d) {
   if (t0 > t1) std::swap(t0, t1);
   for (double t : {t0, t1}) {
     if (!(t > 1e-9)) continue;
-    const D3 p{rel.x + t * d.x, rel.y + t * d.y, rel.z + t * d.z};
+    const Vec3d p{rel.x + t * d.x, rel.y + t * d.y, rel.z + t * d.z};
     const double azimuth = std::atan2(p.x, -p.z) * kToDegrees;
     if (azimuth < s.minAzimuthDegrees || azimuth > s.maxAzimuthDegrees) continue;
     if (sphere) {
@@ -83,7 +78,7 @@ struct ProjectorFrame {
 };
 ProjectorFrame frameOf(const Projector& p) { return {tangentsOf(p.lens), rotationOf(p.orientation)}; }
 
-D3 rayOf(const Projector& p, const ProjectorFrame& f, double px, double py) {
+Vec3d rayOf(const Projector& p, const ProjectorFrame& f, double px, double py) {
   // The image plane at distance 1 along the body's −z: the window's tangents at the image edges,
   // linear in between (a pinhole lens).
   const WindowTangents& t = f.t;
@@ -91,7 +86,7 @@ D3 rayOf(const Projector& p, const ProjectorFrame& f, double px, double py) {
   const double y = t.up - (py / p.height) * (t.up - t.down);
   const Rotation& r = f.r;
   const double v[3] = {x, y, -1};
-  D3 out{};
+  Vec3d out{};
   double* o[3] = {&out.x, &out.y, &out.z};
   for (int i = 0; i < 3; ++i) *o[i] = r.m[i][0] * v[0] + r.m[i][1] * v[1] + r.m[i][2] * v[2];
   const double len = std::sqrt(out.x * out.x + out.y * out.y + out.z * out.z);
@@ -138,7 +133,7 @@ Orientation orientationOf(const Rotation& r) {
 }
 
 Vec3 projectorRay(const Projector& projector, double px, double py) {
-  const D3 d = rayOf(projector, frameOf(projector), px, py);
+  const Vec3d d = rayOf(projector, frameOf(projector), px, py);
   return {float(d.x), float(d.y), float(d.z)};
 }
 
@@ -146,14 +141,14 @@ namespace {
 
 // The screen point pixel (px, py) lights and the unit direction in which the eye sees it, in
 // double; false when the pixel misses the screen or the eye sits on the screen point.
-bool traceView(const DisplayGeometry& g, const ProjectorFrame& f, double px, double py, D3& point,
-               D3& direction) {
-  const D3 o = toD3(g.projector.position);
-  const D3 d = rayOf(g.projector, f, px, py);
+bool traceView(const DisplayGeometry& g, const ProjectorFrame& f, double px, double py,
+               Vec3d& point, Vec3d& direction) {
+  const Vec3d o = toDouble(g.projector.position);
+  const Vec3d d = rayOf(g.projector, f, px, py);
   const double t = hitScreen(g.screen, o, d);
   if (t < 0) return false;
   point = {o.x + t * d.x, o.y + t * d.y, o.z + t * d.z};
-  const D3 e{point.x - g.eye.x, point.y - g.eye.y, point.z - g.eye.z};
+  const Vec3d e{point.x - g.eye.x, point.y - g.eye.y, point.z - g.eye.z};
   const double len = std::sqrt(e.x * e.x + e.y * e.y + e.z * e.z);
   if (!(len > 0)) return false;  // the eye on the screen sees no direction
   direction = {e.x / len, e.y / len, e.z / len};
@@ -163,14 +158,13 @@ bool traceView(const DisplayGeometry& g, const ProjectorFrame& f, double px, dou
 }  // namespace
 
 std::optional<Vec3d> screenPoint(const Screen& screen, Vec3d origin, Vec3d direction) {
-  const double t =
-      hitScreen(screen, {origin.x, origin.y, origin.z}, {direction.x, direction.y, direction.z});
+  const double t = hitScreen(screen, origin, direction);
   if (t < 0) return std::nullopt;
   return origin + direction * t;
 }
 
 PixelView viewOfPixel(const DisplayGeometry& g, double px, double py) {
-  D3 p{}, e{};
+  Vec3d p{}, e{};
   if (!traceView(g, frameOf(g.projector), px, py, p, e)) return {};
   PixelView v;
   v.valid = true;
@@ -180,9 +174,9 @@ PixelView viewOfPixel(const DisplayGeometry& g, double px, double py) {
 }
 
 std::optional<Vec3d> viewDirection(const DisplayGeometry& g, double px, double py) {
-  D3 p{}, e{};
+  Vec3d p{}, e{};
   if (!traceView(g, frameOf(g.projector), px, py, p, e)) return std::nullopt;
-  return Vec3d{e.x, e.y, e.z};
+  return e;
 }
 
 void viewDirections(const DisplayGeometry& g, std::vector<Vec3d>& directions,
@@ -193,9 +187,9 @@ void viewDirections(const DisplayGeometry& g, std::vector<Vec3d>& directions,
   const ProjectorFrame frame = frameOf(g.projector);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
-      D3 p{}, e{};
+      Vec3d p{}, e{};
       const size_t i = size_t(y) * size_t(w) + size_t(x);
-      if (traceView(g, frame, x + 0.5, y + 0.5, p, e)) directions[i] = {e.x, e.y, e.z}, valid[i] = 1;
+      if (traceView(g, frame, x + 0.5, y + 0.5, p, e)) directions[i] = e, valid[i] = 1;
     }
 }
 

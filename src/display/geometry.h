@@ -14,11 +14,6 @@
 
 #include "synthvis/math.h"
 
-namespace sv {
-struct Vec3d;  // core/quadric.h (not included here: its normalize overloads would make a braced
-               // normalize({…}) ambiguous for this header's users)
-}  // namespace sv
-
 namespace sv::display {
 
 // An orientation as Channel's (synthvis/scene.h): heading, then pitch, then bank about the body's

@@ -21,8 +21,8 @@
 #include <numbers>
 #include <set>
 
-#include "core/files.h"
 #include "display/zip_memory.h"
+#include "synthvis/files.h"
 #include "texture/png.h"
 
 namespace sv::display {

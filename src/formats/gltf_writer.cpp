@@ -20,8 +20,8 @@
 #include <numbers>
 #include <sstream>
 
-#include "core/files.h"
 #include "formats/reader.h"
+#include "synthvis/files.h"
 #include "texture/texture.h"
 
 namespace sv::formats {

@@ -24,6 +24,21 @@
 
 namespace sv::formats {
 using namespace gdal;
+
+GeoFrame ownFrame(const HeightField::Geographic& g, int width, int height) {
+  const double degrees = g.radiansPerUnit * 180 / M_PI;
+  return GeoFrame(GeoPoint{(g.lat0 - 0.5 * (height - 1) * g.dLat) * degrees,
+                           (g.lon0 + 0.5 * (width - 1) * g.dLon) * degrees, 0});
+}
+
+void placeGeographic(const HeightField::Geographic& g, const GeoFrame& frame, HeightField& f) {
+  const double degrees = g.radiansPerUnit * 180 / M_PI;
+  f.originU = frame.east(g.lon0 * degrees);
+  f.originV = frame.north(g.lat0 * degrees);
+  f.spacingU = g.dLon * degrees * frame.metresPerDegreeEast();
+  f.spacingV = g.dLat * degrees * frame.metresPerDegreeNorth();
+}
+
 namespace {
 
 // Map positions and extents beyond this are not a ground (the Earth's circumference is 4·10⁷ m):
@@ -86,12 +101,10 @@ Result<GridPlacement> gridPlacement(GDALDatasetH ds, int width, int height,
     placed.spacingU = gt[1];
     placed.spacingV = -gt[5];
   }
-  // A geographic raster: degrees (or the SRS's angular unit) to metres by the equirectangular
-  // projection at the centre latitude (height_field.h). Symbols: k = R·(radians per unit), the
-  // metres per unit along a meridian; kx = k·cos(lat0) along the standard parallel. The map is
-  // linear, u = kx·λ, v = k·φ, so origin and spacing scale alike and the centre (λ0, φ0) lands at
-  // (kx·λ0, k·φ0). The geotransform is in longitude, latitude order whatever the SRS's axis order
-  // (GDAL's "traditional GIS order" for rasters).
+  // A geographic raster: degrees (or the SRS's angular unit) to map metres of the WGS 84 frame at
+  // its own centre (synthvis/geodesy.h; a scene's geodetic frame re-places it: placeGeographic).
+  // The geotransform is in longitude, latitude order whatever the SRS's axis order (GDAL's
+  // "traditional GIS order" for rasters).
   HeightField::Geographic geographic;
   if (georeferenced) {
     if (OGRSpatialReferenceH srs = GDALGetSpatialRef(ds); srs && OSRIsGeographic(srs)) {
@@ -105,11 +118,7 @@ Result<GridPlacement> gridPlacement(GDALDatasetH ds, int width, int height,
                                  lat0, radiansPerUnit)};
       geographic = {true,          placed.originU, placed.originV, placed.spacingU, placed.spacingV,
                     radiansPerUnit};
-      const double k = kEarthRadius * radiansPerUnit, kx = k * std::cos(lat0Radians);
-      placed.originU *= kx;
-      placed.spacingU *= kx;
-      placed.originV *= k;
-      placed.spacingV *= k;
+      placeGeographic(geographic, ownFrame(geographic, width, height), placed);
     }
   }
   if (std::optional<Error> e = checkPlacement(placed, source)) return *e;
@@ -319,15 +328,12 @@ Result<std::vector<HeightField>> onOneLatitude(const std::vector<HeightField>& t
     bottom = std::min(bottom, (t.geographic.lat0 - (t.height - 1) * t.geographic.dLat) *
                                   t.geographic.radiansPerUnit);
   }
-  const double cosLat = std::cos(0.5 * (top + bottom));
+  const HeightField::Geographic& g = tiles.front().geographic;
+  const double degrees = 180 / M_PI;
+  const GeoFrame frame(
+      GeoPoint{0.5 * (top + bottom) * degrees, g.lon0 * g.radiansPerUnit * degrees, 0});
   std::vector<HeightField> out = tiles;
-  for (HeightField& t : out) {
-    const double k = kEarthRadius * t.geographic.radiansPerUnit, kx = k * cosLat;
-    t.originU = t.geographic.lon0 * kx;
-    t.spacingU = t.geographic.dLon * kx;
-    t.originV = t.geographic.lat0 * k;
-    t.spacingV = t.geographic.dLat * k;
-  }
+  for (HeightField& t : out) placeGeographic(t.geographic, frame, t);
   return out;
 }
 

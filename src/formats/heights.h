@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "synthvis/geodesy.h"
 #include "synthvis/height_field.h"
 #include "synthvis/result.h"
 
@@ -37,12 +38,10 @@ Result<HeightField> generateFractal(int size, double spacing, double relief, uin
 //   value are no data, quantize's rule; its scale and offset applied), placed by its geotransform
 //   with (originU, originV) the centre of pixel (0, 0). Only north-up rasters (no rotation or
 //   shear, rows running south). A projected raster's units are taken as metres; a geographic
-//   one's degrees become metres by the equirectangular projection with standard parallel at the
-//   raster's centre latitude lat0 on a sphere of radius kEarthRadius: u = R·cos(lat0)·λ,
-//   v = R·φ (λ, φ longitude and latitude in radians), so the raster's centre (λ0, φ0) lands at
-//   (R·cos(lat0)·λ0, R·φ0) — true to scale along lat0 and along meridians, east–west scale off by
-//   cos(φ)/cos(lat0) away from it (1.7 % at 1° from lat0 = 45°). A raster without a geotransform
-//   gets spacing 1 and origin (0, 0).
+//   one's degrees become map metres of the WGS 84 frame at the raster's centre
+//   (synthvis/geodesy.h: equirectangular with its standard parallel there), the grid's own
+//   angles kept in `geographic` so that a scene's geodetic frame can place it again
+//   (placeGeographic). A raster without a geotransform gets spacing 1 and origin (0, 0).
 // - loadGdalFromMemory: the same from `bytes` (through GDAL's /vsimem/), `name` naming them in
 //   errors and giving drivers that read it (SRTM .hgt) the file name. For untrusted input: only
 //   drivers that read one self-contained file (GTiff, SRTMHGT, AAIGrid, USGSDEM, the Surfer grids,
@@ -50,7 +49,6 @@ Result<HeightField> generateFractal(int size, double spacing, double relief, uin
 // - loadPng16: a 16-bit greyscale PNG (8-bit accepted), codes as heights offset + scale·code with
 //   the caller's spacing and origin (a PNG holds no georeferencing): the table holds the file's
 //   codes unchanged. decodePng16 reads PNG bytes in memory.
-inline constexpr double kEarthRadius = 6371008.8;  // metres, the mean radius (IUGG)
 Result<HeightField> loadGdal(const std::string& path);
 Result<HeightField> loadGdalFromMemory(const std::string& bytes, const std::string& name,
                                        int64_t maxSamples = kMaxHeightSamples);
@@ -63,6 +61,14 @@ Result<HeightField> decodePng16(const void* data, size_t size, const std::string
                                 int64_t maxSamples = kMaxHeightSamples);
 // By extension: .png (any case) → loadPng16, anything else → loadGdal.
 Result<HeightField> loadHeights(const std::string& path, const PngPlacement& pngPlacement);
+
+// The WGS 84 frame at the centre of a geographic grid of width × height samples: where a reader
+// places it when no scene frame is given.
+GeoFrame ownFrame(const HeightField::Geographic& grid, int width, int height);
+// Places `f` by its geographic grid in `frame`'s map metres (synthvis/geodesy.h): sample (0, 0) at
+// the grid's (lon0, lat0), the spacings its steps at the frame's metres per degree — the same
+// conversion the IG places its entities by.
+void placeGeographic(const HeightField::Geographic& grid, const GeoFrame& frame, HeightField& f);
 
 // Several tables side by side as one ground (a DEM mosaic): placed by their map positions on one
 // grid — all the same spacing, aligned to it (to 1/1000 of a step), samples shared where tiles

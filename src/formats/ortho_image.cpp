@@ -16,6 +16,13 @@
 namespace sv::formats {
 namespace {
 
+// The outer edges of a grid of pixel centres: half a pixel beyond the outermost centres.
+std::array<double, 4> outerEdges(double originU, double originV, double spacingU, double spacingV,
+                                 int width, int height) {
+  return {originU - 0.5 * spacingU, originV - (height - 0.5) * spacingV,
+          originU + (width - 0.5) * spacingU, originV + 0.5 * spacingV};
+}
+
 // sRGB-encoded [0, 1] to linear light (IEC 61966-2-1).
 double srgbToLinear(double c) {
   return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
@@ -43,10 +50,9 @@ Result<OrthoImage> loadOrthoImage(const std::string& path, const std::array<int,
   if (!grid) return grid.error();
   OrthoImage out;
   out.georeferenced = grid->georeferenced;
-  // The outer edges: half a pixel beyond the outermost centres.
-  out.bounds = {
-      grid->originU - 0.5 * grid->spacingU, grid->originV - (height - 0.5) * grid->spacingV,
-      grid->originU + (width - 0.5) * grid->spacingU, grid->originV + 0.5 * grid->spacingV};
+  out.geographic = grid->geographic;
+  out.bounds =
+      outerEdges(grid->originU, grid->originV, grid->spacingU, grid->spacingV, width, height);
   out.level.width = width;
   out.level.height = height;
   out.level.texels.resize(size_t(width) * size_t(height));
@@ -83,6 +89,14 @@ Result<OrthoImage> loadOrthoImage(const std::string& path, const std::array<int,
     }
   }
   return out;
+}
+
+void placeGeographic(OrthoImage& image, const GeoFrame& frame) {
+  if (!image.geographic.on) return;
+  HeightField placed;
+  placeGeographic(image.geographic, frame, placed);
+  image.bounds = outerEdges(placed.originU, placed.originV, placed.spacingU, placed.spacingV,
+                            image.level.width, image.level.height);
 }
 
 }  // namespace sv::formats

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "core/files.h"
 #include "scene/append.h"
+#include "synthvis/files.h"
 #include "synthvis/formats.h"
 #include "synthvis/result.h"
 #include "synthvis/scene.h"

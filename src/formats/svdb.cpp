@@ -22,8 +22,8 @@
 #include <span>
 #include <type_traits>
 
-#include "core/files.h"
 #include "formats/reader.h"
+#include "synthvis/files.h"
 #include "terrain/ground.h"
 #include "texture/texture.h"
 
@@ -31,7 +31,7 @@ namespace sv::formats {
 namespace {
 
 constexpr char kMagic[8] = {'S', 'V', 'D', 'B', '\r', '\n', 0x1A, '\n'};
-constexpr uint32_t kVersion = 2;             // 2: lines
+constexpr uint32_t kVersion = 3;             // 2: lines; 3: the geodetic frame
 constexpr uint32_t kByteOrder = 0x01020304;  // as this machine writes it
 constexpr size_t kHeaderBytes = detail::kDatabaseHeaderBytes;
 constexpr size_t kAlign = 16;  // arrays start on 16-byte boundaries of the file
@@ -283,6 +283,11 @@ std::string encode(const Scene& s) {
   w.pod(uint8_t(s.light.enabled));
   w.pod(uint8_t(s.fog.enabled)), w.pod(s.fog.color), w.pod(s.fog.beta);
   w.pod(s.time), w.pod(s.lightSettings);
+  w.pod(uint8_t(s.geodetic.has_value()));
+  if (s.geodetic) {
+    const GeoPoint& o = s.geodetic->origin;
+    w.pod(o.lat), w.pod(o.lon), w.pod(o.alt), w.pod(uint8_t(s.geodetic->curved));
+  }
   w.pod(uint64_t(s.textures.size()));
   for (const TextureMap& t : s.textures) {
     w.str(t.name);
@@ -376,6 +381,15 @@ Scene decode(const char* data, size_t size, const LoadOptions& options) {
   s.fog.beta = r.pod<float>("fog");
   s.time = r.pod<double>("time");
   s.lightSettings = r.pod<LightSettings>("light settings");
+  if (r.pod<uint8_t>("geodetic frame")) {
+    Geodetic g;
+    g.origin.lat = r.pod<double>("geodetic frame"), g.origin.lon = r.pod<double>("geodetic frame");
+    g.origin.alt = r.pod<double>("geodetic frame"), g.curved = r.pod<uint8_t>("geodetic frame");
+    if (!(std::fabs(g.origin.lat) <= 89) || !(std::fabs(g.origin.lon) <= 180) ||
+        !(std::fabs(g.origin.alt) <= 1e5))
+      fail("the geodetic frame's origin is not finite or out of range");
+    s.geodetic = g;
+  }
   uint64_t texels = 0;
   for (size_t k = r.count("textures", 24); k > 0; --k) {
     TextureMap t;

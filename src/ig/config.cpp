@@ -1,13 +1,12 @@
 // The IG configuration file (docs/ig.md, "Configuration"), JSON.
-#include "ig/config.h"
-
-#include "ig/json_input.h"
-
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
+
+#include "ig/json_input.h"
+#include "synthvis/ig.h"
 
 namespace sv::ig {
 namespace {
@@ -94,6 +93,7 @@ IgConfig read(const Json& root, const std::string& path) {
   }
   if (const auto it = root.find("origin"); it != root.end()) {
     known(*it, "origin", {"lat", "lon", "alt"});
+    c.hasOrigin = true;
     if (it->contains("lat")) c.origin.lat = number((*it)["lat"], "origin.lat", -89, 89);
     if (it->contains("lon")) c.origin.lon = number((*it)["lon"], "origin.lon", -180, 180);
     if (it->contains("alt")) c.origin.alt = number((*it)["alt"], "origin.alt", -1e4, 1e5);

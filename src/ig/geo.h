@@ -2,53 +2,24 @@
 // top-level entities geodetically (latitude, longitude in degrees, altitude in metres) and turns
 // them by heading (yaw, clockwise from north), pitch (nose up) and roll (right wing down) — body
 // axes x forward, y right, z down; children by offsets in their parent's body axes. synthvis's
-// world is +x east, +y up, −z north (scene-format.md). The database's origin (a latitude,
-// longitude and altitude in the IG configuration) is the world origin, and geodetic positions
-// map onto its tangent plane on a sphere of the WGS 84 equatorial radius — exact at the origin,
-// within a metre over tens of kilometres, which is what a single-airport database spans.
+// world is +x east, +y up, −z north (scene-format.md). The database's origin (its geodetic frame,
+// or a latitude, longitude and altitude in the IG configuration) is the world origin, and
+// geodetic positions map into the world by that frame (synthvis/geodesy.h: WGS 84, the one
+// conversion the terrain's geographic tables are placed by too).
 #pragma once
 
 #include <cmath>
 #include <numbers>
 
+#include "synthvis/geodesy.h"
 #include "synthvis/math.h"
 
 namespace sv::ig {
 
-inline constexpr double kEarthRadius = 6378137.0;  // m (WGS 84 equatorial)
-
-struct GeoOrigin {
-  double lat = 0, lon = 0, alt = 0;  // degrees, degrees, metres
-};
-
-struct DVec3 {
-  double x = 0, y = 0, z = 0;
-};
-inline DVec3 operator+(DVec3 a, DVec3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-inline DVec3 operator-(DVec3 a, DVec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-inline DVec3 operator*(DVec3 a, double s) { return {a.x * s, a.y * s, a.z * s}; }
-inline double dot(DVec3 a, DVec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-inline Vec3 toFloat(DVec3 a) { return {float(a.x), float(a.y), float(a.z)}; }
-
-// World position of a geodetic point.
-inline DVec3 geodeticToWorld(const GeoOrigin& o, double lat, double lon, double alt) {
-  constexpr double rad = std::numbers::pi / 180;
-  const double north = (lat - o.lat) * rad * kEarthRadius;
-  const double east = (lon - o.lon) * rad * kEarthRadius * std::cos(o.lat * rad);
-  return {east, alt - o.alt, -north};
-}
-// The inverse: latitude, longitude, altitude of a world point.
-inline DVec3 worldToGeodetic(const GeoOrigin& o, DVec3 w) {
-  constexpr double deg = 180 / std::numbers::pi;
-  const double lat = o.lat + (-w.z / kEarthRadius) * deg;
-  const double lon = o.lon + (w.x / (kEarthRadius * std::cos(o.lat * std::numbers::pi / 180))) * deg;
-  return {lat, lon, w.y + o.alt};
-}
-
 // A rotation as three world-space columns: the body's forward, right and down axes.
 struct Frame3 {
-  DVec3 forward{0, 0, -1}, right{1, 0, 0}, down{0, -1, 0};
-  DVec3 apply(DVec3 body) const { return forward * body.x + right * body.y + down * body.z; }
+  Vec3d forward{0, 0, -1}, right{1, 0, 0}, down{0, -1, 0};
+  Vec3d apply(Vec3d body) const { return forward * body.x + right * body.y + down * body.z; }
 };
 
 // Heading ψ, pitch θ, roll φ (degrees) as body axes in a parent frame (z-y-x Euler angles, as
@@ -60,9 +31,9 @@ inline Frame3 eulerFrame(const Frame3& parent, double yawDeg, double pitchDeg, d
   const double cp = std::cos(pitchDeg * rad), sp = std::sin(pitchDeg * rad);
   const double cr = std::cos(rollDeg * rad), sr = std::sin(rollDeg * rad);
   // Body axes in the parent's (forward, right, down) components: the columns of Rz(ψ)Ry(θ)Rx(φ).
-  const DVec3 f{cy * cp, sy * cp, -sp};
-  const DVec3 r{cy * sp * sr - sy * cr, sy * sp * sr + cy * cr, cp * sr};
-  const DVec3 d{cy * sp * cr + sy * sr, sy * sp * cr - cy * sr, cp * cr};
+  const Vec3d f{cy * cp, sy * cp, -sp};
+  const Vec3d r{cy * sp * sr - sy * cr, sy * sp * sr + cy * cr, cp * sr};
+  const Vec3d d{cy * sp * cr + sy * sr, sy * sp * cr - cy * sr, cp * cr};
   return {parent.apply(f), parent.apply(r), parent.apply(d)};
 }
 
@@ -71,10 +42,10 @@ inline Frame3 levelFrame() { return {{0, 0, -1}, {1, 0, 0}, {0, -1, 0}}; }
 
 // A model's placement: model files use glTF's axes (+y up, +z the model's front, −x its right,
 // docs/ig.md), so model +z is body forward, −x body right, −y body down.
-inline Mat4 modelMatrix(const Frame3& body, DVec3 position) {
-  const DVec3 mx = body.right * -1.0, my = body.down * -1.0, mz = body.forward;
+inline Mat4 modelMatrix(const Frame3& body, Vec3d position) {
+  const Vec3d mx = body.right * -1.0, my = body.down * -1.0, mz = body.forward;
   Mat4 m;
-  const DVec3 cols[3] = {mx, my, mz};
+  const Vec3d cols[3] = {mx, my, mz};
   for (int c = 0; c < 3; ++c) {
     m.m[c][0] = float(cols[c].x);
     m.m[c][1] = float(cols[c].y);

@@ -1,6 +1,4 @@
 // The scripted host (docs/ig.md, "The scripted host").
-#include "ig/host.h"
-
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -11,6 +9,7 @@
 #include "ig/geo.h"
 #include "ig/json_input.h"
 #include "ig/udp.h"
+#include "synthvis/ig.h"
 
 namespace sv::ig {
 namespace {
@@ -48,16 +47,16 @@ bool clockTime(const std::string& s, int& h, int& m) {
 }
 
 // A position: lat/lon/alt, or east/north/up from the script's origin.
-void position(const Json& o, const std::string& where, const GeoOrigin& origin, double& lat,
+void position(const Json& o, const std::string& where, const GeoPoint& origin, double& lat,
               double& lon, double& alt) {
   if (!o.is_object()) bad(fmt::format("{}: expected an object", where));
   if (o.contains("east") || o.contains("north") || o.contains("up")) {
-    const DVec3 g = worldToGeodetic(origin, {num(o, "east", where, -1e6, 1e6, 0),
-                                             num(o, "up", where, -1e4, 1e6, 0),
-                                             -num(o, "north", where, -1e6, 1e6, 0)});
-    lat = g.x;
-    lon = g.y;
-    alt = g.z;
+    const GeoPoint g = GeoFrame(origin).toGeodetic({num(o, "east", where, -1e6, 1e6, 0),
+                                                    num(o, "up", where, -1e4, 1e6, 0),
+                                                    -num(o, "north", where, -1e6, 1e6, 0)});
+    lat = g.lat;
+    lon = g.lon;
+    alt = g.alt;
   } else {
     lat = num(o, "lat", where, -90, 90, origin.lat);
     lon = num(o, "lon", where, -180, 180, origin.lon);
@@ -70,7 +69,7 @@ HostScript read(const Json& root) {
   if (!root.is_object() || !root.contains("synthvis-host") || root["synthvis-host"] != 1)
     bad("\"synthvis-host\": 1 expected (the script format's version)");
   HostScript s;
-  GeoOrigin origin;
+  GeoPoint origin;
   if (root.contains("origin")) {
     origin.lat = num(root["origin"], "lat", "origin", -89, 89, 0);
     origin.lon = num(root["origin"], "lon", "origin", -180, 180, 0);

@@ -1,8 +1,6 @@
 // Based on: seed 004 (a real-time image generator: a fixed frame rate, built-in test and
 // diagnostics), seed 002 (overload protection), CIGI 3.3 (the host's frame and the IG's Start of
 // Frame).
-#include "ig/loop.h"
-
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -14,16 +12,17 @@
 #include <map>
 #include <thread>
 
-#include "cigi/cigi.h"
 #include "cigi/pcap.h"
-#include "cluster/cluster.h"
-#include "core/files.h"
 #include "ig/overload.h"
 #include "ig/udp.h"
 #include "ig/world.h"
 #include "present/overlay.h"
 #include "present/present.h"
 #include "present/test_patterns.h"
+#include "synthvis/cigi.h"
+#include "synthvis/cluster.h"
+#include "synthvis/files.h"
+#include "synthvis/ig.h"
 #include "synthvis/render.h"
 
 namespace sv::ig {

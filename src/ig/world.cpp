@@ -61,6 +61,20 @@ Result<IgWorld> IgWorld::load(const IgConfig& config) {
     w.models_.push_back(std::move(m));
   }
   if (Status s = scene::validate(w.base_, config.scene, false); !s) return s.error();
+  // The one Earth frame (synthvis/geodesy.h): the database's own, else the configuration's origin.
+  if (const std::optional<scene::Geodetic>& g = w.base_.geodetic) {
+    if (config.hasOrigin &&
+        (config.origin.lat != g->origin.lat || config.origin.lon != g->origin.lon ||
+         config.origin.alt != g->origin.alt))
+      return Error{config.scene, "",
+                   fmt::format("the database's geodetic origin ({}, {}, {}) is not the "
+                               "configuration's origin ({}, {}, {})",
+                               g->origin.lat, g->origin.lon, g->origin.alt, config.origin.lat,
+                               config.origin.lon, config.origin.alt)};
+    w.earth_ = g->frame();
+  } else {
+    w.earth_ = GeoFrame(config.origin);
+  }
   w.baseInstances_ = w.base_.instances.size();
   w.channels_ = config.channels.empty() ? w.base_.channels : config.channels;
   if (w.channels_.empty()) {
@@ -91,20 +105,20 @@ bool IgWorld::pose(uint16_t id, Pose& out, int depth) const {
     out.position = parent.position + parent.frame.apply({c.latOrX, c.lonOrY, c.altOrZ});
     out.frame = eulerFrame(parent.frame, c.yaw, c.pitch, c.roll);
   } else {
-    out.position = geodeticToWorld(config_.origin, c.latOrX, c.lonOrY, c.altOrZ);
+    out.position = earth_.toWorld({c.latOrX, c.lonOrY, c.altOrZ});
     out.frame = eulerFrame(levelFrame(), c.yaw, c.pitch, c.roll);
   }
   return true;
 }
 
-DVec3 IgWorld::requestPoint(bool entityRelative, uint16_t entity, const double p[3],
+Vec3d IgWorld::requestPoint(bool entityRelative, uint16_t entity, const double p[3],
                             bool& ok) const {
   ok = finite3(p);
   if (!ok) return {};
-  if (!entityRelative) return geodeticToWorld(config_.origin, p[0], p[1], p[2]);
+  if (!entityRelative) return earth_.toWorld({p[0], p[1], p[2]});
   Pose e;
   ok = pose(entity, e);
-  return ok ? e.position + e.frame.apply({p[0], p[1], p[2]}) : DVec3{};
+  return ok ? e.position + e.frame.apply({p[0], p[1], p[2]}) : Vec3d{};
 }
 
 void IgWorld::apply(const cigi::Datagram& datagram, std::vector<cigi::Packet>& replies) {
@@ -236,29 +250,30 @@ void IgWorld::applyPacket(const cigi::Packet& packet, std::vector<cigi::Packet>&
     ++counts_.hatRequests;
     const double q[3] = {hr->latOrX, hr->lonOrY, hr->altOrZ};
     bool ok = false;
-    const DVec3 w = requestPoint(hr->entityCoordinates, hr->entity, q, ok);
+    const Vec3d w = requestPoint(hr->entityCoordinates, hr->entity, q, ok);
     HatHotResponse r;
     r.id = hr->id;
     r.hostFrameLsn = lsn;
     // A HOT asks for the ground under the point; a HAT for the point's height above it (an
     // extended request is answered as a HAT: the extended response is not implemented).
     r.hot = hr->type == HatHotType::hot;
-    if (const std::optional<double> g = ok ? groundHeight(w) : std::nullopt) {
+    if (const std::optional<Ground> g = ok ? groundUnder(w) : std::nullopt) {
       r.valid = true;
-      r.height = r.hot ? *g + config_.origin.alt : w.y - *g;
+      r.height = r.hot ? g->elevation + earth_.origin().alt : g->above;
     }
     replies.push_back(r);
   } else if (const auto* lr = std::get_if<LosSegmentRequest>(&packet)) {
     ++counts_.losRequests;
     bool okA = false, okB = false;
-    const DVec3 a = requestPoint(lr->sourceEntityCoordinates, lr->sourceEntity, lr->source, okA);
-    const DVec3 b = requestPoint(lr->destinationEntityCoordinates, lr->sourceEntity, lr->destination, okB);
+    const Vec3d a = requestPoint(lr->sourceEntityCoordinates, lr->sourceEntity, lr->source, okA);
+    const Vec3d b =
+        requestPoint(lr->destinationEntityCoordinates, lr->sourceEntity, lr->destination, okB);
     LosResponse r;
     r.id = lr->id;
     r.hostFrameLsn = lsn;
     if (okA && okB) {
       const std::optional<double> t = segmentHit(a, b);
-      const DVec3 d = b - a;
+      const Vec3d d = b - a;
       r.valid = t.has_value();  // the range is valid where the segment meets something
       r.visible = !t;
       r.range = t ? *t * std::sqrt(dot(d, d)) : 0;
@@ -278,8 +293,8 @@ void IgWorld::advance(double dt) {
     // The rates in the parent's axes (CIGI's "world/parent" coordinate system) or in the entity's
     // own body axes ("local"), turned into the parent's.
     const Frame3 parentAxes{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};  // forward, right, down as themselves
-    const DVec3 own = r.worldCoordinates
-                          ? DVec3{r.x, r.y, r.z}
+    const Vec3d own = r.worldCoordinates
+                          ? Vec3d{r.x, r.y, r.z}
                           : eulerFrame(parentAxes, c.yaw, c.pitch, c.roll).apply({r.x, r.y, r.z});
     if (c.attached) {
       // Offsets in the parent's body axes (forward, right, down).
@@ -288,8 +303,8 @@ void IgWorld::advance(double dt) {
       c.altOrZ += own.z * dt;
     } else {
       // North, east, down, into degrees and metres up.
-      c.latOrX += own.x * dt / (kEarthRadius * kRad);
-      c.lonOrY += own.y * dt / (kEarthRadius * kRad * std::cos(config_.origin.lat * kRad));
+      c.latOrX += own.x * dt / earth_.metresPerDegreeNorth();
+      c.lonOrY += own.y * dt / earth_.metresPerDegreeEast();
       c.altOrZ -= own.z * dt;
     }
     c.roll = float(std::remainder(c.roll + r.roll * dt, 360.0));
@@ -402,16 +417,16 @@ namespace {
 
 // The nearest t in (0, tMax] where the ray o + t·d meets triangle (a, b, c) — Möller–Trumbore,
 // both faces.
-std::optional<double> rayTriangle(DVec3 o, DVec3 d, DVec3 a, DVec3 b, DVec3 c, double tMax) {
-  const DVec3 e1 = b - a, e2 = c - a;
-  const DVec3 p{d.y * e2.z - d.z * e2.y, d.z * e2.x - d.x * e2.z, d.x * e2.y - d.y * e2.x};
+std::optional<double> rayTriangle(Vec3d o, Vec3d d, Vec3d a, Vec3d b, Vec3d c, double tMax) {
+  const Vec3d e1 = b - a, e2 = c - a;
+  const Vec3d p{d.y * e2.z - d.z * e2.y, d.z * e2.x - d.x * e2.z, d.x * e2.y - d.y * e2.x};
   const double det = dot(e1, p);
   if (std::fabs(det) < 1e-12) return std::nullopt;
   const double inv = 1 / det;
-  const DVec3 s = o - a;
+  const Vec3d s = o - a;
   const double u = dot(s, p) * inv;
   if (u < 0 || u > 1) return std::nullopt;
-  const DVec3 q{s.y * e1.z - s.z * e1.y, s.z * e1.x - s.x * e1.z, s.x * e1.y - s.y * e1.x};
+  const Vec3d q{s.y * e1.z - s.z * e1.y, s.z * e1.x - s.x * e1.z, s.x * e1.y - s.y * e1.x};
   const double v = dot(d, q) * inv;
   if (v < 0 || u + v > 1) return std::nullopt;
   const double t = dot(e2, q) * inv;
@@ -421,7 +436,7 @@ std::optional<double> rayTriangle(DVec3 o, DVec3 d, DVec3 a, DVec3 b, DVec3 c, d
 
 // Whether the segment o → o + d (t in [0, 1]) meets the box [lo, hi] (slabs, in double; a margin
 // of 1e-6 of the extent keeps float boxes conservative).
-bool segmentMeetsBox(DVec3 o, DVec3 d, DVec3 lo, DVec3 hi) {
+bool segmentMeetsBox(Vec3d o, Vec3d d, Vec3d lo, Vec3d hi) {
   double t0 = 0, t1 = 1;
   const double os[3] = {o.x, o.y, o.z}, ds[3] = {d.x, d.y, d.z}, ls[3] = {lo.x, lo.y, lo.z},
                hs[3] = {hi.x, hi.y, hi.z};
@@ -443,14 +458,14 @@ bool segmentMeetsBox(DVec3 o, DVec3 d, DVec3 lo, DVec3 hi) {
 
 // The nearest hit of the segment o → o + d (t in [0, 1]) with instance `i`'s triangles (its full
 // detail), or `best` (the nearest so far).
-std::optional<double> instanceHit(const scene::Scene& s, size_t i, DVec3 o, DVec3 d,
+std::optional<double> instanceHit(const scene::Scene& s, size_t i, Vec3d o, Vec3d d,
                                   std::optional<double> best) {
   const scene::Instance& inst = s.instances[i];
   if (!inst.visible) return best;  // switched off
   const scene::Mesh& mesh = s.meshes[size_t(inst.mesh)];
   // The segment against the instance's world box first.
   const auto box = mesh.bounds();
-  DVec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  Vec3d lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
   for (int k = 0; k < 8; ++k) {
     const Vec3 corner =
         inst.transform.transformPoint({box[k & 1].x, box[(k >> 1) & 1].y, box[(k >> 2) & 1].z});
@@ -462,7 +477,7 @@ std::optional<double> instanceHit(const scene::Scene& s, size_t i, DVec3 o, DVec
   if (!segmentMeetsBox(o, d, lo, hi)) return best;
   auto world = [&](uint32_t index) {
     const Vec3 p = inst.transform.transformPoint(mesh.positions[index]);
-    return DVec3{p.x, p.y, p.z};
+    return Vec3d{p.x, p.y, p.z};
   };
   for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
     const std::optional<double> hit =
@@ -476,7 +491,7 @@ std::optional<double> instanceHit(const scene::Scene& s, size_t i, DVec3 o, DVec
 // The nearest hit of the segment o → o + d (t in [0, 1]) with the database's polygons: through
 // the instance tree for the instances it holds (only the leaves the segment meets), one by one for
 // the rest.
-std::optional<double> polygonHit(const scene::Scene& s, size_t instances, DVec3 o, DVec3 d) {
+std::optional<double> polygonHit(const scene::Scene& s, size_t instances, Vec3d o, Vec3d d) {
   std::optional<double> best;
   size_t from = 0;
   if (const scene::InstanceTree* tree = s.instanceTree.get();
@@ -503,19 +518,21 @@ std::optional<double> polygonHit(const scene::Scene& s, size_t instances, DVec3 
 
 }  // namespace
 
-std::optional<double> IgWorld::groundHeight(DVec3 p) const {
-  std::optional<double> ground;
+std::optional<IgWorld::Ground> IgWorld::groundUnder(Vec3d p) const {
+  std::optional<Ground> ground;
   if (const std::optional<TerrainHeight> t = terrainHeight(base_, p.x, p.y, p.z))
-    ground = p.y - t->above;
-  // The polygons under the point: a vertical segment from far above to far below.
+    ground = Ground{t->elevation, t->above};
+  // The polygons under the point: a vertical segment from far above to far below (world up: the
+  // base's normal near the origin, where a database's polygons are).
   constexpr double kReach = 1e5;
-  const DVec3 top{p.x, p.y + kReach, p.z};
+  const Vec3d top{p.x, p.y + kReach, p.z};
   if (const std::optional<double> t = polygonHit(base_, baseInstances_, top, {0, -2 * kReach, 0}))
-    ground = std::max(ground.value_or(-1e300), top.y - *t * 2 * kReach);
+    if (const double y = top.y - *t * 2 * kReach; !ground || y > ground->elevation)
+      ground = Ground{y, p.y - y};
   return ground;
 }
 
-std::optional<double> IgWorld::segmentHit(DVec3 a, DVec3 b) const {
+std::optional<double> IgWorld::segmentHit(Vec3d a, Vec3d b) const {
   std::optional<double> best;
   const double from[3] = {a.x, a.y, a.z}, to[3] = {b.x, b.y, b.z};
   if (const std::optional<TerrainHit> t = lineOfSight(base_, from, to)) best = t->fraction;

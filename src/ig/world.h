@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "cigi/cigi.h"
-#include "ig/config.h"
 #include "ig/geo.h"
+#include "synthvis/cigi.h"
+#include "synthvis/ig.h"
 #include "synthvis/scene.h"
 
 namespace sv::ig {
@@ -49,15 +49,22 @@ class IgWorld {
   // The channels' sizes as configured (before any replication).
   const std::vector<scene::Channel>& channels() const { return channels_; }
 
-  // Height of the ground (terrain or the database's polygons; the highest) under a world point,
-  // and the first point the segment a → b meets (its fraction along the segment).
-  std::optional<double> groundHeight(DVec3 p) const;
-  std::optional<double> segmentHit(DVec3 a, DVec3 b) const;
+  // The ground under a world point (terrain or the database's polygons; the highest): its height
+  // above the base (the Earth frame's: synthvis/geodesy.h) and the point's height above it,
+  // along the base's normal there. And the first point the segment a → b meets (its fraction
+  // along the segment).
+  struct Ground {
+    double elevation = 0, above = 0;
+  };
+  std::optional<Ground> groundUnder(Vec3d p) const;
+  std::optional<double> segmentHit(Vec3d a, Vec3d b) const;
 
   const TrafficCounts& counts() const { return counts_; }
   TrafficCounts& counts() { return counts_; }
   size_t activeEntities() const;
   const IgConfig& config() const { return config_; }
+  // Where geodetic positions land in the world (synthvis/geodesy.h).
+  const GeoFrame& earth() const { return earth_; }
   const scene::Scene& database() const { return base_; }
 
  private:
@@ -78,15 +85,16 @@ class IgWorld {
     cigi::ViewDefinition definition;
   };
   struct Pose {
-    DVec3 position;
+    Vec3d position;
     Frame3 frame;
   };
 
   bool pose(uint16_t entity, Pose& out, int depth = 0) const;
   void applyPacket(const cigi::Packet& packet, std::vector<cigi::Packet>& replies);
-  DVec3 requestPoint(bool entityRelative, uint16_t entity, const double p[3], bool& ok) const;
+  Vec3d requestPoint(bool entityRelative, uint16_t entity, const double p[3], bool& ok) const;
 
   IgConfig config_;
+  GeoFrame earth_;
   scene::Scene base_;   // the database as loaded, the models' meshes appended
   scene::Scene frame_;  // this frame's scene (base_ plus the entities' instances)
   size_t baseInstances_ = 0;

@@ -1,7 +1,7 @@
 // Image files: PNG through the one PNG codec (texture/png.h); PPM by hand.
 #include <fmt/format.h>
 
-#include "core/files.h"
+#include "synthvis/files.h"
 #include "synthvis/image.h"
 #include "texture/png.h"
 

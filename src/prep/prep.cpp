@@ -1,6 +1,6 @@
 // Based on: SPEC §1 (seed 004's database preparation system); meshoptimizer's vertex fetch,
 // vertex cache, overdraw and simplification algorithms (Kapoulkine, meshoptimizer 0.18).
-#include "prep/prep.h"
+#include "synthvis/prep.h"
 
 #include <fmt/format.h>
 #include <meshoptimizer.h>

@@ -11,9 +11,9 @@
 #include <cstring>
 #include <memory>
 
-#include "core/files.h"
 #include "present/async_writer.h"
 #include "present/outputs.h"
+#include "synthvis/files.h"
 
 namespace sv::present {
 namespace {

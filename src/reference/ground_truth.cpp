@@ -1,4 +1,4 @@
-#include "reference/ground_truth.h"
+#include "synthvis/ground_truth.h"
 
 #include <fmt/format.h>
 

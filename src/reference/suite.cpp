@@ -1,5 +1,3 @@
-#include "reference/suite.h"
-
 #include <fmt/format.h>
 #include <hwy/targets.h>
 
@@ -10,12 +8,13 @@
 #include <limits>
 #include <optional>
 
-#include "core/files.h"
 #include "core/timing.h"
 #include "reference/gl_renderer.h"
 #include "reference/vtk_volume.h"
 #include "render/correction.h"
 #include "render/view_renderer.h"
+#include "synthvis/bench.h"
+#include "synthvis/files.h"
 #include "synthvis/formats.h"
 
 namespace sv::reference {
@@ -245,8 +244,8 @@ Status runDisplayBench(const scene::Scene& sc, const BenchSettings& s, CaseResul
     if (Status st = unwarped.render(sc, flat.image, &flat.stats); !st) return st;
     if (i >= s.warmup) flat.frameMs.push_back(msSince(t));
     for (auto [run, correction, frame] :
-         {std::tuple{&a, render::Correction::subFrusta, &frameA},
-          std::tuple{&b, render::Correction::bilinear, &frameB}}) {
+         {std::tuple{&a, RenderOptions::Correction::subFrusta, &frameA},
+          std::tuple{&b, RenderOptions::Correction::bilinear, &frameB}}) {
       render::CorrectedView view;
       view.table = &centre.table;
       view.plan = &plan;
@@ -256,7 +255,7 @@ Status runDisplayBench(const scene::Scene& sc, const BenchSettings& s, CaseResul
       frame->linear.resize(1);
       frame->images.resize(1);
       run->stats = {};
-      render::CorrectionStats cs;
+      DisplayStats cs;
       t = Clock::now();
       if (Status st = render::renderCorrected(warped, sc, s.options, base.value(), view,
                                               frame->linear[0], run->stats, cs);

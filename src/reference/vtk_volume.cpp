@@ -17,8 +17,8 @@
 #include <nlohmann/json.hpp>
 #include <vector>
 
-#include "core/files.h"
 #include "render/camera.h"
+#include "synthvis/files.h"
 
 #ifndef SV_VTK_SCRIPT_PATH
 #define SV_VTK_SCRIPT_PATH ""

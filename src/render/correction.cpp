@@ -9,14 +9,6 @@
 
 namespace sv::render {
 
-Result<Correction> parseCorrection(const std::string& text) {
-  if (text == "subfrusta") return Correction::subFrusta;
-  if (text == "bilinear") return Correction::bilinear;
-  if (text == "bicubic") return Correction::bicubic;
-  return Error{"", "",
-               fmt::format("correction '{}': expected subfrusta, bilinear or bicubic", text)};
-}
-
 CorrectionRenderer::CorrectionRenderer(const RenderOptions& options)
     : options_(options), gamma_(gammaTableOf(options)), pool_(resolveThreads(options.threads)) {}
 
@@ -56,14 +48,14 @@ display::DirectionMap directionMapOf(const display::DirectionTable& table) {
 
 Status renderCorrected(CorrectionRenderer& renderer, const scene::Scene& scene,
                        const RenderOptions& o, const FrameCamera& base, const CorrectedView& view,
-                       output::LinearImage& out, FrameStats& stats, CorrectionStats& cs) {
+                       output::LinearImage& out, FrameStats& stats, DisplayStats& cs) {
   SV_CHECK(view.table != nullptr);
   const display::DirectionTable& table = *view.table;
   RenderOptions po = o;
   po.width = table.width;
   po.height = table.height;
   if (Status s = validate(po); !s) return s;
-  if (view.correction == Correction::subFrusta) {
+  if (view.correction == RenderOptions::Correction::subFrusta) {
     // Method (a): the plan (given, or made here), then every cell through its own map.
     std::optional<display::SubFrustumPlan> own;
     const display::SubFrustumPlan* plan = view.plan;
@@ -125,7 +117,7 @@ Status renderCorrected(CorrectionRenderer& renderer, const scene::Scene& scene,
     cs.renderMs = core::msSince(t1);
     const auto t2 = core::Clock::now();
     out.resize(table.width, table.height);
-    const display::ResampleFilter filter = view.correction == Correction::bicubic
+    const display::ResampleFilter filter = view.correction == RenderOptions::Correction::bicubic
                                                ? display::ResampleFilter::bicubic
                                                : display::ResampleFilter::bilinear;
     constexpr int kBand = 16;  // rows per task
@@ -244,22 +236,21 @@ Result<display::Mpcdi> mpcdiOf(const DisplaySetup& d) {
 }
 
 Status renderDisplay(CorrectionRenderer& renderer, const scene::Scene& scene,
-                     const RenderOptions& o, const DisplaySetup& display, Correction correction,
-                     DisplayFrame& frame) {
+                     const RenderOptions& o, const DisplaySetup& display, DisplayFrame& frame) {
   const Result<FrameCamera> base = chooseCamera(scene, o);
   if (!base.ok()) return base.error();
   const size_t n = display.projectors.size();
   frame.linear.resize(n);
   frame.images.resize(n);
   frame.stats.assign(n, FrameStats{});
-  frame.correction.assign(n, CorrectionStats{});
+  frame.correction.assign(n, DisplayStats{});
   for (size_t i = 0; i < n; ++i) {
     const ProjectorSetup& p = display.projectors[i];
     CorrectedView view;
     view.table = &p.table;
     view.blend = p.blend ? &*p.blend : nullptr;
     view.eye = display.eye;
-    view.correction = correction;
+    view.correction = o.correction;
     const auto start = core::Clock::now();
     if (Status s = renderCorrected(renderer, scene, o, base.value(), view, frame.linear[i],
                                    frame.stats[i], frame.correction[i]);

@@ -16,25 +16,9 @@
 #include "display/subfrustum.h"
 #include "display/viewer.h"
 #include "render/warped.h"
+#include "synthvis/display.h"
 
 namespace sv::render {
-
-enum class Correction : uint8_t { subFrusta, bilinear, bicubic };
-// "subfrusta", "bilinear", "bicubic" (the CLI's --correction).
-Result<Correction> parseCorrection(const std::string& text);
-
-struct CorrectionStats {
-  // (a): the sub-frustum plan (once per display mapping, or per frame when the eye moves).
-  double planMs = 0;
-  double warpMs = 0;      // (b): the warp, likewise
-  double renderMs = 0;    // (a): the cells; (b): the flat view
-  double resampleMs = 0;  // (b)
-  double blendMs = 0;
-  int cells = 0;                      // (a)
-  double maxResidualPixels = 0;       // (a)
-  int flatWidth = 0, flatHeight = 0;  // (b): the flat view with its margin
-  int64_t outside = 0;                // (b): valid pixels the flat view missed (black)
-};
 
 // What a display's frames are drawn with, kept from frame to frame: the cells' renderers (method
 // (a)) and a view renderer for the flat view (method (b)), each made on first use with the
@@ -71,7 +55,7 @@ struct CorrectedView {
   const display::ResampleWarp* warp = nullptr;
   const display::BlendWeights* blend = nullptr;  // nothing: no edge blending
   Vec3d eye{0, 0, 0};                            // the display's eye in the camera's eye frame
-  Correction correction = Correction::subFrusta;
+  RenderOptions::Correction correction = RenderOptions::Correction::subFrusta;
   int marginPixels = 2;  // (b): the flat view's margin, when the warp is made here
 };
 
@@ -85,7 +69,7 @@ Result<display::ResampleWarp> resampleWarpOf(const display::DirectionTable& tabl
 // used), for the scene seen from `base`'s eyepoint.
 Status renderCorrected(CorrectionRenderer& renderer, const scene::Scene& scene,
                        const RenderOptions& o, const FrameCamera& base, const CorrectedView& view,
-                       output::LinearImage& out, FrameStats& stats, CorrectionStats& cs);
+                       output::LinearImage& out, FrameStats& stats, DisplayStats& cs);
 
 // A display of projectors: each one's name, display mapping and blend weights — the demo rig's
 // (analytic) or an MPCDI file's — and the rig's geometry when it is known (for the viewer).
@@ -117,11 +101,10 @@ struct DisplayFrame {
   std::vector<output::LinearImage> linear;
   std::vector<Image> images;
   std::vector<FrameStats> stats;
-  std::vector<CorrectionStats> correction;
+  std::vector<DisplayStats> correction;
 };
 Status renderDisplay(CorrectionRenderer& renderer, const scene::Scene& scene,
-                     const RenderOptions& o, const DisplaySetup& display, Correction correction,
-                     DisplayFrame& frame);
+                     const RenderOptions& o, const DisplaySetup& display, DisplayFrame& frame);
 // The simulated viewer's view of a rendered display (display::viewerPanorama over the rig's
 // screen, from its eye), through the gamma table. Fails for a display without a known rig.
 Result<Image> viewerImage(const DisplaySetup& display, const DisplayFrame& frame,

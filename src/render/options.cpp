@@ -101,4 +101,31 @@ const char* hsrName(RenderOptions::Hsr hsr) {
   }
 }
 
+Result<RenderOptions::TerrainFilter> parseTerrainFilter(const std::string& text) {
+  if (text == "scene") return RenderOptions::TerrainFilter::scene;
+  if (text == "bilinear") return RenderOptions::TerrainFilter::bilinear;
+  if (text == "bicubic") return RenderOptions::TerrainFilter::bicubic;
+  return Error{"", "",
+               fmt::format("unknown terrain filter '{}' (scene, bilinear or bicubic)", text)};
+}
+
+Result<RenderOptions::Correction> parseCorrection(const std::string& text) {
+  if (text == "subfrusta") return RenderOptions::Correction::subFrusta;
+  if (text == "bilinear") return RenderOptions::Correction::bilinear;
+  if (text == "bicubic") return RenderOptions::Correction::bicubic;
+  return Error{"", "",
+               fmt::format("correction '{}': expected subfrusta, bilinear or bicubic", text)};
+}
+
+const char* correctionName(RenderOptions::Correction correction) {
+  switch (correction) {
+    case RenderOptions::Correction::bilinear:
+      return "bilinear";
+    case RenderOptions::Correction::bicubic:
+      return "bicubic";
+    default:
+      return "subfrusta";
+  }
+}
+
 }  // namespace sv

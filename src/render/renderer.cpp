@@ -4,19 +4,26 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <optional>
 
 #include "core/timing.h"
 #include "render/camera.h"
+#include "render/correction.h"
 #include "render/view_renderer.h"
 #include "synthvis/render.h"
 
 namespace sv {
 
-// What a Renderer keeps from frame to frame: its options, and its threads, tables and buffers.
+// What a Renderer keeps from frame to frame: its options, and its threads, tables and buffers;
+// for a display, its cells' and flat view's renderers (made on its first frame) and its last frame
+// (the viewer's input).
 struct Renderer::Impl {
   explicit Impl(const RenderOptions& o) : options(o), view(o) {}
   RenderOptions options;
   render::ViewRenderer view;
+  std::optional<render::CorrectionRenderer> display;
+  render::DisplayFrame displayFrame;
+  std::optional<Display> displayDrawn;  // what displayFrame shows (held: its tables stay)
 };
 
 Renderer::Renderer(const RenderOptions& options) : impl_(std::make_unique<Impl>(options)) {}
@@ -88,6 +95,35 @@ Status Renderer::renderChannels(const scene::Scene& scene, std::vector<Image>& i
   }
   if (statsOut) *statsOut = std::move(stats);
   return {};
+}
+
+// SPEC §9, §12: every projector of a curved-screen display, pre-distorted and blended
+// (render/correction.h); the frames kept in linear light for the viewer.
+Status Renderer::renderDisplay(const scene::Scene& scene, const Display& display,
+                               std::vector<Image>& images, std::vector<FrameStats>* stats,
+                               std::vector<DisplayStats>* correction) {
+  Impl& m = *impl_;
+  if (Status s = validate(m.options); !s) return s;
+  if (Status s = scene::validate(scene, "", false); !s) return s;
+  if (!m.display) m.display.emplace(m.options);
+  m.displayDrawn.reset();
+  if (Status s =
+          render::renderDisplay(*m.display, scene, m.options, display.setup(), m.displayFrame);
+      !s)
+    return s;
+  m.displayDrawn = display;
+  images = m.displayFrame.images;
+  if (stats) *stats = m.displayFrame.stats;
+  if (correction) *correction = m.displayFrame.correction;
+  return {};
+}
+
+Result<Image> Renderer::viewerImage(const Display& display) const {
+  const Impl& m = *impl_;
+  if (!m.displayDrawn || &m.displayDrawn->setup() != &display.setup())
+    return Error{"", "", "the viewer sees a display this renderer drew last (renderDisplay)"};
+  return render::viewerImage(display.setup(), m.displayFrame, display::PanoramaView{},
+                             m.display->gamma());
 }
 
 }  // namespace sv

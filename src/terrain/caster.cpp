@@ -14,7 +14,6 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // Cells a ray walks directly from its start before marching (Caster::cast).
 constexpr double kDirectCells = 8;
 
-double length(Vec3d v) { return std::sqrt(dot(v, v)); }
 }  // namespace
 
 Caster::Caster(const HeightField& field, const Pyramid& pyramid, Interpolation interp,

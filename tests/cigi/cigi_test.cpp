@@ -1,7 +1,7 @@
 // The CIGI 3.3 codec: round trips of every packet in both byte orders, hand-built datagrams
 // checked byte by byte against the ICD's layout (so that a bug shared by the encoder and the
 // decoder cannot hide behind a round trip), skipped IDs, and malformed datagrams.
-#include "cigi/cigi.h"
+#include "synthvis/cigi.h"
 
 #include <gtest/gtest.h>
 

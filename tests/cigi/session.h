@@ -5,7 +5,7 @@
 
 #include <vector>
 
-#include "cigi/cigi.h"
+#include "synthvis/cigi.h"
 
 namespace sv::cigi::test {
 

@@ -3,7 +3,9 @@
 // the three ranks' channels are bit-identical to the same channels drawn by one process, every
 // rank's frame N is at the same simulation time, a bad assignment is refused at start, and a rank
 // that stops answering ends the job within the timeout with an error naming it — never a hang.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cstdio>
@@ -11,13 +13,9 @@
 #include <fstream>
 #include <sstream>
 
-#include <unistd.h>
-
-#include <fmt/format.h>
-
-#include "ig/config.h"
 #include "support/shell.h"
 #include "support/temp_dir.h"
+#include "synthvis/ig.h"
 
 namespace sv {
 namespace {

@@ -9,10 +9,10 @@
 #include <vector>
 
 #include "core/check.h"
-#include "core/files.h"
 #include "core/streaming.h"
 #include "core/thread_pool.h"
 #include "support/temp_dir.h"
+#include "synthvis/files.h"
 #include "synthvis/frame_stats.h"
 #include "synthvis/math.h"
 

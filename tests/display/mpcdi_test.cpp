@@ -339,7 +339,7 @@ TEST(Mpcdi, HandMadeSampleReadsAsTheStandardLaysItOut) {
   ASSERT_TRUE(d.ok());
   const double k = std::numbers::pi / 180;
   const double t20 = std::tan(20 * k), t10 = std::tan(10 * k);
-  const Vec3 body = normalize({float(-t20 - 0.125 * 2 * t20), float(t10 + 0.25 * 2 * t10), -1});
+  const Vec3 body = normalize(Vec3{float(-t20 - 0.125 * 2 * t20), float(t10 + 0.25 * 2 * t10), -1});
   const Vec3 expected = rotationOf({-30, 5, 0}).apply(body.x, body.y, body.z);
   ASSERT_TRUE(d->isValid(0, 0));
   EXPECT_NEAR(d->direction(0, 0).x, expected.x, 1e-6);

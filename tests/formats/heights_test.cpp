@@ -21,12 +21,28 @@
 #include <string>
 #include <vector>
 
+#include "support/gdal_raster.h"
 #include "texture/png.h"
 
 namespace sv::formats {
 namespace {
 
+using sv::tests::writeRaster;
+
 namespace fs = std::filesystem;
+
+// WGS 84's metres per degree east (along the parallel) and north (along the meridian) at latitude
+// `lat` degrees — N·cos φ and M in radians — from its defining constants, independently of
+// synthvis/geodesy.h.
+double wgs84MetresPerDegreeEast(double lat) {
+  const double a = 6378137, f = 1 / 298.257223563, e2 = f * (2 - f), phi = lat * M_PI / 180;
+  return a / std::sqrt(1 - e2 * std::sin(phi) * std::sin(phi)) * std::cos(phi) * M_PI / 180;
+}
+double wgs84MetresPerDegreeNorth(double lat) {
+  const double a = 6378137, f = 1 / 298.257223563, e2 = f * (2 - f), phi = lat * M_PI / 180;
+  const double w = std::sqrt(1 - e2 * std::sin(phi) * std::sin(phi));
+  return a * (1 - e2) / (w * w * w) * M_PI / 180;
+}
 
 // A fresh directory for the running test's files (ctest runs tests in parallel processes).
 fs::path tempDir() {
@@ -149,20 +165,19 @@ TEST_F(TerrainData, GeographicElevBecomesMetresAtItsCentreLatitudeAndKeepsNoData
   ASSERT_EQ(f->height, h);
   EXPECT_EQ(w, 95);
   EXPECT_EQ(h, 90);
-  // The equirectangular projection at the centre latitude (height_field.h), evaluated here
-  // directly: the raster's centre (lon0, lat0) lands at (R·cos(lat0)·lon0, R·lat0) in radians.
-  const double deg = std::numbers::pi / 180, lat0 = gt[3] + 0.5 * h * gt[5],
-               lon0 = gt[0] + 0.5 * w * gt[1];
-  const double kx = kEarthRadius * std::cos(lat0 * deg) * deg, k = kEarthRadius * deg;
+  // The equirectangular projection on WGS 84 with its standard parallel at the raster's centre
+  // (synthvis/geodesy.h), evaluated here directly: the centre (lon0, lat0) is the map's origin.
+  const double lat0 = gt[3] + 0.5 * h * gt[5], lon0 = gt[0] + 0.5 * w * gt[1];
+  const double kx = wgs84MetresPerDegreeEast(lat0), k = wgs84MetresPerDegreeNorth(lat0);
   EXPECT_NEAR(f->spacingU, gt[1] * kx, 1e-9 * f->spacingU);
   EXPECT_NEAR(f->spacingV, -gt[5] * k, 1e-9 * f->spacingV);
-  EXPECT_NEAR(f->originU, (gt[0] + 0.5 * gt[1]) * kx, 1e-6);
-  EXPECT_NEAR(f->originV, (gt[3] + 0.5 * gt[5]) * k, 1e-6);
-  // The centre of the extent is the middle of the sample grid.
-  EXPECT_NEAR(0.5 * (f->originU + f->eastU()), lon0 * kx, 1e-6);
-  EXPECT_NEAR(0.5 * (f->originV + f->southV()), lat0 * k, 1e-6);
-  EXPECT_NEAR(f->spacingU, 597.9, 0.05);  // 30″ of longitude at 49.8° N
-  EXPECT_NEAR(f->spacingV, 926.6, 0.05);  // 30″ of latitude
+  EXPECT_NEAR(f->originU, (gt[0] + 0.5 * gt[1] - lon0) * kx, 1e-6);
+  EXPECT_NEAR(f->originV, (gt[3] + 0.5 * gt[5] - lat0) * k, 1e-6);
+  // The centre of the extent is the middle of the sample grid: the map's origin.
+  EXPECT_NEAR(0.5 * (f->originU + f->eastU()), 0, 1e-6);
+  EXPECT_NEAR(0.5 * (f->originV + f->southV()), 0, 1e-6);
+  EXPECT_NEAR(f->spacingU, 599.7, 0.05);  // 30″ of longitude at 49.8° N
+  EXPECT_NEAR(f->spacingV, 926.9, 0.05);  // 30″ of latitude
 
   // Heights: GDAL's minimum and maximum (which leave no-data out); no-data cells at the lowest.
   GDALRasterBandH band = GDALGetRasterBand(gdal.ds, 1);
@@ -216,35 +231,6 @@ TEST_F(TerrainData, InMemoryLoadEqualsTheFileLoad) {
   expectOneLineErrorNaming(small, "olinda.tif");
 }
 
-// Writes `values` (w × h) as a one-band raster with GDAL's `driver` at `path`: a MEM dataset
-// first, then CreateCopy (SRTMHGT can only copy).
-void writeRaster(const char* driver, const std::string& path, int w, int h, GDALDataType type,
-                 const std::vector<double>& values, const double* geoTransform, int epsg,
-                 const double* noData = nullptr, double scale = 1, double offset = 0) {
-  GDALAllRegister();
-  GDALDatasetH mem = GDALCreate(GDALGetDriverByName("MEM"), "", w, h, 1, type, nullptr);
-  ASSERT_NE(mem, nullptr);
-  if (geoTransform) GDALSetGeoTransform(mem, const_cast<double*>(geoTransform));
-  if (epsg) {
-    OGRSpatialReferenceH srs = OSRNewSpatialReference(nullptr);
-    ASSERT_EQ(OSRImportFromEPSG(srs, epsg), OGRERR_NONE);
-    GDALSetSpatialRef(mem, srs);
-    OSRDestroySpatialReference(srs);
-  }
-  GDALRasterBandH band = GDALGetRasterBand(mem, 1);
-  if (noData) GDALSetRasterNoDataValue(band, *noData);
-  if (scale != 1) GDALSetRasterScale(band, scale);
-  if (offset != 0) GDALSetRasterOffset(band, offset);
-  ASSERT_EQ(GDALRasterIO(band, GF_Write, 0, 0, w, h, const_cast<double*>(values.data()), w, h,
-                         GDT_Float64, 0, 0),
-            CE_None);
-  GDALDatasetH out = GDALCreateCopy(GDALGetDriverByName(driver), path.c_str(), mem, FALSE, nullptr,
-                                    nullptr, nullptr);
-  ASSERT_NE(out, nullptr) << CPLGetLastErrorMsg();
-  GDALClose(out);
-  GDALClose(mem);
-}
-
 TEST(GdalLoader, ReadsAnSrtmTileWrittenByGdal) {
   // N45E006.hgt: 1201² samples 3″ apart, pixel centres on whole degrees at the edges (SRTM's
   // convention, which GDAL's geotransform states as corners half a pixel out).
@@ -261,11 +247,12 @@ TEST(GdalLoader, ReadsAnSrtmTileWrittenByGdal) {
   ASSERT_TRUE(f.ok()) << f.error().str();
   EXPECT_EQ(f->width, n);
   EXPECT_EQ(f->height, n);
-  const double deg = std::numbers::pi / 180, kx = kEarthRadius * std::cos(45.5 * deg) * deg;
-  EXPECT_NEAR(f->originU, 6 * kx, 1e-6);  // pixel (0, 0)'s centre: 6° E, 46° N
-  EXPECT_NEAR(f->originV, 46 * kEarthRadius * deg, 1e-6);
+  // Pixel (0, 0)'s centre, 6° E 46° N, from the tile's centre, 6.5° E 45.5° N.
+  const double kx = wgs84MetresPerDegreeEast(45.5), ky = wgs84MetresPerDegreeNorth(45.5);
+  EXPECT_NEAR(f->originU, -0.5 * kx, 1e-6);
+  EXPECT_NEAR(f->originV, 0.5 * ky, 1e-6);
   EXPECT_NEAR(f->spacingU, d * kx, 1e-9);
-  EXPECT_NEAR(f->spacingV, d * kEarthRadius * deg, 1e-9);
+  EXPECT_NEAR(f->spacingV, d * ky, 1e-9);
   for (size_t k = 0; k < values.size(); k += 997)
     ASSERT_NEAR(f->at(int(k % n), int(k / n)), values[k], 0.5 * f->scale + 1e-9);
   // The same bytes in memory, under the tile's name (the driver reads the position from it).
@@ -300,9 +287,8 @@ TEST(GdalLoader, GeographicTilesInTwoRowsMosaicOnOneLatitude) {
   ASSERT_TRUE(m.ok()) << m.error().str();
   EXPECT_EQ(m->width, n);
   EXPECT_EQ(m->height, 2 * n - 1);
-  const double k = kEarthRadius * std::numbers::pi / 180;
-  EXPECT_NEAR(m->spacingU, d * k * std::cos(45 * std::numbers::pi / 180), 1e-6);
-  EXPECT_NEAR(m->spacingV, d * k, 1e-6);
+  EXPECT_NEAR(m->spacingU, d * wgs84MetresPerDegreeEast(45), 1e-6);
+  EXPECT_NEAR(m->spacingV, d * wgs84MetresPerDegreeNorth(45), 1e-6);
   for (int j = 0; j < m->height; ++j)
     for (int i = 0; i < m->width; ++i)
       // Quantized twice: each tile's step, then the mosaic's.

@@ -73,10 +73,10 @@ TEST(SurfacePoints, LanesEqualTheScalarFormulasOnEveryTarget) {
         const Vec3d p = cubeToObject.transformPoint({x[i], y[i], z[i]});
         const Vec3d g = f.gradient(p);
         const Vec3d m = g * -1.0;
-        const Vec3d n = normalize(
-            {normalToEye.m[0][0] * m.x + normalToEye.m[0][1] * m.y + normalToEye.m[0][2] * m.z,
-             normalToEye.m[1][0] * m.x + normalToEye.m[1][1] * m.y + normalToEye.m[1][2] * m.z,
-             normalToEye.m[2][0] * m.x + normalToEye.m[2][1] * m.y + normalToEye.m[2][2] * m.z});
+        const Vec3d n = normalize(Vec3d{
+            normalToEye.m[0][0] * m.x + normalToEye.m[0][1] * m.y + normalToEye.m[0][2] * m.z,
+            normalToEye.m[1][0] * m.x + normalToEye.m[1][1] * m.y + normalToEye.m[1][2] * m.z,
+            normalToEye.m[2][0] * m.x + normalToEye.m[2][1] * m.y + normalToEye.m[2][2] * m.z});
         const Vec3d e = toEye.transformPoint(p);
         const Vec3d want[4] = {p, g, n, e};
         const double(*got[4])[16] = {out.point, out.gradient, out.normal, out.eye};

@@ -2,8 +2,6 @@
 // appear in the frame after the host sends them, Start of Frame counts on, heights come back,
 // bad datagrams are counted and dropped while the loop keeps its rate, a recorded session replays
 // to the same frames, and overload protection holds the rate of a scene too heavy for it.
-#include "ig/loop.h"
-
 #include <arpa/inet.h>
 #include <gtest/gtest.h>
 #include <netinet/in.h>
@@ -16,11 +14,11 @@
 #include <set>
 #include <thread>
 
-#include "cigi/cigi.h"
 #include "cigi/pcap.h"
 #include "ig/geo.h"
-#include "ig/host.h"
 #include "support/temp_dir.h"
+#include "synthvis/cigi.h"
+#include "synthvis/ig.h"
 #include "synthvis/image.h"
 
 namespace sv::ig {
@@ -90,7 +88,7 @@ size_t redPixels(const Image& image) {
 // The ownship 50 m up at the origin looking north; entity 1 (the red box) is created by an event
 // at `appear` seconds, 150 m ahead.
 HostScript script(uint16_t igPort, uint64_t frames, double appear) {
-  const GeoOrigin o = config().origin;
+  const GeoPoint o = config().origin;
   HostScript s;
   s.igPort = igPort;
   s.port = 0;
@@ -100,20 +98,21 @@ HostScript script(uint16_t igPort, uint64_t frames, double appear) {
   own.id = 0;
   own.path.push_back({0, o.lat, o.lon, 50, 0, 0, 0});
   s.entities.push_back(own);
-  const DVec3 ahead = worldToGeodetic(o, {0, 50, -150});
+  const GeoFrame frame(o);
+  const GeoPoint ahead = frame.toGeodetic({0, 50, -150});
   cigi::EntityControl box;
   box.entity = 1;
   box.type = 7;
-  box.latOrX = ahead.x;
-  box.lonOrY = ahead.y;
-  box.altOrZ = ahead.z;
+  box.latOrX = ahead.lat;
+  box.lonOrY = ahead.lon;
+  box.altOrZ = ahead.alt;
   s.events.push_back({appear, {box}});
-  const DVec3 hill = worldToGeodetic(o, {30, 100, -150});
+  const GeoPoint hill = frame.toGeodetic({30, 100, -150});
   cigi::HatHotRequest hat;
   hat.id = 21;
-  hat.latOrX = hill.x;
-  hat.lonOrY = hill.y;
-  hat.altOrZ = hill.z;
+  hat.latOrX = hill.lat;
+  hat.lonOrY = hill.lon;
+  hat.altOrZ = hill.alt;
   s.events.push_back({0.1, {hat}});
   return s;
 }

@@ -7,10 +7,9 @@
 #include <cmath>
 #include <cstring>
 
-#include "ig/config.h"
 #include "ig/geo.h"
-#include "ig/host.h"
 #include "ig/overload.h"
+#include "synthvis/ig.h"
 #include "synthvis/render.h"
 #include "synthvis/terrain.h"
 
@@ -37,15 +36,16 @@ std::vector<cigi::Packet> apply(IgWorld& w, std::vector<cigi::Packet> packets) {
 }
 
 TEST(IgGeo, GeodeticPositionsRoundTripAndHeadingsPointTheWayTheySay) {
-  const GeoOrigin o{45, 7, 100};
-  const DVec3 w = geodeticToWorld(o, 45.01, 7.02, 350);
-  EXPECT_NEAR(-w.z, 0.01 * std::numbers::pi / 180 * kEarthRadius, 1e-6);  // north is −z
-  EXPECT_GT(w.x, 0);                                                      // east is +x
+  const GeoFrame o(GeoPoint{45, 7, 100});
+  const Vec3d w = o.toWorld({45.01, 7.02, 350});
+  // North is −z, by WGS 84's meridian radius at 45° (6 367 381.8 m).
+  EXPECT_NEAR(-w.z, 0.01 * std::numbers::pi / 180 * 6367381.816, 1e-3);
+  EXPECT_GT(w.x, 0);  // east is +x
   EXPECT_DOUBLE_EQ(w.y, 250);
-  const DVec3 g = worldToGeodetic(o, w);
-  EXPECT_NEAR(g.x, 45.01, 1e-12);
-  EXPECT_NEAR(g.y, 7.02, 1e-12);
-  EXPECT_NEAR(g.z, 350, 1e-9);
+  const GeoPoint g = o.toGeodetic(w);
+  EXPECT_NEAR(g.lat, 45.01, 1e-12);
+  EXPECT_NEAR(g.lon, 7.02, 1e-12);
+  EXPECT_NEAR(g.alt, 350, 1e-9);
   // Heading 90°: forward is east; pitch 90°: forward is up; roll 90° (right wing down): right
   // points down.
   const Frame3 east = eulerFrame(levelFrame(), 90, 0, 0);
@@ -126,7 +126,7 @@ TEST(IgWorld, AnEntityAppearsWithItsModelAtItsPoseAndGoesWhenDestroyed) {
   const scene::Scene& s = w.frameScene(0);
   ASSERT_EQ(s.instances.size(), base + 1);
   const Mat4& m = s.instances.back().transform;
-  const DVec3 at = geodeticToWorld(w.config().origin, 45.001, 7, 60);
+  const Vec3d at = w.earth().toWorld({45.001, 7, 60});
   EXPECT_NEAR(m.m[3][0], at.x, 1e-3);
   EXPECT_NEAR(m.m[3][1], 60, 1e-3);
   EXPECT_NEAR(m.m[3][2], at.z, 1e-2);
@@ -343,26 +343,26 @@ TEST(IgWorld, TheTimeOfDayMovesTheSunAndFadesTheStars) {
 
 TEST(IgWorld, HeightsAnswerFromTheTerrainQueryAndThePolygons) {
   IgWorld w = loadWorld();
-  const GeoOrigin& o = w.config().origin;
+  const GeoFrame& o = w.earth();
   // Over open ground: the terrain query's own answer.
-  const DVec3 p{30, 100, -150};
+  const Vec3d p{30, 100, -150};
   const std::optional<TerrainHeight> t = terrainHeight(w.database(), p.x, p.y, p.z);
   ASSERT_TRUE(t.has_value());
-  const DVec3 g = worldToGeodetic(o, p);
+  const GeoPoint g = o.toGeodetic(p);
   cigi::HatHotRequest hat;
   hat.id = 11;
-  hat.latOrX = g.x;
-  hat.lonOrY = g.y;
-  hat.altOrZ = g.z;
+  hat.latOrX = g.lat;
+  hat.lonOrY = g.lon;
+  hat.altOrZ = g.alt;
   cigi::HatHotRequest hot = hat;
   hot.id = 12;
   hot.type = cigi::HatHotType::hot;
   // On the tower (80 m tall at x −40, z −250): its roof.
-  const DVec3 roof = worldToGeodetic(o, {-40, 100, -250});
+  const GeoPoint roof = o.toGeodetic({-40, 100, -250});
   cigi::HatHotRequest tower = hat;
   tower.id = 13;
-  tower.latOrX = roof.x;
-  tower.lonOrY = roof.y;
+  tower.latOrX = roof.lat;
+  tower.lonOrY = roof.lon;
   // Off the database: no ground.
   cigi::HatHotRequest off = hat;
   off.id = 14;
@@ -376,23 +376,22 @@ TEST(IgWorld, HeightsAnswerFromTheTerrainQueryAndThePolygons) {
   EXPECT_NEAR(a.height, t->above, 1e-6);
   const auto& b = std::get<cigi::HatHotResponse>(r[1]);
   EXPECT_TRUE(b.hot);
-  EXPECT_NEAR(b.height, p.y - t->above + o.alt, 1e-6);
+  EXPECT_NEAR(b.height, p.y - t->above + o.origin().alt, 1e-6);
   EXPECT_NEAR(std::get<cigi::HatHotResponse>(r[2]).height, 100 - 80, 1e-3);
   EXPECT_FALSE(std::get<cigi::HatHotResponse>(r[3]).valid);
 }
 
 TEST(IgWorld, LinesOfSightStopAtTheTowerAndTheGround) {
   IgWorld w = loadWorld();
-  const GeoOrigin& o = w.config().origin;
-  auto geo = [&](DVec3 p) { return worldToGeodetic(o, p); };
+  auto geo = [&](Vec3d p) { return w.earth().toGeodetic(p); };
   cigi::LosSegmentRequest through;
   through.id = 5;
-  const DVec3 a = geo({-40, 50, -150}), b = geo({-40, 50, -350});  // through the tower
+  const GeoPoint a = geo({-40, 50, -150}), b = geo({-40, 50, -350});  // through the tower
   std::memcpy(through.source, &a, sizeof through.source);
   std::memcpy(through.destination, &b, sizeof through.destination);
   cigi::LosSegmentRequest clear = through;
   clear.id = 6;
-  const DVec3 c = geo({40, 200, -150}), d = geo({40, 200, -350});  // above everything
+  const GeoPoint c = geo({40, 200, -150}), d = geo({40, 200, -350});  // above everything
   std::memcpy(clear.source, &c, sizeof clear.source);
   std::memcpy(clear.destination, &d, sizeof clear.destination);
   const std::vector<cigi::Packet> r = apply(w, {through, clear});

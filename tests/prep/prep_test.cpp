@@ -2,7 +2,7 @@
 // a database holds back exactly the scene it was given; a prepared database renders
 // bit-identically to its source (with levels of detail off, and wherever level 0 is drawn);
 // generated levels shrink and switch at increasing ranges; a damaged file is refused by name.
-#include "prep/prep.h"
+#include "synthvis/prep.h"
 
 #include <gtest/gtest.h>
 
@@ -262,9 +262,9 @@ TEST(Database, RefusesDamagedFiles) {
   flipped[200] ^= 4;
   EXPECT_EQ(error(flipped), "database is damaged (its checksum does not match)");
   std::string newer = good;
-  newer[8] = 3;
+  newer[8] = 4;
   EXPECT_EQ(error(newer),
-            "database version 3, this synthvis reads version 2 (run `synthvis prep` again on the "
+            "database version 4, this synthvis reads version 3 (run `synthvis prep` again on the "
             "source)");
   EXPECT_EQ(error("glTF" + good), "not a synthvis database (no SVDB header)");
   EXPECT_EQ(error(""), "not a synthvis database (empty file)");

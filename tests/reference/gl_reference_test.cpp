@@ -8,9 +8,9 @@
 #include <filesystem>
 
 #include "reference/gl_renderer.h"
-#include "reference/suite.h"
 #include "small_settings.h"
 #include "support/temp_dir.h"
+#include "synthvis/bench.h"
 #include "synthvis/formats.h"
 
 namespace sv::reference {

@@ -1,5 +1,5 @@
 // The ground-truth renderer and the image metrics (src/reference/ground_truth.h).
-#include "reference/ground_truth.h"
+#include "synthvis/ground_truth.h"
 
 #include <gtest/gtest.h>
 

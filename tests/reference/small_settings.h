@@ -1,7 +1,7 @@
 // Shared by the reference tests: a small, quick bench configuration.
 #pragma once
 
-#include "reference/suite.h"
+#include "synthvis/bench.h"
 
 namespace sv::reference::testing {
 

@@ -1,7 +1,5 @@
 // The bench harness (src/reference): suites, PSNR, JSON rows, HTML, and the gl reference drawing
 // the same picture as synthvis.
-#include "reference/suite.h"
-
 #include <gtest/gtest.h>
 #include <hwy/targets.h>
 
@@ -10,6 +8,7 @@
 
 #include "small_settings.h"
 #include "support/temp_dir.h"
+#include "synthvis/bench.h"
 
 namespace sv::reference {
 namespace {

@@ -5,9 +5,9 @@
 #include <cstdlib>
 #include <string>
 
-#include "reference/suite.h"
 #include "reference/vtk_volume.h"
 #include "small_settings.h"
+#include "synthvis/bench.h"
 #include "synthvis/generators.h"
 
 namespace sv::reference {

@@ -18,9 +18,9 @@
 #include <string>
 #include <vector>
 
-#include "reference/ground_truth.h"
-#include "reference/suite.h"
+#include "synthvis/bench.h"
 #include "synthvis/formats.h"
+#include "synthvis/ground_truth.h"
 #include "synthvis/render.h"
 
 namespace sv {

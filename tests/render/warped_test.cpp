@@ -398,12 +398,12 @@ TEST(SubFrusta, AreSharperThanAFlatViewResampled) {
   for (int m = 0; m < 3; ++m) {
     render::CorrectedView view;
     view.table = &table;
-    view.correction = m == 0   ? render::Correction::subFrusta
-                      : m == 1 ? render::Correction::bilinear
-                               : render::Correction::bicubic;
+    view.correction = m == 0   ? RenderOptions::Correction::subFrusta
+                      : m == 1 ? RenderOptions::Correction::bilinear
+                               : RenderOptions::Correction::bicubic;
     output::LinearImage out;
     FrameStats stats;
-    render::CorrectionStats cs;
+    DisplayStats cs;
     ASSERT_TRUE(render::renderCorrected(renderer, s, o, base.value(), view, out, stats, cs));
     rise[m] = edgeRise(table, out);
   }

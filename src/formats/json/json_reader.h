@@ -44,6 +44,7 @@ class SceneReader {
   int readObjectMaterial(const Json& object, const std::string& where);
   void readPrimitive(const Json& object, const std::string& where);
   void readFreeFormObject(const Json& object, const std::string& where);
+  void readGeodetic(const Json& v, const std::string& where);
   void readTerrain(const Json& v, const std::string& where);
   // "lights" (docs/scene-format.md#light-points): appearances, groups, points, strings, arrays,
   // settings, the star field.

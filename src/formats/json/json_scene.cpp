@@ -133,10 +133,10 @@ Scene SceneReader::read(const Json& root) {
     fail("synthvis",
          fmt::format("unsupported format version {} (this reader understands version {})",
                      version->dump(), kFormatVersion));
-  expectKeys(root, "",
-             {"synthvis", "description", "background", "camera", "cameras", "light", "pointLights",
-              "fog", "textures", "colorTable", "materials", "lodGroups", "objects", "terrain",
-              "lights", "lines", "volumes", "time", "channels"});
+  expectKeys(root, "", {"synthvis",  "description", "background", "camera",   "cameras",
+                        "light",     "pointLights", "fog",        "textures", "colorTable",
+                        "materials", "lodGroups",   "objects",    "terrain",  "lights",
+                        "lines",     "volumes",     "time",       "channels", "geodetic"});
 
   if (const Json* description = find(root, "description")) string(*description, "description");
   if (const Json* background = find(root, "background")) {
@@ -159,6 +159,7 @@ Scene SceneReader::read(const Json& root) {
   if (const Json* x = find(root, "textures")) readTextures(*x, "textures");
   if (const Json* x = find(root, "colorTable")) readColorTable(*x, "colorTable");
   if (const Json* materials = find(root, "materials")) readMaterials(*materials, "materials");
+  if (const Json* x = find(root, "geodetic")) readGeodetic(*x, "geodetic");
   // Terrain before the objects: an object may stand on the ground ("onGround").
   if (const Json* x = find(root, "terrain")) {
     array(*x, "terrain");

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <numbers>
 
 #include "formats/heights.h"
 #include "formats/json/json_reader.h"
@@ -23,18 +24,32 @@ void SceneReader::readTerrain(const Json& v, const std::string& where) {
   Terrain t;
   if (const Json* x = find(v, "name")) t.name = string(*x, member(where, "name"));
   HeightField f = readHeights(v, where);
-  t.origin[0] = 0.5 * (f.originU + f.eastU());
-  t.origin[1] = 0.5 * (f.originV + f.southV());
+  // A geographic table in the scene's geodetic frame, whose origin is the world origin; any other
+  // table centred on it unless the scene says where.
+  const bool framed = scene_.geodetic && f.geographic.on;
+  if (framed) placeGeographic(f.geographic, scene_.geodetic->frame(), f);
+  t.origin[0] = framed ? 0 : 0.5 * (f.originU + f.eastU());
+  t.origin[1] = framed ? 0 : 0.5 * (f.originV + f.southV());
   if (const Json* x = find(v, "origin")) {
     const auto o = doubles<2>(*x, member(where, "origin"));
     t.origin[0] = o[0], t.origin[1] = o[1];
   }
+  // The base: a plane, the Earth (the WGS 84 Gaussian sphere at the geodetic frame's latitude,
+  // or at a geographic table's own centre), or a sphere of a given radius; by default the Earth
+  // where the scene's frame says the ground curves.
+  auto earth = [&](const std::string& w) {
+    if (scene_.geodetic) return scene_.geodetic->frame().origin().lat;
+    if (f.geographic.on) return ownFrame(f.geographic, f.width, f.height).origin().lat;
+    fail(w, "\"earth\" needs a latitude: the scene's \"geodetic\" origin, or a geographic table");
+  };
+  if (scene_.geodetic && scene_.geodetic->curved)
+    t.baseRadius = gaussianRadius(earth(where) * std::numbers::pi / 180);
   if (const Json* x = find(v, "base")) {
     const std::string w = member(where, "base");
     if (x->is_string() && x->get<std::string>() == "plane") {
       t.baseRadius = 0;
     } else if (x->is_string() && x->get<std::string>() == "earth") {
-      t.baseRadius = kEarthRadius;
+      t.baseRadius = gaussianRadius(earth(w) * std::numbers::pi / 180);
     } else if (x->is_object()) {
       expectKeys(*x, w, {"sphere"});
       const Json* r = find(*x, "sphere");
@@ -85,6 +100,7 @@ void SceneReader::readTerrain(const Json& v, const std::string& where) {
         fail(member(w, "file"), "referenced files are not read here");
       Result<OrthoImage> img = loadOrthoImage(resolvePath(directoryOf(path_), ref), bands);
       if (!img) fail(member(w, "file"), img.error().str());
+      if (scene_.geodetic) placeGeographic(img.value(), scene_.geodetic->frame());
       if (!bounds && !img->georeferenced)
         fail(w, "the image has no georeferencing: give 'bounds' [west, south, east, north]");
       if (!bounds)
@@ -220,6 +236,25 @@ double SceneReader::groundHeight(double x, double z, const std::string& where) c
   }
   if (std::isnan(best)) fail(where, fmt::format("no terrain under ({}, {}) to stand on", x, z));
   return best;
+}
+
+// "geodetic" (docs/scene-format.md, "Geodetic frame"): {"origin": {"lat", "lon", "alt"},
+// "curved"} — where the world origin lies on WGS 84, and whether the ground curves.
+void SceneReader::readGeodetic(const Json& v, const std::string& where) {
+  expectKeys(v, where, {"origin", "curved"});
+  const Json* o = find(v, "origin");
+  if (!o) fail(where, "missing key 'origin' ({\"lat\", \"lon\", \"alt\"})");
+  const std::string w = member(where, "origin");
+  expectKeys(*o, w, {"lat", "lon", "alt"});
+  Geodetic g;
+  const Json* lat = find(*o, "lat");
+  const Json* lon = find(*o, "lon");
+  if (!lat || !lon) fail(w, "needs 'lat' and 'lon' (degrees)");
+  g.origin.lat = inRange(*lat, member(w, "lat"), -89, 89);
+  g.origin.lon = inRange(*lon, member(w, "lon"), -180, 180);
+  if (const Json* a = find(*o, "alt")) g.origin.alt = inRange(*a, member(w, "alt"), -1e4f, 1e5f);
+  if (const Json* c = find(v, "curved")) g.curved = boolean(*c, member(where, "curved"));
+  scene_.geodetic = g;
 }
 
 }  // namespace sv::formats::json

@@ -59,34 +59,34 @@ enum class PacketId : uint8_t {
 
 enum class IgMode : uint8_t { reset = 0, operate = 1, debug = 2, offlineMaintenance = 3 };
 
-struct IgControl {  // 24 bytes; byte 2 the major version (3), bytes 6-7 the byte-swap magic
+struct IgControl {      // 24 bytes; byte 2 the major version (3), bytes 6-7 the byte-swap magic
   int8_t database = 0;  // byte 3; 0: keep the loaded database
-  IgMode mode = IgMode::operate;  // byte 4, bits 0-1
-  bool timestampValid = false;    // byte 4, bit 2
-  bool extrapolation = false;  // byte 4, bit 3: extrapolation/interpolation enable
+  IgMode mode = IgMode::operate;         // byte 4, bits 0-1
+  bool timestampValid = false;           // byte 4, bit 2
+  bool extrapolation = false;            // byte 4, bit 3: extrapolation/interpolation enable
   uint8_t minorVersion = kMinorVersion;  // byte 4, bits 4-7
-  uint32_t hostFrame = 0;    // bytes 8-11
-  uint32_t timestamp = 0;    // bytes 12-15, 10 µs ticks
-  uint32_t lastIgFrame = 0;  // bytes 16-19
+  uint32_t hostFrame = 0;                // bytes 8-11
+  uint32_t timestamp = 0;                // bytes 12-15, 10 µs ticks
+  uint32_t lastIgFrame = 0;              // bytes 16-19
 
   friend bool operator==(const IgControl&, const IgControl&) = default;
 };
 
 enum class EntityState : uint8_t { inactive = 0, active = 1, destroyed = 2 };
 
-struct EntityControl {  // 48 bytes
+struct EntityControl {                      // 48 bytes
   uint16_t entity = 0;                      // bytes 2-3
   EntityState state = EntityState::active;  // byte 4, bits 0-1
   bool attached = false;  // byte 4, bit 2: a child of `parent`, placed by offsets in its body frame
   bool collisionDetection = false;  // byte 4, bit 3
   bool inheritAlpha = false;        // byte 4, bit 4
-  uint8_t groundClamp = 0;  // byte 4, bits 5-6: 0 none, 1 non-conformal, 2 conformal
+  uint8_t groundClamp = 0;          // byte 4, bits 5-6: 0 none, 1 non-conformal, 2 conformal
   // Byte 5, bits 0-3 as sent: bit 0 animation direction, bit 1 loop mode, bits 2-3 state.
   uint8_t animationFlags = 0;
-  bool extrapolation = false;  // linear extrapolation/interpolation enable (byte 5, bit 4)
-  uint8_t alpha = 255;  // byte 6
-  uint16_t type = 0;    // bytes 8-9: the model table's key
-  uint16_t parent = 0;  // bytes 10-11
+  bool extrapolation = false;          // linear extrapolation/interpolation enable (byte 5, bit 4)
+  uint8_t alpha = 255;                 // byte 6
+  uint16_t type = 0;                   // bytes 8-9: the model table's key
+  uint16_t parent = 0;                 // bytes 10-11
   float roll = 0, pitch = 0, yaw = 0;  // bytes 12-23, degrees
   // Bytes 24-47. Top level: latitude, longitude (degrees), altitude (m); attached: x, y, z
   // offsets (m) in the parent's body frame (x forward, y right, z down).
@@ -127,43 +127,43 @@ struct ComponentControl {
   friend bool operator==(const ComponentControl&, const ComponentControl&) = default;
 };
 
-struct RateControl {  // 32 bytes
-  uint16_t entity = 0;  // bytes 2-3
-  uint8_t part = 0;     // byte 4
+struct RateControl {         // 32 bytes
+  uint16_t entity = 0;       // bytes 2-3
+  uint8_t part = 0;          // byte 4
   bool applyToPart = false;  // byte 5, bit 0
   // Byte 5, bit 1, the coordinate system: 0 world/parent, 1 the entity's body (local). This flag is
   // true when the bit is 0 (the name says what it means; the wire bit is its negation).
   bool worldCoordinates = false;
-  float x = 0, y = 0, z = 0;             // bytes 8-19, m/s
-  float roll = 0, pitch = 0, yaw = 0;    // bytes 20-31, degrees/s
+  float x = 0, y = 0, z = 0;           // bytes 8-19, m/s
+  float roll = 0, pitch = 0, yaw = 0;  // bytes 20-31, degrees/s
 
   friend bool operator==(const RateControl&, const RateControl&) = default;
 };
 
-struct CelestialSphereControl {  // 16 bytes
+struct CelestialSphereControl {   // 16 bytes
   uint8_t hour = 12, minute = 0;  // bytes 2, 3
   // Byte 4, bits 0-4 in this order.
   bool ephemeris = false, sun = true, moon = false, starField = true, dateValid = false;
-  uint32_t date = 0;  // bytes 8-11, MMDDYYYY as a decimal number
+  uint32_t date = 0;          // bytes 8-11, MMDDYYYY as a decimal number
   float starIntensity = 100;  // bytes 12-15, percent
 
   friend bool operator==(const CelestialSphereControl&, const CelestialSphereControl&) = default;
 };
 
-struct AtmosphereControl {  // 32 bytes
-  bool modelEnabled = false;  // byte 2, bit 0
-  uint8_t humidity = 30;  // byte 3, percent
-  float temperature = 15;  // bytes 4-7, °C
-  float visibility = 1e5f;  // bytes 8-11, m
+struct AtmosphereControl {                                        // 32 bytes
+  bool modelEnabled = false;                                      // byte 2, bit 0
+  uint8_t humidity = 30;                                          // byte 3, percent
+  float temperature = 15;                                         // bytes 4-7, °C
+  float visibility = 1e5f;                                        // bytes 8-11, m
   float windHorizontal = 0, windVertical = 0, windDirection = 0;  // bytes 12-23, m/s, m/s, degrees
-  float pressure = 1013.25f;  // bytes 24-27, mbar
+  float pressure = 1013.25f;                                      // bytes 24-27, mbar
 
   friend bool operator==(const AtmosphereControl&, const AtmosphereControl&) = default;
 };
 
 struct EnvironmentalRegionControl {  // 48 bytes
-  uint16_t region = 0;  // bytes 2-3
-  uint8_t state = 0;  // byte 4, bits 0-1: 0 inactive, 1 active, 2 destroyed
+  uint16_t region = 0;               // bytes 2-3
+  uint8_t state = 0;                 // byte 4, bits 0-1: 0 inactive, 1 active, 2 destroyed
   // Byte 4, bits 2-5, shifted down: bit 0 merge weather, 1 aerosols, 2 maritime, 3 terrestrial
   // surface conditions.
   uint8_t mergeFlags = 0;
@@ -171,122 +171,121 @@ struct EnvironmentalRegionControl {  // 48 bytes
   // Bytes 24-43: m, m, m, degrees, m (the transition perimeter).
   float sizeX = 0, sizeY = 0, cornerRadius = 0, rotation = 0, transition = 0;
 
-  friend bool operator==(const EnvironmentalRegionControl&, const EnvironmentalRegionControl&) = default;
+  friend bool operator==(const EnvironmentalRegionControl&,
+                         const EnvironmentalRegionControl&) = default;
 };
 
-struct WeatherControl {  // 56 bytes
+struct WeatherControl {         // 56 bytes
   uint16_t entityOrRegion = 0;  // bytes 2-3
-  uint8_t layer = 0;     // byte 4
-  uint8_t humidity = 0;  // byte 5, percent
+  uint8_t layer = 0;            // byte 4
+  uint8_t humidity = 0;         // byte 5, percent
   bool enabled = false, scud = false, randomWinds = false, randomLightning = false;  // byte 6, 0-3
   uint8_t cloudType = 0;  // byte 6, bits 4-7
-  uint8_t scope = 0;  // byte 7, bits 0-1: 0 global, 1 regional, 2 entity
-  uint8_t severity = 0;  // byte 7, bits 2-4
+  uint8_t scope = 0;      // byte 7, bits 0-1: 0 global, 1 regional, 2 entity
+  uint8_t severity = 0;   // byte 7, bits 2-4
   // Bytes 8-55, in this order: °C, m, %, %, m, m, m, m/s, m/s, degrees, mbar, g/m³.
   float temperature = 15, visibility = 1e5f, scudFrequency = 0, coverage = 0;
   float baseElevation = 0, thickness = 0, transitionBand = 0;
-  float windHorizontal = 0, windVertical = 0, windDirection = 0, pressure = 1013.25f,
-        aerosol = 0;
+  float windHorizontal = 0, windVertical = 0, windDirection = 0, pressure = 1013.25f, aerosol = 0;
 
   friend bool operator==(const WeatherControl&, const WeatherControl&) = default;
 };
 
-struct ViewControl {  // 32 bytes
-  uint16_t view = 0;   // bytes 2-3
-  uint8_t group = 0;   // byte 4
-  uint8_t enable = 0;  // byte 5, bits 0-5: x, y, z offset, roll, pitch, yaw enable
-  uint16_t entity = 0;  // bytes 6-7
+struct ViewControl {                   // 32 bytes
+  uint16_t view = 0;                   // bytes 2-3
+  uint8_t group = 0;                   // byte 4
+  uint8_t enable = 0;                  // byte 5, bits 0-5: x, y, z offset, roll, pitch, yaw enable
+  uint16_t entity = 0;                 // bytes 6-7
   float x = 0, y = 0, z = 0;           // bytes 8-19, m, in the entity's body frame
   float roll = 0, pitch = 0, yaw = 0;  // bytes 20-31, degrees
 
   friend bool operator==(const ViewControl&, const ViewControl&) = default;
 };
 
-struct ViewDefinition {  // 32 bytes
-  uint16_t view = 0;   // bytes 2-3
-  uint8_t group = 0;   // byte 4
-  uint8_t enable = 0;  // byte 5, bits 0-5: near, far, left, right, top, bottom enable
+struct ViewDefinition {          // 32 bytes
+  uint16_t view = 0;             // bytes 2-3
+  uint8_t group = 0;             // byte 4
+  uint8_t enable = 0;            // byte 5, bits 0-5: near, far, left, right, top, bottom enable
   uint8_t mirror = 0;            // byte 5, bits 6-7
   uint8_t pixelReplication = 0;  // byte 6, bits 0-2
   bool orthographic = false;     // byte 6, bit 3: the projection type
   bool reorder = false;          // byte 6, bit 4
   uint8_t viewType = 0;          // byte 6, bits 5-7
-  float nearPlane = 0.1f, farPlane = 1e5f;  // bytes 8-15, m
+  float nearPlane = 0.1f, farPlane = 1e5f;               // bytes 8-15, m
   float left = -30, right = 30, top = 20, bottom = -20;  // bytes 16-31, half-angles, degrees
 
   friend bool operator==(const ViewDefinition&, const ViewDefinition&) = default;
 };
 
 enum class HatHotType : uint8_t { hat = 0, hot = 1, extended = 2 };
-struct HatHotRequest {  // 32 bytes
+struct HatHotRequest {                // 32 bytes
   uint16_t id = 0;                    // bytes 2-3
   HatHotType type = HatHotType::hat;  // byte 4, bits 0-1
-  bool entityCoordinates = false;  // byte 4, bit 2: offsets from `entity` instead of geodetic
-  uint8_t updatePeriod = 0;  // byte 5
-  uint16_t entity = 0;       // bytes 6-7
+  bool entityCoordinates = false;     // byte 4, bit 2: offsets from `entity` instead of geodetic
+  uint8_t updatePeriod = 0;           // byte 5
+  uint16_t entity = 0;                // bytes 6-7
   double latOrX = 0, lonOrY = 0, altOrZ = 0;  // bytes 8-31
 
   friend bool operator==(const HatHotRequest&, const HatHotRequest&) = default;
 };
 
 struct LosSegmentRequest {  // 64 bytes
-  uint16_t id = 0;        // bytes 2-3
-  bool extended = false;  // byte 4, bit 0: the request type (basic 0, extended 1)
+  uint16_t id = 0;          // bytes 2-3
+  bool extended = false;    // byte 4, bit 0: the request type (basic 0, extended 1)
   // Byte 4, bits 1-4 in this order.
   bool sourceEntityCoordinates = false, destinationEntityCoordinates = false,
        responseEntityCoordinates = false, destinationEntityValid = false;
-  uint8_t alphaThreshold = 0;  // byte 5
-  uint16_t sourceEntity = 0;   // bytes 6-7
+  uint8_t alphaThreshold = 0;                  // byte 5
+  uint16_t sourceEntity = 0;                   // bytes 6-7
   double source[3] = {}, destination[3] = {};  // bytes 8-55: lat, lon, alt or x, y, z
-  uint32_t materialMask = 0;  // bytes 56-59
-  uint8_t updatePeriod = 0;   // byte 60
-  uint16_t destinationEntity = 0;  // bytes 62-63
+  uint32_t materialMask = 0;                   // bytes 56-59
+  uint8_t updatePeriod = 0;                    // byte 60
+  uint16_t destinationEntity = 0;              // bytes 62-63
 
   friend bool operator==(const LosSegmentRequest&, const LosSegmentRequest&) = default;
 };
 
 // ---- IG → host -----------------------------------------------------------------------------
 
-struct StartOfFrame {  // 24 bytes; byte 2 the major version (3), bytes 6-7 the byte-swap magic
+struct StartOfFrame {    // 24 bytes; byte 2 the major version (3), bytes 6-7 the byte-swap magic
   int8_t database = 0;   // byte 3
   uint8_t igStatus = 0;  // byte 4; 0: normal
-  IgMode mode = IgMode::operate;  // byte 5, bits 0-1
-  bool timestampValid = false;    // byte 5, bit 2
-  bool earthReferenceModel = false;  // byte 5, bit 3; 0: WGS 84
+  IgMode mode = IgMode::operate;         // byte 5, bits 0-1
+  bool timestampValid = false;           // byte 5, bit 2
+  bool earthReferenceModel = false;      // byte 5, bit 3; 0: WGS 84
   uint8_t minorVersion = kMinorVersion;  // byte 5, bits 4-7
-  uint32_t igFrame = 0;        // bytes 8-11
-  uint32_t timestamp = 0;      // bytes 12-15, 10 µs ticks
-  uint32_t lastHostFrame = 0;  // bytes 16-19
+  uint32_t igFrame = 0;                  // bytes 8-11
+  uint32_t timestamp = 0;                // bytes 12-15, 10 µs ticks
+  uint32_t lastHostFrame = 0;            // bytes 16-19
 
   friend bool operator==(const StartOfFrame&, const StartOfFrame&) = default;
 };
 
 struct HatHotResponse {  // 16 bytes
-  uint16_t id = 0;     // bytes 2-3
-  bool valid = false;  // byte 4, bit 0
-  bool hot = false;  // byte 4, bit 1, the type: height of terrain (true) or above it (false)
+  uint16_t id = 0;       // bytes 2-3
+  bool valid = false;    // byte 4, bit 0
+  bool hot = false;      // byte 4, bit 1, the type: height of terrain (true) or above it (false)
   uint8_t hostFrameLsn = 0;  // byte 4, bits 4-7: the host frame's four low bits
-  double height = 0;  // bytes 8-15, m
+  double height = 0;         // bytes 8-15, m
 
   friend bool operator==(const HatHotResponse&, const HatHotResponse&) = default;
 };
 
-struct LosResponse {  // 16 bytes
-  uint16_t id = 0;  // bytes 2-3
+struct LosResponse {                                         // 16 bytes
+  uint16_t id = 0;                                           // bytes 2-3
   bool valid = false, entityValid = false, visible = false;  // byte 4, bits 0-2
-  uint8_t hostFrameLsn = 0;  // byte 4, bits 4-7
-  uint8_t count = 1;  // byte 5: responses to this request
-  uint16_t entity = 0;  // bytes 6-7
-  double range = 0;  // bytes 8-15, m
+  uint8_t hostFrameLsn = 0;                                  // byte 4, bits 4-7
+  uint8_t count = 1;                                         // byte 5: responses to this request
+  uint16_t entity = 0;                                       // bytes 6-7
+  double range = 0;                                          // bytes 8-15, m
 
   friend bool operator==(const LosResponse&, const LosResponse&) = default;
 };
 
 using Packet = std::variant<IgControl, EntityControl, ComponentControl, RateControl,
-                            CelestialSphereControl, AtmosphereControl,
-                            EnvironmentalRegionControl, WeatherControl, ViewControl,
-                            ViewDefinition, HatHotRequest, LosSegmentRequest, StartOfFrame,
-                            HatHotResponse, LosResponse>;
+                            CelestialSphereControl, AtmosphereControl, EnvironmentalRegionControl,
+                            WeatherControl, ViewControl, ViewDefinition, HatHotRequest,
+                            LosSegmentRequest, StartOfFrame, HatHotResponse, LosResponse>;
 
 // Every struct compares field by field (operator==), as the round-trip tests do.
 struct Datagram {

@@ -36,11 +36,11 @@ struct PrepOptions {
 
 struct PrepReport {
   size_t meshes = 0, instances = 0;
-  uint64_t trianglesIn = 0;          // over the meshes (each counted once)
+  uint64_t trianglesIn = 0;  // over the meshes (each counted once)
   uint64_t verticesIn = 0, verticesOut = 0;
-  double acmrIn = 0, acmrOut = 0;    // average cache miss ratio (16-entry FIFO), over all meshes
+  double acmrIn = 0, acmrOut = 0;  // average cache miss ratio (16-entry FIFO), over all meshes
   size_t groupsMade = 0, levelsMade = 0;
-  uint64_t levelTriangles = 0;       // in the generated levels
+  uint64_t levelTriangles = 0;  // in the generated levels
   std::string summary() const;
 };
 

@@ -18,7 +18,7 @@ namespace sv::reference {
 
 // A scene to time: a generator with its parameters, or a scene file.
 struct BenchCase {
-  std::string name;                                     // e.g. "tris-100k-a10", or the file's path
+  std::string name;  // e.g. "tris-100k-a10", or the file's path
   generators::Generator generator = generators::Generator::none;  // none: `file`
   generators::TrisParams tris;
   generators::LayersParams layers;

@@ -1,0 +1,65 @@
+// Curved-screen displays (SPEC §9, §12's distortion correction; docs/display.md): projectors on a
+// curved screen, each pixel showing its own direction from the design eye, drawn pre-distorted and
+// edge-blended by Renderer::renderDisplay, as display channels are by Renderer::renderChannels.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "synthvis/result.h"
+
+namespace sv {
+
+namespace render {
+struct DisplaySetup;  // src/render/correction.h: the projectors' direction tables and blends
+}
+
+// A display: its projectors, each with a name, a size in pixels, the direction each of its pixels
+// shows (its display mapping) and, where the projectors overlap, its blend weights. Immutable and
+// cheap to copy (copies share the tables).
+class Display {
+ public:
+  // Issue 34's demo rig: three projectors of `width` × `height` on a cylinder, overlapping by
+  // `overlapDegrees`, with their exact directions and alpha maps (docs/display.md).
+  static Display cylinder(int width, int height, double overlapDegrees = 10);
+  // An MPCDI file's regions (the 3d profile: each region's frustum and warp give its directions,
+  // its alpha and beta maps its blend), named by their ids. Errors name the file and the problem.
+  static Result<Display> readMpcdi(const std::string& path);
+  // The rig as an MPCDI file (3d profile, level 2: a region per projector, its frustum the
+  // projector's covering flat view, a warp per pixel, its alpha map). Only an analytic rig
+  // (cylinder) can be written; an error says so for a display read from a file.
+  Status writeMpcdi(const std::string& path) const;
+
+  int projectorCount() const;
+  const std::string& projectorName(int projector) const;
+  int projectorWidth(int projector) const;
+  int projectorHeight(int projector) const;
+  // Whether the screen's geometry is known (an analytic rig): what Renderer::viewerImage needs.
+  bool hasGeometry() const;
+
+  const render::DisplaySetup& setup() const { return *setup_; }  // the renderer's view of it
+
+ private:
+  explicit Display(std::shared_ptr<const render::DisplaySetup> setup);
+  std::shared_ptr<const render::DisplaySetup> setup_;
+};
+
+// How a projector's frame was made (Renderer::renderDisplay), in milliseconds and counts.
+struct DisplayStats {
+  // Sub-frusta (RenderOptions::Correction::subFrusta): the plan, made from the display mapping
+  // (once per frame today), its cells and the largest residual of their projective maps.
+  double planMs = 0;
+  int cells = 0;
+  double maxResidualPixels = 0;
+  // Resampling (bilinear, bicubic): the warp (once per frame today), the flat view's size, the
+  // resampling, and the valid pixels the flat view missed (black).
+  double warpMs = 0;
+  int flatWidth = 0, flatHeight = 0;
+  double resampleMs = 0;
+  int64_t outside = 0;
+  double renderMs = 0;  // the cells, or the flat view
+  double blendMs = 0;
+};
+
+}  // namespace sv
