@@ -66,6 +66,16 @@ Status addArcChannels(scene::Scene& scene, const RenderOptions& o, int n, float 
   return {};
 }
 
+// A frame whose every triangle was culled for facing away (single-sided materials seen from
+// behind) is an empty picture that says why.
+void warnIfAllFacedAway(const FrameStats& stats, const std::string& image) {
+  if (stats.drawn == 0 && stats.culledFacing > 0)
+    fmt::print(stderr,
+               "synthvis: warning: {}: every triangle faced away from the camera and was culled "
+               "(its materials are single-sided; --no-cull draws back faces)\n",
+               image);
+}
+
 // A scene with display channels (SPEC §9): all of them in one call; OUT-<name>.png each (the
 // channel's index for an unnamed one), a statistics line each, and the mosaic if asked for.
 int renderChannels(const RenderArgs& a, const scene::Scene& scene, Renderer& renderer) {
@@ -82,6 +92,7 @@ int renderChannels(const RenderArgs& a, const scene::Scene& scene, Renderer& ren
     const std::string path = withSuffix(a.output, c.name.empty() ? std::to_string(i) : c.name);
     if (Status s = writeImage(images[i], path); !s) return fail(s.error());
     fmt::print("{}: {}x{} | {}\n", path, images[i].width, images[i].height, stats[i].summary());
+    warnIfAllFacedAway(stats[i], path);
     totalMs += stats[i].totalMs;
   }
   fmt::print("frame: {} channels, {:.2f} ms\n", images.size(), totalMs);
@@ -212,6 +223,7 @@ int runRender(const RenderArgs& a) {
   }
   if (Status s = writeImage(image, a.output); !s) return fail(s.error());
   fmt::print("{}: {}x{} | {}\n", a.output, o.width, o.height, stats.summary());
+  warnIfAllFacedAway(stats, a.output);
   return 0;
 }
 

@@ -132,6 +132,7 @@ class IgLoop {
  private:
   IgLoop();
   struct Impl;
+  struct Session;  // one run's frames (loop.cpp)
   std::unique_ptr<Impl> impl_;
   std::atomic<bool> stop_{false};
 };

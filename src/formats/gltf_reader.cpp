@@ -20,7 +20,10 @@
 #include <limits>
 #include <map>
 #include <new>
+#include <nlohmann/json.hpp>
 #include <numbers>
+#include <optional>
+#include <string_view>
 #include <tuple>
 #include <utility>
 
@@ -104,6 +107,51 @@ bool nestingWithin(const char* text, size_t size, int limit) {
     }
   }
   return true;
+}
+
+// KHR_draco_mesh_compression lets a primitive's accessors go without a bufferView (the Draco
+// bufferView holds the data), but tinygltf 2.7.0 refuses an indices accessor without one
+// ("accessor[0] invalid bufferView": Khronos' own 2CylinderEngine sample). The indices of a Draco
+// primitive are the decoded mesh's (convertDracoPrimitive), so such a primitive's "indices" is
+// dropped from the JSON before tinygltf sees it. Returns the rewritten file (text, or a GLB with
+// its JSON chunk replaced), or nothing when no primitive needs it.
+std::optional<std::string> withoutDracoIndices(const std::string& bytes, bool binary,
+                                               const char* json, size_t jsonSize) {
+  if (std::string_view(json, jsonSize).find("KHR_draco_mesh_compression") == std::string::npos)
+    return std::nullopt;
+  nlohmann::json doc = nlohmann::json::parse(json, json + jsonSize, nullptr, false);
+  if (doc.is_discarded() || !doc.is_object() || !doc.contains("meshes") ||
+      !doc["meshes"].is_array() || !doc.contains("accessors") || !doc["accessors"].is_array())
+    return std::nullopt;  // tinygltf reports what is wrong with it
+  const nlohmann::json& accessors = doc["accessors"];
+  bool changed = false;
+  for (nlohmann::json& mesh : doc["meshes"]) {
+    if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array())
+      continue;
+    for (nlohmann::json& p : mesh["primitives"]) {
+      if (!p.is_object() || !p.contains("indices") || !p["indices"].is_number_unsigned() ||
+          !p.contains("extensions") || !p["extensions"].is_object() ||
+          !p["extensions"].contains("KHR_draco_mesh_compression"))
+        continue;
+      const size_t a = p["indices"].get<size_t>();
+      if (a < accessors.size() && accessors[a].is_object() && !accessors[a].contains("bufferView"))
+        p.erase("indices"), changed = true;
+    }
+  }
+  if (!changed) return std::nullopt;
+  std::string text = doc.dump();
+  if (!binary) return text;
+  // GLB (spec 4.4): the header, the JSON chunk padded with spaces to 4 bytes, the rest as it was.
+  while (text.size() % 4) text += ' ';
+  const size_t rest = 20 + jsonSize;
+  std::string out(20, '\0');
+  const auto put = [&](size_t at, uint32_t v) { std::memcpy(out.data() + at, &v, 4); };
+  std::memcpy(out.data(), "glTF", 4);
+  put(4, 2);
+  put(8, uint32_t(20 + text.size() + (bytes.size() - rest)));
+  put(12, uint32_t(text.size()));
+  put(16, 0x4E4F534A);  // JSON
+  return out + text + bytes.substr(rest);
 }
 
 // --- File access for tinygltf: external buffers only, through readFile's checks. ---
@@ -1068,6 +1116,8 @@ Result<Scene> loadGltfFromMemory(const std::string& bytes, const std::string& pa
           fmt::format("JSON values are nested more than {} levels deep", kMaxGltfJsonDepth)};
 
     // Step 2: tinygltf parses, with file access routed through readFile and images skipped.
+    const std::optional<std::string> rewritten = withoutDracoIndices(bytes, binary, json, jsonSize);
+    const std::string& input = rewritten ? *rewritten : bytes;
     bool follow = options.followReferences;
     tinygltf::TinyGLTF loader;
     loader.SetFsCallbacks(
@@ -1080,10 +1130,10 @@ Result<Scene> loadGltfFromMemory(const std::string& bytes, const std::string& pa
     const std::string baseDir = directoryOf(path);
     bool ok =
         binary ? loader.LoadBinaryFromMemory(&model, &err, &warn,
-                                             reinterpret_cast<const unsigned char*>(bytes.data()),
-                                             static_cast<unsigned int>(bytes.size()), baseDir)
-               : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(),
-                                            static_cast<unsigned int>(bytes.size()), baseDir);
+                                             reinterpret_cast<const unsigned char*>(input.data()),
+                                             static_cast<unsigned int>(input.size()), baseDir)
+               : loader.LoadASCIIFromString(&model, &err, &warn, input.data(),
+                                            static_cast<unsigned int>(input.size()), baseDir);
     if (!ok)
       return Error{path, "",
                    fmt::format("invalid glTF: {}", err.empty() ? "parse failed" : oneLine(err))};

@@ -215,10 +215,19 @@ void addBigFaces(const std::vector<BigFace>& big, const tinyobj::attrib_t& attri
   }
 }
 
-Scene convertObj(const tinyobj::attrib_t& attrib, const std::vector<tinyobj::shape_t>& shapes,
-                 const std::vector<tinyobj::material_t>& materials, const LoadOptions& options,
-                 const std::string& baseDir) {
-  Scene scene;
+// OBJ says nothing of sidedness, and a model's faces are often wound either way: its materials,
+// and the default one it gets where it names none, are two-sided (a single-sided default drew
+// nothing of a model that faced away from the camera).
+Material defaultObjMaterial() {
+  Material m;
+  m.name = "OBJ default";
+  m.doubleSided = true;
+  return m;
+}
+
+// The .mtl materials (colour, dissolve, illum 0, map_Kd), appended to `scene` in order.
+void convertMaterials(const std::vector<tinyobj::material_t>& materials, const LoadOptions& options,
+                      const std::string& baseDir, Scene& scene) {
   std::map<std::string, int> textureByFile;
   uint64_t texels = 0;  // LoadOptions::maxTexels
   for (const tinyobj::material_t& mtl : materials) {
@@ -229,11 +238,12 @@ Scene convertObj(const tinyobj::attrib_t& attrib, const std::vector<tinyobj::sha
     Material m{
         .name = mtl.name,
         .baseColor = {unit(channels[0]), unit(channels[1]), unit(channels[2]), unit(channels[3])},
-        .doubleSided = false,
+        .doubleSided = true,  // defaultObjMaterial says why
         // Illumination model 0 is "colour on, ambient off": a constant colour.
         .unlit = mtl.illum == 0};
     if (mtl.dissolve < 1) m.alphaMode = AlphaMode::blend;
-    // map_Kd: the diffuse colour map, a PNG relative to the OBJ's directory.
+    // map_Kd: the diffuse colour map (PNG, JPEG or SGI), relative to the OBJ's directory; a path
+    // written with Windows separators is read with '/' (core::resolvePath).
     if (!mtl.diffuse_texname.empty()) {
       auto it = textureByFile.find(mtl.diffuse_texname);
       if (it == textureByFile.end()) {
@@ -259,131 +269,161 @@ Scene convertObj(const tinyobj::attrib_t& attrib, const std::vector<tinyobj::sha
     }
     scene.materials.push_back(std::move(m));
   }
+}
 
-  const size_t nv = attrib.vertices.size() / 3;
-  const size_t nn = attrib.normals.size() / 3;
-  const size_t nt = attrib.texcoords.size() / 2;
-  // Vertex colours exist only if every "v" line had them (tinyobjloader stops collecting at the
-  // first one without).
-  const bool hasColors = nv > 0 && attrib.colors.size() == attrib.vertices.size();
+// The vertex data an OBJ's faces and lines index.
+struct Vertices {
+  const tinyobj::attrib_t& attrib;
+  size_t nv, nn, nt;
+  bool hasColors;  // every "v" line had one (tinyobjloader stops collecting at the first without)
+  Vec3 position(size_t v) const {
+    return {attrib.vertices[3 * v], attrib.vertices[3 * v + 1], attrib.vertices[3 * v + 2]};
+  }
+  Vec3 color(size_t v) const {
+    return {std::clamp(attrib.colors[3 * v], 0.0f, 1.0f),
+            std::clamp(attrib.colors[3 * v + 1], 0.0f, 1.0f),
+            std::clamp(attrib.colors[3 * v + 2], 0.0f, 1.0f)};
+  }
+};
+
+// A shape's triangles, one Mesh per material (the OBJ default where it names none), each distinct
+// corner one vertex, placed once; `triangles` counts against LoadOptions::maxTriangles.
+void convertFaces(const tinyobj::shape_t& shape, const Vertices& vs,
+                  const std::vector<tinyobj::material_t>& materials, const LoadOptions& options,
+                  uint64_t& triangles, int& defaultMaterial, Scene& scene) {
+  const tinyobj::attrib_t& attrib = vs.attrib;
+  const size_t nv = vs.nv, nn = vs.nn, nt = vs.nt;
+  const bool hasColors = vs.hasColors;
+  const tinyobj::mesh_t& m = shape.mesh;
+  if (m.num_face_vertices.size() != m.material_ids.size())
+    fail(fmt::format("shape '{}': inconsistent face data", shape.name));
+
+  // Step 1: check every corner; find which faces go to which material, and whether every corner
+  // of a material group has a normal (and texcoord): a Mesh attribute is all or nothing.
+  struct Group {
+    std::vector<size_t> faces;  // offsets of triangles into m.indices
+    bool allNormals = true, allUvs = true;
+  };
+  std::map<int, Group> groups;
+  size_t offset = 0;
+  for (size_t f = 0; f < m.num_face_vertices.size(); ++f) {
+    const size_t fv = m.num_face_vertices[f];
+    if (offset + fv > m.indices.size())
+      fail(fmt::format("shape '{}': inconsistent face data", shape.name));
+    if (fv == 3) {
+      int material = m.material_ids[f];
+      if (material < 0 || size_t(material) >= materials.size()) material = -1;
+      Group& g = groups[material];
+      for (size_t k = 0; k < 3; ++k) {
+        const tinyobj::index_t& c = m.indices[offset + k];
+        if (c.vertex_index < 0 || size_t(c.vertex_index) >= nv)
+          fail(fmt::format("shape '{}': face {} uses vertex {}, but there are {} vertices",
+                           shape.name, f + 1, c.vertex_index + 1, nv));
+        if (c.normal_index >= 0 ? size_t(c.normal_index) >= nn : c.normal_index != -1)
+          fail(fmt::format("shape '{}': face {} uses normal {}, but there are {} normals",
+                           shape.name, f + 1, c.normal_index + 1, nn));
+        if (c.texcoord_index >= 0 ? size_t(c.texcoord_index) >= nt : c.texcoord_index != -1)
+          fail(fmt::format("shape '{}': face {} uses texture coordinate {}, but there are {}",
+                           shape.name, f + 1, c.texcoord_index + 1, nt));
+        g.allNormals &= c.normal_index >= 0;
+        g.allUvs &= c.texcoord_index >= 0;
+      }
+      g.faces.push_back(offset);
+    }
+    offset += fv;  // anything but a triangle is what triangulation could not handle: skipped
+  }
+
+  // Step 2: one Mesh per group, each distinct corner one vertex.
+  for (const auto& [material, g] : groups) {
+    triangles += g.faces.size();
+    if (triangles > options.maxTriangles)
+      fail(fmt::format("the scene would have more than {} triangles", options.maxTriangles));
+    Mesh mesh;
+    mesh.name = groups.size() == 1 || material < 0
+                    ? shape.name
+                    : fmt::format("{}:{}", shape.name, materials[size_t(material)].name);
+    if (material < 0 && defaultMaterial < 0) {
+      scene.materials.push_back(defaultObjMaterial());
+      defaultMaterial = int(scene.materials.size()) - 1;
+    }
+    mesh.material = material >= 0 ? material : defaultMaterial;
+    std::unordered_map<Corner, uint32_t, CornerHash> vertexOf;
+    vertexOf.reserve(g.faces.size() * 3);
+    mesh.indices.reserve(g.faces.size() * 3);
+    for (size_t faceOffset : g.faces)
+      for (size_t k = 0; k < 3; ++k) {
+        const tinyobj::index_t& c = m.indices[faceOffset + k];
+        Corner corner{c.vertex_index, g.allNormals ? c.normal_index : -1,
+                      g.allUvs ? c.texcoord_index : -1};
+        auto [it, added] = vertexOf.try_emplace(corner, uint32_t(mesh.positions.size()));
+        if (added) {
+          const size_t v = size_t(corner.v);
+          mesh.positions.push_back(
+              {attrib.vertices[3 * v], attrib.vertices[3 * v + 1], attrib.vertices[3 * v + 2]});
+          if (hasColors)
+            mesh.colors.push_back({std::clamp(attrib.colors[3 * v], 0.0f, 1.0f),
+                                   std::clamp(attrib.colors[3 * v + 1], 0.0f, 1.0f),
+                                   std::clamp(attrib.colors[3 * v + 2], 0.0f, 1.0f), 1});
+          if (corner.vn >= 0) {
+            const size_t n = size_t(corner.vn);
+            mesh.normals.push_back(
+                {attrib.normals[3 * n], attrib.normals[3 * n + 1], attrib.normals[3 * n + 2]});
+          }
+          if (corner.vt >= 0) {
+            const size_t t = size_t(corner.vt);
+            // OBJ's v runs up from the image's bottom row; synthvis's (glTF's) runs down.
+            mesh.uvs.push_back({attrib.texcoords[2 * t], 1 - attrib.texcoords[2 * t + 1]});
+          }
+        }
+        mesh.indices.push_back(it->second);
+      }
+    scene.meshes.push_back(std::move(mesh));
+    scene.instances.push_back({int(scene.meshes.size() - 1), Mat4{}});
+  }
+}
+
+// A shape's `l` elements: polylines, each consecutive pair a line segment in the vertices' colour
+// (white without vertex colours; tinyobjloader keeps no material for lines).
+void convertLines(const tinyobj::shape_t& shape, const Vertices& vs, Scene& scene) {
+  const size_t nv = vs.nv;
+  const tinyobj::lines_t& l = shape.lines;
+  size_t at = 0;
+  for (size_t k = 0; k < l.num_line_vertices.size(); ++k) {
+    const size_t n = size_t(std::max(l.num_line_vertices[k], 0));
+    if (at + n > l.indices.size())
+      fail(fmt::format("shape '{}': inconsistent line data", shape.name));
+    if (n >= 2 && scene.lines.size() + n - 1 > kMaxLines)
+      fail(fmt::format("more than {} line segments", kMaxLines));
+    for (size_t j = 0; j < n; ++j) {
+      const int v = l.indices[at + j].vertex_index;
+      if (v < 0 || size_t(v) >= nv)
+        fail(fmt::format("shape '{}': line {} uses vertex {}, but there are {} vertices",
+                         shape.name, k + 1, v + 1, nv));
+    }
+    auto position = [&](size_t j) { return vs.position(size_t(l.indices[at + j].vertex_index)); };
+    auto color = [&](size_t j) {
+      return vs.hasColors ? vs.color(size_t(l.indices[at + j].vertex_index)) : Vec3{1, 1, 1};
+    };
+    for (size_t j = 0; j + 1 < n; ++j)
+      scene.lines.push_back({position(j), position(j + 1), (color(j) + color(j + 1)) * 0.5f});
+    at += n;
+  }
+}
+
+Scene convertObj(const tinyobj::attrib_t& attrib, const std::vector<tinyobj::shape_t>& shapes,
+                 const std::vector<tinyobj::material_t>& materials, const LoadOptions& options,
+                 const std::string& baseDir) {
+  Scene scene;
+  convertMaterials(materials, options, baseDir, scene);
+  const Vertices vs{attrib, attrib.vertices.size() / 3, attrib.normals.size() / 3,
+                    attrib.texcoords.size() / 2,
+                    attrib.vertices.size() >= 3 && attrib.colors.size() == attrib.vertices.size()};
   uint64_t triangles = 0;
   size_t points = 0;
-
+  int defaultMaterial = -1;  // made when a face needs it
   for (const tinyobj::shape_t& shape : shapes) {
-    const tinyobj::mesh_t& m = shape.mesh;
-    if (m.num_face_vertices.size() != m.material_ids.size())
-      fail(fmt::format("shape '{}': inconsistent face data", shape.name));
-
-    // Step 1: check every corner; find which faces go to which material, and whether every corner
-    // of a material group has a normal (and texcoord): a Mesh attribute is all or nothing.
-    struct Group {
-      std::vector<size_t> faces;  // offsets of triangles into m.indices
-      bool allNormals = true, allUvs = true;
-    };
-    std::map<int, Group> groups;
-    size_t offset = 0;
-    for (size_t f = 0; f < m.num_face_vertices.size(); ++f) {
-      const size_t fv = m.num_face_vertices[f];
-      if (offset + fv > m.indices.size())
-        fail(fmt::format("shape '{}': inconsistent face data", shape.name));
-      if (fv == 3) {
-        int material = m.material_ids[f];
-        if (material < 0 || size_t(material) >= materials.size()) material = -1;
-        Group& g = groups[material];
-        for (size_t k = 0; k < 3; ++k) {
-          const tinyobj::index_t& c = m.indices[offset + k];
-          if (c.vertex_index < 0 || size_t(c.vertex_index) >= nv)
-            fail(fmt::format("shape '{}': face {} uses vertex {}, but there are {} vertices",
-                             shape.name, f + 1, c.vertex_index + 1, nv));
-          if (c.normal_index >= 0 ? size_t(c.normal_index) >= nn : c.normal_index != -1)
-            fail(fmt::format("shape '{}': face {} uses normal {}, but there are {} normals",
-                             shape.name, f + 1, c.normal_index + 1, nn));
-          if (c.texcoord_index >= 0 ? size_t(c.texcoord_index) >= nt : c.texcoord_index != -1)
-            fail(fmt::format("shape '{}': face {} uses texture coordinate {}, but there are {}",
-                             shape.name, f + 1, c.texcoord_index + 1, nt));
-          g.allNormals &= c.normal_index >= 0;
-          g.allUvs &= c.texcoord_index >= 0;
-        }
-        g.faces.push_back(offset);
-      }
-      offset += fv;  // anything but a triangle is what triangulation could not handle: skipped
-    }
-
-    // Step 2: one Mesh per group, each distinct corner one vertex.
-    for (const auto& [material, g] : groups) {
-      triangles += g.faces.size();
-      if (triangles > options.maxTriangles)
-        fail(fmt::format("the scene would have more than {} triangles", options.maxTriangles));
-      Mesh mesh;
-      mesh.name = groups.size() == 1 || material < 0
-                      ? shape.name
-                      : fmt::format("{}:{}", shape.name, materials[size_t(material)].name);
-      mesh.material = material;
-      std::unordered_map<Corner, uint32_t, CornerHash> vertexOf;
-      vertexOf.reserve(g.faces.size() * 3);
-      mesh.indices.reserve(g.faces.size() * 3);
-      for (size_t faceOffset : g.faces)
-        for (size_t k = 0; k < 3; ++k) {
-          const tinyobj::index_t& c = m.indices[faceOffset + k];
-          Corner corner{c.vertex_index, g.allNormals ? c.normal_index : -1,
-                        g.allUvs ? c.texcoord_index : -1};
-          auto [it, added] = vertexOf.try_emplace(corner, uint32_t(mesh.positions.size()));
-          if (added) {
-            const size_t v = size_t(corner.v);
-            mesh.positions.push_back(
-                {attrib.vertices[3 * v], attrib.vertices[3 * v + 1], attrib.vertices[3 * v + 2]});
-            if (hasColors)
-              mesh.colors.push_back({std::clamp(attrib.colors[3 * v], 0.0f, 1.0f),
-                                     std::clamp(attrib.colors[3 * v + 1], 0.0f, 1.0f),
-                                     std::clamp(attrib.colors[3 * v + 2], 0.0f, 1.0f), 1});
-            if (corner.vn >= 0) {
-              const size_t n = size_t(corner.vn);
-              mesh.normals.push_back(
-                  {attrib.normals[3 * n], attrib.normals[3 * n + 1], attrib.normals[3 * n + 2]});
-            }
-            if (corner.vt >= 0) {
-              const size_t t = size_t(corner.vt);
-              // OBJ's v runs up from the image's bottom row; synthvis's (glTF's) runs down.
-              mesh.uvs.push_back({attrib.texcoords[2 * t], 1 - attrib.texcoords[2 * t + 1]});
-            }
-          }
-          mesh.indices.push_back(it->second);
-        }
-      scene.meshes.push_back(std::move(mesh));
-      scene.instances.push_back({int(scene.meshes.size() - 1), Mat4{}});
-    }
-
-    // `l` elements: polylines, each consecutive pair a line segment in the vertices' colour
-    // (white without vertex colours; tinyobjloader keeps no material for lines).
-    const tinyobj::lines_t& l = shape.lines;
-    size_t at = 0;
-    for (size_t k = 0; k < l.num_line_vertices.size(); ++k) {
-      const size_t n = size_t(std::max(l.num_line_vertices[k], 0));
-      if (at + n > l.indices.size())
-        fail(fmt::format("shape '{}': inconsistent line data", shape.name));
-      if (n >= 2 && scene.lines.size() + n - 1 > kMaxLines)
-        fail(fmt::format("more than {} line segments", kMaxLines));
-      for (size_t j = 0; j < n; ++j) {
-        const int v = l.indices[at + j].vertex_index;
-        if (v < 0 || size_t(v) >= nv)
-          fail(fmt::format("shape '{}': line {} uses vertex {}, but there are {} vertices",
-                           shape.name, k + 1, v + 1, nv));
-      }
-      auto position = [&](size_t j) {
-        const size_t v = size_t(l.indices[at + j].vertex_index);
-        return Vec3{attrib.vertices[3 * v], attrib.vertices[3 * v + 1], attrib.vertices[3 * v + 2]};
-      };
-      auto color = [&](size_t j) {
-        if (!hasColors) return Vec3{1, 1, 1};
-        const size_t v = size_t(l.indices[at + j].vertex_index);
-        return Vec3{std::clamp(attrib.colors[3 * v], 0.0f, 1.0f),
-                    std::clamp(attrib.colors[3 * v + 1], 0.0f, 1.0f),
-                    std::clamp(attrib.colors[3 * v + 2], 0.0f, 1.0f)};
-      };
-      for (size_t j = 0; j + 1 < n; ++j)
-        scene.lines.push_back({position(j), position(j + 1), (color(j) + color(j + 1)) * 0.5f});
-      at += n;
-    }
+    convertFaces(shape, vs, materials, options, triangles, defaultMaterial, scene);
+    convertLines(shape, vs, scene);
     points += shape.points.indices.size();
   }
   // `p` elements: named, not drawn.

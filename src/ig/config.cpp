@@ -38,11 +38,6 @@ void known(const Json& object, const char* what, std::initializer_list<const cha
   }
 }
 
-std::string directoryOf(const std::string& path) {
-  const size_t slash = path.find_last_of('/');
-  return slash == std::string::npos ? std::string() : path.substr(0, slash + 1);
-}
-
 IgConfig read(const Json& root, const std::string& path) {
   known(root, "configuration",
         {"synthvis-ig", "scene", "rate", "channels", "width", "height", "models", "origin", "port",
@@ -53,7 +48,7 @@ IgConfig read(const Json& root, const std::string& path) {
   if (!root.contains("scene") || !root["scene"].is_string() || root["scene"].get<std::string>().empty())
     bad("\"scene\": the database's file name expected");
   c.scene = root["scene"].get<std::string>();
-  if (c.scene[0] != '/') c.scene = directoryOf(path) + c.scene;
+  c.scene = core::resolvePath(core::directoryOf(path), c.scene);
   if (root.contains("rate")) c.rate = number(root["rate"], "rate", 1, 240);
   if (root.contains("width")) c.width = integer(root["width"], "width", 1, kMaxRasterSize);
   if (root.contains("height")) c.height = integer(root["height"], "height", 1, kMaxRasterSize);
@@ -87,7 +82,7 @@ IgConfig read(const Json& root, const std::string& path) {
       if (!value.is_string() || value.get<std::string>().empty())
         bad(fmt::format("models.{}: a model file name expected", key));
       std::string file = value.get<std::string>();
-      if (file[0] != '/') file = directoryOf(path) + file;
+      file = core::resolvePath(core::directoryOf(path), file);
       c.models[uint16_t(type)] = file;
     }
   }

@@ -5,11 +5,10 @@
 
 #include <fmt/format.h>
 
-#include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <string>
 
+#include "synthvis/files.h"
 #include "synthvis/result.h"
 
 namespace sv::ig {
@@ -39,14 +38,11 @@ Result<T> parseJsonInput(const std::string& text, const std::string& path, Read&
   }
 }
 
-// A JSON input file's text (at most 1 MiB: these are hand-written files).
+// A JSON input file's text, by the scene readers' rules (synthvis/files.h): a regular file only —
+// a device such as /dev/zero or a pipe is refused before anything is read — of at most 1 MiB
+// (these are hand-written files), its size checked before it is read.
 inline Result<std::string> readJsonInput(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Error{path, "", "cannot open the file"};
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (text.str().size() > (1u << 20)) return Error{path, "", "larger than 1 MiB"};
-  return text.str();
+  return core::readFile(path, uint64_t(1) << 20);
 }
 
 }  // namespace sv::ig

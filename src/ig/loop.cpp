@@ -10,6 +10,8 @@
 #include <cstdio>
 #include <cstring>
 #include <map>
+#include <nlohmann/json.hpp>
+#include <optional>
 #include <thread>
 
 #include "cigi/pcap.h"
@@ -279,40 +281,65 @@ Result<std::unique_ptr<IgLoop>> IgLoop::create(const IgConfig& config,
   return loop;
 }
 
-Result<IgRunReport> IgLoop::run() {
-  Impl& m = *impl_;
-  IgWorld& world = *m.world;
-  const double periodMs = 1000 / m.config.rate;
-  const auto period = std::chrono::duration_cast<Clock::duration>(
-      std::chrono::duration<double, std::milli>(periodMs));
-  OverloadGovernor governor(qualityLevels(m.config.render, !world.database().lodGroups.empty()),
-                            m.config.deadline * periodMs);
-  std::optional<present::TestPattern> pattern;
-  if (!m.options.testPattern.empty()) pattern = present::parseTestPattern(m.options.testPattern).value();
+// One run of the loop (IgLoop::run): what lasts from frame to frame, and each frame's steps, in
+// the order the file comment gives them.
+struct IgLoop::Session {
+  explicit Session(Impl& impl)
+      : m(impl),
+        world(*impl.world),
+        periodMs(1000 / impl.config.rate),
+        period(std::chrono::duration_cast<Clock::duration>(
+            std::chrono::duration<double, std::milli>(periodMs))),
+        governor(qualityLevels(impl.config.render, !world.database().lodGroups.empty()),
+                 impl.config.deadline * periodMs),
+        // In a job of several, this rank's channels only, whole or its part; it presents those
+        // it draws whole and the shared ones it assembles (part 0).
+        only(impl.ranks > 1 ? &impl.mine : nullptr) {
+    if (!m.options.testPattern.empty())
+      pattern = present::parseTestPattern(m.options.testPattern).value();
+  }
 
+  Impl& m;
+  IgWorld& world;
+  const double periodMs;
+  const Clock::duration period;
+  OverloadGovernor governor;
+  const std::vector<ChannelShare>* only;
+  std::optional<present::TestPattern> pattern;
   IgRunReport report;
   std::vector<double> frameMs, periodsMs, loopMs;
   std::vector<std::vector<uint8_t>> incoming;
   std::vector<cigi::Packet> replies;
-  std::vector<Image> images, enlarged;
+  std::vector<Image> images, enlarged, mineShown;
   std::vector<FrameStats> stats;
   std::vector<std::string> names;
-  std::vector<Image> mineShown;
   std::vector<uint8_t> input;
-  // In a job of several, this rank's channels only, whole or its part; it presents those it
-  // draws whole and the shared ones it assembles (part 0).
-  const std::vector<ChannelShare>* only = m.ranks > 1 ? &m.mine : nullptr;
-  const auto drawn = [&](size_t c) {
+  Clock::time_point t0;
+  bool replayEnded = false;
+
+  // Whether this rank presents channel c: it draws it whole, or assembles it (part 0).
+  bool drawn(size_t c) const {
     return !only || std::any_of(only->begin(), only->end(), [&](const ChannelShare& s) {
              return s.channel == int(c) && s.tiles.part == 0;
            });
-  };
+  }
+
+  // Each shown channel enlarged by pixel replication (a governor level drawn at a fraction of
+  // the size): `enlarged` keeps its memory from frame to frame.
+  void enlarge(int replication) {
+    enlarged.resize(images.size());
+    for (size_t c = 0; c < images.size(); ++c)
+      if (drawn(c))
+        replicate(images[c], replication, world.channels()[c].width, world.channels()[c].height,
+                  enlarged[c]);
+  }
+
   // Before the clock starts, the first frame at every quality level: once each to make the
   // renderers' threads and buffers and touch their memory (so the first timed frame is not the
   // slowest), then three rounds over all levels, whose median per level is the governor's
   // calibration — what the levels cost against each other on this machine and this database.
   // Round by round, so that a slow moment of the machine weighs on every level alike.
-  if (!pattern && m.options.governor && m.options.replay.empty()) {
+  Status calibrate() {
     const int levels = governor.levels();
     std::vector<std::vector<double>> times(static_cast<size_t>(levels));
     std::vector<double> works(static_cast<size_t>(levels));
@@ -322,17 +349,10 @@ Result<IgRunReport> IgLoop::run() {
         works[size_t(level)] = work(world.frameScene(0));
         const scene::Scene& first = world.atQuality(q.stars, q.replication);
         const Clock::time_point warm = Clock::now();
-        if (Status s =
-                m.rendererFor(level, q.options).renderChannels(first, images, &stats, only);
+        if (Status s = m.rendererFor(level, q.options).renderChannels(first, images, &stats, only);
             !s)
           return s.error();
-        if (q.replication > 1) {  // the enlargements' memory too
-          enlarged.resize(images.size());
-          for (size_t c = 0; c < images.size(); ++c)
-            if (drawn(c))
-              replicate(images[c], q.replication, world.channels()[c].width,
-                      world.channels()[c].height, enlarged[c]);
-        }
+        if (q.replication > 1) enlarge(q.replication);  // the enlargements' memory too
         if (round > 0) times[size_t(level)].push_back(msBetween(warm, Clock::now()));
       }
     for (int level = 0; level < levels; ++level) {
@@ -341,19 +361,12 @@ Result<IgRunReport> IgLoop::run() {
       std::fprintf(stderr, "synthvis ig: quality level %d (%s): %.2f ms a frame\n", level,
                    governor.at(level).change.c_str(), ms);
     }
+    return {};
   }
-  const Clock::time_point t0 = Clock::now();
-  Clock::time_point slot = t0, lastStart = t0;
-  bool replayEnded = false;
 
-  for (uint32_t frame = 0; !stop_; ++frame) {
-    if (m.options.frames && frame >= m.options.frames) break;
-    if (m.options.realtime) std::this_thread::sleep_until(slot);
-    const Clock::time_point start = Clock::now();
-    if (frame > 0) periodsMs.push_back(msBetween(lastStart, start));
-    lastStart = start;
-
-    // 1. The host's datagrams, applied in the order they came.
+  // 1. The host's datagrams, applied in the order they came; the level a replayed frame was
+  // recorded at (−1: none).
+  int receive(uint32_t frame, Clock::time_point start) {
     int recordedLevel = -1;
     if (m.rank == 0) m.hostDatagrams(frame, incoming, replayEnded, recordedLevel);
     if (m.ranks > 1) {  // rank 0's input to every rank: the state changes alike everywhere
@@ -362,7 +375,7 @@ Result<IgRunReport> IgLoop::run() {
         m.cluster->abort(fmt::format("frame {}: {}", frame, s.error().message));
       unpackInput(input, replayEnded, recordedLevel, incoming);
     }
-    if (replayEnded && incoming.empty()) break;
+    if (replayEnded && incoming.empty()) return recordedLevel;
     replies.clear();
     world.setFrame(frame);
     if (frame > 0) world.advance(periodMs / 1000);
@@ -371,7 +384,9 @@ Result<IgRunReport> IgLoop::run() {
       if (!d) {
         ++world.counts().malformed;
         if (!m.loggedMalformed)
-          std::fprintf(stderr, "synthvis ig: a malformed datagram dropped (%s); further ones are counted, not logged\n",
+          std::fprintf(stderr,
+                       "synthvis ig: a malformed datagram dropped (%s); further ones are counted, "
+                       "not logged\n",
                        d.error().str().c_str());
         m.loggedMalformed = true;
         continue;
@@ -383,10 +398,12 @@ Result<IgRunReport> IgLoop::run() {
       if (m.recording) (void)m.recorder.add({msBetween(t0, start) / 1000, true, bytes});
       world.apply(d.value(), replies);
     }
+    return recordedLevel;
+  }
 
-    // 2. The quality the deadline allows. A replay draws each frame at the level it was
-    // recorded at: the governor's choice depends on the machine's timing, the frame must not.
-    const double frameWork = work(world.frameScene(frame / m.config.rate));
+  // 2. The quality the deadline allows. A replay draws each frame at the level it was recorded
+  // at: the governor's choice depends on the machine's timing, the frame must not.
+  int chooseLevel(uint32_t frame, int recordedLevel, double frameWork) {
     int level = m.options.governor && !pattern ? governor.choose(frameWork) : 0;
     if (!m.options.replay.empty())
       level = recordedLevel >= 0 && recordedLevel < governor.levels() ? recordedLevel : 0;
@@ -397,9 +414,12 @@ Result<IgRunReport> IgLoop::run() {
       if (!worst) m.cluster->abort(worst.error().message);
       level = worst.value();
     }
+    return level;
+  }
 
-    // 3. Start of Frame and the answers, at once: the host sends its next frame on it. The IG
-    // status is the quality level (0: full quality; docs/ig.md).
+  // 3. Start of Frame and the answers: the host sends its next frame on it. The IG status is the
+  // quality level (0: full quality; docs/ig.md).
+  cigi::StartOfFrame startOfFrame(uint32_t frame, int level, Clock::time_point start) const {
     cigi::StartOfFrame sof;
     sof.igFrame = frame;
     sof.lastHostFrame = world.lastHostFrame();
@@ -407,19 +427,20 @@ Result<IgRunReport> IgLoop::run() {
     sof.igStatus = uint8_t(level);
     sof.timestampValid = true;
     sof.timestamp = uint32_t(std::llround(msBetween(t0, start) * 100));  // 10 µs ticks
-    // In a job of several it goes after the frame lock, once every rank has drawn the frame.
-    const auto answerHost = [&] {
-      replies.insert(replies.begin(), sof);
-      const std::vector<uint8_t> answer = cigi::writeDatagram(replies);
-      if (m.network && m.hostKnown) m.socket.send(answer, m.host);
-      if (m.recording) (void)m.recorder.add({msBetween(t0, start) / 1000, false, answer});
-    };
-    if (m.ranks == 1) answerHost();
+    return sof;
+  }
+  void answerHost(const cigi::StartOfFrame& sof, Clock::time_point start) {
+    replies.insert(replies.begin(), sof);
+    const std::vector<uint8_t> answer = cigi::writeDatagram(replies);
+    if (m.network && m.hostKnown) m.socket.send(answer, m.host);
+    if (m.recording) (void)m.recorder.add({msBetween(t0, start) / 1000, false, answer});
+  }
 
-    // 4. The frame.
+  // 4. The frame: every channel of this rank at `level` (or the test pattern), and what is shown
+  // — the images, or with replication their enlargements.
+  Result<std::vector<Image>*> draw(uint32_t frame, int level) {
     const QualityLevel& q = governor.at(level);
     const scene::Scene& scene = world.atQuality(q.stars, q.replication);
-    const Clock::time_point renderStart = Clock::now();
     if (pattern) {
       images.resize(scene.channels.size());
       for (size_t c = 0; c < scene.channels.size(); ++c)
@@ -433,45 +454,43 @@ Result<IgRunReport> IgLoop::run() {
         return s.error();
       }
     }
-    // What is shown: the images, or with replication their enlargements.
-    std::vector<Image>* shown = &images;
-    if (q.replication > 1) {
-      enlarged.resize(images.size());
-      for (size_t c = 0; c < images.size(); ++c)
-        if (drawn(c))
-          replicate(images[c], q.replication, world.channels()[c].width,
-                  world.channels()[c].height, enlarged[c]);
-      shown = &enlarged;
-    }
-    const double renderMs = msBetween(renderStart, Clock::now());
     names.clear();
     for (const scene::Channel& c : scene.channels) names.push_back(c.name);
-    if (m.options.overlay && !shown->empty() && drawn(0)) {
-      double vertex = 0, setup = 0, raster = 0, lights = 0;
-      for (const FrameStats& s : stats) {
-        vertex += s.vertexMs;
-        setup += s.setupMs;
-        raster += s.rasterMs;
-        lights += s.lightsMs;
-      }
-      const std::vector<std::string> lines = {
-          fmt::format("frame {}  {:.0f} Hz  render {:.1f} ms / budget {:.1f} ms", frame,
-                      m.config.rate, renderMs, governor.budgetMs()),
-          fmt::format("vertex {:.1f}  setup {:.1f}  tiles {:.1f}  lights {:.1f} ms", vertex,
-                      setup, raster, lights),
-          fmt::format("level {} ({})", level, q.change),
-          fmt::format("entities {}  datagrams {}  malformed {}  missed {}",
-                      world.activeEntities(), world.counts().datagrams, world.counts().malformed,
-                      report.missed)};
-      present::drawOverlay((*shown)[0], lines, std::max(1, (*shown)[0].height / 360));
+    if (q.replication <= 1) return &images;
+    enlarge(q.replication);
+    return &enlarged;
+  }
+
+  // The overlay on channel 0: stage times, the quality level, counts (--overlay).
+  void drawOverlay(uint32_t frame, int level, double renderMs, Image& image) const {
+    double vertex = 0, setup = 0, raster = 0, lights = 0;
+    for (const FrameStats& s : stats) {
+      vertex += s.vertexMs;
+      setup += s.setupMs;
+      raster += s.rasterMs;
+      lights += s.lightsMs;
     }
+    const std::vector<std::string> lines = {
+        fmt::format("frame {}  {:.0f} Hz  render {:.1f} ms / budget {:.1f} ms", frame,
+                    m.config.rate, renderMs, governor.budgetMs()),
+        fmt::format("vertex {:.1f}  setup {:.1f}  tiles {:.1f}  lights {:.1f} ms", vertex, setup,
+                    raster, lights),
+        fmt::format("level {} ({})", level, governor.at(level).change),
+        fmt::format("entities {}  datagrams {}  malformed {}  missed {}", world.activeEntities(),
+                    world.counts().datagrams, world.counts().malformed, report.missed)};
+    present::drawOverlay(image, lines, std::max(1, image.height / 360));
+  }
+
+  // 5. In a job of several, the frame lock — presented together, or the job ends naming the rank
+  // that did not come — then Start of Frame (rank 0), and this rank's channels by their names (an
+  // unnamed one by its index in the whole set). Then the channels presented.
+  Status present(uint32_t frame, int level, cigi::StartOfFrame& sof, Clock::time_point start,
+                 std::vector<Image>* shown) {
     if (m.ranks > 1) {
-      // The frame lock: presented together, or the job ends naming the rank that did not come.
       Result<int> worst = m.cluster->frameLock({frame, level}, m.config.rankTimeout);
       if (!worst) m.cluster->abort(worst.error().str());
       sof.igStatus = uint8_t(worst.value());
-      if (m.rank == 0) answerHost();
-      // This rank's channels, by their names (an unnamed one by its index in the whole set).
+      if (m.rank == 0) answerHost(sof, start);
       mineShown.clear();
       std::vector<std::string> mineNames;
       for (const ChannelShare& share : m.mine) {
@@ -488,58 +507,106 @@ Result<IgRunReport> IgLoop::run() {
     // Not bound to a rate, the loop waits for the writer instead of letting it drop frames.
     if (!m.options.realtime)
       if (Status s = m.presenter->flush(); !s) return s.error();
+    return {};
+  }
+
+  // 6. The frame counted, and its status line (--status): one JSON object a line.
+  void writeStatus(uint32_t frame, int level, double ms, double renderMs) {
+    uint64_t shareBytes = 0;
+    double shareMs = 0;
+    for (const FrameStats& st : stats) shareBytes += st.shareBytes, shareMs += st.shareMs;
+    // Milliseconds to the microsecond: what the clock resolves, and short lines.
+    const auto us = [](double x) { return std::round(x * 1000) / 1000; };
+    const nlohmann::ordered_json line = {{"frame", frame},
+                                         {"rank", m.rank},
+                                         {"time", std::round(frame / m.config.rate * 1e6) / 1e6},
+                                         {"ms", us(ms)},
+                                         {"renderMs", us(renderMs)},
+                                         {"shareBytes", shareBytes},
+                                         {"shareMs", us(shareMs)},
+                                         {"budgetMs", us(governor.budgetMs())},
+                                         {"level", level},
+                                         {"entities", world.activeEntities()},
+                                         {"datagrams", world.counts().datagrams},
+                                         {"malformed", world.counts().malformed},
+                                         {"rejected", world.counts().rejected},
+                                         {"missed", report.missed}};
+    const std::string text = line.dump() + "\n";
+    errno = 0;
+    if (std::fwrite(text.data(), 1, text.size(), m.status) != text.size() ||
+        std::fflush(m.status) != 0)
+      m.giveUpStatus(errno);
+  }
+
+  // The run's figures (IgRunReport), once the loop has ended.
+  Result<IgRunReport> finish() {
+    if (Status s = m.presenter->flush(); !s) return s.error();
+    report.dropped = m.presenter->dropped();
+    report.frameMsP50 = percentile(frameMs, 0.5);
+    report.frameMsP99 = percentile(frameMs, 0.99);
+    report.frameMsMax = frameMs.empty() ? 0 : *std::max_element(frameMs.begin(), frameMs.end());
+    report.periodMsP50 = percentile(periodsMs, 0.5);
+    report.periodMsP99 = percentile(periodsMs, 0.99);
+    double sum = 0;
+    for (double x : loopMs) sum += x;
+    report.loopMsMean = loopMs.empty() ? 0 : sum / double(loopMs.size());
+    report.datagrams = world.counts().datagrams;
+    report.malformed = world.counts().malformed;
+    report.rejected = world.counts().rejected;
+    return report;
+  }
+};
+
+Result<IgRunReport> IgLoop::run() {
+  Session s(*impl_);
+  const IgRunOptions& options = impl_->options;
+  if (!s.pattern && options.governor && options.replay.empty())
+    if (Status st = s.calibrate(); !st) return st.error();
+  s.t0 = Clock::now();
+  Clock::time_point slot = s.t0, lastStart = s.t0;
+  for (uint32_t frame = 0; !stop_; ++frame) {
+    if (options.frames && frame >= options.frames) break;
+    if (options.realtime) std::this_thread::sleep_until(slot);
+    const Clock::time_point start = Clock::now();
+    if (frame > 0) s.periodsMs.push_back(msBetween(lastStart, start));
+    lastStart = start;
+    const int recordedLevel = s.receive(frame, start);  // 1
+    if (s.replayEnded && s.incoming.empty()) break;
+    const double frameWork = work(s.world.frameScene(frame / impl_->config.rate));
+    const int level = s.chooseLevel(frame, recordedLevel, frameWork);  // 2
+    cigi::StartOfFrame sof = s.startOfFrame(frame, level, start);      // 3
+    // In a job of several it goes after the frame lock, once every rank has drawn the frame.
+    if (impl_->ranks == 1) s.answerHost(sof, start);
+    const Clock::time_point renderStart = Clock::now();
+    Result<std::vector<Image>*> shown = s.draw(frame, level);  // 4
+    if (!shown) return shown.error();
+    const double renderMs = msBetween(renderStart, Clock::now());
+    if (options.overlay && !shown.value()->empty() && s.drawn(0))
+      s.drawOverlay(frame, level, renderMs, (*shown.value())[0]);
+    if (Status st = s.present(frame, level, sof, start, shown.value()); !st)  // 5
+      return st.error();
+    // 6. The deadline is the whole frame's: the governor learns what a frame costs, start to
+    // shown.
     const Clock::time_point end = Clock::now();
     const double ms = msBetween(start, end);
-    // The deadline is the whole frame's: the governor learns what a frame costs, start to shown.
-    if (!pattern) governor.record(level, frameWork, ms);
-
-    frameMs.push_back(ms);
-    loopMs.push_back(ms - renderMs);
-    ++report.frames;
-    report.degraded += level > 0;
-    report.worstLevel = std::max(report.worstLevel, level);
-    report.overruns += ms > governor.budgetMs();
-    slot += period;
-    if (m.options.realtime && end > slot) {
+    if (!s.pattern) s.governor.record(level, frameWork, ms);
+    s.frameMs.push_back(ms);
+    s.loopMs.push_back(ms - renderMs);
+    ++s.report.frames;
+    s.report.degraded += level > 0;
+    s.report.worstLevel = std::max(s.report.worstLevel, level);
+    s.report.overruns += ms > s.governor.budgetMs();
+    slot += s.period;
+    if (options.realtime && end > slot) {
       // Late: this frame took its successor's slot. The schedule moves on to the next free slot;
       // no frame is queued behind.
-      ++report.missed;
-      while (slot < end) slot += period;
+      ++s.report.missed;
+      while (slot < end) slot += s.period;
     }
-    if (m.status) {
-      uint64_t shareBytes = 0;
-      double shareMs = 0;
-      for (const FrameStats& st : stats) shareBytes += st.shareBytes, shareMs += st.shareMs;
-      errno = 0;
-      const int written = std::fprintf(
-          m.status,
-          "{\"frame\":%u,\"rank\":%d,\"time\":%.6f,\"ms\":%.3f,\"renderMs\":%.3f,"
-          "\"shareBytes\":%llu,\"shareMs\":%.3f,\"budgetMs\":%.3f,\"level\":%d,"
-          "\"entities\":%zu,\"datagrams\":%llu,\"malformed\":%llu,\"rejected\":%llu,"
-          "\"missed\":%llu}\n",
-          frame, m.rank, frame / m.config.rate, ms, renderMs, (unsigned long long)shareBytes,
-          shareMs, governor.budgetMs(), level, world.activeEntities(),
-          (unsigned long long)world.counts().datagrams,
-          (unsigned long long)world.counts().malformed, (unsigned long long)world.counts().rejected,
-          (unsigned long long)report.missed);
-      if (written < 0 || std::fflush(m.status) != 0) m.giveUpStatus(errno);
-    }
-    if (m.presenter->closed()) break;
+    if (impl_->status) s.writeStatus(frame, level, ms, renderMs);
+    if (impl_->presenter->closed()) break;
   }
-  if (Status s = m.presenter->flush(); !s) return s.error();
-  report.dropped = m.presenter->dropped();
-  report.frameMsP50 = percentile(frameMs, 0.5);
-  report.frameMsP99 = percentile(frameMs, 0.99);
-  report.frameMsMax = frameMs.empty() ? 0 : *std::max_element(frameMs.begin(), frameMs.end());
-  report.periodMsP50 = percentile(periodsMs, 0.5);
-  report.periodMsP99 = percentile(periodsMs, 0.99);
-  double sum = 0;
-  for (double x : loopMs) sum += x;
-  report.loopMsMean = loopMs.empty() ? 0 : sum / double(loopMs.size());
-  report.datagrams = world.counts().datagrams;
-  report.malformed = world.counts().malformed;
-  report.rejected = world.counts().rejected;
-  return report;
+  return s.finish();
 }
 
 std::string IgRunReport::summary() const {

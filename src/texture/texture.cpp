@@ -1,16 +1,19 @@
 #include "texture/texture.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <iterator>
 
+#include "synthvis/files.h"
 #include "texture/jpeg.h"
-#include "texture/sgi.h"
 #include "texture/png.h"
+#include "texture/sgi.h"
 
 namespace sv::texture {
 
@@ -306,18 +309,21 @@ constexpr PngLimits kTextureLimits{kMaxTextureSide, kMaxTextureTexels};
 }  // namespace
 
 Result<Level> readTextureImage(const std::string& path) {
-  // A JPEG or SGI image is recognised by its first bytes (a short read; the decoder reads the whole file).
-  if (std::FILE* f = std::fopen(path.c_str(), "rb")) {
-    unsigned char magic[3] = {};
-    const size_t got = std::fread(magic, 1, 3, f);
-    std::fclose(f);
-    if (looksLikeJpeg(magic, got) || looksLikeSgi(magic, got)) {
-      std::ifstream in(path, std::ios::binary);
-      const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-      if (!in.good() && !in.eof()) return Error{path, "", "read error"};
-      return decodeTextureImage(bytes.data(), bytes.size(), path);
-    }
+  // The kind is recognised by the first bytes, whatever the name says (a short read; the decoder
+  // reads the whole file): a file that cannot be opened is named as such, not as a bad PNG.
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return Error{path, "", fmt::format("cannot open file: {}", std::strerror(errno))};
+  unsigned char magic[8] = {};
+  const size_t got = std::fread(magic, 1, sizeof magic, f);
+  std::fclose(f);
+  if (looksLikeJpeg(magic, got) || looksLikeSgi(magic, got)) {
+    Result<std::string> bytes = core::readFile(path);
+    if (!bytes) return bytes.error();
+    return decodeTextureImage(bytes->data(), bytes->size(), path);
   }
+  constexpr unsigned char kPngMagic[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+  if (got < sizeof magic || std::memcmp(magic, kPngMagic, sizeof magic) != 0)
+    return Error{path, "", "not a PNG, JPEG or SGI image"};
   auto png = readPng(path, PngLayout::rgba8OrLinear16, kTextureLimits);
   if (!png.ok()) return png.error();
   return toLevel(png.value());

@@ -156,6 +156,36 @@ TEST(Cli, WrongTypesAreReported) {
   expectOneLineError(run("render " + f + " -o " + (tempDir() / "x.png").string()), f, "background");
 }
 
+// The IG's configuration and the host's script are read by the scene readers' rules: a device is
+// refused before anything is read (`synthvis ig /dev/zero` used to read it for ever), and so is a
+// file over the inputs' 1 MiB, by its size.
+TEST(Cli, TheIgsInputsRefuseDevicesAndHugeFilesBeforeReadingThem) {
+  expectOneLineError(run("ig /dev/zero --frames 1"), "/dev/zero", "not a regular file");
+  expectOneLineError(run("host /dev/zero --frames 1"), "/dev/zero", "not a regular file");
+  const std::string huge = write("huge.json", std::string((1 << 20) + 1, ' '));
+  expectOneLineError(run("ig " + huge + " --frames 1"), huge, "file is too large");
+  expectOneLineError(run("host " + huge), huge, "file is too large");
+}
+
+// A model whose every triangle faces away from the camera renders an empty picture and says why;
+// --no-cull draws it.
+TEST(Cli, APictureEmptiedByBackFaceCullingSaysSo) {
+  const std::string scene =
+      write("away.json",
+            R"({"synthvis": 1, "camera": {"position": [0, 0, 3], "target": [0, 0, 0]},
+          "objects": [{"mesh": {"positions": [-1, -1, 0, 0, 1, 0, 1, -1, 0]}}]})");
+  const std::string out = (tempDir() / "away.png").string();
+  const CliRun culled = run("render " + scene + " -o " + out + " --width 64 --height 48");
+  EXPECT_EQ(culled.status, 0) << culled.out;
+  EXPECT_NE(culled.out.find("synthvis: warning: " + out +
+                            ": every triangle faced away from the camera and was culled"),
+            std::string::npos)
+      << culled.out;
+  const CliRun drawn = run("render " + scene + " -o " + out + " --width 64 --height 48 --no-cull");
+  EXPECT_EQ(drawn.status, 0) << drawn.out;
+  EXPECT_EQ(drawn.out.find("warning"), std::string::npos) << drawn.out;
+}
+
 TEST(Cli, MissingSceneFileAndBadOptions) {
   expectOneLineError(run("render /no/such/scene.json -o x.png"), "/no/such/scene.json", "");
   const CliRun big = run("render --width 100000 -o " + (tempDir() / "x.png").string());

@@ -538,6 +538,21 @@ TEST(Gltf, ReadsDracoCompressedPrimitives) {
     EXPECT_NEAR(m.uvs[i].x, m.positions[i].x / 4, 1e-2);
     EXPECT_NEAR(m.uvs[i].y, m.positions[i].y / 4, 1e-2);
   }
+  // With an indices accessor that has no bufferView — what Khronos' own sample (2CylinderEngine)
+  // writes, valid for a Draco primitive and once refused ("accessor[2] invalid bufferView") —
+  // the same mesh, from text and from GLB.
+  GltfBuilder withIndices = b;
+  withIndices.doc["accessors"].push_back(
+      {{"componentType", 5125}, {"count", 3 * faces}, {"type", "SCALAR"}});
+  withIndices.doc["meshes"][0]["primitives"][0]["indices"] = 2;
+  TempDir dir;
+  for (const std::string& path :
+       {dir.write("d.gltf", withIndices.gltf()), dir.write("d.glb", withIndices.glb())}) {
+    Result<Scene> r2 = loadScene(path);
+    ASSERT_TRUE(r2.ok()) << r2.error().str();
+    EXPECT_EQ(r2->meshes[0].positions, m.positions) << path;
+    EXPECT_EQ(r2->meshes[0].indices, m.indices) << path;
+  }
   // Corrupt bytes are refused with the place named.
   for (size_t i = 8; i < 24 && offset + i < b.buffer.size(); ++i) b.buffer[offset + i] = char(0xFF);
   Result<Scene> bad = load(b);

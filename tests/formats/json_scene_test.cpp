@@ -258,6 +258,23 @@ TEST(JsonScene, ObjectColourMakesOneSharedDerivedMaterial) {
   EXPECT_EQ(r->materials[size_t(r->meshes[2].material)].baseColor, (Vec4{0, 1, 0, 1}));
 }
 
+// A colour's alpha below 1 is translucency, as "opacity" is — the format's own example calls such
+// a material "glass" — on a material and on an object's colour; an alpha of 1 stays opaque, and a
+// cut-out stays a cut-out.
+TEST(JsonScene, AColoursAlphaBelowOneIsTranslucent) {
+  Result<Scene> r = parse(R"({"synthvis": 1,
+      "materials": [{"name": "glass", "color": [0.6, 0.7, 0.8, 0.5]},
+                    {"name": "solid", "color": [0.6, 0.7, 0.8, 1]},
+                    {"name": "leaf", "color": [1, 1, 1, 0.4], "alphaCutoff": 0.3}],
+      "objects": [{"primitive": "box", "material": "solid", "color": [1, 0, 0, 0.25]}]})");
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  EXPECT_EQ(r->materials[0].alphaMode, AlphaMode::blend);
+  EXPECT_FLOAT_EQ(r->materials[0].baseColor.w, 0.5f);
+  EXPECT_EQ(r->materials[1].alphaMode, AlphaMode::opaque);
+  EXPECT_EQ(r->materials[2].alphaMode, AlphaMode::mask);
+  EXPECT_EQ(r->materials[size_t(r->meshes[0].material)].alphaMode, AlphaMode::blend);
+}
+
 TEST(JsonScene, EveryPrimitiveKindLoadsWithItsParameters) {
   Result<Scene> r = parse(withObjects(R"(
       {"primitive": "box", "size": [1, 2, 3]},

@@ -162,13 +162,27 @@ TEST(Obj, TriangulatesFacesOfAnyVertexCount) {
   EXPECT_EQ(huge.error().str(), "big.obj:2: a face with 8193 vertices (the limit is 8192)");
 }
 
-TEST(Obj, MissingMaterialLibraryFallsBackToTheDefaultMaterial) {
+// Faces without a material get the OBJ's default, white and two-sided (OBJ says nothing of
+// sidedness), made once however many faces need it.
+TEST(Obj, MissingMaterialLibraryFallsBackToTheTwoSidedDefaultMaterial) {
   TempDir dir;
-  std::string path =
-      dir.write("m.obj", "mtllib nowhere.mtl\nusemtl red\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  std::string path = dir.write(
+      "m.obj",
+      "mtllib nowhere.mtl\nusemtl red\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\no b\nf 3 2 1\n");
   Result<Scene> r = loadObj(path);
   ASSERT_TRUE(r.ok()) << r.error().str();
-  EXPECT_EQ(r->meshes[0].material, -1);
+  ASSERT_EQ(r->materials.size(), 1u);
+  EXPECT_EQ(r->materials[0].name, "OBJ default");
+  EXPECT_TRUE(r->materials[0].doubleSided);
+  for (const Mesh& m : r->meshes) EXPECT_EQ(m.material, 0);
+}
+
+// A model that faces away from the camera is drawn: its .mtl materials are two-sided too.
+TEST(Obj, MaterialsAreTwoSided) {
+  Result<Scene> r = loadObj(sourcePath("scenes/house.obj"));
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  ASSERT_FALSE(r->materials.empty());
+  for (const Material& m : r->materials) EXPECT_TRUE(m.doubleSided) << m.name;
 }
 
 TEST(Obj, ReadsNoMaterialLibraryWhenReferencesAreOff) {
@@ -177,7 +191,8 @@ TEST(Obj, ReadsNoMaterialLibraryWhenReferencesAreOff) {
   Result<Scene> r = parseObj(testing::readText(sourcePath("scenes/house.obj")),
                              sourcePath("scenes/house.obj"), options);
   ASSERT_TRUE(r.ok()) << r.error().str();
-  EXPECT_TRUE(r->materials.empty());
+  ASSERT_EQ(r->materials.size(), 1u);  // the OBJ default alone
+  EXPECT_EQ(r->materials[0].name, "OBJ default");
   EXPECT_EQ(r->triangleCount(), 16u);
 }
 

@@ -2,10 +2,12 @@
 // (baseColorTexture with its sampler's wrap modes, embedded and external PNG images, alphaMode),
 // the JSON format's "textures", "fog", "pointLights", "colorTable" and material keys, OBJ's map_Kd.
 #include <gtest/gtest.h>
+#include <turbojpeg.h>
 
 #include <cmath>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include "formats/formats_test_util.h"
 #include "synthvis/image.h"
@@ -254,6 +256,41 @@ TEST(ObjTextures, MapKdIsReadAndVRunsDownTheImage) {
   ASSERT_EQ(r->meshes[0].uvs.size(), 3u);
   EXPECT_FLOAT_EQ(r->meshes[0].uvs[0].y, 1.0f);  // OBJ's v = 0 is the image's bottom row
   EXPECT_FLOAT_EQ(r->meshes[0].uvs[2].y, 0.0f);
+}
+
+// An 8 × 8 grey JPEG (libjpeg-turbo).
+std::string jpegBytes() {
+  const std::vector<unsigned char> rgb(8 * 8 * 3, 128);
+  tjhandle tj = tjInitCompress();
+  unsigned char* jpeg = nullptr;
+  unsigned long size = 0;
+  EXPECT_EQ(tjCompress2(tj, rgb.data(), 8, 0, 8, TJPF_RGB, &jpeg, &size, TJSAMP_444, 90, 0), 0);
+  std::string bytes(reinterpret_cast<char*>(jpeg), size);
+  tjFree(jpeg);
+  tjDestroy(tj);
+  return bytes;
+}
+
+// A map_Kd written with Windows separators (".\t.jpg", as exporters on Windows write it) names
+// the file beside the OBJ, as the other readers read such paths; a JPEG is read as one; and a
+// missing file is named as a file that cannot be opened, not as a PNG that cannot be read.
+TEST(ObjTextures, AWindowsPathToAJpegIsReadAndAMissingOneIsNamed) {
+  TempDir dir;
+  dir.write("t.jpg", jpegBytes());
+  dir.write("m.mtl", "newmtl tex\nKd 1 1 1\nmap_Kd .\\t.jpg\n");
+  const std::string obj =
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl tex\n"
+      "f 1/1 2/2 3/3\n";
+  Result<Scene> r = loadObj(dir.write("m.obj", "mtllib m.mtl\n" + obj));
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  ASSERT_EQ(r->textures.size(), 1u);
+  EXPECT_EQ(r->textures[0].texture->level(0).width, 8);
+  dir.write("n.mtl", "newmtl tex\nKd 1 1 1\nmap_Kd .\\gone.jpg\n");
+  Result<Scene> missing = loadObj(dir.write("n.obj", "mtllib n.mtl\n" + obj));
+  ASSERT_FALSE(missing.ok());
+  EXPECT_TRUE(contains(missing.error().str(), "gone.jpg: cannot open file"))
+      << missing.error().str();
+  EXPECT_FALSE(contains(missing.error().str(), "PNG"));
 }
 
 }  // namespace

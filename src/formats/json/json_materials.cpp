@@ -186,6 +186,9 @@ void SceneReader::readMaterials(const Json& v, const std::string& where) {
       m.alphaCutoff = inRange(*x, member(w, "alphaCutoff"), 0, 1);
       m.alphaMode = AlphaMode::mask;
     }
+    // A colour's alpha below 1 is translucency, as 'opacity' is (and as OBJ's d and glTF's
+    // BLEND are): a "glass" of alpha 0.5 must not draw opaque.
+    if (m.alphaMode == AlphaMode::opaque && m.baseColor.w < 1) m.alphaMode = AlphaMode::blend;
     scene_.materials.push_back(std::move(m));
   }
 }
@@ -221,6 +224,7 @@ int SceneReader::readObjectMaterial(const Json& object, const std::string& where
     Material m = material >= 0 ? scene_.materials[size_t(material)] : Material{};
     m.name = m.name.empty() ? std::string("color") : m.name + "+color";
     m.baseColor = c;
+    if (m.alphaMode == AlphaMode::opaque && c.w < 1) m.alphaMode = AlphaMode::blend;  // as above
     scene_.materials.push_back(std::move(m));
     material = int(scene_.materials.size() - 1);
     colorMaterials_.emplace(key, material);
