@@ -6,7 +6,7 @@ SV_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 # scripts/fresh-check proves the list there. The reference renderer links libOpenGL and libEGL
 # (libopengl-dev, libegl-dev; libgl-dev for the headers) and runs on llvmpipe (libegl-mesa0,
 # libgl1-mesa-dri); python3 is for scripts/quality and scripts/bench-masking; clang and its runtime
-# (libclang-rt-14-dev) build the libFuzzer targets (scripts/fuzz, and scripts/test builds them);
+# (libclang-rt-14-dev) build the libFuzzer targets (scripts/fuzz builds and runs them);
 # libgdal-dev is the terrain loaders' reader of DEM rasters (GeoTIFF, SRTM .hgt, …); openscenegraph's
 # osgconv is the OpenFlight tests' independent peer (it writes and reads .flt); libopenvdb-dev is the
 # volume loader's reader of OpenVDB files (and the tests' writer of them); python3-vtk9 is VTK's CPU

@@ -4,7 +4,8 @@
 // section, src/formats/json/).
 //
 // Every reader reads one file and returns a Scene or an Error naming the file and the problem.
-// None crashes, hangs or allocates without bound on malformed input (each has a fuzz target);
+// None crashes, hangs or allocates without bound on malformed input (each has a fuzz target, but
+// Assimp's, whose library runs in a child process with a time and a memory limit);
 // every limit is in docs/scene-format.md.
 #pragma once
 

@@ -1,5 +1,5 @@
 // Based on: OpenVDB's io::File and tree API (openvdb/io/File.h, Grid.h, tree/ValueAccessor.h),
-// run in a forked child (scene/openvdb_loader.h says why); the pattern of scene/assimp_loader.cpp.
+// run in a forked child (formats/openvdb_reader.h says why); the pattern of formats/assimp_reader.cpp.
 //
 // The exchange through the pipe, child to parent: 'E' and a one-line reason; or 'G', a Header, the
 // grid's name, then nx·ny·nz samples (x fastest) — written in pieces as they are densified, so

@@ -2,7 +2,7 @@
 // library in a child process: its reader is not hardened against malformed files (it may throw,
 // crash, loop or allocate without bound), so that must cost only the child, which has a time and
 // a memory limit. The child densifies the chosen grid and pipes its samples to the parent, which
-// builds the VolumeGrid (volume_loader.cpp). OpenVDB's headers stay in openvdb_loader.cpp.
+// builds the VolumeGrid (volume_files.cpp). OpenVDB's headers stay in openvdb_reader.cpp.
 #pragma once
 
 #include <cstddef>

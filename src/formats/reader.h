@@ -1,5 +1,5 @@
 // Plumbing shared by the readers: one-line messages, polygons as triangles, and the context that
-// carries limits and open files through nested loads. Files and paths are core's (core/files.h:
+// carries limits and open files through nested loads. Files and paths are core's (synthvis/files.h:
 // bounded reading, the one path helper).
 #pragma once
 

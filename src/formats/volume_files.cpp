@@ -1,6 +1,6 @@
 // Volume files (SPEC §11 voxel arrays; docs/scene-format.md "Volumes"): NIfTI-1 (.nii, .nii.gz),
 // NRRD (.nrrd with its data attached, .nhdr with a detached data file; raw or gzip encoding) and
-// OpenVDB (.vdb, through the OpenVDB library in a child process: scene/openvdb_loader.h).
+// OpenVDB (.vdb, through the OpenVDB library in a child process: formats/openvdb_reader.h).
 // Every size in a header is checked against the limits before anything is allocated, a truncated
 // file is named as such, and 8- and 16-bit data keep their exact values.
 #include <fmt/format.h>

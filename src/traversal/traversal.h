@@ -1,4 +1,4 @@
-// The traversal stage (SPEC §1 stage 1→2): which instances a view draws, and at which level of
+// The traversal stage (SPEC §1 stage 2): which instances a view draws, and at which level of
 // detail — the instance tree culled against the view volume, levels chosen by range with
 // screen-door dissolves across each switch — before any vertex is transformed. Between the
 // database and the vertex stage: it reads the scene, and the renderer calls it once a view

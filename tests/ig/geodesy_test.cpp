@@ -19,9 +19,10 @@
 namespace sv::ig {
 namespace {
 
-// A 1° × 1.3° geographic raster (EPSG:4326) north-east of (45° N, 7° E), 0.01° a sample, heights a
-// smooth function of the sample; the scene placing it by a geodetic frame at (45° N, 7° E); the
-// IG's configuration naming the scene (and no origin of its own: the database's frame is used).
+// A 1° × 1.3° geographic raster (EPSG:4326) north-east of (45° N, 7° E), 0.01° a sample, its
+// heights altitudes, a smooth function of the sample; the scene placing it by a geodetic frame at
+// (45° N, 7° E, 120 m); the IG's configuration naming the scene (and no origin of its own: the
+// database's frame is used).
 struct Database {
   tests::TempDir dir;
   static constexpr int kW = 131, kH = 101;
@@ -37,7 +38,7 @@ struct Database {
     tests::writeRaster("GTiff", dir.path("dem.tif"), kW, kH, GDT_Float64, heights, gt, 4326);
     config.scene = dir.write(
         "scene.json",
-        std::string(R"({"synthvis": 1, "geodetic": {"origin": {"lat": 45, "lon": 7, "alt": 0},)") +
+        std::string(R"({"synthvis": 1, "geodetic": {"origin": {"lat": 45, "lon": 7, "alt": 120},)") +
             R"( "curved": )" + (curved ? "true" : "false") +
             R"(}, "terrain": [{"heights": "dem.tif"}]})");
     config.port = 0;
@@ -59,9 +60,11 @@ TEST(OneEarthModel, TheTerrainAndTheIgAgreeToACentimetreAt100Km) {
     for (const auto& [i, j] : {std::pair{1, 1}, {65, 50}, {129, 1}, {1, 99}, {129, 99}}) {
       const double lat = Database::kLat0 - j * Database::kStep;
       const double lon = Database::kLon0 + i * Database::kStep;
-      const double h = t.heights->at(i, j);
+      const double h = t.heights->at(i, j);  // above the base: the world's y = 0 at 120 m
+      const double altitude = h + 120;       // the table's own value (to its quantization)
+      EXPECT_NEAR(altitude, 200 + 150 * std::sin(i * 0.07) * std::cos(j * 0.05), 0.01);
       const Vec3d terrain = caster.toWorld(i, j, h);
-      const Vec3d entity = w.earth().toWorld({lat, lon, h});
+      const Vec3d entity = w.earth().toWorld({lat, lon, altitude});
       EXPECT_LT(length(terrain - entity), 0.01) << i << ", " << j;
       if (i == 129 && j == 1) {
         EXPECT_GT(entity.x, 1.0e5);
@@ -71,7 +74,7 @@ TEST(OneEarthModel, TheTerrainAndTheIgAgreeToACentimetreAt100Km) {
       cigi::HatHotRequest hot;
       hot.id = uint16_t(i + j);
       hot.type = cigi::HatHotType::hot;
-      hot.latOrX = lat, hot.lonOrY = lon, hot.altOrZ = h + 50;
+      hot.latOrX = lat, hot.lonOrY = lon, hot.altOrZ = altitude + 50;
       cigi::Datagram d;
       d.packets = {cigi::IgControl{}, hot};
       std::vector<cigi::Packet> replies;
@@ -79,7 +82,7 @@ TEST(OneEarthModel, TheTerrainAndTheIgAgreeToACentimetreAt100Km) {
       ASSERT_EQ(replies.size(), 1u);
       const auto& r = std::get<cigi::HatHotResponse>(replies[0]);
       ASSERT_TRUE(r.valid);
-      EXPECT_NEAR(r.height, h, 0.01) << i << ", " << j;
+      EXPECT_NEAR(r.height, altitude, 0.01) << i << ", " << j;
     }
   }
 }
@@ -92,7 +95,7 @@ TEST(OneEarthModel, AConfigurationOriginOtherThanTheDatabasesIsRefused) {
   const Result<IgWorld> w = IgWorld::load(db.config);
   ASSERT_FALSE(w.ok());
   EXPECT_EQ(w.error().str(), db.config.scene +
-                                 ": the database's geodetic origin (45, 7, 0) is not the "
+                                 ": the database's geodetic origin (45, 7, 120) is not the "
                                  "configuration's origin (45, 7.5, 0)");
 }
 

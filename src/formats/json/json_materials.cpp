@@ -53,7 +53,7 @@ void SceneReader::readTextures(const Json& v, const std::string& where) {
     if (const Json* x = find(v[i], "name")) map.name = string(*x, member(w, "name"));
     const Json* file = find(v[i], "file");
     const Json* generate = find(v[i], "generate");
-    if (!file == !generate) fail(w, "give either 'file' (a PNG) or 'generate' (a pattern)");
+    if (!file == !generate) fail(w, "give either 'file' (a PNG, JPEG or SGI image) or 'generate' (a pattern)");
     texture::Wrap wrap[2] = {texture::Wrap::repeat, texture::Wrap::repeat};
     if (const Json* x = find(v[i], "wrap")) {
       std::string ww = member(w, "wrap");

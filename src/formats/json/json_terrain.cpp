@@ -28,6 +28,9 @@ void SceneReader::readTerrain(const Json& v, const std::string& where) {
   // table centred on it unless the scene says where.
   const bool framed = scene_.geodetic && f.geographic.on;
   if (framed) placeGeographic(f.geographic, scene_.geodetic->frame(), f);
+  // Under a geodetic frame a table's heights are altitudes, and the world's y = 0 is the frame
+  // origin's altitude: the IG's geodetic positions and the ground then agree (GeoFrame::toWorld).
+  if (scene_.geodetic) f.offset -= scene_.geodetic->origin.alt;
   t.origin[0] = framed ? 0 : 0.5 * (f.originU + f.eastU());
   t.origin[1] = framed ? 0 : 0.5 * (f.originV + f.southV());
   if (const Json* x = find(v, "origin")) {
