@@ -56,23 +56,26 @@ std::vector<double> columnMajor(const Mat4& m) {
   return v;
 }
 
-}  // namespace
+// The bounds the specification requires on a POSITION accessor.
+void setBounds(tinygltf::Model& model, int accessor, Vec3 lo, Vec3 hi) {
+  model.accessors[size_t(accessor)].minValues = {lo.x, lo.y, lo.z};
+  model.accessors[size_t(accessor)].maxValues = {hi.x, hi.y, hi.z};
+}
 
-Status saveGltf(const Scene& scene, const std::string& path) {
-  if (Status s = validate(scene, path); !s) return s;
-  const bool binary = path.size() >= 4 && path.compare(path.size() - 4, 4, ".glb") == 0;
-  const bool text = path.size() >= 5 && path.compare(path.size() - 5, 5, ".gltf") == 0;
-  if (!binary && !text) return Error{path, "", "the file name must end in .glb or .gltf"};
-  if (!scene.freeForms.empty())
-    return Error{path, "",
-                 fmt::format("glTF holds triangles: the scene's {} free forms cannot be written "
-                             "(render or bench them directly)",
-                             scene.freeForms.size())};
+// Appends `node` to the model and to the scene's root nodes.
+void addRootNode(tinygltf::Model& model, tinygltf::Scene& root, tinygltf::Node node) {
+  model.nodes.push_back(std::move(node));
+  root.nodes.push_back(int(model.nodes.size()) - 1);
+}
 
-  tinygltf::Model model;
-  model.asset.version = "2.0";
-  model.asset.generator = "synthvis";
-  model.buffers.resize(1);
+int gltfWrap(texture::Wrap w) {
+  return w == texture::Wrap::clamp    ? TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE
+         : w == texture::Wrap::mirror ? TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT
+                                      : TINYGLTF_TEXTURE_WRAP_REPEAT;
+}
+
+// Texture i as image i (its level 0 as a PNG in the buffer), sampler i and texture i.
+Status addTextures(const Scene& scene, const std::string& path, tinygltf::Model& model) {
   for (size_t i = 0; i < scene.textures.size(); ++i) {
     const texture::Texture& t = *scene.textures[i].texture;
     auto png = texture::encodeTexturePng(t.level(0), path);
@@ -89,14 +92,9 @@ Status saveGltf(const Scene& scene, const std::string& path) {
     image.mimeType = "image/png";
     image.bufferView = int(model.bufferViews.size()) - 1;
     model.images.push_back(image);
-    auto wrap = [](texture::Wrap w) {
-      return w == texture::Wrap::clamp    ? TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE
-             : w == texture::Wrap::mirror ? TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT
-                                          : TINYGLTF_TEXTURE_WRAP_REPEAT;
-    };
     tinygltf::Sampler sampler;
-    sampler.wrapS = wrap(t.wrapX());
-    sampler.wrapT = wrap(t.wrapY());
+    sampler.wrapS = gltfWrap(t.wrapX());
+    sampler.wrapT = gltfWrap(t.wrapY());
     sampler.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
     sampler.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR;
     model.samplers.push_back(sampler);
@@ -105,6 +103,11 @@ Status saveGltf(const Scene& scene, const std::string& path) {
     texture.sampler = int(i);
     model.textures.push_back(texture);
   }
+  return {};
+}
+
+// Material i as material i; KHR_materials_unlit declared when one uses it.
+void addMaterials(const Scene& scene, tinygltf::Model& model) {
   bool unlitUsed = false;
   for (const Material& m : scene.materials) {
     tinygltf::Material out;
@@ -126,7 +129,11 @@ Status saveGltf(const Scene& scene, const std::string& path) {
     model.materials.push_back(out);
   }
   if (unlitUsed) model.extensionsUsed.push_back("KHR_materials_unlit");
+}
 
+// Mesh i as glTF mesh i: one triangle primitive of its arrays, the UVs times the material's
+// uvScale.
+void addMeshes(const Scene& scene, tinygltf::Model& model) {
   for (const Mesh& m : scene.meshes) {
     tinygltf::Primitive prim;
     prim.mode = TINYGLTF_MODE_TRIANGLES;
@@ -134,10 +141,8 @@ Status saveGltf(const Scene& scene, const std::string& path) {
     const int pos =
         addAccessor(model, m.positions.data(), m.positions.size(), sizeof(Vec3), TINYGLTF_TYPE_VEC3,
                     TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
-    // The specification requires bounds on POSITION.
     const auto [lo, hi] = m.bounds();
-    model.accessors[size_t(pos)].minValues = {lo.x, lo.y, lo.z};
-    model.accessors[size_t(pos)].maxValues = {hi.x, hi.y, hi.z};
+    setBounds(model, pos, lo, hi);
     prim.attributes["POSITION"] = pos;
     if (!m.normals.empty())
       prim.attributes["NORMAL"] =
@@ -163,49 +168,55 @@ Status saveGltf(const Scene& scene, const std::string& path) {
     out.primitives.push_back(prim);
     model.meshes.push_back(out);
   }
+}
 
-  tinygltf::Scene root;
+// Each instance as a root node of its mesh and matrix.
+void addInstances(const Scene& scene, tinygltf::Model& model, tinygltf::Scene& root) {
   for (const Instance& inst : scene.instances) {
     tinygltf::Node node;
     node.mesh = inst.mesh;
     node.matrix = columnMajor(inst.transform);
-    model.nodes.push_back(node);
-    root.nodes.push_back(int(model.nodes.size()) - 1);
+    addRootNode(model, root, std::move(node));
   }
-  // The lines: one LINES primitive in world coordinates, each segment's colour on both its ends.
-  if (!scene.lines.empty()) {
-    std::vector<Vec3> positions;
-    std::vector<Vec4> colors;
-    for (const LineSegment& l : scene.lines) {
-      positions.insert(positions.end(), {l.a, l.b});
-      const Vec4 c{l.color.x, l.color.y, l.color.z, 1};
-      colors.insert(colors.end(), {c, c});
-    }
-    tinygltf::Primitive prim;
-    prim.mode = TINYGLTF_MODE_LINE;
-    const int pos =
-        addAccessor(model, positions.data(), positions.size(), sizeof(Vec3), TINYGLTF_TYPE_VEC3,
-                    TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
-    Vec3 lo = positions[0], hi = positions[0];
-    for (const Vec3& p : positions) {
-      lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
-      hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
-    }
-    model.accessors[size_t(pos)].minValues = {lo.x, lo.y, lo.z};
-    model.accessors[size_t(pos)].maxValues = {hi.x, hi.y, hi.z};
-    prim.attributes["POSITION"] = pos;
-    prim.attributes["COLOR_0"] =
-        addAccessor(model, colors.data(), colors.size(), sizeof(Vec4), TINYGLTF_TYPE_VEC4,
-                    TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
-    tinygltf::Mesh lines;
-    lines.name = "lines";
-    lines.primitives.push_back(prim);
-    model.meshes.push_back(lines);
-    tinygltf::Node node;
-    node.mesh = int(model.meshes.size()) - 1;
-    model.nodes.push_back(node);
-    root.nodes.push_back(int(model.nodes.size()) - 1);
+}
+
+// The lines: one LINES primitive in world coordinates, each segment's colour on both its ends,
+// as a mesh of its own under a root node.
+void addLines(const Scene& scene, tinygltf::Model& model, tinygltf::Scene& root) {
+  if (scene.lines.empty()) return;
+  std::vector<Vec3> positions;
+  std::vector<Vec4> colors;
+  for (const LineSegment& l : scene.lines) {
+    positions.insert(positions.end(), {l.a, l.b});
+    const Vec4 c{l.color.x, l.color.y, l.color.z, 1};
+    colors.insert(colors.end(), {c, c});
   }
+  tinygltf::Primitive prim;
+  prim.mode = TINYGLTF_MODE_LINE;
+  const int pos =
+      addAccessor(model, positions.data(), positions.size(), sizeof(Vec3), TINYGLTF_TYPE_VEC3,
+                  TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
+  Vec3 lo = positions[0], hi = positions[0];
+  for (const Vec3& p : positions) {
+    lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+    hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+  }
+  setBounds(model, pos, lo, hi);
+  prim.attributes["POSITION"] = pos;
+  prim.attributes["COLOR_0"] =
+      addAccessor(model, colors.data(), colors.size(), sizeof(Vec4), TINYGLTF_TYPE_VEC4,
+                  TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
+  tinygltf::Mesh lines;
+  lines.name = "lines";
+  lines.primitives.push_back(prim);
+  model.meshes.push_back(lines);
+  tinygltf::Node node;
+  node.mesh = int(model.meshes.size()) - 1;
+  addRootNode(model, root, std::move(node));
+}
+
+// Each camera as a perspective camera under a root node of its camera-to-world matrix.
+void addCameras(const Scene& scene, tinygltf::Model& model, tinygltf::Scene& root) {
   for (const Camera& c : scene.cameras) {
     tinygltf::Camera cam;
     cam.type = "perspective";
@@ -227,9 +238,36 @@ Status saveGltf(const Scene& scene, const std::string& path) {
     node.name = c.name;
     node.camera = int(model.cameras.size()) - 1;
     node.matrix = columnMajor(m);
-    model.nodes.push_back(node);
-    root.nodes.push_back(int(model.nodes.size()) - 1);
+    addRootNode(model, root, std::move(node));
   }
+}
+
+}  // namespace
+
+Status saveGltf(const Scene& scene, const std::string& path) {
+  if (Status s = validate(scene, path); !s) return s;
+  const bool binary = path.size() >= 4 && path.compare(path.size() - 4, 4, ".glb") == 0;
+  const bool text = path.size() >= 5 && path.compare(path.size() - 5, 5, ".gltf") == 0;
+  if (!binary && !text) return Error{path, "", "the file name must end in .glb or .gltf"};
+  if (!scene.freeForms.empty())
+    return Error{path, "",
+                 fmt::format("glTF holds triangles: the scene's {} free forms cannot be written "
+                             "(render or bench them directly)",
+                             scene.freeForms.size())};
+
+  // The model, in the order the indices between its parts assume: textures before the
+  // materials naming them, meshes before the nodes placing them.
+  tinygltf::Model model;
+  model.asset.version = "2.0";
+  model.asset.generator = "synthvis";
+  model.buffers.resize(1);
+  if (Status s = addTextures(scene, path, model); !s) return s;
+  addMaterials(scene, model);
+  addMeshes(scene, model);
+  tinygltf::Scene root;
+  addInstances(scene, model, root);
+  addLines(scene, model, root);
+  addCameras(scene, model, root);
   model.scenes.push_back(root);
   model.defaultScene = 0;
   model.buffers[0].uri.clear();

@@ -371,9 +371,10 @@ std::string encode(const Scene& s) {
   return std::move(w.out);
 }
 
-Scene decode(const char* data, size_t size, const LoadOptions& options) {
-  Reader r(data, size);
-  Scene s;
+// --- The scene's other records, read back (encode writes them in line) ---------------------------
+
+// The background, the light, the fog, the time and the geodetic frame.
+void getEnvironment(Reader& r, Scene& s) {
   s.background = r.pod<Vec3>("background");
   s.light.direction = r.pod<Vec3>("light"), s.light.color = r.pod<Vec3>("light");
   s.light.ambient = r.pod<float>("light"), s.light.enabled = r.pod<uint8_t>("light");
@@ -390,135 +391,169 @@ Scene decode(const char* data, size_t size, const LoadOptions& options) {
       fail("the geodetic frame's origin is not finite or out of range");
     s.geodetic = g;
   }
-  uint64_t texels = 0;
-  for (size_t k = r.count("textures", 24); k > 0; --k) {
-    TextureMap t;
-    t.name = r.str("texture");
-    const int32_t width = r.pod<int32_t>("texture"), height = r.pod<int32_t>("texture");
-    const auto wx = r.pod<texture::Wrap>("texture"), wy = r.pod<texture::Wrap>("texture");
-    if (width < 1 || height < 1 || width > texture::kMaxTextureSide ||
-        height > texture::kMaxTextureSide || uint8_t(wx) > 2 || uint8_t(wy) > 2)
-      fail(fmt::format("texture '{}': size {}×{} or wrap modes out of range", t.name, width,
-                       height));
-    std::vector<texture::PackedTexel> pyramid = r.array<texture::PackedTexel>("texture texels");
-    if (pyramid.size() != texture::Texture::pyramidTexels(width, height))
-      fail(fmt::format("texture '{}': {} texels for a {}×{} pyramid", t.name, pyramid.size(), width,
-                       height));
-    texels += uint64_t(width) * uint64_t(height);
-    if (texels > options.maxTexels)
-      fail(fmt::format("the textures exceed {} texels", options.maxTexels));
-    t.texture = std::make_shared<texture::Texture>(width, height, wx, wy, std::move(pyramid));
-    s.textures.push_back(std::move(t));
+}
+
+// A texture and its pyramid; its level 0 counted into `texels` against the options' limit.
+TextureMap getTexture(Reader& r, uint64_t& texels, const LoadOptions& options) {
+  TextureMap t;
+  t.name = r.str("texture");
+  const int32_t width = r.pod<int32_t>("texture"), height = r.pod<int32_t>("texture");
+  const auto wx = r.pod<texture::Wrap>("texture"), wy = r.pod<texture::Wrap>("texture");
+  if (width < 1 || height < 1 || width > texture::kMaxTextureSide ||
+      height > texture::kMaxTextureSide || uint8_t(wx) > 2 || uint8_t(wy) > 2)
+    fail(fmt::format("texture '{}': size {}×{} or wrap modes out of range", t.name, width, height));
+  std::vector<texture::PackedTexel> pyramid = r.array<texture::PackedTexel>("texture texels");
+  if (pyramid.size() != texture::Texture::pyramidTexels(width, height))
+    fail(fmt::format("texture '{}': {} texels for a {}×{} pyramid", t.name, pyramid.size(), width,
+                     height));
+  texels += uint64_t(width) * uint64_t(height);
+  if (texels > options.maxTexels)
+    fail(fmt::format("the textures exceed {} texels", options.maxTexels));
+  t.texture = std::make_shared<texture::Texture>(width, height, wx, wy, std::move(pyramid));
+  return t;
+}
+
+Mesh getMesh(Reader& r) {
+  Mesh m;
+  m.name = r.str("mesh"), m.material = r.pod<int32_t>("mesh");
+  m.positions = r.array<Vec3>("positions"), m.normals = r.array<Vec3>("normals");
+  m.colors = r.array<Vec4>("colors"), m.uvs = r.array<Vec2>("uvs");
+  m.indices = r.array<uint32_t>("indices");
+  return m;
+}
+
+Instance getInstance(Reader& r) {
+  Instance i;
+  i.mesh = r.pod<int32_t>("instance"), i.transform = r.pod<Mat4>("instance");
+  i.priority = r.pod<int32_t>("instance"), i.lod = r.pod<int32_t>("instance");
+  i.visible = r.pod<uint8_t>("instance"), i.articulated = r.pod<uint8_t>("instance");
+  return i;
+}
+
+LodGroup getLodGroup(Reader& r) {
+  LodGroup g;
+  g.name = r.str("LOD group"), g.fade = r.pod<float>("LOD group");
+  const bool centred = r.pod<uint8_t>("LOD group");
+  const Vec3 c = r.pod<Vec3>("LOD group");
+  if (centred) g.center = c;
+  g.levels = r.array<LodLevel>("LOD levels");
+  return g;
+}
+
+Switch getSwitch(Reader& r) {
+  Switch sw;
+  sw.name = r.str("switch"), sw.current = size_t(r.pod<uint64_t>("switch"));
+  for (size_t c = r.count("switch children", 8); c > 0; --c)
+    sw.children.push_back(r.array<uint32_t>("switch child"));
+  for (size_t m = r.count("switch masks", 8); m > 0; --m) {
+    const std::vector<uint8_t> flags = r.array<uint8_t>("switch mask");
+    sw.masks.emplace_back(flags.begin(), flags.end());
   }
+  return sw;
+}
+
+Dof getDof(Reader& r) {
+  Dof d;
+  d.name = r.str("dof"), d.parent = r.pod<int32_t>("dof");
+  d.place = r.pod<Mat4>("dof"), d.frame = r.pod<Mat4>("dof");
+  d.current = getMotion(r), d.min = getMotion(r), d.max = getMotion(r);
+  const std::vector<uint32_t> parts = r.array<uint32_t>("dof parts");
+  const std::vector<Mat4> transforms = r.array<Mat4>("dof parts");
+  if (parts.size() != transforms.size()) fail("dof: parts and transforms differ in number");
+  for (size_t i = 0; i < parts.size(); ++i) d.parts.push_back({parts[i], transforms[i]});
+  return d;
+}
+
+// The instance tree over `instances` instances, every index checked in range so that a
+// traversal of a damaged tree stays inside its arrays.
+std::shared_ptr<InstanceTree> getInstanceTree(Reader& r, size_t instances) {
+  auto tree = std::make_shared<InstanceTree>();
+  tree->nodes = r.array<InstanceTree::Node>("instance tree nodes");
+  tree->order = r.array<uint32_t>("instance tree order");
+  tree->loose = r.array<uint32_t>("instance tree loose");
+  tree->instanceCount = size_t(r.pod<uint64_t>("instance tree"));
+  for (const InstanceTree::Node& n : tree->nodes)
+    if ((n.count > 0 && (n.first > tree->order.size() || n.count > tree->order.size() - n.first)) ||
+        (n.count == 0 &&
+         (n.first + 1ull >= tree->nodes.size() || n.first <= size_t(&n - tree->nodes.data()))))
+      fail("instance tree: a node's range is out of bounds");
+  for (uint32_t i : tree->order)
+    if (i >= instances) fail("instance tree: an instance out of range");
+  for (uint32_t i : tree->loose)
+    if (i >= instances) fail("instance tree: an instance out of range");
+  return tree;
+}
+
+FreeFormObject getFreeFormObject(Reader& r) {
+  FreeFormObject f;
+  f.name = r.str("free form"), f.form = getFreeForm(r, 0);
+  f.transform = r.pod<Mat4>("free form"), f.material = r.pod<int32_t>("free form");
+  return f;
+}
+
+Camera getCamera(Reader& r) {
+  Camera c;
+  c.name = r.str("camera"), c.position = r.pod<Vec3>("camera"), c.target = r.pod<Vec3>("camera");
+  c.up = r.pod<Vec3>("camera"), c.yfovDegrees = r.pod<float>("camera");
+  c.znear = r.pod<float>("camera"), c.zfar = r.pod<float>("camera");
+  return c;
+}
+
+Channel getChannel(Reader& r) {
+  Channel c;
+  c.name = r.str("channel"), c.yawDegrees = r.pod<float>("channel");
+  c.pitchDegrees = r.pod<float>("channel"), c.rollDegrees = r.pod<float>("channel");
+  c.offset = r.pod<Vec3>("channel");
+  const bool framed = r.pod<uint8_t>("channel");
+  const ChannelFrustum f = r.pod<ChannelFrustum>("channel");
+  if (framed) c.frustum = f;
+  c.width = r.pod<int32_t>("channel"), c.height = r.pod<int32_t>("channel");
+  return c;
+}
+
+LightGroup getLightGroup(Reader& r) {
+  LightGroup g;
+  g.name = r.str("light group"), g.on = r.pod<uint8_t>("light group");
+  g.dim = r.pod<float>("light group");
+  return g;
+}
+
+// The payload as encode wrote it, record by record, each count bounded by the bytes left (at
+// least the record's smallest size each).
+Scene decode(const char* data, size_t size, const LoadOptions& options) {
+  Reader r(data, size);
+  Scene s;
+  getEnvironment(r, s);
+  uint64_t texels = 0;
+  for (size_t k = r.count("textures", 24); k > 0; --k)
+    s.textures.push_back(getTexture(r, texels, options));
   for (size_t k = r.count("materials", 40); k > 0; --k) s.materials.push_back(getMaterial(r));
   uint64_t triangles = 0;
   for (size_t k = r.count("meshes", 48); k > 0; --k) {
-    Mesh m;
-    m.name = r.str("mesh"), m.material = r.pod<int32_t>("mesh");
-    m.positions = r.array<Vec3>("positions"), m.normals = r.array<Vec3>("normals");
-    m.colors = r.array<Vec4>("colors"), m.uvs = r.array<Vec2>("uvs");
-    m.indices = r.array<uint32_t>("indices");
+    s.meshes.push_back(getMesh(r));
     // The limit counts the triangles stored (its meshes'), not their placements: a database of
     // instances and levels of detail stands for far more than it holds.
-    triangles += m.triangleCount();
-    s.meshes.push_back(std::move(m));
+    triangles += s.meshes.back().triangleCount();
   }
-  for (size_t k = r.count("instances", 78); k > 0; --k) {
-    Instance i;
-    i.mesh = r.pod<int32_t>("instance"), i.transform = r.pod<Mat4>("instance");
-    i.priority = r.pod<int32_t>("instance"), i.lod = r.pod<int32_t>("instance");
-    i.visible = r.pod<uint8_t>("instance"), i.articulated = r.pod<uint8_t>("instance");
-    s.instances.push_back(i);
-  }
+  for (size_t k = r.count("instances", 78); k > 0; --k) s.instances.push_back(getInstance(r));
   if (triangles > options.maxTriangles)
     fail(fmt::format("more than {} triangles", options.maxTriangles));
-  for (size_t k = r.count("LOD groups", 25); k > 0; --k) {
-    LodGroup g;
-    g.name = r.str("LOD group"), g.fade = r.pod<float>("LOD group");
-    const bool centred = r.pod<uint8_t>("LOD group");
-    const Vec3 c = r.pod<Vec3>("LOD group");
-    if (centred) g.center = c;
-    g.levels = r.array<LodLevel>("LOD levels");
-    s.lodGroups.push_back(std::move(g));
-  }
-  for (size_t k = r.count("switches", 28); k > 0; --k) {
-    Switch sw;
-    sw.name = r.str("switch"), sw.current = size_t(r.pod<uint64_t>("switch"));
-    for (size_t c = r.count("switch children", 8); c > 0; --c)
-      sw.children.push_back(r.array<uint32_t>("switch child"));
-    for (size_t m = r.count("switch masks", 8); m > 0; --m) {
-      const std::vector<uint8_t> flags = r.array<uint8_t>("switch mask");
-      sw.masks.emplace_back(flags.begin(), flags.end());
-    }
-    s.switches.push_back(std::move(sw));
-  }
-  for (size_t k = r.count("degrees of freedom", 250); k > 0; --k) {
-    Dof d;
-    d.name = r.str("dof"), d.parent = r.pod<int32_t>("dof");
-    d.place = r.pod<Mat4>("dof"), d.frame = r.pod<Mat4>("dof");
-    d.current = getMotion(r), d.min = getMotion(r), d.max = getMotion(r);
-    const std::vector<uint32_t> parts = r.array<uint32_t>("dof parts");
-    const std::vector<Mat4> transforms = r.array<Mat4>("dof parts");
-    if (parts.size() != transforms.size()) fail("dof: parts and transforms differ in number");
-    for (size_t i = 0; i < parts.size(); ++i) d.parts.push_back({parts[i], transforms[i]});
-    s.dofs.push_back(std::move(d));
-  }
-  if (r.pod<uint8_t>("instance tree")) {
-    auto tree = std::make_shared<InstanceTree>();
-    tree->nodes = r.array<InstanceTree::Node>("instance tree nodes");
-    tree->order = r.array<uint32_t>("instance tree order");
-    tree->loose = r.array<uint32_t>("instance tree loose");
-    tree->instanceCount = size_t(r.pod<uint64_t>("instance tree"));
-    // Every index in range, so that a traversal of a damaged tree stays inside its arrays.
-    for (const InstanceTree::Node& n : tree->nodes)
-      if ((n.count > 0 &&
-           (n.first > tree->order.size() || n.count > tree->order.size() - n.first)) ||
-          (n.count == 0 &&
-           (n.first + 1ull >= tree->nodes.size() || n.first <= size_t(&n - tree->nodes.data()))))
-        fail("instance tree: a node's range is out of bounds");
-    for (uint32_t i : tree->order)
-      if (i >= s.instances.size()) fail("instance tree: an instance out of range");
-    for (uint32_t i : tree->loose)
-      if (i >= s.instances.size()) fail("instance tree: an instance out of range");
-    s.instanceTree = std::move(tree);
-  }
+  for (size_t k = r.count("LOD groups", 25); k > 0; --k) s.lodGroups.push_back(getLodGroup(r));
+  for (size_t k = r.count("switches", 28); k > 0; --k) s.switches.push_back(getSwitch(r));
+  for (size_t k = r.count("degrees of freedom", 250); k > 0; --k) s.dofs.push_back(getDof(r));
+  if (r.pod<uint8_t>("instance tree")) s.instanceTree = getInstanceTree(r, s.instances.size());
   const size_t terrains = r.count("terrains", 120);
   if (terrains > 64) fail(fmt::format("{} terrains (at most 64)", terrains));
   for (size_t k = 0; k < terrains; ++k) s.terrains.push_back(getTerrain(r, s, texels, options));
-  for (size_t k = r.count("free forms", 100); k > 0; --k) {
-    FreeFormObject f;
-    f.name = r.str("free form"), f.form = getFreeForm(r, 0);
-    f.transform = r.pod<Mat4>("free form"), f.material = r.pod<int32_t>("free form");
-    s.freeForms.push_back(std::move(f));
-  }
-  for (size_t k = r.count("cameras", 52); k > 0; --k) {
-    Camera c;
-    c.name = r.str("camera"), c.position = r.pod<Vec3>("camera"), c.target = r.pod<Vec3>("camera");
-    c.up = r.pod<Vec3>("camera"), c.yfovDegrees = r.pod<float>("camera");
-    c.znear = r.pod<float>("camera"), c.zfar = r.pod<float>("camera");
-    s.cameras.push_back(std::move(c));
-  }
-  for (size_t k = r.count("channels", 53); k > 0; --k) {
-    Channel c;
-    c.name = r.str("channel"), c.yawDegrees = r.pod<float>("channel");
-    c.pitchDegrees = r.pod<float>("channel"), c.rollDegrees = r.pod<float>("channel");
-    c.offset = r.pod<Vec3>("channel");
-    const bool framed = r.pod<uint8_t>("channel");
-    const ChannelFrustum f = r.pod<ChannelFrustum>("channel");
-    if (framed) c.frustum = f;
-    c.width = r.pod<int32_t>("channel"), c.height = r.pod<int32_t>("channel");
-    s.channels.push_back(std::move(c));
-  }
+  for (size_t k = r.count("free forms", 100); k > 0; --k)
+    s.freeForms.push_back(getFreeFormObject(r));
+  for (size_t k = r.count("cameras", 52); k > 0; --k) s.cameras.push_back(getCamera(r));
+  for (size_t k = r.count("channels", 53); k > 0; --k) s.channels.push_back(getChannel(r));
   s.pointLights = r.array<PointLight>("point lights");
   for (size_t k = r.count("light appearances", 90); k > 0; --k)
     s.lightAppearances.push_back(getAppearance(r));
   s.lightPoints = r.array<LightPoint>("light points");
-  for (size_t k = r.count("light groups", 9); k > 0; --k) {
-    LightGroup g;
-    g.name = r.str("light group"), g.on = r.pod<uint8_t>("light group");
-    g.dim = r.pod<float>("light group");
-    s.lightGroups.push_back(std::move(g));
-  }
+  for (size_t k = r.count("light groups", 9); k > 0; --k) s.lightGroups.push_back(getLightGroup(r));
   s.stars.stars = r.array<Star>("stars");
   s.stars.latitude = r.pod<float>("stars"), s.stars.siderealTime = r.pod<float>("stars");
   s.stars.brightness = r.pod<float>("stars"), s.stars.limit = r.pod<float>("stars");

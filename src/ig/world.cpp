@@ -130,6 +130,136 @@ void IgWorld::apply(const cigi::Datagram& datagram, std::vector<cigi::Packet>& r
   }
 }
 
+void IgWorld::applyEntityControl(const cigi::EntityControl& ec) {
+  const double v[3] = {ec.latOrX, ec.lonOrY, ec.altOrZ};
+  if (ec.entity >= entities_.size() || !finite3(v) || !std::isfinite(ec.roll) ||
+      !std::isfinite(ec.pitch) || !std::isfinite(ec.yaw) ||
+      (ec.attached && (ec.parent >= entities_.size() || ec.parent == ec.entity))) {
+    ++counts_.rejected;
+    return;
+  }
+  Entity& e = entities_[ec.entity];
+  if (ec.state == cigi::EntityState::destroyed) {
+    e = Entity{};
+    return;
+  }
+  if (!e.exists || e.control.type != ec.type) {
+    e.model = -1;
+    for (size_t m = 0; m < modelTypes_.size(); ++m)
+      if (modelTypes_[m] == ec.type) e.model = int(m);
+    e.hasRate = false;
+  }
+  e.exists = true;
+  e.control = ec;
+  e.hasRate = false;  // a new pose from the host ends the extrapolation from the old one
+}
+
+void IgWorld::applyComponentControl(const cigi::ComponentControl& cc) {
+  if (cc.componentClass == cigi::ComponentClass::system) {
+    // Light groups (docs/ig.md): component ID = the group's index, state 0 off, 1 on, 2 on and
+    // dimmed to data[0] read as an IEEE float (0 … 1).
+    if (cc.component >= base_.lightGroups.size()) {
+      ++counts_.rejected;
+      return;
+    }
+    scene::LightGroup& g = frame_.lightGroups[cc.component];
+    g.on = cc.state != 0;
+    g.dim = 1;
+    if (cc.state == 2) {
+      float dim;
+      std::memcpy(&dim, &cc.data[0], sizeof dim);
+      if (!(dim >= 0 && dim <= 1)) {
+        ++counts_.rejected;
+        return;
+      }
+      g.dim = dim;
+    }
+  } else if (cc.componentClass == cigi::ComponentClass::entity) {
+    // An entity switch: component 0 of entity `instance`, state 0 hidden, 1 shown.
+    if (cc.instance >= entities_.size() || cc.component != 0) {
+      ++counts_.rejected;
+      return;
+    }
+    entities_[cc.instance].visible = cc.state != 0;
+  } else {
+    ++counts_.skipped;
+  }
+}
+
+void IgWorld::applyRateControl(const cigi::RateControl& rc) {
+  const float r[6] = {rc.x, rc.y, rc.z, rc.roll, rc.pitch, rc.yaw};
+  const bool finite = std::all_of(r, r + 6, [](float x) { return std::isfinite(x); });
+  if (rc.entity >= entities_.size() || !entities_[rc.entity].exists || !finite) {
+    ++counts_.rejected;
+    return;
+  }
+  if (rc.applyToPart) {
+    ++counts_.skipped;  // articulated parts: not modelled
+    return;
+  }
+  entities_[rc.entity].rate = rc;
+  entities_[rc.entity].hasRate = true;
+}
+
+void IgWorld::applyViewControl(const cigi::ViewControl& vc) {
+  const float v[6] = {vc.x, vc.y, vc.z, vc.roll, vc.pitch, vc.yaw};
+  if (vc.view >= views_.size() || vc.entity >= entities_.size() ||
+      !std::all_of(v, v + 6, [](float x) { return std::isfinite(x); })) {
+    ++counts_.rejected;
+    return;
+  }
+  views_[vc.view].controlled = true;
+  views_[vc.view].control = vc;
+}
+
+void IgWorld::applyViewDefinition(const cigi::ViewDefinition& vd) {
+  const float v[6] = {vd.nearPlane, vd.farPlane, vd.left, vd.right, vd.top, vd.bottom};
+  const bool ok = std::all_of(v, v + 6, [](float x) { return std::isfinite(x); }) &&
+                  vd.left < vd.right && vd.bottom < vd.top && vd.left > -90 && vd.right < 90 &&
+                  vd.bottom > -90 && vd.top < 90 && vd.nearPlane > 0 && vd.farPlane > vd.nearPlane;
+  if (vd.view >= views_.size() || !ok) {
+    ++counts_.rejected;
+    return;
+  }
+  views_[vd.view].defined = true;
+  views_[vd.view].definition = vd;
+}
+
+cigi::HatHotResponse IgWorld::answerHatHot(const cigi::HatHotRequest& hr, uint8_t lsn) const {
+  const double q[3] = {hr.latOrX, hr.lonOrY, hr.altOrZ};
+  bool ok = false;
+  const Vec3d w = requestPoint(hr.entityCoordinates, hr.entity, q, ok);
+  cigi::HatHotResponse r;
+  r.id = hr.id;
+  r.hostFrameLsn = lsn;
+  // A HOT asks for the ground under the point; a HAT for the point's height above it (an
+  // extended request is answered as a HAT: the extended response is not implemented).
+  r.hot = hr.type == cigi::HatHotType::hot;
+  if (const std::optional<Ground> g = ok ? groundUnder(w) : std::nullopt) {
+    r.valid = true;
+    r.height = r.hot ? g->elevation + earth_.origin().alt : g->above;
+  }
+  return r;
+}
+
+cigi::LosResponse IgWorld::answerLos(const cigi::LosSegmentRequest& lr, uint8_t lsn) const {
+  bool okA = false, okB = false;
+  const Vec3d a = requestPoint(lr.sourceEntityCoordinates, lr.sourceEntity, lr.source, okA);
+  const Vec3d b =
+      requestPoint(lr.destinationEntityCoordinates, lr.sourceEntity, lr.destination, okB);
+  cigi::LosResponse r;
+  r.id = lr.id;
+  r.hostFrameLsn = lsn;
+  if (okA && okB) {
+    const std::optional<double> t = segmentHit(a, b);
+    const Vec3d d = b - a;
+    r.valid = t.has_value();  // the range is valid where the segment meets something
+    r.visible = !t;
+    r.range = t ? *t * std::sqrt(dot(d, d)) : 0;
+  }
+  return r;
+}
+
 void IgWorld::applyPacket(const cigi::Packet& packet, std::vector<cigi::Packet>& replies) {
   using namespace cigi;
   const uint8_t lsn = uint8_t(lastHostFrame_ & 0xF);
@@ -140,70 +270,11 @@ void IgWorld::applyPacket(const cigi::Packet& packet, std::vector<cigi::Packet>&
     if (ig->mode == IgMode::reset)
       for (Entity& e : entities_) e = Entity{};
   } else if (const auto* ec = std::get_if<EntityControl>(&packet)) {
-    const double v[3] = {ec->latOrX, ec->lonOrY, ec->altOrZ};
-    if (ec->entity >= entities_.size() || !finite3(v) || !std::isfinite(ec->roll) ||
-        !std::isfinite(ec->pitch) || !std::isfinite(ec->yaw) ||
-        (ec->attached && (ec->parent >= entities_.size() || ec->parent == ec->entity))) {
-      ++counts_.rejected;
-      return;
-    }
-    Entity& e = entities_[ec->entity];
-    if (ec->state == EntityState::destroyed) {
-      e = Entity{};
-      return;
-    }
-    if (!e.exists || e.control.type != ec->type) {
-      e.model = -1;
-      for (size_t m = 0; m < modelTypes_.size(); ++m)
-        if (modelTypes_[m] == ec->type) e.model = int(m);
-      e.hasRate = false;
-    }
-    e.exists = true;
-    e.control = *ec;
-    e.hasRate = false;  // a new pose from the host ends the extrapolation from the old one
+    applyEntityControl(*ec);
   } else if (const auto* cc = std::get_if<ComponentControl>(&packet)) {
-    if (cc->componentClass == ComponentClass::system) {
-      // Light groups (docs/ig.md): component ID = the group's index, state 0 off, 1 on, 2 on and
-      // dimmed to data[0] read as an IEEE float (0 … 1).
-      if (cc->component >= base_.lightGroups.size()) {
-        ++counts_.rejected;
-        return;
-      }
-      scene::LightGroup& g = frame_.lightGroups[cc->component];
-      g.on = cc->state != 0;
-      g.dim = 1;
-      if (cc->state == 2) {
-        float dim;
-        std::memcpy(&dim, &cc->data[0], sizeof dim);
-        if (!(dim >= 0 && dim <= 1)) {
-          ++counts_.rejected;
-          return;
-        }
-        g.dim = dim;
-      }
-    } else if (cc->componentClass == ComponentClass::entity) {
-      // An entity switch: component 0 of entity `instance`, state 0 hidden, 1 shown.
-      if (cc->instance >= entities_.size() || cc->component != 0) {
-        ++counts_.rejected;
-        return;
-      }
-      entities_[cc->instance].visible = cc->state != 0;
-    } else {
-      ++counts_.skipped;
-    }
+    applyComponentControl(*cc);
   } else if (const auto* rc = std::get_if<RateControl>(&packet)) {
-    const float r[6] = {rc->x, rc->y, rc->z, rc->roll, rc->pitch, rc->yaw};
-    const bool finite = std::all_of(r, r + 6, [](float x) { return std::isfinite(x); });
-    if (rc->entity >= entities_.size() || !entities_[rc->entity].exists || !finite) {
-      ++counts_.rejected;
-      return;
-    }
-    if (rc->applyToPart) {
-      ++counts_.skipped;  // articulated parts: not modelled
-      return;
-    }
-    entities_[rc->entity].rate = *rc;
-    entities_[rc->entity].hasRate = true;
+    applyRateControl(*rc);
   } else if (const auto* cs = std::get_if<CelestialSphereControl>(&packet)) {
     if (cs->hour > 23 || cs->minute > 59 || !std::isfinite(cs->starIntensity)) {
       ++counts_.rejected;
@@ -226,59 +297,15 @@ void IgWorld::applyPacket(const cigi::Packet& packet, std::vector<cigi::Packet>&
     if (wc->scope == 0) weatherVisibility_ = wc->enabled ? wc->visibility : 0;
     else ++counts_.skipped;
   } else if (const auto* vc = std::get_if<ViewControl>(&packet)) {
-    const float v[6] = {vc->x, vc->y, vc->z, vc->roll, vc->pitch, vc->yaw};
-    if (vc->view >= views_.size() || vc->entity >= entities_.size() ||
-        !std::all_of(v, v + 6, [](float x) { return std::isfinite(x); })) {
-      ++counts_.rejected;
-      return;
-    }
-    views_[vc->view].controlled = true;
-    views_[vc->view].control = *vc;
+    applyViewControl(*vc);
   } else if (const auto* vd = std::get_if<ViewDefinition>(&packet)) {
-    const float v[6] = {vd->nearPlane, vd->farPlane, vd->left, vd->right, vd->top, vd->bottom};
-    const bool ok = std::all_of(v, v + 6, [](float x) { return std::isfinite(x); }) &&
-                    vd->left < vd->right && vd->bottom < vd->top && vd->left > -90 &&
-                    vd->right < 90 && vd->bottom > -90 && vd->top < 90 && vd->nearPlane > 0 &&
-                    vd->farPlane > vd->nearPlane;
-    if (vd->view >= views_.size() || !ok) {
-      ++counts_.rejected;
-      return;
-    }
-    views_[vd->view].defined = true;
-    views_[vd->view].definition = *vd;
+    applyViewDefinition(*vd);
   } else if (const auto* hr = std::get_if<HatHotRequest>(&packet)) {
     ++counts_.hatRequests;
-    const double q[3] = {hr->latOrX, hr->lonOrY, hr->altOrZ};
-    bool ok = false;
-    const Vec3d w = requestPoint(hr->entityCoordinates, hr->entity, q, ok);
-    HatHotResponse r;
-    r.id = hr->id;
-    r.hostFrameLsn = lsn;
-    // A HOT asks for the ground under the point; a HAT for the point's height above it (an
-    // extended request is answered as a HAT: the extended response is not implemented).
-    r.hot = hr->type == HatHotType::hot;
-    if (const std::optional<Ground> g = ok ? groundUnder(w) : std::nullopt) {
-      r.valid = true;
-      r.height = r.hot ? g->elevation + earth_.origin().alt : g->above;
-    }
-    replies.push_back(r);
+    replies.push_back(answerHatHot(*hr, lsn));
   } else if (const auto* lr = std::get_if<LosSegmentRequest>(&packet)) {
     ++counts_.losRequests;
-    bool okA = false, okB = false;
-    const Vec3d a = requestPoint(lr->sourceEntityCoordinates, lr->sourceEntity, lr->source, okA);
-    const Vec3d b =
-        requestPoint(lr->destinationEntityCoordinates, lr->sourceEntity, lr->destination, okB);
-    LosResponse r;
-    r.id = lr->id;
-    r.hostFrameLsn = lsn;
-    if (okA && okB) {
-      const std::optional<double> t = segmentHit(a, b);
-      const Vec3d d = b - a;
-      r.valid = t.has_value();  // the range is valid where the segment meets something
-      r.visible = !t;
-      r.range = t ? *t * std::sqrt(dot(d, d)) : 0;
-    }
-    replies.push_back(r);
+    replies.push_back(answerLos(*lr, lsn));
   } else {
     ++counts_.skipped;  // decoded but not acted on (environmental regions; IG → host packets)
   }

@@ -91,6 +91,16 @@ class IgWorld {
 
   bool pose(uint16_t entity, Pose& out, int depth = 0) const;
   void applyPacket(const cigi::Packet& packet, std::vector<cigi::Packet>& replies);
+  // applyPacket's cases: each packet the IG acts on, a packet out of range or not finite counted
+  // as rejected and ignored.
+  void applyEntityControl(const cigi::EntityControl& ec);
+  void applyComponentControl(const cigi::ComponentControl& cc);
+  void applyRateControl(const cigi::RateControl& rc);
+  void applyViewControl(const cigi::ViewControl& vc);
+  void applyViewDefinition(const cigi::ViewDefinition& vd);
+  // The answers to the host's requests, naming the host frame they were asked in (its low 4 bits).
+  cigi::HatHotResponse answerHatHot(const cigi::HatHotRequest& hr, uint8_t lsn) const;
+  cigi::LosResponse answerLos(const cigi::LosSegmentRequest& lr, uint8_t lsn) const;
   Vec3d requestPoint(bool entityRelative, uint16_t entity, const double p[3], bool& ok) const;
 
   IgConfig config_;

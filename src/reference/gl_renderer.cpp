@@ -364,6 +364,166 @@ Result<std::unique_ptr<GlRenderer>> GlRenderer::create(const RenderOptions& opti
   return r;
 }
 
+namespace {
+
+// The scene's lines as one mesh of GL lines in world coordinates, each segment's colour on its
+// two ends; drawn unlit (GL's own wide lines: not synthvis's strips — the reference).
+scene::Mesh linesMesh(const scene::Scene& scene) {
+  scene::Mesh lines;
+  for (const scene::LineSegment& l : scene.lines) {
+    lines.positions.insert(lines.positions.end(), {l.a, l.b});
+    const Vec4 c{l.color.x, l.color.y, l.color.z, 1};
+    lines.colors.insert(lines.colors.end(), {c, c});
+    lines.indices.insert(lines.indices.end(),
+                         {uint32_t(lines.indices.size()), uint32_t(lines.indices.size() + 1)});
+  }
+  return lines;
+}
+
+// A mesh's arrays in static buffers under a vertex array of its own, at the vertex shader's
+// locations (0 position, 1 normal, 2 colour, 3 uv); the arrays it lacks left disabled.
+Mesh uploadMesh(const scene::Mesh& m, GLenum mode) {
+  Mesh out;
+  out.mode = mode;
+  glGenVertexArrays(1, &out.vao);
+  glGenBuffers(5, out.buffers);
+  glBindVertexArray(out.vao);
+  auto upload = [](GLenum target, GLuint buffer, const void* data, size_t bytes) {
+    glBindBuffer(target, buffer);
+    glBufferData(target, GLsizeiptr(bytes), data, GL_STATIC_DRAW);
+  };
+  upload(GL_ARRAY_BUFFER, out.buffers[0], m.positions.data(), m.positions.size() * sizeof(Vec3));
+  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(Vec3), nullptr);
+  glEnableVertexAttribArray(0);
+  out.hasNormals = !m.normals.empty();
+  if (out.hasNormals) {
+    upload(GL_ARRAY_BUFFER, out.buffers[1], m.normals.data(), m.normals.size() * sizeof(Vec3));
+    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, sizeof(Vec3), nullptr);
+    glEnableVertexAttribArray(1);
+  }
+  out.hasColors = !m.colors.empty();
+  if (out.hasColors) {
+    upload(GL_ARRAY_BUFFER, out.buffers[2], m.colors.data(), m.colors.size() * sizeof(Vec4));
+    glVertexAttribPointer(2, 4, GL_FLOAT, GL_FALSE, sizeof(Vec4), nullptr);
+    glEnableVertexAttribArray(2);
+  }
+  out.hasUvs = !m.uvs.empty();
+  if (out.hasUvs) {
+    upload(GL_ARRAY_BUFFER, out.buffers[4], m.uvs.data(), m.uvs.size() * sizeof(Vec2));
+    glVertexAttribPointer(3, 2, GL_FLOAT, GL_FALSE, sizeof(Vec2), nullptr);
+    glEnableVertexAttribArray(3);
+  }
+  upload(GL_ELEMENT_ARRAY_BUFFER, out.buffers[3], m.indices.data(),
+         m.indices.size() * sizeof(uint32_t));
+  out.indexCount = GLsizei(m.indices.size());
+  return out;
+}
+
+// GL's texture filters nearest the frame's texture filter.
+struct GlFilters {
+  GLint min = GL_LINEAR_MIPMAP_LINEAR, mag = GL_LINEAR;
+  float anisotropy = 1;
+};
+GlFilters glFilters(scene::TextureFilter filter) {
+  GlFilters f;
+  switch (filter) {
+    case scene::TextureFilter::point:
+      f.min = GL_NEAREST;
+      f.mag = GL_NEAREST;
+      break;
+    case scene::TextureFilter::nearest:
+      f.min = GL_NEAREST_MIPMAP_NEAREST;
+      f.mag = GL_NEAREST;
+      break;
+    case scene::TextureFilter::threePoint:
+    case scene::TextureFilter::bilinear:
+      f.min = GL_LINEAR_MIPMAP_NEAREST;
+      break;
+    case scene::TextureFilter::anisotropic:
+      f.anisotropy = 16;
+      break;
+    default:
+      break;
+  }
+  return f;
+}
+
+GLint glWrap(texture::Wrap w) {
+  return w == texture::Wrap::clamp    ? GL_CLAMP_TO_EDGE
+         : w == texture::Wrap::mirror ? GL_MIRRORED_REPEAT
+                                      : GL_REPEAT;
+}
+
+// A texture as synthvis's own pyramid, level by level, in 8-bit sRGB (GL's usual texture format;
+// the sampler decodes to linear), with its wrap modes and `filters`. GL puts the first row
+// uploaded at t = 0 and ours is the image's top row, at v = 0 (glTF's convention): (s, t) = (u, v).
+GLuint uploadTexture(const texture::Texture& t, const GlFilters& filters) {
+  GLuint id = 0;
+  glGenTextures(1, &id);
+  glBindTexture(GL_TEXTURE_2D, id);
+  for (int k = 0; k < t.levelCount(); ++k) {
+    const texture::LevelView level = t.level(k);
+    // Straight (not premultiplied) colour, sRGB-encoded; alpha linear.
+    const std::vector<uint8_t> rgba = texture::toSrgb8(level);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glTexImage2D(GL_TEXTURE_2D, k, GL_SRGB8_ALPHA8, level.width, level.height, 0, GL_RGBA,
+                 GL_UNSIGNED_BYTE, rgba.data());
+  }
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, t.levelCount() - 1);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, filters.min);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, filters.mag);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, glWrap(t.wrapX()));
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, glWrap(t.wrapY()));
+  if (filters.anisotropy > 1)
+    glTexParameterf(GL_TEXTURE_2D, 0x84FE /* GL_TEXTURE_MAX_ANISOTROPY */, filters.anisotropy);
+  return id;
+}
+
+// A draw's matrices as GL's uniforms want them, column by column.
+void setMatrices(Draw& d, const Mat4& mvp, const Mat4& modelView) {
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r) {
+      d.mvp[c * 4 + r] = mvp.m[c][r];
+      d.modelView[c * 4 + r] = modelView.m[c][r];
+    }
+}
+
+// An instance's draw: its matrices under the view, its material's colour, texture and facing.
+Draw instanceDraw(const scene::Scene& scene, const scene::Instance& inst, const Mat4& camera,
+                  const Mat4& view, const std::vector<GLuint>& textures, bool cullBackFaces) {
+  const scene::Mesh& mesh = scene.meshes[size_t(inst.mesh)];
+  const scene::Material& mat = scene.materialAt(mesh.material);
+  Draw d;
+  d.mesh = size_t(inst.mesh);
+  setMatrices(d, camera * inst.transform, view * inst.transform);
+  const Mat4 n = inst.transform.normalMatrix();
+  for (int c = 0; c < 3; ++c)
+    for (int r = 0; r < 3; ++r) d.normalToWorld[c * 3 + r] = n.m[c][r];
+  d.baseColor[0] = mat.baseColor.x;
+  d.baseColor[1] = mat.baseColor.y;
+  d.baseColor[2] = mat.baseColor.z;
+  d.baseColor[3] = mat.baseColor.w;
+  d.lit = scene.light.enabled && !mat.unlit && !mesh.normals.empty();
+  d.texture = mat.texture >= 0 ? textures[size_t(mat.texture)] : 0;
+  d.uvScale[0] = mat.uvScale.x;
+  d.uvScale[1] = mat.uvScale.y;
+  d.cull = cullBackFaces && !mat.doubleSided;
+  return d;
+}
+
+// The lines' draw (mesh `mesh`): already in the world, white, unlit, untextured, both faces.
+Draw linesDraw(size_t mesh, const Mat4& camera, const Mat4& view) {
+  Draw d{};
+  d.mesh = mesh;
+  setMatrices(d, camera, view);
+  for (int c = 0; c < 3; ++c) d.normalToWorld[c * 3 + c] = 1;
+  for (float& b : d.baseColor) b = 1;
+  d.uvScale[0] = d.uvScale[1] = 1;
+  return d;
+}
+
+}  // namespace
+
 Status GlRenderer::load(const scene::Scene& scene) {
   Impl& g = *impl_;
   if (Status s = scene::validate(scene, ""); !s) return s;
@@ -374,151 +534,22 @@ Status GlRenderer::load(const scene::Scene& scene) {
   if (!view.ok()) return view.error();
   g.freeMeshes();
   g.draws.clear();
-  // The scene's lines as one mesh of GL lines in world coordinates, each segment's colour on its
-  // two ends; drawn unlit (GL's own wide lines: not synthvis's strips — the reference).
-  scene::Mesh lines;
-  for (const scene::LineSegment& l : scene.lines) {
-    lines.positions.insert(lines.positions.end(), {l.a, l.b});
-    const Vec4 c{l.color.x, l.color.y, l.color.z, 1};
-    lines.colors.insert(lines.colors.end(), {c, c});
-    lines.indices.insert(lines.indices.end(),
-                         {uint32_t(lines.indices.size()), uint32_t(lines.indices.size() + 1)});
-  }
-  std::vector<const scene::Mesh*> meshes;
-  for (const scene::Mesh& m : scene.meshes) meshes.push_back(&m);
-  if (!scene.lines.empty()) meshes.push_back(&lines);
-  for (const scene::Mesh* mp : meshes) {
-    const scene::Mesh& m = *mp;
-    Mesh out;
-    if (mp == &lines) out.mode = GL_LINES;
-    glGenVertexArrays(1, &out.vao);
-    glGenBuffers(5, out.buffers);
-    glBindVertexArray(out.vao);
-    auto upload = [](GLenum target, GLuint buffer, const void* data, size_t bytes) {
-      glBindBuffer(target, buffer);
-      glBufferData(target, GLsizeiptr(bytes), data, GL_STATIC_DRAW);
-    };
-    upload(GL_ARRAY_BUFFER, out.buffers[0], m.positions.data(), m.positions.size() * sizeof(Vec3));
-    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(Vec3), nullptr);
-    glEnableVertexAttribArray(0);
-    out.hasNormals = !m.normals.empty();
-    if (out.hasNormals) {
-      upload(GL_ARRAY_BUFFER, out.buffers[1], m.normals.data(), m.normals.size() * sizeof(Vec3));
-      glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, sizeof(Vec3), nullptr);
-      glEnableVertexAttribArray(1);
-    }
-    out.hasColors = !m.colors.empty();
-    if (out.hasColors) {
-      upload(GL_ARRAY_BUFFER, out.buffers[2], m.colors.data(), m.colors.size() * sizeof(Vec4));
-      glVertexAttribPointer(2, 4, GL_FLOAT, GL_FALSE, sizeof(Vec4), nullptr);
-      glEnableVertexAttribArray(2);
-    }
-    out.hasUvs = !m.uvs.empty();
-    if (out.hasUvs) {
-      upload(GL_ARRAY_BUFFER, out.buffers[4], m.uvs.data(), m.uvs.size() * sizeof(Vec2));
-      glVertexAttribPointer(3, 2, GL_FLOAT, GL_FALSE, sizeof(Vec2), nullptr);
-      glEnableVertexAttribArray(3);
-    }
-    upload(GL_ELEMENT_ARRAY_BUFFER, out.buffers[3], m.indices.data(),
-           m.indices.size() * sizeof(uint32_t));
-    out.indexCount = GLsizei(m.indices.size());
-    g.meshes.push_back(out);
-  }
+  // The geometry: the scene's meshes, then its lines as one more.
+  for (const scene::Mesh& m : scene.meshes) g.meshes.push_back(uploadMesh(m, GL_TRIANGLES));
+  if (!scene.lines.empty()) g.meshes.push_back(uploadMesh(linesMesh(scene), GL_LINES));
   glBindVertexArray(0);
-
-  // Textures: synthvis's own pyramid, level by level, as 8-bit sRGB (GL's usual texture format;
-  // the sampler decodes to linear), with the frame's texture filter as GL's nearest it.
-  GLint minFilter = GL_LINEAR_MIPMAP_LINEAR, magFilter = GL_LINEAR;
-  float anisotropy = 1;
-  switch (g.options.textureFilter) {
-    case scene::TextureFilter::point:
-      minFilter = GL_NEAREST;
-      magFilter = GL_NEAREST;
-      break;
-    case scene::TextureFilter::nearest:
-      minFilter = GL_NEAREST_MIPMAP_NEAREST;
-      magFilter = GL_NEAREST;
-      break;
-    case scene::TextureFilter::threePoint:
-    case scene::TextureFilter::bilinear:
-      minFilter = GL_LINEAR_MIPMAP_NEAREST;
-      break;
-    case scene::TextureFilter::anisotropic:
-      anisotropy = 16;
-      break;
-    default:
-      break;
-  }
-  auto wrapOf = [](texture::Wrap w) {
-    return w == texture::Wrap::clamp    ? GL_CLAMP_TO_EDGE
-           : w == texture::Wrap::mirror ? GL_MIRRORED_REPEAT
-                                        : GL_REPEAT;
-  };
-  for (const scene::TextureMap& map : scene.textures) {
-    const texture::Texture& t = *map.texture;
-    GLuint id = 0;
-    glGenTextures(1, &id);
-    g.textures.push_back(id);
-    glBindTexture(GL_TEXTURE_2D, id);
-    for (int k = 0; k < t.levelCount(); ++k) {
-      const texture::LevelView level = t.level(k);
-      // Straight (not premultiplied) colour, sRGB-encoded; alpha linear.
-      const std::vector<uint8_t> rgba = texture::toSrgb8(level);
-      glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-      glTexImage2D(GL_TEXTURE_2D, k, GL_SRGB8_ALPHA8, level.width, level.height, 0, GL_RGBA,
-                   GL_UNSIGNED_BYTE, rgba.data());
-    }
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, t.levelCount() - 1);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, minFilter);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, magFilter);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, wrapOf(t.wrapX()));
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, wrapOf(t.wrapY()));
-    if (anisotropy > 1)
-      glTexParameterf(GL_TEXTURE_2D, 0x84FE /* GL_TEXTURE_MAX_ANISOTROPY */, anisotropy);
-  }
-  // GL puts the first row uploaded at t = 0 and ours is the image's top row, at v = 0 (glTF's
-  // convention): (s, t) = (u, v).
-
-  for (const scene::Instance& inst : scene.instances) {
-    const scene::Mesh& mesh = scene.meshes[size_t(inst.mesh)];
-    const scene::Material& mat = scene.materialAt(mesh.material);
-    Draw d;
-    d.mesh = size_t(inst.mesh);
-    const Mat4 mvp = camera.value() * inst.transform;
-    const Mat4 modelView = view.value() * inst.transform;
-    const Mat4 n = inst.transform.normalMatrix();
-    for (int c = 0; c < 4; ++c)
-      for (int r = 0; r < 4; ++r) {
-        d.mvp[c * 4 + r] = mvp.m[c][r];
-        d.modelView[c * 4 + r] = modelView.m[c][r];
-      }
-    for (int c = 0; c < 3; ++c)
-      for (int r = 0; r < 3; ++r) d.normalToWorld[c * 3 + r] = n.m[c][r];
-    d.baseColor[0] = mat.baseColor.x;
-    d.baseColor[1] = mat.baseColor.y;
-    d.baseColor[2] = mat.baseColor.z;
-    d.baseColor[3] = mat.baseColor.w;
-    d.lit = scene.light.enabled && !mat.unlit && !mesh.normals.empty();
-    d.texture = mat.texture >= 0 ? g.textures[size_t(mat.texture)] : 0;
-    d.uvScale[0] = mat.uvScale.x;
-    d.uvScale[1] = mat.uvScale.y;
-    d.cull = g.options.cullBackFaces && !mat.doubleSided;
-    g.draws.push_back(d);
-  }
+  const GlFilters filters = glFilters(g.options.textureFilter);
+  for (const scene::TextureMap& map : scene.textures)
+    g.textures.push_back(uploadTexture(*map.texture, filters));
+  // The draws: one per instance, then the lines'.
+  for (const scene::Instance& inst : scene.instances)
+    g.draws.push_back(instanceDraw(scene, inst, camera.value(), view.value(), g.textures,
+                                   g.options.cullBackFaces));
   if (!scene.lines.empty()) {
-    Draw d{};
-    d.mesh = g.meshes.size() - 1;
-    for (int c = 0; c < 4; ++c)
-      for (int r = 0; r < 4; ++r) {
-        d.mvp[c * 4 + r] = camera.value().m[c][r];
-        d.modelView[c * 4 + r] = view.value().m[c][r];
-      }
-    for (int c = 0; c < 3; ++c) d.normalToWorld[c * 3 + c] = 1;
-    for (float& b : d.baseColor) b = 1;
-    d.uvScale[0] = d.uvScale[1] = 1;
-    g.draws.push_back(d);
+    g.draws.push_back(linesDraw(g.meshes.size() - 1, camera.value(), view.value()));
     g.lineWidth = scene.lineSettings.width;
   }
+  // The light, the fog and the background, for every frame's uniforms.
   const Vec3 toLight = normalize(-scene.light.direction);
   g.toLight[0] = toLight.x;
   g.toLight[1] = toLight.y;

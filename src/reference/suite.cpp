@@ -315,12 +315,10 @@ Status runPipelinesBench(const scene::Scene& sc, const BenchSettings& s, CaseRes
   return {};
 }
 
-}  // namespace
-
-Result<CaseResult> BenchRunner::run(const BenchCase& c) {
-  const BenchSettings& s = impl_->settings;
-  if (s.frames < 1 || s.frames > 100000 || s.warmup < 0 || s.warmup > 100000)
-    return Error{"", "", "frames must be 1…100000 and warmup 0…100000"};
+// The case's scene as the settings show it: shaded as they say, in their channels, and for VTK
+// its volumes alone (VTK draws nothing else: in both renderers they are timed without what
+// surrounds them, the row's "volumes_alone" says so).
+Result<CaseScene> benchScene(const BenchCase& c, const BenchSettings& s, bool gl) {
   BenchCase shaded = c;
   shaded.tris.textured = shaded.layers.textured = s.textured;
   shaded.tris.fog = shaded.layers.fog = shaded.grazing.fog = s.fog;
@@ -333,15 +331,175 @@ Result<CaseResult> BenchRunner::run(const BenchCase& c) {
       return Error{"", "",
                    fmt::format("--channels {}: must be 1…{}", s.channels, scene::kMaxChannels)};
   }
-  if (!made.value().scene.channels.empty() && impl_->gl)
+  if (!made.value().scene.channels.empty() && gl)
     return Error{"", "",
                  "channels: the gl reference draws one view only (use --renderer synthvis)"};
-  // VTK draws volumes alone: a volume scene compared with it is timed, in both renderers, without
-  // what surrounds its volumes (the row's "volumes_alone" says so).
   if (s.vtk && !made.value().scene.volumes.empty() && !besideVolumes(made.value().scene).empty()) {
     made.value().params["volumes_alone"] = true;
     made.value().scene = volumesAlone(made.value().scene);
   }
+  return made;
+}
+
+// A renderer's run before its first frame.
+RendererRun startedRun(std::string renderer, std::string description) {
+  RendererRun run;
+  run.renderer = std::move(renderer);
+  run.description = std::move(description);
+  return run;
+}
+
+// One comparison of BenchSettings: synthvis as asked against its reference — synthvis another
+// way (free forms marched or tessellated, every instance at full detail), VTK or GL — timed
+// frame by frame.
+struct Comparison {
+  Comparison(const BenchSettings& settings, GlRenderer* glRenderer)
+      : s(settings), gl(glRenderer), renderer(settings.options) {}
+  const BenchSettings& s;
+  GlRenderer* gl;  // the gl reference, when started
+  Renderer renderer;
+  std::optional<Renderer> marcher;          // synthvis as the reference
+  std::unique_ptr<VtkVolumeRenderer> vtk;   // VTK as the reference
+  std::optional<scene::Scene> tessellated;  // free forms and terrain as triangles
+  std::optional<RendererRun> ours, ref;
+  std::vector<Image> oursImages, refImages;  // with channels: each channel's last frame
+
+  // The scene the polygon references draw.
+  const scene::Scene& polygons(const scene::Scene& sc) const {
+    return tessellated ? *tessellated : sc;
+  }
+  // Synthvis another way: its reference is itself, not VTK or GL.
+  bool selfReference() const { return s.sphereTrace || s.tessellated || s.fullDetail; }
+};
+
+// The renderers the comparison needs beside synthvis, or why the case cannot be compared.
+Status startRenderers(Comparison& k, const scene::Scene& sc, CaseResult& r) {
+  const BenchSettings& s = k.s;
+  RenderOptions marchOptions = s.options;
+  marchOptions.freeFormMethod = RenderOptions::FreeFormMethod::march;
+  RenderOptions fullDetailOptions = s.options;
+  fullDetailOptions.cullInstances = fullDetailOptions.lod = false;
+  if (k.selfReference())
+    k.marcher.emplace(s.sphereTrace ? marchOptions : s.fullDetail ? fullDetailOptions : s.options);
+  // Volumes have no polygon form: a gl row would leave them out, and its ratio and PSNR would
+  // compare different pictures. Their baseline is VTK's ray caster (issue 33).
+  if (s.vtk && !sc.volumes.empty()) {
+    auto v = VtkVolumeRenderer::create(sc, s.options);
+    if (!v.ok()) return v.error();
+    k.vtk = std::move(v).value();
+  } else if (k.gl && !sc.volumes.empty()) {
+    return Error{"", "", fmt::format("the gl reference does not draw volumes ({} in the scene)",
+                                     sc.volumes.size())};
+  } else if (s.vtk && !s.synthvis) {
+    return Error{"", "", "the vtk reference draws volume scenes only"};
+  }
+  // Free forms as triangles, for the polygon baseline and for the gl reference.
+  if ((!sc.freeForms.empty() || !sc.terrains.empty()) && (s.tessellated || k.gl)) {
+    auto t = tessellatedScene(sc, s.options);
+    if (!t.ok()) return t.error();
+    k.tessellated = std::move(t).value();
+    r.params["tessellated_triangles"] = k.tessellated->triangleCount();
+  }
+  return {};
+}
+
+// The runs to time: synthvis's when asked, and the reference's (the gl reference loads the
+// scene here, untimed).
+Status startRuns(Comparison& k, const scene::Scene& sc, const std::string& glDescription) {
+  const BenchSettings& s = k.s;
+  if (s.synthvis) k.ours = startedRun("synthvis", "synthvis");
+  if (s.sphereTrace) {
+    k.ref = startedRun("sphere-trace", fmt::format("synthvis, free forms marched in {} steps",
+                                                   s.options.marchSteps));
+  } else if (s.tessellated) {
+    k.ref = startedRun("tessellated", fmt::format("synthvis, free forms as {} triangles",
+                                                  k.polygons(sc).triangleCount()));
+  } else if (s.fullDetail) {
+    k.ref = startedRun(
+        "full-detail",
+        fmt::format("synthvis, every instance at full detail ({} triangles)", sc.triangleCount()));
+  } else if (k.vtk) {
+    k.ref = startedRun("vtk", k.vtk->description());
+  } else if (k.gl) {
+    if (Status st = k.gl->load(k.polygons(sc)); !st) return st;
+    k.ref = startedRun("gl", glDescription);
+  }
+  return {};
+}
+
+// One frame: the classic view, or every channel (SPEC §9), timed as one.
+Status renderFrame(Renderer& with, const scene::Scene& scene, RendererRun& run,
+                   std::vector<Image>& images) {
+  if (scene.channels.empty()) return with.render(scene, run.image, &run.stats);
+  if (Status st = with.renderChannels(scene, images, &run.channelStats); !st) return st;
+  run.stats = run.channelStats[0];
+  return {};
+}
+
+// A/B, frame by frame: synthvis's frame, then the reference's; the warm-up frames not kept.
+Status timeFrames(Comparison& k, const scene::Scene& sc) {
+  const BenchSettings& s = k.s;
+  for (int i = 0; i < s.warmup + s.frames; ++i) {
+    if (k.ours) {
+      const auto t0 = Clock::now();
+      if (Status st = renderFrame(k.renderer, sc, *k.ours, k.oursImages); !st) return st;
+      const double ms = msSince(t0);
+      if (i >= s.warmup) k.ours->frameMs.push_back(ms);
+    }
+    if (k.ref && k.selfReference()) {
+      const auto t0 = Clock::now();
+      if (Status st = renderFrame(*k.marcher, s.sphereTrace || s.fullDetail ? sc : k.polygons(sc),
+                                  *k.ref, k.refImages);
+          !st)
+        return st;
+      const double ms = msSince(t0);
+      if (i >= s.warmup) k.ref->frameMs.push_back(ms);
+    } else if (k.ref && k.vtk) {
+      const Result<double> ms = k.vtk->render();  // VTK's own render call, timed by the script
+      if (!ms.ok()) return ms.error();
+      if (i >= s.warmup) k.ref->frameMs.push_back(ms.value());
+    } else if (k.ref) {
+      const auto t0 = Clock::now();
+      if (Status st = k.gl->render(); !st) return st;
+      if (s.referenceReadback)
+        if (Status st = k.gl->readImage(k.ref->image); !st) return st;
+      const double ms = msSince(t0);
+      if (i >= s.warmup) k.ref->frameMs.push_back(ms);
+    }
+  }
+  return {};
+}
+
+// The timed runs into the case's result, synthvis's first, with their last images (the
+// reference's read back untimed) and the PSNR between them.
+Status collectRuns(Comparison& k, CaseResult& r) {
+  if (k.ours) {
+    finish(*k.ours);
+    if (!k.ours->channelStats.empty()) k.ours->image = mosaic(k.oursImages);
+    r.runs.push_back(std::move(*k.ours));
+  }
+  if (k.ref) {
+    finish(*k.ref);
+    if (!k.ref->channelStats.empty()) k.ref->image = mosaic(k.refImages);
+    if (k.vtk) {
+      if (Status st = k.vtk->readImage(k.ref->image); !st) return st;
+    } else if (!k.selfReference()) {
+      if (Status st = k.gl->readImage(k.ref->image); !st) return st;
+    }
+    if (!r.runs.empty()) r.psnrDb = psnr(r.runs[0].image, k.ref->image);
+    r.runs.push_back(std::move(*k.ref));
+  }
+  return {};
+}
+
+}  // namespace
+
+Result<CaseResult> BenchRunner::run(const BenchCase& c) {
+  const BenchSettings& s = impl_->settings;
+  if (s.frames < 1 || s.frames > 100000 || s.warmup < 0 || s.warmup > 100000)
+    return Error{"", "", "frames must be 1…100000 and warmup 0…100000"};
+  auto made = benchScene(c, s, impl_->gl != nullptr);
+  if (!made.ok()) return made.error();
   const scene::Scene& sc = made.value().scene;
 
   CaseResult r;
@@ -362,129 +520,11 @@ Result<CaseResult> BenchRunner::run(const BenchCase& c) {
     if (Status st = runPipelinesBench(sc, s, r); !st) return st.error();
     return r;
   }
-  std::optional<RendererRun> ours, ref;
-  if (s.synthvis) ours = RendererRun{"synthvis", "synthvis", {}, 0, 0, 0, {}, {}, {}};
-  Renderer renderer(s.options);
-  RenderOptions marchOptions = s.options;
-  marchOptions.freeFormMethod = RenderOptions::FreeFormMethod::march;
-  std::optional<Renderer> marcher;
-  RenderOptions fullDetailOptions = s.options;
-  fullDetailOptions.cullInstances = fullDetailOptions.lod = false;
-  if (s.sphereTrace || s.tessellated || s.fullDetail)
-    marcher.emplace(s.sphereTrace ? marchOptions : s.fullDetail ? fullDetailOptions : s.options);
-  // Volumes have no polygon form: a gl row would leave them out, and its ratio and PSNR would
-  // compare different pictures. Their baseline is VTK's ray caster (issue 33).
-  std::unique_ptr<VtkVolumeRenderer> vtk;
-  if (s.vtk && !sc.volumes.empty()) {
-    auto v = VtkVolumeRenderer::create(sc, s.options);
-    if (!v.ok()) return v.error();
-    vtk = std::move(v).value();
-  } else if (impl_->gl && !sc.volumes.empty()) {
-    return Error{"", "", fmt::format("the gl reference does not draw volumes ({} in the scene)",
-                                     sc.volumes.size())};
-  } else if (s.vtk && !s.synthvis) {
-    return Error{"", "", "the vtk reference draws volume scenes only"};
-  }
-  // Free forms as triangles, for the polygon baseline and for the gl reference.
-  std::optional<scene::Scene> tessellated;
-  if ((!sc.freeForms.empty() || !sc.terrains.empty()) && (s.tessellated || impl_->gl)) {
-    auto t = tessellatedScene(sc, s.options);
-    if (!t.ok()) return t.error();
-    tessellated = std::move(t).value();
-    r.params["tessellated_triangles"] = tessellated->triangleCount();
-  }
-  const scene::Scene& polygons = tessellated ? *tessellated : sc;
-  // One frame: the classic view, or every channel (SPEC §9), timed as one.
-  std::vector<Image> oursImages, refImages;
-  auto renderFrame = [&](Renderer& with, const scene::Scene& scene, RendererRun& run,
-                         std::vector<Image>& images) -> Status {
-    if (scene.channels.empty()) return with.render(scene, run.image, &run.stats);
-    if (Status st = with.renderChannels(scene, images, &run.channelStats); !st) return st;
-    run.stats = run.channelStats[0];
-    return {};
-  };
-  if (s.sphereTrace) {
-    ref = RendererRun{"sphere-trace",
-                      fmt::format("synthvis, free forms marched in {} steps", s.options.marchSteps),
-                      {},
-                      0,
-                      0,
-                      0,
-                      {},
-                      {},
-                      {}};
-  } else if (s.tessellated) {
-    ref = RendererRun{"tessellated",
-                      fmt::format("synthvis, free forms as {} triangles", polygons.triangleCount()),
-                      {},
-                      0,
-                      0,
-                      0,
-                      {},
-                      {},
-                      {}};
-  } else if (s.fullDetail) {
-    ref = RendererRun{"full-detail",
-                      fmt::format("synthvis, every instance at full detail ({} triangles)",
-                                  sc.triangleCount()),
-                      {},
-                      0,
-                      0,
-                      0,
-                      {},
-                      {},
-                      {}};
-  } else if (vtk) {
-    ref = RendererRun{"vtk", vtk->description(), {}, 0, 0, 0, {}, {}, {}};
-  } else if (impl_->gl) {
-    if (Status st = impl_->gl->load(polygons); !st) return st.error();
-    ref = RendererRun{"gl", impl_->glDescription, {}, 0, 0, 0, {}, {}, {}};
-  }
-  // A/B, frame by frame.
-  for (int i = 0; i < s.warmup + s.frames; ++i) {
-    if (ours) {
-      const auto t0 = Clock::now();
-      if (Status st = renderFrame(renderer, sc, *ours, oursImages); !st) return st.error();
-      const double ms = msSince(t0);
-      if (i >= s.warmup) ours->frameMs.push_back(ms);
-    }
-    if (ref && (s.sphereTrace || s.tessellated || s.fullDetail)) {
-      const auto t0 = Clock::now();
-      if (Status st = renderFrame(*marcher, s.sphereTrace || s.fullDetail ? sc : polygons, *ref,
-                                  refImages);
-          !st)
-        return st.error();
-      const double ms = msSince(t0);
-      if (i >= s.warmup) ref->frameMs.push_back(ms);
-    } else if (ref && vtk) {
-      const Result<double> ms = vtk->render();  // VTK's own render call, timed by the script
-      if (!ms.ok()) return ms.error();
-      if (i >= s.warmup) ref->frameMs.push_back(ms.value());
-    } else if (ref) {
-      const auto t0 = Clock::now();
-      if (Status st = impl_->gl->render(); !st) return st.error();
-      if (s.referenceReadback)
-        if (Status st = impl_->gl->readImage(ref->image); !st) return st.error();
-      const double ms = msSince(t0);
-      if (i >= s.warmup) ref->frameMs.push_back(ms);
-    }
-  }
-  if (ours) {
-    finish(*ours);
-    if (!ours->channelStats.empty()) ours->image = mosaic(oursImages);
-    r.runs.push_back(std::move(*ours));
-  }
-  if (ref) {
-    finish(*ref);
-    if (!ref->channelStats.empty()) ref->image = mosaic(refImages);
-    if (vtk) {
-      if (Status st = vtk->readImage(ref->image); !st) return st.error();
-    } else if (!s.sphereTrace && !s.tessellated && !s.fullDetail) {
-      if (Status st = impl_->gl->readImage(ref->image); !st) return st.error();
-    }
-    if (!r.runs.empty()) r.psnrDb = psnr(r.runs[0].image, ref->image);
-    r.runs.push_back(std::move(*ref));
-  }
+  Comparison k(s, impl_->gl.get());
+  if (Status st = startRenderers(k, sc, r); !st) return st.error();
+  if (Status st = startRuns(k, sc, impl_->glDescription); !st) return st.error();
+  if (Status st = timeFrames(k, sc); !st) return st.error();
+  if (Status st = collectRuns(k, r); !st) return st.error();
   return r;
 }
 

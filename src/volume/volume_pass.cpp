@@ -162,6 +162,32 @@ struct PixelComposite {
       if (!done[k]) next = std::min(next, limit[k]);
     }
   }
+
+  // Starts the composite of pixel (lx, ly) of `tile`, of s samples, each limited by its surface;
+  // returns the eye depth of the farthest of them (no ray goes beyond it).
+  [[gnu::always_inline]] double start(const raster::TileTarget& tile, const EyeRays& r, int lx,
+                                      int ly, int s) {
+    samples = s;
+    double farthest = 0;
+    for (int k = 0; k < s; ++k) {
+      limit[k] = r.depthToS(tile.depth[FrameBuffer::depthOffset(lx, ly, s, k)]);
+      done[k] = false;
+      farthest = std::max(farthest, limit[k]);
+    }
+    return farthest;
+  }
+
+  // Samples the rays did not reach take the whole composite; then each goes over its surface.
+  [[gnu::always_inline]] void writeOver(const raster::TileTarget& tile, int lx, int ly) {
+    reach(1e300);
+    for (int k = 0; k < samples; ++k) {
+      for (int c = 0; c < 3; ++c) {
+        uint16_t& out = tile.color[FrameBuffer::colorOffset(lx, ly, c, samples, k)];
+        const double v = snapC[k][c] + snapT[k] * (out / 65535.0);
+        out = uint16_t(std::lrint(std::clamp(v, 0.0, 1.0) * 65535.0));
+      }
+    }
+  }
 };
 
 }  // namespace
@@ -432,202 +458,234 @@ void VolumePass::addStats(FrameStats& stats) const {
   stats.volumeTerminated += c.terminated;
 }
 
+namespace {
+
+using Prepared = VolumePass::Prepared;
+using VolumeList = std::array<const Prepared*, 64>;
+
+// The volumes whose screen bounds meet the tile at (ox, oy) into `listed` (64 at most); their
+// number.
+int tileVolumes(const std::vector<Prepared>& volumes, int ox, int oy, VolumeList& listed) {
+  int count = 0;
+  for (const Prepared& p : volumes)
+    if (p.x0 < ox + kTileSize && p.x1 > ox && p.y0 < oy + kTileSize && p.y1 > oy && count < 64)
+      listed[size_t(count++)] = &p;
+  return count;
+}
+
+// A volume's stretch of one pixel's ray o + s·dir (its own space). s0, s1: the box's (the sample
+// lattice starts at s0); from, to: within the shell and the window's depths.
+struct Stretch {
+  const Prepared* p;
+  double s0, s1, o[3], dir[3], from, to;
+};
+using StretchList = std::array<Stretch, 64>;
+
+// The stretches of the ray of pixel (px, py), world direction d, through the listed volumes
+// that can show there, nearest entry first; their number.
+[[gnu::always_inline]] inline int rayStretches(const VolumeList& listed, int count,
+                                               const EyeRays& r, int px, int py, const Vec3d& d,
+                                               StretchList& stretches) {
+  int n = 0;
+  for (int v = 0; v < count; ++v) {
+    const Prepared& p = *listed[size_t(v)];
+    if (px < p.x0 || px >= p.x1 || py < p.y0 || py >= p.y1) continue;
+    // The window's depth interval (windowDepths); empty where no brick with content shows.
+    const size_t w = p.windowNear.empty() ? 0
+                                          : size_t(py / VolumePass::kWindow) * size_t(p.windowsX) +
+                                                size_t(px / VolumePass::kWindow);
+    if (!p.windowNear.empty() && !(p.windowNear[w] < p.windowFar[w])) continue;
+    Stretch st{&p, r.znear, r.zfar, {}, {}, 0, 0};
+    for (int a = 0; a < 3; ++a) {
+      st.o[a] = p.toOwn[a][0] * r.eye.x + p.toOwn[a][1] * r.eye.y + p.toOwn[a][2] * r.eye.z +
+                p.toOwn[a][3];
+      st.dir[a] = p.toOwn[a][0] * d.x + p.toOwn[a][1] * d.y + p.toOwn[a][2] * d.z;
+    }
+    const double lo[3] = {0, 0, 0};
+    clipToBox(st.o, st.dir, lo, p.extent, st.s0, st.s1);
+    st.from = st.s0, st.to = st.s1;
+    if (!p.windowNear.empty()) {
+      st.from = std::max(st.from, double(p.windowNear[w]));
+      st.to = std::min(st.to, double(p.windowFar[w]));
+      if (!(st.from < st.to)) continue;
+    }
+    for (const auto& q : p.object->shell) clipToQuadric(q, st.o, st.dir, st.from, st.to);
+    if (st.s0 < st.s1 && st.from < st.to) stretches[size_t(n++)] = st;
+  }
+  std::sort(stretches.begin(), stretches.begin() + n,
+            [](const Stretch& a, const Stretch& b) { return a.s0 < b.s0; });
+  return n;
+}
+
+// The bricks along a stretch's ray, walked from the first sample's (Amanatides and Woo's grid
+// traversal): each the stretch of s up to its exit; the outermost bricks reach to infinity (a
+// sample clamps into them).
+struct BrickWalk {
+  int bi[3], stepAxis[3];    // the brick; per axis the step across its faces, −1, 0 or 1
+  double next[3], delta[3];  // per axis: s at the next face crossed; s between its faces
+
+  // Starts at the brick holding the ray's point at s = mid.
+  [[gnu::always_inline]] void start(const Stretch& st, const double brickSize[3], double mid) {
+    const Prepared& p = *st.p;
+    for (int ax = 0; ax < 3; ++ax) {
+      const double q = st.o[ax] + mid * st.dir[ax];
+      // (Clamped first, the truncation is the floor.)
+      bi[ax] = int(std::clamp(q / brickSize[ax], 0.0, double(p.bricks[ax] - 1)));
+      stepAxis[ax] = st.dir[ax] > 0 ? 1 : st.dir[ax] < 0 ? -1 : 0;
+      const bool edge = stepAxis[ax] == 0 || (stepAxis[ax] > 0 && bi[ax] == p.bricks[ax] - 1) ||
+                        (stepAxis[ax] < 0 && bi[ax] == 0);
+      delta[ax] = stepAxis[ax] ? brickSize[ax] / std::fabs(st.dir[ax]) : 1e300;
+      next[ax] =
+          edge ? 1e300 : ((bi[ax] + (stepAxis[ax] > 0)) * brickSize[ax] - st.o[ax]) / st.dir[ax];
+    }
+  }
+  // The s at which the ray leaves the brick.
+  [[gnu::always_inline]] double exit() const { return std::min({next[0], next[1], next[2]}); }
+  // The brick's index in Prepared::emptyBrick.
+  [[gnu::always_inline]] size_t index(const Prepared& p) const {
+    return (size_t(bi[2]) * size_t(p.bricks[1]) + size_t(bi[1])) * size_t(p.bricks[0]) +
+           size_t(bi[0]);
+  }
+  // On to the next brick, across the nearest of its faces; false when the brick was the last.
+  [[gnu::always_inline]] bool step(const Prepared& p) {
+    const int ax = next[0] <= next[1] ? (next[0] <= next[2] ? 0 : 2) : (next[1] <= next[2] ? 1 : 2);
+    if (next[ax] >= 1e300) return false;
+    bi[ax] += stepAxis[ax];
+    const bool edge =
+        (stepAxis[ax] > 0 && bi[ax] == p.bricks[ax] - 1) || (stepAxis[ax] < 0 && bi[ax] == 0);
+    next[ax] = edge ? 1e300 : next[ax] + delta[ax];
+    return true;
+  }
+};
+
+// Casts the ray through one stretch (SPEC §12): its samples, up to the farthest surface of the
+// pixel, classified a batch at a time (sample_kernel.h) and composited front to back into `pc`.
+// True once the ray's transparency fell below ε (the ray ends there).
+[[gnu::always_inline]] inline bool castStretch(const Stretch& st, double farthest, double worldPerS,
+                                               const VolumeInput& in, SampleBatch& batch,
+                                               PixelComposite& pc, VolumeCounts& counts) {
+  const Prepared& p = *st.p;
+  const scene::VolumeGrid& g = *p.grid;
+  const double epsilon = in.settings.termination;
+  const double dirLength =
+      std::sqrt(st.dir[0] * st.dir[0] + st.dir[1] * st.dir[1] + st.dir[2] * st.dir[2]);
+  const double ds = p.stepOwn / dirLength;  // a step in s
+  const double end = std::min(st.s1, farthest);
+  const double brickSize[3] = {VolumePass::kBrick * double(g.spacing.x),
+                               VolumePass::kBrick * double(g.spacing.y),
+                               VolumePass::kBrick * double(g.spacing.z)};
+  // The samples waiting in `batch`, in ray order: their segments' starts and lengths in s.
+  double start[kBatch], length[kBatch];
+  int pending = 0;
+  // Classifies the waiting samples together (sample_kernel.h), then composites them in
+  // order: false once the ray's transparency fell below ε.
+  auto flush = [&]() -> bool {
+    classifySamples(p.source, pending, batch);
+    const int waiting = pending;
+    pending = 0;
+    for (int j = 0; j < waiting; ++j) {
+      pc.reach(start[j]);
+      ++counts.samples;
+      const float opacity = batch.opacity[j];
+      if (!(opacity > 0)) continue;
+      // SPEC §12: the opacity of a sample of length l is 1 − (1 − W)^(l / unit) — tabled
+      // for a full step under a uniform scale.
+      const bool full = length[j] == ds;
+      const double w =
+          full && p.source.stepOpacity ? double(batch.w[j])
+          : opacity >= 1               ? 1.0
+                         : 1 - std::pow(1 - double(opacity), length[j] * worldPerS / p.opacityUnit);
+      double color[3] = {batch.r[j], batch.g[j], batch.b[j]};
+      if (in.fogBeta > 0) {
+        const double mid = start[j] + 0.5 * length[j];
+        const double fog = std::exp2(-double(in.fogBeta) * mid * worldPerS);  // SPEC §8
+        const double fc[3] = {in.fogColor.x, in.fogColor.y, in.fogColor.z};
+        for (int c = 0; c < 3; ++c) color[c] = color[c] * fog + fc[c] * (1 - fog);
+      }
+      for (int c = 0; c < 3; ++c) pc.C[c] += pc.T * w * color[c];
+      pc.T *= 1 - w;
+      if (pc.T < epsilon) {
+        ++counts.terminated;
+        return false;
+      }
+    }
+    return true;
+  };
+  // Segments [s0 + i·ds, s0 + (i + 1)·ds) ∩ [s0, end), each sampled at its middle.
+  // From the segment holding the shell's entry to the one holding its exit: the samples
+  // outside the shell are transparent (its promise), the lattice the box's.
+  const int64_t first = int64_t(std::max(0.0, std::floor((st.from - st.s0) / ds)));
+  const double perS = 1 / ds;
+  const double lastSegment = std::ceil((end - st.s0) * perS) - 1;
+  // Brick by brick: a brick every sample of which the transfer function makes transparent is
+  // stepped over whole (its samples' cells' corners all lie in it), a brick with content sampled
+  // without looking again.
+  BrickWalk walk;
+  walk.start(st, brickSize, st.s0 + (double(first) + 0.5) * ds);
+  for (int64_t i = first; double(i) <= lastSegment && st.s0 + double(i) * ds <= st.to;) {
+    // Segment j's middle is s0 + (j + ½)·ds; those with it below the exit are in the brick.
+    // (⌈x⌉ of x capped first, by truncation: the baseline target has no rounding
+    // instruction, and std::ceil is a call.)
+    const double x = std::clamp((walk.exit() - st.s0) * perS - 0.5, -1.0, lastSegment + 1);
+    const double cut = double(int64_t(x));
+    const double through = std::min((cut < x ? cut + 1 : cut) - 1, lastSegment);
+    if (through >= double(i)) {
+      const int64_t last = int64_t(std::min(through, 1e15));
+      if (in.settings.skipEmpty && p.emptyBrick[walk.index(p)]) {
+        counts.skipped += uint64_t(last - i + 1);
+      } else {
+        // Samples i … last, up to the stretch's end and the shell's exit.
+        for (int64_t j = i; j <= last; ++j) {
+          const double a = st.s0 + double(j) * ds;
+          if (!(a < end) || a > st.to) break;
+          const bool full = a + ds <= end;
+          const double b = full ? a + ds : end, middle = 0.5 * (a + b);
+          start[pending] = a;
+          length[pending] = full ? ds : b - a;
+          batch.x[pending] = float(st.o[0] + middle * st.dir[0]);
+          batch.y[pending] = float(st.o[1] + middle * st.dir[1]);
+          batch.z[pending] = float(st.o[2] + middle * st.dir[2]);
+          if (++pending == kBatch && !flush()) return true;
+        }
+      }
+      i = last + 1;
+    }
+    if (!walk.step(p)) break;
+  }
+  return pending > 0 && !flush();
+}
+
+}  // namespace
+
 void VolumePass::drawTile(const raster::TileTarget& tile) {
   if (volumes_.empty()) return;
   VolumeCounts& counts = counts_[size_t(tile.worker)].counts;
+  SampleBatch& batch = batches_[size_t(tile.worker)].batch;
   const EyeRays& r = input_.rays;
   const int ox = tile.tileX * kTileSize, oy = tile.tileY * kTileSize;
-  const int s = samples_;
-  const scene::VolumeSettings& settings = input_.settings;
-  const double epsilon = settings.termination;
-  // The volumes this tile may show, by their screen bounds.
-  std::array<const Prepared*, 64> listed{};
-  int count = 0;
-  for (const Prepared& p : volumes_)
-    if (p.x0 < ox + kTileSize && p.x1 > ox && p.y0 < oy + kTileSize && p.y1 > oy && count < 64)
-      listed[size_t(count++)] = &p;
+  // Step 1: the volumes this tile may show, by their screen bounds.
+  VolumeList listed{};
+  const int count = tileVolumes(volumes_, ox, oy, listed);
   if (count == 0) return;
   for (int ly = 0; ly < kTileSize && oy + ly < r.height; ++ly)
     for (int lx = 0; lx < kTileSize && ox + lx < r.width; ++lx) {
       const int px = ox + lx, py = oy + ly;
       const Vec3d d = r.direction(px + 0.5, py + 0.5);
       const double worldPerS = std::sqrt(dot(d, d));
-      // Each listed volume's stretch of the ray, nearest entry first.
-      // s0, s1: the box's (the sample lattice starts at s0); from, to: within the shell.
-      struct Stretch {
-        const Prepared* p;
-        double s0, s1, o[3], dir[3], from, to;
-      };
-      std::array<Stretch, 64> stretches;
-      int n = 0;
-      for (int v = 0; v < count; ++v) {
-        const Prepared& p = *listed[size_t(v)];
-        if (px < p.x0 || px >= p.x1 || py < p.y0 || py >= p.y1) continue;
-        // The window's depth interval (windowDepths); empty where no brick with content shows.
-        const size_t w = p.windowNear.empty()
-                             ? 0
-                             : size_t(py / kWindow) * size_t(p.windowsX) + size_t(px / kWindow);
-        if (!p.windowNear.empty() && !(p.windowNear[w] < p.windowFar[w])) continue;
-        Stretch st{&p, r.znear, r.zfar, {}, {}, 0, 0};
-        for (int a = 0; a < 3; ++a) {
-          st.o[a] = p.toOwn[a][0] * r.eye.x + p.toOwn[a][1] * r.eye.y + p.toOwn[a][2] * r.eye.z +
-                    p.toOwn[a][3];
-          st.dir[a] = p.toOwn[a][0] * d.x + p.toOwn[a][1] * d.y + p.toOwn[a][2] * d.z;
-        }
-        const double lo[3] = {0, 0, 0};
-        clipToBox(st.o, st.dir, lo, p.extent, st.s0, st.s1);
-        st.from = st.s0, st.to = st.s1;
-        if (!p.windowNear.empty()) {
-          st.from = std::max(st.from, double(p.windowNear[w]));
-          st.to = std::min(st.to, double(p.windowFar[w]));
-          if (!(st.from < st.to)) continue;
-        }
-        for (const auto& q : p.object->shell) clipToQuadric(q, st.o, st.dir, st.from, st.to);
-        if (st.s0 < st.s1 && st.from < st.to) stretches[size_t(n++)] = st;
-      }
+      // Step 2: the pixel's ray through each volume it meets, nearest first.
+      StretchList stretches;
+      const int n = rayStretches(listed, count, r, px, py, d, stretches);
       if (n == 0) continue;
-      std::sort(stretches.begin(), stretches.begin() + n,
-                [](const Stretch& a, const Stretch& b) { return a.s0 < b.s0; });
+      // Step 3: front to back from the eye, each of the pixel's samples stopping at its surface,
+      // until the ray's transparency falls below ε.
       PixelComposite pc;
-      pc.samples = s;
-      double farthest = 0;
-      for (int k = 0; k < s; ++k) {
-        pc.limit[k] = r.depthToS(tile.depth[FrameBuffer::depthOffset(lx, ly, s, k)]);
-        pc.done[k] = false;
-        farthest = std::max(farthest, pc.limit[k]);
-      }
+      const double farthest = pc.start(tile, r, lx, ly, samples_);
       ++counts.rays;
-      bool terminated = false;
-      for (int v = 0; v < n && !terminated; ++v) {
-        const Stretch& st = stretches[size_t(v)];
-        const Prepared& p = *st.p;
-        const scene::VolumeGrid& g = *p.grid;
-        const double dirLength = std::sqrt(st.dir[0] * st.dir[0] + st.dir[1] * st.dir[1] +
-                                           st.dir[2] * st.dir[2]);
-        const double ds = p.stepOwn / dirLength;  // a step in s
-        const double end = std::min(st.s1, farthest);
-        const double brickSize[3] = {kBrick * double(g.spacing.x), kBrick * double(g.spacing.y),
-                                     kBrick * double(g.spacing.z)};
-        // The samples waiting in `batch`, in ray order: their segments' starts and lengths in s.
-        SampleBatch& batch = batches_[size_t(tile.worker)].batch;
-        double start[kBatch], length[kBatch];
-        int pending = 0;
-        // Classifies the waiting samples together (sample_kernel.h), then composites them in
-        // order: false once the ray's transparency fell below ε.
-        auto flush = [&]() -> bool {
-          classifySamples(p.source, pending, batch);
-          const int waiting = pending;
-          pending = 0;
-          for (int j = 0; j < waiting; ++j) {
-            pc.reach(start[j]);
-            ++counts.samples;
-            const float opacity = batch.opacity[j];
-            if (!(opacity > 0)) continue;
-            // SPEC §12: the opacity of a sample of length l is 1 − (1 − W)^(l / unit) — tabled
-            // for a full step under a uniform scale.
-            const bool full = length[j] == ds;
-            const double w =
-                full && p.source.stepOpacity ? double(batch.w[j])
-                : opacity >= 1               ? 1.0
-                                             : 1 - std::pow(1 - double(opacity),
-                                                            length[j] * worldPerS / p.opacityUnit);
-            double color[3] = {batch.r[j], batch.g[j], batch.b[j]};
-            if (input_.fogBeta > 0) {
-              const double mid = start[j] + 0.5 * length[j];
-              const double fog = std::exp2(-double(input_.fogBeta) * mid * worldPerS);  // SPEC §8
-              const double fc[3] = {input_.fogColor.x, input_.fogColor.y, input_.fogColor.z};
-              for (int c = 0; c < 3; ++c) color[c] = color[c] * fog + fc[c] * (1 - fog);
-            }
-            for (int c = 0; c < 3; ++c) pc.C[c] += pc.T * w * color[c];
-            pc.T *= 1 - w;
-            if (pc.T < epsilon) {
-              ++counts.terminated;
-              return false;
-            }
-          }
-          return true;
-        };
-        // Segments [s0 + i·ds, s0 + (i + 1)·ds) ∩ [s0, end), each sampled at its middle.
-        // From the segment holding the shell's entry to the one holding its exit: the samples
-        // outside the shell are transparent (its promise), the lattice the box's.
-        const int64_t first = int64_t(std::max(0.0, std::floor((st.from - st.s0) / ds)));
-        const double perS = 1 / ds;
-        const double lastSegment = std::ceil((end - st.s0) * perS) - 1;
-        // The bricks along the ray, walked from the first sample's (Amanatides and Woo's grid
-        // traversal): each the stretch of s up to its exit `next`; the outermost bricks reach to
-        // infinity (a sample clamps into them). A brick every sample of which the transfer
-        // function makes transparent is stepped over whole (its samples' cells' corners all lie in
-        // it), a brick with content sampled without looking again.
-        int bi[3], stepAxis[3];
-        double next[3], delta[3];
-        {
-          const double mid = st.s0 + (double(first) + 0.5) * ds;
-          for (int ax = 0; ax < 3; ++ax) {
-            const double q = st.o[ax] + mid * st.dir[ax];
-            // (Clamped first, the truncation is the floor.)
-            bi[ax] = int(std::clamp(q / brickSize[ax], 0.0, double(p.bricks[ax] - 1)));
-            stepAxis[ax] = st.dir[ax] > 0 ? 1 : st.dir[ax] < 0 ? -1 : 0;
-            const bool edge = stepAxis[ax] == 0 || (stepAxis[ax] > 0 && bi[ax] == p.bricks[ax] - 1) ||
-                              (stepAxis[ax] < 0 && bi[ax] == 0);
-            delta[ax] = stepAxis[ax] ? brickSize[ax] / std::fabs(st.dir[ax]) : 1e300;
-            next[ax] = edge ? 1e300
-                            : ((bi[ax] + (stepAxis[ax] > 0)) * brickSize[ax] - st.o[ax]) / st.dir[ax];
-          }
-        }
-        for (int64_t i = first; double(i) <= lastSegment && st.s0 + double(i) * ds <= st.to;) {
-          // Segment j's middle is s0 + (j + ½)·ds; those with it below the exit are in the brick.
-          const double exit = std::min({next[0], next[1], next[2]});
-          // (⌈x⌉ of x capped first, by truncation: the baseline target has no rounding
-          // instruction, and std::ceil is a call.)
-          const double x = std::clamp((exit - st.s0) * perS - 0.5, -1.0, lastSegment + 1);
-          const double cut = double(int64_t(x));
-          const double through = std::min((cut < x ? cut + 1 : cut) - 1, lastSegment);
-          if (through >= double(i)) {
-            const int64_t last = int64_t(std::min(through, 1e15));
-            if (settings.skipEmpty &&
-                p.emptyBrick[(size_t(bi[2]) * size_t(p.bricks[1]) + size_t(bi[1])) *
-                                 size_t(p.bricks[0]) + size_t(bi[0])]) {
-              counts.skipped += uint64_t(last - i + 1);
-            } else {
-              // Samples i … last, up to the stretch's end and the shell's exit.
-              for (int64_t j = i; j <= last; ++j) {
-                const double a = st.s0 + double(j) * ds;
-                if (!(a < end) || a > st.to) break;
-                const bool full = a + ds <= end;
-                const double b = full ? a + ds : end, middle = 0.5 * (a + b);
-                start[pending] = a;
-                length[pending] = full ? ds : b - a;
-                batch.x[pending] = float(st.o[0] + middle * st.dir[0]);
-                batch.y[pending] = float(st.o[1] + middle * st.dir[1]);
-                batch.z[pending] = float(st.o[2] + middle * st.dir[2]);
-                if (++pending == kBatch && !flush()) {
-                  terminated = true;
-                  break;
-                }
-              }
-              if (terminated) break;
-            }
-            i = last + 1;
-          }
-          // On to the next brick: across the nearest of its faces.
-          const int ax = next[0] <= next[1] ? (next[0] <= next[2] ? 0 : 2) : (next[1] <= next[2] ? 1 : 2);
-          if (next[ax] >= 1e300) break;
-          bi[ax] += stepAxis[ax];
-          const bool edge = (stepAxis[ax] > 0 && bi[ax] == p.bricks[ax] - 1) ||
-                            (stepAxis[ax] < 0 && bi[ax] == 0);
-          next[ax] = edge ? 1e300 : next[ax] + delta[ax];
-        }
-        if (!terminated && pending > 0 && !flush()) terminated = true;
-      }
-      // Samples the rays did not reach take the whole composite; then each over its surface.
-      pc.reach(1e300);
-      for (int k = 0; k < s; ++k) {
-        for (int c = 0; c < 3; ++c) {
-          uint16_t& out = tile.color[FrameBuffer::colorOffset(lx, ly, c, s, k)];
-          const double v = pc.snapC[k][c] + pc.snapT[k] * (out / 65535.0);
-          out = uint16_t(std::lrint(std::clamp(v, 0.0, 1.0) * 65535.0));
-        }
-      }
+      for (int v = 0; v < n; ++v)
+        if (castStretch(stretches[size_t(v)], farthest, worldPerS, input_, batch, pc, counts))
+          break;
+      // Step 4: the composite over what each sample holds.
+      pc.writeOver(tile, lx, ly);
     }
 }
 
