@@ -12,12 +12,14 @@ SV_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 # volume loader's reader of OpenVDB files (and the tests' writer of them); python3-vtk9 is VTK's CPU
 # volume ray caster, the volumes' baseline (bench/vtk_volume.py, under xvfb-run); libminizip-dev and
 # libtinyxml2-dev are the display stage's zip and XML readers of MPCDI files (docs/display.md);
-# libopenmpi-dev and openmpi-bin (mpirun) run an IG over several processes (docs/cluster.md).
+# libopenmpi-dev and openmpi-bin (mpirun) run an IG over several processes (docs/cluster.md);
+# universal-ctags measures the functions for the short-functions rule (scripts/long-functions).
 SV_PACKAGES=(cmake g++ ninja-build pkg-config libgtest-dev libgmock-dev libbenchmark-dev
   libhwy-dev libtinygltf-dev libtinyobjloader-dev libstb-dev libpng-dev zlib1g-dev libturbojpeg0-dev libdraco-dev libassimp-dev nlohmann-json3-dev
   libcli11-dev libfmt-dev libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri python3
   clang libclang-rt-14-dev libgdal-dev libsdl2-dev xvfb xauth x11-apps tshark openscenegraph libmeshoptimizer-dev
-  libopenvdb-dev python3-vtk9 libminizip-dev libtinyxml2-dev libopenmpi-dev openmpi-bin)
+  libopenvdb-dev python3-vtk9 libminizip-dev libtinyxml2-dev libopenmpi-dev openmpi-bin
+  universal-ctags)
 
 sv_install_packages() {
   local missing=()

@@ -300,7 +300,7 @@ void addBenchCommand(CLI::App& app, Run& run) {
                    "measure each scene N times (warm-up and timed frames each) and print the "
                    "medians over them, with the ratio's range")
       ->capture_default_str();
-  bench->add_option("--aa", b.aa, "synthvis: samples per pixel (1, 4, 8, 16, 64)")
+  bench->add_option("--aa", b.aa, "synthvis: samples per pixel (" + sampleCountNames() + ")")
       ->capture_default_str();
   bench->add_option(
       "--gl-aa", b.glAa,

@@ -263,7 +263,7 @@ void addRenderOptions(CLI::App* render, RenderArgs& r) {
       ->capture_default_str();
   render
       ->add_option("--aa", r.options.samples,
-                   "anti-aliasing: samples per pixel, 1 (none), 4, 8, 16 or 64")
+                   "anti-aliasing: samples per pixel, " + sampleCountNames() + " (1: none)")
       ->capture_default_str();
   render->add_option("--filter", r.filter, "resolve filter: box or tent3 (3x3 triangle)")
       ->capture_default_str();

@@ -10,6 +10,7 @@
 #include "synthvis/frame_stats.h"
 #include "synthvis/image.h"
 #include "synthvis/result.h"
+#include "synthvis/sample_counts.h"
 #include "synthvis/scene.h"
 #include "synthvis/tile_share.h"
 
@@ -40,7 +41,7 @@ struct RenderOptions {
   // rounding of the vertices' placement. Only with `lod`, under the Z-buffer (masking draws
   // objects nearest first, which a merged cell is not). False: every member drawn on its own.
   bool mergeCells = true;
-  int camera = 0;             // index into Scene::cameras (a default camera if there is none)
+  int camera = 0;  // index into Scene::cameras (a default camera if there is none)
   // False-colour diagnostics instead of the image (one sample per pixel): how many triangles
   // covered each pixel (no depth test); where the visible triangle's subdivision stopped (the
   // window size it was filled at, or a 4×4 leaf tested pixel by pixel); which windows masking
@@ -53,8 +54,8 @@ struct RenderOptions {
   // pixel is the average of its k×k samples in linear light (the 1×1 box filter). The baseline
   // synthvis's own anti-aliasing (issue 4) is measured against.
   int supersample = 1;
-  // Anti-aliasing (SPEC §5): samples per pixel, 1 (point sampling at pixel centres) or 4, 8, 16,
-  // 64 — sub-pixel masks from tables (patterns in docs/quality.md), depth per sample, colour shaded
+  // Anti-aliasing (SPEC §5): samples per pixel, one of kSampleCounts (synthvis/sample_counts.h):
+  // 1 (point sampling at pixel centres) or 4, 8, 16, 64 — sub-pixel masks from tables (patterns in docs/quality.md), depth per sample, colour shaded
   // once per pixel. Frame-buffer memory per pixel: samples × 10 bytes (whole frame only in frames
   // of more than 2^18 triangles; otherwise per 64×64 tile and thread).
   int samples = 1;

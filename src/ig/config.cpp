@@ -109,9 +109,8 @@ IgConfig read(const Json& root, const std::string& path) {
       c.render.threads = integer((*it)["threads"], "render.threads", 1, kMaxThreads);
     if (it->contains("aa")) {
       c.render.samples = integer((*it)["aa"], "render.aa", 1, 64);
-      if (c.render.samples & (c.render.samples - 1) || c.render.samples == 2 ||
-          c.render.samples == 32)
-        bad("render.aa: 1, 4, 8, 16 or 64 samples");
+      if (!isSampleCount(c.render.samples))
+        bad(fmt::format("render.aa: {} samples", sampleCountNames()));
     }
     if (it->contains("textureFilter")) {
       const Json& f = (*it)["textureFilter"];

@@ -11,6 +11,7 @@
 #include "hwy/foreach_target.h"  // IWYU pragma: keep
 #include "hwy/highway.h"
 #include "output/resolve.h"
+#include "synthvis/sample_counts.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace sv::output {
@@ -131,13 +132,13 @@ HWY_EXPORT(ResolveSampleTileLinear);
 
 void resolveSampleTile(const uint16_t* color, const int32_t* sums, int tileX, int tileY,
                        int samples, const GammaTable& gamma, Image& image) {
-  SV_CHECK(samples == 4 || samples == 8 || samples == 16 || samples == 64);
+  SV_CHECK(samples > 1 && isSampleCount(samples));
   HWY_DYNAMIC_DISPATCH(ResolveSampleTile)(color, sums, tileX, tileY, samples, gamma, image);
 }
 
 void resolveSampleTileLinear(const uint16_t* color, const int32_t* sums, int tileX, int tileY,
                              int samples, const LinearTarget& target) {
-  SV_CHECK(samples == 1 || samples == 4 || samples == 8 || samples == 16 || samples == 64);
+  SV_CHECK(isSampleCount(samples));
   HWY_DYNAMIC_DISPATCH(ResolveSampleTileLinear)(color, sums, tileX, tileY, samples, target);
 }
 }  // namespace sv::output

@@ -26,10 +26,10 @@ Status validate(const RenderOptions& o) {
   const bool debug = o.debugView != RenderOptions::DebugView::none;
   if (o.supersample > 1 && debug)
     return Error{"", "", "a debug view shows one value per pixel; it cannot be supersampled"};
-  if (o.samples != 1 && o.samples != 4 && o.samples != 8 && o.samples != 16 && o.samples != 64)
+  if (!isSampleCount(o.samples))
     return Error{
         "", "",
-        fmt::format("{} samples per pixel is not supported (1, 4, 8, 16 or 64)", o.samples)};
+        fmt::format("{} samples per pixel is not supported ({})", o.samples, sampleCountNames())};
   if (o.samples > 1 && o.supersample > 1)
     return Error{"", "", "anti-aliasing and supersampling are alternatives; choose one"};
   if (o.samples > 1 && debug)

@@ -10,10 +10,12 @@
 #include <map>
 #include <random>
 
+#include "synthvis/sample_counts.h"
+
 namespace sv::raster {
 namespace {
 
-constexpr int kCounts[] = {1, 4, 8, 16, 64};
+constexpr auto kCounts = kSampleCounts;
 
 TEST(SamplePatterns, InsideThePixelOnTheBinaryGridAndDistinct) {
   for (int n : kCounts) {
