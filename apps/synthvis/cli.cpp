@@ -28,14 +28,6 @@ Result<RenderOptions::Filter> parseFilter(const std::string& name) {
   return Error{"", "", fmt::format("unknown filter '{}' (box or tent3)", name)};
 }
 
-std::string withSuffix(const std::string& path, const std::string& suffix) {
-  const size_t slash = path.find_last_of('/');
-  const size_t dot = path.find_last_of('.');
-  if (dot == std::string::npos || (slash != std::string::npos && dot < slash))
-    return path + "-" + suffix;
-  return path.substr(0, dot) + "-" + suffix + path.substr(dot);
-}
-
 // The `render` subcommand's options, into `r`.
 void addSegmentChannelOptions(CLI::App* app, RenderOptions& o) {
   app->add_flag("--donor", o.segmentChannel.donor,

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "synthvis/bench.h"
+#include "synthvis/files.h"
 #include "synthvis/generators.h"
 #include "synthvis/render.h"
 #include "synthvis/result.h"
@@ -39,8 +40,7 @@ Result<scene::Scene> loadSceneOrDemo(const std::string& path);
 // --filter box|tent3.
 Result<RenderOptions::Filter> parseFilter(const std::string& name);
 
-// `path` with "-" + `suffix` before its extension: out.png → out-left.png.
-std::string withSuffix(const std::string& path, const std::string& suffix);
+using core::withSuffix;  // synthvis/files.h: out.png → out-left.png
 
 // The segment pipeline's video channel (RenderOptions::SegmentChannel), for render and bench.
 void addSegmentChannelOptions(CLI::App* app, RenderOptions& o);

@@ -48,6 +48,10 @@ std::string directoryOf(const std::string& path);
 std::string resolvePath(const std::string& base, const std::string& ref);
 // The extension of `path` in lower case, with its dot (".json"), or "".
 std::string lowerExtension(const std::string& path);
+// The file name part of `path` ("dem.tif" of "maps/dem.tif"; "" for "maps/").
+std::string fileName(const std::string& path);
+// `path` with "-" + `suffix` before its extension: out.png → out-left.png (out → out-left).
+std::string withSuffix(const std::string& path, const std::string& suffix);
 // A stable key for "the same file": the canonical path when it can be computed, else `path`.
 std::string canonicalKey(const std::string& path);
 

@@ -58,6 +58,16 @@ std::string lowerExtension(const std::string& path) {
   return ext;
 }
 
+std::string fileName(const std::string& path) { return fs::path(path).filename().string(); }
+
+std::string withSuffix(const std::string& path, const std::string& suffix) {
+  const fs::path p(path);
+  if (!p.has_extension()) return path + "-" + suffix;
+  fs::path out = p;
+  out.replace_filename(p.stem().string() + "-" + suffix + p.extension().string());
+  return out.string();
+}
+
 std::string canonicalKey(const std::string& path) {
   std::error_code ec;
   const fs::path canonical = fs::weakly_canonical(fs::path(path), ec);

@@ -5,6 +5,8 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <initializer_list>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,7 +33,7 @@ Result<HeightField> quantize(const std::vector<double>& values, int width, int h
 // same seed gives the same table on every machine.
 Result<HeightField> generateFractal(int size, double spacing, double relief, uint32_t seed);
 
-// Loaders (heights.cpp), each with one-line errors naming the file and the problem, and
+// Loaders (heights_gdal.cpp, heights_png.cpp), each with one-line errors naming the file and the problem, and
 // each refusing a size beyond kMaxHeightSide / kMaxHeightSamples (or the `maxSamples` budget of the in-memory
 // forms) before reading a sample:
 // - loadGdal: any raster GDAL reads (GeoTIFF, SRTM .hgt, …), band 1 (samples equal to its no-data
@@ -76,5 +78,13 @@ void placeGeographic(const HeightField::Geographic& grid, const GeoFrame& frame,
 // quantizations — and merged into one table, so the ground has no seams to crack at. Samples no
 // tile covers take the lowest height. The result is requantized over the union's range.
 Result<HeightField> mosaic(const std::vector<HeightField>& tiles);
+
+namespace detail {
+// All of `values` finite.
+bool finite(std::initializer_list<double> values);
+// The problem of `f`'s origin and spacing (not finite, not positive, or a map extent beyond
+// ±1e8 m: a broken file), naming `source`; nothing when it is a placement.
+std::optional<Error> checkPlacement(const HeightField& f, const std::string& source);
+}  // namespace detail
 
 }  // namespace sv::formats

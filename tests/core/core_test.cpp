@@ -176,6 +176,38 @@ TEST(FrameStats, SummingAddsEveryField) {
   EXPECT_EQ(sum.volumeTerminated, 2u);
 }
 
+// The one path helper (synthvis/files.h), case by case.
+TEST(Paths, AreTakenApartLexically) {
+  EXPECT_EQ(core::directoryOf("scenes/ig/airport.json"), "scenes/ig");
+  EXPECT_EQ(core::directoryOf("scene.json"), "");
+  EXPECT_EQ(core::directoryOf("/scene.json"), "/");
+  EXPECT_EQ(core::resolvePath("scenes/ig", "../airport.json"), "scenes/airport.json");
+  EXPECT_EQ(core::resolvePath("scenes", "/abs/x.glb"), "/abs/x.glb");
+  EXPECT_EQ(core::resolvePath("", "x.glb"), "x.glb");
+  // Windows separators, as exporters on Windows write them: the file beside the referrer.
+  EXPECT_EQ(core::resolvePath("models", ".\\textures\\wall.jpg"), "models/textures/wall.jpg");
+  EXPECT_EQ(core::lowerExtension("a/B.GLB"), ".glb");
+  EXPECT_EQ(core::lowerExtension("a.d/README"), "");
+  EXPECT_EQ(core::fileName("maps/dem.tif"), "dem.tif");
+  EXPECT_EQ(core::fileName("maps/"), "");
+  EXPECT_EQ(core::withSuffix("out.png", "left"), "out-left.png");
+  EXPECT_EQ(core::withSuffix("dir.v2/out", "0"), "dir.v2/out-0");
+  EXPECT_EQ(core::withSuffix("a/b.tar.gz", "gl"), "a/b.tar-gl.gz");
+}
+
+// Reading is bounded and refuses what is not a regular file, naming the file and why.
+TEST(ReadFile, RefusesDevicesDirectoriesAndFilesOverTheLimit) {
+  const Result<std::string> device = core::readFile("/dev/zero");
+  ASSERT_FALSE(device.ok());
+  EXPECT_EQ(device.error().str(), "/dev/zero: cannot open file: not a regular file");
+  EXPECT_FALSE(core::readFile("/").ok());
+  const std::string path = tests::processTemp().write("six.txt", "123456");
+  EXPECT_EQ(core::readFile(path).value(), "123456");
+  const Result<std::string> big = core::readFile(path, 5);
+  ASSERT_FALSE(big.ok());
+  EXPECT_EQ(big.error().str(), path + ": file is too large (6 bytes, the limit is 5)");
+}
+
 TEST(WriteFile, WritesThePartsInOrder) {
   const std::string path = sv::tests::processTemp().path("parts.bin");
   const uint8_t bytes[] = {0, 1, 255};

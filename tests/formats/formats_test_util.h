@@ -137,4 +137,11 @@ inline GltfBuilder oneTriangle() {
 
 using sv::tests::contains;
 
+// Each component of `a` within `eps` of `b`'s.
+inline void expectNear(Vec3 a, Vec3 b, float eps = 1e-5f) {
+  EXPECT_NEAR(a.x, b.x, eps);
+  EXPECT_NEAR(a.y, b.y, eps);
+  EXPECT_NEAR(a.z, b.z, eps);
+}
+
 }  // namespace sv::formats::testing

@@ -34,11 +34,7 @@ std::string errorOf(const GltfBuilder& b) {
   return r.ok() ? std::string() : r.error().str();
 }
 
-void expectNear(Vec3 a, Vec3 b, float eps = 1e-5f) {
-  EXPECT_NEAR(a.x, b.x, eps);
-  EXPECT_NEAR(a.y, b.y, eps);
-  EXPECT_NEAR(a.z, b.z, eps);
-}
+using testing::expectNear;
 
 TEST(Gltf, LoadsTheSamplePyramidWithColoursMaterialAndNodeRotation) {
   Result<Scene> r = loadScene(sourcePath("scenes/pyramid.gltf"));

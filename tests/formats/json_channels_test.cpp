@@ -11,12 +11,12 @@ namespace {
 
 using testing::contains;
 
-Result<Scene> parse(const std::string& channels) {
+Result<Scene> parseChannels(const std::string& channels) {
   return parseJsonScene(R"({"synthvis": 1, "channels": )" + channels + "}", "t.json");
 }
 
 TEST(JsonChannels, ReadsEveryFieldAndTheArcForm) {
-  Result<Scene> r = parse(R"([
+  Result<Scene> r = parseChannels(R"([
       {"name": "left", "yaw": -50, "pitch": 2, "roll": -3, "offset": [-0.5, 0, 0.25],
        "frustum": {"left": -20, "right": 25, "down": -15, "up": 10}, "width": 640, "height": 360},
       {"width": 320, "height": 200}])");
@@ -38,7 +38,7 @@ TEST(JsonChannels, ReadsEveryFieldAndTheArcForm) {
   EXPECT_FALSE(r->channels[1].frustum.has_value());
   EXPECT_EQ(r->channels[1].yawDegrees, 0);
 
-  Result<Scene> arc = parse(R"({"arc": 150, "count": 3, "width": 640, "height": 360})");
+  Result<Scene> arc = parseChannels(R"({"arc": 150, "count": 3, "width": 640, "height": 360})");
   ASSERT_TRUE(arc.ok()) << arc.error().str();
   ASSERT_EQ(arc->channels.size(), 3u);
   EXPECT_FLOAT_EQ(arc->channels[0].yawDegrees, -50);
@@ -82,14 +82,14 @@ TEST(JsonChannels, RejectsEachMalformedChannelNamingTheFileAndTheField) {
       {R"({"arc": 150, "count": 3, "width": 64})", "channels: missing key 'height'"},
   };
   for (const Row& row : rows) {
-    Result<Scene> r = parse(row.channels);
+    Result<Scene> r = parseChannels(row.channels);
     ASSERT_FALSE(r.ok()) << row.channels;
     EXPECT_TRUE(contains(r.error().str(), row.expected))
         << r.error().str() << "\n  expected: " << row.expected;
   }
   std::string many = "[";
   for (int i = 0; i < 17; ++i) many += std::string(i ? "," : "") + R"({"width": 8, "height": 8})";
-  Result<Scene> r = parse(many + "]");
+  Result<Scene> r = parseChannels(many + "]");
   ASSERT_FALSE(r.ok());
   EXPECT_TRUE(contains(r.error().str(), "t.json: channels: 17 channels is more than the 16"));
 }

@@ -31,11 +31,7 @@ std::string withObjects(const std::string& objects) {
   return R"({"synthvis": 1, "objects": [)" + objects + "]}";
 }
 
-void expectNear(Vec3 a, Vec3 b, float eps = 1e-5f) {
-  EXPECT_NEAR(a.x, b.x, eps);
-  EXPECT_NEAR(a.y, b.y, eps);
-  EXPECT_NEAR(a.z, b.z, eps);
-}
+using testing::expectNear;
 
 // --- Values ---
 

@@ -145,9 +145,9 @@ TEST(OpenFlight, ReadsEveryNodeKind) {
 TEST(OpenFlight, PlacedByASceneFileKeepsItsArticulationsAndLights) {
   TempDir dir;
   dir.write("every.flt", testing::everyNodeFlt());
-  const std::string json = dir.write("two.json", R"({"synthvis": 1, "objects": [
+  const std::string sceneFile = dir.write("two.json", R"({"synthvis": 1, "objects": [
     {"mesh": "every.flt"}, {"mesh": "every.flt", "transform": {"translate": [0, 0, -50]}}]})");
-  Result<Scene> r = loadScene(json);
+  Result<Scene> r = loadScene(sceneFile);
   ASSERT_TRUE(r.ok()) << r.error().str();
   ASSERT_EQ(r->switches.size(), 2u);
   ASSERT_EQ(r->dofs.size(), 2u);
@@ -161,7 +161,7 @@ TEST(OpenFlight, PlacedByASceneFileKeepsItsArticulationsAndLights) {
   t.dofs[1].current.rotate = {0, 0, 0};
   applyArticulations(t);
   EXPECT_NEAR(t.instances[part].transform.transformPoint({6, 0, 0.25f}).z, -50, 1e-4);
-  ASSERT_TRUE(validate(t, json).ok());
+  ASSERT_TRUE(validate(t, sceneFile).ok());
 }
 
 // Textures: an SGI image (OpenFlight's own format) is read; one that cannot be read is named in a

@@ -170,12 +170,13 @@ TEST(GltfTextures, ProblemsAreNamed) {
       "unknown wrap mode 1234"));
 }
 
-Result<Scene> parse(const std::string& body) {
+// A scene of `body`'s keys beside the version.
+Result<Scene> parseKeys(const std::string& body) {
   return parseJsonScene(R"({"synthvis": 1, )" + body + "}", "t.json");
 }
 
 TEST(JsonTextures, GeneratedTexturesFogLightsAndMaterialKeysAreRead) {
-  Result<Scene> r = parse(R"(
+  Result<Scene> r = parseKeys(R"(
     "fog": {"color": [0.5, 0.6, 0.7], "beta": 0.25},
     "pointLights": [{"position": [1, 2, 3], "color": [2, 2, 2]}],
     "colorTable": [[1, 0, 0], [0.2, 0.4, 0.6]],
@@ -207,7 +208,7 @@ TEST(JsonTextures, GeneratedTexturesFogLightsAndMaterialKeysAreRead) {
   EXPECT_EQ(b.texture, 1);
   EXPECT_EQ(b.alphaMode, AlphaMode::mask);
   // The same seed gives the same texels.
-  Result<Scene> again = parse(R"("textures": [{"generate": "noise", "size": 16, "seed": 3}])");
+  Result<Scene> again = parseKeys(R"("textures": [{"generate": "noise", "size": 16, "seed": 3}])");
   ASSERT_TRUE(again.ok());
   EXPECT_EQ(again->textures[0].texture->level(0).packed(5, 7),
             s.textures[0].texture->level(0).packed(5, 7));
@@ -215,7 +216,7 @@ TEST(JsonTextures, GeneratedTexturesFogLightsAndMaterialKeysAreRead) {
 
 TEST(JsonTextures, ProblemsAreNamed) {
   auto error = [](const std::string& body) {
-    Result<Scene> r = parse(body);
+    Result<Scene> r = parseKeys(body);
     return r.ok() ? std::string("loaded") : r.error().str();
   };
   EXPECT_TRUE(contains(error(R"("textures": [{"generate": "stripes"}])"),

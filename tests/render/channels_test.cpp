@@ -22,7 +22,7 @@ namespace sv {
 namespace {
 
 // The camera at the origin looking down −z, no light, black background.
-scene::Scene emptyScene() {
+scene::Scene unlitScene() {
   scene::Scene s = tests::emptyScene();
   s.materials.push_back({});
   s.materials[0].unlit = true;
@@ -54,14 +54,8 @@ std::vector<Image> renderChannels(const scene::Scene& s, int threads,
 
 bool lit(const Image& im, int x, int y) { return im.pixel(x, y)[0] > 127; }
 
-scene::Scene smallTerrain() {
-  generators::TerrainParams p;
-  p.size = 129;
-  return generators::generateTerrain(p).value();
-}
-
 TEST(Channels, ACentredChannelIsTheClassicViewBitForBit) {
-  for (scene::Scene s : {formats::demoScene(), smallTerrain()}) {
+  for (scene::Scene s : {formats::demoScene(), tests::smallTerrain()}) {
     RenderOptions o;
     o.width = 160;
     o.height = 112;
@@ -88,7 +82,7 @@ TEST(Channels, ACentredChannelIsTheClassicViewBitForBit) {
 // included, and nothing of the other.
 TEST(Channels, AnEdgeInTheSharedPlaneEndsExactlyAtTheBoundary) {
   for (int side : {-1, 1}) {
-    scene::Scene s = emptyScene();
+    scene::Scene s = unlitScene();
     // x from 0 to 100·side, y ±100, at depth 10: facing the camera either way (double-sided).
     addQuad(s, {0, -100, -10}, {100.0f * side, 0, 0}, {0, 200, 0});
     s.channels = scene::arcChannels(2, 90, 64, 48);
@@ -135,7 +129,7 @@ double fitAt(const Image& im, const std::vector<int>& columns, double at) {
 // overlap, and the line each channel draws, carried to the shared edge, lands on the same row
 // there. A gap or overlap of one pixel between the frusta would move them apart by about a row.
 TEST(Channels, AnObliqueStripCrossingTheBoundaryIsContinuous) {
-  scene::Scene s = emptyScene();
+  scene::Scene s = unlitScene();
   const float t = 0.3f;  // the strip's height, about 2.5 pixels at the boundary
   addQuad(s, {-2, -1.5f - 0.5f * t, -10}, {4, 4, 0}, {0, t, 0});
   s.channels = scene::arcChannels(2, 90, 64, 48);
@@ -154,7 +148,7 @@ TEST(Channels, AnObliqueStripCrossingTheBoundaryIsContinuous) {
 }
 
 TEST(Channels, StatisticsAndSizesArePerChannel) {
-  scene::Scene s = emptyScene();
+  scene::Scene s = unlitScene();
   addQuad(s, {-1, -1, -10}, {2, 0, 0}, {0, 2, 0});  // straight ahead: the middle channel only
   s.channels = scene::arcChannels(3, 150, 64, 48);
   s.channels[2].width = 40;
@@ -178,7 +172,7 @@ TEST(Channels, StatisticsAndSizesArePerChannel) {
 }
 
 TEST(Channels, ThreeChannelsGiveTheSameBytesOnOneAndTwoThreads) {
-  for (scene::Scene s : {formats::demoScene(), smallTerrain()}) {
+  for (scene::Scene s : {formats::demoScene(), tests::smallTerrain()}) {
     s.channels = scene::arcChannels(3, 150, 96, 64);
     s.channels[0].offset = {-0.2f, 0.1f, 0};
     s.channels[2].pitchDegrees = 8;
@@ -194,7 +188,7 @@ TEST(Channels, ThreeChannelsGiveTheSameBytesOnOneAndTwoThreads) {
 // Yaw right turns the view to the right: a quad 50° to the right of the camera's view is seen in
 // the middle of a channel with yaw 50.
 TEST(Channels, YawPositiveLooksToTheRight) {
-  scene::Scene s = emptyScene();
+  scene::Scene s = unlitScene();
   const float a = 50 * std::numbers::pi_v<float> / 180;
   const Vec3 at{10 * std::sin(a), 0, -10 * std::cos(a)};
   addQuad(s, at + Vec3{-0.3f, -0.3f, 0}, {0.6f, 0, 0}, {0, 0.6f, 0});
@@ -214,7 +208,7 @@ TEST(Channels, YawPositiveLooksToTheRight) {
 // a depth, the point the polygons' projection puts at that pixel and depth (the inverse of
 // projection · view, through Mat4::frustum) lies on the ground.
 TEST(Channels, TerrainOnAnAsymmetricChannelMeetsTheGroundWhereTheProjectionSays) {
-  const scene::Scene s = smallTerrain();
+  const scene::Scene s = tests::smallTerrain();
   RenderOptions o;
   o.threads = 1;
   scene::Channel c;

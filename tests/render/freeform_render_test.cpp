@@ -50,8 +50,8 @@ scene::Scene sphereOnGround() {
   return s;
 }
 
-Image render(const scene::Scene& s, int w, int h, int samples, int threads = 2,
-             FrameStats* stats = nullptr) {
+Image renderForms(const scene::Scene& s, int w, int h, int samples, int threads = 2,
+                  FrameStats* stats = nullptr) {
   RenderOptions o;
   o.width = w;
   o.height = h;
@@ -99,7 +99,7 @@ TEST(FreeFormRender, IntersectionWithPolygonsIsWhereAnalyticCastingPutsIt) {
   const int w = 160, h = 120;
   const scene::Scene s = sphereOnGround();
   FrameStats stats;
-  const Image one = render(s, w, h, 1, 2, &stats);
+  const Image one = renderForms(s, w, h, 1, 2, &stats);
   EXPECT_EQ(stats.freeForms, 1u);
   EXPECT_GT(stats.freeFormHits, 1000u);
   int wrong = 0;
@@ -112,7 +112,7 @@ TEST(FreeFormRender, IntersectionWithPolygonsIsWhereAnalyticCastingPutsIt) {
   EXPECT_LE(wrong, 3) << "pixels whose centre sees the other surface";
   // With 16 samples the pixels along the curve and the silhouette mix the two colours by the
   // fraction of the pixel each covers: against a 16×16 analytic supersampling, in linear light.
-  const Image aa = render(s, w, h, 16);
+  const Image aa = renderForms(s, w, h, 16);
   auto linear = [](int v) {
     const double c = v / 255.0;
     return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
@@ -173,9 +173,9 @@ TEST(FreeFormRender, SameBytesForAnyThreadCountAndTranslucencyBlendsOverFreeForm
   s.meshes.push_back(pane);
   s.instances.push_back({1, Mat4{}});
   for (int samples : {1, 16}) {
-    const Image a = render(s, 96, 64, samples, 1);
-    EXPECT_EQ(render(s, 96, 64, samples, 2).rgb, a.rgb);
-    EXPECT_EQ(render(s, 96, 64, samples, 8).rgb, a.rgb);
+    const Image a = renderForms(s, 96, 64, samples, 1);
+    EXPECT_EQ(renderForms(s, 96, 64, samples, 2).rgb, a.rgb);
+    EXPECT_EQ(renderForms(s, 96, 64, samples, 8).rgb, a.rgb);
     // Through the pane: red sphere and green glass, half each (in linear light).
     const uint8_t* p = &a.rgb[(size_t(34) * 96 + 50) * 3];
     EXPECT_GT(p[0], 150);
@@ -210,7 +210,7 @@ TEST(FreeFormRender, AbsurdFormsRenderInBoundedTime) {
   }
   for (int samples : {1, 16}) {
     const auto t0 = core::Clock::now();
-    const Image img = render(s, 64, 48, samples);
+    const Image img = renderForms(s, 64, 48, samples);
     EXPECT_EQ(img.rgb.size(), size_t(64 * 48 * 3));
     EXPECT_LT(core::msSince(t0), 30e3) << samples;
   }
@@ -253,7 +253,8 @@ TEST(FreeFormRender, ProjectedTextureMatchesTheSameTextureOnPolygons) {
     }
     return s;
   };
-  const Image p = render(ground(false), 160, 120, 1), f = render(ground(true), 160, 120, 1);
+  const Image p = renderForms(ground(false), 160, 120, 1),
+              f = renderForms(ground(true), 160, 120, 1);
   double sum = 0;
   for (size_t i = 0; i < p.rgb.size(); ++i) sum += std::pow(double(p.rgb[i]) - f.rgb[i], 2);
   const double psnr = 10 * std::log10(255.0 * 255.0 / std::max(1e-9, sum / double(p.rgb.size())));

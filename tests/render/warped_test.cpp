@@ -85,12 +85,6 @@ Difference compare(const Image& a, const Image& b) {
   return d;
 }
 
-scene::Scene smallTerrain() {
-  generators::TerrainParams p;
-  p.size = 129;
-  return generators::generateTerrain(p).value();
-}
-
 TEST(SubFrusta, AFlatDisplayDrawsTheChannelsImage) {
   // One cell whose map is the channel's pinhole: the same image as the channel, but for pixels
   // where the two projections' float roundings put an edge on different sides of a sample.
@@ -102,7 +96,7 @@ TEST(SubFrusta, AFlatDisplayDrawsTheChannelsImage) {
   generators::VolumeParams vp;
   const std::vector<std::pair<const char*, scene::Scene>> scenes = {
       {"demo", formats::demoScene()},
-      {"terrain", smallTerrain()},
+      {"terrain", tests::smallTerrain()},
       {"free forms", generators::generateFreeFormOne()},
       {"volume", generators::generateVolume(vp)}};
   for (const auto& [name, s] : scenes) {

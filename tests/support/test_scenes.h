@@ -1,6 +1,7 @@
 // Scenes the render tests build by hand.
 #pragma once
 
+#include "synthvis/generators.h"
 #include "synthvis/scene.h"
 
 namespace sv::tests {
@@ -19,6 +20,13 @@ inline scene::Scene emptyScene(float zfar = 100, Vec3 background = {0, 0, 0}) {
   s.light.enabled = false;
   s.background = background;
   return s;
+}
+
+// BENCH.md's terrain at 129² heights: a small fractal ground with its camera, light and haze.
+inline scene::Scene smallTerrain() {
+  generators::TerrainParams p;
+  p.size = 129;
+  return generators::generateTerrain(p).value();
 }
 
 }  // namespace sv::tests
