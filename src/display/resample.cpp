@@ -18,12 +18,8 @@ namespace {
 
 constexpr double kToDegrees = 180 / std::numbers::pi;
 
-struct Body {
-  double x, y, z;
-};
-
 // v_body = Rᵀ·v_eye: rotationOf gives v_eye = R·v_body, and R is orthonormal.
-Body toBody(const Rotation& r, Vec3 d) {
+Vec3d toBody(const Rotation& r, Vec3 d) {
   const double v[3] = {d.x, d.y, d.z};
   double b[3];
   for (int c = 0; c < 3; ++c) b[c] = r.m[0][c] * v[0] + r.m[1][c] * v[1] + r.m[2][c] * v[2];
@@ -38,7 +34,7 @@ struct FlatProjection {
   explicit FlatProjection(const FlatView& v)
       : r(rotationOf(v.orientation)), t(tangentsOf(v.window)), width(v.width), height(v.height) {}
   std::optional<FlatPoint> operator()(Vec3 d) const {
-    const Body b = toBody(r, d);
+    const Vec3d b = toBody(r, d);
     const double len = std::sqrt(b.x * b.x + b.y * b.y + b.z * b.z);
     // In front: −z strictly positive, beyond rounding (a direction at the horizon has no image).
     if (!(-b.z > 1e-12 * len)) return std::nullopt;
@@ -207,7 +203,7 @@ Result<FlatView> coveringFlatView(const DirectionMap& display, const Orientation
   for (int y = 0; y < display.height; ++y)
     for (int x = 0; x < display.width; ++x) {
       if (!display.isValid(x, y)) continue;
-      const Body b = toBody(r, display.direction(x, y));
+      const Vec3d b = toBody(r, display.direction(x, y));
       const double len = std::sqrt(b.x * b.x + b.y * b.y + b.z * b.z);
       if (!(-b.z > 1e-12 * len))
         return Error{"", "",

@@ -20,17 +20,6 @@ namespace {
 
 constexpr double kYFov = 60.0 * std::numbers::pi / 180.0;
 
-struct Dvec {
-  double x, y, z;
-};
-Dvec operator+(Dvec a, Dvec b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-Dvec operator*(Dvec a, double s) { return {a.x * s, a.y * s, a.z * s}; }
-double dotd(Dvec a, Dvec b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-Dvec crossd(Dvec a, Dvec b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-Dvec unit(Dvec a) { return a * (1.0 / std::sqrt(dotd(a, a))); }
-
 }  // namespace
 
 Result<SubmitOrder> parseSubmitOrder(const std::string& text) {
@@ -92,9 +81,9 @@ Scene generateTris(const TrisParams& p, TrisStats* stats) {
   const double tanHalf = std::tan(kYFov / 2);
   // Pixel → eye-space direction at depth 1 (camera at the origin looking down −Z).
   auto rayAt = [&](double px, double py) {
-    return Dvec{(2 * px / w - 1) * tanHalf * aspect, (1 - 2 * py / h) * tanHalf, -1};
+    return Vec3d{(2 * px / w - 1) * tanHalf * aspect, (1 - 2 * py / h) * tanHalf, -1};
   };
-  auto project = [&](Dvec q, double& px, double& py) {
+  auto project = [&](Vec3d q, double& px, double& py) {
     px = (q.x / (-q.z) / (tanHalf * aspect) + 1) * 0.5 * w;
     py = (1 - q.y / (-q.z) / tanHalf) * 0.5 * h;
   };
@@ -114,7 +103,7 @@ Scene generateTris(const TrisParams& p, TrisStats* stats) {
     return std::uniform_real_distribution<double>(a, b)(uvRng);
   };
   struct Tri {
-    Dvec v[3];
+    Vec3d v[3];
     float uv[3][2];
     float c[3][3];
     double distance;
@@ -126,20 +115,20 @@ Scene generateTris(const TrisParams& p, TrisStats* stats) {
     const double distance = uniform(2, 20);
     const double sx = w / 2 + (uniform(0, 1) - 0.5) * regionW;
     const double sy = h / 2 + (uniform(0, 1) - 0.5) * regionH;
-    const Dvec dir = unit(rayAt(sx, sy));
-    const Dvec centre = dir * (distance / -dir.z);  // at view depth `distance`
+    const Vec3d dir = normalize(rayAt(sx, sy));
+    const Vec3d centre = dir * (distance / -dir.z);  // at view depth `distance`
     // Plane normal: the direction back to the eye, tilted by up to 60° about a random axis.
-    const Dvec back = dir * -1.0;
-    Dvec helper = std::fabs(back.x) < 0.9 ? Dvec{1, 0, 0} : Dvec{0, 1, 0};
-    const Dvec a1 = unit(crossd(back, helper)), a2 = crossd(back, a1);
+    const Vec3d back = dir * -1.0;
+    Vec3d helper = std::fabs(back.x) < 0.9 ? Vec3d{1, 0, 0} : Vec3d{0, 1, 0};
+    const Vec3d a1 = normalize(cross(back, helper)), a2 = cross(back, a1);
     const double tilt = uniform(0, 60) * std::numbers::pi / 180,
                  azimuth = uniform(0, 2 * std::numbers::pi);
-    const Dvec axis = a1 * std::cos(azimuth) + a2 * std::sin(azimuth);
-    const Dvec n = back * std::cos(tilt) + crossd(axis, back) * std::sin(tilt);
-    const Dvec e1 = unit(crossd(n, helper)), e2 = crossd(n, e1);
+    const Vec3d axis = a1 * std::cos(azimuth) + a2 * std::sin(azimuth);
+    const Vec3d n = back * std::cos(tilt) + cross(axis, back) * std::sin(tilt);
+    const Vec3d e1 = normalize(cross(n, helper)), e2 = cross(n, e1);
     // A roughly equilateral triangle of unit scale in that plane.
     double angle = uniform(0, 2 * std::numbers::pi);
-    Dvec local[3];
+    Vec3d local[3];
     for (int k = 0; k < 3; ++k) {
       const double r = uniform(0.75, 1.25);
       local[k] = e1 * (r * std::cos(angle)) + e2 * (r * std::sin(angle));
@@ -169,9 +158,9 @@ Scene generateTris(const TrisParams& p, TrisStats* stats) {
       const double uvPerWorld = rho / (kTextureSide * pixelWorld);
       const double u0 = uvUniform(0, 1), v0 = uvUniform(0, 1);
       for (int k = 0; k < 3; ++k) {
-        const Dvec d = local[k] * scale;
-        t.uv[k][0] = float(u0 + dotd(d, e1) * uvPerWorld);
-        t.uv[k][1] = float(v0 + dotd(d, e2) * uvPerWorld);
+        const Vec3d d = local[k] * scale;
+        t.uv[k][0] = float(u0 + dot(d, e1) * uvPerWorld);
+        t.uv[k][1] = float(v0 + dot(d, e2) * uvPerWorld);
       }
     }
     for (auto& c : t.c) {
