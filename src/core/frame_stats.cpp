@@ -37,7 +37,8 @@ FrameStats& FrameStats::operator+=(const FrameStats& o) {
   freeFormMaskedCells += o.freeFormMaskedCells, freeFormBounds += o.freeFormBounds;
   freeFormRays += o.freeFormRays, freeFormHits += o.freeFormHits;
   terrains += o.terrains, terrainWindows += o.terrainWindows, terrainSteps += o.terrainSteps;
-  terrainRays += o.terrainRays, terrainHits += o.terrainHits;
+  terrainPacketRays += o.terrainPacketRays, terrainRays += o.terrainRays;
+  terrainHits += o.terrainHits;
   terrainBytes = std::max(terrainBytes, o.terrainBytes);  // the scene's, in every view alike
   terrainLoadMs = std::max(terrainLoadMs, o.terrainLoadMs);
   lightPoints += o.lightPoints, lightsDrawn += o.lightsDrawn, lightsMs += o.lightsMs;
@@ -87,21 +88,20 @@ std::string FrameStats::summary() const {
                                   freeForms, freeFormCells, freeFormMaskedCells, freeFormBounds,
                                   freeFormRays, freeFormHits)
                     : std::string()) +
-         (terrains ? fmt::format(" | terrain {}: windows {}, steps {}, rays {}, hits {}, "
-                                 "{:.1f} MB, loaded in {:.1f} ms",
-                                 terrains, terrainWindows, terrainSteps, terrainRays, terrainHits,
-                                 terrainBytes / 1e6, terrainLoadMs)
+         (terrains ? fmt::format(" | terrain {}: windows {}, steps {}, rays {} in packets and {} "
+                                 "alone, hits {}, {:.1f} MB, loaded in {:.1f} ms",
+                                 terrains, terrainWindows, terrainSteps, terrainPacketRays,
+                                 terrainRays, terrainHits, terrainBytes / 1e6, terrainLoadMs)
                    : std::string()) +
-         (lightPoints ? fmt::format(" | lights {}: drawn {}, {:.2f} ms", lightPoints, lightsDrawn,
-                                    lightsMs)
-                      : std::string()) +
+         (lightPoints
+              ? fmt::format(" | lights {}: drawn {}, {:.2f} ms", lightPoints, lightsDrawn, lightsMs)
+              : std::string()) +
          (lines ? fmt::format(" | lines {}: drawn {}, {:.2f} ms", lines, linesDrawn, linesMs)
                 : std::string()) +
          (shareBytes ? fmt::format(" | shared: {} bytes exchanged, {:.2f} ms", shareBytes, shareMs)
                      : std::string()) +
          (volumes ? fmt::format(" | volumes {}: rays {}, samples {}, skipped {}, terminated {}",
-                                volumes, volumeRays, volumeSamples, volumeSkipped,
-                                volumeTerminated)
+                                volumes, volumeRays, volumeSamples, volumeSkipped, volumeTerminated)
                   : std::string());
 }
 

@@ -330,6 +330,61 @@ double Caster::solveBilinear(Vec3d o, Vec3d d, double sa, double sb, int level) 
   return std::numeric_limits<double>::quiet_NaN();
 }
 
+void Caster::walkPacket(Packet& p, int level, int maxCells, CastCounters& c) const {
+  // The level's grid, as solveBilinear's: x = x0 + s·ex in its sample steps, z in table codes.
+  const Pyramid::MeanLevel m = pyramid_.mean(level);
+  const double k = 1 / m.step, toCode = 1 / field_.scale;
+  const Vec3d& o = p.origin;
+  const double x0 = (ax_ * o.x + bx_) * k, y0 = (ay_ * o.z + by_) * k;
+  const double z0 = (o.y - field_.offset) * toCode;
+  const int count = std::clamp(p.count, 0, kPacketRays);
+  // The packet's reference s (its lanes' t = 0) and anchor: the first live lane's start, the
+  // sample at the corner of its cell (clamped to the grid), and the code nearest its height.
+  double sRef = kInf;
+  int first = -1;
+  for (int l = 0; l < count; ++l) {
+    p.hit[l] = std::numeric_limits<double>::quiet_NaN();
+    p.reached[l] = p.s1[l];
+    if (!(p.s0[l] <= p.s1[l])) continue;
+    if (first < 0) first = l;
+    sRef = std::min(sRef, p.s0[l]);
+  }
+  if (first < 0) return;
+  PacketGrid g;
+  g.q = m.q, g.width = m.width, g.cellsX = m.width - 1, g.cellsY = m.height - 1;
+  const Vec3d& d = p.dir[first];
+  auto corner = [](double v, int cells) {
+    return int(std::clamp(std::floor(std::clamp(v, 0.0, double(cells))), 0.0, double(cells - 1)));
+  };
+  g.anchorI = corner(x0 + sRef * ax_ * d.x * k, g.cellsX);
+  g.anchorJ = corner(y0 + sRef * ay_ * d.z * k, g.cellsY);
+  // An integer code (a float holds it exactly below 2^24).
+  g.anchorZ = float(std::clamp(std::round(z0 + sRef * d.y * toCode), -8388608.0, 8388608.0));
+  g.footX0 = float(-g.anchorI), g.footX1 = float((field_.width - 1) * k - g.anchorI);
+  g.footY0 = float(-g.anchorJ), g.footY1 = float((field_.height - 1) * k - g.anchorJ);
+  PacketLanes lanes;
+  for (int l = 0; l < count; ++l) {
+    if (!(p.s0[l] <= p.s1[l])) {
+      lanes.t0[l] = 0, lanes.t1[l] = -1;  // idle
+      lanes.x0[l] = lanes.y0[l] = lanes.z0[l] = lanes.ex[l] = lanes.ey[l] = lanes.ez[l] = 0;
+      continue;
+    }
+    const double ex = ax_ * p.dir[l].x * k, ey = ay_ * p.dir[l].z * k, ez = p.dir[l].y * toCode;
+    lanes.x0[l] = float(x0 + sRef * ex - g.anchorI);
+    lanes.y0[l] = float(y0 + sRef * ey - g.anchorJ);
+    lanes.z0[l] = float(z0 + sRef * ez - double(g.anchorZ));
+    lanes.ex[l] = float(ex), lanes.ey[l] = float(ey), lanes.ez[l] = float(ez);
+    lanes.t0[l] = float(p.s0[l] - sRef), lanes.t1[l] = float(p.s1[l] - sRef);
+    ++c.lanes;
+  }
+  terrain::walkPacket(g, lanes, count, maxCells);
+  for (int l = 0; l < count; ++l) {
+    if (!(p.s0[l] <= p.s1[l])) continue;
+    if (!std::isnan(lanes.hit[l])) p.hit[l] = sRef + double(lanes.hit[l]), ++c.hits;
+    if (std::isfinite(lanes.reached[l])) p.reached[l] = sRef + double(lanes.reached[l]);
+  }
+}
+
 double Caster::solveAt(Vec3d o, Vec3d d, double sa, double sb, int level) const {
   const bool bilinear = level < pyramid_.gridLevel() || interp_ == Interpolation::bilinear;
   if (placement_.radius <= 0 && bilinear) return solveBilinear(o, d, sa, sb, level);

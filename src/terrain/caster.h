@@ -19,6 +19,7 @@
 
 #include "core/quadric.h"
 #include "terrain/height_field.h"
+#include "terrain/packet_walk.h"
 #include "terrain/pyramid.h"
 
 namespace sv::terrain {
@@ -32,11 +33,13 @@ struct Placement {
 struct CastCounters {
   uint64_t windows = 0;  // screen windows marched
   uint64_t steps = 0;    // depth steps tested against the pyramid
+  uint64_t lanes = 0;    // rays walked in packets (walkPacket's live lanes)
   uint64_t rays = 0;     // single rays cast to the surface
   uint64_t solves = 0;   // finest-level steps solved against the interpolated surface
   uint64_t hits = 0;
   void add(const CastCounters& o) {
-    windows += o.windows, steps += o.steps, rays += o.rays, solves += o.solves, hits += o.hits;
+    windows += o.windows, steps += o.steps, lanes += o.lanes, rays += o.rays, solves += o.solves,
+        hits += o.hits;
   }
 };
 
@@ -95,6 +98,25 @@ class Caster {
   // Exact to 10⁻⁴ of a grid step along the ray.
   double cast(Vec3d origin, Vec3d dir, double s0, double s1, CastCounters& c,
               double pixel = 0) const;
+
+  // The rays of a block walked together (packet_walk.h), each at most `maxCells` cells of
+  // `level`'s bilinear surface from its start — what cast() does for one ray first, for a packet:
+  // the walk of every cell the ray crosses, the exact solve where it may touch. Only on the plane
+  // base with a bilinear surface at `level` (packetsApply). Lane l: origin + s·dir[l] over
+  // [s0[l], s1[l]]; hit[l] its first crossing there (NaN: none in the cells walked), reached[l]
+  // where a ray without one stopped (s1[l]: nothing before s1, else where to go on from).
+  struct Packet {
+    Vec3d origin;
+    int count = 0;
+    Vec3d dir[kPacketRays];
+    double s0[kPacketRays], s1[kPacketRays];
+    double hit[kPacketRays], reached[kPacketRays];
+  };
+  bool packetsApply(int level) const {
+    return placement_.radius <= 0 &&
+           (level < pyramid_.gridLevel() || interp_ == Interpolation::bilinear);
+  }
+  void walkPacket(Packet& p, int level, int maxCells, CastCounters& c) const;
 
   const HeightField& field() const { return field_; }
   const Pyramid& pyramid() const { return pyramid_; }

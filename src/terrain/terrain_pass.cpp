@@ -18,8 +18,13 @@ using raster::kTileSize;
 
 constexpr size_t kPlane = size_t(kTileSize) * kTileSize;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-// The window size whose pixels are cast from its start (TerrainPass::castWindow).
-constexpr int kPixelWindow = 2;
+// The window whose rays are walked together from its start, a packet a sample (castBlock): 4×4
+// pixels, 16 lanes.
+constexpr int kBlock = 4;
+static_assert(kBlock * kBlock == terrain::kPacketRays);
+// Cells each lane of a packet walks before the rays it has not finished go on alone (Caster::cast)
+// — the packet's share of the walk (docs/terrain.md, "Packets").
+constexpr int kPacketCells = 16;
 
 }  // namespace
 
@@ -110,6 +115,7 @@ void TerrainPass::addStats(FrameStats& stats) const {
   stats.terrains += terrains_.size();
   stats.terrainWindows += c.windows;
   stats.terrainSteps += c.steps;
+  stats.terrainPacketRays += c.lanes;
   stats.terrainRays += c.rays;
   stats.terrainHits += c.hits;
   stats.terrainBytes += groundBytes_;
@@ -181,128 +187,241 @@ void TerrainPass::castWindow(Scratch& w, const Drawn& t, int x0, int y0, int siz
       std::max(std::hypot(d1.x, d1.z), std::hypot(d2.x, d2.z)) / std::min(f.spacingU, f.spacingV);
   const double s = t.caster->march(b, start, limit, footprint, t.pixel, *w.counts);
   if (!(s < limit)) return;
-  // The smallest windows cast their pixels from their own start: a march of a smaller footprint
-  // first would find little the pixels' rays do not.
-  if (size <= kPixelWindow) {
-    for (int y = y0; y < y0 + size; ++y)
-      for (int x = x0; x < x0 + size; ++x) castPixel(w, t, x, y, s);
+  // A block's rays go on together from its start: a march of a smaller footprint first would
+  // find little that the walk of their cells does not.
+  if (size <= kBlock) {
+    castBlock(w, t, x0, y0, s);
     return;
   }
   const int h = size / 2;
   for (int c = 0; c < 4; ++c) castWindow(w, t, x0 + (c & 1) * h, y0 + (c >> 1) * h, h, s);
 }
 
-// Pixel (x, y) of the tile: its samples' rays cast from `start` to the depth each holds.
-void TerrainPass::castPixel(Scratch& w, const Drawn& t, int x, int y, double start) const {
-  const int gx = w.ox + x, gy = w.oy + y;
-  if (gx >= width_ || gy >= height_) return;
-  const size_t p = size_t(y * kTileSize + x);
-  bool any = false;
+// The 4×4 block at tile position (x0, y0): per sample, its 16 rays walked together from `start`
+// (Caster::walkPacket) to the depth each holds, a few cells each; those without a hit and depth
+// left go on alone (Caster::cast) from where their walk stopped.
+void TerrainPass::castBlock(Scratch& w, const Drawn& t, int x0, int y0, double start) const {
+  const Caster& c = *t.caster;
+  bool met[kPacketRays] = {};
   for (int k = 0; k < samples_; ++k) {
-    const size_t at = kPlane * size_t(k) + p;
-    const double lim = w.limit[at];
-    if (!(start < lim)) continue;
-    const Vec3d d = rays_.direction(gx + 0.5 + offsetX_[k], gy + 0.5 + offsetY_[k]);
-    const double hs = t.caster->cast(rays_.eye, d, start, lim, *w.counts, t.pixel);
-    if (std::isnan(hs) || !(rays_.sToDepth(hs) < w.depth[at])) continue;
-    w.hit[at] = hs;
-    any = true;
+    Caster::Packet p;
+    p.origin = rays_.eye;
+    p.count = kPacketRays;
+    // The packet's surface: the coarsest level of detail its rays ask for at the start (no ray
+    // walks cells finer than its footprint) — lodLevel falls as the stretch grows, so that of the
+    // longest stretch.
+    double stretch = 0;
+    size_t at[kPacketRays];
+    for (int l = 0; l < kPacketRays; ++l) {
+      const int x = x0 + (l & (kBlock - 1)), y = y0 + l / kBlock;
+      const int gx = w.ox + x, gy = w.oy + y;
+      at[l] = kPlane * size_t(k) + size_t(y * kTileSize + x);
+      p.dir[l] = rays_.direction(gx + 0.5 + offsetX_[k], gy + 0.5 + offsetY_[k]);
+      if (gx >= width_ || gy >= height_ || !(start < w.limit[at[l]])) {
+        p.s0[l] = 1, p.s1[l] = 0;  // beyond the raster, or masked: idle
+        continue;
+      }
+      p.s0[l] = start, p.s1[l] = w.limit[at[l]];
+      stretch = std::max(stretch, c.stretch(p.dir[l]));
+    }
+    const int level = c.lodLevel(start, t.pixel, stretch);
+    if (c.packetsApply(level)) {
+      c.walkPacket(p, level, kPacketCells, *w.counts);
+    } else {
+      for (int l = 0; l < kPacketRays; ++l) p.hit[l] = kNaN, p.reached[l] = p.s0[l];
+    }
+    for (int l = 0; l < kPacketRays; ++l) {
+      if (!(p.s0[l] <= p.s1[l])) continue;
+      double hs = p.hit[l];
+      if (std::isnan(hs) && p.reached[l] < p.s1[l])
+        hs = c.cast(rays_.eye, p.dir[l], p.reached[l], p.s1[l], *w.counts, t.pixel);
+      if (std::isnan(hs) || !(rays_.sToDepth(hs) < w.depth[at[l]])) continue;
+      w.hit[at[l]] = hs;
+      met[l] = true;
+    }
   }
-  if (any) w.pixels.push_back(int(p));
+  for (int l = 0; l < kPacketRays; ++l)
+    if (met[l]) w.pixels.push_back((y0 + l / kBlock) * kTileSize + x0 + (l & (kBlock - 1)));
+}
+
+// The draped image's placement (planar, SPEC §7): texture coordinates from map metres by the
+// image's bounds.
+struct TerrainPass::Drape {
+  const texture::Texture* image = nullptr;
+  double west = 0, south = 0, east = 1, north = 1, width = 1, height = 1;
+  explicit Drape(const Drawn& t)
+      : image(t.material.texture),
+        west(t.imageBounds[0]),
+        south(t.imageBounds[1]),
+        east(t.imageBounds[2]),
+        north(t.imageBounds[3]),
+        width(image ? image->level(0).width : 1),
+        height(image ? image->level(0).height : 1) {}
+};
+
+// Where a pixel's ray met the ground: its first sample's hit.
+struct TerrainPass::PixelHit {
+  double sx = 0, sy = 0, s = 0;  // the sample's raster position, the hit's depth
+  Vec3d d, point;
+  Caster::MapPoint m;
+  double gx = 0, gy = 0;  // the hit's grid position, clamped to the table
+  int level = 0;          // the level of detail of the surface met
+};
+
+TerrainPass::PixelHit TerrainPass::hitOf(const Scratch& w, const Drawn& t, int p) const {
+  const Caster& c = *t.caster;
+  const HeightField& f = *t.field;
+  const int lx = p % kTileSize, ly = p / kTileSize;
+  int k = 0;
+  while (std::isnan(w.hit[kPlane * size_t(k) + size_t(p)])) ++k;
+  PixelHit h;
+  h.sx = w.ox + lx + 0.5 + offsetX_[k], h.sy = w.oy + ly + 0.5 + offsetY_[k];
+  h.d = rays_.direction(h.sx, h.sy);
+  h.s = w.hit[kPlane * size_t(k) + size_t(p)];
+  h.point = rays_.eye + h.d * h.s;
+  h.m = c.toMap(h.point);
+  h.gx = std::clamp(h.m.gx, 0.0, double(f.width - 1));
+  h.gy = std::clamp(h.m.gy, 0.0, double(f.height - 1));
+  h.level = c.lodLevel(h.s, t.pixel, c.stretch(h.d));
+  return h;
+}
+
+// One pixel's eye position, normal, texture coordinates and detail texture, in double: the
+// general case (a sphere's base, bicubic heights, a detail texture) of what shadeLanes does.
+void TerrainPass::shadePixel(const Drawn& t, const Drape& drape, const PixelHit& h, int i,
+                             shade::Fragments& frag, shade::TexCoords& tc) const {
+  const Caster& c = *t.caster;
+  Vec3d eastDir, northDir;
+  // The normal of the surface the ray met: its level of detail's.
+  const Vec3d normal = c.normal(h.gx, h.gy, &eastDir, &northDir, h.level);
+  const Vec3d rel = h.point - rays_.eye;
+  frag.attribute[shade::kEyeX][i] = float(dot(rel, rays_.right));
+  frag.attribute[shade::kEyeY][i] = float(dot(rel, rays_.up));
+  frag.attribute[shade::kEyeZ][i] = float(-dot(rel, rays_.forward));
+  frag.attribute[shade::kNormalX][i] = float(dot(normal, rays_.right));
+  frag.attribute[shade::kNormalY][i] = float(dot(normal, rays_.up));
+  frag.attribute[shade::kNormalZ][i] = float(-dot(normal, rays_.forward));
+  const double u = c.mapU(h.gx), v = c.mapV(h.gy);
+  // The footprint (SPEC §7): where the next pixel's rays, right and down, meet the tangent plane
+  // at the hit — map metres per pixel along east and north.
+  double du[2] = {0, 0}, dv[2] = {0, 0};
+  bool finite = true;
+  for (int axis = 0; axis < 2; ++axis) {
+    const Vec3d dn = rays_.direction(h.sx + (axis == 0), h.sy + (axis == 1));
+    const double den = dot(normal, dn);
+    const double tt = std::fabs(den) > 1e-12 ? dot(normal, rel) / den : -1;
+    if (!(tt > 0) || !std::isfinite(tt)) {
+      finite = false;
+      break;
+    }
+    const Vec3d delta = dn * tt - rel;
+    du[axis] = dot(delta, eastDir);
+    dv[axis] = dot(delta, northDir);
+  }
+  if (!finite) du[0] = du[1] = dv[0] = dv[1] = 1e9;
+  if (drape.image) {
+    const double spanU = drape.east - drape.west, spanV = drape.north - drape.south;
+    const double tu = (u - drape.west) / spanU, tv = (drape.north - v) / spanV;
+    tc.x0[i] = float(tu * drape.width - 0.5);
+    tc.y0[i] = float(tv * drape.height - 0.5);
+    tc.lod[i] = t.material.levelZero
+                    ? 0.0f
+                    : lodOf(du[0] / spanU * drape.width, du[1] / spanU * drape.width,
+                            -dv[0] / spanV * drape.height, -dv[1] / spanV * drape.height);
+  }
+  if (t.detail) {
+    const double dw = t.detail->level(0).width, dh = t.detail->level(0).height;
+    const double k2 = 1 / t.detailSize;
+    const texture::Color4 texel = t.detail->sample(
+        texture::Filter::trilinear,
+        lodOf(du[0] * k2 * dw, du[1] * k2 * dw, -dv[0] * k2 * dh, -dv[1] * k2 * dh),
+        float(std::fmod(u * k2, 1.0) * dw - 0.5), float(std::fmod(-v * k2, 1.0) * dh - 0.5));
+    const float rgb[3] = {texel.r, texel.g, texel.b};
+    for (int ch = 0; ch < 3; ++ch) frag.color[ch][i] = frag.color[ch][i] * 2 * rgb[ch];
+  }
+}
+
+// The frame's constants of shadeLanes for terrain `t`.
+ShadeFrame TerrainPass::shadeFrame(const Drawn& t, const Drape& drape) const {
+  ShadeFrame f;
+  const Vec3d d0 = rays_.direction(0, 0);
+  const Vec3d dX = rays_.direction(1, 0) - d0, dY = rays_.direction(0, 1) - d0;
+  auto put = [](float* out, Vec3d v) {
+    out[0] = float(v.x), out[1] = float(v.y), out[2] = float(v.z);
+  };
+  put(f.d0, d0), put(f.dX, dX), put(f.dY, dY);
+  put(f.right, rays_.right), put(f.up, rays_.up), put(f.forward, rays_.forward);
+  const HeightField& field = *t.field;
+  f.spacingU = float(field.spacingU), f.spacingV = float(field.spacingV);
+  f.scale = float(field.scale);
+  f.image = drape.image != nullptr;
+  f.levelZero = t.material.levelZero;
+  const double spanU = drape.east - drape.west, spanV = drape.north - drape.south;
+  // texel x = ((originU + gx·spacingU) − west)/spanU·width − ½; y from north likewise.
+  f.perMetreX = float(drape.width / spanU), f.perMetreY = float(drape.height / spanV);
+  f.texX = float(field.spacingU * drape.width / spanU);
+  f.texX0 = float((field.originU - drape.west) * drape.width / spanU - 0.5);
+  f.texY = float(field.spacingV * drape.height / spanV);
+  f.texY0 = float((drape.north - field.originV) * drape.height / spanV - 0.5);
+  return f;
 }
 
 // Each pixel that met the ground, shaded once — at its first sample's hit — 16 to a call, and
-// written to every sample whose ray met the ground nearer than what the sample held.
+// written to every sample whose ray met the ground nearer than what the sample held. On the plane
+// with bilinear surfaces and no detail texture, the per-pixel work in SIMD lanes (shadeLanes).
 void TerrainPass::shadeHits(Scratch& w, const Drawn& t, const raster::TileTarget& tile) const {
   const Caster& c = *t.caster;
-  const HeightField& f = *t.field;
-  const texture::Texture* image = t.material.texture;
-  const double west = t.imageBounds[0], south = t.imageBounds[1], east = t.imageBounds[2],
-               north = t.imageBounds[3];
-  const double imageW = image ? image->level(0).width : 1,
-               imageH = image ? image->level(0).height : 1;
+  const Drape drape(t);
+  const ShadeFrame frame = shadeFrame(t, drape);
+  const bool lanesApply = c.placement().radius <= 0 && !t.detail;
+  const int n = c.pyramid().gridLevel();
   const int s = samples_;
   for (size_t begin = 0; begin < w.pixels.size(); begin += shade::kMaxFragments) {
-    const int n = int(std::min<size_t>(shade::kMaxFragments, w.pixels.size() - begin));
+    const int count = int(std::min<size_t>(shade::kMaxFragments, w.pixels.size() - begin));
     shade::Fragments frag;
     shade::TexCoords tc;
-    frag.count = n;
+    frag.count = count;
     for (int i = 0; i < shade::kMaxFragments; ++i) {
       frag.q[i] = 1;
       tc.lod[i] = tc.x0[i] = tc.y0[i] = 0;
       for (int a = 0; a < geometry::kAttributeCount; ++a) frag.attribute[a][i] = 0;
       for (int ch = 0; ch < 3; ++ch) frag.color[ch][i] = 0;
     }
-    for (int i = 0; i < n; ++i) {
-      const int p = w.pixels[begin + size_t(i)];
-      const int lx = p % kTileSize, ly = p / kTileSize;
-      int k = 0;
-      while (std::isnan(w.hit[kPlane * size_t(k) + size_t(p)])) ++k;
-      const double sx = w.ox + lx + 0.5 + offsetX_[k], sy = w.oy + ly + 0.5 + offsetY_[k];
-      const Vec3d d = rays_.direction(sx, sy);
-      const double hs = w.hit[kPlane * size_t(k) + size_t(p)];
-      const Vec3d point = rays_.eye + d * hs;
-      const Caster::MapPoint m = c.toMap(point);
-      const double gxc = std::clamp(m.gx, 0.0, double(f.width - 1));
-      const double gyc = std::clamp(m.gy, 0.0, double(f.height - 1));
-      Vec3d eastDir, northDir;
-      // The normal of the surface the ray met: its level of detail's.
-      const Vec3d normal =
-          c.normal(gxc, gyc, &eastDir, &northDir, c.lodLevel(hs, t.pixel, c.stretch(d)));
-      const Vec3d rel = point - rays_.eye;
-      frag.attribute[shade::kEyeX][i] = float(dot(rel, rays_.right));
-      frag.attribute[shade::kEyeY][i] = float(dot(rel, rays_.up));
-      frag.attribute[shade::kEyeZ][i] = float(-dot(rel, rays_.forward));
-      frag.attribute[shade::kNormalX][i] = float(dot(normal, rays_.right));
-      frag.attribute[shade::kNormalY][i] = float(dot(normal, rays_.up));
-      frag.attribute[shade::kNormalZ][i] = float(-dot(normal, rays_.forward));
-      const double u = c.mapU(gxc), v = c.mapV(gyc);
+    PixelHit hits[shade::kMaxFragments];
+    bool lanes = lanesApply;
+    for (int i = 0; i < count; ++i) {
+      hits[i] = hitOf(w, t, w.pixels[begin + size_t(i)]);
+      lanes = lanes && (hits[i].level < n || t.interp == Interpolation::bilinear);
       Vec3 color{t.color[0], t.color[1], t.color[2]};
-      if (!image) {
-        const Vec3 r = rampAt(t.ramp, m.h);
+      if (!drape.image) {
+        const Vec3 r = rampAt(t.ramp, hits[i].m.h);
         color = {color.x * r.x, color.y * r.y, color.z * r.z};
-      }
-      // The footprint (SPEC §7): where the next pixel's rays, right and down, meet the tangent
-      // plane at the hit — map metres per pixel along east and north.
-      double du[2] = {0, 0}, dv[2] = {0, 0};
-      bool finite = true;
-      for (int axis = 0; axis < 2; ++axis) {
-        const Vec3d dn = rays_.direction(sx + (axis == 0), sy + (axis == 1));
-        const double den = dot(normal, dn);
-        const double tt = std::fabs(den) > 1e-12 ? dot(normal, rel) / den : -1;
-        if (!(tt > 0) || !std::isfinite(tt)) {
-          finite = false;
-          break;
-        }
-        const Vec3d delta = dn * tt - rel;
-        du[axis] = dot(delta, eastDir);
-        dv[axis] = dot(delta, northDir);
-      }
-      if (!finite) du[0] = du[1] = dv[0] = dv[1] = 1e9;
-      if (image) {
-        const double tu = (u - west) / (east - west), tv = (north - v) / (north - south);
-        tc.x0[i] = float(tu * imageW - 0.5);
-        tc.y0[i] = float(tv * imageH - 0.5);
-        tc.lod[i] =
-            t.material.levelZero
-                ? 0.0f
-                : lodOf(du[0] / (east - west) * imageW, du[1] / (east - west) * imageW,
-                        -dv[0] / (north - south) * imageH, -dv[1] / (north - south) * imageH);
-      }
-      if (t.detail) {
-        const double dw = t.detail->level(0).width, dh = t.detail->level(0).height;
-        const double k2 = 1 / t.detailSize;
-        const texture::Color4 texel = t.detail->sample(
-            texture::Filter::trilinear,
-            lodOf(du[0] * k2 * dw, du[1] * k2 * dw, -dv[0] * k2 * dh, -dv[1] * k2 * dh),
-            float(std::fmod(u * k2, 1.0) * dw - 0.5), float(std::fmod(-v * k2, 1.0) * dh - 0.5));
-        color = {color.x * 2 * texel.r, color.y * 2 * texel.g, color.z * 2 * texel.b};
       }
       frag.color[0][i] = color.x, frag.color[1][i] = color.y, frag.color[2][i] = color.z;
     }
+    if (lanes) {
+      ShadeLanes in{};
+      for (int i = 0; i < count; ++i) {
+        const PixelHit& h = hits[i];
+        // The cell of the level met around the hit (meanSurface, caster.cpp).
+        const Pyramid::MeanLevel m = c.pyramid().mean(h.level);
+        const double x = std::clamp(h.gx / m.step, 0.0, double(m.width - 1));
+        const double y = std::clamp(h.gy / m.step, 0.0, double(m.height - 1));
+        const int ci = std::min(int(x), m.width - 2), cj = std::min(int(y), m.height - 2);
+        in.px[i] = float(h.sx), in.py[i] = float(h.sy), in.s[i] = float(h.s);
+        in.gx[i] = float(h.gx), in.gy[i] = float(h.gy);
+        in.cellU[i] = float(x - ci), in.cellV[i] = float(y - cj);
+        in.h00[i] = m.code(ci, cj), in.h10[i] = m.code(ci + 1, cj);
+        in.h01[i] = m.code(ci, cj + 1), in.h11[i] = m.code(ci + 1, cj + 1);
+        in.step[i] = float(m.step);
+      }
+      shadeLanes(frame, in, frag, tc);
+    } else {
+      for (int i = 0; i < count; ++i) shadePixel(t, drape, hits[i], i, frag, tc);
+    }
     alignas(64) float out[4][shade::kMaxFragments];
     shade::shadeFragments(t.material, *environment_, frag, tc, out);
-    for (int i = 0; i < n; ++i) {
+    for (int i = 0; i < count; ++i) {
       const int p = w.pixels[begin + size_t(i)];
       const int lx = p % kTileSize, ly = p / kTileSize;
       uint16_t c16[3];

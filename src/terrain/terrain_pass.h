@@ -18,6 +18,7 @@
 #include "synthvis/height_field.h"
 #include "terrain/caster.h"
 #include "terrain/ground.h"
+#include "terrain/shade_lanes.h"
 #include "texture/texture.h"
 
 namespace sv::terrain {
@@ -69,7 +70,13 @@ class TerrainPass final : public raster::TilePass {
   };
 
   void castWindow(Scratch& w, const Drawn& t, int x0, int y0, int size, double start) const;
-  void castPixel(Scratch& w, const Drawn& t, int x, int y, double start) const;
+  void castBlock(Scratch& w, const Drawn& t, int x0, int y0, double start) const;
+  struct Drape;
+  struct PixelHit;
+  PixelHit hitOf(const Scratch& w, const Drawn& t, int p) const;
+  void shadePixel(const Drawn& t, const Drape& drape, const PixelHit& h, int i,
+                  shade::Fragments& frag, shade::TexCoords& tc) const;
+  ShadeFrame shadeFrame(const Drawn& t, const Drape& drape) const;
   void shadeHits(Scratch& w, const Drawn& t, const raster::TileTarget& tile) const;
   std::vector<Drawn> terrains_;
   const shade::Environment* environment_ = nullptr;

@@ -7,9 +7,12 @@
 #include <random>
 
 #include "formats/heights.h"
+#include "terrain/dense_march.h"
 
 namespace sv::terrain {
 namespace {
+
+using tests::denseMarch;
 
 // Tables to cast over, made as the formats make them.
 using formats::generateFractal;
@@ -56,31 +59,6 @@ TEST(Pyramid, BicubicBoundsIncludeTheOvershoot) {
   const Pyramid p(f, Interpolation::bicubic);
   EXPECT_LE(p.node(p.gridLevel(), 2, 3).lo, low);
   EXPECT_LE(p.node(0, 0, 0).lo, low);
-}
-
-// The first crossing by a march of 1/256 cell, refined by bisection: the reference.
-double denseMarch(const Caster& c, Vec3d o, Vec3d d, double s0, double s1) {
-  const Caster::MapPoint a = c.toMap(o), b = c.toMap(o + d);
-  const double speed = std::max(std::hypot(b.gx - a.gx, b.gy - a.gy), 1e-9);
-  const double step = 1.0 / 256 / speed;
-  auto f = [&](double s) {
-    const Caster::MapPoint m = c.toMap(o + d * s);
-    const double h = c.surface(m.gx, m.gy);
-    return std::isnan(h) ? 1e300 : m.h - h;
-  };
-  double prev = s0;
-  for (double s = s0; s <= s1; s += step) {
-    if (f(s) <= 0) {
-      double lo = prev, hi = s;
-      for (int i = 0; i < 60; ++i) {
-        const double m = 0.5 * (lo + hi);
-        (f(m) <= 0 ? hi : lo) = m;
-      }
-      return hi;
-    }
-    prev = s;
-  }
-  return NAN;
 }
 
 void castAgainstDenseMarch(double radius) {

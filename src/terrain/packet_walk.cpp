@@ -1,0 +1,225 @@
+// Based on: SPEC §12 (the finest level: the ray against the interpolated surface), §11.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "terrain/packet_walk.cpp"
+// clang-format off: foreach_target.h first
+#include "hwy/foreach_target.h"  // IWYU pragma: keep
+#include "hwy/highway.h"
+// clang-format on
+
+#include <algorithm>
+#include <limits>
+
+#include "terrain/packet_walk.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace sv::terrain {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+// A vector of lanes' rays (packet_walk.h: x = x0 + t·ex, …) and a cell's corner codes.
+template <class DF>
+struct CellRays {
+  hn::Vec<DF> x0, y0, z0, ex, ey, ez;
+};
+template <class DF>
+struct Corners {
+  hn::Vec<DF> h00, h10, h01, h11;
+};
+
+// The lanes of `near` whose ray meets the cell's bilinear surface between t and out (the cell's
+// corner at (fi, fj) from the anchor): their first crossing into `hit`, the mask returned.
+template <class DF>
+hn::Mask<DF> SolveCell(DF df, const CellRays<DF>& r, hn::Mask<DF> near, hn::Vec<DF> t,
+                       hn::Vec<DF> out, hn::Vec<DF> fi, hn::Vec<DF> fj, const Corners<DF>& h,
+                       hn::Vec<DF>& hit) {
+  using VF = hn::Vec<DF>;
+  const VF zero = hn::Zero(df), half = hn::Set(df, 0.5f);
+  const VF inf = hn::Set(df, std::numeric_limits<float>::infinity());
+  if (hn::AllFalse(df, near)) return near;
+  // h = h00 + b·u + c·v + g·u·v, u = x − i, v = y − j; along the ray from t, z − h =
+  // f(τ) = A·τ² + B·τ + C. Whether f has a root in [0, span] needs no division: f(0) = C > 0
+  // (else the ray is below the surface at t already: met there); a root iff f(span) ≤ 0, or f is
+  // convex (A > 0) with its vertex −B/2A inside the span and a real root (disc ≥ 0).
+  const VF b = hn::Sub(h.h10, h.h00), c = hn::Sub(h.h01, h.h00);
+  const VF gg = hn::Add(hn::Sub(hn::Sub(h.h11, h.h10), h.h01), h.h00);
+  const VF u0 = hn::Sub(hn::Add(r.x0, hn::Mul(t, r.ex)), fi);
+  const VF v0 = hn::Sub(hn::Add(r.y0, hn::Mul(t, r.ey)), fj);
+  const VF A = hn::Neg(hn::Mul(hn::Mul(gg, r.ex), r.ey));
+  const VF B = hn::Sub(hn::Sub(hn::Sub(r.ez, hn::Mul(b, r.ex)), hn::Mul(c, r.ey)),
+                       hn::Mul(gg, hn::Add(hn::Mul(u0, r.ey), hn::Mul(v0, r.ex))));
+  const VF surface = hn::Add(hn::Add(hn::Add(h.h00, hn::Mul(b, u0)), hn::Mul(c, v0)),
+                             hn::Mul(hn::Mul(gg, u0), v0));
+  const VF C = hn::Sub(hn::Add(r.z0, hn::Mul(t, r.ez)), surface);
+  const VF span = hn::Sub(out, t);
+  const VF atEnd = hn::Add(hn::Mul(hn::Add(hn::Mul(A, span), B), span), C);
+  const VF disc = hn::Sub(hn::Mul(B, B), hn::Mul(hn::Mul(hn::Set(df, 4.0f), A), C));
+  const auto under = hn::Le(C, zero);
+  const auto vertexInside = hn::And(hn::And(hn::Gt(A, zero), hn::Lt(B, zero)),
+                                    hn::Lt(hn::Neg(B), hn::Mul(hn::Add(A, A), span)));
+  const auto met = hn::And(
+      near, hn::Or(hn::Or(under, hn::Le(atEnd, zero)), hn::And(vertexInside, hn::Ge(disc, zero))));
+  if (hn::AllFalse(df, met)) return met;
+  // The first root: of the stable pair q/A and C/q (q = −(B + sign(B)·√disc)/2), the smaller
+  // non-negative one (A = 0 makes q/A infinite and C/q = −C/B), within the span.
+  const VF q = hn::Neg(hn::Mul(half, hn::Add(B, hn::CopySign(hn::Sqrt(hn::Max(disc, zero)), B))));
+  const VF rootA = hn::Div(q, A);
+  const VF rootB = hn::IfThenElse(hn::Eq(q, zero), inf, hn::Div(C, q));
+  const VF firstA = hn::IfThenElse(hn::Ge(rootA, zero), rootA, inf);
+  const VF firstB = hn::IfThenElse(hn::Ge(rootB, zero), rootB, inf);
+  const VF root = hn::IfThenElse(under, zero, hn::Min(hn::Min(firstA, firstB), span));
+  hit = hn::IfThenElse(met, hn::Add(t, root), hit);
+  return met;
+}
+
+// One vector of lanes, from lane `first`: each lane's span clipped to the table's footprint, then
+// its cells walked (Amanatides–Woo) until it is done or has walked maxCells cells — per lane
+// Caster::solveBilinear's steps, in float.
+template <class DF>
+void WalkLanes(DF df, const PacketGrid& g, PacketLanes& L, size_t first, int maxCells) {
+  const hn::RebindToSigned<DF> di;
+  const hn::RebindToUnsigned<DF> du;
+  using VF = hn::Vec<DF>;
+  using VI = hn::Vec<decltype(di)>;
+  const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f);
+  const VF inf = hn::Set(df, std::numeric_limits<float>::infinity());
+  const VF x0 = hn::Load(df, L.x0 + first), y0 = hn::Load(df, L.y0 + first);
+  const VF z0 = hn::Load(df, L.z0 + first);
+  const VF ex = hn::Load(df, L.ex + first), ey = hn::Load(df, L.ey + first);
+  const VF ez = hn::Load(df, L.ez + first);
+  VF t = hn::Load(df, L.t0 + first), t1 = hn::Load(df, L.t1 + first);
+  const auto posX = hn::Gt(ex, zero), posY = hn::Gt(ey, zero);
+  const auto flatX = hn::Eq(ex, zero), flatY = hn::Eq(ey, zero);
+  // The footprint [footX0, footX1] × [footY0, footY1] (slabs): beyond it there is no surface, and
+  // where a ray enters it below the heights it meets the prism's wall.
+  auto active = hn::Le(t, t1);
+  auto clip = [&](VF p0, VF e, auto flat, float lo, float hi) {
+    const VF a = hn::Div(hn::Sub(hn::Set(df, lo), p0), e),
+             b = hn::Div(hn::Sub(hn::Set(df, hi), p0), e);
+    const auto outside = hn::Or(hn::Lt(p0, hn::Set(df, lo)), hn::Gt(p0, hn::Set(df, hi)));
+    active = hn::AndNot(hn::And(flat, outside), active);
+    t = hn::IfThenElse(flat, t, hn::Max(t, hn::Min(a, b)));
+    t1 = hn::IfThenElse(flat, t1, hn::Min(t1, hn::Max(a, b)));
+  };
+  clip(x0, ex, flatX, g.footX0, g.footX1);
+  clip(y0, ey, flatY, g.footY0, g.footY1);
+  active = hn::And(active, hn::Le(t, t1));
+  t = hn::IfThenElseZero(active, t);  // idle lanes: at the anchor's cell (a valid sample index)
+  // The cell holding the start (the last row and column belong to the cells before them),
+  // relative to the anchor.
+  auto cellOf = [&](VF p, int lo, int hi) {
+    const VI c = hn::ConvertTo(di, hn::Floor(hn::IfThenElseZero(active, p)));
+    return hn::Min(hn::Max(c, hn::Set(di, lo)), hn::Set(di, hi));
+  };
+  VI ci = cellOf(hn::Add(x0, hn::Mul(t, ex)), -g.anchorI, g.cellsX - 1 - g.anchorI);
+  VI cj = cellOf(hn::Add(y0, hn::Mul(t, ey)), -g.anchorJ, g.cellsY - 1 - g.anchorJ);
+  VF fi = hn::ConvertTo(df, ci), fj = hn::ConvertTo(df, cj);
+  VI index = hn::Add(hn::Mul(cj, hn::Set(di, g.width)), ci);  // from the anchor's sample
+  // Amanatides–Woo: where the ray crosses the next column and row boundary, and a cell's worth.
+  const VI stepI = hn::IfThenElse(hn::RebindMask(di, posX), hn::Set(di, 1), hn::Set(di, -1));
+  const VI stepJ = hn::IfThenElse(hn::RebindMask(di, posY), hn::Set(di, 1), hn::Set(di, -1));
+  const VI stepRow =
+      hn::IfThenElse(hn::RebindMask(di, posY), hn::Set(di, g.width), hn::Set(di, -g.width));
+  const VF stepFI = hn::IfThenElse(posX, one, hn::Neg(one));
+  const VF stepFJ = hn::IfThenElse(posY, one, hn::Neg(one));
+  const VF dtx = hn::IfThenElse(flatX, inf, hn::Div(one, hn::Abs(ex)));
+  const VF dty = hn::IfThenElse(flatY, inf, hn::Div(one, hn::Abs(ey)));
+  VF tx = hn::IfThenElse(flatX, inf,
+                         hn::Div(hn::Sub(hn::IfThenElse(posX, hn::Add(fi, one), fi), x0), ex));
+  VF ty = hn::IfThenElse(flatY, inf,
+                         hn::Div(hn::Sub(hn::IfThenElse(posY, hn::Add(fj, one), fj), y0), ey));
+  // Cells relative to the anchor (integer Gt and Lt: Highway 1.0 has no integer Ge, Le).
+  const VI belowX = hn::Set(di, -g.anchorI - 1), pastX = hn::Set(di, g.cellsX - g.anchorI);
+  const VI belowY = hn::Set(di, -g.anchorJ - 1), pastY = hn::Set(di, g.cellsY - g.anchorJ);
+  const VI row = hn::Set(di, 2 * g.width);  // bytes to the next row of samples
+  const int32_t* base = reinterpret_cast<const int32_t*>(g.q + size_t(g.anchorJ) * size_t(g.width) +
+                                                         size_t(g.anchorI));
+  const VI low16 = hn::Set(di, 0xFFFF);
+  const VF anchorZ = hn::Set(df, g.anchorZ);
+  VF hit = hn::Set(df, std::numeric_limits<float>::quiet_NaN());
+  VF reached = inf;
+  // The cell's four samples: two 32-bit reads a row, each two adjacent 16-bit codes. The next
+  // cell's are read before this cell is solved (the walk does not depend on the heights), so
+  // that the reads' latency overlaps the solve.
+  auto gather = [&](VI idx, VI& r0, VI& r1) {
+    const VI offset = hn::ShiftLeft<1>(idx);
+    r0 = hn::GatherOffset(di, base, offset);
+    r1 = hn::GatherOffset(di, base, hn::Add(offset, row));
+  };
+  VI r0, r1;
+  gather(index, r0, r1);
+  for (int cells = 0; cells < maxCells && !hn::AllFalse(df, active); ++cells) {
+    const VF out = hn::Min(hn::Min(tx, ty), t1);  // where each ray leaves its cell
+    auto codeLow = [&](VI r) { return hn::Sub(hn::ConvertTo(df, hn::And(r, low16)), anchorZ); };
+    auto codeHigh = [&](VI r) {
+      return hn::Sub(hn::ConvertTo(df, hn::BitCast(di, hn::ShiftRight<16>(hn::BitCast(du, r)))),
+                     anchorZ);
+    };
+    const VF h00 = codeLow(r0), h10 = codeHigh(r0), h01 = codeLow(r1), h11 = codeHigh(r1);
+    // The next cell (Amanatides–Woo), for the lanes that go on unless this cell stops them: t1
+    // reached, or the grid left (Caster::solveBilinear's misses both); a lane that leaves keeps
+    // its last, valid cell.
+    const auto goOn = hn::AndNot(hn::Ge(out, t1), active);
+    const auto alongX = hn::Le(tx, ty);
+    const auto moveX = hn::And(goOn, alongX), moveY = hn::AndNot(alongX, goOn);
+    const auto moveXi = hn::RebindMask(di, moveX), moveYi = hn::RebindMask(di, moveY);
+    const VI nextI = hn::Add(ci, hn::IfThenElseZero(moveXi, stepI));
+    const VI nextJ = hn::Add(cj, hn::IfThenElseZero(moveYi, stepJ));
+    const auto inside = hn::And(hn::And(hn::Gt(nextI, belowX), hn::Lt(nextI, pastX)),
+                                hn::And(hn::Gt(nextJ, belowY), hn::Lt(nextJ, pastY)));
+    const auto moves = hn::And(goOn, hn::RebindMask(df, inside));
+    const auto movesI = hn::RebindMask(di, moves);
+    const VI nextIndex = hn::IfThenElse(
+        movesI,
+        hn::Add(index,
+                hn::Add(hn::IfThenElseZero(moveXi, stepI), hn::IfThenElseZero(moveYi, stepRow))),
+        index);
+    VI n0, n1;
+    gather(nextIndex, n0, n1);
+    // This cell: solved only where the ray's lowest point in it is not above its highest corner.
+    const VF top = hn::Max(hn::Max(h00, h10), hn::Max(h01, h11));
+    const VF lowest = hn::Add(z0, hn::Mul(hn::IfThenElse(hn::Lt(ez, zero), out, t), ez));
+    const auto near = hn::And(active, hn::Le(lowest, top));
+    const auto met = SolveCell(df, CellRays<DF>{x0, y0, z0, ex, ey, ez}, near, t, out, fi, fj,
+                               Corners<DF>{h00, h10, h01, h11}, hit);
+    // On: the lanes that neither met the surface here nor stopped.
+    active = hn::AndNot(met, moves);
+    t = hn::IfThenElse(active, out, t);
+    ci = hn::IfThenElse(movesI, nextI, ci);
+    cj = hn::IfThenElse(movesI, nextJ, cj);
+    index = nextIndex;
+    fi = hn::IfThenElse(hn::And(moves, moveX), hn::Add(fi, stepFI), fi);
+    fj = hn::IfThenElse(hn::And(moves, moveY), hn::Add(fj, stepFJ), fj);
+    tx = hn::IfThenElse(hn::And(moves, moveX), hn::Add(tx, dtx), tx);
+    ty = hn::IfThenElse(hn::And(moves, moveY), hn::Add(ty, dty), ty);
+    r0 = n0, r1 = n1;
+  }
+  reached = hn::IfThenElse(active, t, reached);
+  hn::Store(hit, df, L.hit + first);
+  hn::Store(reached, df, L.reached + first);
+}
+
+void WalkPacket(const PacketGrid& grid, PacketLanes& lanes, int maxCells) {
+  const hn::CappedTag<float, kPacketRays> df;
+  for (size_t first = 0; first < size_t(kPacketRays); first += hn::Lanes(df))
+    WalkLanes(df, grid, lanes, first, maxCells);
+}
+
+}  // namespace HWY_NAMESPACE
+}  // namespace sv::terrain
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace sv::terrain {
+HWY_EXPORT(WalkPacket);
+
+void walkPacket(const PacketGrid& grid, PacketLanes& lanes, int count, int maxCells) {
+  // The lanes past `count`: idle.
+  for (int l = std::max(count, 0); l < kPacketRays; ++l) {
+    lanes.t0[l] = 0, lanes.t1[l] = -1;
+    lanes.x0[l] = lanes.y0[l] = lanes.z0[l] = lanes.ex[l] = lanes.ey[l] = lanes.ez[l] = 0;
+  }
+  HWY_DYNAMIC_DISPATCH(WalkPacket)(grid, lanes, maxCells);
+}
+
+}  // namespace sv::terrain
+#endif  // HWY_ONCE

@@ -1,0 +1,149 @@
+// Based on: SPEC §7 (the footprint's level of detail), §8, §11.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "terrain/shade_lanes.cpp"
+// clang-format off: foreach_target.h first
+#include "hwy/foreach_target.h"  // IWYU pragma: keep
+#include "hwy/highway.h"
+// clang-format on
+
+#include "terrain/shade_lanes.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace sv::terrain {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+template <class DF>
+using VF = hn::Vec<DF>;
+
+// log2 x for x ≥ 1 (finite): the exponent plus log2 of the mantissa m ∈ [1, 2) by the series of
+// atanh: log2 m = 2/ln 2 · (t + t³/3 + t⁵/5 + t⁷/7), t = (m − 1)/(m + 1) ≤ 1/3 — within 2·10⁻⁵,
+// plenty for a level of detail, and the same bits on every target (Mul and Add only).
+template <class DF>
+VF<DF> Log2AtLeastOne(DF df, VF<DF> x) {
+  const hn::RebindToSigned<DF> di;
+  const auto bits = hn::BitCast(di, x);
+  const VF<DF> exponent = hn::ConvertTo(df, hn::Sub(hn::ShiftRight<23>(bits), hn::Set(di, 127)));
+  const VF<DF> m =
+      hn::BitCast(df, hn::Or(hn::And(bits, hn::Set(di, 0x7FFFFF)), hn::Set(di, 0x3F800000)));
+  const VF<DF> one = hn::Set(df, 1.0f);
+  const VF<DF> t = hn::Div(hn::Sub(m, one), hn::Add(m, one)), t2 = hn::Mul(t, t);
+  VF<DF> series = hn::Set(df, 1.0f / 7);
+  series = hn::Add(hn::Mul(series, t2), hn::Set(df, 1.0f / 5));
+  series = hn::Add(hn::Mul(series, t2), hn::Set(df, 1.0f / 3));
+  series = hn::Add(hn::Mul(series, t2), one);
+  return hn::Add(exponent, hn::Mul(hn::Mul(series, t), hn::Set(df, 2.8853900817779268f)));
+}
+
+template <class DF>
+VF<DF> Dot(VF<DF> ax, VF<DF> ay, VF<DF> az, VF<DF> bx, VF<DF> by, VF<DF> bz) {
+  return hn::Add(hn::Add(hn::Mul(ax, bx), hn::Mul(ay, by)), hn::Mul(az, bz));
+}
+
+void ShadeLanesKernel(const ShadeFrame& f, const ShadeLanes& L, shade::Fragments& frag,
+                      shade::TexCoords& tc) {
+  const hn::CappedTag<float, shade::kMaxFragments> df;
+  using V = VF<decltype(df)>;
+  const V zero = hn::Zero(df), one = hn::Set(df, 1.0f), half = hn::Set(df, 0.5f);
+  auto set3 = [&](const float* v, V* out) {
+    for (int k = 0; k < 3; ++k) out[k] = hn::Set(df, v[k]);
+  };
+  V d0[3], dX[3], dY[3], right[3], up[3], forward[3];
+  set3(f.d0, d0), set3(f.dX, dX), set3(f.dY, dY);
+  set3(f.right, right), set3(f.up, up), set3(f.forward, forward);
+  for (size_t i = 0; i < size_t(frag.count); i += hn::Lanes(df)) {
+    const V px = hn::Load(df, L.px + i), py = hn::Load(df, L.py + i), s = hn::Load(df, L.s + i);
+    V d[3], rel[3];
+    for (int k = 0; k < 3; ++k) {
+      d[k] = hn::Add(hn::Add(d0[k], hn::Mul(dX[k], px)), hn::Mul(dY[k], py));
+      rel[k] = hn::Mul(d[k], s);
+    }
+    // The normal of the bilinear surface met (Caster::normal on the plane): its slopes per grid
+    // step in codes, per metre east and north, then (−∂h/∂east, 1, ∂h/∂north) normalized (north
+    // is −z).
+    const V u = hn::Load(df, L.cellU + i), v = hn::Load(df, L.cellV + i);
+    const V h00 = hn::Load(df, L.h00 + i), h10 = hn::Load(df, L.h10 + i);
+    const V h01 = hn::Load(df, L.h01 + i), h11 = hn::Load(df, L.h11 + i);
+    const V step = hn::Load(df, L.step + i);
+    const V top = hn::Add(h00, hn::Mul(hn::Sub(h10, h00), u));
+    const V bottom = hn::Add(h01, hn::Mul(hn::Sub(h11, h01), u));
+    const V slopeX = hn::Div(
+        hn::Add(hn::Mul(hn::Sub(h10, h00), hn::Sub(one, v)), hn::Mul(hn::Sub(h11, h01), v)), step);
+    const V slopeY = hn::Div(hn::Sub(bottom, top), step);
+    const V se = hn::Mul(slopeX, hn::Set(df, f.scale / f.spacingU));
+    const V sn = hn::Neg(hn::Mul(slopeY, hn::Set(df, f.scale / f.spacingV)));
+    const V inv = hn::Div(one, hn::Sqrt(hn::Add(hn::Add(hn::Mul(se, se), one), hn::Mul(sn, sn))));
+    const V n[3] = {hn::Neg(hn::Mul(se, inv)), inv, hn::Mul(sn, inv)};
+    const V eyeX = Dot<decltype(df)>(rel[0], rel[1], rel[2], right[0], right[1], right[2]);
+    const V eyeY = Dot<decltype(df)>(rel[0], rel[1], rel[2], up[0], up[1], up[2]);
+    const V eyeZ =
+        hn::Neg(Dot<decltype(df)>(rel[0], rel[1], rel[2], forward[0], forward[1], forward[2]));
+    hn::Store(eyeX, df, frag.attribute[shade::kEyeX] + i);
+    hn::Store(eyeY, df, frag.attribute[shade::kEyeY] + i);
+    hn::Store(eyeZ, df, frag.attribute[shade::kEyeZ] + i);
+    hn::Store(Dot<decltype(df)>(n[0], n[1], n[2], right[0], right[1], right[2]), df,
+              frag.attribute[shade::kNormalX] + i);
+    hn::Store(Dot<decltype(df)>(n[0], n[1], n[2], up[0], up[1], up[2]), df,
+              frag.attribute[shade::kNormalY] + i);
+    hn::Store(hn::Neg(Dot<decltype(df)>(n[0], n[1], n[2], forward[0], forward[1], forward[2])), df,
+              frag.attribute[shade::kNormalZ] + i);
+    if (!f.image) continue;
+    const V gx = hn::Load(df, L.gx + i), gy = hn::Load(df, L.gy + i);
+    hn::Store(hn::Add(hn::Mul(gx, hn::Set(df, f.texX)), hn::Set(df, f.texX0)), df, tc.x0 + i);
+    hn::Store(hn::Add(hn::Mul(gy, hn::Set(df, f.texY)), hn::Set(df, f.texY0)), df, tc.y0 + i);
+    if (f.levelZero) {
+      hn::Store(zero, df, tc.lod + i);
+      continue;
+    }
+    // The footprint: where the next pixel's rays, right and down, meet the tangent plane at the
+    // hit — map metres east (x) and north (−z) per pixel.
+    const V nRel = Dot<decltype(df)>(n[0], n[1], n[2], rel[0], rel[1], rel[2]);
+    V du[2], dv[2];
+    auto finite = hn::Eq(zero, zero);
+    for (int axis = 0; axis < 2; ++axis) {
+      const V* next = axis == 0 ? dX : dY;
+      const V dn[3] = {hn::Add(d[0], next[0]), hn::Add(d[1], next[1]), hn::Add(d[2], next[2])};
+      const V den = Dot<decltype(df)>(n[0], n[1], n[2], dn[0], dn[1], dn[2]);
+      const V tt = hn::Div(nRel, den);
+      finite =
+          hn::And(finite, hn::And(hn::Gt(hn::Abs(den), hn::Set(df, 1e-12f)),
+                                  hn::And(hn::Gt(tt, zero), hn::Lt(tt, hn::Set(df, 3.0e38f)))));
+      du[axis] = hn::Sub(hn::Mul(dn[0], tt), rel[0]);
+      dv[axis] = hn::Neg(hn::Sub(hn::Mul(dn[2], tt), rel[2]));
+    }
+    const V far = hn::Set(df, 1e9f);
+    const V pmX = hn::Set(df, f.perMetreX), pmY = hn::Set(df, f.perMetreY);
+    // lodOf (terrain_pass.cpp): ½·log2 σ₁² of the texel Jacobian [a b; c d], at least 0.
+    const V a = hn::Mul(hn::IfThenElse(finite, du[0], far), pmX);
+    const V b = hn::Mul(hn::IfThenElse(finite, du[1], far), pmX);
+    const V c = hn::Neg(hn::Mul(hn::IfThenElse(finite, dv[0], far), pmY));
+    const V e = hn::Neg(hn::Mul(hn::IfThenElse(finite, dv[1], far), pmY));
+    const V sum =
+        hn::Add(hn::Add(hn::Add(hn::Mul(a, a), hn::Mul(b, b)), hn::Mul(c, c)), hn::Mul(e, e));
+    const V det = hn::Sub(hn::Mul(a, e), hn::Mul(b, c));
+    const V major2 = hn::Mul(
+        half, hn::Add(sum, hn::Sqrt(hn::Max(hn::Sub(hn::Mul(sum, sum),
+                                                    hn::Mul(hn::Set(df, 4.0f), hn::Mul(det, det))),
+                                            zero))));
+    const auto above = hn::Gt(major2, one);
+    const V lod = hn::Min(hn::Mul(half, Log2AtLeastOne(df, hn::IfThenElse(above, major2, one))),
+                          hn::Set(df, 63.0f));
+    hn::Store(hn::IfThenElseZero(above, lod), df, tc.lod + i);
+  }
+}
+
+}  // namespace HWY_NAMESPACE
+}  // namespace sv::terrain
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace sv::terrain {
+HWY_EXPORT(ShadeLanesKernel);
+
+void shadeLanes(const ShadeFrame& frame, const ShadeLanes& lanes, shade::Fragments& frag,
+                shade::TexCoords& tc) {
+  HWY_DYNAMIC_DISPATCH(ShadeLanesKernel)(frame, lanes, frag, tc);
+}
+
+}  // namespace sv::terrain
+#endif  // HWY_ONCE
