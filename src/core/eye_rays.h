@@ -97,11 +97,18 @@ struct EyeRays {
     return r;
   }
 
-  // The ray through raster point (px, py), its component along `axis` 1 (s is depth).
-  Vec3d direction(double px, double py) const {
-    if (projective) return ndc0 + ndcX * (2 * px / width - 1) + ndcY * (1 - 2 * py / height);
-    return forward + right * ((2 * px / width - 1) * halfX + centreX) +
-           up * ((1 - 2 * py / height) * halfY + centreY);
+  // The ray through raster point (px, py), its component along `axis` 1 (s is depth): the sum
+  // (base + column(px)) + row(py), which a pass that casts many rays of a column or row may
+  // evaluate from the terms it keeps, to the same bits.
+  Vec3d direction(double px, double py) const { return (base() + column(px)) + row(py); }
+  Vec3d base() const { return projective ? ndc0 : forward; }
+  Vec3d column(double px) const {
+    return projective ? ndcX * (2 * px / width - 1)
+                      : right * ((2 * px / width - 1) * halfX + centreX);
+  }
+  Vec3d row(double py) const {
+    return projective ? ndcY * (1 - 2 * py / height)
+                      : up * ((1 - 2 * py / height) * halfY + centreY);
   }
   // Half the view's height in direction per unit depth (at its centre, for a projective view): a
   // pixel spans 2·halfSpanY()/height there.

@@ -64,25 +64,11 @@ double meanSurface(const Pyramid::MeanLevel& m, double gx, double gy, double* dx
 
 }  // namespace
 
-int Caster::lodLevel(double s, double pixel, double stretch) const {
-  const double w = pixel * s * stretch;
-  const int n = pyramid_.gridLevel();
-  if (!(w > 1)) return n;
-  return std::max(n - int(std::ceil(std::log2(w))), 0);
-}
-
-double Caster::stretch(Vec3d d) const {
-  const double r = std::sqrt(dot(d, d));
-  // On a sphere the base's normal varies; the view's vertical is near enough for a level choice.
-  return std::min(kMaxStretch, r / std::max(std::fabs(d.y), 1e-300));
-}
-
 double Caster::surface(double gx, double gy, int level) const {
   if (!(gx >= 0 && gy >= 0 && gx <= field_.width - 1 && gy <= field_.height - 1))
     return std::numeric_limits<double>::quiet_NaN();
   if (level >= pyramid_.gridLevel()) return interpolate(field_, interp_, gx, gy);
-  return field_.offset +
-         field_.scale * meanSurface(pyramid_.mean(level), gx, gy, nullptr, nullptr);
+  return field_.offset + field_.scale * meanSurface(pyramid_.mean(level), gx, gy, nullptr, nullptr);
 }
 
 Vec3d Caster::normal(double gx, double gy, Vec3d* eastOut, Vec3d* northOut, int level) const {
@@ -108,8 +94,7 @@ Vec3d Caster::normal(double gx, double gy, Vec3d* eastOut, Vec3d* northOut, int 
 
 double Caster::gridSpeed(const Bundle& b) const {
   double v = 0;
-  for (const Vec3d& d : b.corner)
-    v = std::max({v, std::fabs(d.x) * ax_, std::fabs(d.z) * ay_});
+  for (const Vec3d& d : b.corner) v = std::max({v, std::fabs(d.x) * ax_, std::fabs(d.z) * ay_});
   return std::max(v, 1e-300);
 }
 
@@ -128,9 +113,12 @@ Caster::Box Caster::bounds(const Bundle& b, double sa, double sb) const {
       box.gy1 = std::max({box.gy1, z0, z1});
     }
     const Vec3d& o = b.origin;
-    return {ax_ * (o.x + box.gx0) + bx_, ax_ * (o.x + box.gx1) + bx_,
-            ay_ * (o.z + box.gy0) + by_, ay_ * (o.z + box.gy1) + by_,
-            o.y + box.h0,                o.y + box.h1};
+    return {ax_ * (o.x + box.gx0) + bx_,
+            ax_ * (o.x + box.gx1) + bx_,
+            ay_ * (o.z + box.gy0) + by_,
+            ay_ * (o.z + box.gy1) + by_,
+            o.y + box.h0,
+            o.y + box.h1};
   }
   // The sphere: the hull of the eight points maps by central projection to the hull of their
   // images (a projective map keeps convexity in front of its centre); heights from the farthest
@@ -171,9 +159,7 @@ double Caster::march(const Bundle& b, double s, double s1, double footprint, dou
   // The bundle's longest stretch on the ground: its coarsest level of detail.
   double stretchMax = 1;
   for (const Vec3d& d : b.corner) stretchMax = std::max(stretchMax, stretch(d));
-  auto stopAt = [&](double at) {
-    return std::min(levelFor(at), lodLevel(at, pixel, stretchMax));
-  };
+  auto stopAt = [&](double at) { return std::min(levelFor(at), lodLevel(at, pixel, stretchMax)); };
   int level = stopAt(s);
   int empties = 0;
   while (s < s1) {
@@ -187,11 +173,11 @@ double Caster::march(const Bundle& b, double s, double s1, double footprint, dou
     // Where a mean level is drawn, one node more on every side: its surface over a node reads its
     // neighbours' samples (pyramid.h), and stops at `level` or finer never read further.
     const int grow = lodLevel(s, pixel, stretchMax) < pyramid_.gridLevel() ? 1 : 0;
-    const Pyramid::Range r = pyramid_.range(
-        level, int(std::floor(std::max(box.gx0, -1.0) * inv)) - grow,
-        int(std::floor(std::min(box.gx1, 1e9) * inv)) + grow,
-        int(std::floor(std::max(box.gy0, -1.0) * inv)) - grow,
-        int(std::floor(std::min(box.gy1, 1e9) * inv)) + grow);
+    const Pyramid::Range r =
+        pyramid_.range(level, int(std::floor(std::max(box.gx0, -1.0) * inv)) - grow,
+                       int(std::floor(std::min(box.gx1, 1e9) * inv)) + grow,
+                       int(std::floor(std::max(box.gy0, -1.0) * inv)) - grow,
+                       int(std::floor(std::min(box.gy1, 1e9) * inv)) + grow);
     if (r.hi < r.lo || box.h0 > r.hi + margin_) {
       // Wholly above the surface (or beyond the table): on, and after two such steps coarser.
       s = sb;
@@ -282,7 +268,8 @@ double Caster::solveBilinear(Vec3d o, Vec3d d, double sa, double sb, int level) 
   double s = sa;
   // The cell holding the point at s (the last row and column belong to the cells before them).
   double x = x0 + s * ex, y = y0 + s * ey;
-  int i = std::clamp(int(std::floor(x)), 0, cellsX - 1), j = std::clamp(int(std::floor(y)), 0, cellsY - 1);
+  int i = std::clamp(int(std::floor(x)), 0, cellsX - 1),
+      j = std::clamp(int(std::floor(y)), 0, cellsY - 1);
   // Amanatides–Woo: the parameters where the ray crosses the next column and row boundary,
   // advanced by a cell's worth each step.
   const int stepI = ex > 0 ? 1 : -1, stepJ = ey > 0 ? 1 : -1;
@@ -356,8 +343,11 @@ void Caster::walkPacket(Packet& p, int level, int maxCells, CastCounters& c) con
   auto corner = [](double v, int cells) {
     return int(std::clamp(std::floor(std::clamp(v, 0.0, double(cells))), 0.0, double(cells - 1)));
   };
-  g.anchorI = corner(x0 + sRef * ax_ * d.x * k, g.cellsX);
-  g.anchorJ = corner(y0 + sRef * ay_ * d.z * k, g.cellsY);
+  const Pyramid::TopLevel tops = pyramid_.tops(level);
+  g.top = tops.top, g.topWidth = tops.width;
+  // The anchor: the corner of the skip map's square holding the first lane's start.
+  g.anchorI = corner(x0 + sRef * ax_ * d.x * k, g.cellsX) & ~(Pyramid::kTopCells - 1);
+  g.anchorJ = corner(y0 + sRef * ay_ * d.z * k, g.cellsY) & ~(Pyramid::kTopCells - 1);
   // An integer code (a float holds it exactly below 2^24).
   g.anchorZ = float(std::clamp(std::round(z0 + sRef * d.y * toCode), -8388608.0, 8388608.0));
   g.footX0 = float(-g.anchorI), g.footX1 = float((field_.width - 1) * k - g.anchorI);
@@ -382,6 +372,48 @@ void Caster::walkPacket(Packet& p, int level, int maxCells, CastCounters& c) con
     if (!(p.s0[l] <= p.s1[l])) continue;
     if (!std::isnan(lanes.hit[l])) p.hit[l] = sRef + double(lanes.hit[l]), ++c.hits;
     if (std::isfinite(lanes.reached[l])) p.reached[l] = sRef + double(lanes.reached[l]);
+  }
+}
+
+void Caster::walkPacketLevels(Packet& p, double pixel, double stretch, int maxCells,
+                              CastCounters& c) const {
+  const int n = pyramid_.gridLevel();
+  const int count = std::clamp(p.count, 0, kPacketRays);
+  Packet left = p;  // each lane's span not walked yet (s0 > s1: none)
+  for (int l = 0; l < count; ++l)
+    p.hit[l] = std::numeric_limits<double>::quiet_NaN(), p.reached[l] = p.s0[l];
+  // Each round a coarser level (at `end`, where the last stopped, lodLevel is still that level).
+  for (int last = n + 1;;) {
+    double from = kInf;
+    for (int l = 0; l < count; ++l)
+      if (left.s0[l] <= left.s1[l]) from = std::min(from, left.s0[l]);
+    if (!std::isfinite(from) || last == 0) return;
+    const int level = std::min(lodLevel(from, pixel, stretch), last - 1);
+    last = level;
+    if (!packetsApply(level)) return;  // the lanes left go on alone from their starts
+    // lodLevel is `level` while pixel·s·stretch ≤ 2^(n − level).
+    const double end =
+        pixel > 0 && level > 0 ? std::ldexp(1.0, n - level) / (pixel * stretch) : kInf;
+    Packet walk = left;
+    for (int l = 0; l < count; ++l)
+      if (left.s0[l] <= left.s1[l] && left.s0[l] < end) {
+        walk.s1[l] = std::min(left.s1[l], end);
+      } else {
+        walk.s0[l] = 1, walk.s1[l] = 0;  // idle this round
+      }
+    walkPacket(walk, level, maxCells, c);
+    for (int l = 0; l < count; ++l) {
+      if (!(walk.s0[l] <= walk.s1[l])) continue;
+      const bool hit = !std::isnan(walk.hit[l]);
+      const bool done = hit || walk.reached[l] >= left.s1[l];
+      if (hit) p.hit[l] = walk.hit[l];
+      p.reached[l] = walk.reached[l];
+      if (done || walk.reached[l] < walk.s1[l]) {
+        left.s0[l] = 1, left.s1[l] = 0;  // finished, or stopped: alone from `reached`
+      } else {
+        left.s0[l] = walk.s1[l];  // on at the next level
+      }
+    }
   }
 }
 

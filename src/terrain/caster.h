@@ -14,6 +14,7 @@
 // curvature has dropped the ground by 3 km.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 
@@ -76,8 +77,17 @@ class Caster {
   // is that width stretched by 1/sin of the ray's angle with the base (at most kMaxStretch).
   // pixel = 0: level n everywhere (the host's queries).
   static constexpr double kMaxStretch = 4;
-  int lodLevel(double s, double pixel, double stretch) const;
-  double stretch(Vec3d dir) const;
+  int lodLevel(double s, double pixel, double stretch) const {
+    const double w = pixel * s * stretch;
+    const int n = pyramid_.gridLevel();
+    if (!(w > 1)) return n;
+    return std::max(n - int(std::ceil(std::log2(w))), 0);
+  }
+  double stretch(Vec3d d) const {
+    const double r = std::sqrt(dot(d, d));
+    // On a sphere the base's normal varies; the view's vertical is near enough for a level choice.
+    return std::min(kMaxStretch, r / std::max(std::fabs(d.y), 1e-300));
+  }
 
   // The surface's height at grid (gx, gy) — level `level` of detail, the table's interpolated
   // surface at level n (and by default); NaN beyond the table's footprint.
@@ -117,6 +127,14 @@ class Caster {
            (level < pyramid_.gridLevel() || interp_ == Interpolation::bilinear);
   }
   void walkPacket(Packet& p, int level, int maxCells, CastCounters& c) const;
+  // The packet walked at the levels of detail along its rays (SPEC §11, work bounded by the
+  // footprint): from the nearest lane's start at that start's level (`pixel` as for lodLevel,
+  // `stretch` the longest of its rays'), each level over the span where it is the level of detail
+  // — then the next coarser one. Results as walkPacket's; a lane whose walk stopped after
+  // maxCells steps at some level, or that reached a level where packets do not apply, has
+  // `reached` where to go on from alone (cast()).
+  void walkPacketLevels(Packet& p, double pixel, double stretch, int maxCells,
+                        CastCounters& c) const;
 
   const HeightField& field() const { return field_; }
   const Pyramid& pyramid() const { return pyramid_; }

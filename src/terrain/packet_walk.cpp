@@ -10,6 +10,7 @@
 #include <limits>
 
 #include "terrain/packet_walk.h"
+#include "terrain/pyramid.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace sv::terrain {
@@ -71,9 +72,34 @@ hn::Mask<DF> SolveCell(DF df, const CellRays<DF>& r, hn::Mask<DF> near, hn::Vec<
   return met;
 }
 
+// The lanes' spans [t, t1] clipped to the footprint [footX0, footX1] × [footY0, footY1] (slabs):
+// beyond it there is no surface, and where a ray enters it below the heights it meets the prism's
+// wall. The lanes left with a span.
+template <class DF>
+hn::Mask<DF> ClipToFootprint(DF df, const PacketGrid& g, hn::Vec<DF> x0, hn::Vec<DF> y0,
+                             hn::Vec<DF> ex, hn::Vec<DF> ey, hn::Vec<DF>& t, hn::Vec<DF>& t1) {
+  using VF = hn::Vec<DF>;
+  auto active = hn::Le(t, t1);
+  auto clip = [&](VF p0, VF e, float lo, float hi) {
+    const auto flat = hn::Eq(e, hn::Zero(df));
+    const VF a = hn::Div(hn::Sub(hn::Set(df, lo), p0), e),
+             b = hn::Div(hn::Sub(hn::Set(df, hi), p0), e);
+    const auto outside = hn::Or(hn::Lt(p0, hn::Set(df, lo)), hn::Gt(p0, hn::Set(df, hi)));
+    active = hn::AndNot(hn::And(flat, outside), active);
+    t = hn::IfThenElse(flat, t, hn::Max(t, hn::Min(a, b)));
+    t1 = hn::IfThenElse(flat, t1, hn::Min(t1, hn::Max(a, b)));
+  };
+  clip(x0, ex, g.footX0, g.footX1);
+  clip(y0, ey, g.footY0, g.footY1);
+  return hn::And(active, hn::Le(t, t1));
+}
+
 // One vector of lanes, from lane `first`: each lane's span clipped to the table's footprint, then
-// its cells walked (Amanatides–Woo) until it is done or has walked maxCells cells — per lane
-// Caster::solveBilinear's steps, in float.
+// walked until it is done or has taken maxCells steps — per lane Caster::solveBilinear's cells, in
+// float, with the skip map's squares passed at once (SPEC §12: a node the ray stays above is
+// skipped). Per step a lane is in one cell; where it has just entered a square, it first asks
+// whether its ray stays above the square's top from there until it leaves the square: then the
+// step takes it to the next square, else it solves the cell as any other.
 template <class DF>
 void WalkLanes(DF df, const PacketGrid& g, PacketLanes& L, size_t first, int maxCells) {
   const hn::RebindToSigned<DF> di;
@@ -89,113 +115,133 @@ void WalkLanes(DF df, const PacketGrid& g, PacketLanes& L, size_t first, int max
   VF t = hn::Load(df, L.t0 + first), t1 = hn::Load(df, L.t1 + first);
   const auto posX = hn::Gt(ex, zero), posY = hn::Gt(ey, zero);
   const auto flatX = hn::Eq(ex, zero), flatY = hn::Eq(ey, zero);
-  // The footprint [footX0, footX1] × [footY0, footY1] (slabs): beyond it there is no surface, and
-  // where a ray enters it below the heights it meets the prism's wall.
-  auto active = hn::Le(t, t1);
-  auto clip = [&](VF p0, VF e, auto flat, float lo, float hi) {
-    const VF a = hn::Div(hn::Sub(hn::Set(df, lo), p0), e),
-             b = hn::Div(hn::Sub(hn::Set(df, hi), p0), e);
-    const auto outside = hn::Or(hn::Lt(p0, hn::Set(df, lo)), hn::Gt(p0, hn::Set(df, hi)));
-    active = hn::AndNot(hn::And(flat, outside), active);
-    t = hn::IfThenElse(flat, t, hn::Max(t, hn::Min(a, b)));
-    t1 = hn::IfThenElse(flat, t1, hn::Min(t1, hn::Max(a, b)));
-  };
-  clip(x0, ex, flatX, g.footX0, g.footX1);
-  clip(y0, ey, flatY, g.footY0, g.footY1);
-  active = hn::And(active, hn::Le(t, t1));
+  auto active = ClipToFootprint(df, g, x0, y0, ex, ey, t, t1);
   t = hn::IfThenElseZero(active, t);  // idle lanes: at the anchor's cell (a valid sample index)
   // The cell holding the start (the last row and column belong to the cells before them),
-  // relative to the anchor.
-  auto cellOf = [&](VF p, int lo, int hi) {
+  // relative to the anchor; and the range of cells, inclusive.
+  const VI loI = hn::Set(di, -g.anchorI), hiI = hn::Set(di, g.cellsX - 1 - g.anchorI);
+  const VI loJ = hn::Set(di, -g.anchorJ), hiJ = hn::Set(di, g.cellsY - 1 - g.anchorJ);
+  auto cellOf = [&](VF p, VI lo, VI hi) {
     const VI c = hn::ConvertTo(di, hn::Floor(hn::IfThenElseZero(active, p)));
-    return hn::Min(hn::Max(c, hn::Set(di, lo)), hn::Set(di, hi));
+    return hn::Min(hn::Max(c, lo), hi);
   };
-  VI ci = cellOf(hn::Add(x0, hn::Mul(t, ex)), -g.anchorI, g.cellsX - 1 - g.anchorI);
-  VI cj = cellOf(hn::Add(y0, hn::Mul(t, ey)), -g.anchorJ, g.cellsY - 1 - g.anchorJ);
-  VF fi = hn::ConvertTo(df, ci), fj = hn::ConvertTo(df, cj);
-  VI index = hn::Add(hn::Mul(cj, hn::Set(di, g.width)), ci);  // from the anchor's sample
-  // Amanatides–Woo: where the ray crosses the next column and row boundary, and a cell's worth.
+  VI ci = cellOf(hn::Add(x0, hn::Mul(t, ex)), loI, hiI);
+  VI cj = cellOf(hn::Add(y0, hn::Mul(t, ey)), loJ, hiJ);
+  // Where the ray crosses x = X: (X − x0)/ex, as a product (flat axes: never).
+  const VF invX = hn::IfThenElse(flatX, zero, hn::Div(one, ex));
+  const VF invY = hn::IfThenElse(flatY, zero, hn::Div(one, ey));
+  auto cross = [&](VF boundary, VF p0, VF inv, auto flat) {
+    return hn::IfThenElse(flat, inf, hn::Mul(hn::Sub(boundary, p0), inv));
+  };
   const VI stepI = hn::IfThenElse(hn::RebindMask(di, posX), hn::Set(di, 1), hn::Set(di, -1));
   const VI stepJ = hn::IfThenElse(hn::RebindMask(di, posY), hn::Set(di, 1), hn::Set(di, -1));
-  const VI stepRow =
-      hn::IfThenElse(hn::RebindMask(di, posY), hn::Set(di, g.width), hn::Set(di, -g.width));
-  const VF stepFI = hn::IfThenElse(posX, one, hn::Neg(one));
-  const VF stepFJ = hn::IfThenElse(posY, one, hn::Neg(one));
-  const VF dtx = hn::IfThenElse(flatX, inf, hn::Div(one, hn::Abs(ex)));
-  const VF dty = hn::IfThenElse(flatY, inf, hn::Div(one, hn::Abs(ey)));
-  VF tx = hn::IfThenElse(flatX, inf,
-                         hn::Div(hn::Sub(hn::IfThenElse(posX, hn::Add(fi, one), fi), x0), ex));
-  VF ty = hn::IfThenElse(flatY, inf,
-                         hn::Div(hn::Sub(hn::IfThenElse(posY, hn::Add(fj, one), fj), y0), ey));
-  // Cells relative to the anchor (integer Gt and Lt: Highway 1.0 has no integer Ge, Le).
-  const VI belowX = hn::Set(di, -g.anchorI - 1), pastX = hn::Set(di, g.cellsX - g.anchorI);
-  const VI belowY = hn::Set(di, -g.anchorJ - 1), pastY = hn::Set(di, g.cellsY - g.anchorJ);
-  const VI row = hn::Set(di, 2 * g.width);  // bytes to the next row of samples
+  const VI squareMask = hn::Set(di, ~(Pyramid::kTopCells - 1));  // a cell → its square's first
+  const VF squareCells = hn::Set(df, float(Pyramid::kTopCells));
+  const VI width = hn::Set(di, g.width), topWidth = hn::Set(di, g.topWidth);
   const int32_t* base = reinterpret_cast<const int32_t*>(g.q + size_t(g.anchorJ) * size_t(g.width) +
                                                          size_t(g.anchorI));
+  const int32_t* topBase = reinterpret_cast<const int32_t*>(
+      g.top + size_t(g.anchorJ / Pyramid::kTopCells) * size_t(g.topWidth) +
+      size_t(g.anchorI / Pyramid::kTopCells));
+  const VI row = hn::Set(di, 2 * g.width);  // bytes to the next row of samples
   const VI low16 = hn::Set(di, 0xFFFF);
   const VF anchorZ = hn::Set(df, g.anchorZ);
   VF hit = hn::Set(df, std::numeric_limits<float>::quiet_NaN());
-  VF reached = inf;
-  // The cell's four samples: two 32-bit reads a row, each two adjacent 16-bit codes. The next
-  // cell's are read before this cell is solved (the walk does not depend on the heights), so
-  // that the reads' latency overlaps the solve.
-  auto gather = [&](VI idx, VI& r0, VI& r1) {
-    const VI offset = hn::ShiftLeft<1>(idx);
+  // A cell's four samples: two 32-bit reads a row, each two adjacent 16-bit codes; its square's
+  // top: one read. The next step's are read before this step's cell is solved (where a lane goes
+  // next does not depend on whether it meets the surface here), so that the reads' latency
+  // overlaps the solve.
+  auto gather = [&](VI i, VI j, VI& r0, VI& r1, VI& top) {
+    const VI offset = hn::ShiftLeft<1>(hn::Add(hn::Mul(j, width), i));
     r0 = hn::GatherOffset(di, base, offset);
     r1 = hn::GatherOffset(di, base, hn::Add(offset, row));
+    const VI square = hn::Add(hn::Mul(hn::ShiftRight<Pyramid::kTopShift>(j), topWidth),
+                              hn::ShiftRight<Pyramid::kTopShift>(i));
+    top = hn::GatherOffset(di, topBase, hn::ShiftLeft<1>(square));
   };
-  VI r0, r1;
-  gather(index, r0, r1);
-  for (int cells = 0; cells < maxCells && !hn::AllFalse(df, active); ++cells) {
-    const VF out = hn::Min(hn::Min(tx, ty), t1);  // where each ray leaves its cell
-    auto codeLow = [&](VI r) { return hn::Sub(hn::ConvertTo(df, hn::And(r, low16)), anchorZ); };
-    auto codeHigh = [&](VI r) {
-      return hn::Sub(hn::ConvertTo(df, hn::BitCast(di, hn::ShiftRight<16>(hn::BitCast(du, r)))),
-                     anchorZ);
-    };
-    const VF h00 = codeLow(r0), h10 = codeHigh(r0), h01 = codeLow(r1), h11 = codeHigh(r1);
-    // The next cell (Amanatides–Woo), for the lanes that go on unless this cell stops them: t1
-    // reached, or the grid left (Caster::solveBilinear's misses both); a lane that leaves keeps
-    // its last, valid cell.
+  auto code = [&](VI r) { return hn::Sub(hn::ConvertTo(df, hn::And(r, low16)), anchorZ); };
+  auto codeHigh = [&](VI r) {
+    return hn::Sub(hn::ConvertTo(df, hn::BitCast(di, hn::ShiftRight<16>(hn::BitCast(du, r)))),
+                   anchorZ);
+  };
+  auto entered = active;  // lanes that have just entered a square
+  VI r0, r1, rTop;
+  gather(ci, cj, r0, r1, rTop);
+  for (int steps = 0; steps < maxCells && !hn::AllFalse(df, active); ++steps) {
+    const VF fi = hn::ConvertTo(df, ci), fj = hn::ConvertTo(df, cj);
+    const VI si = hn::And(ci, squareMask), sj = hn::And(cj, squareMask);
+    const VF fsi = hn::ConvertTo(df, si), fsj = hn::ConvertTo(df, sj);
+    // Where the ray leaves its cell and its square.
+    const VF txCell = cross(hn::IfThenElse(posX, hn::Add(fi, one), fi), x0, invX, flatX);
+    const VF tyCell = cross(hn::IfThenElse(posY, hn::Add(fj, one), fj), y0, invY, flatY);
+    const VF txSquare =
+        cross(hn::IfThenElse(posX, hn::Add(fsi, squareCells), fsi), x0, invX, flatX);
+    const VF tySquare =
+        cross(hn::IfThenElse(posY, hn::Add(fsj, squareCells), fsj), y0, invY, flatY);
+    const VF outCell = hn::Max(hn::Min(hn::Min(txCell, tyCell), t1), t);
+    const VF outSquare = hn::Max(hn::Min(hn::Min(txSquare, tySquare), t1), t);
+    // The square passed: its top below the ray's lowest point in it from t on.
+    const VF lowestInSquare =
+        hn::Add(z0, hn::Mul(hn::IfThenElse(hn::Lt(ez, zero), outSquare, t), ez));
+    const auto skip = hn::And(hn::And(entered, active), hn::Gt(lowestInSquare, code(rTop)));
+    // This step's end: the square's exit for the lanes that pass it, the cell's for the rest.
+    const VF tx = hn::IfThenElse(skip, txSquare, txCell);
+    const VF ty = hn::IfThenElse(skip, tySquare, tyCell);
+    const VF out = hn::IfThenElse(skip, outSquare, outCell);
+    // The next cell, for the lanes that go on unless this cell stops them: t1 reached, or the
+    // grid left (Caster::solveBilinear's misses both); a lane that leaves keeps its last, valid
+    // cell. Out of a square, the next square's cell where the ray enters it.
     const auto goOn = hn::AndNot(hn::Ge(out, t1), active);
-    const auto alongX = hn::Le(tx, ty);
-    const auto moveX = hn::And(goOn, alongX), moveY = hn::AndNot(alongX, goOn);
-    const auto moveXi = hn::RebindMask(di, moveX), moveYi = hn::RebindMask(di, moveY);
-    const VI nextI = hn::Add(ci, hn::IfThenElseZero(moveXi, stepI));
-    const VI nextJ = hn::Add(cj, hn::IfThenElseZero(moveYi, stepJ));
-    const auto inside = hn::And(hn::And(hn::Gt(nextI, belowX), hn::Lt(nextI, pastX)),
-                                hn::And(hn::Gt(nextJ, belowY), hn::Lt(nextJ, pastY)));
+    const auto alongX = hn::RebindMask(di, hn::Le(tx, ty));
+    const auto skipI = hn::RebindMask(di, skip);
+    const VI squareEnd = hn::Set(di, Pyramid::kTopCells - 1);
+    const VI acrossI = hn::IfThenElse(
+        skipI,
+        hn::IfThenElse(hn::RebindMask(di, posX), hn::Add(si, hn::Set(di, Pyramid::kTopCells)),
+                       hn::Sub(si, hn::Set(di, 1))),
+        hn::Add(ci, stepI));
+    const VI acrossJ = hn::IfThenElse(
+        skipI,
+        hn::IfThenElse(hn::RebindMask(di, posY), hn::Add(sj, hn::Set(di, Pyramid::kTopCells)),
+                       hn::Sub(sj, hn::Set(di, 1))),
+        hn::Add(cj, stepJ));
+    // Along the axis not crossed a lane that passed a square is in the cell where it leaves it.
+    auto within = [&](VF p, VI cell, VI square) {
+      const VI c = hn::ConvertTo(di, hn::Floor(p));
+      return hn::IfThenElse(skipI, hn::Min(hn::Max(c, square), hn::Add(square, squareEnd)), cell);
+    };
+    const VF outFinite = hn::IfThenElse(hn::IsFinite(out), out, t);
+    const VI alongI = within(hn::Add(x0, hn::Mul(outFinite, ex)), ci, si);
+    const VI alongJ = within(hn::Add(y0, hn::Mul(outFinite, ey)), cj, sj);
+    const VI nextI = hn::IfThenElse(alongX, acrossI, hn::Min(hn::Max(alongI, loI), hiI));
+    const VI nextJ = hn::IfThenElse(alongX, hn::Min(hn::Max(alongJ, loJ), hiJ), acrossJ);
+    const auto inside = hn::And(hn::And(hn::Gt(nextI, hn::Sub(loI, hn::Set(di, 1))),
+                                        hn::Lt(nextI, hn::Add(hiI, hn::Set(di, 1)))),
+                                hn::And(hn::Gt(nextJ, hn::Sub(loJ, hn::Set(di, 1))),
+                                        hn::Lt(nextJ, hn::Add(hiJ, hn::Set(di, 1)))));
     const auto moves = hn::And(goOn, hn::RebindMask(df, inside));
     const auto movesI = hn::RebindMask(di, moves);
-    const VI nextIndex = hn::IfThenElse(
-        movesI,
-        hn::Add(index,
-                hn::Add(hn::IfThenElseZero(moveXi, stepI), hn::IfThenElseZero(moveYi, stepRow))),
-        index);
-    VI n0, n1;
-    gather(nextIndex, n0, n1);
-    // This cell: solved only where the ray's lowest point in it is not above its highest corner.
+    const VI ni = hn::IfThenElse(movesI, nextI, ci), nj = hn::IfThenElse(movesI, nextJ, cj);
+    VI n0, n1, nTop;
+    gather(ni, nj, n0, n1, nTop);
+    // This cell, for the lanes that did not pass its square: solved only where the ray's lowest
+    // point in it is not above its highest corner.
+    const VF h00 = code(r0), h10 = codeHigh(r0), h01 = code(r1), h11 = codeHigh(r1);
     const VF top = hn::Max(hn::Max(h00, h10), hn::Max(h01, h11));
-    const VF lowest = hn::Add(z0, hn::Mul(hn::IfThenElse(hn::Lt(ez, zero), out, t), ez));
-    const auto near = hn::And(active, hn::Le(lowest, top));
-    const auto met = SolveCell(df, CellRays<DF>{x0, y0, z0, ex, ey, ez}, near, t, out, fi, fj,
+    const VF lowest = hn::Add(z0, hn::Mul(hn::IfThenElse(hn::Lt(ez, zero), outCell, t), ez));
+    const auto near = hn::AndNot(skip, hn::And(active, hn::Le(lowest, top)));
+    const auto met = SolveCell(df, CellRays<DF>{x0, y0, z0, ex, ey, ez}, near, t, outCell, fi, fj,
                                Corners<DF>{h00, h10, h01, h11}, hit);
     // On: the lanes that neither met the surface here nor stopped.
     active = hn::AndNot(met, moves);
     t = hn::IfThenElse(active, out, t);
-    ci = hn::IfThenElse(movesI, nextI, ci);
-    cj = hn::IfThenElse(movesI, nextJ, cj);
-    index = nextIndex;
-    fi = hn::IfThenElse(hn::And(moves, moveX), hn::Add(fi, stepFI), fi);
-    fj = hn::IfThenElse(hn::And(moves, moveY), hn::Add(fj, stepFJ), fj);
-    tx = hn::IfThenElse(hn::And(moves, moveX), hn::Add(tx, dtx), tx);
-    ty = hn::IfThenElse(hn::And(moves, moveY), hn::Add(ty, dty), ty);
-    r0 = n0, r1 = n1;
+    entered = hn::RebindMask(df, hn::Or(hn::Not(hn::Eq(hn::And(ni, squareMask), si)),
+                                        hn::Not(hn::Eq(hn::And(nj, squareMask), sj))));
+    ci = ni, cj = nj;
+    r0 = n0, r1 = n1, rTop = nTop;
   }
-  reached = hn::IfThenElse(active, t, reached);
   hn::Store(hit, df, L.hit + first);
-  hn::Store(reached, df, L.reached + first);
+  hn::Store(hn::IfThenElse(active, t, inf), df, L.reached + first);
 }
 
 void WalkPacket(const PacketGrid& grid, PacketLanes& lanes, int maxCells) {

@@ -22,13 +22,18 @@ constexpr int kPacketRays = 16;
 
 // The surface a packet walks: one level's samples (Pyramid::MeanLevel, or the table itself), its
 // cells [0, cellsX) × [0, cellsY), the table's footprint in the level's steps from the anchor
-// (its last samples may lie beyond it), and the anchor the lanes' coordinates are relative to.
+// (its last samples may lie beyond it), its skip map (Pyramid::TopLevel: the top of each square of
+// Pyramid::kTopCells² cells), and the anchor the lanes' coordinates are relative to.
 struct PacketGrid {
   const uint16_t* q = nullptr;  // width × (cellsY + 1) codes, row-major
   int width = 0;                // samples a row (≥ cellsX + 1)
   int cellsX = 0, cellsY = 0;
-  int anchorI = 0, anchorJ = 0;  // the sample the lanes' x, y are measured from (a cell's corner)
-  float anchorZ = 0;             // the code their z is measured from (an integer)
+  const uint16_t* top = nullptr;  // topWidth × ⌈cellsY / kTopCells⌉ codes, and one of padding
+  int topWidth = 0;
+  // The sample the lanes' x, y are measured from: a corner of a skip map's square (multiples of
+  // Pyramid::kTopCells).
+  int anchorI = 0, anchorJ = 0;
+  float anchorZ = 0;  // the code their z is measured from (an integer)
   float footX0 = 0, footX1 = 0, footY0 = 0, footY1 = 0;
 };
 
@@ -46,9 +51,11 @@ struct PacketLanes {
   alignas(64) float hit[kPacketRays], reached[kPacketRays];
 };
 
-// Walks the packet's lanes at most `maxCells` cells each (the first `count` lanes; the rest are
-// left idle). Cells: a lane solves only where its lowest point in the cell is not above the
-// cell's highest corner, exactly as Caster::solveBilinear.
+// Walks the packet's lanes at most `maxCells` steps each (the first `count` lanes; the rest are
+// left idle). A step is a cell, or a square of the skip map passed at once: where a lane enters a
+// square whose top its ray stays above until it leaves it. Cells: a lane solves only where its
+// lowest point in the cell is not above the cell's highest corner, exactly as
+// Caster::solveBilinear.
 void walkPacket(const PacketGrid& grid, PacketLanes& lanes, int count, int maxCells);
 
 }  // namespace sv::terrain

@@ -13,8 +13,7 @@ constexpr double kBicubicOvershoot = 9.0 / 32.0;
 
 }  // namespace
 
-Pyramid::Pyramid(const HeightField& field, Interpolation interp)
-    : field_(&field), interp_(interp) {
+Pyramid::Pyramid(const HeightField& field, Interpolation interp) : field_(&field), interp_(interp) {
   cellsX_ = field.width - 1;
   cellsY_ = field.height - 1;
   n_ = 1;
@@ -113,6 +112,44 @@ Pyramid::Pyramid(const HeightField& field, Interpolation interp)
     meanW_[size_t(k)] = w;
     meanH_[size_t(k)] = h;
   }
+  buildTops();
+}
+
+void Pyramid::buildTops() {
+  tops_.resize(size_t(n_) + 1);
+  topW_.resize(size_t(n_) + 1);
+  topH_.resize(size_t(n_) + 1);
+  for (int k = 0; k <= n_; ++k) {
+    const MeanLevel m = mean(k);
+    const int w = (m.width - 1 + kTopCells - 1) / kTopCells;
+    const int h = (m.height - 1 + kTopCells - 1) / kTopCells;
+    // Per node column the highest sample of each row it reads, then per node over its rows.
+    std::vector<uint16_t> rows(size_t(w) * size_t(m.height));
+    for (int j = 0; j < m.height; ++j) {
+      const uint16_t* row = m.q + size_t(j) * size_t(m.width);
+      for (int I = 0; I < w; ++I) {
+        uint16_t mx = 0;
+        for (int i = I * kTopCells; i <= std::min((I + 1) * kTopCells, m.width - 1); ++i)
+          mx = std::max(mx, row[i]);
+        rows[size_t(j) * size_t(w) + size_t(I)] = mx;
+      }
+    }
+    std::vector<uint16_t>& top = tops_[size_t(k)];
+    top.assign(size_t(w) * size_t(h) + 1, 0);
+    for (int J = 0; J < h; ++J)
+      for (int j = J * kTopCells; j <= std::min((J + 1) * kTopCells, m.height - 1); ++j)
+        for (int I = 0; I < w; ++I) {
+          uint16_t& t = top[size_t(J) * size_t(w) + size_t(I)];
+          t = std::max(t, rows[size_t(j) * size_t(w) + size_t(I)]);
+        }
+    topW_[size_t(k)] = w;
+    topH_[size_t(k)] = h;
+  }
+}
+
+Pyramid::TopLevel Pyramid::tops(int level) const {
+  const size_t k = size_t(std::clamp(level, 0, n_));
+  return {topW_[k], topH_[k], tops_[k].data()};
 }
 
 Pyramid::MeanLevel Pyramid::mean(int level) const {
@@ -158,6 +195,7 @@ size_t Pyramid::bytes() const {
   size_t b = 0;
   for (const auto& l : levels_) b += l.size() * sizeof(Bound);
   for (const auto& l : means_) b += l.size() * sizeof(uint16_t);
+  for (const auto& l : tops_) b += l.size() * sizeof(uint16_t);
   return b;
 }
 

@@ -58,19 +58,36 @@ class Pyramid {
   };
   MeanLevel mean(int level) const;
 
+  // The packets' skip map beside each level of detail (packet_walk.h): for level k (0 … n, n the
+  // table), the highest of its samples over each square of kTopCells × kTopCells of its cells —
+  // the top of that square's bilinear surface, exactly, in the level's own codes. A packet's lane
+  // passes a square whose top its ray stays above at once instead of cell by cell. Node (I, J)
+  // covers cells kTopCells·I … kTopCells·(I + 1) − 1 (clamped to the level's cells); one code of
+  // padding after the last node, for 32-bit reads.
+  static constexpr int kTopShift = 2;
+  static constexpr int kTopCells = 1 << kTopShift;
+  struct TopLevel {
+    int width = 0, height = 0;  // nodes
+    const uint16_t* top = nullptr;
+  };
+  TopLevel tops(int level) const;
+
  private:
   struct Bound {
     uint16_t lo, hi;  // codes of boundOffset_ + boundScale_·code, rounded outward
   };
   int n_ = 0, cellsX_ = 0, cellsY_ = 0;
   double boundOffset_ = 0, boundScale_ = 1;
-  std::vector<std::vector<Bound>> levels_;  // levels_[k]: 2^k × 2^k nodes, k = 0 … n − 1
-  std::vector<int> sideX_, sideY_;           // per level: the nodes over the footprint
+  std::vector<std::vector<Bound>> levels_;    // levels_[k]: 2^k × 2^k nodes, k = 0 … n − 1
+  std::vector<int> sideX_, sideY_;            // per level: the nodes over the footprint
   std::vector<std::vector<uint16_t>> means_;  // means_[k], k = 0 … n − 1 (MeanLevel)
   std::vector<int> meanW_, meanH_;
+  std::vector<std::vector<uint16_t>> tops_;  // tops_[k], k = 0 … n (TopLevel)
+  std::vector<int> topW_, topH_;
   const HeightField* field_ = nullptr;
   Interpolation interp_ = Interpolation::bilinear;
   Range cell(int i, int j) const;  // level n, computed from the table
+  void buildTops();
 };
 
 }  // namespace sv::terrain

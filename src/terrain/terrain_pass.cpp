@@ -27,6 +27,10 @@ static_assert(kBlock * kBlock == terrain::kPacketRays);
 // 4096², 16 cells a lane left 6 % of the rays to go on alone and took 119 ms a frame, 256 took
 // 84, 1024 80 (docs/terrain.md, "Packets"); the bound keeps a packet's work finite.
 constexpr int kPacketCells = 1024;
+// The windows whose 4×4 blocks walk as packets from the window's start: the windows' marches
+// above them (scalar, a bundle at a time) cost more than the packets' walk over the skip map's
+// squares (4096², one thread: 4 px 156 ms a frame, 8 px 143, 16 px 151).
+constexpr int kPacketWindow = 8;
 
 }  // namespace
 
@@ -73,6 +77,16 @@ struct TerrainPass::Scratch {
   // of 1 << k pixels (k = 0: pixels).
   std::vector<double> windowLimit[7];
   std::vector<int> pixels;  // the tile's pixels some sample of which met the ground
+  // The terms of the tile's rays (EyeRays::direction): per sample plane, its 64 columns' and 64
+  // rows'.
+  std::vector<Vec3d> column, row;
+  // Per pixel, the ray of its first sample that met the ground (where shading looks).
+  struct FirstHit {
+    Vec3d d;
+    double stretch;
+    int sample;
+  };
+  std::vector<FirstHit> first;
   CastCounters* counts = nullptr;
   int ox = 0, oy = 0;
 };
@@ -135,6 +149,14 @@ void TerrainPass::drawTile(const raster::TileTarget& tile) {
   w.depth.resize(kPlane * size_t(s));
   w.hit.resize(kPlane * size_t(s));
   for (int k = 0; k <= 6; ++k) w.windowLimit[k].resize(size_t(64 >> k) * size_t(64 >> k));
+  w.column.resize(size_t(kTileSize) * size_t(s));
+  w.row.resize(size_t(kTileSize) * size_t(s));
+  for (int k = 0; k < s; ++k)
+    for (int i = 0; i < kTileSize; ++i) {
+      w.column[size_t(k * kTileSize + i)] = rays_.column(w.ox + i + 0.5 + offsetX_[k]);
+      w.row[size_t(k * kTileSize + i)] = rays_.row(w.oy + i + 0.5 + offsetY_[k]);
+    }
+  w.first.resize(kPlane);
   for (const Drawn& t : terrains_) {
     // What the tile holds already (polygons, free forms, earlier terrains), as eye depths; per
     // pixel the farthest of its samples, per window the farthest of its pixels.
@@ -191,8 +213,12 @@ void TerrainPass::castWindow(Scratch& w, const Drawn& t, int x0, int y0, int siz
   if (!(s < limit)) return;
   // A block's rays go on together from its start: a march of a smaller footprint first would
   // find little that the walk of their cells does not.
-  if (size <= kBlock) {
-    castBlock(w, t, x0, y0, s);
+  // Packets walk from 8×8 windows where they apply at every level; where the table's own surface
+  // is cast ray by ray (bicubic, or on a sphere) the windows go down to the blocks.
+  const bool bilinear = t.interp == Interpolation::bilinear && t.placement.radius <= 0;
+  if (size <= (bilinear ? kPacketWindow : kBlock)) {
+    for (int y = 0; y < size; y += kBlock)
+      for (int x = 0; x < size; x += kBlock) castBlock(w, t, x0 + x, y0 + y, s);
     return;
   }
   const int h = size / 2;
@@ -205,33 +231,31 @@ void TerrainPass::castWindow(Scratch& w, const Drawn& t, int x0, int y0, int siz
 void TerrainPass::castBlock(Scratch& w, const Drawn& t, int x0, int y0, double start) const {
   const Caster& c = *t.caster;
   bool met[kPacketRays] = {};
+  const Vec3d base = rays_.base();
   for (int k = 0; k < samples_; ++k) {
     Caster::Packet p;
     p.origin = rays_.eye;
     p.count = kPacketRays;
-    // The packet's surface: the coarsest level of detail its rays ask for at the start (no ray
-    // walks cells finer than its footprint) — lodLevel falls as the stretch grows, so that of the
-    // longest stretch.
-    double stretch = 0;
+    // The packet's surfaces: at each depth the coarsest level of detail its rays ask for there
+    // (no ray walks cells finer than its footprint) — lodLevel falls as the stretch grows, so
+    // that of the longest stretch.
+    double stretch = 0, stretches[kPacketRays];
     size_t at[kPacketRays];
     for (int l = 0; l < kPacketRays; ++l) {
       const int x = x0 + (l & (kBlock - 1)), y = y0 + l / kBlock;
       const int gx = w.ox + x, gy = w.oy + y;
       at[l] = kPlane * size_t(k) + size_t(y * kTileSize + x);
-      p.dir[l] = rays_.direction(gx + 0.5 + offsetX_[k], gy + 0.5 + offsetY_[k]);
+      // rays_.direction(gx + 0.5 + offsetX_[k], gy + 0.5 + offsetY_[k]), from its terms.
+      p.dir[l] = (base + w.column[size_t(k * kTileSize + x)]) + w.row[size_t(k * kTileSize + y)];
       if (gx >= width_ || gy >= height_ || !(start < w.limit[at[l]])) {
         p.s0[l] = 1, p.s1[l] = 0;  // beyond the raster, or masked: idle
         continue;
       }
       p.s0[l] = start, p.s1[l] = w.limit[at[l]];
-      stretch = std::max(stretch, c.stretch(p.dir[l]));
+      stretches[l] = c.stretch(p.dir[l]);
+      stretch = std::max(stretch, stretches[l]);
     }
-    const int level = c.lodLevel(start, t.pixel, stretch);
-    if (c.packetsApply(level)) {
-      c.walkPacket(p, level, kPacketCells, *w.counts);
-    } else {
-      for (int l = 0; l < kPacketRays; ++l) p.hit[l] = kNaN, p.reached[l] = p.s0[l];
-    }
+    c.walkPacketLevels(p, t.pixel, stretch, kPacketCells, *w.counts);
     for (int l = 0; l < kPacketRays; ++l) {
       if (!(p.s0[l] <= p.s1[l])) continue;
       double hs = p.hit[l];
@@ -239,6 +263,7 @@ void TerrainPass::castBlock(Scratch& w, const Drawn& t, int x0, int y0, double s
         hs = c.cast(rays_.eye, p.dir[l], p.reached[l], p.s1[l], *w.counts, t.pixel);
       if (std::isnan(hs) || !(rays_.sToDepth(hs) < w.depth[at[l]])) continue;
       w.hit[at[l]] = hs;
+      if (!met[l]) w.first[at[l] - kPlane * size_t(k)] = {p.dir[l], stretches[l], k};
       met[l] = true;
     }
   }
@@ -274,17 +299,17 @@ TerrainPass::PixelHit TerrainPass::hitOf(const Scratch& w, const Drawn& t, int p
   const Caster& c = *t.caster;
   const HeightField& f = *t.field;
   const int lx = p % kTileSize, ly = p / kTileSize;
-  int k = 0;
-  while (std::isnan(w.hit[kPlane * size_t(k) + size_t(p)])) ++k;
+  const Scratch::FirstHit& first = w.first[size_t(p)];
+  const int k = first.sample;
   PixelHit h;
   h.sx = w.ox + lx + 0.5 + offsetX_[k], h.sy = w.oy + ly + 0.5 + offsetY_[k];
-  h.d = rays_.direction(h.sx, h.sy);
+  h.d = first.d;
   h.s = w.hit[kPlane * size_t(k) + size_t(p)];
   h.point = rays_.eye + h.d * h.s;
   h.m = c.toMap(h.point);
   h.gx = std::clamp(h.m.gx, 0.0, double(f.width - 1));
   h.gy = std::clamp(h.m.gy, 0.0, double(f.height - 1));
-  h.level = c.lodLevel(h.s, t.pixel, c.stretch(h.d));
+  h.level = c.lodLevel(h.s, t.pixel, first.stretch);
   return h;
 }
 

@@ -86,7 +86,7 @@ TEST(PacketWalk, EveryLaneMeetsTheSurfaceWhereTheDenseMarchDoes) {
 }
 
 TEST(PacketWalk, AWalkCutShortResumesWhereItStopped) {
-  // Eight cells at a time, each lane resumed from `reached`, meets what one whole walk meets.
+  // Two steps at a time, each lane resumed from `reached`, meets what one whole walk meets.
   const Ground g;
   std::mt19937 rng(5);
   const int n = g.pyramid.gridLevel();
@@ -97,8 +97,8 @@ TEST(PacketWalk, AWalkCutShortResumesWhereItStopped) {
     g.caster.walkPacket(whole.packet, n, 1 << 20, g.counters);
     double hit[kPacketRays];
     for (int l = 0; l < kPacketRays; ++l) hit[l] = NAN;
-    for (int round = 0; round < 200; ++round) {
-      g.caster.walkPacket(cut, n, 8, g.counters);
+    for (int round = 0; round < 2000; ++round) {
+      g.caster.walkPacket(cut, n, 2, g.counters);
       bool more = false;
       for (int l = 0; l < kPacketRays; ++l) {
         if (!std::isnan(cut.hit[l])) hit[l] = cut.hit[l];
@@ -153,6 +153,43 @@ TEST(PacketWalk, AgreesWithThePerRaySolveOnAMeanLevel) {
   EXPECT_GT(hits, 200);
 }
 
+TEST(PacketWalk, WalksEachLevelOfDetailWhereItHolds) {
+  // walkPacketLevels: a ray (a packet of one, its own stretch) against the dense march of the
+  // surface its level of detail gives at each s — the levels coarsening with distance.
+  const Ground g;
+  std::mt19937 rng(17);
+  const double pixel = 1e-2;  // grid steps per unit s: levels n … n − 5 over the rays' 4000 m
+  int hits = 0, coarse = 0;
+  for (int k = 0; k < 20; ++k) {
+    const Block b = randomBlock(rng, 2e-2, 4000);
+    for (int l = 0; l < kPacketRays; ++l) {
+      Caster::Packet p = b.packet;
+      p.count = 1;
+      p.dir[0] = b.packet.dir[l];
+      const Vec3d o = p.origin, d = p.dir[0];
+      const double stretch = g.caster.stretch(d);
+      g.caster.walkPacketLevels(p, pixel, stretch, 1 << 20, g.counters);
+      const double step = 1.0 / 256 / (std::hypot(d.x, d.z) / kSpacing);
+      double want = NAN;
+      for (double s = 0; s <= 4000; s += step) {
+        const Caster::MapPoint m = g.caster.toMap(o + d * s);
+        const double h = g.caster.surface(m.gx, m.gy, g.caster.lodLevel(s, pixel, stretch));
+        if (!std::isnan(h) && m.h - h <= 0) {
+          want = s;
+          break;
+        }
+      }
+      ASSERT_EQ(std::isnan(p.hit[0]), std::isnan(want)) << k << " lane " << l;
+      if (std::isnan(want)) continue;
+      ++hits;
+      coarse += g.caster.lodLevel(want, pixel, stretch) < g.pyramid.gridLevel();
+      EXPECT_NEAR(p.hit[0], want, step + 1e-3 * kSpacing) << k << " lane " << l;
+    }
+  }
+  EXPECT_GT(hits, 100);
+  EXPECT_GT(coarse, 30);
+}
+
 TEST(PacketWalk, EveryTargetGivesTheSameBits) {
   const Ground g;
   std::vector<double> first;
@@ -176,6 +213,53 @@ TEST(PacketWalk, EveryTargetGivesTheSameBits) {
         << hwy::TargetName(target);
   }
   hwy::SetSupportedTargetsForTest(0);
+}
+
+// A flat table with one spike: rays that pass just below its top meet it, rays just above it
+// meet nothing — whatever square of the skip map the spike is in, on its edges and corners too.
+// A walk that passed a square it should have entered (its top misread, the ray's lowest point in
+// the square misjudged by a third of a code, the wrong square) misses the spike.
+TEST(PacketWalk, ASquareIsPassedOnlyWhereTheRayStaysAboveItsTop) {
+  HeightField field;
+  field.width = field.height = 65;
+  field.spacingU = field.spacingV = 10;
+  field.originV = 640;
+  field.scale = 0.01;  // a code a centimetre
+  const uint16_t ground = 1000, spike = 20000;
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> u(0, 1);
+  int rays = 0;
+  for (const auto& [si, sj] : {std::pair{37, 29}, {40, 28}, {44, 44}, {41, 30}, {12, 52}}) {
+    field.q.assign(size_t(field.width) * size_t(field.height), ground);
+    field.q[size_t(sj) * size_t(field.width) + size_t(si)] = spike;
+    const Pyramid pyramid(field, Interpolation::bilinear);
+    const Caster caster(field, pyramid, Interpolation::bilinear, Placement{});
+    CastCounters counters;
+    for (const double margin : {-0.3, 0.3}) {  // codes below and above the top
+      const Vec3d target = caster.toWorld(si, sj, (spike + margin) * field.scale);
+      for (int k = 0; k < kPacketRays; ++k) {
+        // Level to 30° down (above the top: level), any heading, from 200 to 400 m away, through
+        // the point beside the spike's top: a ray a packet (a packet has one origin).
+        const double pitch = margin > 0 || k % 4 == 0 ? 0 : -30 * u(rng) * M_PI / 180;
+        const double heading = 2 * M_PI * u(rng), distance = 200 + 200 * u(rng);
+        Caster::Packet p;
+        p.count = 1;
+        p.dir[0] = {std::cos(pitch) * std::cos(heading), std::sin(pitch),
+                    std::cos(pitch) * std::sin(heading)};
+        p.origin = target - p.dir[0] * distance;
+        p.s0[0] = 0, p.s1[0] = 2 * distance;
+        caster.walkPacket(p, pyramid.gridLevel(), 1 << 20, counters);
+        ++rays;
+        if (margin < 0) {
+          ASSERT_FALSE(std::isnan(p.hit[0])) << si << "," << sj << " ray " << k;
+          EXPECT_LE(p.hit[0], distance + 1e-3);
+        } else {
+          EXPECT_TRUE(std::isnan(p.hit[0])) << si << "," << sj << " ray " << k;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(rays, 5 * 2 * kPacketRays);
 }
 
 TEST(PacketWalk, RaysOffTheTableAndEmptySpansAreIdle) {
