@@ -14,6 +14,77 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // Cells a ray walks directly from its start before marching (Caster::cast).
 constexpr double kDirectCells = 8;
 
+// The ray over [sa, sb] walked cell by cell (Amanatides–Woo) over cells [0, cellsX) × [0, cellsY),
+// clipped to the footprint [0, footX] × [0, footY] (slabs: beyond it there is no surface, and
+// where the ray enters it below the heights it meets the prism's wall): `cell(i, j, s, out)` for
+// each cell the ray is in over [s, out], until one returns a hit (not NaN).
+template <class Cell>
+double walkCells(const GridRay& r, int cellsX, int cellsY, double footX, double footY, double sa,
+                 double sb, Cell&& cell) {
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  for (const auto& [p0, e, hi] : {std::tuple{r.x0, r.ex, footX}, std::tuple{r.y0, r.ey, footY}}) {
+    if (e == 0) {
+      if (p0 < 0 || p0 > hi) return kNaN;
+      continue;
+    }
+    const double t0 = (0 - p0) / e, t1 = (hi - p0) / e;
+    sa = std::max(sa, std::min(t0, t1));
+    sb = std::min(sb, std::max(t0, t1));
+  }
+  if (!(sa <= sb)) return kNaN;
+  double s = sa;
+  // The cell holding the point at s (the last row and column belong to the cells before them).
+  int i = std::clamp(int(std::floor(r.x0 + s * r.ex)), 0, cellsX - 1),
+      j = std::clamp(int(std::floor(r.y0 + s * r.ey)), 0, cellsY - 1);
+  // The parameters where the ray crosses the next column and row boundary, advanced by a cell's
+  // worth each step.
+  const int stepI = r.ex > 0 ? 1 : -1, stepJ = r.ey > 0 ? 1 : -1;
+  const double dtx = r.ex != 0 ? std::fabs(1 / r.ex) : kInf;
+  const double dty = r.ey != 0 ? std::fabs(1 / r.ey) : kInf;
+  double tx = r.ex != 0 ? ((r.ex > 0 ? i + 1 : i) - r.x0) / r.ex : kInf;
+  double ty = r.ey != 0 ? ((r.ey > 0 ? j + 1 : j) - r.y0) / r.ey : kInf;
+  for (;;) {
+    const double out = std::min(std::min(tx, ty), sb);  // where the ray leaves the cell
+    if (const double hit = cell(i, j, s, out); !std::isnan(hit)) return hit;
+    if (out >= sb) break;
+    s = out;
+    if (tx <= ty)
+      i += stepI, tx += dtx;
+    else
+      j += stepJ, ty += dty;
+    if (i < 0 || j < 0 || i >= cellsX || j >= cellsY) break;
+  }
+  return kNaN;
+}
+
+// The first root of f in the bracket [a, b], f(a) = fa > 0 ≥ f(b) = fb, to `tolerance`: regula
+// falsi with the Illinois step while both ends are finite, bisection across the footprint's edge
+// (fa = +∞).
+template <class F>
+double refineRoot(double a, double fa, double b, double fb, double tolerance, F&& f) {
+  int side = 0;
+  for (int it = 0; it < 60 && b - a > tolerance; ++it) {
+    const double m =
+        std::isfinite(fa) && fa - fb > 0 ? b - fb * (b - a) / (fb - fa) : 0.5 * (a + b);
+    const double mm = (m > a && m < b) ? m : 0.5 * (a + b);
+    const double fm = f(mm);
+    if (fm <= 0) {
+      b = mm, fb = fm;
+      if (side == -1) fa *= 0.5;
+      side = -1;
+    } else {
+      a = mm, fa = fm;
+      if (side == 1) fb *= 0.5;
+      side = 1;
+    }
+  }
+  return b;
+}
+
+// Catmull–Rom's basis as powers of t (height_field.cpp's weights): w_c(t) = Σ_k kBasis[k][c]·t^k.
+constexpr double kBasis[4][4] = {
+    {0, 1, 0, 0}, {-0.5, 0, 0.5, 0}, {1, -2.5, 2, -0.5}, {-0.5, 1.5, -1.5, 0.5}};
+
 }  // namespace
 
 Caster::Caster(const HeightField& field, const Pyramid& pyramid, Interpolation interp,
@@ -214,107 +285,118 @@ double Caster::solve(Vec3d o, Vec3d d, double sa, double sb, double fa, int leve
     const double s1 = k == n ? sb : sa + (sb - sa) * k / n;
     const double f1 = above(o, d, s1, level);
     if (f1 <= 0) {
-      // A bracket [s0, s1], f0 > 0 ≥ f1: regula falsi with the Illinois step while both ends are
-      // finite, bisection across the footprint's edge (f0 = +∞).
-      double a = s0, fa2 = f0, b = s1, fb = f1;
-      int side = 0;
       const double tolerance = 1e-4 / std::max(gridSpeed(Bundle{o, {d, d, d, d}}), 1e-300);
-      for (int it = 0; it < 60 && b - a > tolerance; ++it) {
-        const double m =
-            std::isfinite(fa2) && fa2 - fb > 0 ? b - fb * (b - a) / (fb - fa2) : 0.5 * (a + b);
-        const double mm = (m > a && m < b) ? m : 0.5 * (a + b);
-        const double fm = above(o, d, mm, level);
-        if (fm <= 0) {
-          b = mm, fb = fm;
-          if (side == -1) fa2 *= 0.5;
-          side = -1;
-        } else {
-          a = mm, fa2 = fm;
-          if (side == 1) fb *= 0.5;
-          side = 1;
-        }
-      }
-      return b;
+      return refineRoot(s0, f0, s1, f1, tolerance,
+                        [&](double at) { return above(o, d, at, level); });
     }
     s0 = s1, f0 = f1;
   }
   return std::numeric_limits<double>::quiet_NaN();
 }
 
+GridRay Caster::gridRay(Vec3d o, Vec3d d, double step) const {
+  const double k = 1 / step, toCode = 1 / field_.scale;
+  return {(ax_ * o.x + bx_) * k, (ay_ * o.z + by_) * k, (o.y - field_.offset) * toCode,
+          ax_ * d.x * k,         ay_ * d.z * k,         d.y * toCode};
+}
+
 double Caster::solveBilinear(Vec3d o, Vec3d d, double sa, double sb, int level) const {
-  // The level's grid: x = x0 + s·ex, y = y0 + s·ey in its sample steps; heights z = z0 + s·ez
-  // in codes of the table (h = offset + scale·code).
   const Pyramid::MeanLevel m = pyramid_.mean(level);
-  const double k = 1 / m.step;
-  const double x0 = (ax_ * o.x + bx_) * k, ex = ax_ * d.x * k, y0 = (ay_ * o.z + by_) * k,
-               ey = ay_ * d.z * k;
-  const double toCode = 1 / field_.scale;
-  const double z0 = (o.y - field_.offset) * toCode, ez = d.y * toCode;
-  const int cellsX = m.width - 1, cellsY = m.height - 1;
+  const GridRay r = gridRay(o, d, m.step);
   // The table's footprint, in the level's steps (its last samples may lie beyond it).
-  const double footX = (field_.width - 1) * k, footY = (field_.height - 1) * k;
-  // Clipped to the footprint [0, cellsX] × [0, cellsY] (slabs): beyond it there is no surface, and
-  // where the ray enters it below the heights it meets the prism's wall.
-  for (const auto& [p0, e, hi] : {std::tuple{x0, ex, footX}, std::tuple{y0, ey, footY}}) {
-    if (e == 0) {
-      if (p0 < 0 || p0 > hi) return std::numeric_limits<double>::quiet_NaN();
-      continue;
-    }
-    const double t0 = (0 - p0) / e, t1 = (hi - p0) / e;
-    sa = std::max(sa, std::min(t0, t1));
-    sb = std::min(sb, std::max(t0, t1));
-  }
-  if (!(sa <= sb)) return std::numeric_limits<double>::quiet_NaN();
-  double s = sa;
-  // The cell holding the point at s (the last row and column belong to the cells before them).
-  double x = x0 + s * ex, y = y0 + s * ey;
-  int i = std::clamp(int(std::floor(x)), 0, cellsX - 1),
-      j = std::clamp(int(std::floor(y)), 0, cellsY - 1);
-  // Amanatides–Woo: the parameters where the ray crosses the next column and row boundary,
-  // advanced by a cell's worth each step.
-  const int stepI = ex > 0 ? 1 : -1, stepJ = ey > 0 ? 1 : -1;
-  const double dtx = ex != 0 ? std::fabs(1 / ex) : kInf, dty = ey != 0 ? std::fabs(1 / ey) : kInf;
-  double tx = ex != 0 ? ((ex > 0 ? i + 1 : i) - x0) / ex : kInf;
-  double ty = ey != 0 ? ((ey > 0 ? j + 1 : j) - y0) / ey : kInf;
-  for (;;) {
-    const double out = std::min(std::min(tx, ty), sb);  // where the ray leaves the cell
-    const double h00 = m.code(i, j), h10 = m.code(i + 1, j), h01 = m.code(i, j + 1),
-                 h11 = m.code(i + 1, j + 1);
-    // Solved only where the ray's lowest point in the cell is not above its highest corner.
-    if (z0 + (ez < 0 ? out : s) * ez <= std::max(std::max(h00, h10), std::max(h01, h11))) {
-      // h = a + b·u + c·v + g·u·v over the cell, u = x − i, v = y − j; along the ray from s:
-      // u = u0 + t·ex, v = v0 + t·ey, so z − h = A·t² + B·t + C.
-      const double b = h10 - h00, c = h01 - h00, g = h11 - h10 - h01 + h00;
-      const double u0 = x0 + s * ex - i, v0 = y0 + s * ey - j;
-      const double A = -g * ex * ey;
-      const double B = ez - b * ex - c * ey - g * (u0 * ey + v0 * ex);
-      const double C = z0 + s * ez - (h00 + b * u0 + c * v0 + g * u0 * v0);
-      const double span = out - s;
-      if (C <= 0) return s;  // under the surface already (the prism's wall, or the start)
-      double root = kInf;
-      if (std::fabs(A) * span < 1e-12 * (std::fabs(B) + std::fabs(C) / std::max(span, 1e-300))) {
-        if (B < 0) root = -C / B;
-      } else {
-        const double disc = B * B - 4 * A * C;
-        if (disc >= 0) {
-          // The stable pair: q = −(B + sign(B)·√disc)/2, roots q/A and C/q.
-          const double q = -0.5 * (B + std::copysign(std::sqrt(disc), B));
-          const double r1 = q / A, r2 = q != 0 ? C / q : kInf;
-          for (double r : {r1, r2})
-            if (r >= 0 && r < root) root = r;
+  const double footX = (field_.width - 1) / m.step, footY = (field_.height - 1) / m.step;
+  return walkCells(
+      r, m.width - 1, m.height - 1, footX, footY, sa, sb, [&](int i, int j, double s, double out) {
+        const double h00 = m.code(i, j), h10 = m.code(i + 1, j), h01 = m.code(i, j + 1),
+                     h11 = m.code(i + 1, j + 1);
+        // Solved only where the ray's lowest point in the cell is not above its highest corner.
+        if (r.z0 + (r.ez < 0 ? out : s) * r.ez > std::max(std::max(h00, h10), std::max(h01, h11)))
+          return std::numeric_limits<double>::quiet_NaN();
+        // h = a + b·u + c·v + g·u·v over the cell, u = x − i, v = y − j; along the ray from s:
+        // u = u0 + t·ex, v = v0 + t·ey, so z − h = A·t² + B·t + C.
+        const double b = h10 - h00, c = h01 - h00, g = h11 - h10 - h01 + h00;
+        const double u0 = r.x0 + s * r.ex - i, v0 = r.y0 + s * r.ey - j;
+        const double A = -g * r.ex * r.ey;
+        const double B = r.ez - b * r.ex - c * r.ey - g * (u0 * r.ey + v0 * r.ex);
+        const double C = r.z0 + s * r.ez - (h00 + b * u0 + c * v0 + g * u0 * v0);
+        const double span = out - s;
+        if (C <= 0) return s;  // under the surface already (the prism's wall, or the start)
+        double root = kInf;
+        if (std::fabs(A) * span < 1e-12 * (std::fabs(B) + std::fabs(C) / std::max(span, 1e-300))) {
+          if (B < 0) root = -C / B;
+        } else {
+          const double disc = B * B - 4 * A * C;
+          if (disc >= 0) {
+            // The stable pair: q = −(B + sign(B)·√disc)/2, roots q/A and C/q.
+            const double q = -0.5 * (B + std::copysign(std::sqrt(disc), B));
+            const double r1 = q / A, r2 = q != 0 ? C / q : kInf;
+            for (double x : {r1, r2})
+              if (x >= 0 && x < root) root = x;
+          }
         }
-      }
-      if (root <= span) return s + root;
-    }
-    if (out >= sb) break;
-    s = out;
-    if (tx <= ty)
-      i += stepI, tx += dtx;
-    else
-      j += stepJ, ty += dty;
-    if (i < 0 || j < 0 || i >= cellsX || j >= cellsY) break;
-  }
-  return std::numeric_limits<double>::quiet_NaN();
+        return root <= span ? s + root : std::numeric_limits<double>::quiet_NaN();
+      });
+}
+
+double Caster::solveBicubic(Vec3d o, Vec3d d, double sa, double sb) const {
+  const HeightField& f = field_;
+  const GridRay r = gridRay(o, d, 1);
+  const double speed = std::hypot(r.ex, r.ey);  // cells per unit s
+  const double tolerance = 1e-4 / std::max(speed, 1e-300);
+  return walkCells(
+      r, f.width - 1, f.height - 1, f.width - 1, f.height - 1, sa, sb,
+      [&](int i, int j, double s, double out) {
+        // The 4×4 samples the cell's surface reads (clamped to the table).
+        double h[4][4];
+        for (int y = 0; y < 4; ++y)
+          for (int x = 0; x < 4; ++x)
+            h[y][x] = f.code(std::clamp(i - 1 + x, 0, f.width - 1),
+                             std::clamp(j - 1 + y, 0, f.height - 1));
+        // The patch's Bézier control points (a Catmull–Rom segment p1 → p2 is the cubic Bézier p1,
+        // p1 + (p2 − p0)/6, p2 − (p3 − p1)/6, p2, along each axis): the surface stays within their
+        // hull, a far tighter top than the samples' range with the overshoot (pyramid.h).
+        auto bezier = [](const double p[4], double b[4]) {
+          b[0] = p[1], b[1] = p[1] + (p[2] - p[0]) / 6, b[2] = p[2] - (p[3] - p[1]) / 6,
+          b[3] = p[2];
+        };
+        double rowsB[4][4], top = -kInf;
+        for (int y = 0; y < 4; ++y) bezier(h[y], rowsB[y]);
+        for (int x = 0; x < 4; ++x) {
+          const double column[4] = {rowsB[0][x], rowsB[1][x], rowsB[2][x], rowsB[3][x]};
+          double b[4];
+          bezier(column, b);
+          top = std::max({top, b[0], b[1], b[2], b[3]});
+        }
+        if (r.z0 + (r.ez < 0 ? out : s) * r.ez > top)
+          return std::numeric_limits<double>::quiet_NaN();
+        // The patch as a polynomial: P(u, v) = Σ a[l][k]·u^k·v^l, a = B·H·Bᵀ over the basis.
+        double rows[4][4] = {}, a[4][4] = {};
+        for (int y = 0; y < 4; ++y)
+          for (int k = 0; k < 4; ++k)
+            for (int x = 0; x < 4; ++x) rows[y][k] += kBasis[k][x] * h[y][x];
+        for (int l = 0; l < 4; ++l)
+          for (int k = 0; k < 4; ++k)
+            for (int y = 0; y < 4; ++y) a[l][k] += kBasis[l][y] * rows[y][k];
+        auto above = [&](double t) {
+          const double u = r.x0 + t * r.ex - i, v = r.y0 + t * r.ey - j;
+          double p = 0;
+          for (int l = 3; l >= 0; --l)
+            p = p * v + (((a[l][3] * u + a[l][2]) * u + a[l][1]) * u + a[l][0]);
+          return r.z0 + t * r.ez - p;
+        };
+        // Samples an eighth of a cell apart along the ray (solve()'s rule), then the bracket refined.
+        const double fs = above(s);
+        if (fs <= 0) return s;
+        const int n = std::clamp(int(std::ceil(8 * (out - s) * speed)), 1, 64);
+        double s0 = s, f0 = fs;
+        for (int k = 1; k <= n; ++k) {
+          const double s1 = k == n ? out : s + (out - s) * k / n;
+          const double f1 = above(s1);
+          if (f1 <= 0) return refineRoot(s0, f0, s1, f1, tolerance, above);
+          s0 = s1, f0 = f1;
+        }
+        return std::numeric_limits<double>::quiet_NaN();
+      });
 }
 
 void Caster::walkPacket(Packet& p, int level, int maxCells, CastCounters& c) const {
@@ -420,6 +502,7 @@ void Caster::walkPacketLevels(Packet& p, double pixel, double stretch, int maxCe
 double Caster::solveAt(Vec3d o, Vec3d d, double sa, double sb, int level) const {
   const bool bilinear = level < pyramid_.gridLevel() || interp_ == Interpolation::bilinear;
   if (placement_.radius <= 0 && bilinear) return solveBilinear(o, d, sa, sb, level);
+  if (placement_.radius <= 0) return solveBicubic(o, d, sa, sb);
   return solve(o, d, sa, sb, above(o, d, sa, level), level);
 }
 

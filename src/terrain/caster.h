@@ -52,6 +52,12 @@ struct Bundle {
   Vec3d corner[4];
 };
 
+// A ray in a level's grid: x = x0 + s·ex, y = y0 + s·ey in its sample steps, heights
+// z = z0 + s·ez in codes of the table (h = offset + scale·code).
+struct GridRay {
+  double x0, y0, z0, ex, ey, ez;
+};
+
 class Caster {
  public:
   Caster(const HeightField& field, const Pyramid& pyramid, Interpolation interp,
@@ -153,7 +159,13 @@ class Caster {
   // exactly: the ray walked cell by cell (a 2D DDA), in each cell the height above the surface a
   // quadratic in s, its first root.
   double solveBilinear(Vec3d origin, Vec3d dir, double sa, double sb, int level) const;
-  // The first root in [sa, sb] at `level`, by whichever of the two applies.
+  // The same for the plane base and the table's Catmull–Rom surface: cell by cell, a cell solved
+  // only where the ray may touch its bound, there its patch as a polynomial sampled at eighths of
+  // a cell along the ray and the first bracket refined.
+  double solveBicubic(Vec3d origin, Vec3d dir, double sa, double sb) const;
+  // The ray in the grid of a level `step` grid steps apart (GridRay).
+  GridRay gridRay(Vec3d origin, Vec3d dir, double step) const;
+  // The first root in [sa, sb] at `level`, by whichever of the three applies.
   double solveAt(Vec3d origin, Vec3d dir, double sa, double sb, int level) const;
   // Grid steps per unit s of the fastest of the bundle's directions, horizontally.
   double gridSpeed(const Bundle& b) const;

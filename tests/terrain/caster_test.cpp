@@ -123,5 +123,42 @@ TEST(Caster, TheSideOfThePrismIsAWall) {
   EXPECT_TRUE(std::isnan(c.cast({-20, 150, 0}, {1, 0, 0}, 0, 100, counters)));
 }
 
+TEST(Caster, ABicubicPeakBetweenSamplesIsMetBelowItsTopAndMissedAbove) {
+  // Four high samples in a flat table: the Catmull–Rom surface overshoots them between the four,
+  // inside a cell. Level rays that pass a third of the overshoot below that peak meet it, a third
+  // of a code above miss it — a cell passed on the samples' range alone (without the overshoot)
+  // would miss the first. (A ray that grazes the peak by less than the surface falls over an
+  // eighth of a cell may miss it: caster.h.)
+  HeightField f;
+  f.width = f.height = 33;
+  f.spacingU = f.spacingV = 10;
+  f.originV = 320;
+  f.scale = 0.01;
+  f.q.assign(size_t(f.width) * size_t(f.height), 1000);
+  for (int j = 15; j <= 16; ++j)
+    for (int i = 15; i <= 16; ++i) f.q[size_t(j) * size_t(f.width) + size_t(i)] = 10000;
+  const Pyramid p(f, Interpolation::bicubic);
+  const Caster c(f, p, Interpolation::bicubic, Placement{});
+  // The peak: at the cell's centre by symmetry.
+  const double peak = c.surface(15.5, 15.5);
+  ASSERT_GT(peak, 10000 * f.scale + 5);  // overshoot of metres, not rounding
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(0, 2 * M_PI);
+  for (const double margin : {-(peak - 10000 * f.scale) / 3, 0.3 * f.scale})
+    for (int k = 0; k < 32; ++k) {
+      const double heading = u(rng);
+      const Vec3d d{std::cos(heading), 0, std::sin(heading)};
+      const Vec3d o = c.toWorld(15.5, 15.5, peak + margin) - d * 150.0;
+      CastCounters counters;
+      const double hit = c.cast(o, d, 0, 300, counters);
+      if (margin < 0) {
+        ASSERT_FALSE(std::isnan(hit)) << "heading " << heading;
+        EXPECT_LE(hit, 150 + 1e-3);
+      } else {
+        EXPECT_TRUE(std::isnan(hit)) << "heading " << heading;
+      }
+    }
+}
+
 }  // namespace
 }  // namespace sv::terrain
