@@ -54,6 +54,10 @@ struct FrameStats {
            terrainRays = 0, terrainHits = 0;
   uint64_t terrainBytes = 0;
   double terrainLoadMs = 0;
+  // The terrain pass's time: its tiles' CPU time over the frame's workers (its share of the
+  // frame's wall time, the tiles being shared out evenly) — what the IG's governor predicts the
+  // terrain's cost from (docs/ig.md).
+  double terrainMs = 0;
   // Light points (SPEC §13): lights and stars considered, those drawn (lit, in front of the eye,
   // on screen, bright enough), and the light pass's time (its per-frame preparation plus the
   // busiest worker's tile work).

@@ -108,6 +108,9 @@ struct IgRunReport {
   uint64_t overruns = 0;  // frames that ended after their deadline
   uint64_t degraded = 0;  // frames drawn below full quality
   int worstLevel = 0;
+  // The quality levels the frames were drawn at: per level (0 … the last), its name (what it gave
+  // up) and how many frames.
+  std::vector<std::pair<std::string, uint64_t>> levels;
   double frameMsP50 = 0, frameMsP99 = 0, frameMsMax = 0;  // the frame's work, start to presented
   double periodMsP50 = 0, periodMsP99 = 0;                // from one frame's start to the next's
   double loopMsMean = 0;  // receive, update, answer and present: everything but the render

@@ -110,6 +110,10 @@ struct RenderOptions {
   // ground is drawn from the mean pyramid's level of its size, as a texture's MIP levels are;
   // false: the table's own surface everywhere (exact, and aliased in the distance).
   bool terrainLod = true;
+  // With terrainLod: each step draws the ground one level of detail coarser than its pixels' size
+  // asks (a pixel taken as 2^bias wide: a quarter of the rays' cells walked a step, blurrier in the
+  // distance) — a quality level of the IG's governor (docs/ig.md).
+  int terrainLodBias = 0;
   // How a curved-screen display's frames are pre-distorted (Renderer::renderDisplay; SPEC §12,
   // docs/display.md): the seeds' sub-frusta, each drawn through its own projective map with no
   // resampling; or a flat view with a margin, rendered and resampled bilinearly or bicubically

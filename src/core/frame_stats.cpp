@@ -38,7 +38,7 @@ FrameStats& FrameStats::operator+=(const FrameStats& o) {
   freeFormRays += o.freeFormRays, freeFormHits += o.freeFormHits;
   terrains += o.terrains, terrainWindows += o.terrainWindows, terrainSteps += o.terrainSteps;
   terrainPacketRays += o.terrainPacketRays, terrainRays += o.terrainRays;
-  terrainHits += o.terrainHits;
+  terrainHits += o.terrainHits, terrainMs += o.terrainMs;
   terrainBytes = std::max(terrainBytes, o.terrainBytes);  // the scene's, in every view alike
   terrainLoadMs = std::max(terrainLoadMs, o.terrainLoadMs);
   lightPoints += o.lightPoints, lightsDrawn += o.lightsDrawn, lightsMs += o.lightsMs;
@@ -89,9 +89,10 @@ std::string FrameStats::summary() const {
                                   freeFormRays, freeFormHits)
                     : std::string()) +
          (terrains ? fmt::format(" | terrain {}: windows {}, steps {}, rays {} in packets and {} "
-                                 "alone, hits {}, {:.1f} MB, loaded in {:.1f} ms",
+                                 "alone, hits {}, {:.2f} ms, {:.1f} MB, loaded in {:.1f} ms",
                                  terrains, terrainWindows, terrainSteps, terrainPacketRays,
-                                 terrainRays, terrainHits, terrainBytes / 1e6, terrainLoadMs)
+                                 terrainRays, terrainHits, terrainMs, terrainBytes / 1e6,
+                                 terrainLoadMs)
                    : std::string()) +
          (lightPoints
               ? fmt::format(" | lights {}: drawn {}, {:.2f} ms", lightPoints, lightsDrawn, lightsMs)

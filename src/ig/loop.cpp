@@ -43,8 +43,18 @@ double percentile(std::vector<double> v, double p) {
   return v[i];
 }
 
-// What the governor scales its estimates by: the frame's triangles and light points.
-double work(const scene::Scene& s) { return double(s.triangleCount() + s.lightPoints.size()); }
+// What the governor scales the polygons' and lights' estimates by: the frame's triangles and light
+// points.
+double geometryWork(const scene::Scene& s) {
+  return double(s.triangleCount() + s.lightPoints.size());
+}
+
+// What the database's terrain gives the governor to give up.
+TerrainLevels terrainLevels(const scene::Scene& s) {
+  TerrainLevels t;
+  for (const scene::Terrain& terrain : s.terrains) t.present = true, t.bicubic |= terrain.bicubic;
+  return t;
+}
 
 // Each pixel of `image` shown r × r times in `out`, cropped to width × height (pixel
 // replication): each source row expanded once, then copied r times. `out` keeps its memory from
@@ -123,9 +133,9 @@ struct IgLoop::Impl {
   // The job (docs/cluster.md): this rank's channels (all of them in a job of one).
   cluster::Cluster* cluster = nullptr;
   int rank = 0, ranks = 1;
-  std::vector<ChannelShare> mine;  // in channel order
+  std::vector<ChannelShare> mine;                        // in channel order
   std::vector<std::unique_ptr<TileExchange>> exchanges;  // this rank's split channels'
-  bool splits = false;  // some channel is drawn by several ranks
+  bool splits = false;                                   // some channel is drawn by several ranks
 
   ~Impl() {
     if (ownsStatus && status) std::fclose(status);
@@ -290,7 +300,8 @@ struct IgLoop::Session {
         periodMs(1000 / impl.config.rate),
         period(std::chrono::duration_cast<Clock::duration>(
             std::chrono::duration<double, std::milli>(periodMs))),
-        governor(qualityLevels(impl.config.render, !world.database().lodGroups.empty()),
+        governor(qualityLevels(impl.config.render, !world.database().lodGroups.empty(),
+                               terrainLevels(world.database())),
                  impl.config.deadline * periodMs),
         // In a job of several, this rank's channels only, whole or its part; it presents those
         // it draws whole and the shared ones it assembles (part 0).
@@ -312,6 +323,7 @@ struct IgLoop::Session {
   std::vector<cigi::Packet> replies;
   std::vector<Image> images, enlarged, mineShown;
   std::vector<FrameStats> stats;
+  double ground = 0;  // the ground's share of the last frame's samples (groundShare)
   std::vector<std::string> names;
   std::vector<uint8_t> input;
   Clock::time_point t0;
@@ -320,8 +332,8 @@ struct IgLoop::Session {
   // Whether this rank presents channel c: it draws it whole, or assembles it (part 0).
   bool drawn(size_t c) const {
     return !only || std::any_of(only->begin(), only->end(), [&](const ChannelShare& s) {
-             return s.channel == int(c) && s.tiles.part == 0;
-           });
+      return s.channel == int(c) && s.tiles.part == 0;
+    });
   }
 
   // Each shown channel enlarged by pixel replication (a governor level drawn at a fraction of
@@ -342,26 +354,48 @@ struct IgLoop::Session {
   Status calibrate() {
     const int levels = governor.levels();
     std::vector<std::vector<double>> times(static_cast<size_t>(levels));
-    std::vector<double> works(static_cast<size_t>(levels));
+    std::vector<std::vector<double>> terrainTimes(static_cast<size_t>(levels));
+    std::vector<FrameWork> works(static_cast<size_t>(levels));
     for (int round = 0; round < 4; ++round)
       for (int level = 0; level < levels; ++level) {
         const QualityLevel& q = governor.at(level);
-        works[size_t(level)] = work(world.frameScene(0));
         const scene::Scene& first = world.atQuality(q.stars, q.replication);
         const Clock::time_point warm = Clock::now();
         if (Status s = m.rendererFor(level, q.options).renderChannels(first, images, &stats, only);
             !s)
           return s.error();
         if (q.replication > 1) enlarge(q.replication);  // the enlargements' memory too
-        if (round > 0) times[size_t(level)].push_back(msBetween(warm, Clock::now()));
+        works[size_t(level)] = {geometryWork(world.frameScene(0)), groundShare(q)};
+        if (round > 0) {
+          times[size_t(level)].push_back(msBetween(warm, Clock::now()));
+          terrainTimes[size_t(level)].push_back(terrainMs());
+        }
       }
     for (int level = 0; level < levels; ++level) {
       const double ms = percentile(times[size_t(level)], 0.5);
-      governor.calibrate(level, works[size_t(level)], ms);
+      governor.calibrate(level, works[size_t(level)],
+                         {ms, percentile(terrainTimes[size_t(level)], 0.5)});
+      ground = works[0].terrain;
       std::fprintf(stderr, "synthvis ig: quality level %d (%s): %.2f ms a frame\n", level,
                    governor.at(level).change.c_str(), ms);
     }
     return {};
+  }
+
+  // The last frame's terrain: its pass's time over the channels drawn, and the share of their
+  // samples whose rays met the ground (the governor's terrain work; the same at every level).
+  double terrainMs() const {
+    double ms = 0;
+    for (const FrameStats& s : stats) ms += s.terrainMs;
+    return ms;
+  }
+  double groundShare(const QualityLevel& q) const {
+    double hits = 0, samples = 0;
+    for (size_t c = 0; c < stats.size() && c < images.size(); ++c) {
+      hits += double(stats[c].terrainHits);
+      samples += double(images[c].width) * images[c].height * std::max(q.options.samples, 1);
+    }
+    return samples > 0 ? std::min(hits / samples, 1.0) : 0.0;
   }
 
   // 1. The host's datagrams, applied in the order they came; the level a replayed frame was
@@ -403,7 +437,7 @@ struct IgLoop::Session {
 
   // 2. The quality the deadline allows. A replay draws each frame at the level it was recorded
   // at: the governor's choice depends on the machine's timing, the frame must not.
-  int chooseLevel(uint32_t frame, int recordedLevel, double frameWork) {
+  int chooseLevel(uint32_t frame, int recordedLevel, const FrameWork& frameWork) {
     int level = m.options.governor && !pattern ? governor.choose(frameWork) : 0;
     if (!m.options.replay.empty())
       level = recordedLevel >= 0 && recordedLevel < governor.levels() ? recordedLevel : 0;
@@ -470,11 +504,14 @@ struct IgLoop::Session {
       raster += s.rasterMs;
       lights += s.lightsMs;
     }
+    const std::string terrain = world.database().terrains.empty()
+                                    ? std::string()
+                                    : fmt::format("  terrain {:.1f}", terrainMs());
     const std::vector<std::string> lines = {
         fmt::format("frame {}  {:.0f} Hz  render {:.1f} ms / budget {:.1f} ms", frame,
                     m.config.rate, renderMs, governor.budgetMs()),
-        fmt::format("vertex {:.1f}  setup {:.1f}  tiles {:.1f}  lights {:.1f} ms", vertex, setup,
-                    raster, lights),
+        fmt::format("vertex {:.1f}  setup {:.1f}  tiles {:.1f}{}  lights {:.1f} ms", vertex, setup,
+                    raster, terrain, lights),
         fmt::format("level {} ({})", level, governor.at(level).change),
         fmt::format("entities {}  datagrams {}  malformed {}  missed {}", world.activeEntities(),
                     world.counts().datagrams, world.counts().malformed, report.missed)};
@@ -572,7 +609,10 @@ Result<IgRunReport> IgLoop::run() {
     lastStart = start;
     const int recordedLevel = s.receive(frame, start);  // 1
     if (s.replayEnded && s.incoming.empty()) break;
-    const double frameWork = work(s.world.frameScene(frame / impl_->config.rate));
+    // The coming frame's work: its triangles and lights, and the ground's share of the last
+    // frame's samples (a flight changes it little from frame to frame).
+    const FrameWork frameWork{geometryWork(s.world.frameScene(frame / impl_->config.rate)),
+                              s.ground};
     const int level = s.chooseLevel(frame, recordedLevel, frameWork);  // 2
     cigi::StartOfFrame sof = s.startOfFrame(frame, level, start);      // 3
     // In a job of several it goes after the frame lock, once every rank has drawn the frame.
@@ -589,12 +629,19 @@ Result<IgRunReport> IgLoop::run() {
     // shown.
     const Clock::time_point end = Clock::now();
     const double ms = msBetween(start, end);
-    if (!s.pattern) s.governor.record(level, frameWork, ms);
+    if (!s.pattern) {
+      s.governor.record(level, frameWork, {ms, s.terrainMs()});
+      s.ground = s.groundShare(s.governor.at(level));
+    }
     s.frameMs.push_back(ms);
     s.loopMs.push_back(ms - renderMs);
     ++s.report.frames;
     s.report.degraded += level > 0;
     s.report.worstLevel = std::max(s.report.worstLevel, level);
+    if (s.report.levels.empty())
+      for (int l = 0; l < s.governor.levels(); ++l)
+        s.report.levels.push_back({s.governor.at(l).change, 0});
+    ++s.report.levels[size_t(level)].second;
     s.report.overruns += ms > s.governor.budgetMs();
     slot += s.period;
     if (options.realtime && end > slot) {
@@ -610,15 +657,21 @@ Result<IgRunReport> IgLoop::run() {
 }
 
 std::string IgRunReport::summary() const {
+  std::string used;
+  for (size_t l = 0; l < levels.size(); ++l)
+    if (levels[l].second)
+      used += fmt::format("{}{} ({}): {} frames", used.empty() ? "" : ", ", l, levels[l].first,
+                          levels[l].second);
   return fmt::format(
+      "{}"
       "frames {}: missed {}, over the deadline {}, degraded {} (worst level {})\n"
       "frame time p50 {:.2f} ms, p99 {:.2f} ms, max {:.2f} ms; period p50 {:.2f} ms, p99 {:.2f} ms "
       "(jitter {:.2f} ms)\n"
       "loop overhead (receive, update, answer, present) {:.3f} ms a frame\n"
       "host datagrams {}, malformed {}, packets rejected {}; frames the output dropped {}",
-      frames, missed, overruns, degraded, worstLevel, frameMsP50, frameMsP99, frameMsMax,
-      periodMsP50, periodMsP99, periodMsP99 - periodMsP50, loopMsMean, datagrams, malformed,
-      rejected, dropped);
+      used.empty() ? std::string() : "levels used: " + used + "\n", frames, missed, overruns,
+      degraded, worstLevel, frameMsP50, frameMsP99, frameMsMax, periodMsP50, periodMsP99,
+      periodMsP99 - periodMsP50, loopMsMean, datagrams, malformed, rejected, dropped);
 }
 
 }  // namespace sv::ig

@@ -1,8 +1,9 @@
 // Based on: seed 002 (overload protection: a frame that never breaks), seed 004 (a real-time system).
 #include "ig/overload.h"
 
-#include <algorithm>
 #include <fmt/format.h>
+
+#include <algorithm>
 
 namespace sv::ig {
 namespace {
@@ -17,7 +18,8 @@ constexpr double kStaleDrift = 0.05;
 
 }  // namespace
 
-std::vector<QualityLevel> qualityLevels(const RenderOptions& full, bool levelsOfDetail) {
+std::vector<QualityLevel> qualityLevels(const RenderOptions& full, bool levelsOfDetail,
+                                        const TerrainLevels& terrain) {
   std::vector<QualityLevel> levels{{full, true, 1, "full quality"}};
   auto next = [&](const char* what, auto&& change) {
     QualityLevel l = levels.back();
@@ -36,9 +38,16 @@ std::vector<QualityLevel> qualityLevels(const RenderOptions& full, bool levelsOf
     next("bilinear textures",
          [](QualityLevel& l) { l.options.textureFilter = scene::TextureFilter::bilinear; });
   next("no stars", [](QualityLevel& l) { l.stars = false; });
-  next("bilinear terrain", [](QualityLevel& l) {
-    l.options.terrainFilter = RenderOptions::TerrainFilter::bilinear;
-  });
+  // The terrain's reductions, the larger gain first (docs/ig.md: bicubic costs several times
+  // bilinear; a level of detail coarser saves a part of the cells walked).
+  const bool bicubic =
+      full.terrainFilter == RenderOptions::TerrainFilter::bicubic ||
+      (full.terrainFilter == RenderOptions::TerrainFilter::scene && terrain.bicubic);
+  if (terrain.present && bicubic)
+    next("bilinear terrain",
+         [](QualityLevel& l) { l.options.terrainFilter = RenderOptions::TerrainFilter::bilinear; });
+  if (terrain.present && full.terrainLod)
+    next("coarser terrain", [](QualityLevel& l) { ++l.options.terrainLodBias; });
   // Geometry: every level of detail switched at half its range (RenderOptions::lodScale).
   if (levelsOfDetail && full.lod)
     next("coarser levels of detail", [](QualityLevel& l) { l.options.lodScale *= 2; });
@@ -48,13 +57,27 @@ std::vector<QualityLevel> qualityLevels(const RenderOptions& full, bool levelsOf
 
 OverloadGovernor::OverloadGovernor(std::vector<QualityLevel> levels, double budgetMs,
                                    int holdFrames)
-    : levels_(std::move(levels)), estimates_(levels_.size()), budgetMs_(budgetMs),
+    : levels_(std::move(levels)),
+      estimates_(levels_.size()),
+      budgetMs_(budgetMs),
       hold_(holdFrames) {}
 
-void OverloadGovernor::calibrate(int level, double work, double ms) {
+void OverloadGovernor::update(Estimate& e, const FrameWork& work, const FrameCost& cost,
+                              double weight) {
+  // The terrain's part by the ground's share of the samples, the rest by triangles and lights.
+  const double terrainMs = std::clamp(cost.terrainMs, 0.0, cost.ms);
+  const double geometry = (std::max(cost.ms, 1e-3) - terrainMs) / std::max(work.geometry, 1.0);
+  if (!e.measured) weight = 1;
+  e.perGeometry += weight * (geometry - e.perGeometry);
+  if (work.terrain > 1e-6) e.perTerrain += weight * (terrainMs / work.terrain - e.perTerrain);
+  e.measured = true;
+}
+
+void OverloadGovernor::calibrate(int level, const FrameWork& work, const FrameCost& cost) {
   Estimate& e = estimates_[size_t(level)];
-  e.calibrated = std::max(ms, 1e-3) / std::max(work, 1.0);
-  e.msPerWork = e.calibrated;
+  e.measured = false;
+  update(e, work, cost, 1);
+  e.calibrated = std::max(cost.ms, 1e-3);
 }
 
 double OverloadGovernor::prior(int level) const {
@@ -67,18 +90,17 @@ double OverloadGovernor::prior(int level) const {
   return from != to ? std::max(0.25, double(to) / double(from)) : kPriorOther;
 }
 
-double OverloadGovernor::predict(int level, double work) const {
+double OverloadGovernor::predict(int level, const FrameWork& work) const {
   // The nearest measured level at or above this one, scaled down by the priors in between.
   double scale = 1;
   for (int l = level; l >= 0; --l) {
-    if (estimates_[size_t(l)].msPerWork > 0) return estimates_[size_t(l)].msPerWork * work * scale;
+    if (estimates_[size_t(l)].measured) return estimates_[size_t(l)].predict(work) * scale;
     if (l > 0) scale *= prior(l);
   }
   return 0;
 }
 
-int OverloadGovernor::choose(double work) {
-  work = std::max(work, 1.0);
+int OverloadGovernor::choose(const FrameWork& work) {
   if (predict(level_, work) > budgetMs_) {
     // Down to the first level predicted to fit (or the last).
     while (level_ + 1 < levels() && predict(level_, work) > budgetMs_) ++level_;
@@ -96,22 +118,24 @@ int OverloadGovernor::choose(double work) {
   return level_;
 }
 
-void OverloadGovernor::record(int level, double work, double ms) {
-  work = std::max(work, 1.0);
+void OverloadGovernor::record(int level, const FrameWork& work, const FrameCost& cost) {
   Estimate& e = estimates_[size_t(level)];
-  const double rate = ms / work;
-  e.msPerWork = e.msPerWork > 0 ? e.msPerWork + kSmoothing * (rate - e.msPerWork) : rate;
+  update(e, work, cost, kSmoothing);
   // The levels above were last measured when they were drawn, perhaps in a passing overload (the
   // machine busy, a heavy view): their estimates drift down toward what this level's measurement
   // implies for them, so that a stale figure cannot keep the quality down for good.
-  double implied = rate;
+  double implied = std::max(cost.ms, 1e-3);
   for (int l = level; l > 0; --l) {
     implied /= prior(l);
     Estimate& above = estimates_[size_t(l - 1)];
-    if (above.msPerWork > implied) above.msPerWork += kStaleDrift * (implied - above.msPerWork);
+    const double theirs = above.predict(work);
+    if (above.measured && theirs > implied) {
+      const double shrink = 1 + kStaleDrift * (implied / theirs - 1);
+      above.perGeometry *= shrink, above.perTerrain *= shrink;
+    }
   }
   // An overrun the prediction missed: down a level at once, and start the hold again.
-  if (ms > budgetMs_ && level == level_ && level_ + 1 < levels()) {
+  if (cost.ms > budgetMs_ && level == level_ && level_ + 1 < levels()) {
     ++level_;
     fitting_ = 0;
   }

@@ -3,6 +3,7 @@
 #include "render/terrains.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "terrain/ground.h"
 
@@ -47,9 +48,11 @@ std::vector<terrain::TerrainDraw> terrainDraws(const scene::Scene& scene, const 
     d.ramp = t.ramp.empty() ? terrain::defaultRamp(f.offset, f.offset + 65535 * f.scale) : t.ramp;
     // A pixel's width per unit eye depth, in grid steps (at the view's centre: the level of
     // detail needs no more), or 0 for the exact surface everywhere.
-    d.pixel = options.terrainLod ? 2 * rays.halfSpanY() / (options.height * options.supersample) /
-                                       std::min(f.spacingU, f.spacingV)
-                                 : 0.0;
+    d.pixel = options.terrainLod
+                  ? std::ldexp(2 * rays.halfSpanY() / (options.height * options.supersample) /
+                                   std::min(f.spacingU, f.spacingV),
+                               std::clamp(options.terrainLodBias, 0, 8))
+                  : 0.0;
     draws.push_back(std::move(d));
   }
   return draws;

@@ -3,6 +3,7 @@
 #include "terrain/terrain_pass.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -127,7 +128,9 @@ void TerrainPass::prepare(const raster::PassFrame& frame) {
 
 void TerrainPass::addStats(FrameStats& stats) const {
   CastCounters c;
-  for (const WorkerStats& s : stats_) c.add(s.counts);
+  double ms = 0;
+  for (const WorkerStats& s : stats_) c.add(s.counts), ms += s.ms;
+  stats.terrainMs += ms / double(std::max<size_t>(stats_.size(), 1));
   stats.terrains += terrains_.size();
   stats.terrainWindows += c.windows;
   stats.terrainSteps += c.steps;
@@ -140,6 +143,13 @@ void TerrainPass::addStats(FrameStats& stats) const {
 
 void TerrainPass::drawTile(const raster::TileTarget& tile) {
   if (terrains_.empty()) return;
+  const auto begin = std::chrono::steady_clock::now();
+  drawTerrains(tile);
+  stats_[size_t(tile.worker)].ms +=
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - begin).count();
+}
+
+void TerrainPass::drawTerrains(const raster::TileTarget& tile) {
   Scratch& w = *scratch_[size_t(tile.worker)];
   w.counts = &stats_[size_t(tile.worker)].counts;
   w.ox = tile.tileX * kTileSize;

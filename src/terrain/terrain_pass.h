@@ -67,8 +67,10 @@ class TerrainPass final : public raster::TilePass {
   struct Scratch;
   struct alignas(64) WorkerStats {
     CastCounters counts;
+    double ms = 0;  // the worker's time in drawTile this frame
   };
 
+  void drawTerrains(const raster::TileTarget& tile);
   void castWindow(Scratch& w, const Drawn& t, int x0, int y0, int size, double start) const;
   void castBlock(Scratch& w, const Drawn& t, int x0, int y0, double start) const;
   struct Drape;

@@ -286,8 +286,8 @@ TEST(IgWorld, TheEyeRidesTheOwnshipAndViewsSetTheChannels) {
   cigi::ViewControl vc;
   vc.view = 0;
   vc.enable = 1 | 2 | 32;  // x and y offsets, yaw
-  vc.x = 5;   // 5 m forward
-  vc.y = -2;  // 2 m left
+  vc.x = 5;                // 5 m forward
+  vc.y = -2;               // 2 m left
   vc.yaw = -20;
   cigi::ViewDefinition vd;
   vd.view = 0;
@@ -409,30 +409,30 @@ TEST(IgOverload, StepsDownWhenOverrunAndBackUpWithHysteresis) {
   RenderOptions full;
   full.samples = 16;
   const std::vector<QualityLevel> levels = qualityLevels(full);
-  // aa 8, aa 4, aa 1, bilinear textures, no stars, bilinear terrain, half resolution.
-  ASSERT_EQ(levels.size(), 8u);
-  EXPECT_EQ(levels[7].replication, 2);
+  // aa 8, aa 4, aa 1, bilinear textures, no stars, half resolution (no terrain: none of its).
+  ASSERT_EQ(levels.size(), 7u);
+  EXPECT_EQ(levels[6].replication, 2);
   EXPECT_EQ(levels[1].options.samples, 8);
   EXPECT_EQ(levels[3].options.samples, 1);
   EXPECT_FALSE(levels[5].stars);
   // A database with levels of detail gives up geometry before resolution.
   const std::vector<QualityLevel> withLod = qualityLevels(full, true);
-  ASSERT_EQ(withLod.size(), 9u);
-  EXPECT_EQ(withLod[7].change, "coarser levels of detail");
+  ASSERT_EQ(withLod.size(), 8u);
+  EXPECT_EQ(withLod[6].change, "coarser levels of detail");
+  EXPECT_EQ(withLod[6].options.lodScale, 2);
+  EXPECT_EQ(withLod[6].replication, 1);
   EXPECT_EQ(withLod[7].options.lodScale, 2);
-  EXPECT_EQ(withLod[7].replication, 1);
-  EXPECT_EQ(withLod[8].options.lodScale, 2);
-  EXPECT_EQ(withLod[8].replication, 2);
+  EXPECT_EQ(withLod[7].replication, 2);
   OverloadGovernor g(levels, 10.0, 5);
   // The frame's cost: 24 ms at full quality, halving with each anti-aliasing step.
   auto cost = [&](int level) { return 24.0 / (1 << std::min(level, 3)); };
-  EXPECT_EQ(g.choose(1000), 0);  // nothing measured yet
-  g.record(0, 1000, cost(0));    // overran: down at once
+  EXPECT_EQ(g.choose(FrameWork{1000}), 0);  // nothing measured yet
+  g.record(0, FrameWork{1000}, {cost(0)});  // overran: down at once
   EXPECT_GE(g.level(), 1);
   int level = 0;
   for (int f = 0; f < 20; ++f) {
-    level = g.choose(1000);
-    g.record(level, 1000, cost(level));
+    level = g.choose(FrameWork{1000});
+    g.record(level, FrameWork{1000}, {cost(level)});
     EXPECT_LE(level, 3);
   }
   EXPECT_EQ(level, 2);  // the first that fits 10 ms: aa 4's 6 ms (aa 8 takes 12)
@@ -440,8 +440,8 @@ TEST(IgOverload, StepsDownWhenOverrunAndBackUpWithHysteresis) {
   // quality (7.2 ms, within three quarters of the budget).
   std::vector<int> seen;
   for (int f = 0; f < 40; ++f) {
-    level = g.choose(300);
-    g.record(level, 300, cost(level) * 0.3);
+    level = g.choose(FrameWork{300});
+    g.record(level, FrameWork{300}, {cost(level) * 0.3});
     if (seen.empty() || seen.back() != level) seen.push_back(level);
   }
   EXPECT_EQ(seen, (std::vector<int>{2, 1, 0}));
@@ -452,18 +452,56 @@ TEST(IgOverload, OnePassingOverloadDoesNotKeepTheQualityDown) {
   full.samples = 16;
   OverloadGovernor g(qualityLevels(full), 10.0, 5);
   auto cost = [](int level) { return 4.0 / (1 << std::min(level, 3)); };  // fits at full quality
-  for (int f = 0; f < 10; ++f) g.record(g.choose(1000), 1000, cost(g.level()));
+  for (int f = 0; f < 10; ++f)
+    g.record(g.choose(FrameWork{1000}), FrameWork{1000}, {cost(g.level())});
   ASSERT_EQ(g.level(), 0);
-  g.record(g.choose(1000), 1000, 100);  // one frame the machine was busy
+  g.record(g.choose(FrameWork{1000}), FrameWork{1000}, {100});  // one frame the machine was busy
   ASSERT_GE(g.level(), 1);
   int frames = 0;
   while (g.level() > 0 && frames < 200) {
-    const int level = g.choose(1000);
-    g.record(level, 1000, cost(level));
+    const int level = g.choose(FrameWork{1000});
+    g.record(level, FrameWork{1000}, {cost(level)});
     ++frames;
   }
   EXPECT_EQ(g.level(), 0);
   EXPECT_LT(frames, 80);
+}
+
+TEST(IgOverload, TerrainLevelsComeInTheOrderOfTheirGain) {
+  RenderOptions full;
+  const std::vector<QualityLevel> bicubic = qualityLevels(full, false, {true, true});
+  // bilinear textures, no stars, bilinear terrain, coarser terrain, half resolution.
+  ASSERT_EQ(bicubic.size(), 6u);
+  EXPECT_EQ(bicubic[3].change, "bilinear terrain");
+  EXPECT_EQ(bicubic[3].options.terrainFilter, RenderOptions::TerrainFilter::bilinear);
+  EXPECT_EQ(bicubic[4].change, "coarser terrain");
+  EXPECT_EQ(bicubic[4].options.terrainLodBias, 1);
+  EXPECT_EQ(bicubic[4].options.terrainFilter, RenderOptions::TerrainFilter::bilinear);
+  // Bilinear terrain only: nothing to gain from "bilinear terrain".
+  const std::vector<QualityLevel> bilinear = qualityLevels(full, false, {true, false});
+  ASSERT_EQ(bilinear.size(), 5u);
+  EXPECT_EQ(bilinear[3].change, "coarser terrain");
+}
+
+TEST(IgOverload, TheTerrainsCostIsPredictedFromTheGroundsShare) {
+  // A frame of 2 ms of polygons and a terrain pass of 40 ms per unit of ground share; the budget
+  // 12 ms. Flown at a fifth of the picture ground (10 ms) it holds full quality; when the ground
+  // fills half of it (22 ms) the governor steps down before the frame, not after an overrun — a
+  // prediction from triangles alone would still say 10 ms.
+  RenderOptions full;
+  OverloadGovernor g(qualityLevels(full, false, {true, false}), 12.0, 5);
+  auto cost = [](int level, double ground) {
+    const double terrain = 40 * ground / (level >= 3 ? 2.0 : 1.0);  // coarser terrain: half
+    return FrameCost{2 + terrain, terrain};
+  };
+  for (int f = 0; f < 10; ++f) {
+    const FrameWork w{1000, 0.2};
+    const int level = g.choose(w);
+    g.record(level, w, cost(level, 0.2));
+  }
+  ASSERT_EQ(g.level(), 0);
+  EXPECT_NEAR(g.predict(0, FrameWork{1000, 0.5}), 22, 1e-6);
+  EXPECT_GE(g.choose(FrameWork{1000, 0.5}), 1);
 }
 
 }  // namespace
