@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <thread>
 
 #include "cli.h"
 #include "synthvis/files.h"
@@ -174,6 +175,18 @@ Result<ref::CaseResult> measureCase(ref::BenchRunner& runner, const ref::BenchCa
     fmt::print("{}\n", ref::summaryLine(cr));
     if (settings.synthvis && cr.runs[0].channelStats.empty())
       fmt::print("  synthvis last frame: {}\n", cr.runs[0].stats.summary());
+    if (settings.synthvis && cr.runs[0].stats.terrains && cr.runs[0].medianMs > 0) {
+      // The terrain's rays a second a core (issue 58): the frame's sample rays over its median
+      // time and the worker threads.
+      const int threads = settings.options.threads > 0
+                              ? settings.options.threads
+                              : int(std::max(1u, std::thread::hardware_concurrency()));
+      const double rays = double(cr.runs[0].stats.terrainSampleRays);
+      fmt::print(
+          "  terrain: {:.1f} M rays/s a core ({:.2f} M rays a frame, {} threads, SIMD target {})\n",
+          rays / (cr.runs[0].medianMs / 1e3) / threads / 1e6, rays / 1e6, threads,
+          ref::simdTarget());
+    }
     for (size_t ch = 0; ch < cr.runs[0].channelStats.size(); ++ch)
       fmt::print("  synthvis last frame, channel {}: {}\n", ch,
                  cr.runs[0].channelStats[ch].summary());

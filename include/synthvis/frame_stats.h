@@ -47,11 +47,12 @@ struct FrameStats {
   uint64_t freeForms = 0, freeFormCells = 0, freeFormMaskedCells = 0, freeFormBounds = 0,
            freeFormRays = 0, freeFormHits = 0;
   // Terrain (SPEC §11–§12): height fields drawn, screen windows marched in depth, depth steps
-  // bounded by the pyramids, sample rays walked in packets (a 4×4 block's together) and cast
-  // alone (those a packet did not finish), and those that met the ground; the grounds' memory
-  // (heights and pyramids) and the time their loading took (once, when the scene was read).
-  uint64_t terrains = 0, terrainWindows = 0, terrainSteps = 0, terrainPacketRays = 0,
-           terrainRays = 0, terrainHits = 0;
+  // bounded by the pyramids, the sample rays cast (each once), of them those walked in packets (a
+  // 4×4 block's together), rays cast alone (where packets do not apply, and those a packet did
+  // not finish), and those that met the ground; the grounds' memory (heights and pyramids) and
+  // the time their loading took (once, when the scene was read).
+  uint64_t terrains = 0, terrainWindows = 0, terrainSteps = 0, terrainSampleRays = 0,
+           terrainPacketRays = 0, terrainRays = 0, terrainHits = 0;
   uint64_t terrainBytes = 0;
   double terrainLoadMs = 0;
   // The terrain pass's time: its tiles' CPU time over the frame's workers (its share of the

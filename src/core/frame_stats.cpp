@@ -37,7 +37,8 @@ FrameStats& FrameStats::operator+=(const FrameStats& o) {
   freeFormMaskedCells += o.freeFormMaskedCells, freeFormBounds += o.freeFormBounds;
   freeFormRays += o.freeFormRays, freeFormHits += o.freeFormHits;
   terrains += o.terrains, terrainWindows += o.terrainWindows, terrainSteps += o.terrainSteps;
-  terrainPacketRays += o.terrainPacketRays, terrainRays += o.terrainRays;
+  terrainSampleRays += o.terrainSampleRays, terrainPacketRays += o.terrainPacketRays;
+  terrainRays += o.terrainRays;
   terrainHits += o.terrainHits, terrainMs += o.terrainMs;
   terrainBytes = std::max(terrainBytes, o.terrainBytes);  // the scene's, in every view alike
   terrainLoadMs = std::max(terrainLoadMs, o.terrainLoadMs);
@@ -55,12 +56,12 @@ std::string FrameStats::summary() const {
   // A segment-pipeline frame (RenderOptions::Pipeline::segments) has no windows, fragments or
   // tiles to report: its triangles, its segments and runs, and its times.
   if (segments || repeatedLines)
-    return fmt::format("triangles in {} / culled {} (facing {}, outside {}, degenerate {}, invalid "
-                       "{}) / drawn {} | segments {}: runs {}, lines repeated {} | {:.2f} ms "
-                       "(vertex {:.2f}, setup {:.2f}, lines {:.2f})",
-                       trianglesIn, culled(), culledFacing, culledOutside, culledDegenerate,
-                       culledInvalid, drawn, segments, segmentRuns, repeatedLines, totalMs,
-                       vertexMs, setupMs, rasterMs) +
+    return fmt::format(
+               "triangles in {} / culled {} (facing {}, outside {}, degenerate {}, invalid "
+               "{}) / drawn {} | segments {}: runs {}, lines repeated {} | {:.2f} ms "
+               "(vertex {:.2f}, setup {:.2f}, lines {:.2f})",
+               trianglesIn, culled(), culledFacing, culledOutside, culledDegenerate, culledInvalid,
+               drawn, segments, segmentRuns, repeatedLines, totalMs, vertexMs, setupMs, rasterMs) +
            lodSummary();
   return fmt::format(
              "triangles in {} / culled {} (facing {}, outside {}{}, degenerate {}, invalid {}{}) / "
@@ -88,12 +89,12 @@ std::string FrameStats::summary() const {
                                   freeForms, freeFormCells, freeFormMaskedCells, freeFormBounds,
                                   freeFormRays, freeFormHits)
                     : std::string()) +
-         (terrains ? fmt::format(" | terrain {}: windows {}, steps {}, rays {} in packets and {} "
-                                 "alone, hits {}, {:.2f} ms, {:.1f} MB, loaded in {:.1f} ms",
-                                 terrains, terrainWindows, terrainSteps, terrainPacketRays,
-                                 terrainRays, terrainHits, terrainMs, terrainBytes / 1e6,
-                                 terrainLoadMs)
-                   : std::string()) +
+         (terrains
+              ? fmt::format(" | terrain {}: windows {}, steps {}, rays {} in packets and {} "
+                            "alone, hits {}, {:.2f} ms, {:.1f} MB, loaded in {:.1f} ms",
+                            terrains, terrainWindows, terrainSteps, terrainPacketRays, terrainRays,
+                            terrainHits, terrainMs, terrainBytes / 1e6, terrainLoadMs)
+              : std::string()) +
          (lightPoints
               ? fmt::format(" | lights {}: drawn {}, {:.2f} ms", lightPoints, lightsDrawn, lightsMs)
               : std::string()) +

@@ -461,7 +461,9 @@ void Caster::walkPacketLevels(Packet& p, double pixel, double stretch, int maxCe
                               CastCounters& c) const {
   const int n = pyramid_.gridLevel();
   const int count = std::clamp(p.count, 0, kPacketRays);
-  Packet left = p;  // each lane's span not walked yet (s0 > s1: none)
+  Packet left = p;                 // each lane's span not walked yet (s0 > s1: none)
+  const uint64_t lanes = c.lanes;  // a lane counts once, however many levels it walks
+  uint64_t walked = 0;
   for (int l = 0; l < count; ++l)
     p.hit[l] = std::numeric_limits<double>::quiet_NaN(), p.reached[l] = p.s0[l];
   // Each round a coarser level (at `end`, where the last stopped, lodLevel is still that level).
@@ -469,10 +471,12 @@ void Caster::walkPacketLevels(Packet& p, double pixel, double stretch, int maxCe
     double from = kInf;
     for (int l = 0; l < count; ++l)
       if (left.s0[l] <= left.s1[l]) from = std::min(from, left.s0[l]);
-    if (!std::isfinite(from) || last == 0) return;
+    if (!std::isfinite(from) || last == 0) break;
     const int level = std::min(lodLevel(from, pixel, stretch), last - 1);
+    if (!packetsApply(level)) break;  // the lanes left go on alone from their starts
+    if (last > n)                     // the first round: its lanes are the packet's rays
+      for (int l = 0; l < count; ++l) walked += left.s0[l] <= left.s1[l];
     last = level;
-    if (!packetsApply(level)) return;  // the lanes left go on alone from their starts
     // lodLevel is `level` while pixel·s·stretch ≤ 2^(n − level).
     const double end =
         pixel > 0 && level > 0 ? std::ldexp(1.0, n - level) / (pixel * stretch) : kInf;
@@ -497,6 +501,7 @@ void Caster::walkPacketLevels(Packet& p, double pixel, double stretch, int maxCe
       }
     }
   }
+  c.lanes = lanes + walked;
 }
 
 double Caster::solveAt(Vec3d o, Vec3d d, double sa, double sb, int level) const {

@@ -34,13 +34,14 @@ struct Placement {
 struct CastCounters {
   uint64_t windows = 0;  // screen windows marched
   uint64_t steps = 0;    // depth steps tested against the pyramid
-  uint64_t lanes = 0;    // rays walked in packets (walkPacket's live lanes)
+  uint64_t samples = 0;  // sample rays cast (each once, whether in a packet or alone)
+  uint64_t lanes = 0;    // rays walked in packets (walkPacket's live lanes; once per packet walk)
   uint64_t rays = 0;     // single rays cast to the surface
   uint64_t solves = 0;   // finest-level steps solved against the interpolated surface
   uint64_t hits = 0;
   void add(const CastCounters& o) {
-    windows += o.windows, steps += o.steps, lanes += o.lanes, rays += o.rays, solves += o.solves,
-        hits += o.hits;
+    windows += o.windows, steps += o.steps, samples += o.samples, lanes += o.lanes, rays += o.rays,
+        solves += o.solves, hits += o.hits;
   }
 };
 

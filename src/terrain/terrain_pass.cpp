@@ -134,6 +134,7 @@ void TerrainPass::addStats(FrameStats& stats) const {
   stats.terrains += terrains_.size();
   stats.terrainWindows += c.windows;
   stats.terrainSteps += c.steps;
+  stats.terrainSampleRays += c.samples;
   stats.terrainPacketRays += c.lanes;
   stats.terrainRays += c.rays;
   stats.terrainHits += c.hits;
@@ -262,6 +263,7 @@ void TerrainPass::castBlock(Scratch& w, const Drawn& t, int x0, int y0, double s
         continue;
       }
       p.s0[l] = start, p.s1[l] = w.limit[at[l]];
+      ++w.counts->samples;
       stretches[l] = c.stretch(p.dir[l]);
       stretch = std::max(stretch, stretches[l]);
     }
