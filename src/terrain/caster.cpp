@@ -98,9 +98,8 @@ Caster::Caster(const HeightField& field, const Pyramid& pyramid, Interpolation i
   margin_ = 1e-9 * (std::fabs(field.offset) + 65535 * field.scale) + 1e-12;
 }
 
-Caster::MapPoint Caster::toMap(Vec3d p) const {
+Caster::MapPoint Caster::toMapOnSphere(Vec3d p) const {
   const double R = placement_.radius;
-  if (R <= 0) return {ax_ * p.x + bx_, ay_ * p.z + by_, p.y};
   // Gnomonic: the tangent plane y = 0 met by the line from the centre (0, −R, 0) through p.
   const Vec3d d{p.x, p.y + R, p.z};
   const double r = length(d);

@@ -69,7 +69,10 @@ class Caster {
   struct MapPoint {
     double gx, gy, h;
   };
-  MapPoint toMap(Vec3d world) const;
+  MapPoint toMap(Vec3d world) const {
+    if (placement_.radius <= 0) return {ax_ * world.x + bx_, ay_ * world.z + by_, world.y};
+    return toMapOnSphere(world);
+  }
   Vec3d toWorld(double gx, double gy, double h) const;
   // The map position (metres) of grid coordinates.
   double mapU(double gx) const { return field_.originU + gx * field_.spacingU; }
@@ -148,6 +151,7 @@ class Caster {
   const Placement& placement() const { return placement_; }
 
  private:
+  MapPoint toMapOnSphere(Vec3d world) const;
   struct Box {
     double gx0, gx1, gy0, gy1, h0, h1;  // grid rectangle and heights above the base
   };
