@@ -340,62 +340,70 @@ double Caster::solveBilinear(Vec3d o, Vec3d d, double sa, double sb, int level) 
 double Caster::solveBicubic(Vec3d o, Vec3d d, double sa, double sb) const {
   const HeightField& f = field_;
   const GridRay r = gridRay(o, d, 1);
+  const Pyramid::TopLevel bounds = pyramid_.cellTops();
+  return walkCells(r, f.width - 1, f.height - 1, f.width - 1, f.height - 1, sa, sb,
+                   [&](int i, int j, double s, double out) {
+                     // Solved only where the ray may touch the cell's Bézier hull.
+                     double top = kInf;
+                     if (bounds.top) {
+                       const uint16_t t = bounds.top[size_t(j) * size_t(bounds.width) + size_t(i)];
+                       if (t != Pyramid::kNoTop) top = t;
+                     }
+                     if (r.z0 + (r.ez < 0 ? out : s) * r.ez > top)
+                       return std::numeric_limits<double>::quiet_NaN();
+                     return solveBicubicCell(r, i, j, s, out, bounds.top != nullptr);
+                   });
+}
+
+double Caster::solveBicubicCell(const GridRay& r, int i, int j, double s, double out,
+                                bool bounded) const {
+  double h[4][4];
+  cellSamples(field_, i, j, h);
+  if (!bounded && r.z0 + (r.ez < 0 ? out : s) * r.ez > bezierTop(h))
+    return std::numeric_limits<double>::quiet_NaN();
+  // The patch as a polynomial: P(u, v) = Σ a[l][k]·u^k·v^l, a = B·H·Bᵀ over the basis.
+  double rows[4][4] = {}, a[4][4] = {};
+  for (int y = 0; y < 4; ++y)
+    for (int k = 0; k < 4; ++k)
+      for (int x = 0; x < 4; ++x) rows[y][k] += kBasis[k][x] * h[y][x];
+  for (int l = 0; l < 4; ++l)
+    for (int k = 0; k < 4; ++k)
+      for (int y = 0; y < 4; ++y) a[l][k] += kBasis[l][y] * rows[y][k];
+  // Along the ray from s (τ = t − s): u = u0 + τ·ex, v = v0 + τ·ey, so P is a polynomial of degree
+  // 6 in τ and f(τ) = z − P its height above the patch: composed once, then each evaluation is
+  // Horner's rule of degree 6.
+  const double u0 = r.x0 + s * r.ex - i, v0 = r.y0 + s * r.ey - j;
+  double U[4][4] = {{1}}, V[4][4] = {{1}};  // U[k]: (u0 + τ·ex)^k's coefficients
+  for (int k = 1; k < 4; ++k)
+    for (int c = 0; c <= k; ++c) {
+      U[k][c] = (c < k ? U[k - 1][c] * u0 : 0) + (c > 0 ? U[k - 1][c - 1] * r.ex : 0);
+      V[k][c] = (c < k ? V[k - 1][c] * v0 : 0) + (c > 0 ? V[k - 1][c - 1] * r.ey : 0);
+    }
+  double f[7] = {r.z0 + s * r.ez, r.ez, 0, 0, 0, 0, 0};
+  for (int l = 0; l < 4; ++l) {
+    double q[4] = {};  // Σ_k a[l][k]·U[k]
+    for (int k = 0; k < 4; ++k)
+      for (int c = 0; c <= k; ++c) q[c] += a[l][k] * U[k][c];
+    for (int c = 0; c <= l; ++c)
+      for (int e = 0; e < 4; ++e) f[c + e] -= V[l][c] * q[e];
+  }
+  auto above = [&](double t) {
+    const double x = t - s;
+    return (((((f[6] * x + f[5]) * x + f[4]) * x + f[3]) * x + f[2]) * x + f[1]) * x + f[0];
+  };
+  // Samples an eighth of a cell apart along the ray (solve()'s rule), then the bracket refined.
   const double speed = std::hypot(r.ex, r.ey);  // cells per unit s
-  const double tolerance = 1e-4 / std::max(speed, 1e-300);
-  return walkCells(
-      r, f.width - 1, f.height - 1, f.width - 1, f.height - 1, sa, sb,
-      [&](int i, int j, double s, double out) {
-        // The 4×4 samples the cell's surface reads (clamped to the table).
-        double h[4][4];
-        for (int y = 0; y < 4; ++y)
-          for (int x = 0; x < 4; ++x)
-            h[y][x] = f.code(std::clamp(i - 1 + x, 0, f.width - 1),
-                             std::clamp(j - 1 + y, 0, f.height - 1));
-        // The patch's Bézier control points (a Catmull–Rom segment p1 → p2 is the cubic Bézier p1,
-        // p1 + (p2 − p0)/6, p2 − (p3 − p1)/6, p2, along each axis): the surface stays within their
-        // hull, a far tighter top than the samples' range with the overshoot (pyramid.h).
-        auto bezier = [](const double p[4], double b[4]) {
-          b[0] = p[1], b[1] = p[1] + (p[2] - p[0]) / 6, b[2] = p[2] - (p[3] - p[1]) / 6,
-          b[3] = p[2];
-        };
-        double rowsB[4][4], top = -kInf;
-        for (int y = 0; y < 4; ++y) bezier(h[y], rowsB[y]);
-        for (int x = 0; x < 4; ++x) {
-          const double column[4] = {rowsB[0][x], rowsB[1][x], rowsB[2][x], rowsB[3][x]};
-          double b[4];
-          bezier(column, b);
-          top = std::max({top, b[0], b[1], b[2], b[3]});
-        }
-        if (r.z0 + (r.ez < 0 ? out : s) * r.ez > top)
-          return std::numeric_limits<double>::quiet_NaN();
-        // The patch as a polynomial: P(u, v) = Σ a[l][k]·u^k·v^l, a = B·H·Bᵀ over the basis.
-        double rows[4][4] = {}, a[4][4] = {};
-        for (int y = 0; y < 4; ++y)
-          for (int k = 0; k < 4; ++k)
-            for (int x = 0; x < 4; ++x) rows[y][k] += kBasis[k][x] * h[y][x];
-        for (int l = 0; l < 4; ++l)
-          for (int k = 0; k < 4; ++k)
-            for (int y = 0; y < 4; ++y) a[l][k] += kBasis[l][y] * rows[y][k];
-        auto above = [&](double t) {
-          const double u = r.x0 + t * r.ex - i, v = r.y0 + t * r.ey - j;
-          double p = 0;
-          for (int l = 3; l >= 0; --l)
-            p = p * v + (((a[l][3] * u + a[l][2]) * u + a[l][1]) * u + a[l][0]);
-          return r.z0 + t * r.ez - p;
-        };
-        // Samples an eighth of a cell apart along the ray (solve()'s rule), then the bracket refined.
-        const double fs = above(s);
-        if (fs <= 0) return s;
-        const int n = std::clamp(int(std::ceil(8 * (out - s) * speed)), 1, 64);
-        double s0 = s, f0 = fs;
-        for (int k = 1; k <= n; ++k) {
-          const double s1 = k == n ? out : s + (out - s) * k / n;
-          const double f1 = above(s1);
-          if (f1 <= 0) return refineRoot(s0, f0, s1, f1, tolerance, above);
-          s0 = s1, f0 = f1;
-        }
-        return std::numeric_limits<double>::quiet_NaN();
-      });
+  const double fs = above(s);
+  if (fs <= 0) return s;
+  const int n = std::clamp(int(std::ceil(8 * (out - s) * speed)), 1, 64);
+  double s0 = s, f0 = fs;
+  for (int k = 1; k <= n; ++k) {
+    const double s1 = k == n ? out : s + (out - s) * k / n;
+    const double f1 = above(s1);
+    if (f1 <= 0) return refineRoot(s0, f0, s1, f1, 1e-4 / std::max(speed, 1e-300), above);
+    s0 = s1, f0 = f1;
+  }
+  return std::numeric_limits<double>::quiet_NaN();
 }
 
 void Caster::walkPacket(Packet& p, int level, int maxCells, CastCounters& c) const {
@@ -426,6 +434,8 @@ void Caster::walkPacket(Packet& p, int level, int maxCells, CastCounters& c) con
   };
   const Pyramid::TopLevel tops = pyramid_.tops(level);
   g.top = tops.top, g.topWidth = tops.width;
+  if (level >= pyramid_.gridLevel() && interp_ == Interpolation::bicubic)
+    g.cellTop = pyramid_.cellTops().top;
   // The anchor: the corner of the skip map's square holding the first lane's start.
   g.anchorI = corner(x0 + sRef * ax_ * d.x * k, g.cellsX) & ~(Pyramid::kTopCells - 1);
   g.anchorJ = corner(y0 + sRef * ay_ * d.z * k, g.cellsY) & ~(Pyramid::kTopCells - 1);
@@ -472,8 +482,8 @@ void Caster::walkPacketLevels(Packet& p, double pixel, double stretch, int maxCe
       if (left.s0[l] <= left.s1[l]) from = std::min(from, left.s0[l]);
     if (!std::isfinite(from) || last == 0) break;
     const int level = std::min(lodLevel(from, pixel, stretch), last - 1);
-    if (!packetsApply(level)) break;  // the lanes left go on alone from their starts
-    if (last > n)                     // the first round: its lanes are the packet's rays
+    if (!packetsApply()) break;  // the lanes left go on alone from their starts
+    if (last > n)                // the first round: its lanes are the packet's rays
       for (int l = 0; l < count; ++l) walked += left.s0[l] <= left.s1[l];
     last = level;
     // lodLevel is `level` while pixel·s·stretch ≤ 2^(n − level).

@@ -119,12 +119,14 @@ class Caster {
   double cast(Vec3d origin, Vec3d dir, double s0, double s1, CastCounters& c,
               double pixel = 0) const;
 
-  // The rays of a block walked together (packet_walk.h), each at most `maxCells` cells of
-  // `level`'s bilinear surface from its start — what cast() does for one ray first, for a packet:
-  // the walk of every cell the ray crosses, the exact solve where it may touch. Only on the plane
-  // base with a bilinear surface at `level` (packetsApply). Lane l: origin + s·dir[l] over
-  // [s0[l], s1[l]]; hit[l] its first crossing there (NaN: none in the cells walked), reached[l]
-  // where a ray without one stopped (s1[l]: nothing before s1, else where to go on from).
+  // The rays of a block walked together (packet_walk.h), each at most `maxCells` steps over
+  // `level`'s surface from its start — what cast() does for one ray first, for a packet: the walk
+  // of every cell the ray crosses, the exact solve where it may touch its bilinear surface. On the
+  // table's bicubic surface a lane stops, unsolved, at the first cell whose patch's bound it may
+  // touch: reached[l] there, for cast() to solve alone. Only on the plane base (packetsApply).
+  // Lane l: origin + s·dir[l] over [s0[l], s1[l]]; hit[l] its first crossing there (NaN: none in
+  // the cells walked), reached[l] where a ray without one stopped (s1[l]: nothing before s1, else
+  // where to go on from).
   struct Packet {
     Vec3d origin;
     int count = 0;
@@ -132,10 +134,7 @@ class Caster {
     double s0[kPacketRays], s1[kPacketRays];
     double hit[kPacketRays], reached[kPacketRays];
   };
-  bool packetsApply(int level) const {
-    return placement_.radius <= 0 &&
-           (level < pyramid_.gridLevel() || interp_ == Interpolation::bilinear);
-  }
+  bool packetsApply() const { return placement_.radius <= 0; }
   void walkPacket(Packet& p, int level, int maxCells, CastCounters& c) const;
   // The packet walked at the levels of detail along its rays (SPEC §11, work bounded by the
   // footprint): from the nearest lane's start at that start's level (`pixel` as for lodLevel,
@@ -168,6 +167,9 @@ class Caster {
   // only where the ray may touch its bound, there its patch as a polynomial sampled at eighths of
   // a cell along the ray and the first bracket refined.
   double solveBicubic(Vec3d origin, Vec3d dir, double sa, double sb) const;
+  // Its cell (i, j) over [s, out]: the first root there, or NaN. `bounded`: the ray may touch
+  // the cell's Bézier hull (Pyramid::cellTops said so); else that is tested first.
+  double solveBicubicCell(const GridRay& r, int i, int j, double s, double out, bool bounded) const;
   // The ray in the grid of a level `step` grid steps apart (GridRay).
   GridRay gridRay(Vec3d origin, Vec3d dir, double step) const;
   // The first root in [sa, sb] at `level`, by whichever of the three applies.

@@ -74,4 +74,27 @@ double interpolate(const HeightField& f, Interpolation interp, double x, double 
   return f.offset + f.scale * v;
 }
 
+void cellSamples(const HeightField& f, int i, int j, double h[4][4]) {
+  for (int y = 0; y < 4; ++y) {
+    const uint16_t* row =
+        f.q.data() + size_t(std::clamp(j - 1 + y, 0, f.height - 1)) * size_t(f.width);
+    for (int x = 0; x < 4; ++x) h[y][x] = row[std::clamp(i - 1 + x, 0, f.width - 1)];
+  }
+}
+
+double bezierTop(const double h[4][4]) {
+  auto bezier = [](const double p[4], double b[4]) {
+    b[0] = p[1], b[1] = p[1] + (p[2] - p[0]) / 6, b[2] = p[2] - (p[3] - p[1]) / 6, b[3] = p[2];
+  };
+  double rows[4][4], top = -std::numeric_limits<double>::infinity();
+  for (int y = 0; y < 4; ++y) bezier(h[y], rows[y]);
+  for (int x = 0; x < 4; ++x) {
+    const double column[4] = {rows[0][x], rows[1][x], rows[2][x], rows[3][x]};
+    double b[4];
+    bezier(column, b);
+    top = std::max({top, b[0], b[1], b[2], b[3]});
+  }
+  return top;
+}
+
 }  // namespace sv::terrain

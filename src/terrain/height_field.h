@@ -26,4 +26,13 @@ const char* interpolationName(Interpolation i);
 double interpolate(const HeightField& f, Interpolation interp, double x, double y,
                    double* dx = nullptr, double* dy = nullptr);
 
+// The 4×4 codes the Catmull–Rom surface of cell (i, j) reads (edge samples repeated), h[row][col]
+// from (i − 1, j − 1).
+void cellSamples(const HeightField& f, int i, int j, double h[4][4]);
+// The highest of the cell's patch's 16 Bézier control points (a Catmull–Rom segment p1 → p2 is the
+// cubic Bézier p1, p1 + (p2 − p0)/6, p2 − (p3 − p1)/6, p2 along each axis), in codes: the surface
+// over the cell stays below it — far tighter than the samples' range widened by the 9/32
+// overshoot (pyramid.h).
+double bezierTop(const double h[4][4]);
+
 }  // namespace sv::terrain

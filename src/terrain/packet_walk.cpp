@@ -94,13 +94,34 @@ hn::Mask<DF> ClipToFootprint(DF df, const PacketGrid& g, hn::Vec<DF> x0, hn::Vec
   return hn::And(active, hn::Le(t, t1));
 }
 
+// Along an axis the lane crosses: the next cell — past its square's edge for a lane that passed
+// the square (`skip`), else the cell beside.
+template <class DI, class MI, class MF>
+hn::Vec<DI> Across(DI di, MI skip, MF positive, hn::Vec<DI> square, hn::Vec<DI> cell,
+                   hn::Vec<DI> step) {
+  const hn::Vec<DI> past =
+      hn::IfThenElse(hn::RebindMask(di, positive), hn::Add(square, hn::Set(di, Pyramid::kTopCells)),
+                     hn::Sub(square, hn::Set(di, 1)));
+  return hn::IfThenElse(skip, past, hn::Add(cell, step));
+}
+// Along the axis it does not cross: its cell — for a lane that passed a square, the one of the
+// square's where it leaves it (`p` its coordinate there), within the grid's [lo, hi].
+template <class DI, class MI, class VF>
+hn::Vec<DI> Within(DI di, MI skip, VF p, hn::Vec<DI> cell, hn::Vec<DI> square, hn::Vec<DI> lo,
+                   hn::Vec<DI> hi) {
+  const hn::Vec<DI> c = hn::ConvertTo(di, hn::Floor(p));
+  const hn::Vec<DI> inSquare =
+      hn::Min(hn::Max(c, square), hn::Add(square, hn::Set(di, Pyramid::kTopCells - 1)));
+  return hn::Min(hn::Max(hn::IfThenElse(skip, inSquare, cell), lo), hi);
+}
+
 // One vector of lanes, from lane `first`: each lane's span clipped to the table's footprint, then
 // walked until it is done or has taken maxCells steps — per lane Caster::solveBilinear's cells, in
 // float, with the skip map's squares passed at once (SPEC §12: a node the ray stays above is
 // skipped). Per step a lane is in one cell; where it has just entered a square, it first asks
 // whether its ray stays above the square's top from there until it leaves the square: then the
 // step takes it to the next square, else it solves the cell as any other.
-template <class DF>
+template <bool kBicubic, class DF>
 void WalkLanes(DF df, const PacketGrid& g, PacketLanes& L, size_t first, int maxCells) {
   const hn::RebindToSigned<DF> di;
   const hn::RebindToUnsigned<DF> du;
@@ -137,9 +158,12 @@ void WalkLanes(DF df, const PacketGrid& g, PacketLanes& L, size_t first, int max
   const VI stepJ = hn::IfThenElse(hn::RebindMask(di, posY), hn::Set(di, 1), hn::Set(di, -1));
   const VI squareMask = hn::Set(di, ~(Pyramid::kTopCells - 1));  // a cell → its square's first
   const VF squareCells = hn::Set(df, float(Pyramid::kTopCells));
-  const VI width = hn::Set(di, g.width), topWidth = hn::Set(di, g.topWidth);
-  const int32_t* base = reinterpret_cast<const int32_t*>(g.q + size_t(g.anchorJ) * size_t(g.width) +
-                                                         size_t(g.anchorI));
+  // The cells' samples (bilinear), or their tops (bicubic: a row of cellsX).
+  const int rowCells = kBicubic ? g.cellsX : g.width;
+  const uint16_t* cells = kBicubic ? g.cellTop : g.q;
+  const int32_t* base = reinterpret_cast<const int32_t*>(
+      cells + size_t(g.anchorJ) * size_t(rowCells) + size_t(g.anchorI));
+  const VI width = hn::Set(di, rowCells), topWidth = hn::Set(di, g.topWidth);
   const int32_t* topBase = reinterpret_cast<const int32_t*>(
       g.top + size_t(g.anchorJ / Pyramid::kTopCells) * size_t(g.topWidth) +
       size_t(g.anchorI / Pyramid::kTopCells));
@@ -154,7 +178,7 @@ void WalkLanes(DF df, const PacketGrid& g, PacketLanes& L, size_t first, int max
   auto gather = [&](VI i, VI j, VI& r0, VI& r1, VI& top) {
     const VI offset = hn::ShiftLeft<1>(hn::Add(hn::Mul(j, width), i));
     r0 = hn::GatherOffset(di, base, offset);
-    r1 = hn::GatherOffset(di, base, hn::Add(offset, row));
+    r1 = kBicubic ? r0 : hn::GatherOffset(di, base, hn::Add(offset, row));
     const VI square = hn::Add(hn::Mul(hn::ShiftRight<Pyramid::kTopShift>(j), topWidth),
                               hn::ShiftRight<Pyramid::kTopShift>(i));
     top = hn::GatherOffset(di, topBase, hn::ShiftLeft<1>(square));
@@ -164,7 +188,10 @@ void WalkLanes(DF df, const PacketGrid& g, PacketLanes& L, size_t first, int max
     return hn::Sub(hn::ConvertTo(df, hn::BitCast(di, hn::ShiftRight<16>(hn::BitCast(du, r)))),
                    anchorZ);
   };
-  auto entered = active;  // lanes that have just entered a square
+  const VI noTop = hn::Set(di, Pyramid::kNoTop);
+  auto bounded = [&](VI r) { return hn::RebindMask(df, hn::Lt(hn::And(r, low16), noTop)); };
+  auto entered = active;           // lanes that have just entered a square
+  auto stopped = hn::Lt(t, zero);  // bicubic: lanes stopped at the cell they may touch (none yet)
   VI r0, r1, rTop;
   gather(ci, cj, r0, r1, rTop);
   for (int steps = 0; steps < maxCells && !hn::AllFalse(df, active); ++steps) {
@@ -183,7 +210,8 @@ void WalkLanes(DF df, const PacketGrid& g, PacketLanes& L, size_t first, int max
     // The square passed: its top below the ray's lowest point in it from t on.
     const VF lowestInSquare =
         hn::Add(z0, hn::Mul(hn::IfThenElse(hn::Lt(ez, zero), outSquare, t), ez));
-    const auto skip = hn::And(hn::And(entered, active), hn::Gt(lowestInSquare, code(rTop)));
+    const auto skip = hn::And(hn::And(hn::And(entered, active), bounded(rTop)),
+                              hn::Gt(lowestInSquare, code(rTop)));
     // This step's end: the square's exit for the lanes that pass it, the cell's for the rest.
     const VF tx = hn::IfThenElse(skip, txSquare, txCell);
     const VF ty = hn::IfThenElse(skip, tySquare, tyCell);
@@ -194,45 +222,41 @@ void WalkLanes(DF df, const PacketGrid& g, PacketLanes& L, size_t first, int max
     const auto goOn = hn::AndNot(hn::Ge(out, t1), active);
     const auto alongX = hn::RebindMask(di, hn::Le(tx, ty));
     const auto skipI = hn::RebindMask(di, skip);
-    const VI squareEnd = hn::Set(di, Pyramid::kTopCells - 1);
-    const VI acrossI = hn::IfThenElse(
-        skipI,
-        hn::IfThenElse(hn::RebindMask(di, posX), hn::Add(si, hn::Set(di, Pyramid::kTopCells)),
-                       hn::Sub(si, hn::Set(di, 1))),
-        hn::Add(ci, stepI));
-    const VI acrossJ = hn::IfThenElse(
-        skipI,
-        hn::IfThenElse(hn::RebindMask(di, posY), hn::Add(sj, hn::Set(di, Pyramid::kTopCells)),
-                       hn::Sub(sj, hn::Set(di, 1))),
-        hn::Add(cj, stepJ));
-    // Along the axis not crossed a lane that passed a square is in the cell where it leaves it.
-    auto within = [&](VF p, VI cell, VI square) {
-      const VI c = hn::ConvertTo(di, hn::Floor(p));
-      return hn::IfThenElse(skipI, hn::Min(hn::Max(c, square), hn::Add(square, squareEnd)), cell);
-    };
     const VF outFinite = hn::IfThenElse(hn::IsFinite(out), out, t);
-    const VI alongI = within(hn::Add(x0, hn::Mul(outFinite, ex)), ci, si);
-    const VI alongJ = within(hn::Add(y0, hn::Mul(outFinite, ey)), cj, sj);
-    const VI nextI = hn::IfThenElse(alongX, acrossI, hn::Min(hn::Max(alongI, loI), hiI));
-    const VI nextJ = hn::IfThenElse(alongX, hn::Min(hn::Max(alongJ, loJ), hiJ), acrossJ);
-    const auto inside = hn::And(hn::And(hn::Gt(nextI, hn::Sub(loI, hn::Set(di, 1))),
-                                        hn::Lt(nextI, hn::Add(hiI, hn::Set(di, 1)))),
-                                hn::And(hn::Gt(nextJ, hn::Sub(loJ, hn::Set(di, 1))),
-                                        hn::Lt(nextJ, hn::Add(hiJ, hn::Set(di, 1)))));
+    const VI nextI =
+        hn::IfThenElse(alongX, Across(di, skipI, posX, si, ci, stepI),
+                       Within(di, skipI, hn::Add(x0, hn::Mul(outFinite, ex)), ci, si, loI, hiI));
+    const VI nextJ = hn::IfThenElse(
+        alongX, Within(di, skipI, hn::Add(y0, hn::Mul(outFinite, ey)), cj, sj, loJ, hiJ),
+        Across(di, skipI, posY, sj, cj, stepJ));
+    auto in = [&](VI v, VI lo, VI hi) {
+      return hn::And(hn::Gt(v, hn::Sub(lo, hn::Set(di, 1))),
+                     hn::Lt(v, hn::Add(hi, hn::Set(di, 1))));
+    };
+    const auto inside = hn::And(in(nextI, loI, hiI), in(nextJ, loJ, hiJ));
     const auto moves = hn::And(goOn, hn::RebindMask(df, inside));
     const auto movesI = hn::RebindMask(di, moves);
     const VI ni = hn::IfThenElse(movesI, nextI, ci), nj = hn::IfThenElse(movesI, nextJ, cj);
     VI n0, n1, nTop;
     gather(ni, nj, n0, n1, nTop);
     // This cell, for the lanes that did not pass its square: solved only where the ray's lowest
-    // point in it is not above its highest corner.
-    const VF h00 = code(r0), h10 = codeHigh(r0), h01 = code(r1), h11 = codeHigh(r1);
-    const VF top = hn::Max(hn::Max(h00, h10), hn::Max(h01, h11));
+    // point in it is not above its highest corner — or, bicubic, left where it is not above the
+    // cell's bound, to be solved alone.
     const VF lowest = hn::Add(z0, hn::Mul(hn::IfThenElse(hn::Lt(ez, zero), outCell, t), ez));
-    const auto near = hn::AndNot(skip, hn::And(active, hn::Le(lowest, top)));
-    const auto met = SolveCell(df, CellRays<DF>{x0, y0, z0, ex, ey, ez}, near, t, outCell, fi, fj,
-                               Corners<DF>{h00, h10, h01, h11}, hit);
-    // On: the lanes that neither met the surface here nor stopped.
+    hn::Mask<DF> met;
+    if constexpr (kBicubic) {
+      met =
+          hn::AndNot(skip, hn::And(active, hn::Or(hn::Not(bounded(r0)), hn::Le(lowest, code(r0)))));
+      stopped = hn::Or(stopped, met);
+    } else {
+      const VF h00 = code(r0), h10 = codeHigh(r0), h01 = code(r1), h11 = codeHigh(r1);
+      const VF top = hn::Max(hn::Max(h00, h10), hn::Max(h01, h11));
+      const auto near = hn::AndNot(skip, hn::And(active, hn::Le(lowest, top)));
+      met = SolveCell(df, CellRays<DF>{x0, y0, z0, ex, ey, ez}, near, t, outCell, fi, fj,
+                      Corners<DF>{h00, h10, h01, h11}, hit);
+    }
+    // On: the lanes that neither met the surface here (or stopped at it) nor stopped; a lane
+    // stopped at a cell keeps its t, the cell's entry.
     active = hn::AndNot(met, moves);
     t = hn::IfThenElse(active, out, t);
     entered = hn::RebindMask(df, hn::Or(hn::Not(hn::Eq(hn::And(ni, squareMask), si)),
@@ -241,13 +265,17 @@ void WalkLanes(DF df, const PacketGrid& g, PacketLanes& L, size_t first, int max
     r0 = n0, r1 = n1, rTop = nTop;
   }
   hn::Store(hit, df, L.hit + first);
-  hn::Store(hn::IfThenElse(active, t, inf), df, L.reached + first);
+  hn::Store(hn::IfThenElse(hn::Or(active, stopped), t, inf), df, L.reached + first);
 }
 
 void WalkPacket(const PacketGrid& grid, PacketLanes& lanes, int maxCells) {
   const hn::CappedTag<float, kPacketRays> df;
-  for (size_t first = 0; first < size_t(kPacketRays); first += hn::Lanes(df))
-    WalkLanes(df, grid, lanes, first, maxCells);
+  for (size_t first = 0; first < size_t(kPacketRays); first += hn::Lanes(df)) {
+    if (grid.cellTop)
+      WalkLanes<true>(df, grid, lanes, first, maxCells);
+    else
+      WalkLanes<false>(df, grid, lanes, first, maxCells);
+  }
 }
 
 }  // namespace HWY_NAMESPACE

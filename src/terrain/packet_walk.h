@@ -30,6 +30,11 @@ struct PacketGrid {
   int cellsX = 0, cellsY = 0;
   const uint16_t* top = nullptr;  // topWidth × ⌈cellsY / kTopCells⌉ codes, and one of padding
   int topWidth = 0;
+  // The table's bicubic surface (Pyramid::cellTops: per cell the top of its patch's Bézier hull,
+  // cellsX a row): a lane walks the cells by these bounds and stops, unsolved, at the first whose
+  // bound its ray may touch — the cell to solve the patch in, alone (Caster::solveBicubic). Null:
+  // the bilinear surface of q, solved in the walk.
+  const uint16_t* cellTop = nullptr;
   // The sample the lanes' x, y are measured from: a corner of a skip map's square (multiples of
   // Pyramid::kTopCells).
   int anchorI = 0, anchorJ = 0;
@@ -47,7 +52,7 @@ struct PacketLanes {
   // Results: the first t at which the ray meets the surface (or is below it at its start: that
   // t), NaN where it met nothing in the cells walked; where its walk stopped: +∞ when it is done
   // (a hit, t1 reached, the footprint left, or idle), else the t where its next, unwalked cell
-  // begins.
+  // begins (on the bicubic surface: the cell it may touch).
   alignas(64) float hit[kPacketRays], reached[kPacketRays];
 };
 

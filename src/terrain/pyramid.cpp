@@ -116,6 +116,18 @@ Pyramid::Pyramid(const HeightField& field, Interpolation interp) : field_(&field
 }
 
 void Pyramid::buildTops() {
+  if (interp_ == Interpolation::bicubic) {
+    const HeightField& f = *field_;
+    cellTops_.assign(size_t(cellsX_) * size_t(cellsY_) + 1, kNoTop);
+    double h[4][4];
+    for (int j = 0; j < cellsY_; ++j)
+      for (int i = 0; i < cellsX_; ++i) {
+        cellSamples(f, i, j, h);
+        const double top = std::ceil(bezierTop(h));
+        cellTops_[size_t(j) * size_t(cellsX_) + size_t(i)] =
+            top < kNoTop ? uint16_t(std::max(top, 0.0)) : kNoTop;
+      }
+  }
   tops_.resize(size_t(n_) + 1);
   topW_.resize(size_t(n_) + 1);
   topH_.resize(size_t(n_) + 1);
@@ -123,6 +135,18 @@ void Pyramid::buildTops() {
     const MeanLevel m = mean(k);
     const int w = (m.width - 1 + kTopCells - 1) / kTopCells;
     const int h = (m.height - 1 + kTopCells - 1) / kTopCells;
+    topW_[size_t(k)] = w;
+    topH_[size_t(k)] = h;
+    std::vector<uint16_t>& top = tops_[size_t(k)];
+    top.assign(size_t(w) * size_t(h) + 1, 0);
+    if (k == n_ && !cellTops_.empty()) {  // the bicubic table: its cells' tops
+      for (int j = 0; j < cellsY_; ++j)
+        for (int i = 0; i < cellsX_; ++i) {
+          uint16_t& t = top[size_t(j / kTopCells) * size_t(w) + size_t(i / kTopCells)];
+          t = std::max(t, cellTops_[size_t(j) * size_t(cellsX_) + size_t(i)]);
+        }
+      continue;
+    }
     // Per node column the highest sample of each row it reads, then per node over its rows.
     std::vector<uint16_t> rows(size_t(w) * size_t(m.height));
     for (int j = 0; j < m.height; ++j) {
@@ -134,16 +158,12 @@ void Pyramid::buildTops() {
         rows[size_t(j) * size_t(w) + size_t(I)] = mx;
       }
     }
-    std::vector<uint16_t>& top = tops_[size_t(k)];
-    top.assign(size_t(w) * size_t(h) + 1, 0);
     for (int J = 0; J < h; ++J)
       for (int j = J * kTopCells; j <= std::min((J + 1) * kTopCells, m.height - 1); ++j)
         for (int I = 0; I < w; ++I) {
           uint16_t& t = top[size_t(J) * size_t(w) + size_t(I)];
           t = std::max(t, rows[size_t(j) * size_t(w) + size_t(I)]);
         }
-    topW_[size_t(k)] = w;
-    topH_[size_t(k)] = h;
   }
 }
 
@@ -196,6 +216,7 @@ size_t Pyramid::bytes() const {
   for (const auto& l : levels_) b += l.size() * sizeof(Bound);
   for (const auto& l : means_) b += l.size() * sizeof(uint16_t);
   for (const auto& l : tops_) b += l.size() * sizeof(uint16_t);
+  b += cellTops_.size() * sizeof(uint16_t);
   return b;
 }
 

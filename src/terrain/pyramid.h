@@ -60,10 +60,12 @@ class Pyramid {
 
   // The packets' skip map beside each level of detail (packet_walk.h): for level k (0 … n, n the
   // table), the highest of its samples over each square of kTopCells × kTopCells of its cells —
-  // the top of that square's bilinear surface, exactly, in the level's own codes. A packet's lane
-  // passes a square whose top its ray stays above at once instead of cell by cell. Node (I, J)
-  // covers cells kTopCells·I … kTopCells·(I + 1) − 1 (clamped to the level's cells); one code of
-  // padding after the last node, for 32-bit reads.
+  // the top of that square's bilinear surface, exactly, in the level's own codes; for the table's
+  // own bicubic surface, the highest of its cells' tops (cellTops). A packet's lane passes a
+  // square whose top its ray stays above at once instead of cell by cell. Node (I, J) covers cells
+  // kTopCells·I … kTopCells·(I + 1) − 1 (clamped to the level's cells); one code of padding after
+  // the last node, for 32-bit reads. A top of 65535 (kNoTop) bounds nothing: the bicubic surface
+  // may overshoot the codes' range.
   static constexpr int kTopShift = 2;
   static constexpr int kTopCells = 1 << kTopShift;
   struct TopLevel {
@@ -71,6 +73,13 @@ class Pyramid {
     const uint16_t* top = nullptr;
   };
   TopLevel tops(int level) const;
+  static constexpr uint16_t kNoTop = 65535;
+  // With bicubic interpolation: per cell of the table, the top of its patch's Bézier hull
+  // (bezierTop, rounded up; kNoTop where it reaches beyond the codes) — the bound a packet walks
+  // the table's bicubic surface by (packet_walk.h). Empty (top null) for bilinear.
+  TopLevel cellTops() const {
+    return {cellsX_, cellsY_, cellTops_.empty() ? nullptr : cellTops_.data()};
+  }
 
  private:
   struct Bound {
@@ -84,6 +93,7 @@ class Pyramid {
   std::vector<int> meanW_, meanH_;
   std::vector<std::vector<uint16_t>> tops_;  // tops_[k], k = 0 … n (TopLevel)
   std::vector<int> topW_, topH_;
+  std::vector<uint16_t> cellTops_;  // cellsX_ × cellsY_ and one of padding (bicubic only)
   const HeightField* field_ = nullptr;
   Interpolation interp_ = Interpolation::bilinear;
   Range cell(int i, int j) const;  // level n, computed from the table

@@ -224,10 +224,9 @@ void TerrainPass::castWindow(Scratch& w, const Drawn& t, int x0, int y0, int siz
   if (!(s < limit)) return;
   // A block's rays go on together from its start: a march of a smaller footprint first would
   // find little that the walk of their cells does not.
-  // Packets walk from 8×8 windows where they apply at every level; where the table's own surface
-  // is cast ray by ray (bicubic, or on a sphere) the windows go down to the blocks.
-  const bool bilinear = t.interp == Interpolation::bilinear && t.placement.radius <= 0;
-  if (size <= (bilinear ? kPacketWindow : kBlock)) {
+  // Packets walk from 8×8 windows; on a sphere, where the rays are cast one by one, the windows
+  // go down to the blocks.
+  if (size <= (t.caster->packetsApply() ? kPacketWindow : kBlock)) {
     for (int y = 0; y < size; y += kBlock)
       for (int x = 0; x < size; x += kBlock) castBlock(w, t, x0 + x, y0 + y, s);
     return;

@@ -190,6 +190,40 @@ TEST(PacketWalk, WalksEachLevelOfDetailWhereItHolds) {
   EXPECT_GT(coarse, 30);
 }
 
+TEST(PacketWalk, OnTheBicubicTableLanesStopWhereTheyMayTouchAndFinishAlone) {
+  // The table's Catmull–Rom surface: a lane walks the cells by their patches' Bézier tops and stops
+  // unsolved at the first it may touch; cast() from there meets the surface where the dense march
+  // does — none is stopped past its hit, and none stopped where nothing follows.
+  const HeightField field = formats::generateFractal(129, kSpacing, 600, 9).value();
+  const Pyramid pyramid(field, Interpolation::bicubic);
+  const Caster caster(field, pyramid, Interpolation::bicubic, Placement{});
+  CastCounters counters;
+  std::mt19937 rng(19);
+  int hits = 0, stopped = 0;
+  for (int k = 0; k < 40; ++k) {
+    Block b = randomBlock(rng, k % 2 ? 5e-4 : 2e-2, 4000);
+    caster.walkPacket(b.packet, pyramid.gridLevel(), 1 << 20, counters);
+    for (int l = 0; l < kPacketRays; ++l) {
+      const Vec3d o = b.packet.origin, d = b.packet.dir[l];
+      ASSERT_TRUE(std::isnan(b.packet.hit[l]));  // never solved in the walk
+      const double want = denseMarch(caster, o, d, 0, 4000);
+      const bool open = b.packet.reached[l] < b.packet.s1[l];
+      stopped += open;
+      if (!std::isnan(want)) {
+        ASSERT_TRUE(open && b.packet.reached[l] <= want + 1e-3)  // float t: 10⁻⁸ relative
+            << k << " lane " << l << " reached " << b.packet.reached[l] << " want " << want;
+      }
+      const double got = open ? caster.cast(o, d, b.packet.reached[l], 4000, counters) : NAN;
+      ASSERT_EQ(std::isnan(got), std::isnan(want)) << k << " lane " << l;
+      if (std::isnan(want)) continue;
+      ++hits;
+      ASSERT_NEAR(got, want, 2e-3 * kSpacing) << k << " lane " << l;
+    }
+  }
+  EXPECT_GT(hits, 300);
+  EXPECT_GE(stopped, hits);
+}
+
 TEST(PacketWalk, EveryTargetGivesTheSameBits) {
   const Ground g;
   std::vector<double> first;
