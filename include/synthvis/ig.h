@@ -195,7 +195,8 @@ struct HostLog {
 
 // Runs the script against an IG over UDP until its frames are sent (and the IG's answers to the
 // last of them have come, or `timeoutMs` passed without a Start of Frame: an error naming the IG's
-// address).
-Result<HostLog> runHost(const HostScript& script, int timeoutMs = 2000);
+// address). The first Start of Frame is waited for `startMs`: an IG loads its database and
+// calibrates its governor before its first frame (seconds for a large terrain).
+Result<HostLog> runHost(const HostScript& script, int timeoutMs = 2000, int startMs = 60000);
 
 }  // namespace sv::ig

@@ -159,7 +159,8 @@ HostScript read(const Json& root) {
         const Json& q = e["los"];
         cigi::LosSegmentRequest r;
         r.id = uint16_t(num(q, "id", where, 0, 65535, 0));
-        if (!q.contains("from") || !q.contains("to")) bad(where + ".los: \"from\" and \"to\" expected");
+        if (!q.contains("from") || !q.contains("to"))
+          bad(where + ".los: \"from\" and \"to\" expected");
         position(q["from"], where + ".los.from", origin, r.source[0], r.source[1], r.source[2]);
         position(q["to"], where + ".los.to", origin, r.destination[0], r.destination[1],
                  r.destination[2]);
@@ -184,7 +185,8 @@ HostScript read(const Json& root) {
         ev.packets.push_back(c);
       }
       if (ev.packets.empty())
-        bad(where + ": nothing to do (lights, visibility, timeOfDay, hat, hot, los, create or destroy)");
+        bad(where +
+            ": nothing to do (lights, visibility, timeOfDay, hat, hot, los, create or destroy)");
       s.events.push_back(std::move(ev));
     }
     std::stable_sort(s.events.begin(), s.events.end(),
@@ -253,7 +255,7 @@ std::vector<cigi::Packet> hostFrame(const HostScript& script, uint64_t frame,
   return out;
 }
 
-Result<HostLog> runHost(const HostScript& script, int timeoutMs) {
+Result<HostLog> runHost(const HostScript& script, int timeoutMs, int startMs) {
   UdpSocket socket;
   if (Status s = socket.open(script.port); !s) return s.error();
   Result<sockaddr_in> address = udpAddress(script.igAddress, script.igPort);
@@ -274,9 +276,11 @@ Result<HostLog> runHost(const HostScript& script, int timeoutMs) {
       sockaddr_in from{};
       if (!socket.receive(bytes, from, 100)) {
         waitedMs += 100;
-        if (waitedMs >= timeoutMs)
-          return Error{"", "", fmt::format("no Start of Frame from the IG at {}:{} for {} ms",
-                                           script.igAddress, script.igPort, timeoutMs)};
+        const int limit = log.startOfFrames == 0 ? startMs : timeoutMs;
+        if (waitedMs >= limit)
+          return Error{"", "",
+                       fmt::format("no Start of Frame from the IG at {}:{} for {} ms",
+                                   script.igAddress, script.igPort, limit)};
         if (log.startOfFrames == 0) send(hello);
         continue;
       }
