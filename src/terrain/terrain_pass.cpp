@@ -23,10 +23,11 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // pixels, 16 lanes.
 constexpr int kBlock = 4;
 static_assert(kBlock * kBlock == terrain::kPacketRays);
-// Cells each lane of a packet walks before the rays it has not finished go on alone (Caster::cast):
-// a lane-masked cell is cheaper than a ray's march over the pyramid, so the packet walks on — at
-// 4096², 16 cells a lane left 6 % of the rays to go on alone and took 119 ms a frame, 256 took
-// 84, 1024 80 (docs/terrain.md, "Packets"); the bound keeps a packet's work finite.
+// Steps (cells, or the skip map's squares) each lane of a packet walks at a level of detail before
+// the rays it has not finished go on alone (Caster::cast): a lane-masked step is cheaper than a
+// ray's march over the pyramid, so the packet walks on — at 4096², 16 cells a lane left 6 % of the
+// rays to go on alone and took 119 ms a frame, 256 took 84, 1024 80 (before the skip map;
+// docs/terrain.md, "Packets"); the bound keeps a packet's work finite.
 constexpr int kPacketCells = 1024;
 // The windows whose 4×4 blocks walk as packets from the window's start: the windows' marches
 // above them (scalar, a bundle at a time) cost more than the packets' walk over the skip map's

@@ -2,9 +2,10 @@
 // scene's height fields (terrain/caster.h) into each tile's depth and samples, after the opaque
 // polygons and the free forms, shading each pixel once where its samples meet the ground.
 //
-// Based on: SPEC §12 (multi-level ray casting: the screen quadtree from the tile down to pixels,
-// each window marched in depth from where its parent stopped — front to back, bounded by the
-// farthest depth already in the window, so what polygons hide is never cast), §5 (one ray per
+// Based on: SPEC §12 (multi-level ray casting: the screen quadtree from the tile down to 8×8
+// windows, each marched in depth from where its parent stopped — front to back, bounded by the
+// farthest depth already in the window, so what polygons hide is never cast — then its 4×4
+// blocks' rays walked together as packets, packet_walk.h), §5 (one ray per
 // sample, the frame's sample pattern: silhouettes and ridges anti-aliased with the polygons'),
 // §7 (seed 001's planar texture: the draped image by the map plane's anchor and axes), §8.
 #pragma once
