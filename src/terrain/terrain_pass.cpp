@@ -307,13 +307,12 @@ struct TerrainPass::PixelHit {
   int level = 0;          // the level of detail of the surface met
 };
 
-TerrainPass::PixelHit TerrainPass::hitOf(const Scratch& w, const Drawn& t, int p) const {
+void TerrainPass::hitOf(const Scratch& w, const Drawn& t, int p, PixelHit& h) const {
   const Caster& c = *t.caster;
   const HeightField& f = *t.field;
   const int lx = p % kTileSize, ly = p / kTileSize;
   const Scratch::FirstHit& first = w.first[size_t(p)];
   const int k = first.sample;
-  PixelHit h;
   h.sx = w.ox + lx + 0.5 + offsetX_[k], h.sy = w.oy + ly + 0.5 + offsetY_[k];
   h.d = first.d;
   h.s = w.hit[kPlane * size_t(k) + size_t(p)];
@@ -322,7 +321,6 @@ TerrainPass::PixelHit TerrainPass::hitOf(const Scratch& w, const Drawn& t, int p
   h.gx = std::clamp(h.m.gx, 0.0, double(f.width - 1));
   h.gy = std::clamp(h.m.gy, 0.0, double(f.height - 1));
   h.level = c.lodLevel(h.s, t.pixel, first.stretch);
-  return h;
 }
 
 // One pixel's eye position, normal, texture coordinates and detail texture, in double: the
@@ -429,7 +427,7 @@ void TerrainPass::shadeHits(Scratch& w, const Drawn& t, const raster::TileTarget
     PixelHit hits[shade::kMaxFragments];
     bool lanes = lanesApply;
     for (int i = 0; i < count; ++i) {
-      hits[i] = hitOf(w, t, w.pixels[begin + size_t(i)]);
+      hitOf(w, t, w.pixels[begin + size_t(i)], hits[i]);
       lanes = lanes && (hits[i].level < n || t.interp == Interpolation::bilinear);
       Vec3 color{t.color[0], t.color[1], t.color[2]};
       if (!drape.image) {

@@ -76,7 +76,8 @@ class TerrainPass final : public raster::TilePass {
   void castBlock(Scratch& w, const Drawn& t, int x0, int y0, double start) const;
   struct Drape;
   struct PixelHit;
-  PixelHit hitOf(const Scratch& w, const Drawn& t, int p) const;
+  // Where pixel p's first sample met the ground, into `h` (filled in place: 16 a batch).
+  void hitOf(const Scratch& w, const Drawn& t, int p, PixelHit& h) const;
   void shadePixel(const Drawn& t, const Drape& drape, const PixelHit& h, int i,
                   shade::Fragments& frag, shade::TexCoords& tc) const;
   ShadeFrame shadeFrame(const Drawn& t, const Drape& drape) const;
