@@ -251,6 +251,7 @@ void TerrainPass::castBlock(Scratch& w, const Drawn& t, int x0, int y0, double s
     // (no ray walks cells finer than its footprint) — lodLevel falls as the stretch grows, so
     // that of the longest stretch.
     double stretch = 0, stretches[kPacketRays];
+    uint64_t rays = 0;
     size_t at[kPacketRays];
     for (int l = 0; l < kPacketRays; ++l) {
       const int x = x0 + (l & (kBlock - 1)), y = y0 + l / kBlock;
@@ -263,10 +264,11 @@ void TerrainPass::castBlock(Scratch& w, const Drawn& t, int x0, int y0, double s
         continue;
       }
       p.s0[l] = start, p.s1[l] = w.limit[at[l]];
-      ++w.counts->samples;
+      ++rays;
       stretches[l] = c.stretch(p.dir[l]);
       stretch = std::max(stretch, stretches[l]);
     }
+    w.counts->samples += rays;
     c.walkPacketLevels(p, t.pixel, stretch, kPacketCells, *w.counts);
     for (int l = 0; l < kPacketRays; ++l) {
       if (!(p.s0[l] <= p.s1[l])) continue;
@@ -275,7 +277,10 @@ void TerrainPass::castBlock(Scratch& w, const Drawn& t, int x0, int y0, double s
         hs = c.cast(rays_.eye, p.dir[l], p.reached[l], p.s1[l], *w.counts, t.pixel);
       if (std::isnan(hs) || !(rays_.sToDepth(hs) < w.depth[at[l]])) continue;
       w.hit[at[l]] = hs;
-      if (!met[l]) w.first[at[l] - kPlane * size_t(k)] = {p.dir[l], stretches[l], k};
+      if (!met[l]) {  // field by field: a braced temporary's copy stalled on store forwarding
+        Scratch::FirstHit& first = w.first[at[l] - kPlane * size_t(k)];
+        first.d = p.dir[l], first.stretch = stretches[l], first.sample = k;
+      }
       met[l] = true;
     }
   }
