@@ -407,6 +407,11 @@ double Caster::solveBicubicCell(const GridRay& r, int i, int j, double s, double
 }
 
 void Caster::walkPacket(Packet& p, int level, int maxCells, CastCounters& c) const {
+  walkLanes(p, p.s0, p.s1, p.hit, p.reached, level, maxCells, c);
+}
+
+void Caster::walkLanes(const Packet& p, const double* s0, const double* s1, double* hit,
+                       double* reached, int level, int maxCells, CastCounters& c) const {
   // The level's grid, as solveBilinear's: x = x0 + s·ex in its sample steps, z in table codes.
   const Pyramid::MeanLevel m = pyramid_.mean(level);
   const double k = 1 / m.step, toCode = 1 / field_.scale;
@@ -419,11 +424,11 @@ void Caster::walkPacket(Packet& p, int level, int maxCells, CastCounters& c) con
   double sRef = kInf;
   int first = -1;
   for (int l = 0; l < count; ++l) {
-    p.hit[l] = std::numeric_limits<double>::quiet_NaN();
-    p.reached[l] = p.s1[l];
-    if (!(p.s0[l] <= p.s1[l])) continue;
+    hit[l] = std::numeric_limits<double>::quiet_NaN();
+    reached[l] = s1[l];
+    if (!(s0[l] <= s1[l])) continue;
     if (first < 0) first = l;
-    sRef = std::min(sRef, p.s0[l]);
+    sRef = std::min(sRef, s0[l]);
   }
   if (first < 0) return;
   PacketGrid g;
@@ -445,7 +450,7 @@ void Caster::walkPacket(Packet& p, int level, int maxCells, CastCounters& c) con
   g.footY0 = float(-g.anchorJ), g.footY1 = float((field_.height - 1) * k - g.anchorJ);
   PacketLanes lanes;
   for (int l = 0; l < count; ++l) {
-    if (!(p.s0[l] <= p.s1[l])) {
+    if (!(s0[l] <= s1[l])) {
       lanes.t0[l] = 0, lanes.t1[l] = -1;  // idle
       lanes.x0[l] = lanes.y0[l] = lanes.z0[l] = lanes.ex[l] = lanes.ey[l] = lanes.ez[l] = 0;
       continue;
@@ -455,14 +460,14 @@ void Caster::walkPacket(Packet& p, int level, int maxCells, CastCounters& c) con
     lanes.y0[l] = float(y0 + sRef * ey - g.anchorJ);
     lanes.z0[l] = float(z0 + sRef * ez - double(g.anchorZ));
     lanes.ex[l] = float(ex), lanes.ey[l] = float(ey), lanes.ez[l] = float(ez);
-    lanes.t0[l] = float(p.s0[l] - sRef), lanes.t1[l] = float(p.s1[l] - sRef);
+    lanes.t0[l] = float(s0[l] - sRef), lanes.t1[l] = float(s1[l] - sRef);
     ++c.lanes;
   }
   terrain::walkPacket(g, lanes, count, maxCells);
   for (int l = 0; l < count; ++l) {
-    if (!(p.s0[l] <= p.s1[l])) continue;
-    if (!std::isnan(lanes.hit[l])) p.hit[l] = sRef + double(lanes.hit[l]), ++c.hits;
-    if (std::isfinite(lanes.reached[l])) p.reached[l] = sRef + double(lanes.reached[l]);
+    if (!(s0[l] <= s1[l])) continue;
+    if (!std::isnan(lanes.hit[l])) hit[l] = sRef + double(lanes.hit[l]), ++c.hits;
+    if (std::isfinite(lanes.reached[l])) reached[l] = sRef + double(lanes.reached[l]);
   }
 }
 
@@ -470,43 +475,45 @@ void Caster::walkPacketLevels(Packet& p, double pixel, double stretch, int maxCe
                               CastCounters& c) const {
   const int n = pyramid_.gridLevel();
   const int count = std::clamp(p.count, 0, kPacketRays);
-  Packet left = p;                 // each lane's span not walked yet (s0 > s1: none)
+  // Each lane's span not walked yet (from > to: none), and a round's spans and results.
+  double from[kPacketRays], to[kPacketRays];
+  double walkFrom[kPacketRays], walkTo[kPacketRays], hit[kPacketRays], reached[kPacketRays];
   const uint64_t lanes = c.lanes;  // a lane counts once, however many levels it walks
   uint64_t walked = 0;
-  for (int l = 0; l < count; ++l)
+  for (int l = 0; l < count; ++l) {
+    from[l] = p.s0[l], to[l] = p.s1[l];
     p.hit[l] = std::numeric_limits<double>::quiet_NaN(), p.reached[l] = p.s0[l];
+  }
   // Each round a coarser level (at `end`, where the last stopped, lodLevel is still that level).
   for (int last = n + 1;;) {
-    double from = kInf;
+    double nearest = kInf;
     for (int l = 0; l < count; ++l)
-      if (left.s0[l] <= left.s1[l]) from = std::min(from, left.s0[l]);
-    if (!std::isfinite(from) || last == 0) break;
-    const int level = std::min(lodLevel(from, pixel, stretch), last - 1);
+      if (from[l] <= to[l]) nearest = std::min(nearest, from[l]);
+    if (!std::isfinite(nearest) || last == 0) break;
+    const int level = std::min(lodLevel(nearest, pixel, stretch), last - 1);
     if (!packetsApply()) break;  // the lanes left go on alone from their starts
     if (last > n)                // the first round: its lanes are the packet's rays
-      for (int l = 0; l < count; ++l) walked += left.s0[l] <= left.s1[l];
+      for (int l = 0; l < count; ++l) walked += from[l] <= to[l];
     last = level;
     // lodLevel is `level` while pixel·s·stretch ≤ 2^(n − level).
     const double end =
         pixel > 0 && level > 0 ? std::ldexp(1.0, n - level) / (pixel * stretch) : kInf;
-    Packet walk = left;
     for (int l = 0; l < count; ++l)
-      if (left.s0[l] <= left.s1[l] && left.s0[l] < end) {
-        walk.s1[l] = std::min(left.s1[l], end);
+      if (from[l] <= to[l] && from[l] < end) {
+        walkFrom[l] = from[l], walkTo[l] = std::min(to[l], end);
       } else {
-        walk.s0[l] = 1, walk.s1[l] = 0;  // idle this round
+        walkFrom[l] = 1, walkTo[l] = 0;  // idle this round
       }
-    walkPacket(walk, level, maxCells, c);
+    walkLanes(p, walkFrom, walkTo, hit, reached, level, maxCells, c);
     for (int l = 0; l < count; ++l) {
-      if (!(walk.s0[l] <= walk.s1[l])) continue;
-      const bool hit = !std::isnan(walk.hit[l]);
-      const bool done = hit || walk.reached[l] >= left.s1[l];
-      if (hit) p.hit[l] = walk.hit[l];
-      p.reached[l] = walk.reached[l];
-      if (done || walk.reached[l] < walk.s1[l]) {
-        left.s0[l] = 1, left.s1[l] = 0;  // finished, or stopped: alone from `reached`
+      if (!(walkFrom[l] <= walkTo[l])) continue;
+      const bool met = !std::isnan(hit[l]);
+      if (met) p.hit[l] = hit[l];
+      p.reached[l] = reached[l];
+      if (met || reached[l] >= to[l] || reached[l] < walkTo[l]) {
+        from[l] = 1, to[l] = 0;  // finished, or stopped: alone from `reached`
       } else {
-        left.s0[l] = walk.s1[l];  // on at the next level
+        from[l] = walkTo[l];  // on at the next level
       }
     }
   }

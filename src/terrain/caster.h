@@ -151,6 +151,10 @@ class Caster {
 
  private:
   MapPoint toMapOnSphere(Vec3d world) const;
+  // walkPacket's work for the packet's rays over spans [s0[l], s1[l]], its results into hit and
+  // reached (walkPacketLevels walks a packet's rays over several spans without copying it).
+  void walkLanes(const Packet& rays, const double* s0, const double* s1, double* hit,
+                 double* reached, int level, int maxCells, CastCounters& c) const;
   struct Box {
     double gx0, gx1, gy0, gy1, h0, h1;  // grid rectangle and heights above the base
   };
