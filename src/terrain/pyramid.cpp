@@ -172,12 +172,6 @@ Pyramid::TopLevel Pyramid::tops(int level) const {
   return {topW_[k], topH_[k], tops_[k].data()};
 }
 
-Pyramid::MeanLevel Pyramid::mean(int level) const {
-  if (level >= n_) return {field_->width, field_->height, 1.0, field_->q.data()};
-  return {meanW_[size_t(level)], meanH_[size_t(level)], double(nodeCells(level)),
-          means_[size_t(level)].data()};
-}
-
 Pyramid::Range Pyramid::cell(int i, int j) const {
   const HeightField& f = *field_;
   const int a = interp_ == Interpolation::bicubic ? 1 : 0;

@@ -56,7 +56,11 @@ class Pyramid {
     const uint16_t* q = nullptr;
     uint16_t code(int i, int j) const { return q[size_t(j) * size_t(width) + size_t(i)]; }
   };
-  MeanLevel mean(int level) const;
+  MeanLevel mean(int level) const {
+    if (level >= n_) return {field_->width, field_->height, 1.0, field_->q.data()};
+    return {meanW_[size_t(level)], meanH_[size_t(level)], double(nodeCells(level)),
+            means_[size_t(level)].data()};
+  }
 
   // The packets' skip map beside each level of detail (packet_walk.h): for level k (0 … n, n the
   // table), the highest of its samples over each square of kTopCells × kTopCells of its cells —
