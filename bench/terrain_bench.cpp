@@ -5,6 +5,7 @@
 // leaves a block: docs/terrain.md, "Casting"):
 //   the per-ray cast from the block's start (Caster::cast: direct walk, march, exact solve) → rays/s
 //   the packet walk of the same rays (Caster::walkPacket, 16 cells a lane)                → rays/s
+//   the same rays walked from the eye at the levels of detail (walkPacketLevels)        → rays/s
 // `finished` reports the share of rays the packet walk ended (a hit, or nothing before its limit).
 // SV_BENCH_TARGET=avx2 (or avx3, sse4, scalar) runs the kernels on that SIMD target alone, to
 // quote an AVX2 figure from an AVX-512 machine.
@@ -116,6 +117,34 @@ void BM_TerrainPacketWalk(benchmark::State& state) {
   state.counters["finished"] = double(finished) / double(std::max<size_t>(rays, 1));
 }
 BENCHMARK(BM_TerrainPacketWalk)->Arg(8)->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond);
+
+// The same rays walked from the eye, at the levels of detail of BENCH.md's pixel
+// (walkPacketLevels): the long walks the skip map's squares shorten.
+void BM_TerrainPacketWalkFromTheEye(benchmark::State& state) {
+  const View& v = view();
+  // A pixel of 1920×1080 at 60° of vertical field, per unit s, in grid steps (40 m).
+  const double pixel = 2 * std::tan(30 * M_PI / 180) / 1080 / v.field.spacingU;
+  CastCounters counters;
+  size_t rays = 0, finished = 0;
+  for (auto _ : state)
+    for (const Caster::Packet& block : v.blocks) {
+      Caster::Packet p = block;
+      double stretch = 1;
+      for (int l = 0; l < p.count; ++l) {
+        p.s0[l] = 0;
+        stretch = std::max(stretch, v.caster->stretch(p.dir[l]));
+      }
+      v.caster->walkPacketLevels(p, pixel, stretch, 1024, counters);
+      for (int l = 0; l < p.count; ++l)
+        finished += !std::isnan(p.hit[l]) || p.reached[l] >= p.s1[l];
+      rays += size_t(p.count);
+    }
+  state.counters["rays/s"] = benchmark::Counter(double(rays), benchmark::Counter::kIsRate);
+  state.counters["ns/ray"] =
+      benchmark::Counter(double(rays), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["finished"] = double(finished) / double(std::max<size_t>(rays, 1));
+}
+BENCHMARK(BM_TerrainPacketWalkFromTheEye)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace sv::terrain
