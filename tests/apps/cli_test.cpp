@@ -2,6 +2,7 @@
 // and the problem, and a non-zero exit — never a crash.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -81,8 +82,7 @@ TEST(Cli, TheSegmentPipelineDrawsThePriorityImageAndRefusesWhatItCannotDraw) {
   const CliRun tiled = run("render " + scene + " -o " + seg + " --donor");
   EXPECT_EQ(tiled.status, 1) << tiled.out;
   EXPECT_NE(tiled.out.find("--pipeline segments"), std::string::npos) << tiled.out;
-  const CliRun fifo =
-      run("render " + scene + " -o " + seg + " --pipeline segments --fifo-words 3");
+  const CliRun fifo = run("render " + scene + " -o " + seg + " --pipeline segments --fifo-words 3");
   EXPECT_EQ(fifo.status, 1) << fifo.out;
   EXPECT_NE(fifo.out.find("FIFO of 3"), std::string::npos) << fifo.out;
   const CliRun bad = run("render " + scene + " -o " + seg + " --pipeline scanlines");
@@ -111,9 +111,11 @@ TEST(Cli, TheSegmentPipelinesFogIsTheTilePipelines) {
   const std::string clearScene = write("unfogged.json", text("0"));
   const std::string seg = (tempDir() / "fog-segments.png").string();
   const std::string tiles = (tempDir() / "fog-tiles.png").string();
-  const CliRun a = run("render " + scene + " -o " + seg + " --width 320 --height 180 --pipeline segments");
+  const CliRun a =
+      run("render " + scene + " -o " + seg + " --width 320 --height 180 --pipeline segments");
   ASSERT_EQ(a.status, 0) << a.out;
-  const CliRun b = run("render " + scene + " -o " + tiles + " --width 320 --height 180 --hsr priority");
+  const CliRun b =
+      run("render " + scene + " -o " + tiles + " --width 320 --height 180 --hsr priority");
   ASSERT_EQ(b.status, 0) << b.out;
   const CliRun c = run("compare " + seg + " " + tiles);
   ASSERT_EQ(c.status, 0) << c.out;
@@ -165,6 +167,19 @@ TEST(Cli, TheIgsInputsRefuseDevicesAndHugeFilesBeforeReadingThem) {
   const std::string huge = write("huge.json", std::string((1 << 20) + 1, ' '));
   expectOneLineError(run("ig " + huge + " --frames 1"), huge, "file is too large");
   expectOneLineError(run("host " + huge), huge, "file is too large");
+}
+
+// A host with no IG at its port waits `--wait` seconds for the first Start of Frame, then says
+// where it looked; --wait outside its range is refused.
+TEST(Cli, TheHostWaitsForTheIgsFirstFrameAsLongAsItIsTold) {
+  const std::string script = std::string(SV_SOURCE_DIR) + "/scenes/ig/terrain-host.json";
+  const auto start = std::chrono::steady_clock::now();
+  const CliRun r = run("host " + script + " --ig-port 1 --port 0 --wait 0.3");
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  expectOneLineError(r, "127.0.0.1:1", "no Start of Frame from the IG");
+  EXPECT_NE(r.out.find("for 300 ms"), std::string::npos) << r.out;
+  EXPECT_LT(s, 10.0);
+  EXPECT_NE(run("host " + script + " --wait 0").status, 0);
 }
 
 // A model whose every triangle faces away from the camera renders an empty picture and says why;
