@@ -98,15 +98,17 @@ void BM_TerrainRayCast(benchmark::State& state) {
 }
 BENCHMARK(BM_TerrainRayCast)->Unit(benchmark::kMillisecond);
 
-void BM_TerrainPacketWalk(benchmark::State& state) {
+// Walks every block of the view (a copy, prepared by `prepare`, walked by `walk`), and reports
+// rays a second, ns a ray and the share of rays the walk finished.
+template <class Prepare, class Walk>
+void walkBlocks(benchmark::State& state, Prepare&& prepare, Walk&& walk) {
   const View& v = view();
-  const int cells = int(state.range(0));
-  CastCounters counters;
   size_t rays = 0, finished = 0;
   for (auto _ : state)
     for (const Caster::Packet& block : v.blocks) {
       Caster::Packet p = block;
-      v.caster->walkPacket(p, v.pyramid.gridLevel(), cells, counters);
+      prepare(p);
+      walk(p);
       for (int l = 0; l < p.count; ++l)
         finished += !std::isnan(p.hit[l]) || p.reached[l] >= p.s1[l];
       rays += size_t(p.count);
@@ -115,6 +117,15 @@ void BM_TerrainPacketWalk(benchmark::State& state) {
   state.counters["ns/ray"] =
       benchmark::Counter(double(rays), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
   state.counters["finished"] = double(finished) / double(std::max<size_t>(rays, 1));
+}
+
+void BM_TerrainPacketWalk(benchmark::State& state) {
+  const View& v = view();
+  const int cells = int(state.range(0));
+  CastCounters counters;
+  walkBlocks(
+      state, [](Caster::Packet&) {},
+      [&](Caster::Packet& p) { v.caster->walkPacket(p, v.pyramid.gridLevel(), cells, counters); });
 }
 BENCHMARK(BM_TerrainPacketWalk)->Arg(8)->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond);
 
@@ -125,24 +136,17 @@ void BM_TerrainPacketWalkFromTheEye(benchmark::State& state) {
   // A pixel of 1920×1080 at 60° of vertical field, per unit s, in grid steps (40 m).
   const double pixel = 2 * std::tan(30 * M_PI / 180) / 1080 / v.field.spacingU;
   CastCounters counters;
-  size_t rays = 0, finished = 0;
-  for (auto _ : state)
-    for (const Caster::Packet& block : v.blocks) {
-      Caster::Packet p = block;
-      double stretch = 1;
-      for (int l = 0; l < p.count; ++l) {
-        p.s0[l] = 0;
-        stretch = std::max(stretch, v.caster->stretch(p.dir[l]));
-      }
-      v.caster->walkPacketLevels(p, pixel, stretch, 1024, counters);
-      for (int l = 0; l < p.count; ++l)
-        finished += !std::isnan(p.hit[l]) || p.reached[l] >= p.s1[l];
-      rays += size_t(p.count);
-    }
-  state.counters["rays/s"] = benchmark::Counter(double(rays), benchmark::Counter::kIsRate);
-  state.counters["ns/ray"] =
-      benchmark::Counter(double(rays), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
-  state.counters["finished"] = double(finished) / double(std::max<size_t>(rays, 1));
+  double stretch = 1;
+  walkBlocks(
+      state,
+      [&](Caster::Packet& p) {
+        stretch = 1;
+        for (int l = 0; l < p.count; ++l) {
+          p.s0[l] = 0;
+          stretch = std::max(stretch, v.caster->stretch(p.dir[l]));
+        }
+      },
+      [&](Caster::Packet& p) { v.caster->walkPacketLevels(p, pixel, stretch, 1024, counters); });
 }
 BENCHMARK(BM_TerrainPacketWalkFromTheEye)->Unit(benchmark::kMillisecond);
 

@@ -55,15 +55,14 @@ double interpolate(const HeightField& f, Interpolation interp, double x, double 
   double wx[4], dwx[4], wy[4], dwy[4];
   catmullRom(s, wx, dwx);
   catmullRom(t, wy, dwy);
+  double h[4][4];
+  cellSamples(f, i, j, h);
   double v = 0, vx = 0, vy = 0;
   for (int r = 0; r < 4; ++r) {
-    const int jj = std::clamp(j - 1 + r, 0, f.height - 1);
-    const uint16_t* row = f.q.data() + size_t(jj) * size_t(f.width);
     double a = 0, ad = 0;
     for (int c = 0; c < 4; ++c) {
-      const double h = row[std::clamp(i - 1 + c, 0, f.width - 1)];
-      a += wx[c] * h;
-      ad += dwx[c] * h;
+      a += wx[c] * h[r][c];
+      ad += dwx[c] * h[r][c];
     }
     v += wy[r] * a;
     vx += wy[r] * ad;
