@@ -121,9 +121,9 @@ class Caster {
 
   // The rays of a block walked together (packet_walk.h), each at most `maxCells` steps over
   // `level`'s surface from its start — what cast() does for one ray first, for a packet: the walk
-  // of every cell the ray crosses, the exact solve where it may touch its bilinear surface. On the
-  // table's bicubic surface a lane stops, unsolved, at the first cell whose patch's bound it may
-  // touch: reached[l] there, for cast() to solve alone. Only on the plane base (packetsApply).
+  // of every cell the ray crosses, the exact solve where it may touch its surface (bilinear, or
+  // the table's bicubic patches, solved for the lanes parked at them together). Only on the
+  // plane base (packetsApply).
   // Lane l: origin + s·dir[l] over [s0[l], s1[l]]; hit[l] its first crossing there (NaN: none in
   // the cells walked), reached[l] where a ray without one stopped (s1[l]: nothing before s1, else
   // where to go on from).

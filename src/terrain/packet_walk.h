@@ -1,16 +1,17 @@
-// The rays of a screen block walked together over a bilinear height surface, one ray a SIMD lane
-// (Highway, per target): the packet form of Caster::solveBilinear (caster.h), the unit of work of
+// The rays of a screen block walked together over a height surface, one ray a SIMD lane (Highway,
+// per target): the packet form of Caster::solveBilinear and solveBicubic (caster.h), the unit of work of
 // the terrain's last levels (docs/terrain.md, "Packets").
 //
 // Each lane walks its own cells (a lane-masked Amanatides–Woo DDA) and, in every cell its ray may
-// touch, solves the height above the surface exactly — a quadratic in t — as the per-ray solve
+// touch, solves the height above the surface exactly — a quadratic in t (bilinear), or the
+// degree-6 polynomial of a Catmull–Rom patch along the ray (bicubic) — as the per-ray solve
 // does, in float and in coordinates relative to the packet's anchor cell (a few hundred cells at
 // most from it: 10⁻⁵ of a cell where the table's own coordinates would leave 10⁻³ at 16384). The
 // lanes are independent — a lane's result depends only on its own ray, never on its neighbours or
 // the lane count — so every SIMD target and the scalar fallback give the same bits.
 //
 // Based on: SPEC §12 (multi-level ray casting: at the finest level, the ray against the
-// interpolated surface), §11 (bilinear interpolation between the table's samples).
+// interpolated surface), §11 (bilinear or bicubic interpolation between the table's samples).
 #pragma once
 
 #include <cstdint>
@@ -31,9 +32,10 @@ struct PacketGrid {
   const uint16_t* top = nullptr;  // topWidth × ⌈cellsY / kTopCells⌉ codes, and one of padding
   int topWidth = 0;
   // The table's bicubic surface (Pyramid::cellTops: per cell the top of its patch's Bézier hull,
-  // cellsX a row): a lane walks the cells by these bounds and stops, unsolved, at the first whose
-  // bound its ray may touch — the cell to solve the patch in, alone (Caster::solveBicubic). Null:
-  // the bilinear surface of q, solved in the walk.
+  // cellsX a row): a lane walks the cells by these bounds and is parked at each whose bound its
+  // ray may touch; the parked lanes' patches are solved together (Caster::solveBicubicCell's rule,
+  // in float), and those that miss walk on. q is then the table. Null: the bilinear surface of q,
+  // solved in the walk.
   const uint16_t* cellTop = nullptr;
   // The sample the lanes' x, y are measured from: a corner of a skip map's square (multiples of
   // Pyramid::kTopCells).
@@ -51,8 +53,8 @@ struct PacketLanes {
   alignas(64) float t0[kPacketRays], t1[kPacketRays];
   // Results: the first t at which the ray meets the surface (or is below it at its start: that
   // t), NaN where it met nothing in the cells walked; where its walk stopped: +∞ when it is done
-  // (a hit, t1 reached, the footprint left, or idle), else the t where its next, unwalked cell
-  // begins (on the bicubic surface: the cell it may touch).
+  // (a hit, t1 reached, the footprint left, or idle), else — its steps taken — the t where its
+  // next, unwalked cell begins.
   alignas(64) float hit[kPacketRays], reached[kPacketRays];
 };
 
@@ -60,7 +62,8 @@ struct PacketLanes {
 // left idle). A step is a cell, or a square of the skip map passed at once: where a lane enters a
 // square whose top its ray stays above until it leaves it. Cells: a lane solves only where its
 // lowest point in the cell is not above the cell's highest corner, exactly as
-// Caster::solveBilinear.
+// Caster::solveBilinear — on the bicubic table, not above its patch's top, as
+// Caster::solveBicubic.
 void walkPacket(const PacketGrid& grid, PacketLanes& lanes, int count, int maxCells);
 
 }  // namespace sv::terrain

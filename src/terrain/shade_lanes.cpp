@@ -35,6 +35,20 @@ VF<DF> Log2AtLeastOne(DF df, VF<DF> x) {
   return hn::Add(exponent, hn::Mul(hn::Mul(series, t), hn::Set(df, 2.8853900817779268f)));
 }
 
+// Catmull–Rom's weights at t for the samples −1 … 2, and their derivatives (height_field.cpp).
+template <class DF>
+void CatmullRom(DF df, VF<DF> t, VF<DF> w[4], VF<DF> dw[4]) {
+  const VF<DF> half = hn::Set(df, 0.5f), t2 = hn::Mul(t, t), t3 = hn::Mul(t2, t);
+  auto k = [&](float v) { return hn::Set(df, v); };
+  auto poly = [&](float c3, float c2, float c1, float c0) {  // ½·(c3·t³ + c2·t² + c1·t + c0)
+    return hn::Mul(half, hn::Add(hn::Add(hn::Mul(k(c3), t3), hn::Mul(k(c2), t2)),
+                                 hn::Add(hn::Mul(k(c1), t), k(c0))));
+  };
+  w[0] = poly(-1, 2, -1, 0), w[1] = poly(3, -5, 0, 2), w[2] = poly(-3, 4, 1, 0), w[3] = poly(1, -1, 0, 0);
+  dw[0] = poly(0, -3, 4, -1), dw[1] = poly(0, 9, -10, 0), dw[2] = poly(0, -9, 8, 1),
+  dw[3] = poly(0, 3, -2, 0);
+}
+
 template <class DF>
 VF<DF> Dot(VF<DF> ax, VF<DF> ay, VF<DF> az, VF<DF> bx, VF<DF> by, VF<DF> bz) {
   return hn::Add(hn::Add(hn::Mul(ax, bx), hn::Mul(ay, by)), hn::Mul(az, bz));
@@ -67,9 +81,31 @@ void ShadeLanesKernel(const ShadeFrame& f, const ShadeLanes& L, shade::Fragments
     const V step = hn::Load(df, L.step + i);
     const V top = hn::Add(h00, hn::Mul(hn::Sub(h10, h00), u));
     const V bottom = hn::Add(h01, hn::Mul(hn::Sub(h11, h01), u));
-    const V slopeX = hn::Div(
+    V slopeX = hn::Div(
         hn::Add(hn::Mul(hn::Sub(h10, h00), hn::Sub(one, v)), hn::Mul(hn::Sub(h11, h01), v)), step);
-    const V slopeY = hn::Div(hn::Sub(bottom, top), step);
+    V slopeY = hn::Div(hn::Sub(bottom, top), step);
+    if (L.bicubic) {
+      // interpolate (height_field.cpp): ∂P/∂u = Σ_y w_y(v)·Σ_x w'_x(u)·h[y][x], ∂P/∂v likewise;
+      // the samples relative to the cell's own (the weights' derivatives sum to 0).
+      V wu[4], dwu[4], wv[4], dwv[4];
+      CatmullRom(df, u, wu, dwu);
+      CatmullRom(df, v, wv, dwv);
+      const V ref = hn::Load(df, L.patch[5] + i);
+      V du = zero, dv = zero;
+      for (int y = 0; y < 4; ++y) {
+        V row = zero, rowD = zero;
+        for (int x = 0; x < 4; ++x) {
+          const V h = hn::Sub(hn::Load(df, L.patch[4 * y + x] + i), ref);
+          row = hn::Add(row, hn::Mul(wu[x], h));
+          rowD = hn::Add(rowD, hn::Mul(dwu[x], h));
+        }
+        du = hn::Add(du, hn::Mul(wv[y], rowD));
+        dv = hn::Add(dv, hn::Mul(dwv[y], row));
+      }
+      const auto cubic = hn::Gt(hn::Load(df, L.cubic + i), zero);
+      slopeX = hn::IfThenElse(cubic, du, slopeX);
+      slopeY = hn::IfThenElse(cubic, dv, slopeY);
+    }
     const V se = hn::Mul(slopeX, hn::Set(df, f.scale / f.spacingU));
     const V sn = hn::Neg(hn::Mul(slopeY, hn::Set(df, f.scale / f.spacingV)));
     const V inv = hn::Div(one, hn::Sqrt(hn::Add(hn::Add(hn::Mul(se, se), one), hn::Mul(sn, sn))));

@@ -1,8 +1,9 @@
 // The per-pixel work before shading a terrain's hits, 16 pixels at a time in SIMD lanes (Highway,
 // per target, float): the normal of the surface met, the hit in eye space, and the draped image's
 // texture coordinates and level of detail from the pixel's footprint (SPEC §7) — what
-// TerrainPass::shadeHits does per pixel, for the plane base and a bilinear surface (a mean level,
-// or the table's bilinear interpolation). The lanes are independent, and only Add, Mul, Div and
+// TerrainPass::shadeHits does per pixel, for the plane base: the normal of a bilinear surface (a
+// mean level, or the table's bilinear interpolation) from its cell's corners, of the table's
+// Catmull–Rom surface from the 4×4 samples around the cell. The lanes are independent, and only Add, Mul, Div and
 // Sqrt are used (no fused multiply-add, no library functions), so every target gives the same
 // bits.
 //
@@ -39,6 +40,11 @@ struct ShadeLanes {
   alignas(64) float h00[shade::kMaxFragments], h10[shade::kMaxFragments];
   alignas(64) float h01[shade::kMaxFragments], h11[shade::kMaxFragments];
   alignas(64) float step[shade::kMaxFragments];
+  // Where `bicubic` is set, the pixels whose `cubic` is 1 met the table's Catmull–Rom surface:
+  // the 4×4 codes around their cell (cellSamples, patch[4·y + x]) instead of its corners.
+  bool bicubic = false;
+  alignas(64) float cubic[shade::kMaxFragments];
+  alignas(64) float patch[16][shade::kMaxFragments];
 };
 
 // Fills the eye position and normal attributes of `frag` (its count lanes) and, with an image,

@@ -329,7 +329,7 @@ void TerrainPass::hitOf(const Scratch& w, const Drawn& t, int p, PixelHit& h) co
 }
 
 // One pixel's eye position, normal, texture coordinates and detail texture, in double: the
-// general case (a sphere's base, bicubic heights, a detail texture) of what shadeLanes does.
+// general case (a sphere's base, a detail texture) of what shadeLanes does.
 void TerrainPass::shadePixel(const Drawn& t, const Drape& drape, const PixelHit& h, int i,
                              shade::Fragments& frag, shade::TexCoords& tc) const {
   const Caster& c = *t.caster;
@@ -410,7 +410,8 @@ ShadeFrame TerrainPass::shadeFrame(const Drawn& t, const Drape& drape) const {
 
 // Each pixel that met the ground, shaded once — at its first sample's hit — 16 to a call, and
 // written to every sample whose ray met the ground nearer than what the sample held. On the plane
-// with bilinear surfaces and no detail texture, the per-pixel work in SIMD lanes (shadeLanes).
+// without a detail texture, the per-pixel work in SIMD lanes (shadeLanes; on the bicubic table,
+// from the surface's slopes).
 void TerrainPass::shadeHits(Scratch& w, const Drawn& t, const raster::TileTarget& tile) const {
   const Caster& c = *t.caster;
   const Drape drape(t);
@@ -430,10 +431,10 @@ void TerrainPass::shadeHits(Scratch& w, const Drawn& t, const raster::TileTarget
       for (int ch = 0; ch < 3; ++ch) frag.color[ch][i] = 0;
     }
     PixelHit hits[shade::kMaxFragments];
-    bool lanes = lanesApply;
+    bool bicubic = false;  // a pixel met the table's bicubic surface
     for (int i = 0; i < count; ++i) {
       hitOf(w, t, w.pixels[begin + size_t(i)], hits[i]);
-      lanes = lanes && (hits[i].level < n || t.interp == Interpolation::bilinear);
+      bicubic = bicubic || (hits[i].level >= n && t.interp == Interpolation::bicubic);
       Vec3 color{t.color[0], t.color[1], t.color[2]};
       if (!drape.image) {
         const Vec3 r = rampAt(t.ramp, hits[i].m.h);
@@ -441,21 +442,38 @@ void TerrainPass::shadeHits(Scratch& w, const Drawn& t, const raster::TileTarget
       }
       frag.color[0][i] = color.x, frag.color[1][i] = color.y, frag.color[2][i] = color.z;
     }
-    if (lanes) {
+    if (lanesApply) {
       ShadeLanes in{};
+      in.bicubic = bicubic;
       for (int i = 0; i < count; ++i) {
         const PixelHit& h = hits[i];
+        in.px[i] = float(h.sx), in.py[i] = float(h.sy), in.s[i] = float(h.s);
+        in.gx[i] = float(h.gx), in.gy[i] = float(h.gy);
         // The cell of the level met around the hit (meanSurface, caster.cpp).
         const Pyramid::MeanLevel m = c.pyramid().mean(h.level);
         const double x = std::clamp(h.gx / m.step, 0.0, double(m.width - 1));
         const double y = std::clamp(h.gy / m.step, 0.0, double(m.height - 1));
         const int ci = std::min(int(x), m.width - 2), cj = std::min(int(y), m.height - 2);
-        in.px[i] = float(h.sx), in.py[i] = float(h.sy), in.s[i] = float(h.s);
-        in.gx[i] = float(h.gx), in.gy[i] = float(h.gy);
         in.cellU[i] = float(x - ci), in.cellV[i] = float(y - cj);
         in.h00[i] = m.code(ci, cj), in.h10[i] = m.code(ci + 1, cj);
         in.h01[i] = m.code(ci, cj + 1), in.h11[i] = m.code(ci + 1, cj + 1);
         in.step[i] = float(m.step);
+        if (bicubic && h.level >= n) {
+          // cellSamples, read straight from the rows away from the table's edges.
+          const HeightField& f = *t.field;
+          in.cubic[i] = 1;
+          if (ci >= 1 && cj >= 1 && ci + 2 < f.width && cj + 2 < f.height) {
+            for (int r = 0; r < 4; ++r) {
+              const uint16_t* row = f.q.data() + size_t(cj - 1 + r) * size_t(f.width) + size_t(ci - 1);
+              for (int q = 0; q < 4; ++q) in.patch[4 * r + q][i] = row[q];
+            }
+          } else {
+            double patch[4][4];
+            cellSamples(f, ci, cj, patch);
+            for (int r = 0; r < 4; ++r)
+              for (int q = 0; q < 4; ++q) in.patch[4 * r + q][i] = float(patch[r][q]);
+          }
+        }
       }
       shadeLanes(frame, in, frag, tc);
     } else {

@@ -1,6 +1,7 @@
 // The packet walk (terrain/packet_walk.h) against the per-ray exact solve and the dense march:
-// blocks of rays over a fractal table, grazing ones and blocks whose rays part included; every
-// SIMD target and the scalar fallback bit for bit; walks cut short and resumed.
+// blocks of rays over a fractal table, bilinear and bicubic, grazing ones and blocks whose rays
+// part included; every SIMD target and the scalar fallback bit for bit; walks cut short and
+// resumed.
 #include "terrain/packet_walk.h"
 
 #include <gtest/gtest.h>
@@ -49,15 +50,18 @@ Block randomBlock(std::mt19937& rng, double spread, double s1) {
   return b;
 }
 
+// A fractal table, bilinear or on its Catmull–Rom surface.
 struct Ground {
+  explicit Ground(Interpolation i = Interpolation::bilinear) : interp(i) {}
+  Interpolation interp;
   HeightField field = formats::generateFractal(129, kSpacing, 600, 9).value();
-  Pyramid pyramid{field, Interpolation::bilinear};
-  Caster caster{field, pyramid, Interpolation::bilinear, Placement{}};
+  Pyramid pyramid{field, interp};
+  Caster caster{field, pyramid, interp, Placement{}};
   mutable CastCounters counters;
 };
 
-TEST(PacketWalk, EveryLaneMeetsTheSurfaceWhereTheDenseMarchDoes) {
-  const Ground g;
+// Blocks walked over the table whole: every lane meets the surface where the dense march does.
+void expectLanesMeetTheDenseMarch(const Ground& g) {
   std::mt19937 rng(3);
   int hits = 0, misses = 0, grazing = 0;
   for (int k = 0; k < 60; ++k) {
@@ -85,9 +89,18 @@ TEST(PacketWalk, EveryLaneMeetsTheSurfaceWhereTheDenseMarchDoes) {
   EXPECT_GT(grazing, 3);
 }
 
-TEST(PacketWalk, AWalkCutShortResumesWhereItStopped) {
-  // Two steps at a time, each lane resumed from `reached`, meets what one whole walk meets.
-  const Ground g;
+TEST(PacketWalk, EveryLaneMeetsTheSurfaceWhereTheDenseMarchDoes) {
+  expectLanesMeetTheDenseMarch(Ground{});
+}
+
+TEST(PacketWalk, OnTheBicubicTableEveryLaneMeetsThePatchWhereTheDenseMarchDoes) {
+  // Lanes walk the cells by their patches' Bézier tops, are parked at those they may touch, and
+  // solve those patches together (SolvePatches): the same hits as the dense march of the surface.
+  expectLanesMeetTheDenseMarch(Ground{Interpolation::bicubic});
+}
+
+// Two steps at a time, each lane resumed from `reached`, meets what one whole walk meets.
+void expectACutWalkResumes(const Ground& g) {
   std::mt19937 rng(5);
   const int n = g.pyramid.gridLevel();
   int resumed = 0;
@@ -117,6 +130,13 @@ TEST(PacketWalk, AWalkCutShortResumesWhereItStopped) {
     }
   }
   EXPECT_GT(resumed, 40);
+}
+
+TEST(PacketWalk, AWalkCutShortResumesWhereItStopped) { expectACutWalkResumes(Ground{}); }
+
+TEST(PacketWalk, OnTheBicubicTableAWalkCutShortResumesWhereItStopped) {
+  // Lanes parked at a patch when their steps run out are solved before the walk returns.
+  expectACutWalkResumes(Ground{Interpolation::bicubic});
 }
 
 TEST(PacketWalk, AgreesWithThePerRaySolveOnAMeanLevel) {
@@ -190,42 +210,7 @@ TEST(PacketWalk, WalksEachLevelOfDetailWhereItHolds) {
   EXPECT_GT(coarse, 30);
 }
 
-TEST(PacketWalk, OnTheBicubicTableLanesStopWhereTheyMayTouchAndFinishAlone) {
-  // The table's Catmull–Rom surface: a lane walks the cells by their patches' Bézier tops and stops
-  // unsolved at the first it may touch; cast() from there meets the surface where the dense march
-  // does — none is stopped past its hit, and none stopped where nothing follows.
-  const HeightField field = formats::generateFractal(129, kSpacing, 600, 9).value();
-  const Pyramid pyramid(field, Interpolation::bicubic);
-  const Caster caster(field, pyramid, Interpolation::bicubic, Placement{});
-  CastCounters counters;
-  std::mt19937 rng(19);
-  int hits = 0, stopped = 0;
-  for (int k = 0; k < 40; ++k) {
-    Block b = randomBlock(rng, k % 2 ? 5e-4 : 2e-2, 4000);
-    caster.walkPacket(b.packet, pyramid.gridLevel(), 1 << 20, counters);
-    for (int l = 0; l < kPacketRays; ++l) {
-      const Vec3d o = b.packet.origin, d = b.packet.dir[l];
-      ASSERT_TRUE(std::isnan(b.packet.hit[l]));  // never solved in the walk
-      const double want = denseMarch(caster, o, d, 0, 4000);
-      const bool open = b.packet.reached[l] < b.packet.s1[l];
-      stopped += open;
-      if (!std::isnan(want)) {
-        ASSERT_TRUE(open && b.packet.reached[l] <= want + 1e-3)  // float t: 10⁻⁸ relative
-            << k << " lane " << l << " reached " << b.packet.reached[l] << " want " << want;
-      }
-      const double got = open ? caster.cast(o, d, b.packet.reached[l], 4000, counters) : NAN;
-      ASSERT_EQ(std::isnan(got), std::isnan(want)) << k << " lane " << l;
-      if (std::isnan(want)) continue;
-      ++hits;
-      ASSERT_NEAR(got, want, 2e-3 * kSpacing) << k << " lane " << l;
-    }
-  }
-  EXPECT_GT(hits, 300);
-  EXPECT_GE(stopped, hits);
-}
-
-TEST(PacketWalk, EveryTargetGivesTheSameBits) {
-  const Ground g;
+void expectEveryTargetGivesTheSameBits(const Ground& g) {
   std::vector<double> first;
   for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
     hwy::SetSupportedTargetsForTest(target);
@@ -247,6 +232,11 @@ TEST(PacketWalk, EveryTargetGivesTheSameBits) {
         << hwy::TargetName(target);
   }
   hwy::SetSupportedTargetsForTest(0);
+}
+
+TEST(PacketWalk, EveryTargetGivesTheSameBits) {
+  expectEveryTargetGivesTheSameBits(Ground{});
+  expectEveryTargetGivesTheSameBits(Ground{Interpolation::bicubic});
 }
 
 // A flat table with one spike: rays that pass just below its top meet it, rays just above it
