@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "formats/heights.h"
+#include "bench_target.h"
 #include "terrain/caster.h"
 
 namespace sv::terrain {
@@ -154,21 +155,7 @@ BENCHMARK(BM_TerrainPacketWalkFromTheEye)->Unit(benchmark::kMillisecond);
 }  // namespace sv::terrain
 
 int main(int argc, char** argv) {
-  if (const char* want = std::getenv("SV_BENCH_TARGET"); want && *want) {
-    int64_t chosen = 0;
-    for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
-      std::string name = hwy::TargetName(target);
-      for (char& ch : name) ch = char(std::tolower(static_cast<unsigned char>(ch)));
-      if (name == want || (std::string(want) == "scalar" && (name == "emu128" || name == "scalar")))
-        chosen = target;
-    }
-    if (!chosen) {
-      std::fprintf(stderr, "sv_terrain_bench: SIMD target '%s' is not available here\n", want);
-      return 2;
-    }
-    hwy::SetSupportedTargetsForTest(chosen);
-  }
-  std::printf("SIMD target %s\n", hwy::TargetName(hwy::SupportedAndGeneratedTargets().front()));
+  if (!sv::bench::selectBenchTarget("sv_terrain_bench")) return 2;
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::RunSpecifiedBenchmarks();

@@ -175,16 +175,28 @@ Result<ref::CaseResult> measureCase(ref::BenchRunner& runner, const ref::BenchCa
     fmt::print("{}\n", ref::summaryLine(cr));
     if (settings.synthvis && cr.runs[0].channelStats.empty())
       fmt::print("  synthvis last frame: {}\n", cr.runs[0].stats.summary());
+    const int threads = settings.options.threads > 0
+                            ? settings.options.threads
+                            : int(std::max(1u, std::thread::hardware_concurrency()));
     if (settings.synthvis && cr.runs[0].stats.terrains && cr.runs[0].medianMs > 0) {
       // The terrain's rays a second a core (issue 58): the frame's sample rays over its median
       // time and the worker threads.
-      const int threads = settings.options.threads > 0
-                              ? settings.options.threads
-                              : int(std::max(1u, std::thread::hardware_concurrency()));
       const double rays = double(cr.runs[0].stats.terrainSampleRays);
       fmt::print(
           "  terrain: {:.1f} M rays/s a core ({:.2f} M rays a frame, {} threads, SIMD target {})\n",
           rays / (cr.runs[0].medianMs / 1e3) / threads / 1e6, rays / 1e6, threads,
+          ref::simdTarget());
+    }
+    if (settings.synthvis && cr.runs[0].stats.volumeSamples && cr.runs[0].stats.volumeMs > 0) {
+      // The volume pass's samples a second a core (issue 59), over the pass's own time in the
+      // last frame (its tiles' CPU time: a scene's other passes left out), and a ray's samples.
+      const FrameStats& s = cr.runs[0].stats;
+      fmt::print(
+          "  volume: {:.1f} M samples/s a core, {:.1f} samples a ray ({:.2f} M samples, {:.2f} M "
+          "rays a frame; the pass {:.1f} ms; {} threads, SIMD target {})\n",
+          double(s.volumeSamples) / (s.volumeMs / 1e3 * threads) / 1e6,
+          double(s.volumeSamples) / double(std::max<uint64_t>(s.volumeRays, 1)),
+          double(s.volumeSamples) / 1e6, double(s.volumeRays) / 1e6, s.volumeMs, threads,
           ref::simdTarget());
     }
     for (size_t ch = 0; ch < cr.runs[0].channelStats.size(); ++ch)

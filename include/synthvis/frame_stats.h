@@ -80,8 +80,10 @@ struct FrameStats {
   double linesMs = 0;
   // Volumes (the volume pass): volumes in the frame, pixels whose ray met one, samples classified,
   // samples stepped over in empty regions, and rays ended by their transparency (early ray
-  // termination).
+  // termination); the pass's time as terrainMs is the terrain's (its tiles' CPU time over the
+  // frame's workers).
   uint64_t volumes = 0, volumeRays = 0, volumeSamples = 0, volumeSkipped = 0, volumeTerminated = 0;
+  double volumeMs = 0;
   // rasterMs: the tile pass, which includes resolving each finished tile into the image.
   double vertexMs = 0, setupMs = 0, rasterMs = 0, totalMs = 0;
 

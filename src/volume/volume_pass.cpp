@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <climits>
 #include <cmath>
 #include <limits>
@@ -450,7 +451,9 @@ void VolumePass::prepare(const raster::PassFrame& frame) {
 
 void VolumePass::addStats(FrameStats& stats) const {
   VolumeCounts c;
-  for (const WorkerCounts& w : counts_) c.add(w.counts);
+  double ms = 0;
+  for (const WorkerCounts& w : counts_) c.add(w.counts), ms += w.ms;
+  stats.volumeMs += ms / double(std::max<size_t>(counts_.size(), 1));
   stats.volumes += volumes_.size();
   stats.volumeRays += c.rays;
   stats.volumeSamples += c.samples;
@@ -659,6 +662,13 @@ struct BrickWalk {
 
 void VolumePass::drawTile(const raster::TileTarget& tile) {
   if (volumes_.empty()) return;
+  const auto begin = std::chrono::steady_clock::now();
+  drawVolumes(tile);
+  counts_[size_t(tile.worker)].ms +=
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - begin).count();
+}
+
+void VolumePass::drawVolumes(const raster::TileTarget& tile) {
   VolumeCounts& counts = counts_[size_t(tile.worker)].counts;
   SampleBatch& batch = batches_[size_t(tile.worker)].batch;
   const EyeRays& r = input_.rays;

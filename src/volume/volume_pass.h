@@ -109,7 +109,9 @@ class VolumePass final : public raster::TilePass {
  private:
   struct alignas(64) WorkerCounts {
     VolumeCounts counts;
+    double ms = 0;  // the worker's time in the pass's tiles
   };
+  void drawVolumes(const raster::TileTarget& tile);
   void prepareTables(Prepared& p) const;
   void screenBounds(Prepared& p) const;
   void windowDepths(Prepared& p) const;
