@@ -6,6 +6,7 @@
 #include "hwy/highway.h"
 // clang-format on
 
+#include "core/lane_math-inl.h"
 #include "terrain/shade_lanes.h"
 
 HWY_BEFORE_NAMESPACE();
@@ -15,25 +16,6 @@ namespace hn = hwy::HWY_NAMESPACE;
 
 template <class DF>
 using VF = hn::Vec<DF>;
-
-// log2 x for x ≥ 1 (finite): the exponent plus log2 of the mantissa m ∈ [1, 2) by the series of
-// atanh: log2 m = 2/ln 2 · (t + t³/3 + t⁵/5 + t⁷/7), t = (m − 1)/(m + 1) ≤ 1/3 — within 2·10⁻⁵,
-// plenty for a level of detail, and the same bits on every target (Mul and Add only).
-template <class DF>
-VF<DF> Log2AtLeastOne(DF df, VF<DF> x) {
-  const hn::RebindToSigned<DF> di;
-  const auto bits = hn::BitCast(di, x);
-  const VF<DF> exponent = hn::ConvertTo(df, hn::Sub(hn::ShiftRight<23>(bits), hn::Set(di, 127)));
-  const VF<DF> m =
-      hn::BitCast(df, hn::Or(hn::And(bits, hn::Set(di, 0x7FFFFF)), hn::Set(di, 0x3F800000)));
-  const VF<DF> one = hn::Set(df, 1.0f);
-  const VF<DF> t = hn::Div(hn::Sub(m, one), hn::Add(m, one)), t2 = hn::Mul(t, t);
-  VF<DF> series = hn::Set(df, 1.0f / 7);
-  series = hn::Add(hn::Mul(series, t2), hn::Set(df, 1.0f / 5));
-  series = hn::Add(hn::Mul(series, t2), hn::Set(df, 1.0f / 3));
-  series = hn::Add(hn::Mul(series, t2), one);
-  return hn::Add(exponent, hn::Mul(hn::Mul(series, t), hn::Set(df, 2.8853900817779268f)));
-}
 
 // Catmull–Rom's weights at t for the samples −1 … 2, and their derivatives (height_field.cpp).
 template <class DF>
@@ -162,7 +144,7 @@ void ShadeLanesKernel(const ShadeFrame& f, const ShadeLanes& L, shade::Fragments
                                                     hn::Mul(hn::Set(df, 4.0f), hn::Mul(det, det))),
                                             zero))));
     const auto above = hn::Gt(major2, one);
-    const V lod = hn::Min(hn::Mul(half, Log2AtLeastOne(df, hn::IfThenElse(above, major2, one))),
+    const V lod = hn::Min(hn::Mul(half, sv::core::HWY_NAMESPACE::Log2Positive(df, hn::IfThenElse(above, major2, one))),
                           hn::Set(df, 63.0f));
     hn::Store(hn::IfThenElseZero(above, lod), df, tc.lod + i);
   }

@@ -9,6 +9,7 @@
 
 #include "hwy/foreach_target.h"  // IWYU pragma: keep
 #include "hwy/highway.h"
+#include "core/lane_math-inl.h"
 #include "volume/sample_kernel.h"
 
 HWY_BEFORE_NAMESPACE();
@@ -262,6 +263,16 @@ void ClassifySamples(const SampleSource& s, int count, SampleBatch& b) {
       const VF c0 = hn::GatherIndex(df, s.stepOpacity, e);
       const VF c1 = two ? hn::GatherIndex(df, s.stepOpacity, hn::Add(e, hn::Set(di, 1))) : c0;
       hn::Store(Lerp(c0, c1, f), df, b.w + i);
+    } else if (b.exponent > 0) {
+      // The same for the ray's own step: (1 − W)^e = 2^(e·log2(1 − W)); W ≥ 1 stays opaque.
+      const VF one = hn::Set(df, 1.0f);
+      const VF clear = hn::Sub(one, hn::Min(channel[3], one));
+      const auto opaque = hn::Not(hn::Gt(clear, hn::Set(df, 1e-30f)));
+      const VF left = sv::core::HWY_NAMESPACE::Exp2(
+          df, hn::Mul(hn::Set(df, b.exponent),
+                      sv::core::HWY_NAMESPACE::Log2Positive(
+                          df, hn::IfThenElse(opaque, one, clear))));
+      hn::Store(hn::IfThenElse(opaque, one, hn::Sub(one, left)), df, b.w + i);
     }
     // Transparent samples are not composited: their colour is zero, and where the whole vector is
     // transparent neither the gradient nor the weighting is taken (the same bits in every lane

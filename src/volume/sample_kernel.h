@@ -52,7 +52,12 @@ inline constexpr int kBatch = 16;
 struct SampleBatch {
   alignas(64) float x[kBatch], y[kBatch], z[kBatch];
   alignas(64) float opacity[kBatch];  // the transfer function's, uncorrected
-  alignas(64) float w[kBatch];        // corrected for a full step (when stepOpacity is given)
+  // Corrected for a full step: from SampleSource::stepOpacity when given, else — where
+  // `exponent` is positive — 1 − (1 − opacity)^exponent in the lanes.
+  alignas(64) float w[kBatch];
+  // A full step's length over the opacity unit, l / unit, for the batch's ray (under a transform
+  // that is not a similarity each ray's steps have their own length in the world); 0: none.
+  float exponent = 0;
   alignas(64) float r[kBatch], g[kBatch], b[kBatch];  // shaded colour
 };
 

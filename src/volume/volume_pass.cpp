@@ -579,6 +579,7 @@ struct BrickWalk {
                                VolumePass::kBrick * double(g.spacing.z)};
   // The samples waiting in `batch`, in ray order: their segments' starts and lengths in s.
   double start[kBatch], length[kBatch];
+  batch.exponent = p.source.stepOpacity ? 0.0f : float(ds * worldPerS / p.opacityUnit);
   int pending = 0;
   // Classifies the waiting samples together (sample_kernel.h), then composites them in
   // order: false once the ray's transparency fell below ε.
@@ -591,11 +592,11 @@ struct BrickWalk {
       ++counts.samples;
       const float opacity = batch.opacity[j];
       if (!(opacity > 0)) continue;
-      // SPEC §12: the opacity of a sample of length l is 1 − (1 − W)^(l / unit) — tabled
-      // for a full step under a uniform scale.
+      // SPEC §12: the opacity of a sample of length l is 1 − (1 − W)^(l / unit) — for a full
+      // step tabled under a uniform scale, else taken in the kernel's lanes for the ray's step.
       const bool full = length[j] == ds;
       const double w =
-          full && p.source.stepOpacity ? double(batch.w[j])
+          full && (p.source.stepOpacity || batch.exponent > 0) ? double(batch.w[j])
           : opacity >= 1               ? 1.0
                          : 1 - std::pow(1 - double(opacity), length[j] * worldPerS / p.opacityUnit);
       double color[3] = {batch.r[j], batch.g[j], batch.b[j]};

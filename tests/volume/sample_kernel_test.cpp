@@ -217,6 +217,39 @@ TEST(SampleKernel, EveryTargetGivesTheSameBitsAndTheyAreTheScalarFormulas) {
   }
 }
 
+// Without the tabled step opacity (a transform that is not a similarity), a ray's step opacity
+// 1 − (1 − W)^e is taken in the lanes: the same bits on every target, and the formula in double
+// within 10⁻⁴ (the lanes' log2 is within 2·10⁻⁵; the table's linear reading, the other way, within
+// 2·10⁻⁴) — for steps shorter and longer than the unit, and opaque samples staying opaque.
+TEST(SampleKernel, ARaysOwnStepOpacityIsTakenInTheLanes) {
+  Fixture f;
+  f.source.stepOpacity = nullptr;
+  f.table[size_t(40) * 4 + 3] = 1;  // an opaque entry among the others
+  for (const float exponent : {0.37f, 1.0f, 2.5f, 11.0f}) {
+    for (int round = 0; round < 4; ++round) {
+      SampleBatch first{};
+      bool have = false;
+      for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
+        hwy::SetSupportedTargetsForTest(target);
+        SampleBatch b{};
+        positions(b, round);
+        b.exponent = exponent;
+        classifySamples(f.source, kBatch, b);
+        if (!have) {
+          first = b, have = true;
+          continue;
+        }
+        EXPECT_EQ(std::memcmp(b.w, first.w, sizeof b.w), 0) << hwy::TargetName(target);
+      }
+      hwy::SetSupportedTargetsForTest(0);
+      for (int i = 0; i < kBatch; ++i) {
+        const double w = 1 - std::pow(1 - std::min(double(first.opacity[i]), 1.0), exponent);
+        EXPECT_NEAR(first.w[i], w, 1e-4) << "exponent " << exponent << " sample " << i;
+      }
+    }
+  }
+}
+
 // The bordered 8-bit codes give the bits the 16-bit ones give, on the samples of whole vectors of
 // transparent samples too (their gradients are skipped alike).
 TEST(SampleKernel, EightBitCodesGiveTheSixteenBitCodesBits) {
