@@ -363,6 +363,11 @@ void addBenchCommand(CLI::App& app, Run& run) {
                    "off (the table's own surface everywhere)")
       ->capture_default_str();
   bench
+      ->add_option("--volume-window-tolerance", b.options.volumeWindowTolerance,
+                   "volumes: the largest difference between a screen window's corner rays for its "
+                   "pixels to be interpolated (0: every pixel cast; default: the scene's own)")
+      ->check(CLI::Range(0.0f, 1.0f));
+  bench
       ->add_option("--channels", b.channels,
                    "display channels: N abutting views (each --width x --height) in one frame; the "
                    "time is the whole frame's (synthvis only)")

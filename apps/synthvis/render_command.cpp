@@ -292,6 +292,11 @@ void addRenderOptions(CLI::App* render, RenderArgs& r) {
   render->add_option("--march-steps", r.options.marchSteps, "--freeform march: steps per ray")
       ->capture_default_str();
   render
+      ->add_option("--volume-window-tolerance", r.options.volumeWindowTolerance,
+                   "volumes: the largest difference between a screen window's corner rays for its "
+                   "pixels to be interpolated (0: every pixel cast; default: the scene's own)")
+      ->check(CLI::Range(0.0f, 1.0f));
+  render
       ->add_option("--terrain-filter", r.terrainFilter,
                    "terrain interpolation: scene (each terrain's own), bilinear or bicubic")
       ->capture_default_str();

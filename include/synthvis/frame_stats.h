@@ -83,6 +83,7 @@ struct FrameStats {
   // termination); the pass's time as terrainMs is the terrain's (its tiles' CPU time over the
   // frame's workers).
   uint64_t volumes = 0, volumeRays = 0, volumeSamples = 0, volumeSkipped = 0, volumeTerminated = 0;
+  uint64_t volumeInterpolated = 0;  // pixels blended from their screen window's corner rays
   double volumeMs = 0;
   // rasterMs: the tile pass, which includes resolving each finished tile into the image.
   double vertexMs = 0, setupMs = 0, rasterMs = 0, totalMs = 0;

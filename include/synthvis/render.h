@@ -114,6 +114,9 @@ struct RenderOptions {
   // asks (a pixel taken as 2^bias wide: a quarter of the rays' cells walked a step, blurrier in the
   // distance) — a quality level of the IG's governor (docs/ig.md).
   int terrainLodBias = 0;
+  // The volumes' screen-window tolerance (VolumeSettings::windowTolerance; the CLI's
+  // --volume-window-tolerance): negative, the scene's own; 0, every pixel's ray cast.
+  float volumeWindowTolerance = -1;
   // How a curved-screen display's frames are pre-distorted (Renderer::renderDisplay; SPEC §12,
   // docs/display.md): the seeds' sub-frusta, each drawn through its own projective map with no
   // resampling; or a flat view with a margin, rendered and resampled bilinearly or bicubically

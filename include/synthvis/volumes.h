@@ -61,6 +61,11 @@ struct VolumeSettings {
   // while traversing (six more reads a lit sample); true, each grid sample's gradient direction
   // precomputed once (4 bytes a sample) and interpolated — faster, more memory, a little softer.
   bool precomputedNormals = false;
+  // SPEC §12's screen subdivision taken to the pixel: a window's corner rays are cast first, and
+  // where no two of them differ by more than this in colour or transparency (and every corner's
+  // composite ended before its surfaces) the pixels within are interpolated from them; elsewhere
+  // the window is split in four, down to single pixels. 0: every pixel's ray cast.
+  float windowTolerance = 0;
 };
 
 // A volume placed in the world.

@@ -48,7 +48,7 @@ FrameStats& FrameStats::operator+=(const FrameStats& o) {
   shareBytes += o.shareBytes, shareMs += o.shareMs;
   volumes += o.volumes, volumeRays += o.volumeRays, volumeSamples += o.volumeSamples;
   volumeSkipped += o.volumeSkipped, volumeTerminated += o.volumeTerminated;
-  volumeMs += o.volumeMs;
+  volumeMs += o.volumeMs, volumeInterpolated += o.volumeInterpolated;
   vertexMs += o.vertexMs, setupMs += o.setupMs, rasterMs += o.rasterMs, totalMs += o.totalMs;
   return *this;
 }
@@ -104,9 +104,10 @@ std::string FrameStats::summary() const {
          (shareBytes ? fmt::format(" | shared: {} bytes exchanged, {:.2f} ms", shareBytes, shareMs)
                      : std::string()) +
          (volumes ? fmt::format(
-                        " | volumes {}: rays {}, samples {}, skipped {}, terminated {}, {:.2f} ms",
+                        " | volumes {}: rays {}, samples {}, skipped {}, terminated {}, pixels "
+                        "interpolated {}, {:.2f} ms",
                         volumes, volumeRays, volumeSamples, volumeSkipped, volumeTerminated,
-                        volumeMs)
+                        volumeInterpolated, volumeMs)
                   : std::string());
 }
 

@@ -48,6 +48,7 @@ std::vector<raster::TilePass*> FramePasses::compose(const scene::Scene& scene,
     volume::VolumeInput in;
     in.volumes = &scene.volumes;
     in.settings = scene.volumeSettings;
+    if (o.volumeWindowTolerance >= 0) in.settings.windowTolerance = o.volumeWindowTolerance;
     in.rays = eyeRays(camera);
     in.viewProjection = camera.projection * camera.view;
     in.lightOn = scene.light.enabled;

@@ -149,6 +149,7 @@ struct PixelComposite {
   double snapC[64][3], snapT[64];
 
   double next = -1e300;  // no sample not yet recorded has its surface before this depth
+  double last = 0;       // the end of the last sample composited (not transparent), as s
 
   // Records the samples whose surface lies at or before eye depth s.
   void reach(double s) {
@@ -447,6 +448,7 @@ void VolumePass::prepare(const raster::PassFrame& frame) {
   const int workers = frame.pool ? frame.pool->threadCount() : 1;
   counts_.assign(size_t(workers), WorkerCounts{});
   batches_.resize(size_t(workers));
+  windows_.resize(size_t(workers));
 }
 
 void VolumePass::addStats(FrameStats& stats) const {
@@ -459,6 +461,7 @@ void VolumePass::addStats(FrameStats& stats) const {
   stats.volumeSamples += c.samples;
   stats.volumeSkipped += c.skipped;
   stats.volumeTerminated += c.terminated;
+  stats.volumeInterpolated += c.interpolated;
 }
 
 namespace {
@@ -608,6 +611,7 @@ struct BrickWalk {
       }
       for (int c = 0; c < 3; ++c) pc.C[c] += pc.T * w * color[c];
       pc.T *= 1 - w;
+      pc.last = start[j] + length[j];
       if (pc.T < epsilon) {
         ++counts.terminated;
         return false;
@@ -659,6 +663,165 @@ struct BrickWalk {
   return pending > 0 && !flush();
 }
 
+// Steps 2–4 for one pixel of a tile: its ray through the listed volumes, nearest first,
+// composited front to back — each of the pixel's samples stopping at its surface, until the
+// transparency falls below ε — and written over what each sample holds.
+struct PixelCaster {
+  const raster::TileTarget& tile;
+  const EyeRays& r;
+  const VolumeInput& in;
+  int samples;
+  const VolumeList& listed;
+  int count;
+  SampleBatch& batch;
+  VolumeCounts& counts;
+
+  WindowPixel cast(int lx, int ly) const {
+    WindowPixel out;
+    out.state = WindowPixel::cast;
+    const int px = tile.tileX * kTileSize + lx, py = tile.tileY * kTileSize + ly;
+    const Vec3d d = r.direction(px + 0.5, py + 0.5);
+    const double worldPerS = std::sqrt(dot(d, d));
+    StretchList stretches;
+    const int n = rayStretches(listed, count, r, px, py, d, stretches);
+    if (n == 0) return out;
+    PixelComposite pc;
+    const double farthest = pc.start(tile, r, lx, ly, samples);
+    ++counts.rays;
+    // Where the ray's composite ends of itself: its transparency below ε, or its last stretch's
+    // end. Complete: every sample's surface lies beyond it (no surface cut the ray short).
+    double ended = 0;
+    for (int v = 0; v < n; ++v) {
+      const Stretch& st = stretches[size_t(v)];
+      ended = std::max(ended, std::min(st.s1, st.to));
+      if (castStretch(st, farthest, worldPerS, in, batch, pc, counts)) {
+        ended = pc.last;
+        break;
+      }
+    }
+    out.met = true;
+    out.complete = true;
+    for (int k = 0; k < samples; ++k) out.complete = out.complete && pc.limit[k] >= ended;
+    out.C[0] = pc.C[0], out.C[1] = pc.C[1], out.C[2] = pc.C[2], out.T = pc.T;
+    out.last = pc.last;
+    pc.writeOver(tile, lx, ly);
+    return out;
+  }
+
+  // The nearest of the pixel's samples' surfaces, as s.
+  double nearest(int lx, int ly) const {
+    double s = 1e300;
+    for (int k = 0; k < samples; ++k)
+      s = std::min(s, r.depthToS(tile.depth[FrameBuffer::depthOffset(lx, ly, samples, k)]));
+    return s;
+  }
+
+  // The composite (C, T) over every sample of the pixel.
+  void write(int lx, int ly, const double C[3], double T) const {
+    for (int k = 0; k < samples; ++k)
+      for (int c = 0; c < 3; ++c) {
+        uint16_t& o = tile.color[FrameBuffer::colorOffset(lx, ly, c, samples, k)];
+        o = uint16_t(std::lrint(std::clamp(C[c] + T * (o / 65535.0), 0.0, 1.0) * 65535.0));
+      }
+  }
+};
+
+// SPEC §12's screen subdivision down to the pixel (VolumeSettings::windowTolerance): the tile's
+// windows of kWindow pixels have their corner rays cast; a window whose corners all met a volume,
+// ended their composites before their surfaces, and differ by at most `tolerance` in colour and
+// transparency is a leaf, any other is split in four (its edges' and centre's rays cast) down to
+// windows without inner pixels. Then each leaf's pixels not cast take the bilinear blend of its
+// corners — where the pixel's nearest surface lies beyond the corners' last samples (else its ray
+// is cast). The tile alone decides (no ray of another tile is read): the same bits for any number
+// of threads.
+void refineWindows(const PixelCaster& caster, int w, int h, float tolerance,
+                   WindowScratch& scratch) {
+  std::vector<WindowPixel>& window = scratch.window;
+  window.assign(size_t(kTileSize) * kTileSize, WindowPixel{});
+  auto at = [&](int x, int y) -> WindowPixel& { return window[size_t(y) * kTileSize + size_t(x)]; };
+  auto ensure = [&](int x, int y) -> WindowPixel& {
+    WindowPixel& p = at(x, y);
+    if (p.state == WindowPixel::none) p = caster.cast(x, y);
+    return p;
+  };
+  using Leaf = WindowRect;
+  std::vector<Leaf>& leaves = scratch.leaves;
+  leaves.clear();
+  auto similar = [&](const Leaf& c) {
+    const WindowPixel* q[4] = {&at(c.x0, c.y0), &at(c.x1, c.y0), &at(c.x0, c.y1), &at(c.x1, c.y1)};
+    double lo[4], hi[4];
+    for (int k = 0; k < 4; ++k) lo[k] = 1e300, hi[k] = -1e300;
+    for (const WindowPixel* p : q) {
+      if (!p->met || !p->complete) return false;
+      const double v[4] = {p->C[0], p->C[1], p->C[2], p->T};
+      for (int k = 0; k < 4; ++k) lo[k] = std::min(lo[k], v[k]), hi[k] = std::max(hi[k], v[k]);
+    }
+    for (int k = 0; k < 4; ++k)
+      if (hi[k] - lo[k] > tolerance) return false;
+    return true;
+  };
+  // Windows in the order of a stack, each with its corners cast.
+  std::vector<Leaf>& stack = scratch.stack;
+  stack.clear();
+  for (int y0 = 0; y0 < h - 1; y0 += VolumePass::kRefineWindow)
+    for (int x0 = 0; x0 < w - 1; x0 += VolumePass::kRefineWindow)
+      stack.push_back({x0, y0, std::min(x0 + VolumePass::kRefineWindow, w - 1),
+                       std::min(y0 + VolumePass::kRefineWindow, h - 1)});
+  for (const Leaf& c : stack)
+    ensure(c.x0, c.y0), ensure(c.x1, c.y0), ensure(c.x0, c.y1), ensure(c.x1, c.y1);
+  // A single row or column has no window: its pixels cast as they are.
+  if (w == 1 || h == 1)
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) ensure(x, y);
+  while (!stack.empty()) {
+    const Leaf c = stack.back();
+    stack.pop_back();
+    if (c.x1 - c.x0 <= 1 && c.y1 - c.y0 <= 1) continue;  // no inner pixel
+    if (similar(c)) {
+      leaves.push_back(c);
+      continue;
+    }
+    // Split where the window has inner pixels: in four, or in two along its longer side.
+    const bool alongX = c.x1 - c.x0 > 1, alongY = c.y1 - c.y0 > 1;
+    const int xm = alongX ? (c.x0 + c.x1) / 2 : c.x0, ym = alongY ? (c.y0 + c.y1) / 2 : c.y0;
+    for (const int y : {c.y0, ym, c.y1})
+      for (const int x : {c.x0, xm, c.x1}) ensure(x, y);
+    const Leaf halves[4] = {{c.x0, c.y0, alongX ? xm : c.x1, alongY ? ym : c.y1},
+                            {xm, c.y0, c.x1, alongY ? ym : c.y1},
+                            {c.x0, ym, alongX ? xm : c.x1, c.y1},
+                            {xm, ym, c.x1, c.y1}};
+    stack.push_back(halves[0]);
+    if (alongX) stack.push_back(halves[1]);
+    if (alongY) stack.push_back(halves[2]);
+    if (alongX && alongY) stack.push_back(halves[3]);
+  }
+  for (const Leaf& c : leaves) {
+    const WindowPixel *a = &at(c.x0, c.y0), *b = &at(c.x1, c.y0), *e = &at(c.x0, c.y1),
+                      *f = &at(c.x1, c.y1);
+    const double last = std::max({a->last, b->last, e->last, f->last});
+    for (int y = c.y0; y <= c.y1; ++y)
+      for (int x = c.x0; x <= c.x1; ++x) {
+        WindowPixel& p = at(x, y);
+        if (p.state != WindowPixel::none) continue;
+        if (!(caster.nearest(x, y) > last)) {
+          p = caster.cast(x, y);
+          continue;
+        }
+        const double u = c.x1 > c.x0 ? double(x - c.x0) / (c.x1 - c.x0) : 0;
+        const double v = c.y1 > c.y0 ? double(y - c.y0) / (c.y1 - c.y0) : 0;
+        const double wa = (1 - u) * (1 - v), wb = u * (1 - v), we = (1 - u) * v, wf = u * v;
+        double C[3];
+        for (int ch = 0; ch < 3; ++ch)
+          C[ch] = wa * a->C[ch] + wb * b->C[ch] + we * e->C[ch] + wf * f->C[ch];
+        const double T = wa * a->T + wb * b->T + we * e->T + wf * f->T;
+        caster.write(x, y, C, T);
+        p.state = WindowPixel::interpolated;
+        ++caster.counts.interpolated;
+      }
+  }
+  // Pixels of no window (a tile one pixel wide or high was cast above).
+}
+
 }  // namespace
 
 void VolumePass::drawTile(const raster::TileTarget& tile) {
@@ -671,33 +834,21 @@ void VolumePass::drawTile(const raster::TileTarget& tile) {
 
 void VolumePass::drawVolumes(const raster::TileTarget& tile) {
   VolumeCounts& counts = counts_[size_t(tile.worker)].counts;
-  SampleBatch& batch = batches_[size_t(tile.worker)].batch;
   const EyeRays& r = input_.rays;
   const int ox = tile.tileX * kTileSize, oy = tile.tileY * kTileSize;
   // Step 1: the volumes this tile may show, by their screen bounds.
   VolumeList listed{};
   const int count = tileVolumes(volumes_, ox, oy, listed);
   if (count == 0) return;
-  for (int ly = 0; ly < kTileSize && oy + ly < r.height; ++ly)
-    for (int lx = 0; lx < kTileSize && ox + lx < r.width; ++lx) {
-      const int px = ox + lx, py = oy + ly;
-      const Vec3d d = r.direction(px + 0.5, py + 0.5);
-      const double worldPerS = std::sqrt(dot(d, d));
-      // Step 2: the pixel's ray through each volume it meets, nearest first.
-      StretchList stretches;
-      const int n = rayStretches(listed, count, r, px, py, d, stretches);
-      if (n == 0) continue;
-      // Step 3: front to back from the eye, each of the pixel's samples stopping at its surface,
-      // until the ray's transparency falls below ε.
-      PixelComposite pc;
-      const double farthest = pc.start(tile, r, lx, ly, samples_);
-      ++counts.rays;
-      for (int v = 0; v < n; ++v)
-        if (castStretch(stretches[size_t(v)], farthest, worldPerS, input_, batch, pc, counts))
-          break;
-      // Step 4: the composite over what each sample holds.
-      pc.writeOver(tile, lx, ly);
-    }
+  const PixelCaster caster{tile,    r,     input_, samples_, listed, count,
+                           batches_[size_t(tile.worker)].batch, counts};
+  const int w = std::min(kTileSize, r.width - ox), h = std::min(kTileSize, r.height - oy);
+  if (input_.settings.windowTolerance > 0) {
+    refineWindows(caster, w, h, input_.settings.windowTolerance, windows_[size_t(tile.worker)]);
+    return;
+  }
+  for (int ly = 0; ly < h; ++ly)
+    for (int lx = 0; lx < w; ++lx) caster.cast(lx, ly);
 }
 
 }  // namespace sv::volume

@@ -42,9 +42,31 @@ struct VolumeCounts {
   uint64_t samples = 0;         // samples classified
   uint64_t skipped = 0;         // samples stepped over in empty regions
   uint64_t terminated = 0;      // rays ended by their transparency falling below ε
+  uint64_t interpolated = 0;    // pixels blended from their window's corner rays, not cast
   void add(const VolumeCounts& o) {
     rays += o.rays, samples += o.samples, skipped += o.skipped, terminated += o.terminated;
+    interpolated += o.interpolated;
   }
+};
+
+// A pixel of a tile in the screen-window refinement (VolumeSettings::windowTolerance): whether
+// its ray was cast or its composite blended from its window's corners, and what a cast gave.
+struct WindowPixel {
+  enum State : uint8_t { none, cast, interpolated } state = none;
+  bool met = false;       // its ray composited something of a volume
+  bool complete = false;  // ... and ended before every one of its samples' surfaces
+  double C[3] = {0, 0, 0}, T = 1;
+  double last = 0;  // the end of its last sample composited, as s (eye depth)
+};
+// A screen window of the refinement: pixels [x0, x1] × [y0, y1] of a tile, corners included.
+struct WindowRect {
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+};
+// A worker's screen-window refinement: the tile's pixels, the windows still to look at, and the
+// leaves (windows whose pixels are blended from their corners).
+struct WindowScratch {
+  std::vector<WindowPixel> window;
+  std::vector<WindowRect> stack, leaves;
 };
 
 class VolumePass final : public raster::TilePass {
@@ -62,6 +84,8 @@ class VolumePass final : public raster::TilePass {
   static constexpr int kBrick = 8;
   // The edge, in pixels, of the screen windows whose rays share their depth interval.
   static constexpr int kWindow = 8;
+  // The edge of the largest windows of the screen-window refinement (windowTolerance).
+  static constexpr int kRefineWindow = 4;
   // Entries of the transfer function's table over the grid's codes (fewer for 8-bit data: one per
   // code).
   static constexpr int kTableSize = 4096;
@@ -124,6 +148,7 @@ class VolumePass final : public raster::TilePass {
     SampleBatch batch;
   };
   std::vector<WorkerBatch> batches_;  // per worker: its ray's samples waiting to be classified
+  std::vector<WindowScratch> windows_;  // per worker
 };
 
 }  // namespace sv::volume

@@ -122,21 +122,28 @@ TEST(VolumePass, AHomogeneousSlabCompositesToTheAnalyticSolution) {
   }
 }
 
-TEST(VolumePass, AnOpaquePolygonInsideTheVolumeCutsTheRaysAtItsDepth) {
+// The slab of opacity 0.1 with an unlit, opaque mesh of colour (0.2, 0.4, 0.6) inside it.
+scene::Scene slabWithMesh(std::vector<Vec3> positions, std::vector<uint32_t> indices) {
   scene::Scene s = emptyScene();
   s.volumes.push_back(slab(0.1f));
-  // An unlit quad across the slab's middle, z = −15.
   scene::Material m;
   m.baseColor = {0.2f, 0.4f, 0.6f, 1};
   m.unlit = true;
   m.doubleSided = true;
   s.materials.push_back(m);
-  scene::Mesh quad;
-  quad.positions = {{-2, -2, -15}, {2, -2, -15}, {2, 2, -15}, {-2, 2, -15}};
-  quad.indices = {0, 1, 2, 0, 2, 3};
-  quad.material = 0;
-  s.meshes.push_back(quad);
+  scene::Mesh mesh;
+  mesh.positions = std::move(positions);
+  mesh.indices = std::move(indices);
+  mesh.material = 0;
+  s.meshes.push_back(mesh);
   s.instances.push_back({0, Mat4{}});
+  return s;
+}
+
+TEST(VolumePass, AnOpaquePolygonInsideTheVolumeCutsTheRaysAtItsDepth) {
+  // A quad across the slab's middle, z = −15.
+  const scene::Scene s = slabWithMesh({{-2, -2, -15}, {2, -2, -15}, {2, 2, -15}, {-2, 2, -15}},
+                                      {0, 1, 2, 0, 2, 3});
   const Image img = render(s, options());
   const double front = std::pow(0.9, 5.0);  // the transparency of the 5 units before the quad
   const uint8_t* p = img.pixel(kW / 2, kH / 2);
@@ -265,16 +272,106 @@ TEST(VolumePass, ATrueShellChangesNoPixel) {
   for (size_t i = 3; i < cut.rgb.size(); ++i) ASSERT_EQ(cut.rgb[i], cut.rgb[i % 3]) << i;
 }
 
-TEST(VolumePass, TheSameImageForAnyThreadCount) {
+// marschnerLobbScene with a triangle through the volume.
+scene::Scene marschnerLobbCut() {
   scene::Scene s = marschnerLobbScene();
   s.meshes.push_back({});
   s.meshes[0].positions = {{-8, -8, -17}, {8, -8, -11}, {0, 8, -14}};
   s.meshes[0].indices = {0, 1, 2};
   s.instances.push_back({0, Mat4{}});
+  return s;
+}
+
+TEST(VolumePass, TheSameImageForAnyThreadCount) {
+  const scene::Scene s = marschnerLobbCut();
   for (int samples : {1, 4}) {
     const Image two = render(s, options(samples, 2));
     for (int threads : {1, 3}) EXPECT_EQ(render(s, options(samples, threads)).rgb, two.rgb);
   }
+}
+
+// Linear-light RMSE of two 8-bit images (gamma 1).
+double rmse(const Image& a, const Image& b) {
+  double sum = 0;
+  for (size_t i = 0; i < a.rgb.size(); ++i) {
+    const double d = (int(a.rgb[i]) - int(b.rgb[i])) / 255.0;
+    sum += d * d;
+  }
+  return std::sqrt(sum / double(a.rgb.size()));
+}
+
+// The screen-window refinement (VolumeSettings::windowTolerance): the shaded Marschner–Lobb
+// volume (detail a few pixels across at this size) with a triangle through it casts fewer rays
+// and stays within 40 dB of every pixel cast (at 1 and 4 samples); a tolerance of 0 is the exact
+// cast itself; any thread count, the same bits.
+TEST(VolumePass, WindowRefinementCastsFewerRaysWithin40Decibels) {
+  const scene::Scene s = marschnerLobbCut();
+  for (int samples : {1, 4}) {
+    RenderOptions exact = options(samples), refined = options(samples);
+    refined.volumeWindowTolerance = 0.05f;
+    FrameStats all, fewer;
+    const Image reference = render(s, exact, &all);
+    const Image img = render(s, refined, &fewer);
+    EXPECT_EQ(all.volumeInterpolated, 0u);
+    EXPECT_GT(fewer.volumeInterpolated, 0u);
+    EXPECT_LT(fewer.volumeRays, all.volumeRays) << samples;
+    EXPECT_GE(fewer.volumeRays + fewer.volumeInterpolated, all.volumeRays);
+    EXPECT_GT(20 * std::log10(1 / rmse(img, reference)), 40.0) << samples;
+    for (int threads : {1, 5}) {
+      RenderOptions o = refined;
+      o.threads = threads;
+      EXPECT_EQ(render(s, o).rgb, img.rgb) << threads;
+    }
+    exact.volumeWindowTolerance = 0;
+    EXPECT_EQ(render(s, exact).rgb, reference.rgb);
+  }
+}
+
+// A pixel whose surface lies inside the volume is cast, never blended from its window: the slab
+// with an opaque quad through its middle, refined with a tolerance under which any two corners
+// agree — the pixels on and about the quad are the exact cast's.
+TEST(VolumePass, WindowRefinementCastsThePixelsWhoseSurfaceIsInsideTheVolume) {
+  // A quad (pixel rows 43 … 46), and below it a sliver half a pixel high holding the centres of
+  // row 49 alone, between the rows 48 and 52 of the windows' corners: windows whose corners all
+  // miss it hold pixels on it. Both within the slab's middle, away from where its rays begin to
+  // leave by its sides (beyond 5/20 of the focal length from the centre).
+  const scene::Scene s =
+      slabWithMesh({{-1.7f, 0.3f, -15}, {1.6f, 0.3f, -15}, {1.6f, 1.6f, -15}, {-1.7f, 1.6f, -15},
+                    {-1.4f, -0.48f, -13}, {1.4f, -0.48f, -13}, {1.4f, -0.33f, -13},
+                    {-1.4f, -0.33f, -13}},
+                   {0, 1, 2, 0, 2, 3, 4, 5, 6, 4, 6, 7});
+  RenderOptions loose = options();
+  loose.volumeWindowTolerance = 1;
+  FrameStats stats;
+  const Image img = render(s, loose, &stats);
+  EXPECT_GT(stats.volumeInterpolated, 0u);
+  // The pixels the quad and the sliver show in (where the exact image differs from the slab's
+  // alone) are cast: the exact cast's bits; and the pixels about them are blended from corners
+  // that the surfaces did not cut short: within 3 levels of the exact cast. (Farther away a
+  // tolerance of 1 blends across the slab's own gradients: that is the tolerance's error, not
+  // this test's.)
+  const Image exact = render(s, options());
+  scene::Scene alone = s;
+  alone.instances.clear();
+  const Image slabOnly = render(alone, options());
+  auto shows = [&](int x, int y) {
+    return std::abs(int(exact.pixel(x, y)[2]) - int(slabOnly.pixel(x, y)[2])) > 3;
+  };
+  int onSurface = 0;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      bool near = false;
+      for (int dy = -3; dy <= 3; ++dy)
+        for (int dx = -3; dx <= 3; ++dx)
+          near = near || (x + dx >= 0 && x + dx < kW && y + dy >= 0 && y + dy < kH &&
+                          shows(x + dx, y + dy));
+      if (!near) continue;
+      const bool on = shows(x, y);
+      onSurface += on;
+      for (int c = 0; c < 3; ++c)
+        ASSERT_NEAR(img.pixel(x, y)[c], exact.pixel(x, y)[c], on ? 0 : 3) << x << ", " << y;
+    }
+  EXPECT_GT(onSurface, 40);
 }
 
 // A renderer keeps a volume's tables from frame to frame: a scene with another grid, or another

@@ -11,7 +11,8 @@
 namespace sv::formats::json {
 
 void SceneReader::readVolumes(const Json& v, const std::string& where) {
-  expectKeys(v, where, {"step", "termination", "skipEmpty", "precomputedNormals", "objects"});
+  expectKeys(v, where,
+             {"step", "termination", "skipEmpty", "precomputedNormals", "windowTolerance", "objects"});
   VolumeSettings& settings = scene_.volumeSettings;
   if (const Json* x = find(v, "step")) settings.step = inRange(*x, member(where, "step"), 0.05f, 8);
   if (const Json* x = find(v, "termination"))
@@ -20,6 +21,8 @@ void SceneReader::readVolumes(const Json& v, const std::string& where) {
     settings.skipEmpty = boolean(*x, member(where, "skipEmpty"));
   if (const Json* x = find(v, "precomputedNormals"))
     settings.precomputedNormals = boolean(*x, member(where, "precomputedNormals"));
+  if (const Json* x = find(v, "windowTolerance"))
+    settings.windowTolerance = inRange(*x, member(where, "windowTolerance"), 0, 1);
   const Json* objects = find(v, "objects");
   if (!objects) return;
   const std::string w = member(where, "objects");
