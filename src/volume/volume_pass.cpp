@@ -702,8 +702,10 @@ struct PixelCaster {
     out.met = true;
     out.complete = true;
     for (int k = 0; k < samples; ++k) out.complete = out.complete && pc.limit[k] >= ended;
-    out.C[0] = pc.C[0], out.C[1] = pc.C[1], out.C[2] = pc.C[2], out.T = pc.T;
-    out.last = pc.last;
+    for (int c = 0; c < 3; ++c) out.C[c] = float(pc.C[c]);
+    out.T = float(pc.T);
+    // Rounded up: a pixel blended must lie beyond it.
+    out.last = std::nextafter(float(pc.last), 3.0e38f);
     pc.writeOver(tile, lx, ly);
     return out;
   }
@@ -737,7 +739,9 @@ struct PixelCaster {
 void refineWindows(const PixelCaster& caster, int w, int h, float tolerance,
                    WindowScratch& scratch) {
   std::vector<WindowPixel>& window = scratch.window;
-  window.assign(size_t(kTileSize) * kTileSize, WindowPixel{});
+  window.resize(size_t(kTileSize) * kTileSize);
+  for (int y = 0; y < h; ++y)
+    std::fill_n(window.begin() + ptrdiff_t(y) * kTileSize, w, WindowPixel{});
   auto at = [&](int x, int y) -> WindowPixel& { return window[size_t(y) * kTileSize + size_t(x)]; };
   auto ensure = [&](int x, int y) -> WindowPixel& {
     WindowPixel& p = at(x, y);
@@ -798,7 +802,7 @@ void refineWindows(const PixelCaster& caster, int w, int h, float tolerance,
   for (const Leaf& c : leaves) {
     const WindowPixel *a = &at(c.x0, c.y0), *b = &at(c.x1, c.y0), *e = &at(c.x0, c.y1),
                       *f = &at(c.x1, c.y1);
-    const double last = std::max({a->last, b->last, e->last, f->last});
+    const double last = double(std::max({a->last, b->last, e->last, f->last}));
     for (int y = c.y0; y <= c.y1; ++y)
       for (int x = c.x0; x <= c.x1; ++x) {
         WindowPixel& p = at(x, y);
@@ -812,8 +816,10 @@ void refineWindows(const PixelCaster& caster, int w, int h, float tolerance,
         const double wa = (1 - u) * (1 - v), wb = u * (1 - v), we = (1 - u) * v, wf = u * v;
         double C[3];
         for (int ch = 0; ch < 3; ++ch)
-          C[ch] = wa * a->C[ch] + wb * b->C[ch] + we * e->C[ch] + wf * f->C[ch];
-        const double T = wa * a->T + wb * b->T + we * e->T + wf * f->T;
+          C[ch] = wa * double(a->C[ch]) + wb * double(b->C[ch]) + we * double(e->C[ch]) +
+                  wf * double(f->C[ch]);
+        const double T = wa * double(a->T) + wb * double(b->T) + we * double(e->T) +
+                         wf * double(f->T);
         caster.write(x, y, C, T);
         p.state = WindowPixel::interpolated;
         ++caster.counts.interpolated;
