@@ -49,11 +49,13 @@ double geometryWork(const scene::Scene& s) {
   return double(s.triangleCount() + s.lightPoints.size());
 }
 
-// What the database's terrain gives the governor to give up.
-TerrainLevels terrainLevels(const scene::Scene& s) {
-  TerrainLevels t;
-  for (const scene::Terrain& terrain : s.terrains) t.present = true, t.bicubic |= terrain.bicubic;
-  return t;
+// What the database's ray-cast passes give the governor to give up.
+PassLevels passLevels(const scene::Scene& s) {
+  PassLevels p;
+  for (const scene::Terrain& terrain : s.terrains) p.terrain = true, p.bicubic |= terrain.bicubic;
+  p.volumes = !s.volumes.empty();
+  p.volumeWindowTolerance = s.volumeSettings.windowTolerance;
+  return p;
 }
 
 // Each pixel of `image` shown r × r times in `out`, cropped to width × height (pixel
@@ -301,7 +303,7 @@ struct IgLoop::Session {
         period(std::chrono::duration_cast<Clock::duration>(
             std::chrono::duration<double, std::milli>(periodMs))),
         governor(qualityLevels(impl.config.render, !world.database().lodGroups.empty(),
-                               terrainLevels(world.database())),
+                               passLevels(world.database())),
                  impl.config.deadline * periodMs),
         // In a job of several, this rank's channels only, whole or its part; it presents those
         // it draws whole and the shared ones it assembles (part 0).

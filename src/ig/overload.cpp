@@ -19,7 +19,7 @@ constexpr double kStaleDrift = 0.05;
 }  // namespace
 
 std::vector<QualityLevel> qualityLevels(const RenderOptions& full, bool levelsOfDetail,
-                                        const TerrainLevels& terrain) {
+                                        const PassLevels& passes) {
   std::vector<QualityLevel> levels{{full, true, 1, "full quality"}};
   auto next = [&](const char* what, auto&& change) {
     QualityLevel l = levels.back();
@@ -38,15 +38,24 @@ std::vector<QualityLevel> qualityLevels(const RenderOptions& full, bool levelsOf
     next("bilinear textures",
          [](QualityLevel& l) { l.options.textureFilter = scene::TextureFilter::bilinear; });
   next("no stars", [](QualityLevel& l) { l.stars = false; });
+  // Volumes: their screen windows blended more widely (docs/volumes.md: at 0.05 the cloud layer
+  // casts 15 % of its rays, 54 dB from the exact cast).
+  if (passes.volumes) {
+    const float own =
+        full.volumeWindowTolerance >= 0 ? full.volumeWindowTolerance : passes.volumeWindowTolerance;
+    const float wider = std::min(1.0f, std::max(0.05f, 2 * own));
+    next("coarser volume windows",
+         [wider](QualityLevel& l) { l.options.volumeWindowTolerance = wider; });
+  }
   // The terrain's reductions, the larger gain first (docs/ig.md: bicubic costs several times
   // bilinear; a level of detail coarser saves a part of the cells walked).
   const bool bicubic =
       full.terrainFilter == RenderOptions::TerrainFilter::bicubic ||
-      (full.terrainFilter == RenderOptions::TerrainFilter::scene && terrain.bicubic);
-  if (terrain.present && bicubic)
+      (full.terrainFilter == RenderOptions::TerrainFilter::scene && passes.bicubic);
+  if (passes.terrain && bicubic)
     next("bilinear terrain",
          [](QualityLevel& l) { l.options.terrainFilter = RenderOptions::TerrainFilter::bilinear; });
-  if (terrain.present && full.terrainLod)
+  if (passes.terrain && full.terrainLod)
     next("coarser terrain", [](QualityLevel& l) { ++l.options.terrainLodBias; });
   // Geometry: every level of detail switched at half its range (RenderOptions::lodScale).
   if (levelsOfDetail && full.lod)

@@ -35,19 +35,22 @@ struct QualityLevel {
   std::string change;   // what this level gave up against the one before ("aa 4", "no stars")
 };
 
-// What the database's terrain allows the governor to give up.
-struct TerrainLevels {
-  bool present = false;  // the database has terrain
+// What the database's ray-cast passes allow the governor to give up.
+struct PassLevels {
+  bool terrain = false;  // the database has terrain
   bool bicubic = false;  // some terrain is drawn bicubic at full quality
+  bool volumes = false;  // the database has volumes
+  float volumeWindowTolerance = 0;  // theirs at full quality (VolumeSettings::windowTolerance)
 };
 
-// The levels from full quality `full` down, each one reduction more than the last; with terrain,
-// its reductions (bicubic → bilinear where some terrain is bicubic, then the ground a level of
-// detail coarser: the order of their measured gain, docs/ig.md); with `levelsOfDetail` (the
-// database has level-of-detail groups) one that switches every group's levels at half their
-// ranges, before half resolution.
+// The levels from full quality `full` down, each one reduction more than the last; with volumes,
+// their screen windows blended at twice the tolerance (at least 0.05); with terrain, its
+// reductions (bicubic → bilinear where some terrain is bicubic, then the ground a level of detail
+// coarser: the order of their measured gain, docs/ig.md); with `levelsOfDetail` (the database has
+// level-of-detail groups) one that switches every group's levels at half their ranges, before
+// half resolution.
 std::vector<QualityLevel> qualityLevels(const RenderOptions& full, bool levelsOfDetail = false,
-                                        const TerrainLevels& terrain = {});
+                                        const PassLevels& passes = {});
 
 // What a frame draws, by the work each pass's cost is predicted from.
 struct FrameWork {

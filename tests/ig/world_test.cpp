@@ -483,6 +483,25 @@ TEST(IgOverload, TerrainLevelsComeInTheOrderOfTheirGain) {
   EXPECT_EQ(bilinear[3].change, "coarser terrain");
 }
 
+TEST(IgOverload, VolumesWidenTheirScreenWindowsBeforeTheTerrainsLevels) {
+  RenderOptions full;
+  // Exact volumes (the default, 0): windows blended at 0.05; a database at 0.05 already: 0.1.
+  for (const float own : {0.0f, 0.05f}) {
+    const std::vector<QualityLevel> levels = qualityLevels(full, false, {true, false, true, own});
+    // bilinear textures, no stars, coarser volume windows, coarser terrain, half resolution.
+    ASSERT_EQ(levels.size(), 6u);
+    EXPECT_EQ(levels[0].options.volumeWindowTolerance, -1.0f);  // the scene's own
+    EXPECT_EQ(levels[3].change, "coarser volume windows");
+    EXPECT_EQ(levels[3].options.volumeWindowTolerance, own > 0 ? 0.1f : 0.05f);
+    EXPECT_EQ(levels[4].change, "coarser terrain");
+    EXPECT_EQ(levels[5].options.volumeWindowTolerance, levels[3].options.volumeWindowTolerance);
+  }
+  // An explicit tolerance at full quality is the one doubled.
+  full.volumeWindowTolerance = 0.2f;
+  EXPECT_EQ(qualityLevels(full, false, {false, false, true, 0})[3].options.volumeWindowTolerance,
+            0.4f);
+}
+
 TEST(IgOverload, TheTerrainsCostIsPredictedFromTheGroundsShare) {
   // A frame of 2 ms of polygons and a terrain pass of 40 ms per unit of ground share; the budget
   // 12 ms. Flown at a fifth of the picture ground (10 ms) it holds full quality; when the ground
