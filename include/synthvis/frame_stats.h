@@ -84,6 +84,7 @@ struct FrameStats {
   // frame's workers).
   uint64_t volumes = 0, volumeRays = 0, volumeSamples = 0, volumeSkipped = 0, volumeTerminated = 0;
   uint64_t volumeInterpolated = 0;  // pixels blended from their screen window's corner rays
+  uint64_t volumeClosedForm = 0;    // samples composited in closed form (constant bricks)
   double volumeMs = 0;
   // rasterMs: the tile pass, which includes resolving each finished tile into the image.
   double vertexMs = 0, setupMs = 0, rasterMs = 0, totalMs = 0;

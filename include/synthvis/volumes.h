@@ -66,6 +66,10 @@ struct VolumeSettings {
   // composite ended before its surfaces) the pixels within are interpolated from them; elsewhere
   // the window is split in four, down to single pixels. 0: every pixel's ray cast.
   float windowTolerance = 0;
+  // A brick whose samples, and those about it its gradients read, hold one code is composited in
+  // closed form over its length (Beer–Lambert: 1 − (1 − w)^n, fog a geometric series) instead
+  // of sample by sample — the same result up to rounding; false: every sample taken.
+  bool closedForm = true;
 };
 
 // A volume placed in the world.

@@ -49,6 +49,7 @@ FrameStats& FrameStats::operator+=(const FrameStats& o) {
   volumes += o.volumes, volumeRays += o.volumeRays, volumeSamples += o.volumeSamples;
   volumeSkipped += o.volumeSkipped, volumeTerminated += o.volumeTerminated;
   volumeMs += o.volumeMs, volumeInterpolated += o.volumeInterpolated;
+  volumeClosedForm += o.volumeClosedForm;
   vertexMs += o.vertexMs, setupMs += o.setupMs, rasterMs += o.rasterMs, totalMs += o.totalMs;
   return *this;
 }
@@ -104,10 +105,10 @@ std::string FrameStats::summary() const {
          (shareBytes ? fmt::format(" | shared: {} bytes exchanged, {:.2f} ms", shareBytes, shareMs)
                      : std::string()) +
          (volumes ? fmt::format(
-                        " | volumes {}: rays {}, samples {}, skipped {}, terminated {}, pixels "
-                        "interpolated {}, {:.2f} ms",
-                        volumes, volumeRays, volumeSamples, volumeSkipped, volumeTerminated,
-                        volumeInterpolated, volumeMs)
+                        " | volumes {}: rays {}, samples {}, skipped {}, in closed form {}, "
+                        "terminated {}, pixels interpolated {}, {:.2f} ms",
+                        volumes, volumeRays, volumeSamples, volumeSkipped, volumeClosedForm,
+                        volumeTerminated, volumeInterpolated, volumeMs)
                   : std::string());
 }
 

@@ -276,6 +276,25 @@ void VolumePass::setVolumes(const VolumeInput& input) {
 // The transfer function as a table over the grid's codes, and the map of bricks whose every sample
 // it makes transparent. A sample reads the table linearly between the two entries around its code,
 // so a brick is transparent when every entry from below its smallest code to above its largest is.
+namespace {
+
+// Whether brick (bx, by, bz)'s samples and those within two samples of it (clamped to the grid:
+// what its samples' trilinear reads and their gradients' crosses can reach) hold one code.
+bool oneCode(const scene::VolumeGrid& g, int bx, int by, int bz) {
+  const int b = VolumePass::kBrick;
+  const uint16_t code = g.codes[g.at(std::min(bx * b, g.nx - 1), std::min(by * b, g.ny - 1),
+                                     std::min(bz * b, g.nz - 1))];
+  for (int k = std::max(0, bz * b - 2); k <= std::min(bz * b + b + 2, g.nz - 1); ++k)
+    for (int j = std::max(0, by * b - 2); j <= std::min(by * b + b + 2, g.ny - 1); ++j) {
+      const uint16_t* row = g.codes.data() + g.at(0, j, k);
+      for (int i = std::max(0, bx * b - 2); i <= std::min(bx * b + b + 2, g.nx - 1); ++i)
+        if (row[i] != code) return false;
+    }
+  return true;
+}
+
+}  // namespace
+
 void VolumePass::prepareTables(Prepared& p) const {
   const scene::VolumeGrid& g = *p.grid;
   const uint16_t top = g.codes.empty() ? 1 : std::max<uint16_t>(1, *std::max_element(g.codes.begin(), g.codes.end()));
@@ -292,6 +311,7 @@ void VolumePass::prepareTables(Prepared& p) const {
   const int n[3] = {g.nx, g.ny, g.nz};
   for (int a = 0; a < 3; ++a) p.bricks[a] = (n[a] - 2) / kBrick + 1;
   p.emptyBrick.assign(size_t(p.bricks[0]) * size_t(p.bricks[1]) * size_t(p.bricks[2]), 0);
+  p.constantBrick.assign(p.emptyBrick.size(), 0);
   p.contentBricks.clear();
   for (int bz = 0; bz < p.bricks[2]; ++bz)
     for (int by = 0; by < p.bricks[1]; ++by)
@@ -315,6 +335,7 @@ void VolumePass::prepareTables(Prepared& p) const {
             (size_t(bz) * size_t(p.bricks[1]) + size_t(by)) * size_t(p.bricks[0]) + size_t(bx);
         p.emptyBrick[index] = opaqueBefore[size_t(last) + 1] == opaqueBefore[size_t(first)];
         if (!p.emptyBrick[index]) p.contentBricks.push_back(uint32_t(index));
+        p.constantBrick[index] = !p.emptyBrick[index] && oneCode(g, bx, by, bz);
       }
 }
 
@@ -462,6 +483,7 @@ void VolumePass::addStats(FrameStats& stats) const {
   stats.volumeSkipped += c.skipped;
   stats.volumeTerminated += c.terminated;
   stats.volumeInterpolated += c.interpolated;
+  stats.volumeClosedForm += c.closedForm;
 }
 
 namespace {
@@ -564,6 +586,42 @@ struct BrickWalk {
   }
 };
 
+// SPEC §12's compositing over up to n full steps of one classified sample (a constant brick's:
+// opacity w a step, colour c), in closed form — what the samples would sum: after m steps the
+// transparency T·a^m (a = 1 − w), the colour T·w·Σ_{k<m} a^k·(c·f_k + fog·(1 − f_k)), the fog's
+// f_k = f_0·q^k a geometric series too (no fog: T·c·(1 − a^m)) — stopping, as the samples would,
+// at the first step after which the transparency is below ε. `firstMiddle`: the first step's
+// middle, s. Returns the steps composited, negative when the ray ended there.
+int64_t compositeConstant(double w, const double c[3], int64_t n, double firstMiddle, double ds,
+                          double worldPerS, const VolumeInput& in, PixelComposite& pc) {
+  const double a = 1 - w, epsilon = in.settings.termination;
+  int64_t m = n;
+  bool ended = false;
+  if (epsilon > 0 && pc.T * std::pow(a, double(n)) < epsilon) {
+    // The first m ≥ 1 with T·a^m < ε (the logarithm's guess, made exact).
+    m = a <= 0 ? 1 : std::clamp<int64_t>(int64_t(std::ceil(std::log(epsilon / pc.T) / std::log(a))), 1, n);
+    while (m > 1 && pc.T * std::pow(a, double(m - 1)) < epsilon) --m;
+    while (m < n && !(pc.T * std::pow(a, double(m)) < epsilon)) ++m;
+    ended = true;
+  }
+  auto series = [&](double x) {  // Σ_{k<m} x^k
+    return std::fabs(1 - x) < 1e-12 ? double(m) : (1 - std::pow(x, double(m))) / (1 - x);
+  };
+  const double am = std::pow(a, double(m));
+  if (in.fogBeta > 0) {
+    const double f0 = std::exp2(-double(in.fogBeta) * firstMiddle * worldPerS);  // SPEC §8
+    const double q = std::exp2(-double(in.fogBeta) * ds * worldPerS);
+    const double fogged = series(a * q), plain = series(a);
+    const double fc[3] = {in.fogColor.x, in.fogColor.y, in.fogColor.z};
+    for (int k = 0; k < 3; ++k)
+      pc.C[k] += pc.T * w * (c[k] * f0 * fogged + fc[k] * (plain - f0 * fogged));
+  } else {
+    for (int k = 0; k < 3; ++k) pc.C[k] += pc.T * c[k] * (1 - am);
+  }
+  pc.T *= am;
+  return ended ? -m : m;
+}
+
 // Casts the ray through one stretch (SPEC §12): its samples, up to the farthest surface of the
 // pixel, classified a batch at a time (sample_kernel.h) and composited front to back into `pc`.
 // True once the ray's transparency fell below ε (the ray ends there).
@@ -642,8 +700,40 @@ struct BrickWalk {
       if (in.settings.skipEmpty && p.emptyBrick[walk.index(p)]) {
         counts.skipped += uint64_t(last - i + 1);
       } else {
-        // Samples i … last, up to the stretch's end and the shell's exit.
-        for (int64_t j = i; j <= last; ++j) {
+        int64_t j = i;
+        if (in.settings.closedForm && p.constantBrick[walk.index(p)]) {
+          // The brick's full steps within the stretch's end and the shell's exit, in closed form
+          // — where no sample of the pixel has its surface among them.
+          int64_t upTo = last;
+          while (upTo >= j && (st.s0 + double(upTo) * ds + ds > end ||
+                                  st.s0 + double(upTo) * ds > st.to))
+            --upTo;
+          pc.reach(st.s0 + double(j) * ds);
+          if (upTo > j && pc.next > st.s0 + double(upTo) * ds) {
+            if (pending > 0 && !flush()) return true;
+            const double middle = st.s0 + (double(j) + 0.5) * ds;
+            batch.x[0] = float(st.o[0] + middle * st.dir[0]);
+            batch.y[0] = float(st.o[1] + middle * st.dir[1]);
+            batch.z[0] = float(st.o[2] + middle * st.dir[2]);
+            classifySamples(p.source, 1, batch);
+            ++counts.samples;
+            if (batch.opacity[0] > 0) {
+              const double color[3] = {batch.r[0], batch.g[0], batch.b[0]};
+              const int64_t m = compositeConstant(batch.w[0], color, upTo - j + 1, middle, ds,
+                                                  worldPerS, in, pc);
+              const int64_t steps = m < 0 ? -m : m;
+              counts.closedForm += uint64_t(steps);
+              pc.last = st.s0 + double(j + steps) * ds;
+              if (m < 0) {
+                ++counts.terminated;
+                return true;
+              }
+            }
+            j = upTo + 1;
+          }
+        }
+        // Samples j … last, up to the stretch's end and the shell's exit.
+        for (; j <= last; ++j) {
           const double a = st.s0 + double(j) * ds;
           if (!(a < end) || a > st.to) break;
           const bool full = a + ds <= end;

@@ -43,9 +43,10 @@ struct VolumeCounts {
   uint64_t skipped = 0;         // samples stepped over in empty regions
   uint64_t terminated = 0;      // rays ended by their transparency falling below ε
   uint64_t interpolated = 0;    // pixels blended from their window's corner rays, not cast
+  uint64_t closedForm = 0;      // samples composited in closed form over a constant brick
   void add(const VolumeCounts& o) {
     rays += o.rays, samples += o.samples, skipped += o.skipped, terminated += o.terminated;
-    interpolated += o.interpolated;
+    interpolated += o.interpolated, closedForm += o.closedForm;
   }
 };
 
@@ -120,6 +121,9 @@ class VolumePass final : public raster::TilePass {
     std::vector<uint8_t> padded8;  // the same a byte a sample, instead, where every code fits
     int bricks[3] = {};
     std::vector<uint8_t> emptyBrick;  // per brick (x fastest): every sample it holds transparent
+    // Per brick: not empty, and every code within two samples of it the same (its samples'
+    // trilinear values and their gradients' reads): composited in closed form.
+    std::vector<uint8_t> constantBrick;
     std::vector<uint32_t> contentBricks;  // the bricks not wholly transparent, by index
     int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // the pixels its box may cover this frame, [x0, x1)
     // SPEC §12's screen subdivision at one level: per window of kWindow² pixels this frame, the

@@ -290,6 +290,36 @@ TEST(VolumePass, TheSameImageForAnyThreadCount) {
   }
 }
 
+// A brick of one code is composited in closed form (VolumeSettings::closedForm) to what its
+// samples sum: the slab (one code throughout) against every sample taken — thin and nearly
+// opaque (ended by ε inside), in fog, with an opaque quad inside it, at 1 and 4 samples a pixel:
+// within one level of 255.
+TEST(VolumePass, AConstantBrickInClosedFormIsItsSamplesSum) {
+  for (const float alpha : {0.02f, 0.3f, 0.9f})
+    for (const bool fog : {false, true})
+      for (const int samples : {1, 4}) {
+        scene::Scene s =
+            slabWithMesh({{-1, -1, -15}, {1, -1, -15}, {1, 1, -15}, {-1, 1, -15}}, {0, 1, 2, 0, 2, 3});
+        s.volumes[0].transfer[0].opacity = alpha;
+        if (fog) {
+          s.fog.enabled = true, s.fog.beta = 0.08f, s.fog.color = {0.3f, 0.5f, 0.9f};
+        }
+        FrameStats closed, sampled;
+        const Image a = render(s, options(samples), &closed);
+        s.volumeSettings.closedForm = false;
+        const Image b = render(s, options(samples), &sampled);
+        EXPECT_GT(closed.volumeClosedForm, 0u);
+        EXPECT_EQ(sampled.volumeClosedForm, 0u);
+        EXPECT_LE(maxDifference(a, b), 1) << alpha << " fog " << fog << " samples " << samples;
+        if (alpha < 0.5f) {
+          // A ray's 20 steps: one classified a brick, the partial ones at its ends sampled.
+          EXPECT_LT(closed.volumeSamples * 3, sampled.volumeSamples);
+        } else {
+          EXPECT_GT(closed.volumeTerminated, 0u);  // ended by ε within a brick
+        }
+      }
+}
+
 // Linear-light RMSE of two 8-bit images (gamma 1).
 double rmse(const Image& a, const Image& b) {
   double sum = 0;

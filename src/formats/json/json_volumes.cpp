@@ -12,7 +12,8 @@ namespace sv::formats::json {
 
 void SceneReader::readVolumes(const Json& v, const std::string& where) {
   expectKeys(v, where,
-             {"step", "termination", "skipEmpty", "precomputedNormals", "windowTolerance", "objects"});
+             {"step", "termination", "skipEmpty", "precomputedNormals", "windowTolerance",
+              "closedForm", "objects"});
   VolumeSettings& settings = scene_.volumeSettings;
   if (const Json* x = find(v, "step")) settings.step = inRange(*x, member(where, "step"), 0.05f, 8);
   if (const Json* x = find(v, "termination"))
@@ -21,6 +22,8 @@ void SceneReader::readVolumes(const Json& v, const std::string& where) {
     settings.skipEmpty = boolean(*x, member(where, "skipEmpty"));
   if (const Json* x = find(v, "precomputedNormals"))
     settings.precomputedNormals = boolean(*x, member(where, "precomputedNormals"));
+  if (const Json* x = find(v, "closedForm"))
+    settings.closedForm = boolean(*x, member(where, "closedForm"));
   if (const Json* x = find(v, "windowTolerance"))
     settings.windowTolerance = inRange(*x, member(where, "windowTolerance"), 0, 1);
   const Json* objects = find(v, "objects");
