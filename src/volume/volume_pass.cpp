@@ -819,10 +819,11 @@ struct PixelCaster {
 };
 
 // SPEC §12's screen subdivision down to the pixel (VolumeSettings::windowTolerance): the tile's
-// windows of kWindow pixels have their corner rays cast; a window whose corners all met a volume,
-// ended their composites before their surfaces, and differ by at most `tolerance` in colour and
-// transparency is a leaf, any other is split in four (its edges' and centre's rays cast) down to
-// windows without inner pixels. Then each leaf's pixels not cast take the bilinear blend of its
+// windows of kRefineWindow pixels (4 × 4: 8 × 8 lost the cloud's lit ripples, docs/volumes.md)
+// have their corner rays cast; a window whose corners all met a volume, ended their composites
+// before their surfaces, and differ by at most `tolerance` in colour and transparency is a leaf,
+// any other is split in four (its edges' and centre's rays cast) down to windows without inner
+// pixels. Then each leaf's pixels not cast take the bilinear blend of its
 // corners — where the pixel's nearest surface lies beyond the corners' last samples (else its ray
 // is cast). The tile alone decides (no ray of another tile is read): the same bits for any number
 // of threads.
@@ -915,7 +916,6 @@ void refineWindows(const PixelCaster& caster, int w, int h, float tolerance,
         ++caster.counts.interpolated;
       }
   }
-  // Pixels of no window (a tile one pixel wide or high was cast above).
 }
 
 }  // namespace
