@@ -241,7 +241,9 @@ void ClassifySamples(const SampleSource& s, int count, SampleBatch& b) {
     const VF x = hn::Load(df, b.x + i), y = hn::Load(df, b.y + i), z = hn::Load(df, b.z + i);
     const Cell cell = Locate(s, x, y, z);
     VF g[3];
-    const bool crossed = s.shade && !s.normals && (s.padded8 || s.padded);
+    // The value from the bordered codes' cross where they are kept: the 8-bit ones lit or not
+    // (one 32-bit gather a row of four codes), the 16-bit ones for the gradient's sake.
+    const bool crossed = !s.normals && (s.padded8 || (s.shade && s.padded));
     CrossRows cross;
     const VF code = !crossed  ? Codes(s, cell)
                     : s.padded8 ? CrossValue(s, s.padded8, cell, cross)

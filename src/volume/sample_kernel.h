@@ -36,7 +36,8 @@ struct SampleSource {
   const uint16_t* padded = nullptr;
   // The same bordered codes a byte each, when every code is below 256 (8-bit data): half the
   // memory, and a row's four codes about the cell in one 32-bit gather (twelve gathers for the
-  // value and its gradient). Read instead of `padded` when given; 4 bytes of slack at the end.
+  // value and its gradient). Read instead of `padded` when given — and for the value alone where
+  // the volume is unlit; 4 bytes of slack at the end.
   const uint8_t* padded8 = nullptr;
   bool shade = false;
   float toWorld[3][3] = {};  // own → world for gradients: the rows of world → own, transposed

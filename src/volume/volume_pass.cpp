@@ -222,14 +222,19 @@ void VolumePass::setVolumes(const VolumeInput& input) {
     if (input.settings.precomputedNormals && v.shaded && p.normals.empty())
       p.normals = sampleNormals(*v.grid);
     if (!input.settings.precomputedNormals) p.normals.clear();
-    if (!input.settings.precomputedNormals && v.shaded && p.padded.empty() && p.padded8.empty()) {
-      const auto& codes = v.grid->codes;
-      if (std::all_of(codes.begin(), codes.end(), [](uint16_t c) { return c < 256; }))
+    // The bordered codes: a byte each where every code fits, read for the value lit or not; 16-bit
+    // ones only for the gradient of a lit volume.
+    const auto& codes = v.grid->codes;
+    const bool bytes =
+        std::all_of(codes.begin(), codes.end(), [](uint16_t c) { return c < 256; });
+    if (!input.settings.precomputedNormals && p.padded.empty() && p.padded8.empty()) {
+      if (bytes)
         p.padded8 = borderedCodes<uint8_t>(*v.grid);
-      else
+      else if (v.shaded)
         p.padded = borderedCodes<uint16_t>(*v.grid);
     }
-    if (input.settings.precomputedNormals || !v.shaded) p.padded.clear(), p.padded8.clear();
+    if (input.settings.precomputedNormals) p.padded.clear(), p.padded8.clear();
+    if (!v.shaded) p.padded.clear();
     // World → own: the inverse of the affine transform, in double (validateVolumes has refused a
     // singular one).
     const bool invertible = affineInverse(v.transform, p.toOwn);

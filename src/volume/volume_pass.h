@@ -118,7 +118,9 @@ class VolumePass final : public raster::TilePass {
     // Gradients taken while traversing: the codes with a one-sample border (sample_kernel.h),
     // 2 bytes a sample; empty with precomputed normals, unlit, or beyond 2^31 bytes.
     std::vector<uint16_t> padded;
-    std::vector<uint8_t> padded8;  // the same a byte a sample, instead, where every code fits
+    // The same a byte a sample, instead, where every code fits — lit or not (the value's reads
+    // too); empty with precomputed normals.
+    std::vector<uint8_t> padded8;
     int bricks[3] = {};
     std::vector<uint8_t> emptyBrick;  // per brick (x fastest): every sample it holds transparent
     // Per brick: not empty, and every code within two samples of it the same (its samples'

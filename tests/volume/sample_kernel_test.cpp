@@ -217,6 +217,36 @@ TEST(SampleKernel, EveryTargetGivesTheSameBitsAndTheyAreTheScalarFormulas) {
   }
 }
 
+// An unlit volume of 8-bit data reads its values from the bordered byte codes' cross as a lit one
+// does: the bits the plain codes' four gathers a cell give (positions inside the box; beyond it
+// the cross clamps the point, the plain codes the cell).
+TEST(SampleKernel, UnlitEightBitValuesFromTheBorderedBytesAreThePlainCodesBits) {
+  Fixture f(256);
+  f.source.shade = false;
+  f.source.normals = nullptr, f.source.padded = nullptr;
+  for (int round = 0; round < 4; ++round) {
+    SampleBatch plain{}, bytes{};
+    positions(plain, round);
+    for (int i = 0; i < kBatch; ++i) {  // inside the box
+      plain.x[i] = std::clamp(plain.x[i], 0.0f, (kNx - 1) * f.source.spacing[0]);
+      plain.y[i] = std::clamp(plain.y[i], 0.0f, (kNy - 1) * f.source.spacing[1]);
+      plain.z[i] = std::clamp(plain.z[i], 0.0f, (kNz - 1) * f.source.spacing[2]);
+    }
+    std::memcpy(bytes.x, plain.x, sizeof plain.x);
+    std::memcpy(bytes.y, plain.y, sizeof plain.y);
+    std::memcpy(bytes.z, plain.z, sizeof plain.z);
+    f.source.padded8 = nullptr;
+    classifySamples(f.source, kBatch, plain);
+    f.source.padded8 = f.padded8.data();
+    classifySamples(f.source, kBatch, bytes);
+    for (int i = 0; i < kBatch; ++i) {
+      EXPECT_EQ(std::memcmp(&plain.opacity[i], &bytes.opacity[i], 4), 0) << round << " " << i;
+      EXPECT_EQ(std::memcmp(&plain.w[i], &bytes.w[i], 4), 0) << i;
+      EXPECT_EQ(std::memcmp(&plain.r[i], &bytes.r[i], 4), 0) << i;
+    }
+  }
+}
+
 // Without the tabled step opacity (a transform that is not a similarity), a ray's step opacity
 // 1 − (1 − W)^e is taken in the lanes: the same bits on every target, and the formula in double
 // within 10⁻⁴ (the lanes' log2 is within 2·10⁻⁵; the table's linear reading, the other way, within
