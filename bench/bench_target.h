@@ -3,6 +3,7 @@
 // Prints the target chosen, as every figure quotes it.
 #pragma once
 
+#include <benchmark/benchmark.h>
 #include <hwy/targets.h>
 
 #include <cctype>
@@ -30,6 +31,16 @@ inline bool selectBenchTarget(const char* program) {
   }
   std::printf("SIMD target %s\n", hwy::TargetName(hwy::SupportedAndGeneratedTargets().front()));
   return true;
+}
+
+// A kernel benchmark's main: the target chosen, then Google Benchmark's run.
+inline int runBenchmarks(int argc, char** argv, const char* program) {
+  if (!selectBenchTarget(program)) return 2;
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
 }
 
 }  // namespace sv::bench

@@ -10,19 +10,14 @@
 // SV_BENCH_TARGET=avx2 (or avx3, sse4, scalar) runs the kernels on that SIMD target alone, to
 // quote an AVX2 figure from an AVX-512 machine.
 #include <benchmark/benchmark.h>
-#include <hwy/targets.h>
 
-#include <cctype>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <memory>
 #include <random>
-#include <string>
 #include <vector>
 
-#include "formats/heights.h"
 #include "bench_target.h"
+#include "formats/heights.h"
 #include "terrain/caster.h"
 
 namespace sv::terrain {
@@ -154,11 +149,4 @@ BENCHMARK(BM_TerrainPacketWalkFromTheEye)->Unit(benchmark::kMillisecond);
 }  // namespace
 }  // namespace sv::terrain
 
-int main(int argc, char** argv) {
-  if (!sv::bench::selectBenchTarget("sv_terrain_bench")) return 2;
-  benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
-}
+int main(int argc, char** argv) { return sv::bench::runBenchmarks(argc, argv, "sv_terrain_bench"); }

@@ -12,10 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
-#include <cstring>
 #include <random>
-#include <string>
 #include <vector>
 
 #include "bench_target.h"
@@ -172,11 +169,4 @@ BENCHMARK(BM_VolumeComposite);
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  if (!sv::bench::selectBenchTarget("sv_volume_bench")) return 2;
-  benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
-}
+int main(int argc, char** argv) { return sv::bench::runBenchmarks(argc, argv, "sv_volume_bench"); }

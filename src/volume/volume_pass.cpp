@@ -138,6 +138,11 @@ void clipToQuadric(const std::array<double, 10>& q, const double o[3], const dou
   s1 = std::min(s1, r1 + margin);
 }
 
+// A composite (colour C, transparency T) of one channel over the 16-bit value a sample holds.
+inline void compositeOver(uint16_t& out, double C, double T) {
+  out = uint16_t(std::lrint(std::clamp(C + T * (out / 65535.0), 0.0, 1.0) * 65535.0));
+}
+
 // One pixel's compositing: the running colour and transparency, and per sample of the pixel the
 // value they had when the ray reached that sample's depth.
 struct PixelComposite {
@@ -183,11 +188,9 @@ struct PixelComposite {
   [[gnu::always_inline]] void writeOver(const raster::TileTarget& tile, int lx, int ly) {
     reach(1e300);
     for (int k = 0; k < samples; ++k) {
-      for (int c = 0; c < 3; ++c) {
-        uint16_t& out = tile.color[FrameBuffer::colorOffset(lx, ly, c, samples, k)];
-        const double v = snapC[k][c] + snapT[k] * (out / 65535.0);
-        out = uint16_t(std::lrint(std::clamp(v, 0.0, 1.0) * 65535.0));
-      }
+      for (int c = 0; c < 3; ++c)
+        compositeOver(tile.color[FrameBuffer::colorOffset(lx, ly, c, samples, k)], snapC[k][c],
+                      snapT[k]);
     }
   }
 };
@@ -710,8 +713,8 @@ int64_t compositeConstant(double w, const double c[3], int64_t n, double firstMi
           // The brick's full steps within the stretch's end and the shell's exit, in closed form
           // — where no sample of the pixel has its surface among them.
           int64_t upTo = last;
-          while (upTo >= j && (st.s0 + double(upTo) * ds + ds > end ||
-                                  st.s0 + double(upTo) * ds > st.to))
+          while (upTo >= j &&
+                 (st.s0 + double(upTo) * ds + ds > end || st.s0 + double(upTo) * ds > st.to))
             --upTo;
           pc.reach(st.s0 + double(j) * ds);
           if (upTo > j && pc.next > st.s0 + double(upTo) * ds) {
@@ -816,10 +819,8 @@ struct PixelCaster {
   // The composite (C, T) over every sample of the pixel.
   void write(int lx, int ly, const double C[3], double T) const {
     for (int k = 0; k < samples; ++k)
-      for (int c = 0; c < 3; ++c) {
-        uint16_t& o = tile.color[FrameBuffer::colorOffset(lx, ly, c, samples, k)];
-        o = uint16_t(std::lrint(std::clamp(C[c] + T * (o / 65535.0), 0.0, 1.0) * 65535.0));
-      }
+      for (int c = 0; c < 3; ++c)
+        compositeOver(tile.color[FrameBuffer::colorOffset(lx, ly, c, samples, k)], C[c], T);
   }
 };
 
@@ -828,9 +829,8 @@ struct PixelCaster {
 // have their corner rays cast; a window whose corners all met a volume, ended their composites
 // before their surfaces, and differ by at most `tolerance` in colour and transparency is a leaf,
 // any other is split in four (its edges' and centre's rays cast) down to windows without inner
-// pixels. Then each leaf's pixels not cast take the bilinear blend of its
-// corners — where the pixel's nearest surface lies beyond the corners' last samples (else its ray
-// is cast). The tile alone decides (no ray of another tile is read): the same bits for any number
+// pixels. Then each leaf's pixels not cast take the bilinear blend of its corners — where the
+// pixel's nearest surface lies beyond the corners' last samples (else its ray is cast). The tile alone decides (no ray of another tile is read): the same bits for any number
 // of threads.
 void refineWindows(const PixelCaster& caster, int w, int h, float tolerance,
                    WindowScratch& scratch) {
