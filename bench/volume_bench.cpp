@@ -38,7 +38,8 @@ struct Grid {
     std::mt19937 rng(7);
     std::uniform_real_distribution<float> u(0, 1);
     float blobs[24][4];
-    for (auto& b : blobs) b[0] = kN * u(rng), b[1] = kN * u(rng), b[2] = kN * u(rng), b[3] = 20 + 30 * u(rng);
+    for (auto& b : blobs)
+      b[0] = kN * u(rng), b[1] = kN * u(rng), b[2] = kN * u(rng), b[3] = 20 + 30 * u(rng);
     for (int k = 0; k < kN; ++k)
       for (int j = 0; j < kN; ++j)
         for (int i = 0; i < kN; ++i) {
@@ -47,7 +48,8 @@ struct Grid {
             const float dx = i - b[0], dy = j - b[1], dz = k - b[2];
             v += std::exp(-(dx * dx + dy * dy + dz * dz) / (b[3] * b[3]));
           }
-          codes[(size_t(k) * kN + size_t(j)) * kN + size_t(i)] = uint16_t(std::min(255.0f, 200 * v));
+          codes[(size_t(k) * kN + size_t(j)) * kN + size_t(i)] =
+              uint16_t(std::min(255.0f, 200 * v));
         }
     const int p = kN + 2;
     padded.resize(size_t(p) * p * p);
@@ -55,7 +57,8 @@ struct Grid {
       for (int j = 0; j < p; ++j)
         for (int i = 0; i < p; ++i)
           padded[(size_t(k) * p + size_t(j)) * p + size_t(i)] =
-              codes[(size_t(std::clamp(k - 1, 0, kN - 1)) * kN + size_t(std::clamp(j - 1, 0, kN - 1))) *
+              codes[(size_t(std::clamp(k - 1, 0, kN - 1)) * kN +
+                     size_t(std::clamp(j - 1, 0, kN - 1))) *
                         kN +
                     size_t(std::clamp(i - 1, 0, kN - 1))];
     padded8.assign(padded.size() + 4, 0);
@@ -123,10 +126,10 @@ void BM_VolumeClassify(benchmark::State& state) {
     benchmark::DoNotOptimize(batch.r[0]);
     done += kBatch;
   }
-  state.counters["ns/sample"] = benchmark::Counter(
-      double(done), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["ns/sample"] =
+      benchmark::Counter(double(done), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
   static const char* const kLabels[] = {"unlit, the plain codes", "lit, 8-bit cross",
-                                       "lit, 16-bit cross", "unlit, 8-bit cross"};
+                                        "lit, 16-bit cross", "unlit, 8-bit cross"};
   state.SetLabel(kLabels[state.range(0)]);
 }
 BENCHMARK(BM_VolumeClassify)->Arg(0)->Arg(1)->Arg(2)->Arg(3);
@@ -142,7 +145,8 @@ void BM_VolumeComposite(benchmark::State& state) {
   for (size_t b = 0; b < batches.size(); ++b) {
     for (int l = 0; l < kBatch; ++l) {
       const size_t at = b * kBatch + size_t(l);
-      batches[b].x[l] = xyz[at * 3], batches[b].y[l] = xyz[at * 3 + 1], batches[b].z[l] = xyz[at * 3 + 2];
+      batches[b].x[l] = xyz[at * 3], batches[b].y[l] = xyz[at * 3 + 1],
+      batches[b].z[l] = xyz[at * 3 + 2];
     }
     sv::volume::classifySamples(source, kBatch, batches[b]);
   }
@@ -162,8 +166,8 @@ void BM_VolumeComposite(benchmark::State& state) {
     done += kBatch;
   }
   benchmark::DoNotOptimize(C[0]);
-  state.counters["ns/sample"] = benchmark::Counter(
-      double(done), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["ns/sample"] =
+      benchmark::Counter(double(done), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(BM_VolumeComposite);
 

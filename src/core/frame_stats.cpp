@@ -104,12 +104,12 @@ std::string FrameStats::summary() const {
                 : std::string()) +
          (shareBytes ? fmt::format(" | shared: {} bytes exchanged, {:.2f} ms", shareBytes, shareMs)
                      : std::string()) +
-         (volumes ? fmt::format(
-                        " | volumes {}: rays {}, samples {}, skipped {}, in closed form {}, "
-                        "terminated {}, pixels interpolated {}, {:.2f} ms",
-                        volumes, volumeRays, volumeSamples, volumeSkipped, volumeClosedForm,
-                        volumeTerminated, volumeInterpolated, volumeMs)
-                  : std::string());
+         (volumes
+              ? fmt::format(" | volumes {}: rays {}, samples {}, skipped {}, in closed form {}, "
+                            "terminated {}, pixels interpolated {}, {:.2f} ms",
+                            volumes, volumeRays, volumeSamples, volumeSkipped, volumeClosedForm,
+                            volumeTerminated, volumeInterpolated, volumeMs)
+              : std::string());
 }
 
 }  // namespace sv

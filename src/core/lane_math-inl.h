@@ -52,8 +52,8 @@ HWY_INLINE hn::Vec<DF> Exp2(DF df, hn::Vec<DF> y) {
   VF p = hn::Set(df, 1.0f / 5040);
   for (const float c : {1.0f / 720, 1.0f / 120, 1.0f / 24, 1.0f / 6, 0.5f, 1.0f, 1.0f})
     p = hn::Add(hn::Mul(p, u), hn::Set(df, c));
-  const VF scale = hn::BitCast(
-      df, hn::ShiftLeft<23>(hn::Add(hn::ConvertTo(di, whole), hn::Set(di, 127))));
+  const VF scale =
+      hn::BitCast(df, hn::ShiftLeft<23>(hn::Add(hn::ConvertTo(di, whole), hn::Set(di, 127))));
   return hn::Mul(p, scale);
 }
 

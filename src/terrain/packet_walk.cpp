@@ -122,11 +122,13 @@ hn::Mask<DF> SolvePatches(DF df, const PacketGrid& g, const CellRays<DF>& r, hn:
   const VI i = hn::Add(ci, hn::Set(di, g.anchorI)), j = hn::Add(cj, hn::Set(di, g.anchorJ));
   const VI colA = hn::Max(hn::Sub(i, hn::Set(di, 1)), hn::Zero(di));
   const VI colB = hn::Min(hn::Add(i, hn::Set(di, 1)), hn::Set(di, g.cellsX - 1));
-  const auto firstColumn = hn::Eq(i, hn::Zero(di)), lastColumn = hn::Eq(i, hn::Set(di, g.cellsX - 1));
+  const auto firstColumn = hn::Eq(i, hn::Zero(di)),
+             lastColumn = hn::Eq(i, hn::Set(di, g.cellsX - 1));
   const int32_t* table = reinterpret_cast<const int32_t*>(g.q);
   VI codes[4][4];
   for (int y = 0; y < 4; ++y) {
-    const VI row = hn::Min(hn::Max(hn::Add(j, hn::Set(di, y - 1)), hn::Zero(di)), hn::Set(di, g.cellsY));
+    const VI row =
+        hn::Min(hn::Max(hn::Add(j, hn::Set(di, y - 1)), hn::Zero(di)), hn::Set(di, g.cellsY));
     const VI start = hn::Mul(row, hn::Set(di, g.width));
     const VI a = hn::GatherOffset(di, table, hn::ShiftLeft<1>(hn::Add(start, colA)));
     const VI b = hn::GatherOffset(di, table, hn::ShiftLeft<1>(hn::Add(start, colB)));
@@ -144,7 +146,8 @@ hn::Mask<DF> SolvePatches(DF df, const PacketGrid& g, const CellRays<DF>& r, hn:
     c[1] = hn::Mul(half, hn::Sub(p[2], p[0]));
     c[2] = hn::Sub(hn::Add(p[0], hn::Add(p[2], p[2])),
                    hn::Add(hn::Mul(hn::Set(df, 2.5f), p[1]), hn::Mul(half, p[3])));
-    c[3] = hn::Add(hn::Mul(hn::Set(df, 1.5f), hn::Sub(p[1], p[2])), hn::Mul(half, hn::Sub(p[3], p[0])));
+    c[3] = hn::Add(hn::Mul(hn::Set(df, 1.5f), hn::Sub(p[1], p[2])),
+                   hn::Mul(half, hn::Sub(p[3], p[0])));
   };
   VF rows[4][4];
   for (int y = 0; y < 4; ++y) {
@@ -201,9 +204,9 @@ hn::Mask<DF> SolvePatches(DF df, const PacketGrid& g, const CellRays<DF>& r, hn:
   const VF f0 = above(zero);
   const auto under = hn::And(lanes, hn::Le(f0, zero));
   // Samples an eighth of a cell apart: n = ⌈8·span·speed⌉ (1 … 12 in a cell).
-  const VF n = hn::Min(hn::Max(hn::Ceil(hn::Mul(hn::Mul(hn::Set(df, 8.0f), span), speed)),
-                               hn::Set(df, 1.0f)),
-                       hn::Set(df, 64.0f));
+  const VF n = hn::Min(
+      hn::Max(hn::Ceil(hn::Mul(hn::Mul(hn::Set(df, 8.0f), span), speed)), hn::Set(df, 1.0f)),
+      hn::Set(df, 64.0f));
   VF lo = zero, fLo = f0, hi = span, fHi = f0;
   auto searching = hn::AndNot(under, lanes), found = hn::And(under, hn::Not(under));
   // Four samples at a time: their evaluations are independent chains the core overlaps.
@@ -233,8 +236,8 @@ hn::Mask<DF> SolvePatches(DF df, const PacketGrid& g, const CellRays<DF>& r, hn:
   for (int it = 0; it < 60 && !hn::AllFalse(df, refining); ++it) {
     const VF secant = hn::Sub(hi, hn::Div(hn::Mul(fHi, hn::Sub(hi, lo)), hn::Sub(fHi, fLo)));
     const VF middle = hn::Mul(half, hn::Add(lo, hi));
-    const auto inside = hn::And(hn::Gt(hn::Sub(fLo, fHi), zero),
-                                hn::And(hn::Gt(secant, lo), hn::Lt(secant, hi)));
+    const auto inside =
+        hn::And(hn::Gt(hn::Sub(fLo, fHi), zero), hn::And(hn::Gt(secant, lo), hn::Lt(secant, hi)));
     const VF m = hn::IfThenElse(inside, secant, middle);
     const VF fm = above(m);
     const auto toHi = hn::And(refining, hn::Le(fm, zero));

@@ -26,7 +26,8 @@ void CatmullRom(DF df, VF<DF> t, VF<DF> w[4], VF<DF> dw[4]) {
     return hn::Mul(half, hn::Add(hn::Add(hn::Mul(k(c3), t3), hn::Mul(k(c2), t2)),
                                  hn::Add(hn::Mul(k(c1), t), k(c0))));
   };
-  w[0] = poly(-1, 2, -1, 0), w[1] = poly(3, -5, 0, 2), w[2] = poly(-3, 4, 1, 0), w[3] = poly(1, -1, 0, 0);
+  w[0] = poly(-1, 2, -1, 0), w[1] = poly(3, -5, 0, 2), w[2] = poly(-3, 4, 1, 0),
+  w[3] = poly(1, -1, 0, 0);
   dw[0] = poly(0, -3, 4, -1), dw[1] = poly(0, 9, -10, 0), dw[2] = poly(0, -9, 8, 1),
   dw[3] = poly(0, 3, -2, 0);
 }
@@ -144,8 +145,8 @@ void ShadeLanesKernel(const ShadeFrame& f, const ShadeLanes& L, shade::Fragments
                                                     hn::Mul(hn::Set(df, 4.0f), hn::Mul(det, det))),
                                             zero))));
     const auto above = hn::Gt(major2, one);
-    const V lod = hn::Min(hn::Mul(half, sv::core::HWY_NAMESPACE::Log2Positive(df, hn::IfThenElse(above, major2, one))),
-                          hn::Set(df, 63.0f));
+    const V log2 = sv::core::HWY_NAMESPACE::Log2Positive(df, hn::IfThenElse(above, major2, one));
+    const V lod = hn::Min(hn::Mul(half, log2), hn::Set(df, 63.0f));
     hn::Store(hn::IfThenElseZero(above, lod), df, tc.lod + i);
   }
 }

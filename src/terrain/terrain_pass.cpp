@@ -411,7 +411,7 @@ ShadeFrame TerrainPass::shadeFrame(const Drawn& t, const Drape& drape) const {
 // Each pixel that met the ground, shaded once — at its first sample's hit — 16 to a call, and
 // written to every sample whose ray met the ground nearer than what the sample held. On the plane
 // without a detail texture, the per-pixel work in SIMD lanes (shadeLanes; on the bicubic table,
-// from the surface's slopes).
+// the normal from the 4×4 samples around the hit's cell).
 void TerrainPass::shadeHits(Scratch& w, const Drawn& t, const raster::TileTarget& tile) const {
   const Caster& c = *t.caster;
   const Drape drape(t);
@@ -464,7 +464,8 @@ void TerrainPass::shadeHits(Scratch& w, const Drawn& t, const raster::TileTarget
           in.cubic[i] = 1;
           if (ci >= 1 && cj >= 1 && ci + 2 < f.width && cj + 2 < f.height) {
             for (int r = 0; r < 4; ++r) {
-              const uint16_t* row = f.q.data() + size_t(cj - 1 + r) * size_t(f.width) + size_t(ci - 1);
+              const uint16_t* row =
+                  f.q.data() + size_t(cj - 1 + r) * size_t(f.width) + size_t(ci - 1);
               for (int q = 0; q < 4; ++q) in.patch[4 * r + q][i] = row[q];
             }
           } else {

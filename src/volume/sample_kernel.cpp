@@ -5,10 +5,13 @@
 // or by central differences) and its two-sided Phong weighting, in lanes.
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "volume/sample_kernel.cpp"
-#include <algorithm>
-
+// clang-format off: foreach_target.h first
 #include "hwy/foreach_target.h"  // IWYU pragma: keep
 #include "hwy/highway.h"
+// clang-format on
+
+#include <algorithm>
+
 #include "core/lane_math-inl.h"
 #include "volume/sample_kernel.h"
 
@@ -271,9 +274,8 @@ void ClassifySamples(const SampleSource& s, int count, SampleBatch& b) {
       const VF clear = hn::Sub(one, hn::Min(channel[3], one));
       const auto opaque = hn::Not(hn::Gt(clear, hn::Set(df, 1e-30f)));
       const VF left = sv::core::HWY_NAMESPACE::Exp2(
-          df, hn::Mul(hn::Set(df, b.exponent),
-                      sv::core::HWY_NAMESPACE::Log2Positive(
-                          df, hn::IfThenElse(opaque, one, clear))));
+          df, hn::Mul(hn::Set(df, b.exponent), sv::core::HWY_NAMESPACE::Log2Positive(
+                                                   df, hn::IfThenElse(opaque, one, clear))));
       hn::Store(hn::IfThenElse(opaque, one, hn::Sub(one, left)), df, b.w + i);
     }
     // Transparent samples are not composited: their colour is zero, and where the whole vector is

@@ -228,8 +228,7 @@ void VolumePass::setVolumes(const VolumeInput& input) {
     // The bordered codes: a byte each where every code fits, read for the value lit or not; 16-bit
     // ones only for the gradient of a lit volume.
     const auto& codes = v.grid->codes;
-    const bool bytes =
-        std::all_of(codes.begin(), codes.end(), [](uint16_t c) { return c < 256; });
+    const bool bytes = std::all_of(codes.begin(), codes.end(), [](uint16_t c) { return c < 256; });
     if (!input.settings.precomputedNormals && p.padded.empty() && p.padded8.empty()) {
       if (bytes)
         p.padded8 = borderedCodes<uint8_t>(*v.grid);
@@ -607,7 +606,9 @@ int64_t compositeConstant(double w, const double c[3], int64_t n, double firstMi
   bool ended = false;
   if (epsilon > 0 && pc.T * std::pow(a, double(n)) < epsilon) {
     // The first m ≥ 1 with T·a^m < ε (the logarithm's guess, made exact).
-    m = a <= 0 ? 1 : std::clamp<int64_t>(int64_t(std::ceil(std::log(epsilon / pc.T) / std::log(a))), 1, n);
+    m = a <= 0
+            ? 1
+            : std::clamp<int64_t>(int64_t(std::ceil(std::log(epsilon / pc.T) / std::log(a))), 1, n);
     while (m > 1 && pc.T * std::pow(a, double(m - 1)) < epsilon) --m;
     while (m < n && !(pc.T * std::pow(a, double(m)) < epsilon)) ++m;
     ended = true;
@@ -666,7 +667,7 @@ int64_t compositeConstant(double w, const double c[3], int64_t n, double firstMi
       const bool full = length[j] == ds;
       const double w =
           full && (p.source.stepOpacity || batch.exponent > 0) ? double(batch.w[j])
-          : opacity >= 1               ? 1.0
+          : opacity >= 1                                       ? 1.0
                          : 1 - std::pow(1 - double(opacity), length[j] * worldPerS / p.opacityUnit);
       double color[3] = {batch.r[j], batch.g[j], batch.b[j]};
       if (in.fogBeta > 0) {
@@ -727,8 +728,8 @@ int64_t compositeConstant(double w, const double c[3], int64_t n, double firstMi
             ++counts.samples;
             if (batch.opacity[0] > 0) {
               const double color[3] = {batch.r[0], batch.g[0], batch.b[0]};
-              const int64_t m = compositeConstant(batch.w[0], color, upTo - j + 1, middle, ds,
-                                                  worldPerS, in, pc);
+              const int64_t m =
+                  compositeConstant(batch.w[0], color, upTo - j + 1, middle, ds, worldPerS, in, pc);
               const int64_t steps = m < 0 ? -m : m;
               counts.closedForm += uint64_t(steps);
               pc.last = st.s0 + double(j + steps) * ds;
@@ -830,8 +831,8 @@ struct PixelCaster {
 // before their surfaces, and differ by at most `tolerance` in colour and transparency is a leaf,
 // any other is split in four (its edges' and centre's rays cast) down to windows without inner
 // pixels. Then each leaf's pixels not cast take the bilinear blend of its corners — where the
-// pixel's nearest surface lies beyond the corners' last samples (else its ray is cast). The tile alone decides (no ray of another tile is read): the same bits for any number
-// of threads.
+// pixel's nearest surface lies beyond the corners' last samples (else its ray is cast). The tile
+// alone decides (no ray of another tile is read): the same bits for any number of threads.
 void refineWindows(const PixelCaster& caster, int w, int h, float tolerance,
                    WindowScratch& scratch) {
   std::vector<WindowPixel>& window = scratch.window;
@@ -914,8 +915,8 @@ void refineWindows(const PixelCaster& caster, int w, int h, float tolerance,
         for (int ch = 0; ch < 3; ++ch)
           C[ch] = wa * double(a->C[ch]) + wb * double(b->C[ch]) + we * double(e->C[ch]) +
                   wf * double(f->C[ch]);
-        const double T = wa * double(a->T) + wb * double(b->T) + we * double(e->T) +
-                         wf * double(f->T);
+        const double T =
+            wa * double(a->T) + wb * double(b->T) + we * double(e->T) + wf * double(f->T);
         caster.write(x, y, C, T);
         p.state = WindowPixel::interpolated;
         ++caster.counts.interpolated;
@@ -941,8 +942,8 @@ void VolumePass::drawVolumes(const raster::TileTarget& tile) {
   VolumeList listed{};
   const int count = tileVolumes(volumes_, ox, oy, listed);
   if (count == 0) return;
-  const PixelCaster caster{tile,    r,     input_, samples_, listed, count,
-                           batches_[size_t(tile.worker)].batch, counts};
+  const PixelCaster caster{
+      tile, r, input_, samples_, listed, count, batches_[size_t(tile.worker)].batch, counts};
   const int w = std::min(kTileSize, r.width - ox), h = std::min(kTileSize, r.height - oy);
   if (input_.settings.windowTolerance > 0) {
     refineWindows(caster, w, h, input_.settings.windowTolerance, windows_[size_t(tile.worker)]);

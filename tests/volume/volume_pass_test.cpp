@@ -142,8 +142,8 @@ scene::Scene slabWithMesh(std::vector<Vec3> positions, std::vector<uint32_t> ind
 
 TEST(VolumePass, AnOpaquePolygonInsideTheVolumeCutsTheRaysAtItsDepth) {
   // A quad across the slab's middle, z = −15.
-  const scene::Scene s = slabWithMesh({{-2, -2, -15}, {2, -2, -15}, {2, 2, -15}, {-2, 2, -15}},
-                                      {0, 1, 2, 0, 2, 3});
+  const scene::Scene s =
+      slabWithMesh({{-2, -2, -15}, {2, -2, -15}, {2, 2, -15}, {-2, 2, -15}}, {0, 1, 2, 0, 2, 3});
   const Image img = render(s, options());
   const double front = std::pow(0.9, 5.0);  // the transparency of the 5 units before the quad
   const uint8_t* p = img.pixel(kW / 2, kH / 2);
@@ -298,8 +298,8 @@ TEST(VolumePass, AConstantBrickInClosedFormIsItsSamplesSum) {
   for (const float alpha : {0.02f, 0.3f, 0.9f})
     for (const bool fog : {false, true})
       for (const int samples : {1, 4}) {
-        scene::Scene s =
-            slabWithMesh({{-1, -1, -15}, {1, -1, -15}, {1, 1, -15}, {-1, 1, -15}}, {0, 1, 2, 0, 2, 3});
+        scene::Scene s = slabWithMesh({{-1, -1, -15}, {1, -1, -15}, {1, 1, -15}, {-1, 1, -15}},
+                                      {0, 1, 2, 0, 2, 3});
         s.volumes[0].transfer[0].opacity = alpha;
         if (fog) {
           s.fog.enabled = true, s.fog.beta = 0.08f, s.fog.color = {0.3f, 0.5f, 0.9f};
@@ -365,11 +365,15 @@ TEST(VolumePass, WindowRefinementCastsThePixelsWhoseSurfaceIsInsideTheVolume) {
   // row 49 alone, between the rows 48 and 52 of the windows' corners: windows whose corners all
   // miss it hold pixels on it. Both within the slab's middle, away from where its rays begin to
   // leave by its sides (beyond 5/20 of the focal length from the centre).
-  const scene::Scene s =
-      slabWithMesh({{-1.7f, 0.3f, -15}, {1.6f, 0.3f, -15}, {1.6f, 1.6f, -15}, {-1.7f, 1.6f, -15},
-                    {-1.4f, -0.48f, -13}, {1.4f, -0.48f, -13}, {1.4f, -0.33f, -13},
-                    {-1.4f, -0.33f, -13}},
-                   {0, 1, 2, 0, 2, 3, 4, 5, 6, 4, 6, 7});
+  const scene::Scene s = slabWithMesh({{-1.7f, 0.3f, -15},
+                                       {1.6f, 0.3f, -15},
+                                       {1.6f, 1.6f, -15},
+                                       {-1.7f, 1.6f, -15},
+                                       {-1.4f, -0.48f, -13},
+                                       {1.4f, -0.48f, -13},
+                                       {1.4f, -0.33f, -13},
+                                       {-1.4f, -0.33f, -13}},
+                                      {0, 1, 2, 0, 2, 3, 4, 5, 6, 4, 6, 7});
   RenderOptions loose = options();
   loose.volumeWindowTolerance = 1;
   FrameStats stats;
