@@ -146,6 +146,11 @@ struct TileWork {
   // the tile's buffers as they stand (PassStage surfaces and volumes: free forms, tile_pass.h), on
   // `worker`. `opaqueDone` is set when they have run (kept across batches by the caller).
   std::span<TilePass* const> afterOpaque;
+  // Scratch for TileTarget::translucentDepth (the tile's depth planes drawn again with its
+  // batch's translucent triangles alone, colour thrown away), laid out as depth and color; or
+  // nullptr, when no pass gets it.
+  float* translucentDepth = nullptr;
+  uint16_t* translucentColor = nullptr;
   int worker = 0;
   uint8_t* opaqueDone = nullptr;
   bool lastBatch = true;

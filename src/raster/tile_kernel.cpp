@@ -67,12 +67,67 @@ void clearTile(const TileWork& w) {
     std::memcpy(w.color + size_t(b) * kColorPerBlock, plane, sizeof(plane));
 }
 
-// The tile's opaque surfaces are all in: TileWork::afterOpaque's passes, once.
-void afterOpaque(const TileWork& w) {
+// The tile's context for the kernel's steps.
+TileContext makeTileContext(const TileWork& w, RasterStats& stats, bool deferred) {
+  return TileContext{
+      w.tileX * kTileSize,
+      w.tileY * kTileSize,
+      w.depth,
+      w.color,
+      &stats,
+      w.coverage,
+      w.coverage ? w.coverage->samples : 1,
+      w.environment,
+      deferred ? w.visible : nullptr,
+      w.setups,
+      w.attributes,
+      w.shade == ShadeMode::overdraw || w.masking == Masking::none ? nullptr : w.occupancy,
+      w.masking == Masking::hybrid};
+}
+
+// TileTarget::translucentDepth for the passes after the opaque surfaces, where one wants it: the
+// tile's depth planes copied to scratch and the batch's translucent triangles drawn into them
+// (depth-tested and written, colour thrown away) — the nearest translucent surface in front of
+// each sample's opaque one. nullptr where no pass wants it.
+template <bool kAA>
+const float* translucentDepth(const TileWork& w) {
+  if (!w.translucentDepth || !w.attributes) return nullptr;
+  bool wanted = false;
+  for (const TilePass* pass : w.afterOpaque) wanted |= pass->wantsTranslucentDepth(w.tileX, w.tileY);
+  if (!wanted) return nullptr;
+  const int samples = w.coverage ? w.coverage->samples : 1;
+  std::copy_n(w.depth, size_t(kTilePixels) * size_t(samples), w.translucentDepth);
+  RasterStats uncounted;  // (the triangles are counted when they are drawn)
+  TileContext ctx = makeTileContext(w, uncounted, false);
+  ctx.depth = w.translucentDepth;
+  ctx.color = w.translucentColor;
+  ctx.occupancy = nullptr;
+  for (int l = 0; l < w.listCount; ++l)
+    for (uint32_t i = 0; i < w.listSizes[l]; ++i) {
+      const uint32_t id = w.lists[l][i];
+      const shade::MaterialShading* m = w.attributes[id].material;
+      if (m && m->alpha == shade::AlphaUse::blend)
+        drawTriangle<PixelOp::gouraud, kAA>(w.setups[id], ctx);
+    }
+  return w.translucentDepth;
+}
+
+// The tile's opaque surfaces are all in: TileWork::afterOpaque's passes, once — before its first
+// translucent triangle (`beforeTranslucent`: with the translucent surfaces' depth, for the passes
+// that want it), or after its last triangle.
+template <bool kAA>
+void afterOpaque(const TileWork& w, bool beforeTranslucent) {
   if (w.afterOpaque.empty() || !w.opaqueDone || *w.opaqueDone) return;
   *w.opaqueDone = true;
-  const TileTarget target{w.tileX, w.tileY, w.depth, w.color, w.worker};
+  TileTarget target{w.tileX, w.tileY, w.depth, w.color, w.worker};
+  if (beforeTranslucent) target.translucentDepth = translucentDepth<kAA>(w);
   for (TilePass* pass : w.afterOpaque) pass->drawTile(target);
+}
+
+// The tile's last batch is drawn: the passes after the opaque surfaces over its translucent ones.
+void overTranslucent(const TileWork& w) {
+  const TileTarget target{w.tileX, w.tileY, w.depth, w.color, w.worker};
+  for (TilePass* pass : w.afterOpaque) pass->overTranslucent(target);
 }
 
 // Object-space culling with masking (TileWork::listObjects): the object last tested, and whether
@@ -120,24 +175,6 @@ HWY_INLINE void prefetchRecords(const TileWork& w, uint32_t ahead, bool wideReco
   }
 }
 
-// The tile's context for the kernel's steps.
-TileContext makeTileContext(const TileWork& w, RasterStats& stats, bool deferred) {
-  return TileContext{
-      w.tileX * kTileSize,
-      w.tileY * kTileSize,
-      w.depth,
-      w.color,
-      &stats,
-      w.coverage,
-      w.coverage ? w.coverage->samples : 1,
-      w.environment,
-      deferred ? w.visible : nullptr,
-      w.setups,
-      w.attributes,
-      w.shade == ShadeMode::overdraw || w.masking == Masking::none ? nullptr : w.occupancy,
-      w.masking == Masking::hybrid};
-}
-
 // One triangle of a pixel-shaded frame (ShadeMode::material): with a material, shaded per pixel —
 // deferred at one sample if opaque (its winning pixels recorded, and the triangle in `winners`);
 // else plain Gouraud. A translucent one first has the deferred pixels shaded and the passes after
@@ -164,7 +201,7 @@ HWY_INLINE void drawShadedTriangle(const TileWork& w, const TileContext& ctx,
   if (alpha == shade::AlphaUse::blend) {
     if (pending) shadeVisible(ctx);
     pending = false;
-    afterOpaque(w);
+    afterOpaque<kAA>(w, true);
   }
   if (a.material)
     drawTriangle<PixelOp::material, kAA>(t, use, &a, kNoTriangle, boxTested);
@@ -237,7 +274,10 @@ void drawLists(const TileWork& w, RasterStats& stats) {
   }
   if (pending) shadeVisible(ctx);
   hybrid.finish(w.lastBatch);
-  if (w.lastBatch) afterOpaque(w);
+  if (w.lastBatch) {
+    afterOpaque<kAA>(w, false);
+    overTranslucent(w);
+  }
 }
 
 void RasterizeTile(const TileWork& w, RasterStats& stats) {

@@ -47,6 +47,11 @@ struct TileTarget {
   float* depth = nullptr;
   uint16_t* color = nullptr;
   int worker = 0;
+  // For passes run before the tile's first translucent polygon, where one asked for it
+  // (TilePass::wantsTranslucentDepth): per sample, laid out as `depth`, the nearest translucent
+  // surface the tile's batch will blend in front of its opaque one — or that one's depth where
+  // none will (a sample has a translucent surface iff translucentDepth < depth). Else nullptr.
+  const float* translucentDepth = nullptr;
 };
 
 // The contract (docs/ARCHITECTURE.md): a pass may read and write the tile's depth and colour
@@ -68,6 +73,14 @@ class TilePass {
   virtual Status exchange() { return {}; }
   // Draws the pass into one tile, once per tile and frame, on worker `tile.worker`.
   virtual void drawTile(const TileTarget& tile) = 0;
+  // For passes of stage surfaces and volumes: whether drawTile of tile (tileX, tileY) wants
+  // TileTarget::translucentDepth — a pass that composites without occluding (volumes) splits its
+  // work there, so that translucent polygons take their place in depth among its samples.
+  virtual bool wantsTranslucentDepth(int /*tileX*/, int /*tileY*/) const { return false; }
+  // For passes of stage surfaces and volumes: once the tile's translucent polygons are all drawn
+  // (its last batch), on a worker of its own (its scratch), before the passes of stage lights —
+  // where a pass lays what it kept back in front of the translucent surfaces over them.
+  virtual void overTranslucent(const TileTarget& /*tile*/) {}
   // Once per frame, after every tile: adds what the pass did to the frame's statistics.
   virtual void addStats(FrameStats& stats) const = 0;
 };

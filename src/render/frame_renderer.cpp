@@ -68,6 +68,9 @@ struct FrameRenderer::Frame {
   // unless some triangle is translucent (never dropped by occupancy).
   bool boxes;
   bool masking, pixelShading;
+  // Some triangle is translucent and some pass runs after the opaque ones: such a pass may want
+  // the translucent surfaces' depth (raster::TileTarget::translucentDepth), drawn in scratch.
+  bool translucentDepth;
   // How much of each pixel-shading record binning stores: the second line only when some material
   // of the frame reads it (AttributeSetup) — the layout's attributes are all the frame's
   // materials read.
@@ -104,6 +107,14 @@ FrameRenderer::Frame FrameRenderer::frameOf(const DrawPackets& packets,
   }
   f.masking = settings.masking != raster::Masking::none;
   f.pixelShading = settings.shade == raster::ShadeMode::material;
+  f.translucentDepth =
+      f.pixelShading &&
+      std::any_of(packets.calls.begin(), packets.calls.end(),
+                  [](const DrawCall& c) {
+                    return c.material && c.material->alpha == shade::AlphaUse::blend;
+                  }) &&
+      std::any_of(settings.passes.begin(), settings.passes.end(),
+                  [](auto* p) { return p->stage() != raster::PassStage::lights; });
   f.recordBytes = raster::AttributeSetup::readsSecondLine(packets.attributeLayout.stored)
                       ? sizeof(raster::AttributeSetup)
                       : raster::AttributeSetup::kLineBytes;
@@ -127,6 +138,7 @@ void FrameRenderer::prepareBuffers(const DrawPackets& packets, const Frame& f) {
   for (WorkerScratch& w : scratch_) {
     w.records.resize(f.chunkSize);
     if (!f.wholeFrame) w.tile.resize(raster::kTileSize, raster::kTileSize, f.samples, f.sums);
+    if (f.translucentDepth) w.translucent.resize(raster::kTileSize, raster::kTileSize, f.samples);
     if (f.pixelShading && f.samples == 1) w.visible.assign(raster::kTilePixels, ~0u);
     if (f.masking && !f.wholeFrame && !w.occupancy)
       w.occupancy = std::make_unique<raster::Occupancy>();
@@ -349,6 +361,10 @@ void FrameRenderer::drawTile(const FrameSettings& settings, const Frame& f, cons
   }
   w.lastBatch = batch.last;
   w.afterOpaque = afterOpaque_;
+  if (f.translucentDepth) {
+    w.translucentDepth = scratch.translucent.tileDepth(0);
+    w.translucentColor = scratch.translucent.tileColor(0);
+  }
   w.worker = worker;
   w.opaqueDone = &opaqueDone_[size_t(tile)];
   raster::rasterizeTile(w, tileStats_[size_t(tile)]);

@@ -107,6 +107,7 @@ class FrameRenderer {
     std::vector<geometry::TriangleSetup> records;  // one chunk's, in submission order
     raster::Binner::Scratch bins;
     raster::FrameBuffer tile;       // 64×64: the tile being drawn, in frames of one batch
+    raster::FrameBuffer translucent;  // 64×64: raster::TileWork::translucentDepth's scratch
     std::vector<uint32_t> visible;  // 64×64 deferred-shading records (TileWork::visible)
     std::unique_ptr<raster::Occupancy> occupancy;  // the tile's, in frames of one batch
     std::vector<uint32_t> objects;  // with masking: the chunk's records' objects (TileWork)

@@ -144,7 +144,8 @@ inline void compositeOver(uint16_t& out, double C, double T) {
 }
 
 // One pixel's compositing: the running colour and transparency, and per sample of the pixel the
-// value they had when the ray reached that sample's depth.
+// value they had when the ray reached that sample's depth — and where a translucent surface lies
+// in front of some samples' opaque ones, the value at the nearest such surface (the split).
 struct PixelComposite {
   double C[3] = {0, 0, 0};
   double T = 1;
@@ -152,14 +153,27 @@ struct PixelComposite {
   double limit[64];   // per sample: its eye depth (the surface already there)
   bool done[64];
   double snapC[64][3], snapT[64];
+  uint64_t split = 0;       // the samples with a translucent surface in front of their opaque one
+  double splitAt = 1e300;   // the nearest of those translucent surfaces, as s
+  bool splitDone = true;
+  double splitC[3] = {0, 0, 0}, splitT = 1;
 
   double next = -1e300;  // no sample not yet recorded has its surface before this depth
   double last = 0;       // the end of the last sample composited (not transparent), as s
 
-  // Records the samples whose surface lies at or before eye depth s.
+  // Records the samples (and the split) whose surface lies at or before eye depth s.
   void reach(double s) {
     if (s < next) return;
     next = 1e300;
+    if (!splitDone) {
+      if (splitAt <= s) {
+        splitDone = true;
+        splitC[0] = C[0], splitC[1] = C[1], splitC[2] = C[2];
+        splitT = T;
+      } else {
+        next = splitAt;
+      }
+    }
     for (int k = 0; k < samples; ++k) {
       if (!done[k] && limit[k] <= s) {
         done[k] = true;
@@ -170,27 +184,49 @@ struct PixelComposite {
     }
   }
 
-  // Starts the composite of pixel (lx, ly) of `tile`, of s samples, each limited by its surface;
-  // returns the eye depth of the farthest of them (no ray goes beyond it).
+  // Starts the composite of pixel (lx, ly) of `tile`, of s samples, each limited by its surface
+  // and split at the translucent surfaces in front of them (tile.translucentDepth); returns the
+  // eye depth of the farthest sample (no ray goes beyond it).
   [[gnu::always_inline]] double start(const raster::TileTarget& tile, const EyeRays& r, int lx,
                                       int ly, int s) {
     samples = s;
     double farthest = 0;
     for (int k = 0; k < s; ++k) {
-      limit[k] = r.depthToS(tile.depth[FrameBuffer::depthOffset(lx, ly, s, k)]);
+      const size_t at = FrameBuffer::depthOffset(lx, ly, s, k);
+      limit[k] = r.depthToS(tile.depth[at]);
       done[k] = false;
       farthest = std::max(farthest, limit[k]);
+      if (tile.translucentDepth && tile.translucentDepth[at] < tile.depth[at]) {
+        split |= uint64_t(1) << k;
+        splitAt = std::min(splitAt, r.depthToS(tile.translucentDepth[at]));
+        splitDone = false;
+      }
     }
     return farthest;
   }
 
-  // Samples the rays did not reach take the whole composite; then each goes over its surface.
-  [[gnu::always_inline]] void writeOver(const raster::TileTarget& tile, int lx, int ly) {
+  // Samples the rays did not reach take the whole composite; then each goes over its surface —
+  // a split sample only the part behind the split (the part before it is laid over the
+  // translucent surfaces later: FrontPixel). A ray that turned opaque (its transparency below ε)
+  // at s = `opaqueAt` before a sample's surface hides it: the sample's depth becomes the ray's.
+  [[gnu::always_inline]] void writeOver(const raster::TileTarget& tile, const EyeRays& r, int lx,
+                                        int ly, double opaqueAt) {
     reach(1e300);
     for (int k = 0; k < samples; ++k) {
-      for (int c = 0; c < 3; ++c)
-        compositeOver(tile.color[FrameBuffer::colorOffset(lx, ly, c, samples, k)], snapC[k][c],
-                      snapT[k]);
+      double c[3] = {snapC[k][0], snapC[k][1], snapC[k][2]}, t = snapT[k];
+      if (split >> k & 1) {
+        // The part behind the split alone: (C − C_f)/T_f and T/T_f. Where T_f vanishes nothing
+        // behind shows (the front's T_f multiplies it), so none is composited.
+        if (!(splitT > 1e-9)) continue;
+        for (int ch = 0; ch < 3; ++ch) c[ch] = (c[ch] - splitC[ch]) / splitT;
+        t /= splitT;
+      }
+      for (int ch = 0; ch < 3; ++ch)
+        compositeOver(tile.color[FrameBuffer::colorOffset(lx, ly, ch, samples, k)], c[ch], t);
+      if (opaqueAt < limit[k]) {
+        float& depth = tile.depth[FrameBuffer::depthOffset(lx, ly, samples, k)];
+        depth = std::min(depth, r.sToDepth(opaqueAt));
+      }
     }
   }
 };
@@ -477,6 +513,8 @@ void VolumePass::prepare(const raster::PassFrame& frame) {
   counts_.assign(size_t(workers), WorkerCounts{});
   batches_.resize(size_t(workers));
   windows_.resize(size_t(workers));
+  tilesX_ = (frame.width + kTileSize - 1) / kTileSize;
+  fronts_.resize(size_t(tilesX_) * size_t((frame.height + kTileSize - 1) / kTileSize));
 }
 
 void VolumePass::addStats(FrameStats& stats) const {
@@ -741,18 +779,27 @@ int64_t compositeConstant(double w, const double c[3], int64_t n, double firstMi
             j = upTo + 1;
           }
         }
-        // Samples j … last, up to the stretch's end and the shell's exit.
-        for (; j <= last; ++j) {
-          const double a = st.s0 + double(j) * ds;
-          if (!(a < end) || a > st.to) break;
-          const bool full = a + ds <= end;
-          const double b = full ? a + ds : end, middle = 0.5 * (a + b);
+        // Samples j … last, up to the stretch's end and the shell's exit; the segment a split
+        // (a translucent surface) crosses is cut there, each part composited on its side.
+        auto sample = [&](double a, double b, bool full) {
+          const double middle = 0.5 * (a + b);
           start[pending] = a;
           length[pending] = full ? ds : b - a;
           batch.x[pending] = float(st.o[0] + middle * st.dir[0]);
           batch.y[pending] = float(st.o[1] + middle * st.dir[1]);
           batch.z[pending] = float(st.o[2] + middle * st.dir[2]);
-          if (++pending == kBatch && !flush()) return true;
+          return ++pending < kBatch || flush();
+        };
+        for (; j <= last; ++j) {
+          const double a = st.s0 + double(j) * ds;
+          if (!(a < end) || a > st.to) break;
+          const bool full = a + ds <= end;
+          const double b = full ? a + ds : end;
+          if (pc.split && a < pc.splitAt && pc.splitAt < b) {
+            if (!sample(a, pc.splitAt, false) || !sample(pc.splitAt, b, false)) return true;
+          } else if (!sample(a, b, full)) {
+            return true;
+          }
         }
       }
       i = last + 1;
@@ -774,6 +821,7 @@ struct PixelCaster {
   int count;
   SampleBatch& batch;
   VolumeCounts& counts;
+  std::vector<FrontPixel>* fronts;  // the tile's split pixels, with tile.translucentDepth
 
   WindowPixel cast(int lx, int ly) const {
     WindowPixel out;
@@ -789,23 +837,32 @@ struct PixelCaster {
     ++counts.rays;
     // Where the ray's composite ends of itself: its transparency below ε, or its last stretch's
     // end. Complete: every sample's surface lies beyond it (no surface cut the ray short).
-    double ended = 0;
+    double ended = 0, opaqueAt = 1e300;
     for (int v = 0; v < n; ++v) {
       const Stretch& st = stretches[size_t(v)];
       ended = std::max(ended, std::min(st.s1, st.to));
       if (castStretch(st, farthest, worldPerS, in, batch, pc, counts)) {
-        ended = pc.last;
+        ended = opaqueAt = pc.last;
+        out.opaque = true;
         break;
       }
     }
     out.met = true;
-    out.complete = true;
+    out.complete = pc.split == 0;
     for (int k = 0; k < samples; ++k) out.complete = out.complete && pc.limit[k] >= ended;
     for (int c = 0; c < 3; ++c) out.C[c] = float(pc.C[c]);
     out.T = float(pc.T);
     // Rounded up: a pixel blended must lie beyond it.
     out.last = std::nextafter(float(pc.last), 3.0e38f);
-    pc.writeOver(tile, lx, ly);
+    pc.writeOver(tile, r, lx, ly, opaqueAt);
+    if (pc.split && pc.splitT < 1) {
+      FrontPixel f;
+      f.pixel = uint16_t(ly * kTileSize + lx);
+      f.samples = pc.split;
+      for (int c = 0; c < 3; ++c) f.C[c] = float(pc.splitC[c]);
+      f.T = float(pc.splitT);
+      fronts->push_back(f);
+    }
     return out;
   }
 
@@ -817,11 +874,26 @@ struct PixelCaster {
     return s;
   }
 
-  // The composite (C, T) over every sample of the pixel.
-  void write(int lx, int ly, const double C[3], double T) const {
-    for (int k = 0; k < samples; ++k)
+  // Whether a translucent surface lies in front of one of the pixel's samples' opaque ones (its
+  // ray is split there: cast, never blended).
+  bool translucent(int lx, int ly) const {
+    if (!tile.translucentDepth) return false;
+    for (int k = 0; k < samples; ++k) {
+      const size_t at = FrameBuffer::depthOffset(lx, ly, samples, k);
+      if (tile.translucentDepth[at] < tile.depth[at]) return true;
+    }
+    return false;
+  }
+
+  // The composite (C, T) over every sample of the pixel; where it turned opaque at s = opaqueAt
+  // (every corner's ray did), the samples beyond take that depth (PixelComposite::writeOver).
+  void write(int lx, int ly, const double C[3], double T, double opaqueAt) const {
+    for (int k = 0; k < samples; ++k) {
       for (int c = 0; c < 3; ++c)
         compositeOver(tile.color[FrameBuffer::colorOffset(lx, ly, c, samples, k)], C[c], T);
+      float& depth = tile.depth[FrameBuffer::depthOffset(lx, ly, samples, k)];
+      if (opaqueAt < r.depthToS(depth)) depth = std::min(depth, r.sToDepth(opaqueAt));
+    }
   }
 };
 
@@ -904,7 +976,7 @@ void refineWindows(const PixelCaster& caster, int w, int h, float tolerance,
       for (int x = c.x0; x <= c.x1; ++x) {
         WindowPixel& p = at(x, y);
         if (p.state != WindowPixel::none) continue;
-        if (!(caster.nearest(x, y) > last)) {
+        if (!(caster.nearest(x, y) > last) || caster.translucent(x, y)) {
           p = caster.cast(x, y);
           continue;
         }
@@ -917,7 +989,8 @@ void refineWindows(const PixelCaster& caster, int w, int h, float tolerance,
                   wf * double(f->C[ch]);
         const double T =
             wa * double(a->T) + wb * double(b->T) + we * double(e->T) + wf * double(f->T);
-        caster.write(x, y, C, T);
+        const bool opaque = a->opaque && b->opaque && e->opaque && f->opaque;
+        caster.write(x, y, C, T, opaque ? last : 1e300);
         p.state = WindowPixel::interpolated;
         ++caster.counts.interpolated;
       }
@@ -934,16 +1007,23 @@ void VolumePass::drawTile(const raster::TileTarget& tile) {
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - begin).count();
 }
 
+bool VolumePass::wantsTranslucentDepth(int tileX, int tileY) const {
+  VolumeList listed;
+  return tileVolumes(volumes_, tileX * kTileSize, tileY * kTileSize, listed) > 0;
+}
+
 void VolumePass::drawVolumes(const raster::TileTarget& tile) {
   VolumeCounts& counts = counts_[size_t(tile.worker)].counts;
   const EyeRays& r = input_.rays;
   const int ox = tile.tileX * kTileSize, oy = tile.tileY * kTileSize;
+  std::vector<FrontPixel>& fronts = fronts_[size_t(tile.tileY * tilesX_ + tile.tileX)];
+  fronts.clear();
   // Step 1: the volumes this tile may show, by their screen bounds.
   VolumeList listed{};
   const int count = tileVolumes(volumes_, ox, oy, listed);
   if (count == 0) return;
-  const PixelCaster caster{
-      tile, r, input_, samples_, listed, count, batches_[size_t(tile.worker)].batch, counts};
+  const PixelCaster caster{tile,  r,     input_, samples_, listed, count, batches_[size_t(tile.worker)].batch,
+                           counts, &fronts};
   const int w = std::min(kTileSize, r.width - ox), h = std::min(kTileSize, r.height - oy);
   if (input_.settings.windowTolerance > 0) {
     refineWindows(caster, w, h, input_.settings.windowTolerance, windows_[size_t(tile.worker)]);
@@ -951,6 +1031,20 @@ void VolumePass::drawVolumes(const raster::TileTarget& tile) {
   }
   for (int ly = 0; ly < h; ++ly)
     for (int lx = 0; lx < w; ++lx) caster.cast(lx, ly);
+}
+
+// The split pixels' parts before the translucent surfaces, over what those surfaces left.
+void VolumePass::overTranslucent(const raster::TileTarget& tile) {
+  if (volumes_.empty()) return;
+  std::vector<FrontPixel>& fronts = fronts_[size_t(tile.tileY * tilesX_ + tile.tileX)];
+  for (const FrontPixel& f : fronts) {
+    const int lx = f.pixel % kTileSize, ly = f.pixel / kTileSize;
+    for (int k = 0; k < samples_; ++k)
+      if (f.samples >> k & 1)
+        for (int c = 0; c < 3; ++c)
+          compositeOver(tile.color[FrameBuffer::colorOffset(lx, ly, c, samples_, k)], f.C[c], f.T);
+  }
+  fronts.clear();
 }
 
 }  // namespace sv::volume

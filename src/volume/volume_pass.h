@@ -56,10 +56,21 @@ struct WindowPixel {
   enum State : uint8_t { none, cast, interpolated } state = none;
   bool met = false;       // its ray composited something of a volume
   bool complete = false;  // ... and ended before every one of its samples' surfaces
+  bool opaque = false;    // ... and ended by its transparency falling below ε
   // What the cast gave, kept in float (24 bytes a pixel: a tile's 4 096 reset per tile).
   float C[3] = {0, 0, 0}, T = 1;
   float last = 0;  // the end of its last sample composited, as s (eye depth)
 };
+// A pixel whose ray was split at the nearest translucent surface in front of its samples'
+// opaque ones (raster::TileTarget::translucentDepth): the part behind it composited over those
+// samples at once, the part before it (C, T) kept here until the tile's translucent polygons are
+// drawn, then laid over them (VolumePass::overTranslucent).
+struct FrontPixel {
+  uint16_t pixel = 0;    // in the tile: y·64 + x
+  uint64_t samples = 0;  // the samples split (bit k: sample k)
+  float C[3] = {0, 0, 0}, T = 1;
+};
+
 // A screen window of the refinement: pixels [x0, x1] × [y0, y1] of a tile, corners included.
 struct WindowRect {
   int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
@@ -80,6 +91,8 @@ class VolumePass final : public raster::TilePass {
   raster::PassStage stage() const override { return raster::PassStage::volumes; }
   void prepare(const raster::PassFrame& frame) override;
   void drawTile(const raster::TileTarget& tile) override;
+  bool wantsTranslucentDepth(int tileX, int tileY) const override;
+  void overTranslucent(const raster::TileTarget& tile) override;
   void addStats(FrameStats& stats) const override;
 
   // The edge of the cubes of grid cells the empty-region map is made of.
@@ -156,6 +169,8 @@ class VolumePass final : public raster::TilePass {
   };
   std::vector<WorkerBatch> batches_;  // per worker: its ray's samples waiting to be classified
   std::vector<WindowScratch> windows_;  // per worker
+  std::vector<std::vector<FrontPixel>> fronts_;  // per tile (y·tiles across + x): its split pixels
+  int tilesX_ = 0;
 };
 
 }  // namespace sv::volume

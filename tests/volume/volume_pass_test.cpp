@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -406,6 +408,85 @@ TEST(VolumePass, WindowRefinementCastsThePixelsWhoseSurfaceIsInsideTheVolume) {
         ASSERT_NEAR(img.pixel(x, y)[c], exact.pixel(x, y)[c], on ? 0 : 3) << x << ", " << y;
     }
   EXPECT_GT(onSurface, 40);
+}
+
+// The slab of opacity `alpha` a unit with a translucent quad (unlit, colour (0.2, 0.4, 0.6),
+// opacity 0.5) a unit wide across its axis at z.
+scene::Scene slabWithPane(float alpha, float z) {
+  scene::Scene s = slabWithMesh({{-0.5f, -0.5f, z}, {0.5f, -0.5f, z}, {0.5f, 0.5f, z}, {-0.5f, 0.5f, z}},
+                                {0, 1, 2, 0, 2, 3});
+  s.materials[0].baseColor.w = 0.5f;
+  s.materials[0].alphaMode = scene::AlphaMode::blend;
+  s.volumes[0] = slab(alpha);
+  return s;
+}
+
+// What the centre pixel should hold (linear, 0…1): the pane's depth order among the slab's
+// samples — the slab's part before it, the pane, the part behind it, over black.
+std::array<double, 3> paneExpected(float alpha, float z) {
+  const double pane[3] = {0.2, 0.4, 0.6}, slabColor[3] = {1, 0.5, 0.25};
+  const double before = std::clamp(-10.0 - double(z), 0.0, 10.0);  // units of the slab before it
+  const double tFront = std::pow(1 - double(alpha), before);
+  const double tBack = std::pow(1 - double(alpha), 10 - before);
+  std::array<double, 3> out;
+  for (int c = 0; c < 3; ++c) {
+    const double back = slabColor[c] * (1 - tBack);
+    out[size_t(c)] = slabColor[c] * (1 - tFront) + tFront * (0.5 * pane[c] + 0.5 * back);
+  }
+  return out;
+}
+
+TEST(VolumePass, TranslucentPolygonsTakeTheirPlaceInDepthAmongTheVolumesSamples) {
+  // Behind a nearly opaque slab (hidden), in front of a thin one (blended over it), inside it (the
+  // slab's part before it over it) — at 1 and 16 samples, with and without screen windows.
+  struct Case {
+    float alpha, z;
+    const char* what;
+  };
+  for (const Case c : {Case{0.9f, -30, "behind"}, Case{0.1f, -5, "in front"},
+                       Case{0.1f, -15, "inside"}, Case{0.1f, -12, "inside, nearer"}})
+    for (int samples : {1, 16})
+      for (float tolerance : {0.0f, 0.05f}) {
+        scene::Scene s = slabWithPane(c.alpha, c.z);
+        s.volumeSettings.windowTolerance = tolerance;
+        const Image img = render(s, options(samples));
+        const auto want = paneExpected(c.alpha, c.z);
+        const uint8_t* p = img.pixel(kW / 2, kH / 2);
+        for (int ch = 0; ch < 3; ++ch)
+          EXPECT_NEAR(p[ch], 255 * want[size_t(ch)], 1.5)
+              << c.what << ", " << samples << " samples, tolerance " << tolerance << ", channel " << ch;
+        // Beside the pane (it covers 5 pixels about the centre at most), the slab alone: 10 units
+        // along the axis, longer along the pixel's ray.
+        const double slant = std::hypot(8.5 / (kH / 2), 0.5 / (kH / 2), 1.0);
+        const double t = std::pow(1 - double(c.alpha), 10.0 * slant);
+        EXPECT_NEAR(img.pixel(kW / 2 + 8, kH / 2)[0], 255 * (1 - t), 1.5) << c.what;
+      }
+}
+
+TEST(VolumePass, APaneInsideTheVolumeGivesTheSameImageForAnyThreadCount) {
+  scene::Scene s = slabWithPane(0.1f, -15);
+  s.volumeSettings.windowTolerance = 0.05f;
+  for (int samples : {1, 16}) {
+    const Image one = render(s, options(samples, 1));
+    for (int threads : {2, 5}) EXPECT_EQ(render(s, options(samples, threads)).rgb, one.rgb);
+  }
+}
+
+TEST(VolumePass, AnOpaqueVolumeHidesALightPointBehindIt) {
+  // A light point behind a nearly opaque slab: the slab's rays turned opaque there and wrote
+  // their depth, which the light's visibility test meets.
+  scene::Scene s = emptyScene();
+  s.volumes.push_back(slab(0.9f));
+  s.lightAppearances.resize(1);
+  s.lightAppearances[0].intensity = 2000;
+  s.lightSettings.exposure = 1000;
+  s.lightPoints.push_back({{0, 0, -40}, 0, 0, -1});
+  const Image hidden = render(s, options());
+  s.volumes.clear();
+  const Image shown = render(s, options());
+  EXPECT_GT(shown.pixel(kW / 2, kH / 2)[2], 100);  // the light alone: bright
+  // Behind the slab: the slab's colour (its blue 0.25), the light's none of it.
+  EXPECT_NEAR(hidden.pixel(kW / 2, kH / 2)[2], 255 * 0.25, 1.5);
 }
 
 // A renderer keeps a volume's tables from frame to frame: a scene with another grid, or another
