@@ -14,6 +14,7 @@
 #include <string_view>
 #include <vector>
 
+#include "synthvis/free_forms.h"
 #include "synthvis/geodesy.h"
 #include "synthvis/height_field.h"
 #include "synthvis/light_points.h"
@@ -217,23 +218,6 @@ struct Dof {
 };
 // The motion matrix T·R·S of `m`.
 Mat4 dofMatrix(const DofMotion& m);
-
-// A free-form surface (SPEC §11; docs/scene-format.md "Free forms"): the quadric
-// F = Ax² + By² + Cz² + Dxy + Exz + Fyz + Gx + Hy + Iz + K (coefficients in this order; inside
-// F ≥ 0) plus, for each perturbation, weight·max(0, Q)³ with Q itself a free form.
-inline constexpr int kMaxFreeFormQuadrics = 256;  // per free-form object, perturbations included
-inline constexpr int kMaxFreeFormDepth = 16;      // nesting of perturbations
-inline constexpr size_t kMaxFreeFormObjects = 65536;
-
-struct FreeFormNode {
-  std::array<double, 10> quadric{};
-  double weight = 1;  // where this node perturbs its parent: R = weight·Q³
-  std::vector<FreeFormNode> perturbations;
-  // At the root only: the form is min(F', C_1, …) — cut to the insides of these plain quadrics
-  // (set-theoretic intersection, e.g. a cylinder capped by two planes).
-  std::vector<std::array<double, 10>> clips;
-  int quadricCount() const;  // this node's, its clips' and all its perturbations', recursively
-};
 
 // A free form placed in the world: rendered directly by multi-level ray casting (SPEC §12), never
 // tessellated, in the same depth and frame buffer as the polygons.

@@ -10,9 +10,11 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "synthvis/free_forms.h"
 #include "synthvis/math.h"
 
 namespace sv::scene {
@@ -91,6 +93,11 @@ struct VolumeObject {
   // transparent. Rays are cast only within it, on the same sample lattice, so a true shell changes
   // no pixel. Empty: the box alone.
   std::vector<std::array<double, 10>> shell;
+  // A free-form shell (seed 003 places volumes inside free forms): a perturbed quadric (R = w·Q³)
+  // with clips, in the volume's own space. It clips the volume: each ray is cast only within the
+  // pieces of it inside the form — entry and exit from the free forms' caster, the sample
+  // segments cut there. Unset: none.
+  std::optional<FreeFormNode> freeFormShell;
 };
 
 }  // namespace sv::scene

@@ -43,6 +43,13 @@ struct Mat4d {
   std::optional<Mat4d> inverse() const;
   // The point p (w = 1) mapped and divided by its w.
   Vec3d transformPoint(Vec3d p) const;
+  // A (column-major, float) Mat4 in double.
+  static Mat4d of(const Mat4& m) {
+    Mat4d d;
+    for (int r = 0; r < 4; ++r)
+      for (int c = 0; c < 4; ++c) d.m[size_t(r)][size_t(c)] = m.m[c][r];
+    return d;
+  }
 };
 
 // The projective map of space taking src[i] to dst[i] for i = 0…4 (SPEC §12: (C)(M^i) = r_i·(P^i),

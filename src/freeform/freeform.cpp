@@ -8,6 +8,15 @@
 
 namespace sv::freeform {
 
+FreeForm fromNode(const scene::FreeFormNode& n) {
+  FreeForm f;
+  f.base.c = n.quadric;
+  f.weight = n.weight;
+  for (const scene::FreeFormNode& p : n.perturbations) f.perturbations.push_back(fromNode(p));
+  for (const auto& c : n.clips) f.clips.push_back(Quadric{c});
+  return f;
+}
+
 // u⁻⁴ and u⁻⁵ over u > 0: the factors of a perturbation's term in the cube (freeform.h).
 struct InversePowers {
   Interval u4, u5;

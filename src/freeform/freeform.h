@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/quadric.h"
+#include "synthvis/free_forms.h"
 
 namespace sv::freeform {
 
@@ -34,6 +35,9 @@ struct FreeForm {
   Interval bound(Interval x, Interval y, Interval z) const;
   int quadricCount() const;  // base and every perturbation, recursively
 };
+
+// A free form as the scene records it (synthvis/free_forms.h), as this stage models it.
+FreeForm fromNode(const scene::FreeFormNode& node);
 
 // A free form carried into the cube by a projective map M (object → cube, e.g. projection · view
 // · model): every quadric becomes S' = M^{-T} S M^{-1} (SPEC §12). A projective map scales a

@@ -13,25 +13,6 @@
 #include "render/terrains.h"
 
 namespace sv::render {
-namespace {
-
-Mat4d toDouble(const Mat4& m) {  // column-major float → row-major double
-  Mat4d d;
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c) d.m[r][c] = m.m[c][r];
-  return d;
-}
-
-}  // namespace
-
-freeform::FreeForm toFreeForm(const scene::FreeFormNode& n) {
-  freeform::FreeForm f;
-  f.base.c = n.quadric;
-  f.weight = n.weight;
-  for (const scene::FreeFormNode& p : n.perturbations) f.perturbations.push_back(toFreeForm(p));
-  for (const auto& c : n.clips) f.clips.push_back(Quadric{c});
-  return f;
-}
 
 std::vector<freeform::ShadedForm> makeShadedForms(const scene::Scene& scene, const Mat4& view,
                                                   const Mat4& projection,
@@ -40,11 +21,11 @@ std::vector<freeform::ShadedForm> makeShadedForms(const scene::Scene& scene, con
   const bool lights = shading.environment.lightOn || !shading.environment.points.empty();
   for (const scene::FreeFormObject& object : scene.freeForms) {
     const scene::Material& mat = scene.materialAt(object.material);
-    const Mat4d toEye = toDouble(view * object.transform);
+    const Mat4d toEye = Mat4d::of(view * object.transform);
     const std::optional<Mat4d> eyeInverse = toEye.inverse();
-    const freeform::FreeForm form = toFreeForm(object.form);
+    const freeform::FreeForm form = freeform::fromNode(object.form);
     std::optional<freeform::ProjectedFreeForm> projected =
-        freeform::ProjectedFreeForm::make(form, toDouble(projection) * toEye);
+        freeform::ProjectedFreeForm::make(form, Mat4d::of(projection) * toEye);
     if (!eyeInverse || !projected) continue;  // a singular placement shows nothing
     freeform::ShadedForm s{form, std::move(*projected), toEye, eyeInverse->transposed(), {}, {},
                            {}};
@@ -90,7 +71,7 @@ Result<scene::Scene> tessellatedScene(const scene::Scene& scene, const RenderOpt
     const scene::FreeFormObject& object = scene.freeForms[i];
     const std::string label = object.name.empty() ? fmt::format("freeForms[{}]", i)
                                                   : fmt::format("free form '{}'", object.name);
-    const freeform::FreeForm form = render::toFreeForm(object.form);
+    const freeform::FreeForm form = freeform::fromNode(object.form);
     bool unbounded = false;
     const std::optional<freeform::Box> box = freeform::surfaceBounds(form, 1e4, 16, unbounded);
     if (unbounded)

@@ -10,9 +10,6 @@
 
 namespace sv::render {
 
-// The scene's free-form tree as the free-form stage models it.
-freeform::FreeForm toFreeForm(const scene::FreeFormNode& node);
-
 // The frame's free forms for the pass: each carried into the cube by projection · view · model
 // (SPEC §12), lit per pixel with its material's colour and specular term (Phong whenever the scene
 // has lights and the material is lit: the normal is exact at every pixel), both sides lit. A

@@ -24,12 +24,6 @@ std::array<Vec3, 2> Mesh::bounds() const {
   return {lo, hi};
 }
 
-int FreeFormNode::quadricCount() const {
-  int n = 1 + int(clips.size());
-  for (const FreeFormNode& p : perturbations) n += p.quadricCount();
-  return n;
-}
-
 const Material& Scene::materialAt(int index) const {
   static const Material defaultMaterial;
   return index >= 0 ? materials[size_t(index)] : defaultMaterial;
@@ -85,6 +79,31 @@ namespace {
 
 bool inRange(float v, float lo, float hi) { return v >= lo && v <= hi; }
 
+// A free form's own invariants (FreeFormNode): its size, finite coefficients and weights, clips
+// at its root alone. `label` names it in the message.
+Status validateForm(const FreeFormNode& form, const std::string& label) {
+  auto fail = [](std::string message) { return Status(Error{"", "", std::move(message)}); };
+  if (form.quadricCount() > kMaxFreeFormQuadrics)
+    return fail(fmt::format("{}: {} quadrics (at most {})", label, form.quadricCount(),
+                            kMaxFreeFormQuadrics));
+  std::vector<const FreeFormNode*> stack{&form};
+  while (!stack.empty()) {
+    const FreeFormNode* n = stack.back();
+    stack.pop_back();
+    bool finite = true;
+    for (double c : n->quadric) finite &= std::fabs(c) <= 1e30;
+    for (const auto& clip : n->clips)
+      for (double c : clip) finite &= std::fabs(c) <= 1e30;
+    if (!finite)
+      return fail(fmt::format("{}: a quadric coefficient is not finite (or over 1e30)", label));
+    if (n != &form && !n->clips.empty())
+      return fail(fmt::format("{}: clips belong to the root of a free form", label));
+    if (!(std::fabs(n->weight) <= 1e30)) return fail(fmt::format("{}: a weight is not finite", label));
+    for (const FreeFormNode& p : n->perturbations) stack.push_back(&p);
+  }
+  return {};
+}
+
 // The volumes' invariants (synthvis/volumes.h): a grid of the size it says, within the limits,
 // finite positive spacing and scale; a finite affine invertible transform; a transfer function of
 // 1 … 256 points, values increasing, colours finite and non-negative, opacities in [0, 1].
@@ -133,6 +152,9 @@ Status validateVolumes(const Scene& scene) {
     for (const auto& q : v.shell)
       for (double c : q)
         if (!std::isfinite(c) || std::fabs(c) > 1e30) return fail(i, v.name, "a shell coefficient is not finite");
+    if (v.freeFormShell)
+      if (Status st = validateForm(*v.freeFormShell, fmt::format("volume '{}': shell", v.name)); !st)
+        return st;
   }
   const VolumeSettings& s = scene.volumeSettings;
   if (!inRange(s.step, 0.05f, 8) || !inRange(s.termination, 0, 0.5f))
@@ -346,25 +368,7 @@ Status validateFreeForms(const Scene& scene) {
       return fail(fmt::format("{}: transform is not affine (last row must be 0, 0, 0, 1)", label));
     if (!(std::fabs(linearDeterminant(f.transform)) > 1e-20))
       return fail(fmt::format("{}: transform is singular", label));
-    if (f.form.quadricCount() > kMaxFreeFormQuadrics)
-      return fail(fmt::format("{}: {} quadrics (at most {})", label, f.form.quadricCount(),
-                              kMaxFreeFormQuadrics));
-    std::vector<const FreeFormNode*> stack{&f.form};
-    while (!stack.empty()) {
-      const FreeFormNode* n = stack.back();
-      stack.pop_back();
-      bool finite = true;
-      for (double c : n->quadric) finite &= std::fabs(c) <= 1e30;
-      for (const auto& clip : n->clips)
-        for (double c : clip) finite &= std::fabs(c) <= 1e30;
-      if (!finite)
-        return fail(fmt::format("{}: a quadric coefficient is not finite (or over 1e30)", label));
-      if (n != &f.form && !n->clips.empty())
-        return fail(fmt::format("{}: clips belong to the root of a free form", label));
-      if (!(std::fabs(n->weight) <= 1e30))
-        return fail(fmt::format("{}: a weight is not finite", label));
-      for (const FreeFormNode& p : n->perturbations) stack.push_back(&p);
-    }
+    if (Status st = validateForm(f.form, label); !st) return st;
   }
   return {};
 }

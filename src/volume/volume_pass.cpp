@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "core/check.h"
+#include "freeform/raycast.h"
 #include "raster/framebuffer.h"
 #include "volume/sample_kernel.h"
 
@@ -273,6 +274,10 @@ void VolumePass::setVolumes(const VolumeInput& input) {
     }
     if (input.settings.precomputedNormals) p.padded.clear(), p.padded8.clear();
     if (!v.shaded) p.padded.clear();
+    p.shellForm.reset();
+    if (v.freeFormShell)
+      p.shellForm = freeform::ProjectedFreeForm::make(
+          freeform::fromNode(*v.freeFormShell), Mat4d::of(input.viewProjection) * Mat4d::of(v.transform));
     // World → own: the inverse of the affine transform, in double (validateVolumes has refused a
     // singular one).
     const bool invertible = affineInverse(v.transform, p.toOwn);
@@ -547,22 +552,69 @@ int tileVolumes(const std::vector<Prepared>& volumes, int ox, int oy, VolumeList
 }
 
 // A volume's stretch of one pixel's ray o + s·dir (its own space). s0, s1: the box's (the sample
-// lattice starts at s0); from, to: within the shell and the window's depths.
+// lattice starts at s0); from, to: within the shell and the window's depths. `exact`: [from, to]
+// is a piece of a free-form shell, which clips — the sample segments are cut there (a quadric
+// shell's stretch only bounds the samples: the segments holding its ends are taken whole).
 struct Stretch {
   const Prepared* p;
   double s0, s1, o[3], dir[3], from, to;
+  bool exact = false;
 };
 using StretchList = std::array<Stretch, 64>;
+
+// The pieces of pixel (px, py)'s ray inside a free-form shell between eye depths from and to, as
+// eye depths, into `pieces` (at most 8: the eighth reaches to `to`): the ray's crossings of
+// the form one after another from the free forms' caster (freeform/raycast.h castRay), its
+// inside at `from` from the form's sign there. Their number.
+int shellPieces(const freeform::ProjectedFreeForm& form, const EyeRays& r, int px, int py,
+                double from, double to, freeform::RayFunction& ray, freeform::RayFunction& scratch,
+                double pieces[8][2]) {
+  const double x = freeform::cubeX(px, r.width, 0), y = freeform::cubeY(py, r.height, 0);
+  form.ray(x, y, ray);
+  const double z0 = std::max(-1.0, ray.cubeDepth(from)), z1 = std::min(1.0, ray.cubeDepth(to));
+  if (!(z0 < z1)) return 0;
+  bool in = ray.evaluate(z0) >= 0;
+  double z = z0, enter = z0;
+  int n = 0;
+  freeform::CastStats stats;
+  while (true) {
+    float depth = float(0.5 * (z1 + 1));  // window depth: crossings nearer than z1
+    uint32_t object = freeform::kNoHit;
+    double hit = 0;
+    freeform::castRay(form, 0, x, y, z, std::nan(""), depth, object, hit, scratch, stats);
+    if (object == freeform::kNoHit || !(hit < z1)) {
+      if (in) pieces[n][0] = enter, pieces[n][1] = z1, ++n;
+      break;
+    }
+    if (in) {
+      if (n == 7) {  // the eighth piece reaches to the end
+        pieces[n][0] = enter, pieces[n][1] = z1, ++n;
+        break;
+      }
+      pieces[n][0] = enter, pieces[n][1] = hit, ++n;
+    } else {
+      enter = hit;
+    }
+    in = !in;
+    z = hit + 1e-9;  // beyond the root (refined to 1e-10 of cube depth)
+  }
+  for (int k = 0; k < n; ++k)
+    pieces[k][0] = ray.eyeDepth(pieces[k][0]), pieces[k][1] = ray.eyeDepth(pieces[k][1]);
+  return n;
+}
 
 // The stretches of the ray of pixel (px, py), world direction d, through the listed volumes
 // that can show there, nearest entry first; their number.
 [[gnu::always_inline]] inline int rayStretches(const VolumeList& listed, int count,
                                                const EyeRays& r, int px, int py, const Vec3d& d,
-                                               StretchList& stretches) {
+                                               StretchList& stretches,
+                                               freeform::RayFunction& shellRay,
+                                               freeform::RayFunction& castRay) {
   int n = 0;
   for (int v = 0; v < count; ++v) {
     const Prepared& p = *listed[size_t(v)];
     if (px < p.x0 || px >= p.x1 || py < p.y0 || py >= p.y1) continue;
+    if (p.object->freeFormShell && !p.shellForm) continue;  // a singular placement: nothing
     // The window's depth interval (windowDepths); empty where no brick with content shows.
     const size_t w = p.windowNear.empty() ? 0
                                           : size_t(py / VolumePass::kWindow) * size_t(p.windowsX) +
@@ -583,10 +635,23 @@ using StretchList = std::array<Stretch, 64>;
       if (!(st.from < st.to)) continue;
     }
     for (const auto& q : p.object->shell) clipToQuadric(q, st.o, st.dir, st.from, st.to);
-    if (st.s0 < st.s1 && st.from < st.to) stretches[size_t(n++)] = st;
+    if (!(st.s0 < st.s1 && st.from < st.to)) continue;
+    if (!p.shellForm) {
+      stretches[size_t(n++)] = st;
+      continue;
+    }
+    double pieces[8][2];
+    const int k = shellPieces(*p.shellForm, r, px, py, st.from, st.to, shellRay, castRay, pieces);
+    for (int i = 0; i < k && n < 64; ++i) {
+      Stretch piece = st;
+      piece.from = std::max(st.from, pieces[i][0]);
+      piece.to = std::min(st.to, pieces[i][1]);
+      piece.exact = true;
+      if (piece.from < piece.to) stretches[size_t(n++)] = piece;
+    }
   }
-  std::sort(stretches.begin(), stretches.begin() + n,
-            [](const Stretch& a, const Stretch& b) { return a.s0 < b.s0; });
+  std::stable_sort(stretches.begin(), stretches.begin() + n,
+                   [](const Stretch& a, const Stretch& b) { return a.s0 < b.s0; });
   return n;
 }
 
@@ -748,12 +813,14 @@ int64_t compositeConstant(double w, const double c[3], int64_t n, double firstMi
         counts.skipped += uint64_t(last - i + 1);
       } else {
         int64_t j = i;
-        if (in.settings.closedForm && p.constantBrick[walk.index(p)]) {
+        if (in.settings.closedForm && p.constantBrick[walk.index(p)] &&
+            (!st.exact || st.s0 + double(j) * ds >= st.from)) {
           // The brick's full steps within the stretch's end and the shell's exit, in closed form
           // — where no sample of the pixel has its surface among them.
+          const double stop = st.exact ? std::min(end, st.to) : end;
           int64_t upTo = last;
           while (upTo >= j &&
-                 (st.s0 + double(upTo) * ds + ds > end || st.s0 + double(upTo) * ds > st.to))
+                 (st.s0 + double(upTo) * ds + ds > stop || st.s0 + double(upTo) * ds > st.to))
             --upTo;
           pc.reach(st.s0 + double(j) * ds);
           if (upTo > j && pc.next > st.s0 + double(upTo) * ds) {
@@ -791,10 +858,16 @@ int64_t compositeConstant(double w, const double c[3], int64_t n, double firstMi
           return ++pending < kBatch || flush();
         };
         for (; j <= last; ++j) {
-          const double a = st.s0 + double(j) * ds;
+          double a = st.s0 + double(j) * ds;
           if (!(a < end) || a > st.to) break;
-          const bool full = a + ds <= end;
-          const double b = full ? a + ds : end;
+          bool full = a + ds <= end;
+          double b = full ? a + ds : end;
+          if (st.exact) {  // a free-form shell's piece: the segment cut to it
+            if (!(a < st.to)) break;
+            full = full && a >= st.from && b <= st.to;
+            a = std::max(a, st.from), b = std::min(b, st.to);
+            if (!(a < b)) continue;
+          }
           if (pc.split && a < pc.splitAt && pc.splitAt < b) {
             if (!sample(a, pc.splitAt, false) || !sample(pc.splitAt, b, false)) return true;
           } else if (!sample(a, b, full)) {
@@ -820,6 +893,7 @@ struct PixelCaster {
   const VolumeList& listed;
   int count;
   SampleBatch& batch;
+  freeform::RayFunction &shellRay, &castRay;  // scratch for free-form shells
   VolumeCounts& counts;
   std::vector<FrontPixel>* fronts;  // the tile's split pixels, with tile.translucentDepth
 
@@ -830,7 +904,7 @@ struct PixelCaster {
     const Vec3d d = r.direction(px + 0.5, py + 0.5);
     const double worldPerS = std::sqrt(dot(d, d));
     StretchList stretches;
-    const int n = rayStretches(listed, count, r, px, py, d, stretches);
+    const int n = rayStretches(listed, count, r, px, py, d, stretches, shellRay, castRay);
     if (n == 0) return out;
     PixelComposite pc;
     const double farthest = pc.start(tile, r, lx, ly, samples);
@@ -1022,8 +1096,9 @@ void VolumePass::drawVolumes(const raster::TileTarget& tile) {
   VolumeList listed{};
   const int count = tileVolumes(volumes_, ox, oy, listed);
   if (count == 0) return;
-  const PixelCaster caster{tile,  r,     input_, samples_, listed, count, batches_[size_t(tile.worker)].batch,
-                           counts, &fronts};
+  WorkerBatch& scratch = batches_[size_t(tile.worker)];
+  const PixelCaster caster{tile,           r,      input_, samples_, listed, count, scratch.batch,
+                           scratch.shellRay, scratch.castRay, counts, &fronts};
   const int w = std::min(kTileSize, r.width - ox), h = std::min(kTileSize, r.height - oy);
   if (input_.settings.windowTolerance > 0) {
     refineWindows(caster, w, h, input_.settings.windowTolerance, windows_[size_t(tile.worker)]);

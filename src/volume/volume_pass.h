@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "core/eye_rays.h"
+#include "freeform/freeform.h"
 #include "raster/tile_pass.h"
 #include "synthvis/volumes.h"
 #include "volume/sample_kernel.h"
@@ -134,6 +135,10 @@ class VolumePass final : public raster::TilePass {
     // The same a byte a sample, instead, where every code fits — lit or not (the value's reads
     // too); empty with precomputed normals.
     std::vector<uint8_t> padded8;
+    // The free-form shell (VolumeObject::freeFormShell) carried into the view's cube (SPEC §12)
+    // this frame: the rays' pieces inside it from the free forms' caster. Unset: none, or its
+    // placement singular (then the volume shows nothing).
+    std::optional<freeform::ProjectedFreeForm> shellForm;
     int bricks[3] = {};
     std::vector<uint8_t> emptyBrick;  // per brick (x fastest): every sample it holds transparent
     // Per brick: not empty, and every code within two samples of it the same (its samples'
@@ -166,6 +171,7 @@ class VolumePass final : public raster::TilePass {
   std::vector<WorkerCounts> counts_;
   struct WorkerBatch {
     SampleBatch batch;
+    freeform::RayFunction shellRay, castRay;  // a free-form shell's, along a pixel's ray
   };
   std::vector<WorkerBatch> batches_;  // per worker: its ray's samples waiting to be classified
   std::vector<WindowScratch> windows_;  // per worker

@@ -176,8 +176,22 @@ TEST(JsonScene, ReadsVolumes) {
                        "values must increase"));
   EXPECT_TRUE(contains(error(R"({"file": "x.nii", "transfer": [{"value": 0}]})"), "x.nii"));
   EXPECT_TRUE(contains(error(R"({"generate": {"kind": "cloud"}, "transfer": [{"value": 0}],
-      "shell": {"quadric": "sphere", "perturbations": [{"quadric": "sphere"}]}})"),
-                       "not perturbed"));
+      "shell": {"quadric": "sphere", "perturbations": [{"quadric": "sphere", "weight": "x"}]}})"),
+                       "weight"));
+}
+
+// A perturbed shell is the volume's free-form shell (it clips; a plain one bounds).
+TEST(JsonScene, ReadsAFreeFormShell) {
+  Result<Scene> r = parse(R"({"synthvis": 1, "volumes": {"objects": [{"generate": {"kind":
+      "cloud", "size": 16}, "transfer": [{"value": 0, "opacity": 0.1}], "shell": {"quadric":
+      "sphere", "radius": 0.5, "perturbations": [{"quadric": "sphere", "center": [0.5, 0, 0],
+      "radius": 0.2, "weight": -2}]}}]}})");
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  const VolumeObject& v = r->volumes[0];
+  EXPECT_TRUE(v.shell.empty());
+  ASSERT_TRUE(v.freeFormShell.has_value());
+  ASSERT_EQ(v.freeFormShell->perturbations.size(), 1u);
+  EXPECT_EQ(v.freeFormShell->perturbations[0].weight, -2);
 }
 
 TEST(JsonScene, ReadsACameraList) {

@@ -15,6 +15,7 @@
 #include <memory>
 #include <string>
 
+#include "freeform/freeform.h"
 #include "synthvis/formats.h"
 #include "synthvis/generators.h"
 #include "synthvis/image.h"
@@ -408,6 +409,61 @@ TEST(VolumePass, WindowRefinementCastsThePixelsWhoseSurfaceIsInsideTheVolume) {
         ASSERT_NEAR(img.pixel(x, y)[c], exact.pixel(x, y)[c], on ? 0 : 3) << x << ", " << y;
     }
   EXPECT_GT(onSurface, 40);
+}
+
+// The slab (opacity 0.1 a unit) clipped by a free-form shell in its own space: a sphere of radius
+// 4 about its centre with a bump (R = 1·Q³, Q a sphere of radius 1.5 on its near pole) — the
+// composite of each ray over the length of it inside the form, as a fine march of the form
+// along the ray measures it.
+TEST(VolumePass, AFreeFormShellClipsTheVolumeWhereTheCasterSays) {
+  scene::Scene s = emptyScene();
+  s.volumes.push_back(slab(0.1f));
+  scene::FreeFormNode shell;
+  shell.quadric = {-1, -1, -1, 0, 0, 0, 10, 10, 10, 16 - 75};  // 16 − |p − (5, 5, 5)|²
+  scene::FreeFormNode bump;
+  bump.quadric = {-1, -1, -1, 0, 0, 0, 10, 10, 18, 2.25 - 25 - 25 - 81};  // 2.25 − |p − (5, 5, 9)|²
+  shell.perturbations.push_back(bump);
+  s.volumes[0].freeFormShell = shell;
+  const freeform::FreeForm form = freeform::fromNode(shell);
+  for (int samples : {1, 4}) {
+    const Image img = render(s, options(samples));
+    int inside = 0;
+    double centre = 0;
+    for (const int px : {60, 61, 63, 66, 70, 74})
+      for (const int py : {48, 45}) {
+        // The pixel centre's ray, eye depth t: t·(x, y, −1) in the world, own = world + (5, 5, 20).
+        const double x = (2 * (px + 0.5) / kW - 1) * kW / kH, y = 1 - 2 * (py + 0.5) / kH;
+        const double length = std::sqrt(x * x + y * y + 1);
+        double in = 0;
+        const double dt = 1e-4;
+        for (double t = 10; t < 20; t += dt) {
+          const Vec3d p{t * x + 5, t * y + 5, -t + 20};
+          if (p.x >= 0 && p.x <= 10 && p.y >= 0 && p.y <= 10 && form.evaluate(p) >= 0)
+            in += dt * length;
+        }
+        inside += in > 0;
+        if (px == 60 && py == 48) centre = in;
+        const double want = 255 * (1 - std::pow(0.9, in));
+        EXPECT_NEAR(img.pixel(px, py)[0], want, 1.5) << px << ", " << py << ": " << in << " units";
+      }
+    EXPECT_GE(inside, 8);  // most rays meet the form
+    EXPECT_GT(centre, 8.5);  // the sphere's chord (8) and the bump's
+  }
+}
+
+TEST(VolumePass, AFreeFormShellGivesTheSameImageForAnyThreadCount) {
+  scene::Scene s = emptyScene();
+  s.volumes.push_back(slab(0.1f));
+  scene::FreeFormNode shell;
+  shell.quadric = {-1, -1, -1, 0, 0, 0, 10, 10, 10, 16 - 75};
+  scene::FreeFormNode dent;
+  dent.quadric = {-1, -1, -1, 0, 0, 0, 14, 10, 18, 4 - 49 - 25 - 81};
+  dent.weight = -1;
+  shell.perturbations.push_back(dent);
+  s.volumes[0].freeFormShell = shell;
+  s.volumeSettings.windowTolerance = 0.05f;
+  const Image one = render(s, options(1, 1));
+  for (int threads : {2, 5}) EXPECT_EQ(render(s, options(1, threads)).rgb, one.rgb);
 }
 
 // The slab of opacity `alpha` a unit with a translucent quad (unlit, colour (0.2, 0.4, 0.6),

@@ -111,14 +111,17 @@ void SceneReader::readVolumes(const Json& v, const std::string& where) {
       vo.opacityUnit = inRange(*x, member(wo, "opacityUnit"), 0, 1e30f);
     if (const Json* x = find(o, "shaded")) vo.shaded = boolean(*x, member(wo, "shaded"));
     if (const Json* x = find(o, "shell")) {
-      // A free form's quadric with its clips, in the volume's own space; no perturbations.
+      // A free form in the volume's own space: a quadric with clips bounds the rays (the box's
+      // samples outside it promised transparent); a perturbed one clips the volume exactly.
       int quadrics = 0;
-      const FreeFormNode shell = readFreeForm(*x, member(wo, "shell"), 0, quadrics, true);
-      if (!shell.perturbations.empty())
-        fail(member(wo, "shell"), "a shell is a quadric with clips, not perturbed");
-      if (shell.clips.size() > 15) fail(member(wo, "shell"), "at most 15 clips");
-      vo.shell.push_back(shell.quadric);
-      vo.shell.insert(vo.shell.end(), shell.clips.begin(), shell.clips.end());
+      FreeFormNode shell = readFreeForm(*x, member(wo, "shell"), 0, quadrics, true);
+      if (!shell.perturbations.empty()) {
+        vo.freeFormShell = std::move(shell);
+      } else {
+        if (shell.clips.size() > 15) fail(member(wo, "shell"), "at most 15 clips");
+        vo.shell.push_back(shell.quadric);
+        vo.shell.insert(vo.shell.end(), shell.clips.begin(), shell.clips.end());
+      }
     }
     scene_.volumes.push_back(std::move(vo));
   }
