@@ -84,7 +84,8 @@ std::vector<HashCase> hashCases() {
         "scenes/grazing-plane.json", "scenes/freeform-mixed.json", "scenes/freeform-sculpture.json",
         "scenes/crate.gltf", "scenes/pyramid.gltf", "scenes/house.obj",
         "scenes/terrain-olinda.json", "scenes/airport.json", "scenes/powerlines.json",
-        "scenes/volume-ml.json", "scenes/mri-head.json"})
+        "scenes/volume-ml.json", "scenes/mri-head.json", "scenes/volume-panes.json",
+        "scenes/cloud-shell.json"})
     both(*file ? file : "demo", fileCase(file), none);
   both("tris", generatorCase("tris"), none);
   both("tris-textured", generatorCase("tris"), none, true);
