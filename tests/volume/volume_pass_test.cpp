@@ -674,5 +674,36 @@ TEST(VolumeQuality, MarschnerLobbAgainstItsAnalyticReference) {
   EXPECT_GT(classic.rms, 10.0);  // 41³ cannot draw the ripples the reference does
 }
 
+// The level-of-detail cast (screen windows, VolumeSettings::windowTolerance 0.05) against the
+// exact cast — every pixel's ray — at 256²: BENCH.md's volume (128³ here, translucent, shaded) and
+// the MRI head of scenes/mri-head.json, each at least 40 dB in linear light (docs/quality.md,
+// "Volumes": the full-size figures).
+TEST(VolumeQuality, ScreenWindowsWithin40DecibelsOfTheExactCast) {
+  generators::VolumeParams params;
+  params.size = 128;
+  auto head = formats::loadScene(std::string(SV_SOURCE_DIR) + "/scenes/mri-head.json");
+  ASSERT_TRUE(head.ok()) << head.error().str();
+  for (const scene::Scene& s : {generators::generateVolume(params), head.value()}) {
+    RenderOptions o;
+    o.width = o.height = 256;
+    o.threads = 2;
+    o.gamma = 1;
+    o.volumeWindowTolerance = 0;
+    FrameStats all, fewer;
+    Image exact, windows;
+    ASSERT_TRUE(Renderer(o).render(s, exact, &all).ok());
+    o.volumeWindowTolerance = 0.05f;
+    ASSERT_TRUE(Renderer(o).render(s, windows, &fewer).ok());
+    double sum = 0;
+    for (size_t i = 0; i < exact.rgb.size(); ++i) {
+      const double d = (double(exact.rgb[i]) - double(windows.rgb[i])) / 255;
+      sum += d * d;
+    }
+    const double psnr = 10 * std::log10(double(exact.rgb.size()) / std::max(sum, 1e-12));
+    EXPECT_GE(psnr, 40.0) << s.volumes[0].name;
+    EXPECT_LT(fewer.volumeRays, all.volumeRays * 3 / 4) << s.volumes[0].name;
+  }
+}
+
 }  // namespace
 }  // namespace sv
