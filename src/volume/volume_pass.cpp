@@ -558,7 +558,7 @@ int tileVolumes(const std::vector<Prepared>& volumes, int ox, int oy, VolumeList
 struct Stretch {
   const Prepared* p;
   double s0, s1, o[3], dir[3], from, to;
-  bool exact = false;
+  bool exact;  // (no initializer: a ray's list of 64 is not constructed pixel by pixel)
 };
 using StretchList = std::array<Stretch, 64>;
 
@@ -566,7 +566,7 @@ using StretchList = std::array<Stretch, 64>;
 // eye depths, into `pieces` (at most 8: the eighth reaches to `to`): the ray's crossings of
 // the form one after another from the free forms' caster (freeform/raycast.h castRay), its
 // inside at `from` from the form's sign there. Their number.
-int shellPieces(const freeform::ProjectedFreeForm& form, const EyeRays& r, int px, int py,
+[[gnu::noinline]] int shellPieces(const freeform::ProjectedFreeForm& form, const EyeRays& r, int px, int py,
                 double from, double to, freeform::RayFunction& ray, freeform::RayFunction& scratch,
                 double pieces[8][2]) {
   const double x = freeform::cubeX(px, r.width, 0), y = freeform::cubeY(py, r.height, 0);
@@ -620,7 +620,7 @@ int shellPieces(const freeform::ProjectedFreeForm& form, const EyeRays& r, int p
                                           : size_t(py / VolumePass::kWindow) * size_t(p.windowsX) +
                                                 size_t(px / VolumePass::kWindow);
     if (!p.windowNear.empty() && !(p.windowNear[w] < p.windowFar[w])) continue;
-    Stretch st{&p, r.znear, r.zfar, {}, {}, 0, 0};
+    Stretch st{&p, r.znear, r.zfar, {}, {}, 0, 0, false};
     for (int a = 0; a < 3; ++a) {
       st.o[a] = p.toOwn[a][0] * r.eye.x + p.toOwn[a][1] * r.eye.y + p.toOwn[a][2] * r.eye.z +
                 p.toOwn[a][3];
@@ -650,8 +650,11 @@ int shellPieces(const freeform::ProjectedFreeForm& form, const EyeRays& r, int p
       if (piece.from < piece.to) stretches[size_t(n++)] = piece;
     }
   }
-  std::stable_sort(stretches.begin(), stretches.begin() + n,
-                   [](const Stretch& a, const Stretch& b) { return a.s0 < b.s0; });
+  // Stable (a shell's pieces of one volume keep their order), without std::stable_sort's buffer:
+  // insertion, the lists being a few entries long.
+  for (int i = 1; i < n; ++i)
+    for (int k = i; k > 0 && stretches[size_t(k)].s0 < stretches[size_t(k - 1)].s0; --k)
+      std::swap(stretches[size_t(k)], stretches[size_t(k - 1)]);
   return n;
 }
 
@@ -760,9 +763,14 @@ int64_t compositeConstant(double w, const double c[3], int64_t n, double firstMi
     classifySamples(p.source, pending, batch);
     const int waiting = pending;
     pending = 0;
+    // The running composite in locals through the loop (registers, not the composite's memory:
+    // its chain T·(1 − w) is the loop's latency), written back where a snapshot reads it.
+    double C[3] = {pc.C[0], pc.C[1], pc.C[2]}, T = pc.T, last = pc.last;
+    auto store = [&] {
+      pc.C[0] = C[0], pc.C[1] = C[1], pc.C[2] = C[2], pc.T = T, pc.last = last;
+    };
     for (int j = 0; j < waiting; ++j) {
-      pc.reach(start[j]);
-      ++counts.samples;
+      if (start[j] >= pc.next) store(), pc.reach(start[j]);
       const float opacity = batch.opacity[j];
       if (!(opacity > 0)) continue;
       // SPEC §12: the opacity of a sample of length l is 1 − (1 − W)^(l / unit) — for a full
@@ -779,14 +787,18 @@ int64_t compositeConstant(double w, const double c[3], int64_t n, double firstMi
         const double fc[3] = {in.fogColor.x, in.fogColor.y, in.fogColor.z};
         for (int c = 0; c < 3; ++c) color[c] = color[c] * fog + fc[c] * (1 - fog);
       }
-      for (int c = 0; c < 3; ++c) pc.C[c] += pc.T * w * color[c];
-      pc.T *= 1 - w;
-      pc.last = start[j] + length[j];
-      if (pc.T < epsilon) {
+      for (int c = 0; c < 3; ++c) C[c] += T * w * color[c];
+      T *= 1 - w;
+      last = start[j] + length[j];
+      if (T < epsilon) {
+        counts.samples += uint64_t(j + 1);
         ++counts.terminated;
+        store();
         return false;
       }
     }
+    counts.samples += uint64_t(waiting);
+    store();
     return true;
   };
   // Segments [s0 + i·ds, s0 + (i + 1)·ds) ∩ [s0, end), each sampled at its middle.
@@ -857,7 +869,15 @@ int64_t compositeConstant(double w, const double c[3], int64_t n, double firstMi
           batch.z[pending] = float(st.o[2] + middle * st.dir[2]);
           return ++pending < kBatch || flush();
         };
-        for (; j <= last; ++j) {
+        // (Most runs have neither a piece's ends nor a split to cut at: their own loop.)
+        const bool plain = !st.exact && !pc.split;
+        for (; plain && j <= last; ++j) {
+          const double a = st.s0 + double(j) * ds;
+          if (!(a < end) || a > st.to) break;
+          const bool full = a + ds <= end;
+          if (!sample(a, full ? a + ds : end, full)) return true;
+        }
+        for (; !plain && j <= last; ++j) {
           double a = st.s0 + double(j) * ds;
           if (!(a < end) || a > st.to) break;
           bool full = a + ds <= end;
