@@ -737,6 +737,52 @@ int64_t compositeConstant(double w, const double c[3], int64_t n, double firstMi
   return ended ? -m : m;
 }
 
+// Composites a classified batch (sample j: segment start[j], length[j]) front to back into `pc`,
+// each sample's opacity corrected for its length (SPEC §12) and fogged by its distance (SPEC §8);
+// false once the transparency fell below ε (the ray ends there).
+[[gnu::always_inline]] inline bool compositeBatch(const SampleBatch& batch, const double* start,
+                                                  const double* length, int waiting, double ds,
+                                                  double worldPerS, const Prepared& p,
+                                                  const VolumeInput& in, PixelComposite& pc,
+                                                  VolumeCounts& counts) {
+  const double epsilon = in.settings.termination;
+  // The running composite in locals through the loop (registers, not the composite's memory:
+  // its chain T·(1 − w) is the loop's latency), written back where a snapshot reads it.
+  double C[3] = {pc.C[0], pc.C[1], pc.C[2]}, T = pc.T, last = pc.last;
+  auto store = [&] { pc.C[0] = C[0], pc.C[1] = C[1], pc.C[2] = C[2], pc.T = T, pc.last = last; };
+  for (int j = 0; j < waiting; ++j) {
+    if (start[j] >= pc.next) store(), pc.reach(start[j]);
+    const float opacity = batch.opacity[j];
+    if (!(opacity > 0)) continue;
+    // SPEC §12: the opacity of a sample of length l is 1 − (1 − W)^(l / unit) — for a full
+    // step tabled under a uniform scale, else taken in the kernel's lanes for the ray's step.
+    const bool full = length[j] == ds;
+    const double w =
+        full && (p.source.stepOpacity || batch.exponent > 0) ? double(batch.w[j])
+        : opacity >= 1                                       ? 1.0
+                       : 1 - std::pow(1 - double(opacity), length[j] * worldPerS / p.opacityUnit);
+    double color[3] = {batch.r[j], batch.g[j], batch.b[j]};
+    if (in.fogBeta > 0) {
+      const double mid = start[j] + 0.5 * length[j];
+      const double fog = std::exp2(-double(in.fogBeta) * mid * worldPerS);  // SPEC §8
+      const double fc[3] = {in.fogColor.x, in.fogColor.y, in.fogColor.z};
+      for (int c = 0; c < 3; ++c) color[c] = color[c] * fog + fc[c] * (1 - fog);
+    }
+    for (int c = 0; c < 3; ++c) C[c] += T * w * color[c];
+    T *= 1 - w;
+    last = start[j] + length[j];
+    if (T < epsilon) {
+      counts.samples += uint64_t(j + 1);
+      ++counts.terminated;
+      store();
+      return false;
+    }
+  }
+  counts.samples += uint64_t(waiting);
+  store();
+  return true;
+}
+
 // Casts the ray through one stretch (SPEC §12): its samples, up to the farthest surface of the
 // pixel, classified a batch at a time (sample_kernel.h) and composited front to back into `pc`.
 // True once the ray's transparency fell below ε (the ray ends there).
@@ -745,7 +791,6 @@ int64_t compositeConstant(double w, const double c[3], int64_t n, double firstMi
                                                PixelComposite& pc, VolumeCounts& counts) {
   const Prepared& p = *st.p;
   const scene::VolumeGrid& g = *p.grid;
-  const double epsilon = in.settings.termination;
   const double dirLength =
       std::sqrt(st.dir[0] * st.dir[0] + st.dir[1] * st.dir[1] + st.dir[2] * st.dir[2]);
   const double ds = p.stepOwn / dirLength;  // a step in s
@@ -763,43 +808,7 @@ int64_t compositeConstant(double w, const double c[3], int64_t n, double firstMi
     classifySamples(p.source, pending, batch);
     const int waiting = pending;
     pending = 0;
-    // The running composite in locals through the loop (registers, not the composite's memory:
-    // its chain T·(1 − w) is the loop's latency), written back where a snapshot reads it.
-    double C[3] = {pc.C[0], pc.C[1], pc.C[2]}, T = pc.T, last = pc.last;
-    auto store = [&] {
-      pc.C[0] = C[0], pc.C[1] = C[1], pc.C[2] = C[2], pc.T = T, pc.last = last;
-    };
-    for (int j = 0; j < waiting; ++j) {
-      if (start[j] >= pc.next) store(), pc.reach(start[j]);
-      const float opacity = batch.opacity[j];
-      if (!(opacity > 0)) continue;
-      // SPEC §12: the opacity of a sample of length l is 1 − (1 − W)^(l / unit) — for a full
-      // step tabled under a uniform scale, else taken in the kernel's lanes for the ray's step.
-      const bool full = length[j] == ds;
-      const double w =
-          full && (p.source.stepOpacity || batch.exponent > 0) ? double(batch.w[j])
-          : opacity >= 1                                       ? 1.0
-                         : 1 - std::pow(1 - double(opacity), length[j] * worldPerS / p.opacityUnit);
-      double color[3] = {batch.r[j], batch.g[j], batch.b[j]};
-      if (in.fogBeta > 0) {
-        const double mid = start[j] + 0.5 * length[j];
-        const double fog = std::exp2(-double(in.fogBeta) * mid * worldPerS);  // SPEC §8
-        const double fc[3] = {in.fogColor.x, in.fogColor.y, in.fogColor.z};
-        for (int c = 0; c < 3; ++c) color[c] = color[c] * fog + fc[c] * (1 - fog);
-      }
-      for (int c = 0; c < 3; ++c) C[c] += T * w * color[c];
-      T *= 1 - w;
-      last = start[j] + length[j];
-      if (T < epsilon) {
-        counts.samples += uint64_t(j + 1);
-        ++counts.terminated;
-        store();
-        return false;
-      }
-    }
-    counts.samples += uint64_t(waiting);
-    store();
-    return true;
+    return compositeBatch(batch, start, length, waiting, ds, worldPerS, p, in, pc, counts);
   };
   // Segments [s0 + i·ds, s0 + (i + 1)·ds) ∩ [s0, end), each sampled at its middle.
   // From the segment holding the shell's entry to the one holding its exit: the samples
