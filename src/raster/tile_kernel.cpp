@@ -93,7 +93,8 @@ template <bool kAA>
 const float* translucentDepth(const TileWork& w) {
   if (!w.translucentDepth || !w.attributes) return nullptr;
   bool wanted = false;
-  for (const TilePass* pass : w.afterOpaque) wanted |= pass->wantsTranslucentDepth(w.tileX, w.tileY);
+  for (const TilePass* pass : w.afterOpaque)
+    wanted |= pass->wantsTranslucentDepth(w.tileX, w.tileY);
   if (!wanted) return nullptr;
   const int samples = w.coverage ? w.coverage->samples : 1;
   std::copy_n(w.depth, size_t(kTilePixels) * size_t(samples), w.translucentDepth);

@@ -98,7 +98,8 @@ Status validateForm(const FreeFormNode& form, const std::string& label) {
       return fail(fmt::format("{}: a quadric coefficient is not finite (or over 1e30)", label));
     if (n != &form && !n->clips.empty())
       return fail(fmt::format("{}: clips belong to the root of a free form", label));
-    if (!(std::fabs(n->weight) <= 1e30)) return fail(fmt::format("{}: a weight is not finite", label));
+    if (!(std::fabs(n->weight) <= 1e30))
+      return fail(fmt::format("{}: a weight is not finite", label));
     for (const FreeFormNode& p : n->perturbations) stack.push_back(&p);
   }
   return {};
@@ -153,7 +154,8 @@ Status validateVolumes(const Scene& scene) {
       for (double c : q)
         if (!std::isfinite(c) || std::fabs(c) > 1e30) return fail(i, v.name, "a shell coefficient is not finite");
     if (v.freeFormShell)
-      if (Status st = validateForm(*v.freeFormShell, fmt::format("volume '{}': shell", v.name)); !st)
+      if (Status st = validateForm(*v.freeFormShell, fmt::format("volume '{}': shell", v.name));
+          !st)
         return st;
   }
   const VolumeSettings& s = scene.volumeSettings;

@@ -154,8 +154,8 @@ struct PixelComposite {
   double limit[64];   // per sample: its eye depth (the surface already there)
   bool done[64];
   double snapC[64][3], snapT[64];
-  uint64_t split = 0;       // the samples with a translucent surface in front of their opaque one
-  double splitAt = 1e300;   // the nearest of those translucent surfaces, as s
+  uint64_t split = 0;      // the samples with a translucent surface in front of their opaque one
+  double splitAt = 1e300;  // the nearest of those translucent surfaces, as s
   bool splitDone = true;
   double splitC[3] = {0, 0, 0}, splitT = 1;
 
@@ -277,7 +277,8 @@ void VolumePass::setVolumes(const VolumeInput& input) {
     p.shellForm.reset();
     if (v.freeFormShell)
       p.shellForm = freeform::ProjectedFreeForm::make(
-          freeform::fromNode(*v.freeFormShell), Mat4d::of(input.viewProjection) * Mat4d::of(v.transform));
+          freeform::fromNode(*v.freeFormShell),
+          Mat4d::of(input.viewProjection) * Mat4d::of(v.transform));
     // World → own: the inverse of the affine transform, in double (validateVolumes has refused a
     // singular one).
     const bool invertible = affineInverse(v.transform, p.toOwn);
@@ -566,9 +567,9 @@ using StretchList = std::array<Stretch, 64>;
 // eye depths, into `pieces` (at most 8: the eighth reaches to `to`): the ray's crossings of
 // the form one after another from the free forms' caster (freeform/raycast.h castRay), its
 // inside at `from` from the form's sign there. Their number.
-[[gnu::noinline]] int shellPieces(const freeform::ProjectedFreeForm& form, const EyeRays& r, int px, int py,
-                double from, double to, freeform::RayFunction& ray, freeform::RayFunction& scratch,
-                double pieces[8][2]) {
+[[gnu::noinline]] int shellPieces(const freeform::ProjectedFreeForm& form, const EyeRays& r, int px,
+                                  int py, double from, double to, freeform::RayFunction& ray,
+                                  freeform::RayFunction& scratch, double pieces[8][2]) {
   const double x = freeform::cubeX(px, r.width, 0), y = freeform::cubeY(py, r.height, 0);
   form.ray(x, y, ray);
   const double z0 = std::max(-1.0, ray.cubeDepth(from)), z1 = std::min(1.0, ray.cubeDepth(to));
@@ -757,10 +758,10 @@ int64_t compositeConstant(double w, const double c[3], int64_t n, double firstMi
     // SPEC §12: the opacity of a sample of length l is 1 − (1 − W)^(l / unit) — for a full
     // step tabled under a uniform scale, else taken in the kernel's lanes for the ray's step.
     const bool full = length[j] == ds;
-    const double w =
-        full && (p.source.stepOpacity || batch.exponent > 0) ? double(batch.w[j])
-        : opacity >= 1                                       ? 1.0
-                       : 1 - std::pow(1 - double(opacity), length[j] * worldPerS / p.opacityUnit);
+    const double w = full && (p.source.stepOpacity || batch.exponent > 0) ? double(batch.w[j])
+                     : opacity >= 1
+                         ? 1.0
+                         : 1 - std::pow(1 - double(opacity), length[j] * worldPerS / p.opacityUnit);
     double color[3] = {batch.r[j], batch.g[j], batch.b[j]};
     if (in.fogBeta > 0) {
       const double mid = start[j] + 0.5 * length[j];
@@ -1126,8 +1127,17 @@ void VolumePass::drawVolumes(const raster::TileTarget& tile) {
   const int count = tileVolumes(volumes_, ox, oy, listed);
   if (count == 0) return;
   WorkerBatch& scratch = batches_[size_t(tile.worker)];
-  const PixelCaster caster{tile,           r,      input_, samples_, listed, count, scratch.batch,
-                           scratch.shellRay, scratch.castRay, counts, &fronts};
+  const PixelCaster caster{tile,
+                           r,
+                           input_,
+                           samples_,
+                           listed,
+                           count,
+                           scratch.batch,
+                           scratch.shellRay,
+                           scratch.castRay,
+                           counts,
+                           &fronts};
   const int w = std::min(kTileSize, r.width - ox), h = std::min(kTileSize, r.height - oy);
   if (input_.settings.windowTolerance > 0) {
     refineWindows(caster, w, h, input_.settings.windowTolerance, windows_[size_t(tile.worker)]);

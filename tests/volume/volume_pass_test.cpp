@@ -446,7 +446,7 @@ TEST(VolumePass, AFreeFormShellClipsTheVolumeWhereTheCasterSays) {
         const double want = 255 * (1 - std::pow(0.9, in));
         EXPECT_NEAR(img.pixel(px, py)[0], want, 1.5) << px << ", " << py << ": " << in << " units";
       }
-    EXPECT_GE(inside, 8);  // most rays meet the form
+    EXPECT_GE(inside, 8);    // most rays meet the form
     EXPECT_GT(centre, 8.5);  // the sphere's chord (8) and the bump's
   }
 }
@@ -469,8 +469,8 @@ TEST(VolumePass, AFreeFormShellGivesTheSameImageForAnyThreadCount) {
 // The slab of opacity `alpha` a unit with a translucent quad (unlit, colour (0.2, 0.4, 0.6),
 // opacity 0.5) a unit wide across its axis at z.
 scene::Scene slabWithPane(float alpha, float z) {
-  scene::Scene s = slabWithMesh({{-0.5f, -0.5f, z}, {0.5f, -0.5f, z}, {0.5f, 0.5f, z}, {-0.5f, 0.5f, z}},
-                                {0, 1, 2, 0, 2, 3});
+  scene::Scene s = slabWithMesh(
+      {{-0.5f, -0.5f, z}, {0.5f, -0.5f, z}, {0.5f, 0.5f, z}, {-0.5f, 0.5f, z}}, {0, 1, 2, 0, 2, 3});
   s.materials[0].baseColor.w = 0.5f;
   s.materials[0].alphaMode = scene::AlphaMode::blend;
   s.volumes[0] = slab(alpha);
@@ -510,7 +510,8 @@ TEST(VolumePass, TranslucentPolygonsTakeTheirPlaceInDepthAmongTheVolumesSamples)
         const uint8_t* p = img.pixel(kW / 2, kH / 2);
         for (int ch = 0; ch < 3; ++ch)
           EXPECT_NEAR(p[ch], 255 * want[size_t(ch)], 1.5)
-              << c.what << ", " << samples << " samples, tolerance " << tolerance << ", channel " << ch;
+              << c.what << ", " << samples << " samples, tolerance " << tolerance << ", channel "
+              << ch;
         // Beside the pane (it covers 5 pixels about the centre at most), the slab alone: 10 units
         // along the axis, longer along the pixel's ray.
         const double slant = std::hypot(8.5 / (kH / 2), 0.5 / (kH / 2), 1.0);
