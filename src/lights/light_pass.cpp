@@ -22,8 +22,6 @@ using raster::kTileSize;
 // Lights are projected in chunks of this many (fixed: the splats' order never depends on the
 // thread count).
 constexpr size_t kChunk = 4096;
-// A light adds less than half a 16-bit step to every pixel below this: not drawn.
-constexpr float kDarkest = 0.5f;
 
 // The equatorial x, y and z axes in the world at the input's time (light_laws.h: starDirection).
 void starAxesOf(const LightInput& in, Vec3 axes[3]) {
@@ -59,48 +57,7 @@ float LightPass::eyeDepthOf(float windowDepth) const {
   return m32_ / (2 * windowDepth - 1 + m22_);
 }
 
-// Clamp a splat's size, weigh its kernel, and scale its colour so that the weights carry Φ.
-bool LightPass::finishSplat(float energy, Vec3 color, Splat& s) const {
-  const float peak = energy * std::max({color.x, color.y, color.z}) * 65535;
-  if (!(peak >= kDarkest)) return false;
-  const scene::LightSettings& ls = in_.settings;
-  s.radius = splatRadius(splatDiameter(energy, ls.minSize, ls.maxSize));
-  if (s.x + s.radius < 0 || s.y + s.radius < 0 || s.x - s.radius > float(frame_.width) ||
-      s.y - s.radius > float(frame_.height))
-    return false;
-  // The weight sum, a product of the two axes' sums (light_laws.h: splatWeightSum), from the
-  // axis weights a small splat keeps for drawing.
-  float sx = 0, sy = 0;
-  if (s.radius <= kSmallSplatRadius) {
-    s.spanX = splatAxis4(s.x, s.radius, s.kx, s.firstX);
-    s.spanY = splatAxis4(s.y, s.radius, s.ky, s.firstY);
-    for (int k = 0; k < 4; ++k) sx += s.kx[k];  // + 0 past the span: the same sum
-    for (int k = 0; k < 4; ++k) sy += s.ky[k];
-  } else {
-    float wx[kMaxSplatSpan], wy[kMaxSplatSpan];
-    s.spanX = splatAxis(s.x, s.radius, wx, s.firstX);
-    s.spanY = splatAxis(s.y, s.radius, wy, s.firstY);
-    for (int k = 0; k < s.spanX; ++k) sx += wx[k];
-    for (int k = 0; k < s.spanY; ++k) sy += wy[k];
-    if (s.spanX <= Splat::kKeptSpan && s.spanY <= Splat::kKeptSpan) {
-      std::copy_n(wx, s.spanX, s.kx);
-      std::copy_n(wy, s.spanY, s.ky);
-    }
-  }
-  const float scale = energy * 65535 / (sx * sy);
-  // A weight-1 pixel's addition, capped where it saturates anyway (so that it converts to int).
-  s.rgb[0] = std::min(color.x * scale, 1e6f);
-  s.rgb[1] = std::min(color.y * scale, 1e6f);
-  s.rgb[2] = std::min(color.z * scale, 1e6f);
-  // The window depth at depthBias in front of the light: a sample no nearer cannot hide it.
-  const float front = s.eyeDepth - in_.settings.depthBias;
-  s.frontDepth = s.eyeDepth == 0   ? 1.0f
-                 : front > 0       ? 0.5f * (-m22_ + m32_ / front) + 0.5f
-                                   : -1.0f;
-  return true;
-}
-
-bool LightPass::projectPoint(const scene::LightPoint& p, Splat& s) const {
+bool LightPass::projectPoint(const scene::LightPoint& p, SizeBatch& batch, int i) const {
   float dim = 1;
   if (p.group >= 0) {
     const scene::LightGroup& g = in_.groups[size_t(p.group)];
@@ -113,20 +70,21 @@ bool LightPass::projectPoint(const scene::LightPoint& p, Splat& s) const {
   const Vec4 c = in_.projection * eye;
   if (!(c.w > 0) || !(c.z >= -c.w) || !(c.z <= c.w)) return false;  // behind, near, beyond far
   const float invW = 1 / c.w;
-  s.x = (c.x * invW + 1) * 0.5f * float(frame_.width);
-  s.y = (1 - c.y * invW) * 0.5f * float(frame_.height);
-  s.eyeDepth = c.w;  // −eye.z for a window, bit for bit; a sub-frustum cell's axis depth
+  batch.x[i] = (c.x * invW + 1) * 0.5f * float(frame_.width);
+  batch.y[i] = (1 - c.y * invW) * 0.5f * float(frame_.height);
+  batch.eyeDepth[i] = c.w;  // −eye.z for a window, bit for bit; a sub-frustum cell's axis depth
   const Vec3 toEye = eye_ - p.position;
   const float d = length(toEye);
   if (!(d > 0)) return false;
   const Vec3 color = appearanceColor(a, lobeAxis(a, p.phase, in_.time), toEye * (1 / d),
                                      lobeTangents_[p.appearance]);
   const float transmission = fogTransmission(in_.fogBeta, in_.settings.punchThrough, d);
-  const float energy = screenEnergy(in_.settings.exposure, a.intensity * dim, transmission, d);
-  return finishSplat(energy, color, s);
+  batch.energy[i] = screenEnergy(in_.settings.exposure, a.intensity * dim, transmission, d);
+  batch.r[i] = color.x, batch.g[i] = color.y, batch.b[i] = color.z;
+  return true;
 }
 
-bool LightPass::projectStar(const scene::Star& star, Splat& s) const {
+bool LightPass::projectStar(const scene::Star& star, SizeBatch& batch, int i) const {
   const scene::StarField& f = *in_.stars;
   if (star.magnitude > f.limit) return false;
   const Vec3 w = starWorld(starAxes_, star.direction);
@@ -134,26 +92,46 @@ bool LightPass::projectStar(const scene::Star& star, Splat& s) const {
   const Vec4 c = in_.projection * eye;
   if (!(c.w > 0)) return false;
   const float invW = 1 / c.w;
-  s.x = (c.x * invW + 1) * 0.5f * float(frame_.width);
-  s.y = (1 - c.y * invW) * 0.5f * float(frame_.height);
-  s.eyeDepth = 0;
-  return finishSplat(f.brightness * std::exp2(-0.4f * std::log2(10.0f) * star.magnitude),
-                     star.color, s);
+  batch.x[i] = (c.x * invW + 1) * 0.5f * float(frame_.width);
+  batch.y[i] = (1 - c.y * invW) * 0.5f * float(frame_.height);
+  batch.eyeDepth[i] = 0;
+  batch.energy[i] = f.brightness * std::exp2(-0.4f * std::log2(10.0f) * star.magnitude);
+  batch.r[i] = star.color.x, batch.g[i] = star.color.y, batch.b[i] = star.color.z;
+  return true;
 }
 
 void LightPass::projectRange(size_t begin, size_t end, std::vector<Splat>& out) const {
   out.clear();
   const size_t points = in_.points.size();
+  // Projected one at a time (their laws branch by kind), sized and weighed 16 at a time.
+  SizeBatch batch;
+  uint32_t light[SizeBatch::kLights];
+  int count = 0;
+  auto size = [&] {
+    sizeSplats(sizeLaws_, count, batch);
+    for (int j = 0; j < count; ++j) {
+      if (!batch.drawn[j]) continue;
+      Splat& s = out.emplace_back();
+      s.x = batch.x[j], s.y = batch.y[j], s.eyeDepth = batch.eyeDepth[j];
+      s.radius = batch.radius[j];
+      s.rgb[0] = batch.red[j], s.rgb[1] = batch.green[j], s.rgb[2] = batch.blue[j];
+      s.frontDepth = batch.frontDepth[j];
+      s.firstX = batch.firstX[j], s.firstY = batch.firstY[j];
+      s.spanX = batch.spanX[j], s.spanY = batch.spanY[j];
+      for (int k = 0; k < Splat::kKeptSpan; ++k) s.kx[k] = batch.kx[k][j], s.ky[k] = batch.ky[k][j];
+      s.light = light[j];
+    }
+    count = 0;
+  };
   for (size_t k = begin; k < end; ++k) {
     const size_t i = in_.subset ? (*in_.subset)[k] : k;
-    Splat s;
-    const bool drawn =
-        i < points ? projectPoint(in_.points[i], s) : projectStar(in_.stars->stars[i - points], s);
-    if (drawn) {
-      s.light = uint32_t(k);
-      out.push_back(s);
-    }
+    const bool projected = i < points ? projectPoint(in_.points[i], batch, count)
+                                      : projectStar(in_.stars->stars[i - points], batch, count);
+    if (!projected) continue;
+    light[count] = uint32_t(k);
+    if (++count == SizeBatch::kLights) size();
   }
+  size();
 }
 
 template <class F>
@@ -185,6 +163,9 @@ void LightPass::prepare(const raster::PassFrame& frame) {
   m22_ = float(depthP22(in_.projection));  // m[2][2] for a window
   m32_ = in_.projection.m[3][2];
   zfar_ = m32_ / (1 + m22_);
+  const scene::LightSettings& ls = in_.settings;
+  sizeLaws_ = SizeLaws{ls.minSize, ls.maxSize, float(frame.width), float(frame.height), ls.depthBias,
+                       m22_, m32_};
   const size_t stars = in_.stars ? in_.stars->stars.size() : 0;
   if (stars) starAxesOf(in_, starAxes_);
   const size_t total = in_.subset ? in_.subset->size() : in_.points.size() + stars;

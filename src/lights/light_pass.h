@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "lights/light_laws.h"
+#include "lights/splat_sizes.h"
 #include "raster/tile_lists.h"
 #include "raster/tile_pass.h"
 #include "synthvis/light_points.h"
@@ -81,9 +82,11 @@ class LightPass final : public raster::TilePass {
  private:
   // Lights [begin, end) of the input (stars after the points), or of its subset, into `out`.
   void projectRange(size_t begin, size_t end, std::vector<Splat>& out) const;
-  bool projectPoint(const scene::LightPoint& p, Splat& s) const;
-  bool projectStar(const scene::Star& star, Splat& s) const;
-  bool finishSplat(float energy, Vec3 color, Splat& s) const;
+  // A light's raster position, eye depth, on-screen energy and colour into lane `i` of `batch`
+  // (sized and weighed 16 at a time: lights/splat_sizes.h); false where it is culled first
+  // (off, blinked out, behind the eye, beyond the far plane, below the star field's limit).
+  bool projectPoint(const scene::LightPoint& p, SizeBatch& batch, int i) const;
+  bool projectStar(const scene::Star& star, SizeBatch& batch, int i) const;
   // Calls f(tile index) for every tile the splat's kernel square reaches.
   template <class F>
   void forTiles(const Splat& s, F&& f) const;
@@ -101,6 +104,7 @@ class LightPass final : public raster::TilePass {
   LightInput in_;
   raster::PassFrame frame_;
   float m22_ = 0, m32_ = 1, zfar_ = 1;  // the projection's depth row, its far plane
+  SizeLaws sizeLaws_;                   // the frame's, for sizeSplats
   Vec3 eye_;
   Vec3 starAxes_[3];                        // equatorial x, y, z in world at this frame's time
   std::vector<LobeTangents> lobeTangents_;  // per appearance, this frame
