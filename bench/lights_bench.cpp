@@ -86,7 +86,18 @@ BENCHMARK(BM_Prepare)->Unit(benchmark::kMillisecond);
 void BM_DrawTiles(benchmark::State& state) {
   LightsFrame& f = frame();
   f.prepare();
-  const size_t drawn = f.pass.splats().size();
+  const std::vector<sv::lights::Splat> splats = f.pass.splats();
+  const size_t drawn = splats.size();
+  size_t large = 0, blocks = 0;
+  for (const sv::lights::Splat& s : splats) {
+    large += s.spanX > sv::lights::Splat::kKeptSpan || s.spanY > sv::lights::Splat::kKeptSpan;
+    blocks += size_t(((s.firstX + s.spanX - 1) >> 2) - (s.firstX >> 2) + 1) *
+              size_t(((s.firstY + s.spanY - 1) >> 2) - (s.firstY >> 2) + 1);
+  }
+  // What the draw does a light: the share of splats wider than four pixels (their weights worked
+  // out again in every tile they reach) and the 4×4 blocks a splat touches on average.
+  state.counters["large_share"] = double(large) / double(drawn);
+  state.counters["blocks_a_splat"] = double(blocks) / double(drawn);
   for (auto _ : state) f.drawTiles();
   state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(drawn));
   state.counters["ns_a_light"] = benchmark::Counter(
