@@ -78,8 +78,8 @@ void BM_Prepare(benchmark::State& state) {
   for (auto _ : state) f.prepare();
   state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(f.scene.lightPoints.size()));
   state.counters["ns_a_light"] = benchmark::Counter(
-      double(f.scene.lightPoints.size()), benchmark::Counter::kIsIterationInvariantRate |
-                                              benchmark::Counter::kInvert);
+      double(f.scene.lightPoints.size()),
+      benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(BM_Prepare)->Unit(benchmark::kMillisecond);
 

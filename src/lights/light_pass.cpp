@@ -164,8 +164,8 @@ void LightPass::prepare(const raster::PassFrame& frame) {
   m32_ = in_.projection.m[3][2];
   zfar_ = m32_ / (1 + m22_);
   const scene::LightSettings& ls = in_.settings;
-  sizeLaws_ = SizeLaws{ls.minSize, ls.maxSize, float(frame.width), float(frame.height), ls.depthBias,
-                       m22_, m32_};
+  sizeLaws_ = SizeLaws{
+      ls.minSize, ls.maxSize, float(frame.width), float(frame.height), ls.depthBias, m22_, m32_};
   const size_t stars = in_.stars ? in_.stars->stars.size() : 0;
   if (stars) starAxesOf(in_, starAxes_);
   const size_t total = in_.subset ? in_.subset->size() : in_.points.size() + stars;

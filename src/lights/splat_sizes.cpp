@@ -29,15 +29,16 @@ HWY_INLINE VI FloorToInt(VF x) {
   const DF df;
   const DI di;
   const VI i = hn::ConvertTo(di, x);
-  return hn::Sub(i, hn::IfThenElseZero(hn::RebindMask(di, hn::Gt(hn::ConvertTo(df, i), x)),
-                                       hn::Set(di, 1)));
+  return hn::Sub(
+      i, hn::IfThenElseZero(hn::RebindMask(di, hn::Gt(hn::ConvertTo(df, i), x)), hn::Set(di, 1)));
 }
 
 // splatWeight of the pixel centre first + k about c: (1 − d²/R²)², 0 from R on.
 HWY_INLINE VF AxisWeight(VI first, int k, VF c, VF invR2) {
   const DF df;
   const DI di;
-  const VF d = hn::Sub(hn::Add(hn::ConvertTo(df, hn::Add(first, hn::Set(di, k))), hn::Set(df, 0.5f)), c);
+  const VF d =
+      hn::Sub(hn::Add(hn::ConvertTo(df, hn::Add(first, hn::Set(di, k))), hn::Set(df, 0.5f)), c);
   const VF u = hn::Sub(hn::Set(df, 1.0f), hn::Mul(hn::Mul(d, d), invR2));
   return hn::IfThenElseZero(hn::Gt(u, hn::Zero(df)), hn::Mul(u, u));
 }
@@ -75,16 +76,17 @@ void SizeSplats(const SizeLaws& laws, int count, SizeBatch& b) {
     const VF peak = hn::Mul(hn::Mul(energy, hn::Max(hn::Max(r, g), bl)), hn::Set(df, 65535.0f));
     auto drawn = hn::Ge(peak, hn::Set(df, 0.5f));
     // splatRadius(splatDiameter(Φ)): std::clamp's comparisons, in its order.
-    const VF natural = hn::Sub(hn::Mul(hn::Set(df, 2 * (15.0f / 16)), hn::Sqrt(energy)), hn::Set(df, 1.0f));
+    const VF natural =
+        hn::Sub(hn::Mul(hn::Set(df, 2 * (15.0f / 16)), hn::Sqrt(energy)), hn::Set(df, 1.0f));
     const VF lo = hn::Set(df, laws.minSize), hi = hn::Set(df, laws.maxSize);
     const VF diameter =
         hn::IfThenElse(hn::Lt(natural, lo), lo, hn::IfThenElse(hn::Lt(hi, natural), hi, natural));
     const VF radius = hn::Add(hn::Mul(hn::Set(df, 0.5f), diameter), hn::Set(df, 0.5f));
     const VF zero = hn::Zero(df);
-    const auto off = hn::Or(
-        hn::Or(hn::Lt(hn::Add(x, radius), zero), hn::Lt(hn::Add(y, radius), zero)),
-        hn::Or(hn::Gt(hn::Sub(x, radius), hn::Set(df, laws.width)),
-               hn::Gt(hn::Sub(y, radius), hn::Set(df, laws.height))));
+    const auto off =
+        hn::Or(hn::Or(hn::Lt(hn::Add(x, radius), zero), hn::Lt(hn::Add(y, radius), zero)),
+               hn::Or(hn::Gt(hn::Sub(x, radius), hn::Set(df, laws.width)),
+                      hn::Gt(hn::Sub(y, radius), hn::Set(df, laws.height))));
     drawn = hn::AndNot(off, drawn);
     const VF invR2 = hn::Div(hn::Set(df, 1.0f), hn::Mul(radius, radius));
     VI firstX, firstY, spanX, spanY;
@@ -109,11 +111,12 @@ void SizeSplats(const SizeLaws& laws, int count, SizeBatch& b) {
     const VF eyeDepth = hn::Load(df, b.eyeDepth + i);
     const VF front = hn::Sub(eyeDepth, hn::Set(df, laws.depthBias));
     const auto ahead = hn::Gt(front, zero);
-    const VF window = hn::Add(
-        hn::Mul(hn::Set(df, 0.5f),
-                hn::Add(hn::Set(df, -laws.m22),
-                        hn::Div(hn::Set(df, laws.m32), hn::IfThenElse(ahead, front, hn::Set(df, 1.0f))))),
-        hn::Set(df, 0.5f));
+    const VF window =
+        hn::Add(hn::Mul(hn::Set(df, 0.5f),
+                        hn::Add(hn::Set(df, -laws.m22),
+                                hn::Div(hn::Set(df, laws.m32),
+                                        hn::IfThenElse(ahead, front, hn::Set(df, 1.0f))))),
+                hn::Set(df, 0.5f));
     hn::Store(hn::IfThenElse(hn::Eq(eyeDepth, zero), hn::Set(df, 1.0f),
                              hn::IfThenElse(ahead, window, hn::Set(df, -1.0f))),
               df, b.frontDepth + i);

@@ -46,8 +46,8 @@ TEST(SplatSizes, LanesEqualOneLightAtATimeOnEveryTarget) {
       SizeBatch got = in;
       sizeSplats(laws, count, got);
       for (int i = 0; i < count; ++i) {
-        SCOPED_TRACE(testing::Message() << hwy::TargetName(target) << ", light " << i << " of round "
-                                        << round << ", energy " << in.energy[i]);
+        SCOPED_TRACE(testing::Message() << hwy::TargetName(target) << ", light " << i
+                                        << " of round " << round << ", energy " << in.energy[i]);
         ASSERT_EQ(got.drawn[i], want.drawn[i]);
         if (!want.drawn[i]) continue;
         EXPECT_TRUE(same(got.radius[i], want.radius[i]));
