@@ -100,21 +100,18 @@ FrameRenderer::Frame FrameRenderer::frameOf(const DrawPackets& packets,
            settings.passes.empty() && !settings.debugOccupancy &&
            (settings.shade == raster::ShadeMode::material ||
             settings.shade == raster::ShadeMode::gouraud);
-  f.boxes = settings.masking == raster::Masking::priority;
+  bool blended = false;  // some triangle is translucent
   for (const DrawCall& call : packets.calls) {
     if (call.material && call.material->alpha != shade::AlphaUse::opaque) f.sums = false;
-    if (call.material && call.material->alpha == shade::AlphaUse::blend) f.boxes = false;
+    blended |= call.material && call.material->alpha == shade::AlphaUse::blend;
   }
+  f.boxes = settings.masking == raster::Masking::priority && !blended;
   f.masking = settings.masking != raster::Masking::none;
   f.pixelShading = settings.shade == raster::ShadeMode::material;
-  f.translucentDepth =
-      f.pixelShading &&
-      std::any_of(packets.calls.begin(), packets.calls.end(),
-                  [](const DrawCall& c) {
-                    return c.material && c.material->alpha == shade::AlphaUse::blend;
-                  }) &&
-      std::any_of(settings.passes.begin(), settings.passes.end(),
-                  [](auto* p) { return p->stage() != raster::PassStage::lights; });
+  f.translucentDepth = f.pixelShading && blended &&
+                       std::any_of(settings.passes.begin(), settings.passes.end(), [](auto* p) {
+                         return p->stage() != raster::PassStage::lights;
+                       });
   f.recordBytes = raster::AttributeSetup::readsSecondLine(packets.attributeLayout.stored)
                       ? sizeof(raster::AttributeSetup)
                       : raster::AttributeSetup::kLineBytes;

@@ -995,6 +995,7 @@ struct PixelCaster {
     for (int k = 0; k < samples; ++k) {
       for (int c = 0; c < 3; ++c)
         compositeOver(tile.color[FrameBuffer::colorOffset(lx, ly, c, samples, k)], C[c], T);
+      if (opaqueAt >= 1e300) continue;  // (most blended pixels: no depth to write)
       float& depth = tile.depth[FrameBuffer::depthOffset(lx, ly, samples, k)];
       if (opaqueAt < r.depthToS(depth)) depth = std::min(depth, r.sToDepth(opaqueAt));
     }
