@@ -184,6 +184,9 @@ void LightPass::prepare(const raster::PassFrame& frame) {
       },
       [&](const Splat& s, auto&& f) { forTiles(s, f); });
   workerMs_.assign(size_t(frame.pool->threadCount()), 0.0);
+  // Every drawn splat's visibility is written (seeTile, exchange) before it is read.
+  visible_.resize(total);
+  entryVisible_.resize(tileSplats_.size());
   prepareMs_ = core::msSince(t0);
 }
 
@@ -193,6 +196,18 @@ std::vector<Splat> LightPass::splats() const {
   return all;
 }
 
+float LightPass::visibilityFromProbes(const Splat& s) const {
+  // The probes exchange() fetched, in the order it stored them.
+  const float* probe = &probes_[probeAt_[s.light]];
+  const int cx = std::clamp(floorToInt(s.x), 0, frame_.width - 1);
+  const int cy = std::clamp(floorToInt(s.y), 0, frame_.height - 1);
+  return visibilityFrom(s, [&](int x, int y, int k) {
+    if (x == cx && y == cy) return probe[k];
+    const int neighbour = (y - cy + 1) * 3 + (x - cx + 1);  // 0 … 8, the centre 4
+    return probe[frame_.samples + neighbour - (neighbour > 4)];
+  });
+}
+
 // Visibility (docs/lights.md): the fraction of the centre pixel's samples that do not hide the
 // light. A sample hides a light when its surface is nearer than the light by more than the
 // depth bias plus the surface's own spread — the largest depth difference between the centre
@@ -200,24 +215,6 @@ std::vector<Splat> LightPass::splats() const {
 // to pixel, so a light standing on it stays lit; a wall facing the eye does not, and hides what
 // is behind it (but within a pixel of a silhouette a light behind shows). A star is seen only
 // where nothing was drawn.
-float LightPass::visibility(const Splat& s) const {
-  if (frame_.share.shared()) {
-    // The probes exchange() fetched, in the order it stored them.
-    const float* probe = &probes_[probeAt_[s.light]];
-    const int cx = std::clamp(floorToInt(s.x), 0, frame_.width - 1);
-    const int cy = std::clamp(floorToInt(s.y), 0, frame_.height - 1);
-    return visibilityFrom(s, [&](int x, int y, int k) {
-      if (x == cx && y == cy) return probe[k];
-      const int neighbour = (y - cy + 1) * 3 + (x - cx + 1);  // 0 … 8, the centre 4
-      return probe[frame_.samples + neighbour - (neighbour > 4)];
-    });
-  }
-  return visibilityFrom(s, [&](int x, int y, int k) {
-    const int tile = (y >> kTileLog2) * tilesX_ + (x >> kTileLog2);
-    return frame_.frame->tileDepth(tile)[FrameBuffer::depthOffset(x, y, frame_.samples, k)];
-  });
-}
-
 template <class DepthAt>
 float LightPass::visibilityFrom(const Splat& s, DepthAt&& depthAt) const {
   const int cx = std::clamp(floorToInt(s.x), 0, frame_.width - 1);
@@ -279,8 +276,40 @@ Status LightPass::exchange() {
           if (dx != 0 || dy != 0) depthAt(cx + dx, cy + dy, 0, probe[at++]);
     }
   const Status s = frame_.share.exchange->maxAll(probes_);
+  if (s)
+    for (const std::vector<Splat>& c : chunks_)
+      for (const Splat& splat : c) visible_[splat.light] = visibilityFromProbes(splat);
+  std::fill(entryVisible_.begin(), entryVisible_.end(), -1.0f);  // drawTile reads visible_
   exchangeMs_ = core::msSince(t0);
   return s;
+}
+
+void LightPass::seeTile(const raster::TileNeighbourhood& tiles) {
+  if (frame_.share.shared()) return;  // exchange() saw every splat
+  const auto t0 = core::Clock::now();
+  const int n = frame_.samples;
+  const auto depthAt = [&](int x, int y, int k) {
+    return tiles.tileHolding(x, y)[FrameBuffer::depthOffset(x, y, n, k)];
+  };
+  // The tile's splats whose centre pixel (clamped into the frame, as visibilityFrom clamps it)
+  // it holds: every splat reaches the tile of its clamped centre.
+  const size_t t = size_t(tiles.tileY * tilesX_ + tiles.tileX);
+  const std::span<const Splat> splats = tileSplats_.tile(t);
+  float* entry = &entryVisible_[tileSplats_.first(t)];
+  const auto inTile = [](float c, float r, int tile) {
+    return floorToInt(c - r) >> kTileLog2 == tile && floorToInt(c + r) >> kTileLog2 == tile;
+  };
+  for (size_t i = 0; i < splats.size(); ++i) {
+    const Splat& s = splats[i];
+    const int cx = std::clamp(floorToInt(s.x), 0, frame_.width - 1);
+    const int cy = std::clamp(floorToInt(s.y), 0, frame_.height - 1);
+    entry[i] = -1;
+    if ((cx >> kTileLog2) != tiles.tileX || (cy >> kTileLog2) != tiles.tileY) continue;
+    entry[i] = visibilityFrom(s, depthAt);
+    if (!inTile(s.x, s.radius, tiles.tileX) || !inTile(s.y, s.radius, tiles.tileY))
+      visible_[s.light] = entry[i];
+  }
+  workerMs_[size_t(tiles.worker)] += core::msSince(t0);
 }
 
 void LightPass::drawTile(const raster::TileTarget& tile) {
@@ -292,16 +321,15 @@ void LightPass::drawTile(const raster::TileTarget& tile) {
   const int n = frame_.samples;
   const std::span<const Splat> splats = tileSplats_.tile(t);
   if (splats.empty()) return;
-  // The tile's depth and colour left the caches while the rest of the frame was drawn: stream
-  // them back in order (the lights then touch them at random).
-  const char* depth = reinterpret_cast<const char*>(tile.depth);
+  // The tile's colour may have left the caches while the tiles around it were drawn: stream it
+  // back in order (the lights then touch it at random).
   const char* color = reinterpret_cast<const char*>(tile.color);
-  for (size_t b = 0; b < size_t(raster::kTilePixels) * size_t(n) * sizeof(float); b += 64)
-    __builtin_prefetch(depth + b);
   for (size_t b = 0; b < size_t(raster::kTilePixels) * size_t(n) * 6; b += 64)
     __builtin_prefetch(color + b, 1);
-  for (const Splat& s : splats) {
-    const float v = visibility(s);
+  const float* entry = &entryVisible_[tileSplats_.first(t)];
+  for (size_t i = 0; i < splats.size(); ++i) {
+    const Splat& s = splats[i];
+    const float v = entry[i] >= 0 ? entry[i] : visible_[s.light];
     if (!(v > 0)) continue;
     SplatInTile part;
     float kx[kMaxSplatSpan], ky[kMaxSplatSpan];

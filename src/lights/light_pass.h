@@ -6,10 +6,12 @@
 // Per frame (prepare, in parallel over chunks of lights): every light projected, culled (behind
 // the eye, off screen, off, dark, beyond the far plane), its blink, lobe, fog, energy, size and
 // weight sum worked out (lights/light_laws.h), then listed for every tile its splat reaches, in
-// light order. Per tile (drawTile): each listed light's visibility from the depth around its
-// centre pixel — which may lie in another tile: the lights stage runs once every tile's other
-// passes are done (FrameRenderer), so the whole frame's depth is final and read-only — then its
-// weights added into the tile's colour samples. Depth is left as it was.
+// light order. Per tile, once its depth and its neighbours' are final (seeTile): the visibility of
+// every light whose centre pixel it holds, from the depth around that pixel — which may lie in
+// the next tile. Per tile, once every tile around it has been seen (drawTile): its lights' weights,
+// times their visibilities, added into its colour samples. Depth is left as it was. A splat
+// reaches at most 33 px from its centre pixel, so the tiles a tile's lights need are the eight
+// around it (FrameRenderer draws the frame as a wavefront of tiles: docs/lights.md).
 #pragma once
 
 #include <span>
@@ -71,8 +73,10 @@ class LightPass final : public raster::TilePass {
   raster::PassStage stage() const override { return raster::PassStage::lights; }
   void prepare(const raster::PassFrame& frame) override;
   // In a shared frame (PassFrame::share): the depths every splat's visibility reads — its centre
-  // pixel's samples and the first sample of the eight around it — from the parts that drew them.
+  // pixel's samples and the first sample of the eight around it — from the parts that drew them;
+  // then every splat's visibility (seeTile does nothing).
   Status exchange() override;
+  void seeTile(const raster::TileNeighbourhood& tiles) override;
   void drawTile(const raster::TileTarget& tile) override;
   void addStats(FrameStats& stats) const override;
 
@@ -90,12 +94,12 @@ class LightPass final : public raster::TilePass {
   // Calls f(tile index) for every tile the splat's kernel square reaches.
   template <class F>
   void forTiles(const Splat& s, F&& f) const;
-  // The fraction of the centre pixel's samples that do not hide splat `s`, from the frame's
-  // depth (or, in a shared frame, the exchanged probes).
-  float visibility(const Splat& s) const;
-  // The same from depthAt(x, y, sample) (in the frame: 0 ≤ x < width, 0 ≤ y < height).
+  // The fraction of the centre pixel's samples that do not hide splat `s`, from depthAt(x, y,
+  // sample) (in the frame: 0 ≤ x < width, 0 ≤ y < height; the centre pixel and the eight around).
   template <class DepthAt>
   float visibilityFrom(const Splat& s, DepthAt&& depthAt) const;
+  // The same from a shared frame's exchanged probes.
+  float visibilityFromProbes(const Splat& s) const;
   // A shared frame's probes per splat: the centre pixel's n samples, then these (the eight
   // neighbours' first samples).
   static constexpr int kNeighbourProbes = 8;
@@ -112,6 +116,11 @@ class LightPass final : public raster::TilePass {
   int tilesX_ = 0;
   size_t tiles_ = 0;
   raster::TileLists<Splat> tileSplats_;  // every tile's splats, in light order
+  // Visibilities (seeTile), for drawTile: per list entry, a splat's whose centre tile is the list's
+  // own, read in list order — or −1, then the splat's in visible_ (per candidate; written only for
+  // splats that reach beyond their centre tile, so the workers seldom share its lines).
+  std::vector<float> entryVisible_;
+  std::vector<float> visible_;
   std::vector<double> workerMs_;
   double prepareMs_ = 0, exchangeMs_ = 0;
   uint64_t candidates_ = 0;

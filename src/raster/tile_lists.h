@@ -51,6 +51,10 @@ class TileLists {
   std::span<const Item> tile(size_t t) const {
     return {items_.data() + start_[t], items_.data() + start_[t + 1]};
   }
+  // Where tile t's items start among every tile's (for arrays kept beside the lists), and how many
+  // items there are in all.
+  size_t first(size_t t) const { return start_[t]; }
+  size_t size() const { return items_.size(); }
 
  private:
   std::vector<uint32_t> at_;     // per chunk and tile: its count, then where its items go

@@ -58,7 +58,10 @@ struct FrameRenderer::Frame {
   // One batch: each tile is cleared, drawn and handed on in a per-thread 64×64 buffer. Several:
   // the tiles persist in a whole-frame buffer from batch to batch.
   bool wholeFrame;
-  bool lights;  // some pass is of stage lights: they run after all tiles, before the sink
+  bool lights;  // some pass is of stage lights: they run last, before the sink
+  // Lights in an unshared frame of one batch: each tile drawn in a buffer of its own, seen and lit
+  // as soon as the tiles around it allow (FrameRenderer::tileDrawn).
+  bool wavefront;
   int tilesX, tilesY, tiles;
   // Colour sums (raster::TileWork::sums): each sample written at most once and read by nothing but
   // the resolve — priority masking (every written sample occupied), opaque triangles only (a
@@ -87,12 +90,15 @@ FrameRenderer::Frame FrameRenderer::frameOf(const DrawPackets& packets,
   f.triangles = static_cast<uint32_t>(packets.indices.size() / 3);
   f.batchTriangles = std::clamp<uint32_t>(settings.batchTriangles, 1, kMaxBatchTriangles);
   f.chunkSize = chunkTriangles(std::min(f.triangles, f.batchTriangles));
-  // Light points read the whole frame's final depth (raster::PassFrame::frame): the tiles are
-  // kept until every one is drawn, then the lights are added and the tiles handed on.
+  // Light points read the depth of the tiles around their own (TilePass::seeTile). A frame of
+  // several batches keeps the whole frame anyway, and a shared frame's lights read what the other
+  // parts drew (TilePass::exchange), once all are drawn: their lights run after every tile. Else
+  // they follow the tiles as a wavefront, and only its tiles are kept.
   f.lights = std::any_of(settings.passes.begin(), settings.passes.end(), [](auto* p) {
     return p->stage() == raster::PassStage::lights;
   });
-  f.wholeFrame = f.triangles > f.batchTriangles || f.lights;
+  f.wholeFrame = f.triangles > f.batchTriangles || (f.lights && settings.share.shared());
+  f.wavefront = f.lights && !f.wholeFrame;
   f.tilesX = (settings.width + raster::kTileSize - 1) >> raster::kTileLog2;
   f.tilesY = (settings.height + raster::kTileSize - 1) >> raster::kTileLog2;
   f.tiles = f.tilesX * f.tilesY;
@@ -134,7 +140,8 @@ void FrameRenderer::prepareBuffers(const DrawPackets& packets, const Frame& f) {
   scratch_.resize(size_t(pool_.threadCount()));
   for (WorkerScratch& w : scratch_) {
     w.records.resize(f.chunkSize);
-    if (!f.wholeFrame) w.tile.resize(raster::kTileSize, raster::kTileSize, f.samples, f.sums);
+    if (!f.wholeFrame && !f.wavefront)
+      w.tile.resize(raster::kTileSize, raster::kTileSize, f.samples, f.sums);
     if (f.translucentDepth) w.translucent.resize(raster::kTileSize, raster::kTileSize, f.samples);
     if (f.pixelShading && f.samples == 1) w.visible.assign(raster::kTilePixels, ~0u);
     if (f.masking && !f.wholeFrame && !w.occupancy)
@@ -153,6 +160,21 @@ void FrameRenderer::prepareBuffers(const DrawPackets& packets, const Frame& f) {
   objects_.clear();
   if (f.masking)
     for (const DrawCall& call : packets.calls) objects_.push_back(call.bound);
+  if (f.wavefront) {
+    if (waitTiles_ != size_t(f.tiles)) {
+      unseen_ = std::make_unique<std::atomic<int>[]>(size_t(f.tiles));
+      unlit_ = std::make_unique<std::atomic<int>[]>(size_t(f.tiles));
+      waitTiles_ = size_t(f.tiles);
+    }
+    for (int t = 0; t < f.tiles; ++t) {
+      const int x = t % f.tilesX, y = t / f.tilesX;
+      const int around = (std::min(f.tilesX - 1, x + 1) - std::max(0, x - 1) + 1) *
+                         (std::min(f.tilesY - 1, y + 1) - std::max(0, y - 1) + 1);
+      unseen_[size_t(t)].store(around, std::memory_order_relaxed);
+      unlit_[size_t(t)].store(around, std::memory_order_relaxed);
+    }
+    tileBufferOf_.assign(size_t(f.tiles), nullptr);
+  }
   tileStats_.assign(size_t(f.tiles), raster::RasterStats{});
   opaqueDone_.assign(size_t(f.tiles), 0);
   chunkCounts_.resize(size_t(maxChunks));
@@ -163,8 +185,10 @@ void FrameRenderer::prepareBuffers(const DrawPackets& packets, const Frame& f) {
 void FrameRenderer::preparePasses(const FrameSettings& settings, const Frame& f) {
   afterOpaque_.clear();
   afterTranslucent_.clear();
-  const raster::PassFrame frame{settings.width, settings.height, f.samples, f.coverage, &pool_,
-                                f.wholeFrame ? &fb_ : nullptr, settings.share};
+  const raster::PassFrame frame{
+      settings.width, settings.height, f.samples,
+      f.coverage,     &pool_,          f.lights && settings.share.shared() ? &fb_ : nullptr,
+      settings.share};
   for (raster::PassStage stage :
        {raster::PassStage::surfaces, raster::PassStage::volumes, raster::PassStage::lights})
     for (raster::TilePass* pass : settings.passes) {
@@ -181,6 +205,11 @@ Status FrameRenderer::render(const DrawPackets& packets, const FrameSettings& se
   drawnTiles_.clear();
   for (int tile = 0; tile < f.tiles; ++tile)
     if (settings.share.owns(tile % f.tilesX, tile / f.tilesX)) drawnTiles_.push_back(tile);
+  // The wavefront keeps the tiles drawn and not yet lit — those within two lines of tiles of the
+  // front: drawn along the shorter side, the lines are shorter (36 tiles kept at 1920×1080, not 62).
+  if (f.wavefront && f.tilesY < f.tilesX)
+    for (int i = 0; i < f.tiles; ++i)
+      drawnTiles_[size_t(i)] = (i % f.tilesY) * f.tilesX + i / f.tilesY;
   preparePasses(settings, f);
   const traversal::Traversal& t = packets.traversal;
   stats.trianglesIn += f.triangles + t.culledTriangles;
@@ -206,12 +235,18 @@ Status FrameRenderer::render(const DrawPackets& packets, const FrameSettings& se
     drawTiles(settings, f, batch);
     stats.rasterMs += core::msSince(t0);
   }
-  if (f.lights) {
+  if (f.lights && f.wholeFrame) {
     // A shared frame's lights read depth the other parts drew (TilePass::exchange).
     if (settings.share.shared())
       for (raster::TilePass* pass : afterTranslucent_)
         if (Status s = pass->exchange(); !s) return s;
     const auto t0 = core::Clock::now();
+    pool_.parallelFor(drawnTiles_.size(), [&](size_t i, int worker) {
+      const int tile = drawnTiles_[i];
+      const raster::TileNeighbourhood around =
+          raster::neighbourhoodIn(fb_, tile % f.tilesX, tile / f.tilesX, worker, settings.share);
+      for (raster::TilePass* pass : afterTranslucent_) pass->seeTile(around);
+    });
     pool_.parallelFor(drawnTiles_.size(), [&](size_t i, int worker) {
       const int tile = drawnTiles_[i];
       finishTile(settings, tile, fb_.tileDepth(tile), fb_.tileColor(tile), nullptr, worker);
@@ -330,7 +365,10 @@ void FrameRenderer::drawTile(const FrameSettings& settings, const Frame& f, cons
   raster::TileWork w;
   w.tileX = tile % f.tilesX;
   w.tileY = tile / f.tilesX;
-  raster::FrameBuffer& buffer = f.wholeFrame ? fb_ : scratch.tile;
+  raster::FrameBuffer& buffer = f.wholeFrame ? fb_
+                                : f.wavefront
+                                    ? *(tileBufferOf_[size_t(tile)] = takeTileBuffer(f.samples))
+                                    : scratch.tile;
   const int index = f.wholeFrame ? tile : 0;
   w.depth = buffer.tileDepth(index);
   w.color = buffer.tileColor(index);
@@ -365,7 +403,57 @@ void FrameRenderer::drawTile(const FrameSettings& settings, const Frame& f, cons
   w.worker = worker;
   w.opaqueDone = &opaqueDone_[size_t(tile)];
   raster::rasterizeTile(w, tileStats_[size_t(tile)]);
-  if (batch.last && !f.lights) finishTile(settings, tile, w.depth, w.color, w.sums, worker);
+  if (!batch.last) return;
+  if (f.wavefront)
+    tileDrawn(settings, f, tile, worker);
+  else if (!f.lights)
+    finishTile(settings, tile, w.depth, w.color, w.sums, worker);
+}
+
+// The wavefront (docs/lights.md): a tile is seen once the 3×3 tiles around it are drawn, and lit
+// once the 3×3 around it are seen — so the tiles kept are those drawn and not yet lit, about two
+// rows of them. Whichever thread completes a tile's neighbourhood does its work; the counts' acq_rel
+// order the drawn depth and colour, and the seen visibilities, before what reads them. What a tile
+// gets never depends on which thread that is.
+void FrameRenderer::tileDrawn(const FrameSettings& settings, const Frame& f, int tile, int worker) {
+  const auto around = [&](int t, auto&& fn) {
+    const int tx = t % f.tilesX, ty = t / f.tilesX;
+    for (int y = std::max(0, ty - 1); y <= std::min(f.tilesY - 1, ty + 1); ++y)
+      for (int x = std::max(0, tx - 1); x <= std::min(f.tilesX - 1, tx + 1); ++x)
+        fn(y * f.tilesX + x, (y - ty + 1) * 3 + x - tx + 1);
+  };
+  around(tile, [&](int seen, int) {
+    if (unseen_[size_t(seen)].fetch_sub(1, std::memory_order_acq_rel) != 1) return;
+    raster::TileNeighbourhood tiles{seen % f.tilesX, seen / f.tilesX, {}, worker};
+    around(seen, [&](int t, int at) { tiles.depth[at] = tileBufferOf_[size_t(t)]->tileDepth(0); });
+    for (raster::TilePass* pass : afterTranslucent_) pass->seeTile(tiles);
+    around(seen, [&](int lit, int) {
+      if (unlit_[size_t(lit)].fetch_sub(1, std::memory_order_acq_rel) != 1) return;
+      raster::FrameBuffer* buffer = tileBufferOf_[size_t(lit)];
+      finishTile(settings, lit, buffer->tileDepth(0), buffer->tileColor(0), nullptr, worker);
+      giveTileBuffer(buffer);
+    });
+  });
+}
+
+raster::FrameBuffer* FrameRenderer::takeTileBuffer(int samples) {
+  raster::FrameBuffer* buffer;
+  {
+    std::lock_guard lock(tileBuffersMutex_);
+    if (freeTileBuffers_.empty()) {
+      buffer = tileBuffers_.emplace_back(std::make_unique<raster::FrameBuffer>()).get();
+    } else {
+      buffer = freeTileBuffers_.back();
+      freeTileBuffers_.pop_back();
+    }
+  }
+  buffer->resize(raster::kTileSize, raster::kTileSize, samples);  // allocates only when it grows
+  return buffer;
+}
+
+void FrameRenderer::giveTileBuffer(raster::FrameBuffer* buffer) {
+  std::lock_guard lock(tileBuffersMutex_);
+  freeTileBuffers_.push_back(buffer);
 }
 
 // A drawn tile's last passes (stage lights) and its sink.

@@ -2,8 +2,10 @@
 // then the tiles in parallel (SPEC §1 stages 3–4, §3.4, §6).
 #pragma once
 
+#include <atomic>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <vector>
 
 #include "core/thread_pool.h"
@@ -53,8 +55,8 @@ struct FrameSettings {
   bool debugOccupancy = false;
   // The frame's passes besides the polygons (raster/tile_pass.h), in the order render composed
   // them: each prepared once, drawn into every tile where its stage says — surfaces and volumes
-  // once the tile's opaque triangles are in, lights once every tile is drawn (the frame then
-  // kept whole), before finishTile — and its statistics added to the frame's.
+  // once the tile's opaque triangles are in, lights once the tiles around it are drawn too,
+  // before finishTile — and its statistics added to the frame's.
   std::vector<raster::TilePass*> passes;
   // A frame shared by several processes (synthvis/tile_share.h): only this part's tiles are
   // drawn and handed to finishTile; setup and binning still see the whole frame.
@@ -98,6 +100,12 @@ class FrameRenderer {
                 int worker);
   void finishTile(const FrameSettings& settings, int tile, float* depth, uint16_t* color,
                   int32_t* sums, int worker);
+  // A frame with light points drawn as a wavefront (Frame::wavefront): tile `tile` is drawn; the
+  // tiles around it that this completes are seen, and those whose neighbourhood that completes
+  // get their lights and go to the sink.
+  void tileDrawn(const FrameSettings& settings, const Frame& f, int tile, int worker);
+  raster::FrameBuffer* takeTileBuffer(int samples);
+  void giveTileBuffer(raster::FrameBuffer* buffer);
   void addTileStats(FrameStats& stats) const;
 
   core::ThreadPool pool_;
@@ -128,6 +136,16 @@ class FrameRenderer {
   std::vector<SetupCounts> chunkCounts_;  // the batch's, per chunk
   std::vector<uint8_t> opaqueDone_;       // per tile: the afterOpaque passes have run
   std::vector<int> drawnTiles_;           // the tiles this part draws (every tile unshared)
+  // Frames with light points and one batch (Frame::wavefront): each tile drawn in a buffer of its
+  // own, kept until its lights are drawn — only the wavefront's tiles at once, about two rows.
+  std::vector<std::unique_ptr<raster::FrameBuffer>> tileBuffers_;  // every one made, kept
+  std::vector<raster::FrameBuffer*> freeTileBuffers_;
+  std::mutex tileBuffersMutex_;
+  std::vector<raster::FrameBuffer*> tileBufferOf_;  // per tile: the one it is drawn in
+  // Per tile: how many tiles of its 3×3 neighbourhood are still to be drawn (before it is seen),
+  // and how many still to be seen (before its lights are drawn).
+  std::unique_ptr<std::atomic<int>[]> unseen_, unlit_;
+  size_t waitTiles_ = 0;  // their size
   // FrameSettings::passes by stage: those that run once a tile's opaque triangles are in, and
   // those after its last triangle.
   std::vector<raster::TilePass*> afterOpaque_, afterTranslucent_;

@@ -30,7 +30,9 @@ struct BareFrame {
     }
   }
   void draw(lights::LightPass& pass) {
-    pass.prepare(raster::PassFrame{fb.width(), fb.height(), 1, nullptr, &pool, &fb, {}});
+    pass.prepare(raster::PassFrame{fb.width(), fb.height(), 1, nullptr, &pool});
+    for (int t = 0; t < fb.tileCount(); ++t)
+      pass.seeTile(raster::neighbourhoodIn(fb, t % fb.tilesX(), t / fb.tilesX(), 0));
     for (int t = 0; t < fb.tileCount(); ++t)
       pass.drawTile({t % fb.tilesX(), t / fb.tilesX(), fb.tileDepth(t), fb.tileColor(t), 0});
   }

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <mutex>
 #include <string>
 #include <utility>
@@ -172,6 +173,104 @@ TEST(TilePass, WhatAPassDrawsIsTheSameForAnyThreadCount) {
   EXPECT_EQ(one.depth[1 * kWidth + 1], 0.0f);
   // (The translucent triangle, drawn after the mark, blends over it but cannot hide it.)
   for (int threads : {2, 8}) EXPECT_TRUE(test::renderQuadtree(scene.packets, s, threads) == one);
+}
+
+// The lights stage (TilePass::seeTile, FrameRenderer's wavefront): each tile is seen once, after
+// the other passes of the nine tiles around it, with their final depth; drawn once, after the nine
+// around it are seen — in a frame of one batch (the wavefront) and of several (the whole frame
+// kept), for any thread count.
+class OrderPass final : public raster::TilePass {
+ public:
+  struct Event {
+    char kind;  // 'o' the tile's other passes done, 's' seen, 'd' drawn
+    int tile;
+  };
+  OrderPass(raster::PassStage stage, std::vector<Event>& log, std::mutex& mutex)
+      : stage_(stage), log_(log), mutex_(mutex) {}
+  raster::PassStage stage() const override { return stage_; }
+  void prepare(const raster::PassFrame& frame) override { samples_ = frame.samples; }
+  // A surfaces pass marks its tile's pixel (2, 2) with a depth of its own; the lights pass checks
+  // the marks of the nine tiles it is shown.
+  static float mark(int tile) { return 0.25f + 0.01f * float(tile); }
+  void seeTile(const raster::TileNeighbourhood& tiles) override {
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const int x = tiles.tileX + dx, y = tiles.tileY + dy;
+        const float* depth = tiles.depth[(dy + 1) * 3 + dx + 1];
+        const bool inside = x >= 0 && y >= 0 && x < kTilesX && y < kTilesY;
+        EXPECT_EQ(depth != nullptr, inside) << "tile " << x << ", " << y;
+        if (inside && depth) {
+          EXPECT_EQ(depth[raster::FrameBuffer::depthOffset(2, 2, samples_)], mark(y * kTilesX + x));
+        }
+      }
+    record('s', tiles.tileY * kTilesX + tiles.tileX);
+  }
+  void drawTile(const raster::TileTarget& tile) override {
+    const int t = tile.tileY * kTilesX + tile.tileX;
+    if (stage_ == raster::PassStage::surfaces)
+      for (int k = 0; k < samples_; ++k)
+        tile.depth[raster::FrameBuffer::depthOffset(2, 2, samples_, k)] = mark(t);
+    record(stage_ == raster::PassStage::surfaces ? 'o' : 'd', t);
+  }
+  void addStats(FrameStats&) const override {}
+
+  static constexpr int kTilesX = 5, kTilesY = 4;
+
+ private:
+  void record(char kind, int tile) {
+    std::lock_guard lock(mutex_);
+    log_.push_back({kind, tile});
+  }
+  raster::PassStage stage_;
+  std::vector<Event>& log_;
+  std::mutex& mutex_;
+  int samples_ = 1;
+};
+
+TEST(TilePass, TheLightsStageSeesATileAfterTheNineAroundItAndDrawsItAfterTheyAreSeen) {
+  constexpr int w = OrderPass::kTilesX * 64 - 20, h = OrderPass::kTilesY * 64 - 7;
+  render::DrawPackets packets;
+  for (int i = 0; i < 40; ++i) {
+    const double x = (i * 53) % (w - 20), y = (i * 29) % (h - 20);
+    test::addTriangle(packets, test::pixelVertex(x, y, w, h), test::pixelVertex(x + 19, y, w, h),
+                      test::pixelVertex(x, y + 17, w, h));
+  }
+  for (const uint32_t batch : {1u << 18, 7u})
+    for (const int threads : {1, 2, 5}) {
+      SCOPED_TRACE(testing::Message() << "batch " << batch << ", threads " << threads);
+      std::vector<OrderPass::Event> log;
+      std::mutex mutex;
+      OrderPass lights(raster::PassStage::lights, log, mutex);
+      OrderPass surfaces(raster::PassStage::surfaces, log, mutex);
+      render::FrameSettings s;
+      s.width = w;
+      s.height = h;
+      s.samples = 4;
+      s.batchTriangles = batch;
+      s.passes = {&lights, &surfaces};
+      test::renderQuadtree(packets, s, threads);
+      constexpr int tiles = OrderPass::kTilesX * OrderPass::kTilesY;
+      std::vector<int> at[3];  // per kind, per tile: where in the log
+      for (auto& a : at) a.assign(tiles, -1);
+      for (size_t i = 0; i < log.size(); ++i) {
+        const int kind = log[i].kind == 'o' ? 0 : log[i].kind == 's' ? 1 : 2;
+        EXPECT_EQ(at[kind][size_t(log[i].tile)], -1)
+            << log[i].kind << " twice, tile " << log[i].tile;
+        at[kind][size_t(log[i].tile)] = int(i);
+      }
+      ASSERT_EQ(log.size(), size_t(3 * tiles));
+      for (int t = 0; t < tiles; ++t) {
+        const int tx = t % OrderPass::kTilesX, ty = t / OrderPass::kTilesX;
+        for (int y = std::max(0, ty - 1); y <= std::min(OrderPass::kTilesY - 1, ty + 1); ++y)
+          for (int x = std::max(0, tx - 1); x <= std::min(OrderPass::kTilesX - 1, tx + 1); ++x) {
+            const size_t u = size_t(y * OrderPass::kTilesX + x);
+            EXPECT_LT(at[0][u], at[1][size_t(t)])
+                << "tile " << t << " seen before " << u << " was drawn";
+            EXPECT_LT(at[1][u], at[2][size_t(t)])
+                << "tile " << t << " drawn before " << u << " was seen";
+          }
+      }
+    }
 }
 
 }  // namespace
