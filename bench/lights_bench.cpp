@@ -62,7 +62,7 @@ struct LightsFrame {
   void prepare() { pass.prepare(sv::raster::PassFrame{kWidth, kHeight, 1, nullptr, &pool}); }
   void drawTiles() {
     for (int t = 0; t < fb.tileCount(); ++t)
-      pass.seeTile(sv::raster::neighbourhoodIn(fb, t % fb.tilesX(), t / fb.tilesX(), 0));
+      pass.seeTile({t % fb.tilesX(), t / fb.tilesX(), fb.tileDepth(t), fb.tileColor(t), 0});
     for (int t = 0; t < fb.tileCount(); ++t)
       pass.drawTile({t % fb.tilesX(), t / fb.tilesX(), fb.tileDepth(t), fb.tileColor(t), 0});
   }

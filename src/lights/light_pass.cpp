@@ -3,6 +3,7 @@
 #include "lights/light_pass.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -33,6 +34,32 @@ void starAxesOf(const LightInput& in, Vec3 axes[3]) {
 
 // A star's direction in the world from its equatorial direction.
 Vec3 starWorld(const Vec3 axes[3], Vec3 e) { return axes[0] * e.x + axes[1] * e.y + axes[2] * e.z; }
+
+// A tile's border as seeTile keeps it: its outermost pixels (the outer ring: 252) with every
+// sample, then the ring inside them (244) with the first. A light centred on the outer ring reads
+// its centre's samples and the first sample of the eight around it — on the two rings, or on the
+// next tile's outer ring; one centred inside reads its own tile only.
+constexpr int kOuterRing = 4 * kTileSize - 4, kInnerRing = 4 * (kTileSize - 2) - 4;
+size_t borderFloats(int samples) { return size_t(kOuterRing) * size_t(samples) + kInnerRing; }
+bool onOuterRing(int lx, int ly) {
+  return lx == 0 || ly == 0 || lx == kTileSize - 1 || ly == kTileSize - 1;
+}
+// Per tile-local pixel (row-major): its slot on the outer ring (0 … 251), on the inner one
+// (252 … 495), or −1.
+const int16_t* borderSlots() {
+  static const auto slots = [] {
+    std::array<int16_t, raster::kTilePixels> s;
+    int16_t outer = 0, inner = kOuterRing;
+    for (int ly = 0; ly < kTileSize; ++ly)
+      for (int lx = 0; lx < kTileSize; ++lx) {
+        const bool onInner = lx == 1 || ly == 1 || lx == kTileSize - 2 || ly == kTileSize - 2;
+        int16_t& slot = s[size_t(ly * kTileSize + lx)];
+        slot = onOuterRing(lx, ly) ? outer++ : onInner ? inner++ : int16_t(-1);
+      }
+    return s;
+  }();
+  return slots.data();
+}
 
 }  // namespace
 
@@ -187,6 +214,7 @@ void LightPass::prepare(const raster::PassFrame& frame) {
   // Every drawn splat's visibility is written (seeTile, exchange) before it is read.
   visible_.resize(total);
   entryVisible_.resize(tileSplats_.size());
+  if (!frame.share.shared()) borders_.resize(tiles_ * borderFloats(frame.samples));
   prepareMs_ = core::msSince(t0);
 }
 
@@ -194,6 +222,20 @@ std::vector<Splat> LightPass::splats() const {
   std::vector<Splat> all;
   for (const std::vector<Splat>& c : chunks_) all.insert(all.end(), c.begin(), c.end());
   return all;
+}
+
+float LightPass::visibilityFromBorders(const Splat& s) const {
+  const int n = frame_.samples;
+  const size_t stride = borderFloats(n);
+  const int16_t* slots = borderSlots();
+  return visibilityFrom(s, [&](int x, int y, int k) {
+    const size_t tile = size_t((y >> kTileLog2) * tilesX_ + (x >> kTileLog2));
+    const int slot = slots[(y & (kTileSize - 1)) * kTileSize + (x & (kTileSize - 1))];
+    const float* border = &borders_[tile * stride];
+    // Only the outer ring keeps more than the first sample (visibilityFrom reads the others at
+    // the centre alone).
+    return slot < kOuterRing ? border[slot * n + k] : border[kOuterRing * n + slot - kOuterRing];
+  });
 }
 
 float LightPass::visibilityFromProbes(const Splat& s) const {
@@ -284,32 +326,50 @@ Status LightPass::exchange() {
   return s;
 }
 
-void LightPass::seeTile(const raster::TileNeighbourhood& tiles) {
+void LightPass::seeTile(const raster::TileTarget& tile) {
   if (frame_.share.shared()) return;  // exchange() saw every splat
   const auto t0 = core::Clock::now();
   const int n = frame_.samples;
-  const auto depthAt = [&](int x, int y, int k) {
-    return tiles.tileHolding(x, y)[FrameBuffer::depthOffset(x, y, n, k)];
+  const size_t t = size_t(tile.tileY * tilesX_ + tile.tileX);
+  // The border, for the lights of the tiles around that are centred on it (drawTile): the outer
+  // ring's pixels are the rows 0 and 63 and the columns 0 and 63; the inner ring's inside them.
+  float* border = &borders_[t * borderFloats(n)];
+  const int16_t* slots = borderSlots();
+  const auto keep = [&](int lx, int ly) {
+    const int slot = slots[ly * kTileSize + lx];
+    if (slot < kOuterRing)
+      for (int k = 0; k < n; ++k)
+        border[slot * n + k] = tile.depth[FrameBuffer::depthOffset(lx, ly, n, k)];
+    else
+      border[kOuterRing * n + slot - kOuterRing] = tile.depth[FrameBuffer::depthOffset(lx, ly, n)];
   };
-  // The tile's splats whose centre pixel (clamped into the frame, as visibilityFrom clamps it)
-  // it holds: every splat reaches the tile of its clamped centre.
-  const size_t t = size_t(tiles.tileY * tilesX_ + tiles.tileX);
+  for (const int ly : {0, 1, kTileSize - 2, kTileSize - 1})
+    for (int lx = 0; lx < kTileSize; ++lx) keep(lx, ly);
+  for (int ly = 2; ly < kTileSize - 2; ++ly)
+    for (const int lx : {0, 1, kTileSize - 2, kTileSize - 1}) keep(lx, ly);
+  // The visibility of the tile's splats centred inside its border: every splat reaches the tile
+  // of its centre pixel (clamped into the frame, as visibilityFrom clamps it).
   const std::span<const Splat> splats = tileSplats_.tile(t);
   float* entry = &entryVisible_[tileSplats_.first(t)];
-  const auto inTile = [](float c, float r, int tile) {
-    return floorToInt(c - r) >> kTileLog2 == tile && floorToInt(c + r) >> kTileLog2 == tile;
+  const auto inTile = [](float c, float r, int tileAt) {
+    return floorToInt(c - r) >> kTileLog2 == tileAt && floorToInt(c + r) >> kTileLog2 == tileAt;
+  };
+  const auto depthAt = [&](int x, int y, int k) {
+    return tile.depth[FrameBuffer::depthOffset(x, y, n, k)];
   };
   for (size_t i = 0; i < splats.size(); ++i) {
     const Splat& s = splats[i];
     const int cx = std::clamp(floorToInt(s.x), 0, frame_.width - 1);
     const int cy = std::clamp(floorToInt(s.y), 0, frame_.height - 1);
     entry[i] = -1;
-    if ((cx >> kTileLog2) != tiles.tileX || (cy >> kTileLog2) != tiles.tileY) continue;
+    if ((cx >> kTileLog2) != tile.tileX || (cy >> kTileLog2) != tile.tileY ||
+        onOuterRing(cx & (kTileSize - 1), cy & (kTileSize - 1)))
+      continue;
     entry[i] = visibilityFrom(s, depthAt);
-    if (!inTile(s.x, s.radius, tiles.tileX) || !inTile(s.y, s.radius, tiles.tileY))
+    if (!inTile(s.x, s.radius, tile.tileX) || !inTile(s.y, s.radius, tile.tileY))
       visible_[s.light] = entry[i];
   }
-  workerMs_[size_t(tiles.worker)] += core::msSince(t0);
+  workerMs_[size_t(tile.worker)] += core::msSince(t0);
 }
 
 void LightPass::drawTile(const raster::TileTarget& tile) {
@@ -329,7 +389,14 @@ void LightPass::drawTile(const raster::TileTarget& tile) {
   const float* entry = &entryVisible_[tileSplats_.first(t)];
   for (size_t i = 0; i < splats.size(); ++i) {
     const Splat& s = splats[i];
-    const float v = entry[i] >= 0 ? entry[i] : visible_[s.light];
+    float v = entry[i];
+    if (v < 0) {
+      const int cx = std::clamp(floorToInt(s.x), 0, frame_.width - 1);
+      const int cy = std::clamp(floorToInt(s.y), 0, frame_.height - 1);
+      v = !frame_.share.shared() && onOuterRing(cx & (kTileSize - 1), cy & (kTileSize - 1))
+              ? visibilityFromBorders(s)
+              : visible_[s.light];
+    }
     if (!(v > 0)) continue;
     SplatInTile part;
     float kx[kMaxSplatSpan], ky[kMaxSplatSpan];

@@ -6,12 +6,13 @@
 // Per frame (prepare, in parallel over chunks of lights): every light projected, culled (behind
 // the eye, off screen, off, dark, beyond the far plane), its blink, lobe, fog, energy, size and
 // weight sum worked out (lights/light_laws.h), then listed for every tile its splat reaches, in
-// light order. Per tile, once its depth and its neighbours' are final (seeTile): the visibility of
-// every light whose centre pixel it holds, from the depth around that pixel — which may lie in
-// the next tile. Per tile, once every tile around it has been seen (drawTile): its lights' weights,
-// times their visibilities, added into its colour samples. Depth is left as it was. A splat
-// reaches at most 33 px from its centre pixel, so the tiles a tile's lights need are the eight
-// around it (FrameRenderer draws the frame as a wavefront of tiles: docs/lights.md).
+// light order. Per tile, once its depth is final (seeTile): the visibility of every light whose
+// centre pixel lies inside its one-pixel border, from the depth around that pixel — all in the
+// tile — and the border's depth kept. Per tile, once every tile around it has been seen
+// (drawTile): the visibility of its lights centred on a border, from the kept borders, then every
+// light's weights, times its visibility, added into its colour samples. Depth is left as it was.
+// A splat reaches at most 33 px from its centre pixel, so what a tile's lights read lies in the
+// eight tiles around it (FrameRenderer draws the frame as a wavefront: docs/lights.md).
 #pragma once
 
 #include <span>
@@ -76,7 +77,7 @@ class LightPass final : public raster::TilePass {
   // pixel's samples and the first sample of the eight around it — from the parts that drew them;
   // then every splat's visibility (seeTile does nothing).
   Status exchange() override;
-  void seeTile(const raster::TileNeighbourhood& tiles) override;
+  void seeTile(const raster::TileTarget& tile) override;
   void drawTile(const raster::TileTarget& tile) override;
   void addStats(FrameStats& stats) const override;
 
@@ -100,6 +101,8 @@ class LightPass final : public raster::TilePass {
   float visibilityFrom(const Splat& s, DepthAt&& depthAt) const;
   // The same from a shared frame's exchanged probes.
   float visibilityFromProbes(const Splat& s) const;
+  // The same, for a splat centred on its tile's outermost pixels, from the borders seeTile kept.
+  float visibilityFromBorders(const Splat& s) const;
   // A shared frame's probes per splat: the centre pixel's n samples, then these (the eight
   // neighbours' first samples).
   static constexpr int kNeighbourProbes = 8;
@@ -117,10 +120,14 @@ class LightPass final : public raster::TilePass {
   size_t tiles_ = 0;
   raster::TileLists<Splat> tileSplats_;  // every tile's splats, in light order
   // Visibilities (seeTile), for drawTile: per list entry, a splat's whose centre tile is the list's
-  // own, read in list order — or −1, then the splat's in visible_ (per candidate; written only for
-  // splats that reach beyond their centre tile, so the workers seldom share its lines).
+  // own and centre pixel inside its border, read in list order — or −1: then the splat's in
+  // visible_ (per candidate; written only for splats that reach beyond their centre tile, so the
+  // workers seldom share its lines), or, centred on a border, worked out from borders_.
   std::vector<float> entryVisible_;
   std::vector<float> visible_;
+  // Per tile (seeTile): the depth of its outermost pixels, every sample, then of the ring inside
+  // them, the first sample — what a border-centred light's visibility reads (light_pass.cpp).
+  std::vector<float> borders_;
   std::vector<double> workerMs_;
   double prepareMs_ = 0, exchangeMs_ = 0;
   uint64_t candidates_ = 0;

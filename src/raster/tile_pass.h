@@ -11,7 +11,6 @@
 
 #include "core/thread_pool.h"
 #include "raster/coverage_masks.h"
-#include "raster/framebuffer.h"
 #include "synthvis/frame_stats.h"
 #include "synthvis/result.h"
 #include "synthvis/tile_share.h"
@@ -22,7 +21,7 @@ namespace sv::raster {
 enum class PassStage : uint8_t {
   surfaces,  // after the opaque polygons: opaque surfaces ray cast into the depth (free forms)
   volumes,   // after the surfaces, before the translucent polygons: composited front to back
-  lights,    // last, once the tile's and its neighbours' other passes are done: light points
+  lights,    // last, once the other passes of the tile and the eight around it are done
 };
 
 // What every pass learns of the frame before its tiles are drawn.
@@ -54,37 +53,9 @@ struct TileTarget {
   const float* translucentDepth = nullptr;
 };
 
-// For passes of stage lights (TilePass::seeTile): a tile and the eight around it, their depth
-// final — every other pass done — and read-only.
-struct TileNeighbourhood {
-  int tileX = 0, tileY = 0;
-  // Row by row from (tileX − 1, tileY − 1); depth[4] is the tile's own. nullptr where the tile lies
-  // outside the frame, or — in a shared frame — is another part's.
-  const float* depth[9] = {};
-  int worker = 0;
-
-  // The depth of the tile holding frame pixel (x, y), one of the nine.
-  const float* tileHolding(int x, int y) const {
-    return depth[((y >> kTileLog2) - tileY + 1) * 3 + (x >> kTileLog2) - tileX + 1];
-  }
-};
-
-// The neighbourhood of tile (tileX, tileY) in a whole-frame buffer, of the tiles `share` owns.
-inline TileNeighbourhood neighbourhoodIn(const FrameBuffer& frame, int tileX, int tileY, int worker,
-                                         const TileShare& share = {}) {
-  TileNeighbourhood n{tileX, tileY, {}, worker};
-  for (int dy = -1; dy <= 1; ++dy)
-    for (int dx = -1; dx <= 1; ++dx) {
-      const int x = tileX + dx, y = tileY + dy;
-      if (x >= 0 && y >= 0 && x < frame.tilesX() && y < frame.tilesY() && share.owns(x, y))
-        n.depth[(dy + 1) * 3 + dx + 1] = frame.tileDepth(y * frame.tilesX() + x);
-    }
-  return n;
-}
-
 // The contract (docs/ARCHITECTURE.md): a pass may read and write the tile's depth and colour
-// samples — and nothing else of the frame — through `drawTile` (a pass of stage lights also reads
-// the depth of the tiles around it, through `seeTile`); it leaves depth as the nearest
+// samples — and nothing else of the frame — through `drawTile` (a pass of stage lights may also
+// keep what it reads of a tile's depth in `seeTile`, for the tiles around it); it leaves depth as the nearest
 // surface drawn so far for every sample it writes (passes after it test against it), colour in
 // linear 16-bit light, and samples it does not touch as it found them. The tile's occupancy
 // (masking) is the polygons' alone: a pass does not read it. Output is the same for any thread
@@ -100,11 +71,13 @@ class TilePass {
   // drawTile — where a pass that reads beyond its tile fetches what the other parts drew
   // (PassFrame::share's exchange). Every part calls it for the same passes in the same order.
   virtual Status exchange() { return {}; }
-  // For passes of stage lights, the one read beyond a tile (a light's splat reaches up to 33 px
-  // from its centre pixel, whose depth and its neighbours' decide whether it is seen): once per
-  // tile and frame, when the tile's depth and that of the eight around it are final, and before
-  // drawTile of any of the nine — drawTile of a tile follows seeTile of every tile around it.
-  virtual void seeTile(const TileNeighbourhood& /*tiles*/) {}
+  // For passes of stage lights, whose work in a tile reads the depth of the tiles around it (a
+  // light's splat reaches up to 33 px from its centre pixel, whose depth and its neighbours'
+  // decide whether it is seen): once per tile and frame, on `tile.worker`, when the tile's depth
+  // is final — its other passes done — and before drawTile of it or of any of the eight around
+  // it. The pass keeps what it needs of the depth: it may be gone by drawTile (tile.depth then
+  // nullptr). drawTile of a tile follows seeTile of every tile around it.
+  virtual void seeTile(const TileTarget& /*tile*/) {}
   // Draws the pass into one tile, once per tile and frame, on worker `tile.worker`.
   virtual void drawTile(const TileTarget& tile) = 0;
   // For passes of stage surfaces and volumes: whether drawTile of tile (tileX, tileY) wants

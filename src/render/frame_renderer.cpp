@@ -59,8 +59,8 @@ struct FrameRenderer::Frame {
   // the tiles persist in a whole-frame buffer from batch to batch.
   bool wholeFrame;
   bool lights;  // some pass is of stage lights: they run last, before the sink
-  // Lights in an unshared frame of one batch: each tile drawn in a buffer of its own, seen and lit
-  // as soon as the tiles around it allow (FrameRenderer::tileDrawn).
+  // Lights in an unshared frame of one batch: each tile drawn in a buffer of its own, seen, and lit
+  // as soon as the tiles around it are seen (FrameRenderer::tileDrawn).
   bool wavefront;
   int tilesX, tilesY, tiles;
   // Colour sums (raster::TileWork::sums): each sample written at most once and read by nothing but
@@ -140,8 +140,7 @@ void FrameRenderer::prepareBuffers(const DrawPackets& packets, const Frame& f) {
   scratch_.resize(size_t(pool_.threadCount()));
   for (WorkerScratch& w : scratch_) {
     w.records.resize(f.chunkSize);
-    if (!f.wholeFrame && !f.wavefront)
-      w.tile.resize(raster::kTileSize, raster::kTileSize, f.samples, f.sums);
+    if (!f.wholeFrame) w.tile.resize(raster::kTileSize, raster::kTileSize, f.samples, f.sums);
     if (f.translucentDepth) w.translucent.resize(raster::kTileSize, raster::kTileSize, f.samples);
     if (f.pixelShading && f.samples == 1) w.visible.assign(raster::kTilePixels, ~0u);
     if (f.masking && !f.wholeFrame && !w.occupancy)
@@ -162,7 +161,6 @@ void FrameRenderer::prepareBuffers(const DrawPackets& packets, const Frame& f) {
     for (const DrawCall& call : packets.calls) objects_.push_back(call.bound);
   if (f.wavefront) {
     if (waitTiles_ != size_t(f.tiles)) {
-      unseen_ = std::make_unique<std::atomic<int>[]>(size_t(f.tiles));
       unlit_ = std::make_unique<std::atomic<int>[]>(size_t(f.tiles));
       waitTiles_ = size_t(f.tiles);
     }
@@ -170,7 +168,6 @@ void FrameRenderer::prepareBuffers(const DrawPackets& packets, const Frame& f) {
       const int x = t % f.tilesX, y = t / f.tilesX;
       const int around = (std::min(f.tilesX - 1, x + 1) - std::max(0, x - 1) + 1) *
                          (std::min(f.tilesY - 1, y + 1) - std::max(0, y - 1) + 1);
-      unseen_[size_t(t)].store(around, std::memory_order_relaxed);
       unlit_[size_t(t)].store(around, std::memory_order_relaxed);
     }
     tileBufferOf_.assign(size_t(f.tiles), nullptr);
@@ -205,8 +202,10 @@ Status FrameRenderer::render(const DrawPackets& packets, const FrameSettings& se
   drawnTiles_.clear();
   for (int tile = 0; tile < f.tiles; ++tile)
     if (settings.share.owns(tile % f.tilesX, tile / f.tilesX)) drawnTiles_.push_back(tile);
-  // The wavefront keeps the tiles drawn and not yet lit — those within two lines of tiles of the
-  // front: drawn along the shorter side, the lines are shorter (36 tiles kept at 1920×1080, not 62).
+  // The wavefront keeps the tiles drawn and not yet lit — those within a line of tiles of the
+  // front: drawn along the shorter side, the lines are shorter (18 tiles kept at 1920×1080, not 31).
+  // (Bands of 2, 4 or 8 tiles across, most tiles lit a few after they are drawn, measured the
+  // same at 16 samples.)
   if (f.wavefront && f.tilesY < f.tilesX)
     for (int i = 0; i < f.tiles; ++i)
       drawnTiles_[size_t(i)] = (i % f.tilesY) * f.tilesX + i / f.tilesY;
@@ -243,9 +242,9 @@ Status FrameRenderer::render(const DrawPackets& packets, const FrameSettings& se
     const auto t0 = core::Clock::now();
     pool_.parallelFor(drawnTiles_.size(), [&](size_t i, int worker) {
       const int tile = drawnTiles_[i];
-      const raster::TileNeighbourhood around =
-          raster::neighbourhoodIn(fb_, tile % f.tilesX, tile / f.tilesX, worker, settings.share);
-      for (raster::TilePass* pass : afterTranslucent_) pass->seeTile(around);
+      const raster::TileTarget target{tile % f.tilesX, tile / f.tilesX, fb_.tileDepth(tile),
+                                      fb_.tileColor(tile), worker};
+      for (raster::TilePass* pass : afterTranslucent_) pass->seeTile(target);
     });
     pool_.parallelFor(drawnTiles_.size(), [&](size_t i, int worker) {
       const int tile = drawnTiles_[i];
@@ -365,12 +364,11 @@ void FrameRenderer::drawTile(const FrameSettings& settings, const Frame& f, cons
   raster::TileWork w;
   w.tileX = tile % f.tilesX;
   w.tileY = tile / f.tilesX;
-  raster::FrameBuffer& buffer = f.wholeFrame ? fb_
-                                : f.wavefront
-                                    ? *(tileBufferOf_[size_t(tile)] = takeTileBuffer(f.samples))
-                                    : scratch.tile;
+  raster::FrameBuffer* kept =
+      f.wavefront ? (tileBufferOf_[size_t(tile)] = takeTileBuffer(f.samples, worker)) : nullptr;
+  raster::FrameBuffer& buffer = f.wholeFrame ? fb_ : kept ? *kept : scratch.tile;
   const int index = f.wholeFrame ? tile : 0;
-  w.depth = buffer.tileDepth(index);
+  w.depth = (kept && !settings.depthToSink ? scratch.tile : buffer).tileDepth(index);
   w.color = buffer.tileColor(index);
   if (f.sums) w.sums = buffer.tileSums(index);
   w.clear = batch.first;
@@ -404,56 +402,54 @@ void FrameRenderer::drawTile(const FrameSettings& settings, const Frame& f, cons
   w.opaqueDone = &opaqueDone_[size_t(tile)];
   raster::rasterizeTile(w, tileStats_[size_t(tile)]);
   if (!batch.last) return;
-  if (f.wavefront)
+  if (f.wavefront) {
+    const raster::TileTarget target{w.tileX, w.tileY, w.depth, w.color, worker};
+    for (raster::TilePass* pass : afterTranslucent_) pass->seeTile(target);
     tileDrawn(settings, f, tile, worker);
-  else if (!f.lights)
+  } else if (!f.lights) {
     finishTile(settings, tile, w.depth, w.color, w.sums, worker);
+  }
 }
 
-// The wavefront (docs/lights.md): a tile is seen once the 3×3 tiles around it are drawn, and lit
-// once the 3×3 around it are seen — so the tiles kept are those drawn and not yet lit, about two
-// rows of them. Whichever thread completes a tile's neighbourhood does its work; the counts' acq_rel
-// order the drawn depth and colour, and the seen visibilities, before what reads them. What a tile
-// gets never depends on which thread that is.
+// The wavefront (docs/lights.md): a tile is seen as soon as it is drawn, and lit once the 3×3
+// tiles around it are seen — so the tiles kept are those drawn and not yet lit, about a line of
+// them. Whichever thread completes a tile's neighbourhood lights it; the count's acq_rel orders
+// the drawn colour, and what the passes kept in seeTile, before what reads them. What a tile gets
+// never depends on which thread that is.
 void FrameRenderer::tileDrawn(const FrameSettings& settings, const Frame& f, int tile, int worker) {
-  const auto around = [&](int t, auto&& fn) {
-    const int tx = t % f.tilesX, ty = t / f.tilesX;
-    for (int y = std::max(0, ty - 1); y <= std::min(f.tilesY - 1, ty + 1); ++y)
-      for (int x = std::max(0, tx - 1); x <= std::min(f.tilesX - 1, tx + 1); ++x)
-        fn(y * f.tilesX + x, (y - ty + 1) * 3 + x - tx + 1);
-  };
-  around(tile, [&](int seen, int) {
-    if (unseen_[size_t(seen)].fetch_sub(1, std::memory_order_acq_rel) != 1) return;
-    raster::TileNeighbourhood tiles{seen % f.tilesX, seen / f.tilesX, {}, worker};
-    around(seen, [&](int t, int at) { tiles.depth[at] = tileBufferOf_[size_t(t)]->tileDepth(0); });
-    for (raster::TilePass* pass : afterTranslucent_) pass->seeTile(tiles);
-    around(seen, [&](int lit, int) {
-      if (unlit_[size_t(lit)].fetch_sub(1, std::memory_order_acq_rel) != 1) return;
+  const int tx = tile % f.tilesX, ty = tile / f.tilesX;
+  for (int y = std::max(0, ty - 1); y <= std::min(f.tilesY - 1, ty + 1); ++y)
+    for (int x = std::max(0, tx - 1); x <= std::min(f.tilesX - 1, tx + 1); ++x) {
+      const int lit = y * f.tilesX + x;
+      if (unlit_[size_t(lit)].fetch_sub(1, std::memory_order_acq_rel) != 1) continue;
       raster::FrameBuffer* buffer = tileBufferOf_[size_t(lit)];
-      finishTile(settings, lit, buffer->tileDepth(0), buffer->tileColor(0), nullptr, worker);
-      giveTileBuffer(buffer);
-    });
-  });
+      finishTile(settings, lit, settings.depthToSink ? buffer->tileDepth(0) : nullptr,
+                 buffer->tileColor(0), nullptr, worker);
+      giveTileBuffer(buffer, worker);
+    }
 }
 
-raster::FrameBuffer* FrameRenderer::takeTileBuffer(int samples) {
-  raster::FrameBuffer* buffer;
+raster::FrameBuffer* FrameRenderer::takeTileBuffer(int samples, int worker) {
+  raster::FrameBuffer* buffer = nullptr;
   {
     std::lock_guard lock(tileBuffersMutex_);
-    if (freeTileBuffers_.empty()) {
-      buffer = tileBuffers_.emplace_back(std::make_unique<raster::FrameBuffer>()).get();
-    } else {
-      buffer = freeTileBuffers_.back();
-      freeTileBuffers_.pop_back();
+    freeTileBuffers_.resize(std::max(freeTileBuffers_.size(), size_t(pool_.threadCount())));
+    for (int k = 0; k < pool_.threadCount() && !buffer; ++k) {
+      std::vector<raster::FrameBuffer*>& free =
+          freeTileBuffers_[size_t((worker + k) % pool_.threadCount())];
+      if (free.empty()) continue;
+      buffer = free.back();
+      free.pop_back();
     }
+    if (!buffer) buffer = tileBuffers_.emplace_back(std::make_unique<raster::FrameBuffer>()).get();
   }
   buffer->resize(raster::kTileSize, raster::kTileSize, samples);  // allocates only when it grows
   return buffer;
 }
 
-void FrameRenderer::giveTileBuffer(raster::FrameBuffer* buffer) {
+void FrameRenderer::giveTileBuffer(raster::FrameBuffer* buffer, int worker) {
   std::lock_guard lock(tileBuffersMutex_);
-  freeTileBuffers_.push_back(buffer);
+  freeTileBuffers_[size_t(worker)].push_back(buffer);
 }
 
 // A drawn tile's last passes (stage lights) and its sink.

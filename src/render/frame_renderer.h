@@ -39,6 +39,11 @@ struct FrameSettings {
   // nothing; otherwise `sums` is nullptr). This is the only way out of the frame: the storage is
   // reused for the next tile as soon as the call returns.
   TileSink finishTile;
+  // finishTile reads the tiles' depth. Without it, a frame with light points lets each tile's
+  // depth go once the lights have kept what they need of it (raster::TilePass::seeTile) — it is
+  // then drawn in a per-thread buffer that stays in the core's cache — and hands finishTile
+  // nullptr for depth.
+  bool depthToSink = true;
   // finishTile can take colour sums (it needs no more than each pixel's mean: a box resolve).
   // They are used when the frame allows — anti-aliased priority masking, every triangle opaque,
   // no pass besides the polygons, no occupancy view (raster::TileWork::sums) — and save writing,
@@ -100,12 +105,14 @@ class FrameRenderer {
                 int worker);
   void finishTile(const FrameSettings& settings, int tile, float* depth, uint16_t* color,
                   int32_t* sums, int worker);
-  // A frame with light points drawn as a wavefront (Frame::wavefront): tile `tile` is drawn; the
-  // tiles around it that this completes are seen, and those whose neighbourhood that completes
-  // get their lights and go to the sink.
+  // A frame with light points drawn as a wavefront (Frame::wavefront): tile `tile` is drawn and
+  // seen; the tiles around it whose neighbourhood that completes get their lights and go to the
+  // sink.
   void tileDrawn(const FrameSettings& settings, const Frame& f, int tile, int worker);
-  raster::FrameBuffer* takeTileBuffer(int samples);
-  void giveTileBuffer(raster::FrameBuffer* buffer);
+  // A buffer of the pool: the one `worker` gave back last (still in its core's cache), else
+  // another's, else a new one.
+  raster::FrameBuffer* takeTileBuffer(int samples, int worker);
+  void giveTileBuffer(raster::FrameBuffer* buffer, int worker);
   void addTileStats(FrameStats& stats) const;
 
   core::ThreadPool pool_;
@@ -136,15 +143,16 @@ class FrameRenderer {
   std::vector<SetupCounts> chunkCounts_;  // the batch's, per chunk
   std::vector<uint8_t> opaqueDone_;       // per tile: the afterOpaque passes have run
   std::vector<int> drawnTiles_;           // the tiles this part draws (every tile unshared)
-  // Frames with light points and one batch (Frame::wavefront): each tile drawn in a buffer of its
-  // own, kept until its lights are drawn — only the wavefront's tiles at once, about two rows.
+  // Frames with light points and one batch (Frame::wavefront): each tile's colour (and depth, for a
+  // sink that reads it) drawn in a buffer of its own, kept until its lights are drawn — only the
+  // wavefront's tiles at once, about a line of them.
   std::vector<std::unique_ptr<raster::FrameBuffer>> tileBuffers_;  // every one made, kept
-  std::vector<raster::FrameBuffer*> freeTileBuffers_;
+  std::vector<std::vector<raster::FrameBuffer*>> freeTileBuffers_;  // per worker
   std::mutex tileBuffersMutex_;
   std::vector<raster::FrameBuffer*> tileBufferOf_;  // per tile: the one it is drawn in
-  // Per tile: how many tiles of its 3×3 neighbourhood are still to be drawn (before it is seen),
-  // and how many still to be seen (before its lights are drawn).
-  std::unique_ptr<std::atomic<int>[]> unseen_, unlit_;
+  // Per tile: how many tiles of its 3×3 neighbourhood are still to be drawn and seen (before its
+  // lights are drawn).
+  std::unique_ptr<std::atomic<int>[]> unlit_;
   size_t waitTiles_ = 0;  // their size
   // FrameSettings::passes by stage: those that run once a tile's opaque triangles are in, and
   // those after its last triangle.

@@ -83,6 +83,7 @@ Status ViewRenderer::run(const scene::Scene& scene, const RenderOptions& o,
   FrameSettings& fs = settings.value();
   ResolveSink sink(o, gamma_, linear_, image, linearOut);
   fs.finishTile = sink.finishTile((fs.width + raster::kTileSize - 1) >> raster::kTileLog2);
+  fs.depthToSink = false;  // the resolve reads colour alone
   fs.colorSums = sink.takesColorSums();
   fs.passes = passes_.compose(scene, o, camera, shading_);
   fs.share = share;

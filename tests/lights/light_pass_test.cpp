@@ -22,17 +22,27 @@ using raster::kTileSize;
 
 // A bare frame: depth at the far plane, colour black; the pass drawn into every tile.
 struct BareFrame {
-  explicit BareFrame(int w, int h) : pool(2) { fb.resize(w, h); clear(); }
+  explicit BareFrame(int w, int h, int samples = 1) : pool(2) {
+    fb.resize(w, h, samples);
+    clear();
+  }
   void clear() {
-    for (int t = 0; t < fb.tileCount(); ++t) {
-      std::fill_n(fb.tileDepth(t), raster::kTilePixels, 1.0f);
-      std::fill_n(fb.tileColor(t), raster::kTilePixels * 3, uint16_t(0));
-    }
+    for (int t = 0; t < fb.tileCount(); ++t)
+      std::fill_n(fb.tileDepth(t), raster::kTilePixels * fb.samples(), 1.0f);
+    clearColor();
+  }
+  void clearColor() {
+    for (int t = 0; t < fb.tileCount(); ++t)
+      std::fill_n(fb.tileColor(t), raster::kTilePixels * 3 * fb.samples(), uint16_t(0));
+  }
+  float& depth(int x, int y, int k) {
+    return fb.tileDepth((y / kTileSize) * fb.tilesX() +
+                        x / kTileSize)[FrameBuffer::depthOffset(x, y, fb.samples(), k)];
   }
   void draw(lights::LightPass& pass) {
-    pass.prepare(raster::PassFrame{fb.width(), fb.height(), 1, nullptr, &pool});
+    pass.prepare(raster::PassFrame{fb.width(), fb.height(), fb.samples(), nullptr, &pool});
     for (int t = 0; t < fb.tileCount(); ++t)
-      pass.seeTile(raster::neighbourhoodIn(fb, t % fb.tilesX(), t / fb.tilesX(), 0));
+      pass.seeTile({t % fb.tilesX(), t / fb.tilesX(), fb.tileDepth(t), fb.tileColor(t), 0});
     for (int t = 0; t < fb.tileCount(); ++t)
       pass.drawTile({t % fb.tilesX(), t / fb.tilesX(), fb.tileDepth(t), fb.tileColor(t), 0});
   }
@@ -42,7 +52,8 @@ struct BareFrame {
     for (int y = 0; y < fb.height(); ++y)
       for (int x = 0; x < fb.width(); ++x) {
         const int t = (y / kTileSize) * fb.tilesX() + x / kTileSize;
-        sum += fb.tileColor(t)[FrameBuffer::colorOffset(x, y, ch)];
+        for (int k = 0; k < fb.samples(); ++k)
+          sum += fb.tileColor(t)[FrameBuffer::colorOffset(x, y, ch, fb.samples(), k)];
       }
     return sum;
   }
@@ -93,6 +104,90 @@ TEST(LightPass, EnergyIsKeptBelowTheMinimumSizeWhereverTheLightFalls) {
   EXPECT_GE(lo, expected - 4.5);
   EXPECT_LE(hi, expected + 4.5);
   EXPECT_LT((hi - lo) / expected, 0.01) << "lo " << lo << " hi " << hi << " of " << expected;
+}
+
+// A light's visibility reads its centre pixel and the eight around it (docs/lights.md); centred on
+// a tile's outermost pixels, some of those lie in the next tile, and the pass reads them from the
+// border that tile's seeTile kept. Depth: a wall at eye depth 5 in front of the lights (at 20), with
+// holes (the far plane) scattered over the pixels around the tile edges — whole pixels, and with
+// 4 samples some pixels whose odd samples alone are holes. By the rule, a light is seen whole when
+// one of the nine pixels' first sample differs from the centre's (the spread), else in the share
+// of its centre's samples that are holes.
+TEST(LightPass, ALightOnATileEdgeIsSeenThroughTheDepthAcrossIt) {
+  constexpr int size = 192;  // 3 × 3 tiles; the edges at 64 and 128
+  for (const int samples : {1, 4}) {
+    BareFrame f(size, size, samples);
+    std::vector<scene::LightAppearance> looks(1);
+    looks[0].intensity = 1;
+    std::vector<scene::LightPoint> points(1);
+    lights::LightInput in = cameraInput(size, size);
+    in.appearances = looks;
+    in.points = points;
+    in.settings.exposure = 400 * 400;  // a few pixels wide at depth 20
+    const Vec4 wall = in.projection * Vec4{0, 0, -5, 1};
+    const float wallDepth = (wall.z / wall.w + 1) / 2;
+    // Where a light is centred at pixel (x, y): the point at eye depth 20 projecting there.
+    const auto at = [&](int x, int y) {
+      return Vec3{(float(x) + 0.5f) / (size / 2.0f) - 1, 1 - (float(y) + 0.5f) / (size / 2.0f),
+                  -1} *
+             20;
+    };
+    const auto drawLight = [&](int x, int y) {
+      points[0].position = at(x, y);
+      lights::LightPass pass;
+      pass.setLights(in);
+      f.clearColor();
+      f.draw(pass);
+      return f.total(0);
+    };
+    // The lights, centred on pixels within two of a tile edge, and each one's total with nothing in
+    // front of it.
+    std::vector<std::pair<int, int>> centres;
+    for (const int edge : {64, 128})
+      for (int across = edge - 2; across <= edge + 1; ++across)
+        for (int along = 56; along < 136; along += 3) {
+          centres.push_back({across, along});
+          centres.push_back({along, across});
+        }
+    std::vector<double> whole;
+    for (const auto& [x, y] : centres) whole.push_back(drawLight(x, y));
+    uint32_t seed = 11;
+    const auto next = [&] { return (seed = seed * 1664525u + 1013904223u) >> 8 & 0xffff; };
+    for (int y = 0; y < size; ++y)
+      for (int x = 0; x < size; ++x) {
+        const uint32_t r = next() % 8;  // 0: a hole, 1: odd samples holes (4 samples), else wall
+        for (int k = 0; k < samples; ++k)
+          f.depth(x, y, k) = r == 0 || (r == 1 && k % 2 == 1) ? 1.0f : wallDepth;
+      }
+    int seen = 0, hidden = 0, part = 0;
+    for (size_t i = 0; i < centres.size(); ++i) {
+      const auto [x, y] = centres[i];
+      bool spread = false;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) spread |= f.depth(x + dx, y + dy, 0) != f.depth(x, y, 0);
+      int holes = 0;
+      for (int k = 0; k < samples; ++k) holes += f.depth(x, y, k) == 1.0f;
+      const double got = drawLight(x, y);
+      SCOPED_TRACE(testing::Message() << samples << " samples, light at " << x << ", " << y);
+      ASSERT_GT(whole[i], 0);
+      if (spread || holes == samples) {
+        EXPECT_EQ(got, whole[i]);
+        ++seen;
+      } else if (holes == 0) {
+        EXPECT_EQ(got, 0);
+        ++hidden;
+      } else {
+        EXPECT_GT(got, 0);
+        EXPECT_LT(got, whole[i]);
+        ++part;
+      }
+    }
+    EXPECT_GT(seen, 20);
+    EXPECT_GT(hidden, 20);
+    if (samples > 1) {
+      EXPECT_GT(part, 5);
+    }
+  }
 }
 
 TEST(LightPass, SizeAndEnergyFollowDistanceAndFog) {

@@ -77,7 +77,7 @@ Frame renderQuadtree(const render::DrawPackets& p, const render::FrameSettings& 
       for (int x = x0; x < std::min(s.width, x0 + raster::kTileSize); ++x) {
         for (int k = 0; k < n; ++k) {
           const size_t i = (size_t(y) * s.width + x) * n + k;
-          f.depth[i] = depth[raster::FrameBuffer::depthOffset(x, y, n, k)];
+          if (depth) f.depth[i] = depth[raster::FrameBuffer::depthOffset(x, y, n, k)];
           for (int ch = 0; ch < 3; ++ch)
             f.color[i * 3 + ch] = color[raster::FrameBuffer::colorOffset(x, y, ch, n, k)];
         }
