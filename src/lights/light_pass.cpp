@@ -61,7 +61,47 @@ const int16_t* borderSlots() {
   return slots.data();
 }
 
+// A point's laws seen from `eye`: off (energy < 0) when its group is off, it is blinked out or at
+// the eye; else its on-screen energy and colour.
+LightLaws::Point pointLaw(const LightInput& in, const scene::LightPoint& p, Vec3 eye,
+                          const LobeTangents& tangents) {
+  LightLaws::Point law;
+  float dim = 1;
+  if (p.group >= 0) {
+    const scene::LightGroup& g = in.groups[size_t(p.group)];
+    if (!g.on) return law;
+    dim = g.dim;
+  }
+  const scene::LightAppearance& a = in.appearances[p.appearance];
+  if (!blinkOn(a.blink, p.phase, in.time)) return law;
+  const Vec3 toEye = eye - p.position;
+  const float d = length(toEye);
+  if (!(d > 0)) return law;
+  const Vec3 color = appearanceColor(a, lobeAxis(a, p.phase, in.time), toEye * (1 / d), tangents);
+  const float transmission = fogTransmission(in.fogBeta, in.settings.punchThrough, d);
+  law.energy = screenEnergy(in.settings.exposure, a.intensity * dim, transmission, d);
+  law.r = color.x, law.g = color.y, law.b = color.z;
+  return law;
+}
+
+std::vector<LobeTangents> lobeTangentsOf(const LightInput& in) {
+  std::vector<LobeTangents> t;
+  for (const scene::LightAppearance& a : in.appearances)
+    t.push_back(lobeTangents(a.horizontalLobe, a.verticalLobe));
+  return t;
+}
+
 }  // namespace
+
+Vec3 viewEye(const Mat4& v) {
+  Vec3 eye;
+  for (int j = 0; j < 3; ++j) {
+    double e = 0;
+    for (int i = 0; i < 3; ++i) e -= double(v.m[j][i]) * double(v.m[3][i]);
+    (j == 0 ? eye.x : j == 1 ? eye.y : eye.z) = float(e);
+  }
+  return eye;
+}
 
 void lightEyePositions(const LightInput& in, std::vector<Vec4>& out) {
   out.clear();
@@ -77,6 +117,19 @@ void lightEyePositions(const LightInput& in, std::vector<Vec4>& out) {
   }
 }
 
+void LightLaws::compute(const LightInput& in, core::ThreadPool& pool) {
+  eye_ = viewEye(in.view);
+  const std::vector<LobeTangents> tangents = lobeTangentsOf(in);
+  points_.resize(in.points.size());
+  const size_t chunks = (points_.size() + kChunk - 1) / kChunk;
+  pool.parallelFor(chunks, [&](size_t c, int) {
+    for (size_t i = c * kChunk; i < std::min(points_.size(), (c + 1) * kChunk); ++i) {
+      const scene::LightPoint& p = in.points[i];
+      points_[i] = pointLaw(in, p, eye_, tangents[p.appearance]);
+    }
+  });
+}
+
 void LightPass::setLights(const LightInput& input) { in_ = input; }
 
 float LightPass::eyeDepthOf(float windowDepth) const {
@@ -84,15 +137,11 @@ float LightPass::eyeDepthOf(float windowDepth) const {
   return m32_ / (2 * windowDepth - 1 + m22_);
 }
 
-bool LightPass::projectPoint(const scene::LightPoint& p, SizeBatch& batch, int i) const {
-  float dim = 1;
-  if (p.group >= 0) {
-    const scene::LightGroup& g = in_.groups[size_t(p.group)];
-    if (!g.on) return false;
-    dim = g.dim;
-  }
-  const scene::LightAppearance& a = in_.appearances[p.appearance];
-  if (!blinkOn(a.blink, p.phase, in_.time)) return false;
+bool LightPass::projectPoint(size_t index, SizeBatch& batch, int i) const {
+  const scene::LightPoint& p = in_.points[index];
+  const LightLaws::Point law =
+      in_.laws ? in_.laws->point(index) : pointLaw(in_, p, eye_, lobeTangents_[p.appearance]);
+  if (law.energy < 0) return false;
   const Vec4 eye = in_.view * Vec4{p.position.x, p.position.y, p.position.z, 1};
   const Vec4 c = in_.projection * eye;
   if (!(c.w > 0) || !(c.z >= -c.w) || !(c.z <= c.w)) return false;  // behind, near, beyond far
@@ -100,14 +149,8 @@ bool LightPass::projectPoint(const scene::LightPoint& p, SizeBatch& batch, int i
   batch.x[i] = (c.x * invW + 1) * 0.5f * float(frame_.width);
   batch.y[i] = (1 - c.y * invW) * 0.5f * float(frame_.height);
   batch.eyeDepth[i] = c.w;  // −eye.z for a window, bit for bit; a sub-frustum cell's axis depth
-  const Vec3 toEye = eye_ - p.position;
-  const float d = length(toEye);
-  if (!(d > 0)) return false;
-  const Vec3 color = appearanceColor(a, lobeAxis(a, p.phase, in_.time), toEye * (1 / d),
-                                     lobeTangents_[p.appearance]);
-  const float transmission = fogTransmission(in_.fogBeta, in_.settings.punchThrough, d);
-  batch.energy[i] = screenEnergy(in_.settings.exposure, a.intensity * dim, transmission, d);
-  batch.r[i] = color.x, batch.g[i] = color.y, batch.b[i] = color.z;
+  batch.energy[i] = law.energy;
+  batch.r[i] = law.r, batch.g[i] = law.g, batch.b[i] = law.b;
   return true;
 }
 
@@ -152,7 +195,7 @@ void LightPass::projectRange(size_t begin, size_t end, std::vector<Splat>& out) 
   };
   for (size_t k = begin; k < end; ++k) {
     const size_t i = in_.subset ? (*in_.subset)[k] : k;
-    const bool projected = i < points ? projectPoint(in_.points[i], batch, count)
+    const bool projected = i < points ? projectPoint(i, batch, count)
                                       : projectStar(in_.stars->stars[i - points], batch, count);
     if (!projected) continue;
     light[count] = uint32_t(k);
@@ -177,16 +220,8 @@ void LightPass::prepare(const raster::PassFrame& frame) {
   frame_ = frame;
   exchangeMs_ = 0;
   probes_.clear();
-  const Mat4& v = in_.view;
-  // The eye: view = [R t], eye = −Rᵀ t.
-  for (int j = 0; j < 3; ++j) {
-    float e = 0;
-    for (int i = 0; i < 3; ++i) e -= v.m[j][i] * v.m[3][i];
-    (j == 0 ? eye_.x : j == 1 ? eye_.y : eye_.z) = e;
-  }
-  lobeTangents_.clear();
-  for (const scene::LightAppearance& a : in_.appearances)
-    lobeTangents_.push_back(lobeTangents(a.horizontalLobe, a.verticalLobe));
+  eye_ = in_.laws ? in_.laws->eye() : viewEye(in_.view);
+  if (!in_.laws) lobeTangents_ = lobeTangentsOf(in_);
   m22_ = float(depthP22(in_.projection));  // m[2][2] for a window
   m32_ = in_.projection.m[3][2];
   zfar_ = m32_ / (1 + m22_);

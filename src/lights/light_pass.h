@@ -26,6 +26,12 @@
 
 namespace sv::lights {
 
+class LightLaws;
+
+// The eye of a view (world → eye, rigid) in the world, as the pass finds it: −Rᵀ t, in double (so
+// that channels turned from one camera find the same eye).
+Vec3 viewEye(const Mat4& view);
+
 // What the pass needs of the scene and the frame's camera (render fills it; the spans and the
 // star field must outlive the frame).
 struct LightInput {
@@ -43,6 +49,30 @@ struct LightInput {
   // Nothing: every light. The frame is the same as with every light as long as the subset holds
   // every light whose splat reaches the view.
   const std::vector<uint32_t>* subset = nullptr;
+  // The points' laws for this frame, when the caller worked them out once for several views of
+  // one eye (LightLaws; it must outlive the frame): their eye is used, not the view's. Nothing:
+  // worked out here, at the view's eye.
+  const LightLaws* laws = nullptr;
+};
+
+// What a frame's light points are, whatever the view, for one eye (issue 60: worked out once for
+// every display channel that shares it, per channel only the projection): per point, off (its
+// group off, blinked out, at the eye) or its on-screen energy and colour — the lobes, the PAPI
+// split, the fog by range. The same bits as the pass works out for a view whose eye it is.
+class LightLaws {
+ public:
+  struct Point {
+    float energy = -1;  // < 0: off
+    float r = 0, g = 0, b = 0;
+  };
+  // `in`'s points (every one: the subset is not read) at viewEye(in.view), in parallel on `pool`.
+  void compute(const LightInput& in, core::ThreadPool& pool);
+  Vec3 eye() const { return eye_; }
+  const Point& point(size_t i) const { return points_[i]; }
+
+ private:
+  Vec3 eye_;
+  std::vector<Point> points_;
 };
 
 // The eye-frame positions of `in`'s lights under in.view, in the pass's order (the points, then
@@ -90,7 +120,7 @@ class LightPass final : public raster::TilePass {
   // A light's raster position, eye depth, on-screen energy and colour into lane `i` of `batch`
   // (sized and weighed 16 at a time: lights/splat_sizes.h); false where it is culled first
   // (off, blinked out, behind the eye, beyond the far plane, below the star field's limit).
-  bool projectPoint(const scene::LightPoint& p, SizeBatch& batch, int i) const;
+  bool projectPoint(size_t index, SizeBatch& batch, int i) const;
   bool projectStar(const scene::Star& star, SizeBatch& batch, int i) const;
   // Calls f(tile index) for every tile the splat's kernel square reaches.
   template <class F>

@@ -7,6 +7,10 @@
 #include "core/eye_rays.h"
 #include "synthvis/render.h"
 
+namespace sv::lights {
+class LightLaws;
+}
+
 namespace sv::render {
 
 struct FrameCamera {
@@ -26,6 +30,9 @@ struct FrameCamera {
   // The lights this view can show, when its caller culled them for it (lights::LightInput::subset:
   // a sub-frustum cell's, culled for every cell at once); nothing: every light.
   const std::vector<uint32_t>* lightSubset = nullptr;
+  // The light points' laws, when the caller worked them out once for several views sharing this
+  // view's eye (lights::LightInput::laws); nothing: the view works them out.
+  const lights::LightLaws* lightLaws = nullptr;
 };
 
 // The camera's rays through its raster (the terrain and volume passes').

@@ -17,6 +17,7 @@ lights::LightInput lightInput(const scene::Scene& scene, const FrameCamera& came
   in.projection = camera.projection;
   in.fogBeta = scene.fog.enabled ? scene.fog.beta : 0.0f;
   in.subset = camera.lightSubset;
+  in.laws = camera.lightLaws;
   return in;
 }
 

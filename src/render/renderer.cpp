@@ -7,8 +7,10 @@
 #include <optional>
 
 #include "core/timing.h"
+#include "lights/light_pass.h"
 #include "render/camera.h"
 #include "render/correction.h"
+#include "render/passes.h"
 #include "render/view_renderer.h"
 #include "synthvis/render.h"
 
@@ -24,6 +26,7 @@ struct Renderer::Impl {
   std::optional<render::CorrectionRenderer> display;
   render::DisplayFrame displayFrame;
   std::optional<Display> displayDrawn;  // what displayFrame shows (held: its tables stay)
+  lights::LightLaws lightLaws;          // renderChannels': the frame's, for the channels' eye
 };
 
 Renderer::Renderer(const RenderOptions& options) : impl_(std::make_unique<Impl>(options)) {}
@@ -67,6 +70,11 @@ Status Renderer::renderChannels(const scene::Scene& scene, std::vector<Image>& i
   const size_t n = scene.channels.size();
   images.resize(n);
   std::vector<FrameStats> stats(n);
+  // Issue 60: the light points' laws once for the channels that share an eye — those without an
+  // offset, turned from one camera — and per channel only the projection. Worked out anew each
+  // frame (the scene's groups, blinking, fog may have changed), at the camera's eye before the
+  // channel's turn: a view of that camera alone (render) finds the same bits.
+  bool lawsThisFrame = false;
   for (size_t i = 0; i < n; ++i) {
     const auto share = only ? std::find_if(only->begin(), only->end(),
                                            [&](const ChannelShare& c) { return c.channel == int(i); })
@@ -82,8 +90,18 @@ Status Renderer::renderChannels(const scene::Scene& scene, std::vector<Image>& i
       return e;
     }
     const auto start = core::Clock::now();
-    const Result<render::FrameCamera> camera = render::channelCamera(scene, o, channel);
+    Result<render::FrameCamera> camera = render::channelCamera(scene, o, channel);
     if (!camera.ok()) return camera.error();
+    if (!scene.lightPoints.empty() && channel.offset == Vec3{0, 0, 0}) {
+      const Result<render::FrameCamera> base = render::chooseCamera(scene, o);
+      if (!base.ok()) return base.error();
+      const Vec3 eye = lights::viewEye(base.value().view);
+      const Vec3 kept = m.lightLaws.eye();
+      if (!lawsThisFrame || !(eye.x == kept.x && eye.y == kept.y && eye.z == kept.z))
+        m.lightLaws.compute(render::lightInput(scene, base.value()), m.view.pool());
+      lawsThisFrame = true;
+      camera.value().lightLaws = &m.lightLaws;
+    }
     if (Status s = m.view.render(scene, o, camera.value(), images[i], stats[i],
                                  only ? share->tiles : TileShare{});
         !s) {

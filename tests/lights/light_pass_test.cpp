@@ -332,6 +332,55 @@ TEST(LightPass, FramesAreBitIdenticalForAnyThreadCount) {
   }
 }
 
+// Issue 60 item 3: the laws worked out once (LightLaws, for every channel that shares the eye) give
+// the splats each view works out itself, bit for bit — groups off and dimmed, blinking, lobes, fog —
+// for every light and for a subset.
+TEST(LightPass, LawsWorkedOutOnceGiveTheSplatsEachViewWorksOut) {
+  scene::Scene s = manyLights();
+  s.lightGroups = {{"dimmed", true, 0.4f}, {"off", false, 1}};
+  for (size_t i = 0; i < s.lightPoints.size(); ++i) s.lightPoints[i].group = int32_t(i % 3) - 1;
+  BareFrame f(300, 170);
+  lights::LightInput in = cameraInput(300, 170);
+  in.view = Mat4::lookAt({0, 1, 5}, {0.5f, 0, -20}, {0, 1, 0});
+  in.appearances = s.lightAppearances;
+  in.points = s.lightPoints;
+  in.groups = s.lightGroups;
+  in.settings = s.lightSettings;
+  in.fogBeta = 0.01f;
+  in.time = 0.3;
+  std::vector<uint32_t> subset;
+  for (uint32_t i = 0; i < s.lightPoints.size(); i += 3) subset.push_back(i);
+  lights::LightLaws laws;
+  laws.compute(in, f.pool);
+  for (const bool some : {false, true}) {
+    in.subset = some ? &subset : nullptr;
+    std::vector<lights::Splat> splats[2];
+    std::vector<uint16_t> color[2];
+    for (const bool shared : {false, true}) {
+      in.laws = shared ? &laws : nullptr;
+      lights::LightPass pass;
+      pass.setLights(in);
+      f.clear();
+      f.draw(pass);
+      splats[shared] = pass.splats();
+      color[shared].assign(f.fb.tileColor(0),
+                           f.fb.tileColor(0) + raster::kTilePixels * 3 * f.fb.tileCount());
+    }
+    SCOPED_TRACE(some ? "a subset" : "every light");
+    ASSERT_EQ(splats[0].size(), splats[1].size());
+    EXPECT_GT(splats[0].size(), some ? 1000u : 3000u);
+    for (size_t i = 0; i < splats[0].size(); ++i) {
+      const lights::Splat &a = splats[0][i], &b = splats[1][i];
+      ASSERT_EQ(a.light, b.light);
+      EXPECT_EQ(a.x, b.x);
+      EXPECT_EQ(a.y, b.y);
+      EXPECT_EQ(a.radius, b.radius);
+      for (int ch = 0; ch < 3; ++ch) EXPECT_EQ(a.rgb[ch], b.rgb[ch]) << "light " << a.light;
+    }
+    EXPECT_TRUE(color[0] == color[1]);
+  }
+}
+
 TEST(LightPass, GroupsSwitchAndDim) {
   scene::Scene s = manyLights();
   s.lightGroups = {{"all", true, 1}};
