@@ -385,7 +385,7 @@ void LightPass::seeTile(const raster::TileTarget& tile) {
   // The visibility of the tile's splats centred inside its border: every splat reaches the tile
   // of its centre pixel (clamped into the frame, as visibilityFrom clamps it).
   const std::span<const Splat> splats = tileSplats_.tile(t);
-  float* entry = &entryVisible_[tileSplats_.first(t)];
+  float* entry = entryVisible_.data() + tileSplats_.first(t);
   const auto inTile = [](float c, float r, int tileAt) {
     return floorToInt(c - r) >> kTileLog2 == tileAt && floorToInt(c + r) >> kTileLog2 == tileAt;
   };
@@ -421,7 +421,7 @@ void LightPass::drawTile(const raster::TileTarget& tile) {
   const char* color = reinterpret_cast<const char*>(tile.color);
   for (size_t b = 0; b < size_t(raster::kTilePixels) * size_t(n) * 6; b += 64)
     __builtin_prefetch(color + b, 1);
-  const float* entry = &entryVisible_[tileSplats_.first(t)];
+  const float* entry = entryVisible_.data() + tileSplats_.first(t);
   for (size_t i = 0; i < splats.size(); ++i) {
     const Splat& s = splats[i];
     float v = entry[i];
