@@ -235,6 +235,24 @@ Result<display::Mpcdi> mpcdiOf(const DisplaySetup& d) {
   return m;
 }
 
+std::shared_ptr<const display::SubFrustumPlan> PlanCache::of(
+    const display::DirectionTable& table, const display::SubFrustumOptions& options,
+    double& madeMs) const {
+  std::lock_guard lock(mutex_);
+  madeMs = 0;
+  const auto same = [](const display::SubFrustumOptions& a, const display::SubFrustumOptions& b) {
+    return a.boundPixels == b.boundPixels && a.minCellSize == b.minCellSize && a.znear == b.znear &&
+           a.zfar == b.zfar;
+  };
+  if (!plan_ || !same(options, options_)) {
+    const auto t0 = core::Clock::now();
+    plan_ = std::make_shared<const display::SubFrustumPlan>(display::planSubFrusta(table, options));
+    options_ = options;
+    madeMs = core::msSince(t0);
+  }
+  return plan_;
+}
+
 Status renderDisplay(CorrectionRenderer& renderer, const scene::Scene& scene,
                      const RenderOptions& o, const DisplaySetup& display, DisplayFrame& frame) {
   const Result<FrameCamera> base = chooseCamera(scene, o);
@@ -252,6 +270,15 @@ Status renderDisplay(CorrectionRenderer& renderer, const scene::Scene& scene,
     view.eye = display.eye;
     view.correction = o.correction;
     const auto start = core::Clock::now();
+    // Method (a)'s plan made once for the display, kept from frame to frame.
+    std::shared_ptr<const display::SubFrustumPlan> plan;
+    if (o.correction == RenderOptions::Correction::subFrusta) {
+      display::SubFrustumOptions so;
+      so.znear = base.value().camera.znear;
+      so.zfar = base.value().camera.zfar;
+      plan = p.plan.of(p.table, so, frame.correction[i].planMs);
+      view.plan = plan.get();
+    }
     if (Status s = renderCorrected(renderer, scene, o, base.value(), view, frame.linear[i],
                                    frame.stats[i], frame.correction[i]);
         !s) {

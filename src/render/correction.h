@@ -6,6 +6,8 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -73,9 +75,34 @@ Status renderCorrected(CorrectionRenderer& renderer, const scene::Scene& scene,
 
 // A display of projectors: each one's name, display mapping and blend weights — the demo rig's
 // (analytic) or an MPCDI file's — and the rig's geometry when it is known (for the viewer).
+// A projector's sub-frustum plan, made the first time a frame needs it and then kept: a display's
+// tables never change (synthvis/display.h holds its setup const), and a plan takes 141 ms at
+// 1920×1080 (issue 61). Made again only for another depth range. A copy starts empty (a copied
+// setup's table may be changed).
+class PlanCache {
+ public:
+  PlanCache() = default;
+  PlanCache(const PlanCache&) {}
+  PlanCache& operator=(const PlanCache&) {
+    std::lock_guard lock(mutex_);
+    plan_.reset();
+    return *this;
+  }
+  // The plan of `table` under `options`: kept, or made now (`madeMs` then its time, else 0).
+  std::shared_ptr<const display::SubFrustumPlan> of(const display::DirectionTable& table,
+                                                    const display::SubFrustumOptions& options,
+                                                    double& madeMs) const;
+
+ private:
+  mutable std::mutex mutex_;
+  mutable std::shared_ptr<const display::SubFrustumPlan> plan_;
+  mutable display::SubFrustumOptions options_;
+};
+
 struct ProjectorSetup {
   std::string name;
   display::DirectionTable table;
+  PlanCache plan;                          // method (a)'s plan of `table`
   std::optional<display::BlendMap> alpha;  // the alpha map `blend` comes from, when known
   std::optional<display::BlendWeights> blend;
 };

@@ -18,6 +18,7 @@
 #include "render/correction.h"
 #include "render/view_renderer.h"
 #include "support/test_scenes.h"
+#include "synthvis/display.h"
 #include "synthvis/formats.h"
 #include "synthvis/generators.h"
 #include "synthvis/render.h"
@@ -259,6 +260,44 @@ TEST(SubFrusta, EveryValidPixelIsDrawnOnceInAnyThreadCount) {
   EXPECT_GT(invalid, 0);
   EXPECT_EQ(images[0].rgb, images[1].rgb);
   EXPECT_EQ(images[0].rgb, images[2].rgb);
+}
+
+// Issue 61: a display's plans are made the first frame and kept — the next frames make none and
+// draw the same bytes; a copy of the display's setup starts without them.
+TEST(SubFrusta, ADisplaysPlansAreMadeOnceAndKept) {
+  scene::Scene s = tests::emptyScene(200, {0, 0, 1});
+  s.materials.resize(1);
+  s.materials[0].baseColor = {0.8f, 0.5f, 0.2f, 1};
+  scene::Mesh quad;
+  quad.positions = {{-30, -5, -40}, {30, -5, -40}, {30, 8, -40}, {-30, 8, -40}};
+  quad.indices = {0, 1, 2, 0, 2, 3};
+  quad.material = 0;
+  s.meshes.push_back(quad);
+  s.instances.push_back({0, Mat4{}});
+  const Display display = Display::cylinder(256, 160);
+  RenderOptions o;
+  o.threads = 2;
+  Renderer r(o);
+  std::vector<std::vector<Image>> frames(3);
+  for (size_t f = 0; f < frames.size(); ++f) {
+    std::vector<DisplayStats> stats;
+    ASSERT_TRUE(r.renderDisplay(s, display, frames[f], nullptr, &stats).ok());
+    ASSERT_EQ(stats.size(), 3u);
+    for (const DisplayStats& c : stats) {
+      EXPECT_GT(c.cells, 1);
+      if (f == 0)
+        EXPECT_GT(c.planMs, 0.0) << "the first frame plans";
+      else
+        EXPECT_EQ(c.planMs, 0.0) << "frame " << f << " planned again";
+    }
+    for (size_t i = 0; i < frames[f].size(); ++i) EXPECT_EQ(frames[f][i].rgb, frames[0][i].rgb);
+  }
+  const render::ProjectorSetup copy = display.setup().projectors[0];
+  double madeMs = 0;
+  display::SubFrustumOptions so;
+  so.znear = s.cameras.empty() ? so.znear : s.cameras[0].znear;
+  EXPECT_NE(copy.plan.of(copy.table, so, madeMs), nullptr);
+  EXPECT_GT(madeMs, 0.0) << "a copied setup kept the plan";
 }
 
 TEST(SubFrusta, TheLightCullDrawsEveryCellAsItsOwnPassOverEveryLightWould) {
