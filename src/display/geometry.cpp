@@ -179,6 +179,12 @@ std::optional<Vec3d> viewDirection(const DisplayGeometry& g, double px, double p
   return e;
 }
 
+std::optional<Vec3d> pixelScreenPoint(const DisplayGeometry& g, double px, double py) {
+  Vec3d p{}, e{};
+  if (!traceView(g, frameOf(g.projector), px, py, p, e)) return std::nullopt;
+  return p;
+}
+
 void viewDirections(const DisplayGeometry& g, std::vector<Vec3d>& directions,
                     std::vector<uint8_t>& valid) {
   const int w = g.projector.width, h = g.projector.height;

@@ -84,6 +84,9 @@ PixelView viewOfPixel(const DisplayGeometry& geometry, double px, double py);
 // viewOfPixel's direction in double, before its rounding to float (nothing when the pixel is
 // invalid): for the sub-frustum maps, whose residuals are measured far below float's 6e-8.
 std::optional<Vec3d> viewDirection(const DisplayGeometry& geometry, double px, double py);
+// The screen point pixel (px, py) lights, in double (nothing when it misses the screen): what a
+// moved eye sees the pixel along (the sub-frustum plan's refit, display/subfrustum.h).
+std::optional<Vec3d> pixelScreenPoint(const DisplayGeometry& geometry, double px, double py);
 // viewDirection at every pixel centre, row by row from the top (x fastest); (0, 0, 0) and valid 0
 // where the pixel misses the screen. The projector's rotation and lens are made once, not per
 // pixel.

@@ -71,12 +71,7 @@ bool fitPixels(const DirectionTable& t, const SubFrustumCell& c, int px[4], int 
 }
 
 // Step 2: H from the four pairs, its third row scaled to unit length and facing the directions.
-bool fitMap(const DirectionTable& t, const int px[4], const int py[4], Mat3d& h) {
-  std::array<Vec3d, 4> dirs, pixels;
-  for (size_t k = 0; k < 4; ++k) {
-    dirs[k] = t.directions[t.index(px[k], py[k])];
-    pixels[k] = {px[k] + 0.5, py[k] + 0.5, 1};
-  }
+bool fitMapOn(const std::array<Vec3d, 4>& dirs, const std::array<Vec3d, 4>& pixels, Mat3d& h) {
   const Result<Mat3d> fit = solveHomography(dirs, pixels);
   if (!fit.ok()) return false;  // the valid pixels are collinear, or too few
   h = fit.value();
@@ -89,6 +84,27 @@ bool fitMap(const DirectionTable& t, const int px[4], const int py[4], Mat3d& h)
   return true;
 }
 
+bool fitMap(const DirectionTable& t, const int px[4], const int py[4], Mat3d& h) {
+  std::array<Vec3d, 4> dirs, pixels;
+  for (size_t k = 0; k < 4; ++k) {
+    dirs[k] = t.directions[t.index(px[k], py[k])];
+    pixels[k] = {px[k] + 0.5, py[k] + 0.5, 1};
+  }
+  return fitMapOn(dirs, pixels, h);
+}
+
+// The residual of a map at one pixel centre (cx, cy) for the exact direction d there, in pixels
+// and radians (measure's two figures).
+void residualAt(const Mat3d& map, const Mat3d& inverse, Vec3d d, double cx, double cy,
+                double& pixels, double& radians) {
+  const Vec3d q = map * d;
+  pixels = q.z > 0 ? std::hypot(q.x / q.z - cx, q.y / q.z - cy)
+                   : std::numeric_limits<double>::infinity();
+  Vec3d m = inverse * Vec3d{cx, cy, 1};
+  if (dot(m, Vec3d{map.m[2][0], map.m[2][1], map.m[2][2]}) < 0) m = m * -1;
+  radians = angleBetween(d, m);
+}
+
 // Step 3: the residuals at every valid pixel centre. With `stopAbove` set, returns as soon as one
 // pixel's error exceeds it (the cell will be split: its exact maximum is not needed).
 void measure(const DirectionTable& t, SubFrustumCell& c, const Mat3d& inverse,
@@ -98,15 +114,10 @@ void measure(const DirectionTable& t, SubFrustumCell& c, const Mat3d& inverse,
     for (int x = c.x0; x < c.x1; ++x) {
       const size_t i = t.index(x, y);
       if (!t.valid[i]) continue;
-      const Vec3d d = t.directions[i];
-      const double cx = x + 0.5, cy = y + 0.5;
-      const Vec3d q = c.map * d;
-      const double pixels = q.z > 0 ? std::hypot(q.x / q.z - cx, q.y / q.z - cy)
-                                    : std::numeric_limits<double>::infinity();
-      Vec3d m = inverse * Vec3d{cx, cy, 1};
-      if (dot(m, Vec3d{c.map.m[2][0], c.map.m[2][1], c.map.m[2][2]}) < 0) m = m * -1;
+      double pixels, radians;
+      residualAt(c.map, inverse, t.directions[i], x + 0.5, y + 0.5, pixels, radians);
       c.residualPixels = std::max(c.residualPixels, pixels);
-      c.residualRadians = std::max(c.residualRadians, angleBetween(d, m));
+      c.residualRadians = std::max(c.residualRadians, radians);
       if (stopAbove && !(c.residualPixels <= *stopAbove)) return;
     }
 }
@@ -260,6 +271,149 @@ CellFrustum cellFrustum(const SubFrustumCell& cell) {
   f.window = {std::atan(left - eps) * kToDegrees, std::atan(right + eps) * kToDegrees,
               std::atan(down - eps) * kToDegrees, std::atan(up + eps) * kToDegrees};
   return f;
+}
+
+PlanScreenPoints planScreenPoints(const SubFrustumPlan& plan, const DirectionTable& table,
+                                  const DisplayGeometry& geometry) {
+  PlanScreenPoints out;
+  out.first.reserve(plan.cells.size() + 1);
+  const auto add = [&](int x, int y) {
+    const double px = x + 0.5, py = y + 0.5;
+    const std::optional<Vec3d> p = pixelScreenPoint(geometry, px, py);
+    if (p) out.points.push_back({px, py, *p});
+  };
+  for (const SubFrustumCell& c : plan.cells) {
+    out.first.push_back(uint32_t(out.points.size()));
+    int px[4], py[4];
+    if (!c.fitted || !fitPixels(table, c, px, py)) continue;
+    for (int k = 0; k < 4; ++k) add(px[k], py[k]);
+    if (out.points.size() - out.first.back() != 4) {  // a fit pixel missed: no refit for it
+      out.points.resize(out.first.back());
+      continue;
+    }
+    // The check grid: up to 5 × 5 pixels spread over the cell, its corners and edges included.
+    const int w = c.x1 - c.x0, h = c.y1 - c.y0;
+    for (int j = 0; j < 5; ++j)
+      for (int i = 0; i < 5; ++i) {
+        const int x = c.x0 + (w - 1) * i / 4, y = c.y0 + (h - 1) * j / 4;
+        if (table.valid[table.index(x, y)]) add(x, y);
+      }
+  }
+  out.first.push_back(uint32_t(out.points.size()));
+  return out;
+}
+
+namespace {
+
+Vec3d directionFrom(Vec3d eye, Vec3d point) { return normalize(point - eye); }
+
+// Cell c planned again from its own pixels' exact directions for the geometry's eye, its cells
+// moved to their place in the display (a map moved by (ox, oy) pixels: H' = T·H).
+void replanCell(const SubFrustumCell& c, const DisplayGeometry& g, const SubFrustumOptions& o,
+                SubFrustumPlan& out) {
+  DirectionTable t;
+  t.width = c.x1 - c.x0;
+  t.height = c.y1 - c.y0;
+  t.directions.assign(size_t(t.width) * size_t(t.height), Vec3d{});
+  t.valid.assign(t.directions.size(), 0);
+  for (int y = 0; y < t.height; ++y)
+    for (int x = 0; x < t.width; ++x)
+      if (const std::optional<Vec3d> d = viewDirection(g, c.x0 + x + 0.5, c.y0 + y + 0.5)) {
+        t.directions[t.index(x, y)] = *d;
+        t.valid[t.index(x, y)] = 1;
+      }
+  SubFrustumPlan part = planSubFrusta(t, o);
+  for (SubFrustumCell& p : part.cells) {
+    p.x0 += c.x0, p.x1 += c.x0, p.y0 += c.y0, p.y1 += c.y0;
+    for (size_t k = 0; k < 3; ++k) {
+      p.map.m[0][k] += c.x0 * p.map.m[2][k];
+      p.map.m[1][k] += c.y0 * p.map.m[2][k];
+    }
+    if (p.fitted) p.projection = cellProjection(p, o.znear, o.zfar);
+    out.cells.push_back(p);
+  }
+  out.maxResidualPixels = std::max(out.maxResidualPixels, part.maxResidualPixels);
+  out.maxResidualRadians = std::max(out.maxResidualRadians, part.maxResidualRadians);
+  out.cellsAboveBound += part.cellsAboveBound;
+  out.unfittedPixels += part.unfittedPixels;
+}
+
+}  // namespace
+
+SubFrustumPlan refitPlan(const SubFrustumPlan& plan, const PlanScreenPoints& points,
+                         const DisplayGeometry& g, const SubFrustumOptions& o, RefitStats* stats,
+                         core::ThreadPool* pool) {
+  const Vec3d eye{g.eye.x, g.eye.y, g.eye.z};
+  // Each cell on its own (in parallel), into its own part; the parts joined in cell order.
+  const size_t n = plan.cells.size();
+  std::vector<SubFrustumPlan> parts(n);
+  std::vector<uint8_t> replanned(n, 0);
+  const auto refitCell = [&](size_t i, int) {
+    const SubFrustumCell& old = plan.cells[i];
+    SubFrustumPlan& part = parts[i];
+    const uint32_t first = points.first[i], end = points.first[i + 1];
+    if (!old.fitted) {  // too few valid pixels for any map: as it was
+      part.unfittedPixels += old.validPixels;
+      part.cells.push_back(old);
+      return;
+    }
+    SubFrustumCell c = old;
+    bool ok = end - first >= 4;
+    std::optional<Mat3d> inverse;
+    if (ok) {
+      std::array<Vec3d, 4> dirs, pixels;
+      for (size_t k = 0; k < 4; ++k) {
+        const PlanScreenPoints::Point& p = points.points[first + k];
+        dirs[k] = directionFrom(eye, p.screen);
+        pixels[k] = {p.px, p.py, 1};
+      }
+      ok = fitMapOn(dirs, pixels, c.map) && (inverse = c.map.inverse()).has_value();
+    }
+    if (ok) {
+      c.residualPixels = c.residualRadians = 0;
+      for (uint32_t k = first + 4; k < end; ++k) {
+        const PlanScreenPoints::Point& p = points.points[k];
+        double pixels, radians;
+        residualAt(c.map, *inverse, directionFrom(eye, p.screen), p.px, p.py, pixels, radians);
+        c.residualPixels = std::max(c.residualPixels, pixels);
+        c.residualRadians = std::max(c.residualRadians, radians);
+      }
+      ok = c.residualPixels <= o.boundPixels;
+    }
+    if (!ok) {
+      replanCell(old, g, o, part);
+      replanned[i] = 1;
+      return;
+    }
+    c.projection = cellProjection(c, o.znear, o.zfar);
+    part.maxResidualPixels = c.residualPixels;
+    part.maxResidualRadians = c.residualRadians;
+    part.cells.push_back(c);
+  };
+  if (pool)
+    pool->parallelFor(n, refitCell);
+  else
+    for (size_t i = 0; i < n; ++i) refitCell(i, 0);
+  SubFrustumPlan out;
+  out.width = plan.width;
+  out.height = plan.height;
+  RefitStats st;
+  for (size_t i = 0; i < n; ++i) {
+    const SubFrustumPlan& part = parts[i];
+    out.cells.insert(out.cells.end(), part.cells.begin(), part.cells.end());
+    out.maxResidualPixels = std::max(out.maxResidualPixels, part.maxResidualPixels);
+    out.maxResidualRadians = std::max(out.maxResidualRadians, part.maxResidualRadians);
+    out.cellsAboveBound += part.cellsAboveBound;
+    out.unfittedPixels += part.unfittedPixels;
+    if (replanned[i]) {
+      ++st.replanned;
+    } else if (plan.cells[i].fitted) {
+      ++st.refitted;
+      st.maxCheckPixels = std::max(st.maxCheckPixels, part.maxResidualPixels);
+    }
+  }
+  if (stats) *stats = st;
+  return out;
 }
 
 }  // namespace sv::display

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/projective.h"
+#include "core/thread_pool.h"
 #include "display/geometry.h"
 
 namespace sv::display {
@@ -72,6 +73,39 @@ struct SubFrustumPlan {
 // be; a wholly invalid cell is dropped. Cells tile the display: every valid pixel centre lies in
 // exactly one cell, and no cell holds only invalid pixels.
 SubFrustumPlan planSubFrusta(const DirectionTable& display, const SubFrustumOptions& options = {});
+
+// Dynamic correction (SPEC §12: the maps "recomputed per frame for dynamic correction (moving eye
+// and projector)"; issue 61): the cells of a plan stay, and a moved eye refits their maps. What of
+// a plan does not depend on the eye — the pixel centres each fitted cell's map is fitted on (its
+// four fit pixels) and checked at (a grid of up to 5 × 5 of its valid pixels), and the screen
+// points they light — kept once.
+struct PlanScreenPoints {
+  struct Point {
+    double px = 0, py = 0;  // a pixel centre
+    Vec3d screen;           // the screen point it lights
+  };
+  std::vector<Point> points;    // per cell: its four fit points, then its check points
+  std::vector<uint32_t> first;  // per cell, and one past the last: where its points start
+};
+// From a plan of `geometry`'s direction table (`table`, for the valid mask) — analytic displays
+// only: an MPCDI file's directions have no screen points.
+PlanScreenPoints planScreenPoints(const SubFrustumPlan& plan, const DirectionTable& table,
+                                  const DisplayGeometry& geometry);
+
+struct RefitStats {
+  int refitted = 0;   // cells whose new map passed its check
+  int replanned = 0;  // cells planned again from their pixels' exact directions (then split)
+  double maxCheckPixels = 0;  // the largest residual at the refitted cells' check points
+};
+// The plan of `geometry` for its eye (geometry.eye), from `plan` (made for another eye of the same
+// projector and screen) and its screen points: each fitted cell's map fitted again on its four fit
+// points seen from the new eye; a cell whose check points then err by more than 0.8 × the bound
+// is planned again from the exact directions of its own pixels (and split as planSubFrusta
+// would). No per-pixel work for the cells that pass: ~1 µs a cell.
+// In parallel on `pool` when given (the same plan for any thread count).
+SubFrustumPlan refitPlan(const SubFrustumPlan& plan, const PlanScreenPoints& points,
+                         const DisplayGeometry& geometry, const SubFrustumOptions& options = {},
+                         RefitStats* stats = nullptr, core::ThreadPool* pool = nullptr);
 
 // SubFrustumCell::projection of a fitted cell for the depth range [znear, zfar] (glFrustum's depth
 // row with the cell's axis depth): a camera's own range, where it differs from the plan's.

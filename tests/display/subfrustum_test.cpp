@@ -291,5 +291,55 @@ TEST(SubFrustum, MovingTheEyeChangesTheMapsAndThePlanIsRecomputed) {
       after.maxResidualPixels, stale);
 }
 
+// Issue 61 item 2: for a moved eye the cells stay and their maps are refitted on their kept screen
+// points (refitPlan) — every valid pixel then within the bound by brute force through the cells'
+// projections against the new eye's exact directions, as a plan made from scratch for that eye;
+// a head's small move refits every cell, a large one plans a few again.
+TEST(SubFrustum, AMovedEyeRefitsTheMapsOfTheSameCellsWithinTheBound) {
+  CylinderRig rig = threeProjectorCylinder(3, 10, 640, 400);
+  const DirectionTable still = directionTable(rig.geometry(0));
+  const SubFrustumPlan plan = planSubFrusta(still);
+  const PlanScreenPoints points = planScreenPoints(plan, still, rig.geometry(0));
+  ASSERT_EQ(points.first.size(), plan.cells.size() + 1);
+  for (const Vec3 eye : {Vec3{0.02f, 0.01f, -0.01f}, Vec3{0.15f, 0.05f, -0.1f}}) {
+    rig.eye = eye;
+    const DisplayGeometry g = rig.geometry(0);
+    RefitStats stats;
+    const auto t0 = std::chrono::steady_clock::now();
+    const SubFrustumPlan refit = refitPlan(plan, points, g, {}, &stats);
+    const double refitMs = millisecondsSince(t0);
+    // On threads: the same plan.
+    core::ThreadPool pool(3);
+    const SubFrustumPlan threaded = refitPlan(plan, points, g, {}, nullptr, &pool);
+    ASSERT_EQ(threaded.cells.size(), refit.cells.size());
+    for (size_t i = 0; i < refit.cells.size(); ++i) {
+      EXPECT_EQ(threaded.cells[i].x0, refit.cells[i].x0);
+      EXPECT_EQ(threaded.cells[i].y1, refit.cells[i].y1);
+      for (int r = 0; r < 3; ++r)
+        for (int k = 0; k < 3; ++k)
+          EXPECT_EQ(threaded.cells[i].map.m[r][k], refit.cells[i].map.m[r][k]);
+    }
+    const DirectionTable moved = directionTable(g);
+    expectTiling(refit, moved);
+    double worst = 0;
+    for (const SubFrustumCell& c : refit.cells)
+      if (c.fitted) worst = std::max(worst, bruteForce(c, moved).pixels);
+    const SubFrustumPlan scratch = planSubFrusta(moved);
+    SCOPED_TRACE(testing::Message() << "eye " << eye.x << ", " << eye.y << ", " << eye.z);
+    EXPECT_LE(worst, 0.1);
+    EXPECT_LE(scratch.maxResidualPixels, 0.1);
+    EXPECT_EQ(stats.refitted + stats.replanned, int(plan.cells.size()));
+    if (eye.x < 0.05f) {
+      EXPECT_EQ(stats.replanned, 0) << "a head's small move refits every cell";
+      EXPECT_EQ(refit.cells.size(), plan.cells.size());
+    }
+    std::printf(
+        "640 x 400, eye moved to (%.2f, %.2f, %.2f): refit %.2f ms (%d cells refitted, %d planned "
+        "again; %zu cells, brute-force max %.4f px); from scratch %zu cells, max %.4f px\n",
+        eye.x, eye.y, eye.z, refitMs, stats.refitted, stats.replanned, refit.cells.size(), worst,
+        scratch.cells.size(), scratch.maxResidualPixels);
+  }
+}
+
 }  // namespace
 }  // namespace sv::display
