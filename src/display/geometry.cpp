@@ -187,7 +187,12 @@ std::optional<Vec3d> pixelScreenPoint(const DisplayGeometry& g, double px, doubl
 
 void viewDirections(const DisplayGeometry& g, std::vector<Vec3d>& directions,
                     std::vector<uint8_t>& valid) {
-  const int w = g.projector.width, h = g.projector.height;
+  viewDirections(g, 0, 0, g.projector.width, g.projector.height, directions, valid);
+}
+
+void viewDirections(const DisplayGeometry& g, int x0, int y0, int x1, int y1,
+                    std::vector<Vec3d>& directions, std::vector<uint8_t>& valid) {
+  const int w = x1 - x0, h = y1 - y0;
   directions.assign(size_t(w) * size_t(h), Vec3d{});
   valid.assign(directions.size(), 0);
   const ProjectorFrame frame = frameOf(g.projector);
@@ -195,7 +200,7 @@ void viewDirections(const DisplayGeometry& g, std::vector<Vec3d>& directions,
     for (int x = 0; x < w; ++x) {
       Vec3d p{}, e{};
       const size_t i = size_t(y) * size_t(w) + size_t(x);
-      if (traceView(g, frame, x + 0.5, y + 0.5, p, e)) directions[i] = e, valid[i] = 1;
+      if (traceView(g, frame, x0 + x + 0.5, y0 + y + 0.5, p, e)) directions[i] = e, valid[i] = 1;
     }
 }
 

@@ -92,6 +92,9 @@ std::optional<Vec3d> pixelScreenPoint(const DisplayGeometry& geometry, double px
 // pixel.
 void viewDirections(const DisplayGeometry& geometry, std::vector<Vec3d>& directions,
                     std::vector<uint8_t>& valid);
+// The same for the pixels [x0, x1) × [y0, y1) alone, row by row (a sub-frustum cell's).
+void viewDirections(const DisplayGeometry& geometry, int x0, int y0, int x1, int y1,
+                    std::vector<Vec3d>& directions, std::vector<uint8_t>& valid);
 
 // The unit ray leaving a projector through its pixel (px, py), in the eye frame.
 Vec3 projectorRay(const Projector& projector, double px, double py);

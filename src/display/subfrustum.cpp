@@ -18,12 +18,13 @@
 // centre, H the cell's homography, (u, v, w) = H·d.
 #include "display/subfrustum.h"
 
-#include "core/quadric.h"
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <numbers>
+
+#include "core/quadric.h"
 
 namespace sv::display {
 namespace {
@@ -314,14 +315,7 @@ void replanCell(const SubFrustumCell& c, const DisplayGeometry& g, const SubFrus
   DirectionTable t;
   t.width = c.x1 - c.x0;
   t.height = c.y1 - c.y0;
-  t.directions.assign(size_t(t.width) * size_t(t.height), Vec3d{});
-  t.valid.assign(t.directions.size(), 0);
-  for (int y = 0; y < t.height; ++y)
-    for (int x = 0; x < t.width; ++x)
-      if (const std::optional<Vec3d> d = viewDirection(g, c.x0 + x + 0.5, c.y0 + y + 0.5)) {
-        t.directions[t.index(x, y)] = *d;
-        t.valid[t.index(x, y)] = 1;
-      }
+  viewDirections(g, c.x0, c.y0, c.x1, c.y1, t.directions, t.valid);
   SubFrustumPlan part = planSubFrusta(t, o);
   for (SubFrustumCell& p : part.cells) {
     p.x0 += c.x0, p.x1 += c.x0, p.y0 += c.y0, p.y1 += c.y0;
@@ -344,17 +338,16 @@ SubFrustumPlan refitPlan(const SubFrustumPlan& plan, const PlanScreenPoints& poi
                          const DisplayGeometry& g, const SubFrustumOptions& o, RefitStats* stats,
                          core::ThreadPool* pool) {
   const Vec3d eye{g.eye.x, g.eye.y, g.eye.z};
-  // Each cell on its own (in parallel), into its own part; the parts joined in cell order.
+  // Each cell on its own (in parallel), into its own slot — or, planned again, its own plan; the
+  // slots joined in cell order.
   const size_t n = plan.cells.size();
-  std::vector<SubFrustumPlan> parts(n);
-  std::vector<uint8_t> replanned(n, 0);
+  std::vector<SubFrustumCell> refitted(n);
+  std::vector<std::unique_ptr<SubFrustumPlan>> replanned(n);
   const auto refitCell = [&](size_t i, int) {
     const SubFrustumCell& old = plan.cells[i];
-    SubFrustumPlan& part = parts[i];
     const uint32_t first = points.first[i], end = points.first[i + 1];
     if (!old.fitted) {  // too few valid pixels for any map: as it was
-      part.unfittedPixels += old.validPixels;
-      part.cells.push_back(old);
+      refitted[i] = old;
       return;
     }
     SubFrustumCell c = old;
@@ -381,14 +374,12 @@ SubFrustumPlan refitPlan(const SubFrustumPlan& plan, const PlanScreenPoints& poi
       ok = c.residualPixels <= o.boundPixels;
     }
     if (!ok) {
-      replanCell(old, g, o, part);
-      replanned[i] = 1;
+      replanned[i] = std::make_unique<SubFrustumPlan>();
+      replanCell(old, g, o, *replanned[i]);
       return;
     }
     c.projection = cellProjection(c, o.znear, o.zfar);
-    part.maxResidualPixels = c.residualPixels;
-    part.maxResidualRadians = c.residualRadians;
-    part.cells.push_back(c);
+    refitted[i] = c;
   };
   if (pool)
     pool->parallelFor(n, refitCell);
@@ -398,19 +389,27 @@ SubFrustumPlan refitPlan(const SubFrustumPlan& plan, const PlanScreenPoints& poi
   out.width = plan.width;
   out.height = plan.height;
   RefitStats st;
+  out.cells.reserve(n);
   for (size_t i = 0; i < n; ++i) {
-    const SubFrustumPlan& part = parts[i];
-    out.cells.insert(out.cells.end(), part.cells.begin(), part.cells.end());
-    out.maxResidualPixels = std::max(out.maxResidualPixels, part.maxResidualPixels);
-    out.maxResidualRadians = std::max(out.maxResidualRadians, part.maxResidualRadians);
-    out.cellsAboveBound += part.cellsAboveBound;
-    out.unfittedPixels += part.unfittedPixels;
-    if (replanned[i]) {
+    if (const SubFrustumPlan* part = replanned[i].get()) {
+      out.cells.insert(out.cells.end(), part->cells.begin(), part->cells.end());
+      out.maxResidualPixels = std::max(out.maxResidualPixels, part->maxResidualPixels);
+      out.maxResidualRadians = std::max(out.maxResidualRadians, part->maxResidualRadians);
+      out.cellsAboveBound += part->cellsAboveBound;
+      out.unfittedPixels += part->unfittedPixels;
       ++st.replanned;
-    } else if (plan.cells[i].fitted) {
-      ++st.refitted;
-      st.maxCheckPixels = std::max(st.maxCheckPixels, part.maxResidualPixels);
+      continue;
     }
+    const SubFrustumCell& c = refitted[i];
+    out.cells.push_back(c);
+    if (!c.fitted) {
+      out.unfittedPixels += c.validPixels;
+      continue;
+    }
+    out.maxResidualPixels = std::max(out.maxResidualPixels, c.residualPixels);
+    out.maxResidualRadians = std::max(out.maxResidualRadians, c.residualRadians);
+    st.maxCheckPixels = std::max(st.maxCheckPixels, c.residualPixels);
+    ++st.refitted;
   }
   if (stats) *stats = st;
   return out;
