@@ -199,6 +199,11 @@ Result<ref::CaseResult> measureCase(ref::BenchRunner& runner, const ref::BenchCa
           double(s.volumeSamples) / 1e6, double(s.volumeRays) / 1e6, s.volumeMs, threads,
           ref::simdTarget());
     }
+    // A display's corrected runs say what their correction cost once (the plan, its refit for a
+    // moved eye, the warp: issue 61).
+    for (const ref::RendererRun& run : cr.runs)
+      if (run.renderer == "subfrusta" || run.renderer == "resampled")
+        fmt::print("  {}: {}\n", run.renderer, run.description);
     for (size_t ch = 0; ch < cr.runs[0].channelStats.size(); ++ch)
       fmt::print("  synthvis last frame, channel {}: {}\n", ch,
                  cr.runs[0].channelStats[ch].summary());
