@@ -171,6 +171,7 @@ void FrameRenderer::prepareBuffers(const DrawPackets& packets, const Frame& f) {
       unlit_[size_t(t)].store(around, std::memory_order_relaxed);
     }
     tileBufferOf_.assign(size_t(f.tiles), nullptr);
+    freeTileBuffers_.resize(size_t(pool_.threadCount()));  // a free list per worker
   }
   tileStats_.assign(size_t(f.tiles), raster::RasterStats{});
   opaqueDone_.assign(size_t(f.tiles), 0);
@@ -433,7 +434,6 @@ raster::FrameBuffer* FrameRenderer::takeTileBuffer(int samples, int worker) {
   raster::FrameBuffer* buffer = nullptr;
   {
     std::lock_guard lock(tileBuffersMutex_);
-    freeTileBuffers_.resize(std::max(freeTileBuffers_.size(), size_t(pool_.threadCount())));
     for (int k = 0; k < pool_.threadCount() && !buffer; ++k) {
       std::vector<raster::FrameBuffer*>& free =
           freeTileBuffers_[size_t((worker + k) % pool_.threadCount())];
