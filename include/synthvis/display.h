@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "synthvis/result.h"
 
@@ -35,8 +36,13 @@ class Display {
   const std::string& projectorName(int projector) const;
   int projectorWidth(int projector) const;
   int projectorHeight(int projector) const;
-  // Whether the screen's geometry is known (an analytic rig): what Renderer::viewerImage needs.
+  // Whether the screen's geometry is known (an analytic rig): what Renderer::viewerImage and a
+  // moved eye's refitted correction (DisplayView::eyeOffset) need.
   bool hasGeometry() const;
+  // The display at 1/r of its projectors' resolution, each ⌈w/r⌉ × ⌈h/r⌉ pixels: the same screen,
+  // lenses and blend (an image generator's half-resolution quality level, each pixel shown r × r
+  // times). r ≥ 1.
+  Display scaled(int r) const;
 
   const render::DisplaySetup& setup() const { return *setup_; }  // the renderer's view of it
 
@@ -45,11 +51,29 @@ class Display {
   std::shared_ptr<const render::DisplaySetup> setup_;
 };
 
+// What Renderer::renderDisplay draws a frame for.
+struct DisplayView {
+  // The eye moved from the display's design eye, metres in the camera's eye frame (x right, y up,
+  // z back): head tracking, or a design eye the host moves. A display whose screen is known
+  // (hasGeometry) refits its sub-frusta's maps for the moved eye whenever it moves (about 1.5 ms
+  // for a 1920×1080 projector, docs/display.md); one read from a file keeps its design eye's
+  // correction and moves the viewpoint alone. Finite.
+  float eyeOffset[3] = {0, 0, 0};
+  // Only these projectors, by index (an image generator's share of them under MPI); the others'
+  // images are left as they were. Empty: every one.
+  std::vector<int> projectors;
+};
+
 // How a projector's frame was made (Renderer::renderDisplay), in milliseconds and counts.
 struct DisplayStats {
   // Sub-frusta (RenderOptions::Correction::subFrusta): the plan, made from the display mapping
   // (once per frame today), its cells and the largest residual of their projective maps.
   double planMs = 0;
+  // For an eye moved from the design eye (DisplayView::eyeOffset, a display whose screen is
+  // known): the maps refitted for it — 0 ms when the eye has not moved since the last frame — and
+  // the cells that had to be planned again from their pixels.
+  double refitMs = 0;
+  int replannedCells = 0;
   int cells = 0;
   double maxResidualPixels = 0;
   // Resampling (bilinear, bicubic): the warp (once per frame today), the flat view's size, the

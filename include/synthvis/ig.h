@@ -58,6 +58,16 @@ struct IgConfig {
     std::vector<int> ranks;
   };
   std::vector<Split> splits;
+  // A curved-screen display instead of flat channels (docs/ig.md, "A curved screen"): each of its
+  // projectors is a channel, drawn pre-distorted and edge-blended as render.correction says
+  // (synthvis/display.h), the test patterns and the overlay through the same correction; View
+  // Control of view 0 moves its eye point. Not with `channels` or channels split among ranks.
+  struct DisplayConfig {
+    std::string mpcdi;                // an MPCDI file (3d profile); empty: the demo cylinder
+    int width = 1920, height = 1080;  // the cylinder's projectors
+    double overlapDegrees = 10;
+  };
+  std::optional<DisplayConfig> display;
 };
 
 // What each of `ranks` processes draws under `config` with `channelCount` channels, by rank, in

@@ -199,9 +199,12 @@ class Renderer {
   // statistics into (*stats)[i] and its correction's into (*correction)[i]. The projectors are
   // drawn one after another, each on all the renderer's threads; the frames in linear light are
   // kept for viewerImage. Identical bytes for any thread count. An error names the projector.
+  // `view` moves the eye and chooses the projectors (DisplayView); a projector not drawn keeps
+  // its image, statistics and correction's from the last call.
   Status renderDisplay(const scene::Scene& scene, const Display& display,
                        std::vector<Image>& images, std::vector<FrameStats>* stats = nullptr,
-                       std::vector<DisplayStats>* correction = nullptr);
+                       std::vector<DisplayStats>* correction = nullptr,
+                       const DisplayView& view = {});
   // The simulated viewer's view of the screen (docs/display.md, "The viewer"): the frames of the
   // last renderDisplay of `display` projected onto its screen and seen from its eye, azimuth
   // −100…100°, elevation −25…25°, through the gamma table. An error for a display whose geometry

@@ -9,6 +9,43 @@
 
 namespace sv::display {
 
+PanoramaPoint panoramaPoint(const PanoramaView& view, Vec3d d) {
+  constexpr double kToDegrees = 180 / std::numbers::pi;
+  // Azimuth from −z toward +x, elevation from the horizontal (the convention of Screen's).
+  const double azimuth = std::atan2(d.x, -d.z) * kToDegrees;
+  const double elevation = std::atan2(d.y, std::hypot(d.x, d.z)) * kToDegrees;
+  return {(azimuth - view.minAzimuthDegrees) / (view.maxAzimuthDegrees - view.minAzimuthDegrees) *
+              view.width,
+          (view.maxElevationDegrees - elevation) /
+              (view.maxElevationDegrees - view.minElevationDegrees) * view.height};
+}
+
+PanoramaView panoramaOf(const std::vector<const DirectionTable*>& tables, double pixelDegrees) {
+  SV_CHECK(pixelDegrees > 0);
+  constexpr double kToDegrees = 180 / std::numbers::pi;
+  double az0 = 180, az1 = -180, el0 = 90, el1 = -90;
+  for (const DirectionTable* t : tables)
+    for (size_t i = 0; i < t->directions.size(); ++i) {
+      if (!t->valid[i]) continue;
+      const Vec3d& d = t->directions[i];
+      const double azimuth = std::atan2(d.x, -d.z) * kToDegrees;
+      const double elevation = std::atan2(d.y, std::hypot(d.x, d.z)) * kToDegrees;
+      az0 = std::min(az0, azimuth), az1 = std::max(az1, azimuth);
+      el0 = std::min(el0, elevation), el1 = std::max(el1, elevation);
+    }
+  PanoramaView v;
+  if (az0 > az1) return v;  // no valid pixel: the default view
+  // Whole pixels, the field centred in them.
+  v.width = std::max(1, int(std::ceil((az1 - az0) / pixelDegrees)));
+  v.height = std::max(1, int(std::ceil((el1 - el0) / pixelDegrees)));
+  const double az = 0.5 * (az0 + az1), el = 0.5 * (el0 + el1);
+  v.minAzimuthDegrees = az - 0.5 * v.width * pixelDegrees;
+  v.maxAzimuthDegrees = az + 0.5 * v.width * pixelDegrees;
+  v.minElevationDegrees = el - 0.5 * v.height * pixelDegrees;
+  v.maxElevationDegrees = el + 0.5 * v.height * pixelDegrees;
+  return v;
+}
+
 ResampledImage viewerPanorama(const Screen& screen, Vec3 eye,
                               const std::vector<Projector>& projectors,
                               const std::vector<const uint16_t*>& images, const PanoramaView& view,

@@ -9,6 +9,7 @@
 
 #include "display/geometry.h"
 #include "display/resample.h"
+#include "display/subfrustum.h"
 
 namespace sv::display {
 
@@ -19,6 +20,19 @@ struct PanoramaView {
   double minElevationDegrees = -25, maxElevationDegrees = 25;
   int width = 1600, height = 400;
 };
+
+// Where direction `d` (any length) lies in the panorama: a continuous pixel (centres at +0.5),
+// beyond [0, width) × [0, height) when the view does not hold it.
+struct PanoramaPoint {
+  double x = 0, y = 0;
+};
+PanoramaPoint panoramaPoint(const PanoramaView& view, Vec3d d);
+
+// The panorama that holds every valid direction of `tables` (the field a display's projectors
+// cover, seen from its eye), `pixelDegrees` a pixel in azimuth and elevation. A field wider than
+// 360° in azimuth is not a panorama: the caller's displays span less (a dome's zenith would need
+// another map, and has none here).
+PanoramaView panoramaOf(const std::vector<const DirectionTable*>& tables, double pixelDegrees);
 
 // Each panorama pixel: the screen point the eye sees in its centre's direction, and there the sum
 // over the projectors of each one's image (`images[i]`: linear-light 16-bit RGB of

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -11,6 +12,7 @@
 #include <cstring>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <optional>
 #include <thread>
 
@@ -21,8 +23,11 @@
 #include "present/overlay.h"
 #include "present/present.h"
 #include "present/test_patterns.h"
+#include "render/correction.h"
+#include "render/view_renderer.h"
 #include "synthvis/cigi.h"
 #include "synthvis/cluster.h"
+#include "synthvis/display.h"
 #include "synthvis/files.h"
 #include "synthvis/ig.h"
 #include "synthvis/render.h"
@@ -131,6 +136,10 @@ struct IgLoop::Impl {
   bool ownsStatus = false;
   std::string statusName;  // for the warning when it can no longer be written
   std::map<int, std::unique_ptr<Renderer>> renderers;  // by quality level
+  // A curved screen (IgConfig::display): its projectors are the channels; at a level drawn at 1/r
+  // of the size, the display at that size (its plans made on its first frame, then kept).
+  std::optional<Display> display;
+  std::map<int, Display> scaledDisplays;  // by r > 1
   bool loggedMalformed = false;
   // The job (docs/cluster.md): this rank's channels (all of them in a job of one).
   cluster::Cluster* cluster = nullptr;
@@ -157,6 +166,14 @@ struct IgLoop::Impl {
     std::unique_ptr<Renderer>& r = renderers[level];
     if (!r) r = std::make_unique<Renderer>(quality);
     return *r;
+  }
+
+  const Display& displayAt(int replication) {
+    if (replication <= 1) return *display;
+    auto it = scaledDisplays.find(replication);
+    if (it == scaledDisplays.end())
+      it = scaledDisplays.emplace(replication, display->scaled(replication)).first;
+    return it->second;
   }
 
   // The host datagrams for frame `frame`: those waiting on the socket, or the replay's — and then
@@ -209,13 +226,34 @@ Result<std::unique_ptr<IgLoop>> IgLoop::create(const IgConfig& config,
   m.config = config;
   m.options = options;
   if (Status s = validate(config.render); !s) return s.error();
-  Result<IgWorld> world = IgWorld::load(config);
+  if (config.display) {
+    // The display's projectors become the channels, named as they are (a file's region ids made
+    // fit to name image files).
+    const IgConfig::DisplayConfig& d = *config.display;
+    Result<Display> display =
+        d.mpcdi.empty() ? Result<Display>(Display::cylinder(d.width, d.height, d.overlapDegrees))
+                        : Display::readMpcdi(d.mpcdi);
+    if (!display) return display.error();
+    m.display = display.value();
+    m.config.channels.clear();
+    for (int p = 0; p < m.display->projectorCount(); ++p) {
+      scene::Channel c;
+      c.name = m.display->projectorName(p);
+      for (char& ch : c.name)
+        if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '-' && ch != '_') ch = '_';
+      if (c.name.empty()) c.name = fmt::format("projector{}", p);
+      c.width = m.display->projectorWidth(p);
+      c.height = m.display->projectorHeight(p);
+      m.config.channels.push_back(c);
+    }
+  }
+  Result<IgWorld> world = IgWorld::load(m.config);
   if (!world) return world.error();
   m.world.emplace(std::move(world.value()));
   m.cluster = options.cluster;
   if (m.cluster) m.rank = m.cluster->rank(), m.ranks = m.cluster->size();
   Result<std::vector<std::vector<ChannelShare>>> byRank =
-      channelsByRank(config, int(m.world->channels().size()), m.ranks);
+      channelsByRank(m.config, int(m.world->channels().size()), m.ranks);
   if (!byRank) return byRank.error();
   m.mine = byRank.value()[size_t(m.rank)];
   // Every rank makes every split's group, in channel order (a collective step); each keeps its
@@ -310,6 +348,11 @@ struct IgLoop::Session {
         only(impl.ranks > 1 ? &impl.mine : nullptr) {
     if (!m.options.testPattern.empty())
       pattern = present::parseTestPattern(m.options.testPattern).value();
+    if (m.display) {
+      if (only)
+        for (const ChannelShare& c : *only) displayView.projectors.push_back(c.channel);
+      if (pattern || m.options.overlay) displayPictures();
+    }
   }
 
   Impl& m;
@@ -330,6 +373,53 @@ struct IgLoop::Session {
   std::vector<uint8_t> input;
   Clock::time_point t0;
   bool replayEnded = false;
+  // A display's: the projectors this rank draws and the eye's offset (View Control of view 0);
+  // the test pattern's frames and the overlay's place, through the correction (made once).
+  DisplayView displayView;
+  std::vector<Image> patternImages;
+  std::optional<render::PanoramaPatch> overlayPatch;
+  int overlayScale = 1;
+
+  // The display's test pattern and overlay as pictures of the viewer's field (a panorama around
+  // the eye, at the centre projector's pixel angle), each projector pixel showing the picture in
+  // its own direction: straight and continuous on the screen, blended in the overlaps.
+  void displayPictures() {
+    const render::DisplaySetup& d = m.display->setup();
+    const display::DirectionTable& centre = d.projectors[d.projectors.size() / 2].table;
+    const int cx = centre.width / 2, cy = centre.height / 2;
+    const double pixelDegrees =
+        angleBetween(centre.directions[centre.index(cx, cy)],
+                     centre.directions[centre.index(std::min(cx + 1, centre.width - 1), cy)]) *
+        180 / std::numbers::pi;
+    const display::PanoramaView view =
+        render::displayPanorama(d, pixelDegrees > 0 ? pixelDegrees : 0.05);
+    overlayScale = std::max(1, centre.height / 360);
+    if (pattern) {
+      const Image picture = present::testPattern(*pattern, view.width, view.height, "display");
+      core::ThreadPool pool(std::max(1, m.config.render.threads));
+      render::showPanorama(d, view, picture, render::gammaTableOf(m.config.render), pool,
+                           patternImages);
+    }
+    if (m.options.overlay) {
+      // Room for four lines of 72 characters, centred at the top of the field.
+      const present::TextSize text =
+          present::measureText(std::string(72, 'M') + "\n\n\n", overlayScale);
+      const int w = text.width + 8 * overlayScale, h = text.height + 8 * overlayScale;
+      overlayPatch =
+          render::panoramaPatch(d, view, std::max(0, (view.width - w) / 2), 2 * overlayScale, w, h);
+    }
+  }
+
+  // Every channel of this rank at quality `q` (level `level`): the display's projectors, or the
+  // channels.
+  Status renderFrame(int level, const QualityLevel& q, const scene::Scene& scene) {
+    Renderer& renderer = m.rendererFor(level, q.options);
+    if (!m.display) return renderer.renderChannels(scene, images, &stats, only);
+    if (!scene.channels.empty())
+      for (int k = 0; k < 3; ++k) displayView.eyeOffset[k] = (&scene.channels[0].offset.x)[k];
+    return renderer.renderDisplay(scene, m.displayAt(q.replication), images, &stats, nullptr,
+                                  displayView);
+  }
 
   // Whether this rank presents channel c: it draws it whole, or assembles it (part 0).
   bool drawn(size_t c) const {
@@ -363,9 +453,7 @@ struct IgLoop::Session {
         const QualityLevel& q = governor.at(level);
         const scene::Scene& first = world.atQuality(q.stars, q.replication);
         const Clock::time_point warm = Clock::now();
-        if (Status s = m.rendererFor(level, q.options).renderChannels(first, images, &stats, only);
-            !s)
-          return s.error();
+        if (Status s = renderFrame(level, q, first); !s) return s.error();
         if (q.replication > 1) enlarge(q.replication);  // the enlargements' memory too
         works[size_t(level)] = {geometryWork(world.frameScene(0)), groundShare(q)};
         if (round > 0) {
@@ -477,15 +565,17 @@ struct IgLoop::Session {
   Result<std::vector<Image>*> draw(uint32_t frame, int level) {
     const QualityLevel& q = governor.at(level);
     const scene::Scene& scene = world.atQuality(q.stars, q.replication);
-    if (pattern) {
+    if (pattern && m.display) {
+      images = patternImages;
+      stats.assign(images.size(), FrameStats{});
+    } else if (pattern) {
       images.resize(scene.channels.size());
       for (size_t c = 0; c < scene.channels.size(); ++c)
         images[c] = present::testPattern(*pattern, scene.channels[c].width,
                                          scene.channels[c].height, scene.channels[c].name);
       stats.assign(images.size(), FrameStats{});
     } else {
-      Renderer& renderer = m.rendererFor(level, q.options);
-      if (Status s = renderer.renderChannels(scene, images, &stats, only); !s) {
+      if (Status s = renderFrame(level, q, scene); !s) {
         if (m.splits) m.cluster->abort(fmt::format("frame {}: {}", frame, s.error().message));
         return s.error();
       }
@@ -497,8 +587,8 @@ struct IgLoop::Session {
     return &enlarged;
   }
 
-  // The overlay on channel 0: stage times, the quality level, counts (--overlay).
-  void drawOverlay(uint32_t frame, int level, double renderMs, Image& image) const {
+  // The overlay (--overlay): on channel 0, or on a display through its correction.
+  void drawOverlay(uint32_t frame, int level, double renderMs, std::vector<Image>& shown) const {
     double vertex = 0, setup = 0, raster = 0, lights = 0;
     for (const FrameStats& s : stats) {
       vertex += s.vertexMs;
@@ -517,7 +607,20 @@ struct IgLoop::Session {
         fmt::format("level {} ({})", level, governor.at(level).change),
         fmt::format("entities {}  datagrams {}  malformed {}  missed {}", world.activeEntities(),
                     world.counts().datagrams, world.counts().malformed, report.missed)};
-    present::drawOverlay(image, lines, std::max(1, image.height / 360));
+    if (!overlayPatch) {
+      present::drawOverlay(shown[0], lines, std::max(1, shown[0].height / 360));
+      return;
+    }
+    // What the overlay makes of black and of white: the pixels under it become v·scale + add.
+    Image onBlack, onWhite;
+    for (Image* layer : {&onBlack, &onWhite}) {
+      layer->width = overlayPatch->width;
+      layer->height = overlayPatch->height;
+      layer->rgb.assign(size_t(layer->width) * size_t(layer->height) * 3,
+                        layer == &onBlack ? 0 : 255);
+      present::drawOverlay(*layer, lines, overlayScale);
+    }
+    render::overlayPatch(*overlayPatch, onBlack, onWhite, shown);
   }
 
   // 5. In a job of several, the frame lock — presented together, or the job ends naming the rank
@@ -623,8 +726,8 @@ Result<IgRunReport> IgLoop::run() {
     Result<std::vector<Image>*> shown = s.draw(frame, level);  // 4
     if (!shown) return shown.error();
     const double renderMs = msBetween(renderStart, Clock::now());
-    if (options.overlay && !shown.value()->empty() && s.drawn(0))
-      s.drawOverlay(frame, level, renderMs, (*shown.value())[0]);
+    if (options.overlay && !shown.value()->empty() && (s.drawn(0) || impl_->display))
+      s.drawOverlay(frame, level, renderMs, *shown.value());
     if (Status st = s.present(frame, level, sof, start, shown.value()); !st)  // 5
       return st.error();
     // 6. The deadline is the whole frame's: the governor learns what a frame costs, start to

@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 
 #include "core/check.h"
 #include "core/timing.h"
@@ -195,10 +197,48 @@ Result<DisplaySetup> mpcdiDisplay(const std::string& path) {
       p.name = r.id;
       p.table = display::directionTable(map.value());
       if (r.alpha || r.beta) p.blend = display::blendWeights(r);
+      p.region = r;
       d.projectors.push_back(std::move(p));
     }
   if (d.projectors.empty()) return Error{path, "", "the file has no regions"};
   return d;
+}
+
+DisplaySetup scaledDisplay(const DisplaySetup& d, int r) {
+  SV_CHECK(r >= 1);
+  DisplaySetup out;
+  out.rig = d.rig;
+  out.eye = d.eye;
+  for (size_t i = 0; i < d.projectors.size(); ++i) {
+    const ProjectorSetup& p = d.projectors[i];
+    const int w = (p.table.width + r - 1) / r, h = (p.table.height + r - 1) / r;
+    ProjectorSetup q;
+    q.name = p.name;
+    q.alpha = p.alpha;
+    display::MpcdiRegion region;
+    if (out.rig) {
+      // The same lens over fewer pixels: the projector's window spans its image's edges.
+      display::Projector& projector = out.rig->projectors[i];
+      projector.width = w;
+      projector.height = h;
+      q.table = display::directionTable(out.rig->geometry(int(i)));
+      region.alpha = p.alpha;
+    } else {
+      SV_CHECK(p.region.has_value());
+      region = *p.region;
+      region.xResolution = w;
+      region.yResolution = h;
+      // Read from a file already: its warp gave a direction map at full size, so it gives one
+      // at this.
+      q.table = display::directionTable(display::directionMap(region).value());
+      q.region = region;
+    }
+    region.xResolution = w;
+    region.yResolution = h;
+    if (region.alpha || region.beta) q.blend = display::blendWeights(region);
+    out.projectors.push_back(std::move(q));
+  }
+  return out;
 }
 
 Result<display::Mpcdi> mpcdiOf(const DisplaySetup& d) {
@@ -253,30 +293,80 @@ std::shared_ptr<const display::SubFrustumPlan> PlanCache::of(
   return plan_;
 }
 
+std::shared_ptr<const display::SubFrustumPlan> PlanCache::moved(
+    const display::DirectionTable& table, const display::SubFrustumOptions& options,
+    const display::DisplayGeometry& design, const display::DisplayGeometry& moved,
+    core::ThreadPool* pool, double& madeMs, double& refitMs, display::RefitStats& stats) const {
+  std::shared_ptr<const display::SubFrustumPlan> plan = of(table, options, madeMs);
+  std::lock_guard lock(mutex_);
+  refitMs = 0;
+  if (madeMs > 0 || !points_) {  // a new design plan: its screen points, and no moved one yet
+    points_ = display::planScreenPoints(*plan, table, design);
+    movedPlan_.reset();
+  }
+  const bool same = movedPlan_ && movedEye_.x == moved.eye.x && movedEye_.y == moved.eye.y &&
+                    movedEye_.z == moved.eye.z;
+  if (!same) {
+    const auto t0 = core::Clock::now();
+    movedPlan_ = std::make_shared<const display::SubFrustumPlan>(
+        display::refitPlan(*plan, *points_, moved, options, &movedStats_, pool));
+    movedEye_ = moved.eye;
+    refitMs = core::msSince(t0);
+  }
+  stats = movedStats_;
+  return movedPlan_;
+}
+
 Status renderDisplay(CorrectionRenderer& renderer, const scene::Scene& scene,
-                     const RenderOptions& o, const DisplaySetup& display, DisplayFrame& frame) {
+                     const RenderOptions& o, const DisplaySetup& display, DisplayFrame& frame,
+                     const DisplayRequest& request) {
   const Result<FrameCamera> base = chooseCamera(scene, o);
   if (!base.ok()) return base.error();
   const size_t n = display.projectors.size();
   frame.linear.resize(n);
   frame.images.resize(n);
-  frame.stats.assign(n, FrameStats{});
-  frame.correction.assign(n, DisplayStats{});
-  for (size_t i = 0; i < n; ++i) {
+  frame.stats.resize(n);
+  frame.correction.resize(n);
+  std::vector<int> every;
+  if (!request.projectors)
+    for (size_t i = 0; i < n; ++i) every.push_back(int(i));
+  const Vec3d offset = request.eyeOffset;
+  if (!std::isfinite(offset.x) || !std::isfinite(offset.y) || !std::isfinite(offset.z))
+    return Error{"", "", "the display's eye offset is not finite"};
+  const bool movedEye = offset.x != 0 || offset.y != 0 || offset.z != 0;
+  for (const int k : request.projectors ? *request.projectors : every) {
+    if (k < 0 || size_t(k) >= n)
+      return Error{"", "", fmt::format("projector {} does not exist ({} projectors)", k, n)};
+    const size_t i = size_t(k);
+    frame.stats[i] = FrameStats{};
+    frame.correction[i] = DisplayStats{};
     const ProjectorSetup& p = display.projectors[i];
     CorrectedView view;
     view.table = &p.table;
     view.blend = p.blend ? &*p.blend : nullptr;
-    view.eye = display.eye;
+    view.eye = display.eye + offset;
     view.correction = o.correction;
     const auto start = core::Clock::now();
-    // Method (a)'s plan made once for the display, kept from frame to frame.
+    // Method (a)'s plan made once for the display, kept from frame to frame; for a moved eye of a
+    // known screen, its maps refitted (kept while the eye stays).
     std::shared_ptr<const display::SubFrustumPlan> plan;
     if (o.correction == RenderOptions::Correction::subFrusta) {
       display::SubFrustumOptions so;
       so.znear = base.value().camera.znear;
       so.zfar = base.value().camera.zfar;
-      plan = p.plan.of(p.table, so, frame.correction[i].planMs);
+      DisplayStats& cs = frame.correction[i];
+      if (movedEye && display.rig) {
+        const display::DisplayGeometry design = display.rig->geometry(int(i));
+        display::DisplayGeometry moved = design;
+        moved.eye = {float(design.eye.x + offset.x), float(design.eye.y + offset.y),
+                     float(design.eye.z + offset.z)};
+        display::RefitStats rs;
+        plan =
+            p.plan.moved(p.table, so, design, moved, &renderer.pool(), cs.planMs, cs.refitMs, rs);
+        cs.replannedCells = rs.replanned;
+      } else {
+        plan = p.plan.of(p.table, so, cs.planMs);
+      }
       view.plan = plan.get();
     }
     if (Status s = renderCorrected(renderer, scene, o, base.value(), view, frame.linear[i],
@@ -291,6 +381,114 @@ Status renderDisplay(CorrectionRenderer& renderer, const scene::Scene& scene,
     frame.stats[i].totalMs = core::msSince(start);
   }
   return {};
+}
+
+display::PanoramaView displayPanorama(const DisplaySetup& display, double pixelDegrees) {
+  std::vector<const display::DirectionTable*> tables;
+  for (const ProjectorSetup& p : display.projectors) tables.push_back(&p.table);
+  return display::panoramaOf(tables, pixelDegrees);
+}
+
+namespace {
+
+// The linear value an 8-bit code stands for under `gamma`: the middle of the values it encodes.
+std::array<uint16_t, 256> decodeTable(const output::GammaTable& gamma) {
+  std::array<uint32_t, 256> lo, hi;
+  lo.fill(65535);
+  hi.fill(0);
+  for (uint32_t v = 0; v < 65536; ++v) {
+    const uint8_t c = gamma.table[v];
+    lo[c] = std::min(lo[c], v), hi[c] = std::max(hi[c], v);
+  }
+  std::array<uint16_t, 256> out{};
+  uint16_t last = 0;
+  for (size_t c = 0; c < 256; ++c) {
+    if (lo[c] <= hi[c]) last = uint16_t((lo[c] + hi[c]) / 2);
+    out[c] = last;  // a code no value encodes: the one below's
+  }
+  return out;
+}
+
+}  // namespace
+
+void showPanorama(const DisplaySetup& display, const display::PanoramaView& view,
+                  const Image& picture, const output::GammaTable& gamma, core::ThreadPool& pool,
+                  std::vector<Image>& images) {
+  SV_CHECK(picture.width == view.width && picture.height == view.height);
+  const std::array<uint16_t, 256> decode = decodeTable(gamma);
+  images.resize(display.projectors.size());
+  output::LinearImage linear;
+  for (size_t k = 0; k < display.projectors.size(); ++k) {
+    const ProjectorSetup& p = display.projectors[k];
+    const display::DirectionTable& t = p.table;
+    linear.resize(t.width, t.height);
+    constexpr int kBand = 16;  // rows per task
+    pool.parallelFor(size_t((t.height + kBand - 1) / kBand), [&](size_t band, int) {
+      const int y0 = int(band) * kBand, y1 = std::min(t.height, y0 + kBand);
+      for (int y = y0; y < y1; ++y)
+        for (int x = 0; x < t.width; ++x) {
+          const size_t i = t.index(x, y);
+          uint16_t* out = &linear.rgb[3 * i];
+          out[0] = out[1] = out[2] = 0;
+          if (!t.valid[i]) continue;
+          // Bilinear between the four pixel centres around the point, clamped at the edges.
+          const display::PanoramaPoint q = display::panoramaPoint(view, t.directions[i]);
+          const double fx = std::clamp(q.x - 0.5, 0.0, double(view.width - 1));
+          const double fy = std::clamp(q.y - 0.5, 0.0, double(view.height - 1));
+          const int x0 = int(fx), y0p = int(fy);
+          const int x1 = std::min(x0 + 1, view.width - 1), y1p = std::min(y0p + 1, view.height - 1);
+          const double ax = fx - x0, ay = fy - y0p;
+          for (int c = 0; c < 3; ++c) {
+            const auto at = [&](int px, int py) {
+              return double(decode[picture.pixel(px, py)[c]]);
+            };
+            const double top = at(x0, y0p) + ax * (at(x1, y0p) - at(x0, y0p));
+            const double bottom = at(x0, y1p) + ax * (at(x1, y1p) - at(x0, y1p));
+            out[c] = uint16_t(std::lround(top + ay * (bottom - top)));
+          }
+        }
+    });
+    if (p.blend) display::applyBlend(*p.blend, linear.rgb.data());
+    output::prepareImage(t.width, t.height, images[k]);
+    pool.parallelFor(size_t((t.height + kBand - 1) / kBand), [&](size_t band, int) {
+      const int y0 = int(band) * kBand;
+      output::encodeRows(linear, gamma, y0, std::min(t.height, y0 + kBand), images[k]);
+    });
+  }
+}
+
+PanoramaPatch panoramaPatch(const DisplaySetup& display, const display::PanoramaView& view, int x0,
+                            int y0, int width, int height) {
+  PanoramaPatch patch;
+  patch.x0 = x0, patch.y0 = y0, patch.width = width, patch.height = height;
+  for (const ProjectorSetup& p : display.projectors) {
+    const display::DirectionTable& t = p.table;
+    std::vector<PanoramaPatch::Pixel>& pixels = patch.pixels.emplace_back();
+    for (size_t i = 0; i < t.directions.size(); ++i) {
+      if (!t.valid[i]) continue;
+      const display::PanoramaPoint q = display::panoramaPoint(view, t.directions[i]);
+      const double px = std::floor(q.x) - x0, py = std::floor(q.y) - y0;
+      if (px >= 0 && px < width && py >= 0 && py < height)
+        pixels.push_back({uint32_t(i), uint32_t(py) * uint32_t(width) + uint32_t(px)});
+    }
+  }
+  return patch;
+}
+
+void overlayPatch(const PanoramaPatch& patch, const Image& onBlack, const Image& onWhite,
+                  std::vector<Image>& images) {
+  SV_CHECK(onBlack.width == patch.width && onBlack.height == patch.height &&
+           onWhite.width == patch.width && onWhite.height == patch.height);
+  for (size_t k = 0; k < patch.pixels.size() && k < images.size(); ++k) {
+    if (images[k].rgb.empty()) continue;  // a projector not drawn here
+    for (const PanoramaPatch::Pixel& px : patch.pixels[k])
+      for (size_t c = 0; c < 3; ++c) {
+        const int add = onBlack.rgb[3 * size_t(px.at) + c];
+        const int white = onWhite.rgb[3 * size_t(px.at) + c];
+        uint8_t& v = images[k].rgb[3 * size_t(px.pixel) + c];
+        v = uint8_t(std::clamp(add + (v * (white - add) + 127) / 255, 0, 255));
+      }
+  }
 }
 
 Result<Image> viewerImage(const DisplaySetup& display, const DisplayFrame& frame,

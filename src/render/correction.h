@@ -86,17 +86,32 @@ class PlanCache {
   PlanCache& operator=(const PlanCache&) {
     std::lock_guard lock(mutex_);
     plan_.reset();
+    points_.reset();
+    movedPlan_.reset();
     return *this;
   }
   // The plan of `table` under `options`: kept, or made now (`madeMs` then its time, else 0).
   std::shared_ptr<const display::SubFrustumPlan> of(const display::DirectionTable& table,
                                                     const display::SubFrustumOptions& options,
                                                     double& madeMs) const;
+  // Dynamic correction (issue 61): the plan for the eye of `moved` — `design` (the geometry
+  // `table` was made from) with its eye moved — refitted from the design plan (display::refitPlan,
+  // the design plan's screen points kept with it), and kept until the eye moves again. The design
+  // eye's own is `of`'s. `refitMs` gets the refit's time (0 when the eye has not moved since the
+  // last call), `stats` its counts.
+  std::shared_ptr<const display::SubFrustumPlan> moved(
+      const display::DirectionTable& table, const display::SubFrustumOptions& options,
+      const display::DisplayGeometry& design, const display::DisplayGeometry& moved,
+      core::ThreadPool* pool, double& madeMs, double& refitMs, display::RefitStats& stats) const;
 
  private:
   mutable std::mutex mutex_;
   mutable std::shared_ptr<const display::SubFrustumPlan> plan_;
   mutable display::SubFrustumOptions options_;
+  mutable std::optional<display::PlanScreenPoints> points_;           // plan_'s, for a moved eye
+  mutable std::shared_ptr<const display::SubFrustumPlan> movedPlan_;  // for movedEye_
+  mutable Vec3 movedEye_{0, 0, 0};
+  mutable display::RefitStats movedStats_;
 };
 
 struct ProjectorSetup {
@@ -105,6 +120,7 @@ struct ProjectorSetup {
   PlanCache plan;                          // method (a)'s plan of `table`
   std::optional<display::BlendMap> alpha;  // the alpha map `blend` comes from, when known
   std::optional<display::BlendWeights> blend;
+  std::optional<display::MpcdiRegion> region;  // an MPCDI file's region it was read from
 };
 struct DisplaySetup {
   std::vector<ProjectorSetup> projectors;
@@ -118,6 +134,12 @@ DisplaySetup cylinderDisplay(int width, int height, double overlapDegrees = 10);
 // An MPCDI file's regions (3d profile: each region's frustum and warp give its directions; its
 // alpha and beta maps its blend), named by their ids.
 Result<DisplaySetup> mpcdiDisplay(const std::string& path);
+// The display at 1/r of its projectors' resolution — each ⌈w/r⌉ × ⌈h/r⌉, the same screen, lenses
+// and blend maps (a rig's projectors resized, an MPCDI region's resolution divided: its warp and
+// alpha maps are sampled at the new pixel centres) — what an image generator draws at a
+// half-resolution quality level and shows each pixel r × r times.
+DisplaySetup scaledDisplay(const DisplaySetup& display, int r);
+
 // The rig of a cylinderDisplay as an MPCDI file (3d profile, level 2): a buffer with a region per
 // projector, its frustum the projector's covering flat view, a per-pixel warp, its alpha map.
 Result<display::Mpcdi> mpcdiOf(const DisplaySetup& display);
@@ -130,8 +152,45 @@ struct DisplayFrame {
   std::vector<FrameStats> stats;
   std::vector<DisplayStats> correction;
 };
+// What one call draws: the eye moved from the design eye (head tracking, or a design eye the
+// host moves: display::refitPlan for a rig, whose screen is known; a display read from a file
+// keeps its design eye's correction and moves the viewpoint alone), and which projectors (the
+// others' frames are left as they were).
+struct DisplayRequest {
+  Vec3d eyeOffset{0, 0, 0};  // metres, in the camera's eye frame (x right, y up, z back)
+  const std::vector<int>* projectors = nullptr;  // nullptr: every one
+};
 Status renderDisplay(CorrectionRenderer& renderer, const scene::Scene& scene,
-                     const RenderOptions& o, const DisplaySetup& display, DisplayFrame& frame);
+                     const RenderOptions& o, const DisplaySetup& display, DisplayFrame& frame,
+                     const DisplayRequest& request = {});
+
+// Pictures in the viewer's frame shown on the display (an image generator's test patterns and
+// overlay, docs/display.md "Pictures on the screen"): a panorama around the display's eye
+// (display::panoramaOf its projectors' directions) that each projector pixel samples in its own
+// direction, so that the picture comes out undistorted and continuous across the projectors.
+display::PanoramaView displayPanorama(const DisplaySetup& display, double pixelDegrees);
+// `picture` (codes as `gamma` encodes them, the panorama's size) on every projector: bilinear in
+// linear light, blended, through `gamma`; invalid pixels black. In bands of rows on `pool`.
+void showPanorama(const DisplaySetup& display, const display::PanoramaView& view,
+                  const Image& picture, const output::GammaTable& gamma, core::ThreadPool& pool,
+                  std::vector<Image>& images);
+// A small picture over the projectors' encoded frames, at (x0, y0) of the panorama: the pixels
+// whose directions fall in its rectangle, found once a display (PanoramaPatch), and each frame
+// their value v made v·scale + add — the picture given as what it makes of black (`add`) and of
+// white (`add + 255·scale`), so that a translucent box and its text keep their look (nearest
+// sample).
+struct PanoramaPatch {
+  int x0 = 0, y0 = 0, width = 0, height = 0;
+  struct Pixel {
+    uint32_t pixel;  // in the projector's frame
+    uint32_t at;     // in the picture
+  };
+  std::vector<std::vector<Pixel>> pixels;  // per projector
+};
+PanoramaPatch panoramaPatch(const DisplaySetup& display, const display::PanoramaView& view, int x0,
+                            int y0, int width, int height);
+void overlayPatch(const PanoramaPatch& patch, const Image& onBlack, const Image& onWhite,
+                  std::vector<Image>& images);
 // The simulated viewer's view of a rendered display (display::viewerPanorama over the rig's
 // screen, from its eye), through the gamma table. Fails for a display without a known rig.
 Result<Image> viewerImage(const DisplaySetup& display, const DisplayFrame& frame,

@@ -39,5 +39,9 @@ const std::string& Display::projectorName(int p) const {
 int Display::projectorWidth(int p) const { return setup_->projectors[size_t(p)].table.width; }
 int Display::projectorHeight(int p) const { return setup_->projectors[size_t(p)].table.height; }
 bool Display::hasGeometry() const { return setup_->rig.has_value(); }
+Display Display::scaled(int r) const {
+  if (r <= 1) return *this;
+  return Display(std::make_shared<const render::DisplaySetup>(render::scaledDisplay(*setup_, r)));
+}
 
 }  // namespace sv

@@ -76,6 +76,20 @@ TEST(IgConfig, MalformedConfigurationsGetAClearError) {
       {R"({"synthvis-ig": 1, "scene": "a.json", "models": {"x": "m.json"}})", "not an entity type"},
       {R"({"synthvis-ig": 1, "scene": "a.json", "render": {"aa": 3}})", "render.aa"},
       {R"({"synthvis-ig": 1, "scene": "a.json", "colour": 1})", "unknown field \"colour\""},
+      {R"({"synthvis-ig": 1, "scene": "a.json", "display": {}})", "display: either"},
+      {R"({"synthvis-ig": 1, "scene": "a.json", "display": {"cylinder": {}, "mpcdi": "r.mpcdi"}})",
+       "display: either"},
+      {R"({"synthvis-ig": 1, "scene": "a.json", "display": {"cylinder": {"width": 8}}})",
+       "display.cylinder.width: 8 is outside"},
+      {R"({"synthvis-ig": 1, "scene": "a.json", "display": {"mpcdi": 3}})", "display.mpcdi"},
+      {R"({"synthvis-ig": 1, "scene": "a.json", "display": {"cylinder": {}, "correction": "warp"}})",
+       "display.correction: subfrusta, bilinear or bicubic"},
+      {R"({"synthvis-ig": 1, "scene": "a.json", "channels": {"count": 2},
+           "display": {"cylinder": {}}})",
+       "not with \"channels\""},
+      {R"({"synthvis-ig": 1, "scene": "a.json", "cluster": {"split": [{"channel": 0, "ranks": [0, 1]}]},
+           "display": {"cylinder": {}}})",
+       "not with cluster.split"},
   };
   expectRefused(parseIgConfig, cases, "ig.json");
 }

@@ -17,6 +17,7 @@
 #include "render/camera.h"
 #include "render/correction.h"
 #include "render/view_renderer.h"
+#include "support/temp_dir.h"
 #include "support/test_scenes.h"
 #include "synthvis/display.h"
 #include "synthvis/formats.h"
@@ -446,6 +447,197 @@ TEST(SubFrusta, AreSharperThanAFlatViewResampled) {
   EXPECT_LT(rise[0], 1.0);
   EXPECT_LT(rise[0] * 1.15, rise[1]);
   EXPECT_LT(rise[0], rise[2]);
+}
+
+// Walls at 1.5, 4 and 20 m in three colours, over a grey floor: what a moved eye sees move.
+scene::Scene parallaxWalls() {
+  scene::Scene s = tests::emptyScene(200, {0.1f, 0.2f, 0.5f});
+  const Vec3 colours[3] = {{0.9f, 0.2f, 0.1f}, {0.1f, 0.8f, 0.2f}, {0.9f, 0.9f, 0.2f}};
+  const float depths[3] = {1.5f, 4, 20};
+  for (int k = 0; k < 3; ++k) {
+    scene::Material m;
+    m.baseColor = {colours[k].x, colours[k].y, colours[k].z, 1};
+    s.materials.push_back(m);
+    const float z = -depths[k], w = 0.25f * depths[k], x = (k - 1) * 0.6f * depths[k];
+    scene::Mesh quad;
+    quad.positions = {{x - w, -0.3f * depths[k], z},
+                      {x + w, -0.3f * depths[k], z},
+                      {x + w, 0.25f * depths[k], z},
+                      {x - w, 0.25f * depths[k], z}};
+    quad.indices = {0, 1, 2, 0, 2, 3};
+    quad.material = uint32_t(k);
+    s.meshes.push_back(quad);
+    s.instances.push_back({k, Mat4{}});
+  }
+  return s;
+}
+
+// Issue 61, dynamic correction: a frame for an eye moved from the design eye is drawn through the
+// design plan's cells refitted for it — the same picture, pixel for pixel but at edges, as a
+// display planned from scratch for that eye — and the refit is made once for an eye that stays.
+TEST(SubFrusta, AMovedEyeIsDrawnThroughItsRefittedMapsAsThroughAPlanMadeForIt) {
+  const scene::Scene s = parallaxWalls();
+  RenderOptions o;
+  o.threads = 2;
+  o.samples = 4;
+  const Display display = Display::cylinder(256, 160);
+  DisplayView moved;
+  moved.eyeOffset[0] = 0.12f, moved.eyeOffset[1] = 0.06f, moved.eyeOffset[2] = -0.10f;
+  Renderer r(o);
+  std::vector<Image> design, refitted, again;
+  std::vector<DisplayStats> stats;
+  ASSERT_TRUE(r.renderDisplay(s, display, design).ok());
+  ASSERT_TRUE(r.renderDisplay(s, display, refitted, nullptr, &stats, moved).ok());
+  for (const DisplayStats& c : stats) {
+    EXPECT_GT(c.refitMs, 0.0) << "the moved eye refits";
+    EXPECT_EQ(c.planMs, 0.0) << "the design plan is kept";
+  }
+  ASSERT_TRUE(r.renderDisplay(s, display, again, nullptr, &stats, moved).ok());
+  for (size_t i = 0; i < stats.size(); ++i) {
+    EXPECT_EQ(stats[i].refitMs, 0.0) << "an eye that stays is not refitted again";
+    EXPECT_EQ(again[i].rgb, refitted[i].rgb);
+  }
+  // The reference: the rig with its eye moved, its tables and plans made from scratch.
+  render::DisplaySetup fresh = render::cylinderDisplay(256, 160);
+  fresh.rig->eye =
+      fresh.rig->eye + Vec3{moved.eyeOffset[0], moved.eyeOffset[1], moved.eyeOffset[2]};
+  fresh.eye = {fresh.rig->eye.x, fresh.rig->eye.y, fresh.rig->eye.z};
+  for (size_t i = 0; i < fresh.projectors.size(); ++i)
+    fresh.projectors[i].table = display::directionTable(fresh.rig->geometry(int(i)));
+  render::CorrectionRenderer renderer(o);
+  render::DisplayFrame frame;
+  ASSERT_TRUE(render::renderDisplay(renderer, s, o, fresh, frame).ok());
+  for (size_t i = 0; i < 3; ++i) {
+    const Difference toFresh = compare(refitted[i], frame.images[i]);
+    const Difference toDesign = compare(refitted[i], design[i]);
+    const int pixels = refitted[i].width * refitted[i].height;
+    std::printf(
+        "projector %zu: %d of %d pixels differ from the plan made for the eye (max %d "
+        "codes), %d from the design eye's frame\n",
+        i, toFresh.differing, pixels, toFresh.maxCode, toDesign.differing);
+    EXPECT_LT(toFresh.differing, pixels / 400) << "projector " << i;
+    EXPECT_GT(toDesign.differing, pixels / 100) << "the eye's move shows (projector " << i << ")";
+  }
+}
+
+// The half-resolution level's display: each pixel shows the direction the full display's 2 × 2
+// block around it does (the same lens over fewer pixels), for the analytic rig and for the same
+// rig read back from an MPCDI file (its warp sampled at the new centres).
+TEST(SubFrusta, AScaledDisplaysPixelsShowTheirBlocksDirections) {
+  const Display full = Display::cylinder(256, 160);
+  tests::TempDir dir;
+  const std::string path = dir.path("rig.mpcdi");
+  ASSERT_TRUE(full.writeMpcdi(path).ok());
+  const Result<Display> file = Display::readMpcdi(path);
+  ASSERT_TRUE(file.ok()) << file.error().str();
+  for (const Display* d : {&full, &file.value()}) {
+    const Display half = d->scaled(2);
+    ASSERT_EQ(half.projectorCount(), 3);
+    for (int p = 0; p < 3; ++p) {
+      EXPECT_EQ(half.projectorWidth(p), 128);
+      EXPECT_EQ(half.projectorHeight(p), 80);
+      const display::DirectionTable& t = half.setup().projectors[size_t(p)].table;
+      const display::DisplayGeometry g = full.setup().rig->geometry(p);
+      double worst = 0;
+      int valid = 0;
+      for (int y = 0; y < t.height; ++y)
+        for (int x = 0; x < t.width; ++x) {
+          if (!t.valid[t.index(x, y)]) continue;
+          const std::optional<Vec3d> exact = display::viewDirection(g, 2 * x + 1, 2 * y + 1);
+          ASSERT_TRUE(exact.has_value());
+          worst = std::max(worst, angleBetween(*exact, t.directions[t.index(x, y)]));
+          ++valid;
+        }
+      EXPECT_GT(valid, t.width * t.height / 2);
+      EXPECT_LT(worst, d == &full ? 1e-6 : 1e-4) << "projector " << p;
+      EXPECT_TRUE(half.setup().projectors[size_t(p)].blend.has_value());
+    }
+  }
+}
+
+// Pictures on the screen (the IG's test patterns): a panorama whose red code rises with azimuth
+// and green with elevation, shown on the rig's projectors without their blend, gives every valid
+// pixel the codes of its own direction.
+TEST(DisplayPictures, EachProjectorPixelShowsThePanoramaInItsOwnDirection) {
+  render::DisplaySetup d = render::cylinderDisplay(192, 120);
+  for (render::ProjectorSetup& p : d.projectors) p.blend.reset();
+  const display::PanoramaView view = render::displayPanorama(d, 0.5);
+  EXPECT_GT(view.width, 360);  // 180° and the overlaps at half a degree
+  Image picture;
+  output::prepareImage(view.width, view.height, picture);
+  for (int y = 0; y < view.height; ++y)
+    for (int x = 0; x < view.width; ++x) {
+      uint8_t* px = picture.pixel(x, y);
+      px[0] = uint8_t(255 * x / (view.width - 1));
+      px[1] = uint8_t(255 * y / (view.height - 1));
+      px[2] = 0;
+    }
+  core::ThreadPool pool(2);
+  std::vector<Image> images;
+  render::showPanorama(d, view, picture, output::GammaTable::srgb(), pool, images);
+  ASSERT_EQ(images.size(), 3u);
+  int checked = 0;
+  for (size_t p = 0; p < 3; ++p) {
+    const display::DirectionTable& t = d.projectors[p].table;
+    for (int y = 0; y < t.height; y += 3)
+      for (int x = 0; x < t.width; x += 3) {
+        const uint8_t* px = images[p].pixel(x, y);
+        if (!t.valid[t.index(x, y)]) {
+          EXPECT_EQ(px[0] + px[1] + px[2], 0);
+          continue;
+        }
+        const display::PanoramaPoint q = display::panoramaPoint(view, t.directions[t.index(x, y)]);
+        const double red = 255 * (q.x - 0.5) / (view.width - 1);
+        const double green = 255 * (q.y - 0.5) / (view.height - 1);
+        ASSERT_NEAR(px[0], red, 2.5) << "projector " << p << " pixel " << x << ", " << y;
+        ASSERT_NEAR(px[1], green, 2.5) << "projector " << p << " pixel " << x << ", " << y;
+        ++checked;
+      }
+  }
+  EXPECT_GT(checked, 3000);
+}
+
+// The overlay's patch: only the pixels whose directions fall in its rectangle change, each to
+// v·scale + add as the two layers say.
+TEST(DisplayPictures, AnOverlayChangesOnlyThePixelsUnderIt) {
+  const render::DisplaySetup d = render::cylinderDisplay(192, 120);
+  const display::PanoramaView view = render::displayPanorama(d, 0.5);
+  const int x0 = view.width / 2 - 20, y0 = 10, w = 40, h = 20;
+  const render::PanoramaPatch patch = render::panoramaPatch(d, view, x0, y0, w, h);
+  ASSERT_EQ(patch.pixels.size(), 3u);
+  EXPECT_TRUE(patch.pixels[0].empty()) << "the left projector sees no azimuth near 0";
+  EXPECT_GT(patch.pixels[1].size(), size_t(w * h / 2));
+  // Opaque 200 in the left half of the patch, untouched (×1 + 0) in the right.
+  Image onBlack, onWhite;
+  for (Image* layer : {&onBlack, &onWhite}) {
+    output::prepareImage(w, h, *layer);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        for (int c = 0; c < 3; ++c)
+          layer->pixel(x, y)[c] = x < w / 2 ? 200 : (layer == &onBlack ? 0 : 255);
+  }
+  std::vector<Image> images(3);
+  for (size_t p = 0; p < 3; ++p) {
+    output::prepareImage(192, 120, images[p]);
+    std::fill(images[p].rgb.begin(), images[p].rgb.end(), uint8_t(50));
+  }
+  render::overlayPatch(patch, onBlack, onWhite, images);
+  const display::DirectionTable& t = d.projectors[1].table;
+  int opaque = 0, kept = 0;
+  for (int y = 0; y < t.height; ++y)
+    for (int x = 0; x < t.width; ++x) {
+      const uint8_t v = images[1].pixel(x, y)[0];
+      bool inLeft = false;
+      if (t.valid[t.index(x, y)]) {
+        const display::PanoramaPoint q = display::panoramaPoint(view, t.directions[t.index(x, y)]);
+        const double px = std::floor(q.x) - x0, py = std::floor(q.y) - y0;
+        inLeft = px >= 0 && px < w / 2 && py >= 0 && py < h;
+      }
+      EXPECT_EQ(v, inLeft ? 200 : 50) << x << ", " << y;
+      (inLeft ? opaque : kept)++;
+    }
+  EXPECT_GT(opaque, 100);
+  EXPECT_EQ(images[0].rgb, std::vector<uint8_t>(images[0].rgb.size(), 50));
 }
 
 }  // namespace
