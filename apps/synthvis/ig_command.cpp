@@ -65,6 +65,8 @@ void addIgCommand(CLI::App& app, Run& run) {
   ig->add_option("--status", args->igOptions.status,
                  "a JSON line a frame to FILE, or - for stdout");
   ig->add_flag("--overlay", args->igOptions.overlay, "draw stage times, quality level and counts");
+  ig->add_option("--viewer", args->igOptions.viewer,
+                 "a cylinder display: write the simulated viewer's view of the last frame here");
   ig->add_option("--test-pattern", args->igOptions.testPattern,
                  "show grid, bars or wedges on every channel instead of the scene");
   ig->add_flag("--as-fast-as-possible", args->igFast, "do not wait for each frame's slot");

@@ -101,6 +101,9 @@ struct IgRunOptions {
   uint64_t frames = 0;   // stop after this many (0: until stopped, or the replay's end)
   bool overlay = false;  // per-stage times, the quality level and counts drawn on channel 0
   std::string testPattern;  // grid, bars or wedges: every channel shows it instead of the scene
+  // A display whose screen is known (the cylinder): where to write, at the end, the simulated
+  // viewer's view of the screen lit by the last frame's projectors (a PNG; docs/display.md).
+  std::string viewer;
   bool realtime = true;     // false: frames as fast as they render (replays, tests)
   bool governor = true;     // overload protection on
   // Under mpirun, the job this process is a rank of (docs/cluster.md): rank 0 alone speaks to

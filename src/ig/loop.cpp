@@ -30,6 +30,7 @@
 #include "synthvis/display.h"
 #include "synthvis/files.h"
 #include "synthvis/ig.h"
+#include "synthvis/image.h"
 #include "synthvis/render.h"
 
 namespace sv::ig {
@@ -316,6 +317,12 @@ Result<std::unique_ptr<IgLoop>> IgLoop::create(const IgConfig& config,
     if (Result<present::TestPattern> t = present::parseTestPattern(options.testPattern); !t)
       return t.error();
   }
+  if (!options.viewer.empty() && !(m.display && m.display->hasGeometry()))
+    return Error{options.viewer, "",
+                 "the simulated viewer needs a display whose screen is known (\"display\": "
+                 "{\"cylinder\": …} in the configuration)"};
+  if (!options.viewer.empty() && m.ranks > 1)
+    return Error{options.viewer, "", "the simulated viewer sees every projector: not under MPI"};
   if (options.status == "-") {
     m.status = stdout;
     m.statusName = "standard output";
@@ -680,9 +687,17 @@ struct IgLoop::Session {
       m.giveUpStatus(errno);
   }
 
-  // The run's figures (IgRunReport), once the loop has ended.
-  Result<IgRunReport> finish() {
+  // The run's figures (IgRunReport), once the loop has ended; the viewer's view of the last
+  // frame's projectors (--viewer).
+  Result<IgRunReport> finish(const std::vector<Image>* lastShown) {
     if (Status s = m.presenter->flush(); !s) return s.error();
+    if (!m.options.viewer.empty() && lastShown) {
+      Result<Image> view =
+          render::viewerImage(m.display->setup(), *lastShown, display::PanoramaView{},
+                              render::gammaTableOf(m.config.render));
+      if (!view) return view.error();
+      if (Status s = writeImage(view.value(), m.options.viewer); !s) return s.error();
+    }
     report.dropped = m.presenter->dropped();
     report.frameMsP50 = percentile(frameMs, 0.5);
     report.frameMsP99 = percentile(frameMs, 0.99);
@@ -706,6 +721,7 @@ Result<IgRunReport> IgLoop::run() {
     if (Status st = s.calibrate(); !st) return st.error();
   s.t0 = Clock::now();
   Clock::time_point slot = s.t0, lastStart = s.t0;
+  const std::vector<Image>* lastShown = nullptr;
   for (uint32_t frame = 0; !stop_; ++frame) {
     if (options.frames && frame >= options.frames) break;
     if (options.realtime) std::this_thread::sleep_until(slot);
@@ -725,6 +741,7 @@ Result<IgRunReport> IgLoop::run() {
     const Clock::time_point renderStart = Clock::now();
     Result<std::vector<Image>*> shown = s.draw(frame, level);  // 4
     if (!shown) return shown.error();
+    lastShown = shown.value();
     const double renderMs = msBetween(renderStart, Clock::now());
     if (options.overlay && !shown.value()->empty() && (s.drawn(0) || impl_->display))
       s.drawOverlay(frame, level, renderMs, *shown.value());
@@ -758,7 +775,7 @@ Result<IgRunReport> IgLoop::run() {
     if (impl_->status) s.writeStatus(frame, level, ms, renderMs);
     if (impl_->presenter->closed()) break;
   }
-  return s.finish();
+  return s.finish(lastShown);
 }
 
 std::string IgRunReport::summary() const {

@@ -491,6 +491,29 @@ void overlayPatch(const PanoramaPatch& patch, const Image& onBlack, const Image&
   }
 }
 
+Result<Image> viewerImage(const DisplaySetup& display, const std::vector<Image>& frames,
+                          const display::PanoramaView& view, const output::GammaTable& gamma) {
+  if (frames.size() != display.projectors.size())
+    return Error{"", "",
+                 fmt::format("{} frames for a display of {} projectors", frames.size(),
+                             display.projectors.size())};
+  const std::array<uint16_t, 256> decode = decodeTable(gamma);
+  DisplayFrame frame;
+  frame.linear.resize(frames.size());
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const display::DirectionTable& t = display.projectors[i].table;
+    if (frames[i].width != t.width || frames[i].height != t.height)
+      return Error{"", "",
+                   fmt::format("projector '{}': a frame of {} × {} for {} × {} pixels",
+                               display.projectors[i].name, frames[i].width, frames[i].height,
+                               t.width, t.height)};
+    frame.linear[i].resize(t.width, t.height);
+    for (size_t k = 0; k < frames[i].rgb.size(); ++k)
+      frame.linear[i].rgb[k] = decode[frames[i].rgb[k]];
+  }
+  return viewerImage(display, frame, view, gamma);
+}
+
 Result<Image> viewerImage(const DisplaySetup& display, const DisplayFrame& frame,
                           const display::PanoramaView& view, const output::GammaTable& gamma) {
   if (!display.rig) return Error{"", "", "the simulated viewer needs the display's geometry"};

@@ -196,6 +196,11 @@ void overlayPatch(const PanoramaPatch& patch, const Image& onBlack, const Image&
 Result<Image> viewerImage(const DisplaySetup& display, const DisplayFrame& frame,
                           const display::PanoramaView& view, const output::GammaTable& gamma);
 
+// The same from a display's encoded frames (what an image generator presented, 8-bit codes as
+// `gamma` encodes them: each code taken back to the middle of the linear values it stands for).
+Result<Image> viewerImage(const DisplaySetup& display, const std::vector<Image>& frames,
+                          const display::PanoramaView& view, const output::GammaTable& gamma);
+
 // The table's directions as floats (a display::DirectionMap: what method (b) resamples through).
 display::DirectionMap directionMapOf(const display::DirectionTable& table);
 

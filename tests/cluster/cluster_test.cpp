@@ -179,6 +179,24 @@ int expectSameFiles(const fs::path& one, const fs::path& other) {
   return files;
 }
 
+// Issue 61: a curved screen under MPI — a projector per rank, each drawn through its own
+// correction and blend — gives the frames one process draws.
+TEST(Cluster, ThreeRanksDrawADisplaysProjectorsAsOneProcessDoes) {
+  const fs::path cfg = tempDir() / "cylinder.json";
+  std::ofstream(cfg) << R"({"synthvis-ig": 1, "scene": ")" << SV_SOURCE_DIR
+                     << R"(/scenes/mixed.json", "rate": 30, "port": 0, "host": {"port": 0},
+    "display": {"cylinder": {"width": 96, "height": 64}}})";
+  const fs::path one = tempDir() / "display-one", three = tempDir() / "display-three";
+  const std::string args =
+      " ig " + cfg.string() + " --frames 3 --as-fast-as-possible --no-governor";
+  const ShellRun a = shell(std::string(SV_CLI) + args + " --output png:" + one.string());
+  ASSERT_EQ(a.status, 0) << a.out;
+  const ShellRun b = shell(mpirun(3) + SV_CLI + args + " --output png:" + three.string());
+  ASSERT_EQ(b.status, 0) << b.out;
+  EXPECT_EQ(expectSameFiles(one, three), 9);  // 3 frames × 3 projectors
+  EXPECT_TRUE(fs::exists(three / "frame-000002-centre.png"));
+}
+
 TEST(Cluster, ASplitChannelIsTheImageOneProcessDraws) {
   // The airport at night (light points, whose visibility reads depth across tile borders; fog),
   // 4 samples a pixel: channel 1 split over ranks 2 and 0 (rank 2 assembles and shows it), the

@@ -8,6 +8,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -259,6 +260,135 @@ TEST(IgLoop, TheReplayDrawsEachFrameAtItsRecordedQuality) {
   expectSameFrames(frames, again, 12);
   fs::remove_all(frames);
   fs::remove_all(again);
+}
+
+// The frame's PNG of a named channel (a display's projector).
+Image projectorImage(const fs::path& dir, uint32_t frame, const std::string& name) {
+  char file[96];
+  std::snprintf(file, sizeof file, "frame-%06u-%s.png", frame, name.c_str());
+  Result<Image> image = readPng((dir / file).string());
+  EXPECT_TRUE(image.ok()) << image.error().str();
+  return image.ok() ? image.value() : Image{};
+}
+
+// The IG tests' configuration on the demo cylinder: three projectors of 128 × 80.
+IgConfig cylinderConfig() {
+  IgConfig c = config();
+  c.channels.clear();
+  c.display = IgConfig::DisplayConfig{"", 128, 80, 10};
+  return c;
+}
+
+// Issue 61: on a curved screen the projectors are the channels, drawn through the correction,
+// the overlay too; View Control of view 0 moves the eye the correction is made for; and the
+// session replays bit for bit.
+TEST(IgLoop, ACurvedScreensProjectorsAreTheChannelsAndAMovedEyeReplaysBitForBit) {
+  const fs::path frames = freshDir("display"), again = freshDir("display-replay");
+  const fs::path capture = frames / "session.pcap";
+  IgRunOptions options;
+  options.output = "png:" + frames.string();
+  options.record = capture.string();
+  options.overlay = true;
+  Result<std::unique_ptr<IgLoop>> loop = IgLoop::create(cylinderConfig(), options);
+  ASSERT_TRUE(loop.ok()) << loop.error().str();
+  std::optional<Result<IgRunReport>> report;
+  std::thread ig([&] { report.emplace(loop.value()->run()); });
+  HostScript sc = script(loop.value()->port(), 20, 100);  // no box this session
+  cigi::ViewControl vc;
+  vc.view = 0;
+  vc.entity = 0;
+  vc.enable = 1 | 2 | 4;
+  vc.x = 0.3f, vc.y = 0.2f, vc.z = -0.8f;  // forward, right and up, metres
+  sc.events.push_back({0.2, {vc}});
+  Result<HostLog> host = runHost(sc);
+  loop.value()->stop();
+  ig.join();
+  ASSERT_TRUE(host.ok()) << host.error().str();
+  ASSERT_TRUE(report->ok()) << report->error().str();
+  const uint64_t drawn = report->value().frames;
+  ASSERT_GE(drawn, 20u);
+  // Three projectors a frame at their own size; the eye's move changes the centre one's view of
+  // the ground (below the overlay, which changes every frame).
+  const Image first = projectorImage(frames, 1, "centre"),
+              last = projectorImage(frames, 19, "centre");
+  ASSERT_EQ(first.width, 128);
+  ASSERT_EQ(first.height, 80);
+  EXPECT_EQ(projectorImage(frames, 1, "left").width, 128);
+  EXPECT_EQ(projectorImage(frames, 1, "right").width, 128);
+  int moved = 0;
+  for (int y = first.height / 2; y < first.height; ++y)
+    for (int x = 0; x < first.width; ++x)
+      moved += std::memcmp(first.pixel(x, y), last.pixel(x, y), 3) != 0;
+  EXPECT_GT(moved, first.width * first.height / 50) << "the moved eye shows";
+
+  IgRunOptions replay;
+  replay.output = "png:" + again.string();
+  replay.replay = capture.string();
+  replay.realtime = false;
+  replay.overlay = true;
+  replay.viewer = (again / "viewer.png").string();
+  Result<std::unique_ptr<IgLoop>> second = IgLoop::create(cylinderConfig(), replay);
+  ASSERT_TRUE(second.ok()) << second.error().str();
+  Result<IgRunReport> r = second.value()->run();
+  ASSERT_TRUE(r.ok()) << r.error().str();
+  EXPECT_EQ(r->frames, drawn);
+  // The simulated viewer's view of the last frame: the lit screen, black beyond it.
+  Result<Image> viewer = readPng(replay.viewer);
+  ASSERT_TRUE(viewer.ok()) << viewer.error().str();
+  size_t lit = 0;
+  for (uint8_t v : viewer->rgb) lit += v > 20;
+  EXPECT_GT(lit, viewer->rgb.size() / 10);
+  EXPECT_EQ(viewer->pixel(0, viewer->height / 2)[0], 0) << "azimuth -100°: beyond the screen";
+  uint32_t compared = 0;
+  for (uint32_t f = 0; f < drawn; ++f)
+    for (const char* name : {"left", "centre", "right"}) {
+      char file[96];
+      std::snprintf(file, sizeof file, "frame-%06u-%s.png", f, name);
+      if (!fs::exists(frames / file)) continue;  // a frame the live run's writer dropped
+      // The overlay's text holds the live frame's times: compare below it.
+      const Image a = projectorImage(frames, f, name), b = projectorImage(again, f, name);
+      ASSERT_EQ(a.rgb.size(), b.rgb.size());
+      const size_t below = size_t(a.width) * 3 * size_t(a.height / 2);
+      ASSERT_TRUE(std::equal(a.rgb.begin() + long(below), a.rgb.end(), b.rgb.begin() + long(below)))
+          << "frame " << f << " " << name;
+      ++compared;
+    }
+  EXPECT_GT(compared, drawn * 3 / 2);
+  fs::remove_all(frames);
+  fs::remove_all(again);
+}
+
+// The test pattern through the correction: one picture of the viewer's field across the
+// projectors — the grid's vertical centre line on the centre projector alone, its horizontal
+// one across all three (a pattern per channel would draw a centre cross on each).
+TEST(IgLoop, ACurvedScreensTestPatternSpansTheProjectorsAsOnePicture) {
+  const fs::path frames = freshDir("display-grid");
+  IgRunOptions options;
+  options.output = "png:" + frames.string();
+  options.frames = 1;
+  options.realtime = false;
+  options.testPattern = "grid";
+  Result<std::unique_ptr<IgLoop>> loop = IgLoop::create(cylinderConfig(), options);
+  ASSERT_TRUE(loop.ok()) << loop.error().str();
+  ASSERT_TRUE(loop.value()->run().ok());
+  for (const char* name : {"left", "centre", "right"}) {
+    const Image image = projectorImage(frames, 0, name);
+    int top = image.height, bottom = -1, yellow = 0;
+    for (int y = 0; y < image.height; ++y)
+      for (int x = 0; x < image.width; ++x) {
+        const uint8_t* p = image.pixel(x, y);
+        if (p[0] > 90 && p[1] > 90 && p[2] < 40) {
+          top = std::min(top, y), bottom = std::max(bottom, y);
+          ++yellow;
+        }
+      }
+    EXPECT_GT(yellow, 20) << name;
+    if (std::string(name) == "centre")
+      EXPECT_GT(bottom - top, image.height / 2) << "the vertical line";
+    else
+      EXPECT_LT(bottom - top, 8) << name << ": the horizontal line alone";
+  }
+  fs::remove_all(frames);
 }
 
 // --status: a JSON line a frame. A stream that cannot be written (here a full disk) is given up
