@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <numbers>
 #include <optional>
 #include <utility>
@@ -42,7 +43,19 @@ struct Cone {
 // farthest corner (a cell's directions form a convex spherical quadrilateral, inside the cap of
 // its corners), widened by `reach` pixels at twice the coarsest pixel angle at a cell's centre (a
 // cell's pixel angle varies by far less across it).
-Cone coneOf(const display::SubFrustumPlan& plan, size_t c0, size_t c1, double reach) {
+Cone coneOf(const PlanCone& base, double reach) {
+  Cone cone;
+  cone.empty = base.empty;
+  cone.axis = base.axis;
+  if (base.empty || base.everyDirection) return cone;
+  const double half = base.halfAngle + 2 * reach * base.pixelAngle;
+  if (half < std::numbers::pi) cone.cosHalf = std::cos(half);
+  return cone;
+}
+
+}  // namespace
+
+PlanCone planCone(const display::SubFrustumPlan& plan, size_t c0, size_t c1) {
   std::vector<Vec3d> corners;
   double pixelAngle = 0;
   for (size_t i = c0; i < c1; ++i) {
@@ -56,21 +69,103 @@ Cone coneOf(const display::SubFrustumPlan& plan, size_t c0, size_t c1, double re
     pixelAngle = std::max({pixelAngle, angleBetween(centre, display::mapPixel(c, cx + 1, cy)),
                            angleBetween(centre, display::mapPixel(c, cx, cy + 1))});
   }
-  Cone cone;
+  PlanCone cone;
   if (corners.empty()) return cone;
   cone.empty = false;
   for (const Vec3d& d : corners) cone.axis = cone.axis + d;
   const double len = std::sqrt(dot(cone.axis, cone.axis));
-  if (!(len > 0)) return cone;  // corners all around: every direction
+  if (!(len > 0)) {  // corners all around: every direction
+    cone.everyDirection = true;
+    return cone;
+  }
   cone.axis = cone.axis * (1 / len);
-  double half = 0;
-  for (const Vec3d& d : corners) half = std::max(half, angleBetween(cone.axis, d));
-  half += 2 * reach * pixelAngle;
-  if (half < std::numbers::pi) cone.cosHalf = std::cos(half);
+  for (const Vec3d& d : corners)
+    cone.halfAngle = std::max(cone.halfAngle, angleBetween(cone.axis, d));
+  cone.pixelAngle = pixelAngle;
   return cone;
 }
 
+namespace {
+
+// A group's first fitted cell, and how far its map places the directions of the group's cells'
+// corners and centres from where their own maps do (pixels, and one more; −1: somewhere behind
+// it, or no fitted cell — every cell is then tried).
+SubFrustumRenderer::PlanState::Group groupOf(const display::SubFrustumPlan& plan, size_t c0,
+                                             size_t c1) {
+  SubFrustumRenderer::PlanState::Group g;
+  g.first = c0;
+  while (g.first < c1 && !plan.cells[g.first].fitted) ++g.first;
+  if (g.first == c1) return g;
+  const display::SubFrustumCell& rep = plan.cells[g.first];
+  double slack = 0;
+  for (size_t i = c0; i < c1; ++i) {
+    const display::SubFrustumCell& c = plan.cells[i];
+    if (!c.fitted) continue;
+    const double cx = 0.5 * (c.x0 + c.x1), cy = 0.5 * (c.y0 + c.y1);
+    for (const auto& [x, y] :
+         {std::pair{double(c.x0), double(c.y0)}, std::pair{double(c.x1), double(c.y0)},
+          std::pair{double(c.x0), double(c.y1)}, std::pair{double(c.x1), double(c.y1)},
+          std::pair{cx, cy}}) {
+      const std::optional<display::PixelPoint> q =
+          display::mapDirection(rep, display::mapPixel(c, x, y));
+      if (!q) return g;
+      slack = std::max({slack, std::abs(q->x - x), std::abs(q->y - y)});
+    }
+  }
+  // The disagreement of two smooth maps grows smoothly between the points measured: twice it,
+  // and a pixel, bound it across the cells.
+  g.slack = 2 * slack + 1;
+  return g;
+}
+
 }  // namespace
+
+void SubFrustumRenderer::preparePlan(const display::SubFrustumPlan& plan) {
+  const size_t n = plan.cells.size();
+  PlanState& st = plan_;
+  bool same = st.cells.size() == n && st.width == plan.width && st.height == plan.height;
+  for (size_t i = 0; same && i < n; ++i) {
+    const display::SubFrustumCell& a = st.cells[i];
+    const display::SubFrustumCell& b = plan.cells[i];
+    same = a.x0 == b.x0 && a.y0 == b.y0 && a.x1 == b.x1 && a.y1 == b.y1 && a.fitted == b.fitted &&
+           std::memcmp(&a.map, &b.map, sizeof(Mat3d)) == 0;
+  }
+  if (same) return;
+  st.width = plan.width;
+  st.height = plan.height;
+  st.cells = plan.cells;
+  // The light cull's cones.
+  const size_t span = kCullGroup * kCullGroups, tops = (n + span - 1) / span;
+  st.top.resize(tops);
+  st.group.resize((n + kCullGroup - 1) / kCullGroup);
+  st.groups.resize(st.group.size());
+  pool_.parallelFor(tops, [&](size_t top, int) {
+    const size_t t0 = top * span, t1 = std::min(n, t0 + span);
+    st.top[top] = planCone(plan, t0, t1);
+    for (size_t c0 = t0; c0 < t1; c0 += kCullGroup) {
+      const size_t c1 = std::min(t1, c0 + kCullGroup);
+      st.group[c0 / kCullGroup] = planCone(plan, c0, c1);
+      st.groups[c0 / kCullGroup] = groupOf(plan, c0, c1);
+    }
+  });
+  // The pixels no cell holds (the plan dropped wholly invalid cells), as runs of rows.
+  std::vector<uint8_t> covered(size_t(plan.width) * size_t(plan.height), 0);
+  for (const display::SubFrustumCell& c : plan.cells)
+    for (int y = c.y0; y < c.y1; ++y)
+      std::fill_n(&covered[size_t(y) * size_t(plan.width) + size_t(c.x0)], size_t(c.x1 - c.x0),
+                  uint8_t(1));
+  st.uncovered.clear();
+  for (int y = 0; y < plan.height; ++y)
+    for (int x = 0; x < plan.width;) {
+      if (covered[size_t(y) * size_t(plan.width) + size_t(x)]) {
+        ++x;
+        continue;
+      }
+      const int x0 = x;
+      while (x < plan.width && !covered[size_t(y) * size_t(plan.width) + size_t(x)]) ++x;
+      st.uncovered.push_back({y, x0, x});
+    }
+}
 
 void SubFrustumRenderer::cullLights(const scene::Scene& scene, const FrameCamera& base, Vec3d eye,
                                     const display::SubFrustumPlan& plan) {
@@ -94,22 +189,31 @@ void SubFrustumRenderer::cullLights(const scene::Scene& scene, const FrameCamera
   // Lights in light order through each level, so every cell's list comes out ascending.
   pool_.parallelFor((n + span - 1) / span, [&](size_t top, int) {
     const size_t t0 = top * span, t1 = std::min(n, t0 + span);
-    const Cone outer = coneOf(plan, t0, t1, reach);
+    const Cone outer = coneOf(plan_.top[top], reach);
     if (outer.empty) return;
     std::vector<const LightDirection*> inOuter, inGroup;
     for (const LightDirection& l : lightDirections_)
       if (dot(l.direction, outer.axis) >= outer.cosHalf) inOuter.push_back(&l);
     for (size_t c0 = t0; c0 < t1; c0 += kCullGroup) {
       const size_t c1 = std::min(t1, c0 + kCullGroup);
-      const Cone group = coneOf(plan, c0, c1, reach);
+      const Cone group = coneOf(plan_.group[c0 / kCullGroup], reach);
       if (group.empty) continue;
       inGroup.clear();
       for (const LightDirection* l : inOuter)
         if (dot(l->direction, group.axis) >= group.cosHalf) inGroup.push_back(l);
-      for (size_t i = c0; i < c1; ++i) {
-        const display::SubFrustumCell& c = plan.cells[i];
-        if (!c.fitted) continue;
-        for (const LightDirection* l : inGroup) {
+      // Each light placed once by the group's first map, then tried exactly on the cells whose
+      // rectangle that place is near (within the maps' disagreement over the group, slack).
+      const PlanState::Group& g = plan_.groups[c0 / kCullGroup];
+      for (const LightDirection* l : inGroup) {
+        std::optional<display::PixelPoint> q;
+        if (g.slack >= 0) q = display::mapDirection(plan.cells[g.first], l->direction);
+        const double near = reach + g.slack;
+        for (size_t i = c0; i < c1; ++i) {
+          const display::SubFrustumCell& c = plan.cells[i];
+          if (!c.fitted) continue;
+          if (q && !(q->x >= c.x0 - near && q->x <= c.x1 + near && q->y >= c.y0 - near &&
+                     q->y <= c.y1 + near))
+            continue;
           const std::optional<display::PixelPoint> p = display::mapDirection(c, l->direction);
           if (p && p->x >= c.x0 - reach && p->x <= c.x1 + reach && p->y >= c.y0 - reach &&
               p->y <= c.y1 + reach)
@@ -143,14 +247,13 @@ Status SubFrustumRenderer::render(const scene::Scene& scene, const RenderOptions
     return Error{"", "", "the display's valid-pixel mask does not match its size"};
   out.resize(o.width, o.height);
   const size_t n = plan.cells.size();
+  preparePlan(plan);
   // Every pixel is written: a fitted cell's by its view; an unfitted cell's, and one that is
   // invalid, black. Pixels outside every cell are invalid (the plan's cells hold every valid one):
-  // without a mask to say so, the frame starts black.
-  int64_t covered = 0;
-  for (const display::SubFrustumCell& c : plan.cells)
-    covered += int64_t(c.x1 - c.x0) * int64_t(c.y1 - c.y0);
-  if (valid.empty() && covered != int64_t(o.width) * int64_t(o.height))
-    std::fill(out.rgb.begin(), out.rgb.end(), uint16_t(0));
+  // black.
+  for (const PlanState::Run& r : plan_.uncovered)
+    std::fill_n(&out.rgb[(size_t(r.y) * size_t(o.width) + size_t(r.x0)) * 3],
+                size_t(r.x1 - r.x0) * 3, uint16_t(0));
   cellStats_.assign(n, FrameStats{});
   cellErrors_.assign(n, Status{});
   const bool lights = !scene.lightPoints.empty() || !scene.stars.stars.empty();
@@ -173,6 +276,13 @@ Status SubFrustumRenderer::render(const scene::Scene& scene, const RenderOptions
     cellErrors_[i] = workers_[size_t(worker)]->renderLinear(
         scene, co, camera, output::LinearTarget{&out, cell.x0, cell.y0, co.width, co.height},
         cellStats_[i]);
+    // Its invalid pixels black, while they are in this core's cache.
+    if (!valid.empty() && cell.validPixels < int64_t(co.width) * co.height)
+      for (int y = cell.y0; y < cell.y1; ++y)
+        for (int x = cell.x0; x < cell.x1; ++x) {
+          const size_t k = size_t(y) * size_t(o.width) + size_t(x);
+          if (!valid[k]) out.rgb[3 * k] = out.rgb[3 * k + 1] = out.rgb[3 * k + 2] = 0;
+        }
   });
   SubFrustumStats counts;
   counts.unfittedPixels = plan.unfittedPixels;
@@ -183,9 +293,6 @@ Status SubFrustumRenderer::render(const scene::Scene& scene, const RenderOptions
     stats += cellStats_[i];
     ++counts.cells;
   }
-  if (!valid.empty())
-    for (size_t i = 0; i < valid.size(); ++i)
-      if (!valid[i]) out.rgb[3 * i] = out.rgb[3 * i + 1] = out.rgb[3 * i + 2] = 0;
   if (cellStats) *cellStats = counts;
   return {};
 }

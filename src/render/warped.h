@@ -26,6 +26,17 @@ namespace sv::render {
 // channel would).
 FrameCamera cellCamera(const FrameCamera& base, const display::SubFrustumCell& cell, Vec3d eye);
 
+// The cone from the display's eye that holds the directions of a run of a plan's cells
+// (render/warped.cpp, the light cull): about the mean of their corners, out to the farthest, and
+// the coarsest pixel angle at a cell's centre (what a reach in pixels widens it by).
+struct PlanCone {
+  Vec3d axis;
+  double halfAngle = 0, pixelAngle = 0;
+  bool empty = true;            // no fitted cell
+  bool everyDirection = false;  // corners all around the eye
+};
+PlanCone planCone(const display::SubFrustumPlan& plan, size_t c0, size_t c1);
+
 struct SubFrustumStats {
   int cells = 0;               // cells drawn (the plan's fitted ones)
   int64_t unfittedPixels = 0;  // valid pixels of cells without a map: black
@@ -68,6 +79,28 @@ class SubFrustumRenderer {
     uint32_t index;   // the light's (LightInput::subset)
   };
   std::vector<LightDirection> lightDirections_;  // this frame's, but for a light at the eye
+ public:
+  // What depends on the plan alone, made when it changes (a new plan, a moved eye's refit) and
+  // known again by its cells: the light cull's cones, per top group and per group of cells, and
+  // the pixels no cell holds, as runs of a row.
+  struct PlanState {
+    int width = 0, height = 0;
+    std::vector<display::SubFrustumCell> cells;
+    std::vector<PlanCone> top, group;
+    struct Group {
+      size_t first = 0;   // the group's first fitted cell
+      double slack = -1;  // SubFrustumRenderer's light cull: see groupOf in warped.cpp
+    };
+    std::vector<Group> groups;
+    struct Run {
+      int y, x0, x1;
+    };
+    std::vector<Run> uncovered;
+  };
+
+ private:
+  void preparePlan(const display::SubFrustumPlan& plan);
+  PlanState plan_;
 };
 
 }  // namespace sv::render

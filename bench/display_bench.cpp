@@ -1,0 +1,113 @@
+// Kernel benchmarks of distortion correction at an IG's rate (issue 61's cost model,
+// docs/display.md "At an IG's rate"), on BENCH.md's display figure — scenes/airport.json on the
+// demo cylinder's centre projector at 1920×1080 — on one thread (/1), so that a figure is ns of a
+// core, and on two (/2, the issue's figure):
+//   the unwarped frame (the scene camera's view)                          → ms a frame
+//   the same through the projector's sub-frusta (the plan made once)     → ms a frame, and
+//     (sub-frusta − unwarped) / cells                                     → µs of a core a cell
+//   the plan refitted for a moved eye (the cells fixed)                   → µs a cell
+// The budget: ≤ 3 µs of a core a cell for the frame (the 1.3× target), ≤ 4 µs a cell for the
+// refit (2 ms on 2 threads). Run: build/bench/sv_display_bench (SV_BENCH_TARGET=avx2 for the AVX2
+// kernels on an AVX-512 machine).
+#include <benchmark/benchmark.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <optional>
+
+#include "bench_target.h"
+#include "display/subfrustum.h"
+#include "render/camera.h"
+#include "render/correction.h"
+#include "render/view_renderer.h"
+#include "render/warped.h"
+#include "synthvis/formats.h"
+
+namespace {
+
+constexpr int kWidth = 1920, kHeight = 1080;
+
+struct DisplayCase {
+  sv::scene::Scene scene;
+  sv::RenderOptions options;
+  sv::render::DisplaySetup display = sv::render::cylinderDisplay(kWidth, kHeight);
+  sv::display::SubFrustumPlan plan;
+  sv::render::FrameCamera base;
+
+  DisplayCase() {
+    const std::string path = std::string(SV_SOURCE_DIR) + "/scenes/airport.json";
+    auto loaded = sv::formats::loadScene(path);
+    if (!loaded.ok()) {
+      std::fprintf(stderr, "sv_display_bench: %s (scripts/demo unpacks its star catalogue)\n",
+                   loaded.error().str().c_str());
+      std::exit(1);
+    }
+    scene = std::move(loaded.value());
+    options.threads = 1;
+    options.width = kWidth;
+    options.height = kHeight;
+    base = sv::render::chooseCamera(scene, options).value();
+    sv::display::SubFrustumOptions so;
+    so.znear = base.camera.znear;
+    so.zfar = base.camera.zfar;
+    plan = sv::display::planSubFrusta(centre().table, so);
+  }
+  const sv::render::ProjectorSetup& centre() const { return display.projectors[1]; }
+};
+
+DisplayCase& theCase() {
+  static DisplayCase c;
+  return c;
+}
+
+void BM_UnwarpedFrame(benchmark::State& state) {
+  DisplayCase& c = theCase();
+  sv::RenderOptions o = c.options;
+  o.threads = int(state.range(0));
+  sv::render::ViewRenderer renderer(o);
+  sv::output::LinearImage out;
+  for (auto _ : state) {
+    sv::FrameStats stats;
+    if (!renderer.renderLinear(c.scene, o, c.base, out, stats)) state.SkipWithError("render");
+  }
+}
+BENCHMARK(BM_UnwarpedFrame)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_SubFrustaFrame(benchmark::State& state) {
+  DisplayCase& c = theCase();
+  sv::RenderOptions o = c.options;
+  o.threads = int(state.range(0));
+  sv::render::SubFrustumRenderer renderer(o);
+  sv::output::LinearImage out;
+  for (auto _ : state) {
+    sv::FrameStats stats;
+    if (!renderer.render(c.scene, o, c.base, c.display.eye, c.plan, c.centre().table.valid, out,
+                         stats))
+      state.SkipWithError("render");
+  }
+  state.counters["cells"] = double(c.plan.cells.size());
+}
+BENCHMARK(BM_SubFrustaFrame)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_RefitPlan(benchmark::State& state) {
+  DisplayCase& c = theCase();
+  const sv::display::DisplayGeometry design = c.display.rig->geometry(1);
+  const sv::display::PlanScreenPoints points =
+      sv::display::planScreenPoints(c.plan, c.centre().table, design);
+  sv::display::DisplayGeometry moved = design;
+  // A head's motion, as `bench --renderer display` moves it: (2, 1, −1) cm.
+  moved.eye = moved.eye + sv::Vec3{0.02f, 0.01f, -0.01f};
+  sv::display::RefitStats st;
+  for (auto _ : state) {
+    sv::display::SubFrustumPlan p = sv::display::refitPlan(c.plan, points, moved, {}, &st);
+    benchmark::DoNotOptimize(p.cells.data());
+  }
+  state.counters["replanned"] = st.replanned;
+  state.counters["cells"] = double(c.plan.cells.size());
+}
+BENCHMARK(BM_RefitPlan)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+
+int main(int argc, char** argv) { return sv::bench::runBenchmarks(argc, argv, "sv_display_bench"); }
