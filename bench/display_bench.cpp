@@ -5,12 +5,15 @@
 //   the unwarped frame (the scene camera's view)                          → ms a frame
 //   the same through the projector's sub-frusta (the plan made once)     → ms a frame, and
 //     (sub-frusta − unwarped) / cells                                     → µs of a core a cell
+//   the two alternating in one run, their medians and ratio              → the ratio
 //   the plan refitted for a moved eye (the cells fixed)                   → µs a cell
 // The budget: ≤ 3 µs of a core a cell for the frame (the 1.3× target), ≤ 4 µs a cell for the
 // refit (2 ms on 2 threads). Run: build/bench/sv_display_bench (SV_BENCH_TARGET=avx2 for the AVX2
 // kernels on an AVX-512 machine).
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
@@ -89,6 +92,46 @@ void BM_SubFrustaFrame(benchmark::State& state) {
   state.counters["cells"] = double(c.plan.cells.size());
 }
 BENCHMARK(BM_SubFrustaFrame)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The two frames alternating, each timed (BENCH.md: ratios from the same run): the medians and
+// their ratio, and (sub-frusta − unwarped) / cells in µs of the threads' time.
+void BM_SubFrustaOverUnwarped(benchmark::State& state) {
+  DisplayCase& c = theCase();
+  sv::RenderOptions o = c.options;
+  o.threads = int(state.range(0));
+  sv::render::ViewRenderer flat(o);
+  sv::render::SubFrustumRenderer cells(o);
+  sv::output::LinearImage a, b;
+  std::vector<double> flatMs, cellsMs;
+  const auto ms = [](auto t0) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  };
+  for (auto _ : state) {
+    sv::FrameStats stats;
+    auto t0 = std::chrono::steady_clock::now();
+    if (!flat.renderLinear(c.scene, o, c.base, a, stats)) state.SkipWithError("render");
+    flatMs.push_back(ms(t0));
+    t0 = std::chrono::steady_clock::now();
+    if (!cells.render(c.scene, o, c.base, c.display.eye, c.plan, c.centre().table.valid, b, stats))
+      state.SkipWithError("render");
+    cellsMs.push_back(ms(t0));
+  }
+  const auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v.empty() ? 0.0 : v[v.size() / 2];
+  };
+  const double f = median(flatMs), s = median(cellsMs);
+  state.counters["unwarped_ms"] = f;
+  state.counters["subfrusta_ms"] = s;
+  state.counters["ratio"] = f > 0 ? s / f : 0;
+  state.counters["us_a_cell"] = (s - f) * 1000 * o.threads / double(c.plan.cells.size());
+}
+BENCHMARK(BM_SubFrustaOverUnwarped)
+    ->Arg(1)
+    ->Arg(2)
+    ->Iterations(30)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 void BM_RefitPlan(benchmark::State& state) {
   DisplayCase& c = theCase();

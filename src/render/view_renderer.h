@@ -5,6 +5,7 @@
 #pragma once
 
 #include "core/thread_pool.h"
+#include "core/timing.h"
 #include "output/resolve.h"
 #include "render/camera.h"
 #include "render/draw_packets.h"
@@ -45,6 +46,15 @@ class ViewRenderer {
   Status renderLinear(const scene::Scene& scene, const RenderOptions& o, const FrameCamera& camera,
                       const output::LinearTarget& target, FrameStats& stats);
 
+  // A view whose stages 2–3 a caller made (shading tables in the camera's eye space, and draw
+  // packets in its clip space, their materials from those tables): setup, the tiles with the
+  // frame's passes and the resolve, into a rectangle of a larger linear image. The sub-frusta
+  // stage's cells: each cell's share of the display's packets, through its own map.
+  Status renderPacketsLinear(const scene::Scene& scene, const RenderOptions& o,
+                             const FrameCamera& camera, const DrawPackets& packets,
+                             const ShadingTables& shading, const output::LinearTarget& target,
+                             FrameStats& stats);
+
   core::ThreadPool& pool() { return frame_.pool(); }
   const output::GammaTable& gamma() const { return gamma_; }
 
@@ -55,6 +65,11 @@ class ViewRenderer {
   Status run(const scene::Scene& scene, const RenderOptions& o, const FrameCamera& camera,
              Image& image, const output::LinearTarget* linearOut, FrameStats& stats,
              const TileShare& share);
+  // Stages 3–5 from `packets` (run's, or a caller's).
+  Status drawPackets(const scene::Scene& scene, const RenderOptions& o, const FrameCamera& camera,
+                     const DrawPackets& packets, const ShadingTables& shading, Image& image,
+                     const output::LinearTarget* linearOut, FrameStats& stats,
+                     const TileShare& share, core::Clock::time_point start);
 
   FrameRenderer frame_;
   SegmentRenderer segments_;

@@ -9,6 +9,7 @@
 #include <optional>
 #include <utility>
 
+#include "core/timing.h"
 #include "lights/light_laws.h"
 #include "render/passes.h"
 
@@ -131,6 +132,7 @@ void SubFrustumRenderer::preparePlan(const display::SubFrustumPlan& plan) {
            std::memcmp(&a.map, &b.map, sizeof(Mat3d)) == 0;
   }
   if (same) return;
+  stage_.znear = stage_.zfar = -1;  // made again for this plan
   st.width = plan.width;
   st.height = plan.height;
   st.cells = plan.cells;
@@ -167,8 +169,8 @@ void SubFrustumRenderer::preparePlan(const display::SubFrustumPlan& plan) {
     }
 }
 
-void SubFrustumRenderer::cullLights(const scene::Scene& scene, const FrameCamera& base, Vec3d eye,
-                                    const display::SubFrustumPlan& plan) {
+void SubFrustumRenderer::lightDirections(const scene::Scene& scene, const FrameCamera& base,
+                                         Vec3d eye) {
   std::vector<Vec4> positions;
   lights::lightEyePositions(lightInput(scene, base), positions);
   lightDirections_.clear();
@@ -178,10 +180,19 @@ void SubFrustumRenderer::cullLights(const scene::Scene& scene, const FrameCamera
     const double len = std::sqrt(dot(d, d));
     if (len > 0) lightDirections_.push_back({d * (1 / len), uint32_t(l)});  // at the eye: never
   }
+}
+
+double SubFrustumRenderer::lightReach(const scene::Scene& scene) {
   // A splat reaches no pixel farther than its kernel radius from its centre (light_laws.h); a
   // pixel more covers the difference between the pass's float projection and the map's double.
   const scene::LightSettings& ls = scene.lightSettings;
-  const double reach = lights::splatRadius(std::max(ls.minSize, ls.maxSize)) + 1;
+  return lights::splatRadius(std::max(ls.minSize, ls.maxSize)) + 1;
+}
+
+void SubFrustumRenderer::cullLights(const scene::Scene& scene, const FrameCamera& base, Vec3d eye,
+                                    const display::SubFrustumPlan& plan) {
+  lightDirections(scene, base, eye);
+  const double reach = lightReach(scene);
   const size_t n = plan.cells.size();
   const size_t span = kCullGroup * kCullGroups;
   cellLights_.resize(n);
@@ -248,6 +259,35 @@ Status SubFrustumRenderer::render(const scene::Scene& scene, const RenderOptions
   out.resize(o.width, o.height);
   const size_t n = plan.cells.size();
   preparePlan(plan);
+  // The stage (subfrustum_stage.cpp) where it can run: the tile pipeline, and a flat cover for
+  // the plan; else every cell a view of its own.
+  const double znear = base.camera.znear, zfar = base.camera.zfar;
+  if (stage_.znear != znear || stage_.zfar != zfar) prepareStage(plan, znear, zfar);
+  const bool stage = useStage_ && stage_.ok && o.pipeline == RenderOptions::Pipeline::tiles;
+  if (stage) {
+    const auto t0 = core::Clock::now();
+    FrameCamera cover = base;
+    cover.view = Mat4::translation(Vec3{float(-eye.x), float(-eye.y), float(-eye.z)}) * base.view;
+    cover.projection = stage_.cover;
+    cover.projective = true;
+    buildShading(scene, o, cover.view, shading_);
+    if (Status s =
+            buildDrawPackets(scene, o, cover, shading_.any ? &shading_ : nullptr, pool_, cover_);
+        !s)
+      return s;
+    binTriangles();
+    cellScratch_.resize(workers_.size());
+    stats.vertexMs += core::msSince(t0);
+    const traversal::Traversal& t = cover_.traversal;
+    stats.trianglesIn += t.culledTriangles;
+    stats.culledOutside += t.culledTriangles;
+    stats.culledInstances += t.culledInstances;
+    for (int k = 0; k < FrameStats::kLodLevels; ++k) stats.lodDrawn[k] += t.lodDrawn[k];
+    stats.lodDissolving += t.lodDissolving;
+    stats.mergedCells += t.mergedCells;
+    stats.mergedInstances += t.mergedInstances;
+    stats.lodBeyond += t.lodBeyond;
+  }
   // Every pixel is written: a fitted cell's by its view; an unfitted cell's, and one that is
   // invalid, black. Pixels outside every cell are invalid (the plan's cells hold every valid one):
   // black.
@@ -257,7 +297,17 @@ Status SubFrustumRenderer::render(const scene::Scene& scene, const RenderOptions
   cellStats_.assign(n, FrameStats{});
   cellErrors_.assign(n, Status{});
   const bool lights = !scene.lightPoints.empty() || !scene.stars.stars.empty();
-  if (lights) cullLights(scene, base, eye, plan);
+  if (lights) {
+    if (stage)
+      binLights(scene, base, eye, plan);  // each cell's lights found as it is drawn
+    else
+      cullLights(scene, base, eye, plan);
+    // Every cell looks from the display's eye: the lights' laws (lobes, PAPI, fog, energy) once
+    // for all of them, as the channels of one eye share theirs (Renderer::renderChannels).
+    FrameCamera moved = base;
+    moved.view = Mat4::translation(Vec3{float(-eye.x), float(-eye.y), float(-eye.z)}) * base.view;
+    if (!scene.lightPoints.empty()) laws_.compute(lightInput(scene, moved), pool_);
+  }
   // Each cell resolves straight into its own rectangle of `out`: the workers never write the same
   // pixel.
   pool_.parallelFor(n, [&](size_t i, int worker) {
@@ -272,10 +322,19 @@ Status SubFrustumRenderer::render(const scene::Scene& scene, const RenderOptions
     co.width = cell.x1 - cell.x0;
     co.height = cell.y1 - cell.y0;
     FrameCamera camera = cellCamera(base, cell, eye);
+    if (lights && stage) cellLightsOf(i, plan);
     if (lights) camera.lightSubset = &cellLights_[i];
-    cellErrors_[i] = workers_[size_t(worker)]->renderLinear(
-        scene, co, camera, output::LinearTarget{&out, cell.x0, cell.y0, co.width, co.height},
-        cellStats_[i]);
+    if (!scene.lightPoints.empty()) camera.lightLaws = &laws_;
+    const output::LinearTarget target{&out, cell.x0, cell.y0, co.width, co.height};
+    if (stage) {
+      CellScratch& scratch = cellScratch_[size_t(worker)];
+      cellPackets(i, scratch);
+      cellErrors_[i] = workers_[size_t(worker)]->renderPacketsLinear(
+          scene, co, camera, scratch.packets, shading_, target, cellStats_[i]);
+    } else {
+      cellErrors_[i] =
+          workers_[size_t(worker)]->renderLinear(scene, co, camera, target, cellStats_[i]);
+    }
     // Its invalid pixels black, while they are in this core's cache.
     if (!valid.empty() && cell.validPixels < int64_t(co.width) * co.height)
       for (int y = cell.y0; y < cell.y1; ++y)

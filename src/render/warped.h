@@ -7,6 +7,7 @@
 // (core/eye_rays.h).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -14,8 +15,11 @@
 #include "core/quadric.h"
 #include "core/thread_pool.h"
 #include "display/subfrustum.h"
+#include "lights/light_laws.h"
 #include "output/resolve.h"
 #include "render/camera.h"
+#include "render/draw_packets.h"
+#include "render/shading_tables.h"
 #include "render/view_renderer.h"
 
 namespace sv::render {
@@ -62,12 +66,18 @@ class SubFrustumRenderer {
                 output::LinearImage& out, FrameStats& stats, SubFrustumStats* cellStats = nullptr);
 
   const output::GammaTable& gamma() const { return workers_[0]->gamma(); }
+  // Whether the cells are drawn as a stage of one frame (the default) or each as a view of its
+  // own (issue 34's way, kept to compare against: tests, bench).
+  void useStage(bool on) { useStage_ = on; }
 
  private:
   // cellLights_ for this frame: every light whose splat can reach a cell, for each cell — culled
   // once for all of them, not by each cell's light pass over every light.
   void cullLights(const scene::Scene& scene, const FrameCamera& base, Vec3d eye,
                   const display::SubFrustumPlan& plan);
+  // lightDirections_ for this frame; how far a splat reaches from its centre, pixels.
+  void lightDirections(const scene::Scene& scene, const FrameCamera& base, Vec3d eye);
+  static double lightReach(const scene::Scene& scene);
 
   core::ThreadPool pool_;
   std::vector<std::unique_ptr<ViewRenderer>> workers_;  // one per pool worker, one thread each
@@ -79,6 +89,7 @@ class SubFrustumRenderer {
     uint32_t index;   // the light's (LightInput::subset)
   };
   std::vector<LightDirection> lightDirections_;  // this frame's, but for a light at the eye
+  lights::LightLaws laws_;                       // this frame's, at the display's eye
  public:
   // What depends on the plan alone, made when it changes (a new plan, a moved eye's refit) and
   // known again by its cells: the light cull's cones, per top group and per group of cells, and
@@ -101,6 +112,52 @@ class SubFrustumRenderer {
  private:
   void preparePlan(const display::SubFrustumPlan& plan);
   PlanState plan_;
+
+  // The sub-frusta as a stage (issue 61, subfrustum_stage.cpp): the display's traversal, shading
+  // tables and vertex stage once a frame, in the clip space of a flat "cover" view that holds
+  // every cell; each triangle binned to the cells whose rectangles its box meets; each cell's
+  // triangles taken to its own clip space by one 4 × 4 map (its projection after the cover's
+  // inverse) and drawn through its own raster. What depends on the plan and the depth range:
+  struct Stage {
+    bool ok = false;  // a cover exists (every cell within 84° of their mean direction)
+    double znear = 0, zfar = 0;
+    Mat4 cover;                // the cover's projection (eye frame from the display's eye → clip)
+    std::vector<Mat4> toCell;  // per cell: its projection · the cover's inverse
+    // Per cell: its rectangle widened by two pixels, as a box of the cover's NDC (x0, y0, x1, y1).
+    std::vector<std::array<float, 4>> box;
+    float grid[4] = {-1, -1, 1, 1};  // the bins' domain: the union of the boxes
+  };
+  Stage stage_;
+  bool useStage_ = true;
+  static constexpr int kBins = 32;  // a side of the grid of bins over the cover's NDC
+  // This frame's: the shading tables and packets in the cover's clip space; each triangle's NDC box
+  // and range of bins (empty for one in no bin); the triangles every cell tries (a vertex at or
+  // behind the eye plane); the bins' triangles (CSR: binStart, binTriangles).
+  ShadingTables shading_;
+  DrawPackets cover_;
+  std::vector<std::array<float, 4>> triangleBox_;
+  std::vector<std::array<int16_t, 4>> triangleBins_;
+  std::vector<uint32_t> binStart_, binTriangles_, everywhere_;
+  struct CellScratch {
+    DrawPackets packets;
+    std::vector<uint32_t> triangles, stamp, remap;
+    uint32_t generation = 0;
+  };
+  std::vector<CellScratch> cellScratch_;  // per worker
+  // The lights on the cover too: each light's place there binned on the same grid, and a cell's
+  // lights those of its bins within its box widened by the splats' reach (lightBox, made when the
+  // reach changes), then tried exactly as cullLights tries them.
+  std::vector<std::array<float, 4>> lightBox_;
+  double lightReach_ = -1;
+  std::vector<std::array<float, 2>> lightPlace_;  // per lightDirections_ entry
+  std::vector<uint32_t> lightBinStart_, lightBinLights_;
+  void binLights(const scene::Scene& scene, const FrameCamera& base, Vec3d eye,
+                 const display::SubFrustumPlan& plan);
+  void cellLightsOf(size_t i, const display::SubFrustumPlan& plan);
+  void prepareStage(const display::SubFrustumPlan& plan, double znear, double zfar);
+  void binTriangles();
+  // Cell i's triangles of cover_, in draw order, taken to its clip space (scratch.packets).
+  void cellPackets(size_t i, CellScratch& scratch);
 };
 
 }  // namespace sv::render
