@@ -106,14 +106,34 @@ void BM_SubFrustaOverUnwarped(benchmark::State& state) {
   const auto ms = [](auto t0) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   };
+  // /…/1: as `bench --renderer display` times them — the unwarped view resolved to 8 bits, the
+  // display's frame (render::renderCorrected, the plan given) and its gamma table.
+  const bool encoded = state.range(1) != 0;
+  sv::render::CorrectionRenderer corrected(o);
+  sv::render::CorrectedView view;
+  view.table = &c.centre().table;
+  view.plan = &c.plan;
+  view.eye = c.display.eye;
+  sv::Image image, encodedImage;
   for (auto _ : state) {
     sv::FrameStats stats;
     auto t0 = std::chrono::steady_clock::now();
-    if (!flat.renderLinear(c.scene, o, c.base, a, stats)) state.SkipWithError("render");
+    if (encoded) {
+      if (!flat.render(c.scene, o, c.base, image, stats)) state.SkipWithError("render");
+    } else if (!flat.renderLinear(c.scene, o, c.base, a, stats)) {
+      state.SkipWithError("render");
+    }
     flatMs.push_back(ms(t0));
     t0 = std::chrono::steady_clock::now();
-    if (!cells.render(c.scene, o, c.base, c.display.eye, c.plan, c.centre().table.valid, b, stats))
+    if (encoded) {
+      sv::DisplayStats cs;
+      if (!sv::render::renderCorrected(corrected, c.scene, o, c.base, view, b, stats, cs,
+                                       state.range(1) == 1 ? &encodedImage : nullptr))
+        state.SkipWithError("render");
+    } else if (!cells.render(c.scene, o, c.base, c.display.eye, c.plan, c.centre().table.valid, b,
+                             stats)) {
       state.SkipWithError("render");
+    }
     cellsMs.push_back(ms(t0));
   }
   const auto median = [](std::vector<double> v) {
@@ -127,8 +147,10 @@ void BM_SubFrustaOverUnwarped(benchmark::State& state) {
   state.counters["us_a_cell"] = (s - f) * 1000 * o.threads / double(c.plan.cells.size());
 }
 BENCHMARK(BM_SubFrustaOverUnwarped)
-    ->Arg(1)
-    ->Arg(2)
+    ->Args({1, 0})
+    ->Args({2, 0})
+    ->Args({2, 1})
+    ->Args({2, 2})
     ->Iterations(30)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();

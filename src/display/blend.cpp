@@ -42,14 +42,20 @@ BlendWeights blendWeights(const MpcdiRegion& r) {
 }
 
 void applyBlend(const BlendWeights& w, uint16_t* rgb) {
-  const size_t n = size_t(w.width) * size_t(w.height);
-  for (size_t i = 0; i < n; ++i) {
-    const float a = w.alpha[i], b = w.beta[i] * 65535.0f;
-    for (int c = 0; c < 3; ++c) {
-      const float v = float(rgb[i * 3 + size_t(c)]) * a + b;
-      rgb[i * 3 + size_t(c)] = uint16_t(std::clamp(std::nearbyint(v), 0.0f, 65535.0f));
+  applyBlend(w, rgb, 0, 0, w.width, w.height);
+}
+
+void applyBlend(const BlendWeights& w, uint16_t* rgb, int x0, int y0, int x1, int y1) {
+  for (int y = y0; y < y1; ++y)
+    for (size_t i = size_t(y) * size_t(w.width) + size_t(x0),
+                end = size_t(y) * size_t(w.width) + size_t(x1);
+         i < end; ++i) {
+      const float a = w.alpha[i], b = w.beta[i] * 65535.0f;
+      for (int c = 0; c < 3; ++c) {
+        const float v = float(rgb[i * 3 + size_t(c)]) * a + b;
+        rgb[i * 3 + size_t(c)] = uint16_t(std::clamp(std::nearbyint(v), 0.0f, 65535.0f));
+      }
     }
-  }
 }
 
 namespace {

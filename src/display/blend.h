@@ -28,6 +28,9 @@ BlendWeights blendWeights(const MpcdiRegion& region);
 // each value becomes round(value·alpha + beta·65535), within 0 … 65535. Beta lifts the black level
 // of a pixel (to match the overlaps', where two projectors' black adds).
 void applyBlend(const BlendWeights& weights, uint16_t* rgb);
+// The same over the rectangle [x0, x1) × [y0, y1) of the frame alone (a sub-frustum cell's, while
+// it is in cache).
+void applyBlend(const BlendWeights& weights, uint16_t* rgb, int x0, int y0, int x1, int y1);
 
 // The demo's alpha maps for threeProjectorCylinder (geometry.h): projector i's weight falls with
 // the screen point's azimuth across each overlap with a neighbour along a smoothstep, so that the

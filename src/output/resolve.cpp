@@ -196,10 +196,15 @@ void tentFilterRows(const LinearImage& linear, const GammaTable& gamma, int rowB
 
 void encodeRows(const LinearImage& linear, const GammaTable& gamma, int rowBegin, int rowEnd,
                 Image& image) {
-  const size_t n = size_t(linear.width) * 3;
-  for (int y = rowBegin; y < rowEnd; ++y) {
-    const uint16_t* src = &linear.rgb[size_t(y) * n];
-    uint8_t* out = image.pixel(0, y);
+  encodeRect(linear, gamma, 0, rowBegin, linear.width, rowEnd, image);
+}
+
+void encodeRect(const LinearImage& linear, const GammaTable& gamma, int x0, int y0, int x1, int y1,
+                Image& image) {
+  const size_t n = size_t(x1 - x0) * 3;
+  for (int y = y0; y < y1; ++y) {
+    const uint16_t* src = &linear.rgb[(size_t(y) * size_t(linear.width) + size_t(x0)) * 3];
+    uint8_t* out = image.pixel(x0, y);
     for (size_t i = 0; i < n; ++i) out[i] = gamma.table[src[i]];
   }
 }

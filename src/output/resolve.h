@@ -93,6 +93,9 @@ void tentFilterRows(const LinearImage& linear, const GammaTable& gamma, int rowB
 // prepareImage).
 void encodeRows(const LinearImage& linear, const GammaTable& gamma, int rowBegin, int rowEnd,
                 Image& image);
+// The same over the rectangle [x0, x1) × [y0, y1) alone (a sub-frustum cell's).
+void encodeRect(const LinearImage& linear, const GammaTable& gamma, int x0, int y0, int x1, int y1,
+                Image& image);
 
 // Debug views: the red channel holds a small number per pixel, shown in false colour. `count`
 // (raster::ShadeMode::overdraw): black for 0, then blue, cyan, green, yellow, red for 1, 2, 3,

@@ -285,10 +285,9 @@ Status runDisplayBench(const scene::Scene& sc, const BenchSettings& s, CaseResul
       DisplayStats cs;
       t = Clock::now();
       if (Status st = render::renderCorrected(warped, sc, s.options, base.value(), view,
-                                              frame->linear[0], run->stats, cs);
+                                              frame->linear[0], run->stats, cs, &run->image);
           !st)
         return st;
-      warped.encode(frame->linear[0], s.options, run->image);
       if (i >= s.warmup) run->frameMs.push_back(msSince(t));
     }
   }

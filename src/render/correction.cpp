@@ -50,8 +50,10 @@ display::DirectionMap directionMapOf(const display::DirectionTable& table) {
 
 Status renderCorrected(CorrectionRenderer& renderer, const scene::Scene& scene,
                        const RenderOptions& o, const FrameCamera& base, const CorrectedView& view,
-                       output::LinearImage& out, FrameStats& stats, DisplayStats& cs) {
+                       output::LinearImage& out, FrameStats& stats, DisplayStats& cs,
+                       Image* image) {
   SV_CHECK(view.table != nullptr);
+  bool finished = false;  // blended and encoded cell by cell
   const display::DirectionTable& table = *view.table;
   RenderOptions po = o;
   po.width = table.width;
@@ -70,10 +72,16 @@ Status renderCorrected(CorrectionRenderer& renderer, const scene::Scene& scene,
       plan = &*own;
       cs.planMs = core::msSince(t0);
     }
+    if (view.blend && (view.blend->width != table.width || view.blend->height != table.height))
+      return Error{"", "",
+                   fmt::format("blend weights of {} × {} pixels for a projector of {} × {}",
+                               view.blend->width, view.blend->height, table.width, table.height)};
     const auto t1 = core::Clock::now();
     SubFrustumStats fs;
-    if (Status s =
-            renderer.cells().render(scene, po, base, view.eye, *plan, table.valid, out, stats, &fs);
+    SubFrustumRenderer::Finish finish{view.blend, &renderer.gamma(), image};
+    finished = image && o.filter == RenderOptions::Filter::box;
+    if (Status s = renderer.cells().render(scene, po, base, view.eye, *plan, table.valid, out,
+                                           stats, &fs, finished ? &finish : nullptr);
         !s)
       return s;
     cs.renderMs = core::msSince(t1);
@@ -134,7 +142,7 @@ Status renderCorrected(CorrectionRenderer& renderer, const scene::Scene& scene,
     cs.flatHeight = f.height;
     cs.outside = warp->outside;
   }
-  if (view.blend) {
+  if (view.blend && !finished) {
     if (view.blend->width != table.width || view.blend->height != table.height)
       return Error{"", "",
                    fmt::format("blend weights of {} × {} pixels for a projector of {} × {}",
@@ -143,6 +151,7 @@ Status renderCorrected(CorrectionRenderer& renderer, const scene::Scene& scene,
     display::applyBlend(*view.blend, out.rgb.data());
     cs.blendMs = core::msSince(t3);
   }
+  if (image && !finished) renderer.encode(out, o, *image);
   return {};
 }
 
@@ -370,14 +379,12 @@ Status renderDisplay(CorrectionRenderer& renderer, const scene::Scene& scene,
       view.plan = plan.get();
     }
     if (Status s = renderCorrected(renderer, scene, o, base.value(), view, frame.linear[i],
-                                   frame.stats[i], frame.correction[i]);
+                                   frame.stats[i], frame.correction[i], &frame.images[i]);
         !s) {
       Error e = s.error();
       e.message = fmt::format("projector '{}': {}", p.name, e.message);
       return e;
     }
-    const output::LinearImage& linear = frame.linear[i];
-    renderer.encode(linear, o, frame.images[i]);
     frame.stats[i].totalMs = core::msSince(start);
   }
   return {};

@@ -68,10 +68,13 @@ Result<display::ResampleWarp> resampleWarpOf(const display::DirectionTable& tabl
                                              int marginPixels = 2);
 
 // The projector's frame in linear light (`out`, the table's size; o.width and o.height are not
-// used), for the scene seen from `base`'s eyepoint.
+// used), for the scene seen from `base`'s eyepoint; with `image`, through the gamma table too
+// (CorrectionRenderer::encode) — for sub-frusta and the box filter, each cell blended and encoded
+// as it is finished (SubFrustumRenderer::Finish), with no pass over the frame after.
 Status renderCorrected(CorrectionRenderer& renderer, const scene::Scene& scene,
                        const RenderOptions& o, const FrameCamera& base, const CorrectedView& view,
-                       output::LinearImage& out, FrameStats& stats, DisplayStats& cs);
+                       output::LinearImage& out, FrameStats& stats, DisplayStats& cs,
+                       Image* image = nullptr);
 
 // A display of projectors: each one's name, display mapping and blend weights — the demo rig's
 // (analytic) or an MPCDI file's — and the rig's geometry when it is known (for the viewer).

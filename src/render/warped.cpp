@@ -9,6 +9,7 @@
 #include <optional>
 #include <utility>
 
+#include "core/check.h"
 #include "core/timing.h"
 #include "lights/light_laws.h"
 #include "render/passes.h"
@@ -247,7 +248,8 @@ Status SubFrustumRenderer::render(const scene::Scene& scene, const RenderOptions
                                   const FrameCamera& base, Vec3d eye,
                                   const display::SubFrustumPlan& plan,
                                   const std::vector<uint8_t>& valid, output::LinearImage& out,
-                                  FrameStats& stats, SubFrustumStats* cellStats) {
+                                  FrameStats& stats, SubFrustumStats* cellStats,
+                                  const Finish* finish) {
   if (o.debugView != RenderOptions::DebugView::none)
     return Error{"", "", "distortion correction draws images, not debug views"};
   if (plan.width != o.width || plan.height != o.height)
@@ -291,9 +293,23 @@ Status SubFrustumRenderer::render(const scene::Scene& scene, const RenderOptions
   // Every pixel is written: a fitted cell's by its view; an unfitted cell's, and one that is
   // invalid, black. Pixels outside every cell are invalid (the plan's cells hold every valid one):
   // black.
-  for (const PlanState::Run& r : plan_.uncovered)
+  if (finish) {
+    SV_CHECK(finish->gamma && finish->image);
+    SV_CHECK(!finish->blend ||
+             (finish->blend->width == o.width && finish->blend->height == o.height));
+    output::prepareImage(o.width, o.height, *finish->image);
+  }
+  // The cell's rectangle blended and encoded (Finish).
+  const auto finishRect = [&](int x0, int y0, int x1, int y1) {
+    if (!finish) return;
+    if (finish->blend) display::applyBlend(*finish->blend, out.rgb.data(), x0, y0, x1, y1);
+    output::encodeRect(out, *finish->gamma, x0, y0, x1, y1, *finish->image);
+  };
+  for (const PlanState::Run& r : plan_.uncovered) {
     std::fill_n(&out.rgb[(size_t(r.y) * size_t(o.width) + size_t(r.x0)) * 3],
                 size_t(r.x1 - r.x0) * 3, uint16_t(0));
+    finishRect(r.x0, r.y, r.x1, r.y + 1);
+  }
   cellStats_.assign(n, FrameStats{});
   cellErrors_.assign(n, Status{});
   const bool lights = !scene.lightPoints.empty() || !scene.stars.stars.empty();
@@ -316,6 +332,7 @@ Status SubFrustumRenderer::render(const scene::Scene& scene, const RenderOptions
       for (int y = cell.y0; y < cell.y1; ++y)
         std::fill_n(&out.rgb[(size_t(y) * size_t(o.width) + size_t(cell.x0)) * 3],
                     size_t(cell.x1 - cell.x0) * 3, uint16_t(0));
+      finishRect(cell.x0, cell.y0, cell.x1, cell.y1);
       return;
     }
     RenderOptions co = o;
@@ -342,6 +359,7 @@ Status SubFrustumRenderer::render(const scene::Scene& scene, const RenderOptions
           const size_t k = size_t(y) * size_t(o.width) + size_t(x);
           if (!valid[k]) out.rgb[3 * k] = out.rgb[3 * k + 1] = out.rgb[3 * k + 2] = 0;
         }
+    if (cellErrors_[i]) finishRect(cell.x0, cell.y0, cell.x1, cell.y1);
   });
   SubFrustumStats counts;
   counts.unfittedPixels = plan.unfittedPixels;

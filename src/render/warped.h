@@ -14,6 +14,7 @@
 
 #include "core/quadric.h"
 #include "core/thread_pool.h"
+#include "display/blend.h"
 #include "display/subfrustum.h"
 #include "lights/light_laws.h"
 #include "output/resolve.h"
@@ -61,9 +62,20 @@ class SubFrustumRenderer {
   // centre and samples, so abutting cells neither crack nor overlap. Pixels that `valid` (one
   // byte a display pixel, or empty: all) marks invalid, and those of unfitted cells, are black.
   // `stats` gets the cells' counts summed. Identical bytes for any thread count.
+  //
+  // With `finish`, each cell's rectangle is then, while it is in cache, blended (finish->blend, in
+  // `out` too) and put through the gamma table into finish->image (sized here): the display's
+  // frame with no pass over it after the cells (issue 61: "resolved through the ordinary tile
+  // path, gamma inline").
+  struct Finish {
+    const display::BlendWeights* blend = nullptr;  // the display's size, or none
+    const output::GammaTable* gamma = nullptr;
+    Image* image = nullptr;
+  };
   Status render(const scene::Scene& scene, const RenderOptions& o, const FrameCamera& base,
                 Vec3d eye, const display::SubFrustumPlan& plan, const std::vector<uint8_t>& valid,
-                output::LinearImage& out, FrameStats& stats, SubFrustumStats* cellStats = nullptr);
+                output::LinearImage& out, FrameStats& stats, SubFrustumStats* cellStats = nullptr,
+                const Finish* finish = nullptr);
 
   const output::GammaTable& gamma() const { return workers_[0]->gamma(); }
   // Whether the cells are drawn as a stage of one frame (the default) or each as a view of its

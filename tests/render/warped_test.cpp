@@ -540,6 +540,36 @@ TEST(SubFrusta, TheStageDrawsWhatEachCellAsAViewOfItsOwnDrew) {
   EXPECT_EQ(frames[0], frames[2]);
 }
 
+// The frame's finish in the cells (each cell blended and put through the gamma table while in
+// cache) gives the bytes of a blend and a gamma pass over the whole frame after.
+TEST(SubFrusta, BlendedAndEncodedCellByCellAsOverTheWholeFrame) {
+  const scene::Scene s = parallaxWalls();
+  const render::DisplaySetup d = render::cylinderDisplay(200, 120);
+  RenderOptions o;
+  o.threads = 2;
+  o.samples = 4;
+  render::CorrectionRenderer renderer(o);
+  const Result<render::FrameCamera> base = render::chooseCamera(s, o);
+  ASSERT_TRUE(base.ok());
+  for (const render::ProjectorSetup& p : d.projectors) {
+    ASSERT_TRUE(p.blend.has_value());
+    render::CorrectedView view;
+    view.table = &p.table;
+    view.blend = &*p.blend;
+    view.eye = d.eye;
+    output::LinearImage a, b;
+    FrameStats stats;
+    DisplayStats cs;
+    Image fused, after;
+    ASSERT_TRUE(render::renderCorrected(renderer, s, o, base.value(), view, a, stats, cs, &fused));
+    ASSERT_TRUE(render::renderCorrected(renderer, s, o, base.value(), view, b, stats, cs));
+    EXPECT_GT(cs.blendMs, 0.0) << "blended over the frame after";
+    renderer.encode(b, o, after);
+    EXPECT_EQ(a.rgb, b.rgb) << p.name;
+    EXPECT_EQ(fused.rgb, after.rgb) << p.name;
+  }
+}
+
 // Issue 61, dynamic correction: a frame for an eye moved from the design eye is drawn through the
 // design plan's cells refitted for it — the same picture, pixel for pixel but at edges, as a
 // display planned from scratch for that eye — and the refit is made once for an eye that stays.
