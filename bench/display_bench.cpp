@@ -69,10 +69,10 @@ void BM_UnwarpedFrame(benchmark::State& state) {
   sv::RenderOptions o = c.options;
   o.threads = int(state.range(0));
   sv::render::ViewRenderer renderer(o);
-  sv::output::LinearImage out;
+  sv::Image image;
   for (auto _ : state) {
     sv::FrameStats stats;
-    if (!renderer.renderLinear(c.scene, o, c.base, out, stats)) state.SkipWithError("render");
+    if (!renderer.render(c.scene, o, c.base, image, stats)) state.SkipWithError("render");
   }
 }
 BENCHMARK(BM_UnwarpedFrame)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
@@ -83,10 +83,14 @@ void BM_SubFrustaFrame(benchmark::State& state) {
   o.threads = int(state.range(0));
   sv::render::SubFrustumRenderer renderer(o);
   sv::output::LinearImage out;
+  // As an image generator draws it: through the gamma table straight into the image.
+  const sv::output::GammaTable gamma = sv::output::GammaTable::srgb();
+  sv::Image image;
+  const sv::render::SubFrustumRenderer::Finish finish{nullptr, &gamma, &image, false};
   for (auto _ : state) {
     sv::FrameStats stats;
     if (!renderer.render(c.scene, o, c.base, c.display.eye, c.plan, c.centre().table.valid, out,
-                         stats))
+                         stats, nullptr, &finish))
       state.SkipWithError("render");
   }
   state.counters["cells"] = double(c.plan.cells.size());
@@ -128,7 +132,7 @@ void BM_SubFrustaOverUnwarped(benchmark::State& state) {
     if (encoded) {
       sv::DisplayStats cs;
       if (!sv::render::renderCorrected(corrected, c.scene, o, c.base, view, b, stats, cs,
-                                       state.range(1) == 1 ? &encodedImage : nullptr))
+                                       state.range(1) == 1 ? &encodedImage : nullptr, false))
         state.SkipWithError("render");
     } else if (!cells.render(c.scene, o, c.base, c.display.eye, c.plan, c.centre().table.valid, b,
                              stats)) {

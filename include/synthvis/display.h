@@ -62,6 +62,10 @@ struct DisplayView {
   // Only these projectors, by index (an image generator's share of them under MPI); the others'
   // images are left as they were. Empty: every one.
   std::vector<int> projectors;
+  // The frames kept in linear light for Renderer::viewerImage. False (an image generator's
+  // frames): each projector's cells resolve through the gamma table straight into its image,
+  // blended as they are drawn — the frame's fastest path — and viewerImage refuses the frame.
+  bool keepLinear = true;
 };
 
 // How a projector's frame was made (Renderer::renderDisplay), in milliseconds and counts.

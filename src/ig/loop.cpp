@@ -356,6 +356,8 @@ struct IgLoop::Session {
     if (!m.options.testPattern.empty())
       pattern = present::parseTestPattern(m.options.testPattern).value();
     if (m.display) {
+      // The frames go to the presenter encoded; the viewer (--viewer) reads them back from there.
+      displayView.keepLinear = false;
       if (only)
         for (const ChannelShare& c : *only) displayView.projectors.push_back(c.channel);
       if (pattern || m.options.overlay) displayPictures();

@@ -73,6 +73,22 @@ inline LinearTarget wholeOf(LinearImage& image) {
   return {&image, 0, 0, image.width, image.height};
 }
 
+// Where a view's tiles go through the gamma table into a rectangle of a larger image (a
+// sub-frustum cell's of its display's frame): the view's pixel (0, 0) at (x, y) of `image`, and
+// optionally edge-blending weights over the whole image (its width × height, one a pixel),
+// applied in linear light before the table — v·alpha + 65535·beta, rounded and clamped, as
+// display::applyBlend.
+struct ImageTarget {
+  Image* image = nullptr;
+  int x = 0, y = 0, width = 0, height = 0;
+  const float* alpha = nullptr;  // with beta, or both nullptr
+  const float* beta = nullptr;
+};
+// One tile of `samples` samples a pixel (1, 4, 8, 16, 64; `sums` as resolveSampleTile) box-resolved
+// into the target: the same bytes as resolveSampleTileLinear, blended, then encodeRect.
+void resolveSampleTileTo(const uint16_t* color, const int32_t* sums, int tileX, int tileY,
+                         int samples, const GammaTable& gamma, const ImageTarget& target);
+
 // Box-resolves one tile of a view into its target instead of the display image, for any of the
 // layouts above: `factor` × `factor` pixels per image pixel (supersampling) or `samples` samples
 // per pixel (one of the two is 1); `sums` as resolveSampleTile.

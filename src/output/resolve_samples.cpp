@@ -6,6 +6,7 @@
 #define HWY_TARGET_INCLUDE "output/resolve_samples.cpp"
 #include <algorithm>
 #include <bit>
+#include <cmath>
 
 #include "core/check.h"
 #include "hwy/foreach_target.h"  // IWYU pragma: keep
@@ -121,6 +122,47 @@ void ResolveSampleTileLinear(const uint16_t* color, const int32_t* sums, int til
                       });
 }
 
+// The same means blended (optionally) and through the table into a rectangle of an image.
+void ResolveSampleTileTo(const uint16_t* color, const int32_t* sums, int tileX, int tileY,
+                         int samples, const GammaTable& gamma, const ImageTarget& t) {
+  using namespace raster;
+  const int w = std::min(kTileSize, t.width - tileX * kTileSize);
+  const int h = std::min(kTileSize, t.height - tileY * kTileSize);
+  const int x0 = t.x + tileX * kTileSize, y0 = t.y + tileY * kTileSize;  // in the image
+  uint8_t* const rgb = t.image->rgb.data();
+  const size_t width = size_t(t.image->width);
+  const uint8_t* HWY_RESTRICT table = gamma.table.data();
+  alignas(64) uint8_t row[3 * kTileSize];
+  ForEachMeanBlockRow(
+      color, sums, w, h, samples,
+      [&](int by, int rows, int blocksX, const uint16_t(*mean)[kColorPerBlock]) {
+        for (int py = 0; py < rows; ++py) {
+          const size_t first = size_t(y0 + by + py) * width + size_t(x0);  // the row's 1st pixel
+          uint8_t* HWY_RESTRICT dst = row;
+          for (int b = 0; b < blocksX; ++b) {
+            const uint16_t* HWY_RESTRICT m = mean[b] + py * kBlockSize;
+            const int cols = std::min(kBlockSize, w - b * kBlockSize);
+            if (!t.alpha) {
+              StoreBlockRow(dst, m, cols, table);
+              dst += 3 * cols;
+              continue;
+            }
+            for (int p = 0; p < cols; ++p, dst += 3) {
+              const size_t i = first + size_t(b * kBlockSize + p);
+              const float a = t.alpha[i], o = t.beta[i] * 65535.0f;
+              for (int c = 0; c < 3; ++c) {
+                const float v = float(m[c * kBlockPixels + p]) * a + o;
+                dst[c] = table[uint16_t(std::clamp(std::nearbyint(v), 0.0f, 65535.0f))];
+              }
+            }
+          }
+          // Plainly: a cell's rows are short and start anywhere (non-temporal stores of partial
+          // lines cost more than the reads they save).
+          std::copy_n(row, 3 * w, rgb + first * 3);
+        }
+      });
+}
+
 }  // namespace HWY_NAMESPACE
 }  // namespace sv::output
 HWY_AFTER_NAMESPACE();
@@ -140,6 +182,14 @@ void resolveSampleTileLinear(const uint16_t* color, const int32_t* sums, int til
                              int samples, const LinearTarget& target) {
   SV_CHECK(isSampleCount(samples));
   HWY_DYNAMIC_DISPATCH(ResolveSampleTileLinear)(color, sums, tileX, tileY, samples, target);
+}
+
+HWY_EXPORT(ResolveSampleTileTo);
+
+void resolveSampleTileTo(const uint16_t* color, const int32_t* sums, int tileX, int tileY,
+                         int samples, const GammaTable& gamma, const ImageTarget& target) {
+  SV_CHECK(isSampleCount(samples) && (target.alpha == nullptr) == (target.beta == nullptr));
+  HWY_DYNAMIC_DISPATCH(ResolveSampleTileTo)(color, sums, tileX, tileY, samples, gamma, target);
 }
 }  // namespace sv::output
 #endif

@@ -285,7 +285,7 @@ Status runDisplayBench(const scene::Scene& sc, const BenchSettings& s, CaseResul
       DisplayStats cs;
       t = Clock::now();
       if (Status st = render::renderCorrected(warped, sc, s.options, base.value(), view,
-                                              frame->linear[0], run->stats, cs, &run->image);
+                                              frame->linear[0], run->stats, cs, &run->image, false);
           !st)
         return st;
       if (i >= s.warmup) run->frameMs.push_back(msSince(t));

@@ -50,8 +50,8 @@ display::DirectionMap directionMapOf(const display::DirectionTable& table) {
 
 Status renderCorrected(CorrectionRenderer& renderer, const scene::Scene& scene,
                        const RenderOptions& o, const FrameCamera& base, const CorrectedView& view,
-                       output::LinearImage& out, FrameStats& stats, DisplayStats& cs,
-                       Image* image) {
+                       output::LinearImage& out, FrameStats& stats, DisplayStats& cs, Image* image,
+                       bool keepLinear) {
   SV_CHECK(view.table != nullptr);
   bool finished = false;  // blended and encoded cell by cell
   const display::DirectionTable& table = *view.table;
@@ -78,7 +78,7 @@ Status renderCorrected(CorrectionRenderer& renderer, const scene::Scene& scene,
                                view.blend->width, view.blend->height, table.width, table.height)};
     const auto t1 = core::Clock::now();
     SubFrustumStats fs;
-    SubFrustumRenderer::Finish finish{view.blend, &renderer.gamma(), image};
+    SubFrustumRenderer::Finish finish{view.blend, &renderer.gamma(), image, keepLinear};
     finished = image && o.filter == RenderOptions::Filter::box;
     if (Status s = renderer.cells().render(scene, po, base, view.eye, *plan, table.valid, out,
                                            stats, &fs, finished ? &finish : nullptr);
@@ -378,8 +378,9 @@ Status renderDisplay(CorrectionRenderer& renderer, const scene::Scene& scene,
       }
       view.plan = plan.get();
     }
-    if (Status s = renderCorrected(renderer, scene, o, base.value(), view, frame.linear[i],
-                                   frame.stats[i], frame.correction[i], &frame.images[i]);
+    if (Status s =
+            renderCorrected(renderer, scene, o, base.value(), view, frame.linear[i], frame.stats[i],
+                            frame.correction[i], &frame.images[i], request.keepLinear);
         !s) {
       Error e = s.error();
       e.message = fmt::format("projector '{}': {}", p.name, e.message);

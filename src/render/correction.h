@@ -70,11 +70,12 @@ Result<display::ResampleWarp> resampleWarpOf(const display::DirectionTable& tabl
 // The projector's frame in linear light (`out`, the table's size; o.width and o.height are not
 // used), for the scene seen from `base`'s eyepoint; with `image`, through the gamma table too
 // (CorrectionRenderer::encode) — for sub-frusta and the box filter, each cell blended and encoded
-// as it is finished (SubFrustumRenderer::Finish), with no pass over the frame after.
+// as it is finished (SubFrustumRenderer::Finish), with no pass over the frame after; without
+// `keepLinear`, `out` is then not written at all (the cells resolve straight into `image`).
 Status renderCorrected(CorrectionRenderer& renderer, const scene::Scene& scene,
                        const RenderOptions& o, const FrameCamera& base, const CorrectedView& view,
                        output::LinearImage& out, FrameStats& stats, DisplayStats& cs,
-                       Image* image = nullptr);
+                       Image* image = nullptr, bool keepLinear = true);
 
 // A display of projectors: each one's name, display mapping and blend weights — the demo rig's
 // (analytic) or an MPCDI file's — and the rig's geometry when it is known (for the viewer).
@@ -162,6 +163,7 @@ struct DisplayFrame {
 struct DisplayRequest {
   Vec3d eyeOffset{0, 0, 0};  // metres, in the camera's eye frame (x right, y up, z back)
   const std::vector<int>* projectors = nullptr;  // nullptr: every one
+  bool keepLinear = true;                        // DisplayFrame::linear written (for the viewer)
 };
 Status renderDisplay(CorrectionRenderer& renderer, const scene::Scene& scene,
                      const RenderOptions& o, const DisplaySetup& display, DisplayFrame& frame,

@@ -128,11 +128,12 @@ Status Renderer::renderDisplay(const scene::Scene& scene, const Display& display
   render::DisplayRequest request;
   request.eyeOffset = {view.eyeOffset[0], view.eyeOffset[1], view.eyeOffset[2]};
   if (!view.projectors.empty()) request.projectors = &view.projectors;
+  request.keepLinear = view.keepLinear;
   if (Status s = render::renderDisplay(*m.display, scene, m.options, display.setup(),
                                        m.displayFrame, request);
       !s)
     return s;
-  m.displayDrawn = display;
+  if (view.keepLinear) m.displayDrawn = display;
   // The drawn projectors' frames handed over, not copied (18 MB a frame for three at 1080p): the
   // renderer reuses the caller's old buffers next time.
   const size_t n = size_t(display.projectorCount());
@@ -153,7 +154,9 @@ Status Renderer::renderDisplay(const scene::Scene& scene, const Display& display
 Result<Image> Renderer::viewerImage(const Display& display) const {
   const Impl& m = *impl_;
   if (!m.displayDrawn || &m.displayDrawn->setup() != &display.setup())
-    return Error{"", "", "the viewer sees a display this renderer drew last (renderDisplay)"};
+    return Error{"", "",
+                 "the viewer sees a display this renderer drew last (renderDisplay), its frames "
+                 "kept in linear light (DisplayView::keepLinear)"};
   return render::viewerImage(display.setup(), m.displayFrame, display::PanoramaView{},
                              m.display->gamma());
 }

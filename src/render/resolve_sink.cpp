@@ -2,19 +2,24 @@
 
 #include <algorithm>
 
+#include "core/check.h"
 #include "core/timing.h"
 
 namespace sv::render {
 
 ResolveSink::ResolveSink(const RenderOptions& options, const output::GammaTable& gamma,
                          output::LinearImage& linear, Image& image,
-                         const output::LinearTarget* linearOut)
+                         const output::LinearTarget* linearOut, const output::ImageTarget* imageOut)
     : options_(options),
       gamma_(gamma),
       linear_(linear),
       image_(image),
-      linearOut_(linearOut != nullptr) {
-  if (linearOut) {
+      linearOut_(linearOut != nullptr),
+      imageOut_(imageOut) {
+  SV_CHECK(!imageOut || (!linearOut && options.supersample == 1 &&
+                         options.debugView == RenderOptions::DebugView::none));
+  if (imageOut) {
+  } else if (linearOut) {
     target_ = *linearOut;
   } else if (options.filter == RenderOptions::Filter::tent3) {
     linear.resize(options.width, options.height);
@@ -29,6 +34,11 @@ bool ResolveSink::takesColorSums() const {
 TileSink ResolveSink::finishTile(int tilesX) {
   const RenderOptions& o = options_;
   const int k = o.supersample;
+  if (imageOut_)
+    return [this, tilesX](int tile, const float*, const uint16_t* color, const int32_t* sums) {
+      output::resolveSampleTileTo(color, sums, tile % tilesX, tile / tilesX, options_.samples,
+                                  gamma_, *imageOut_);
+    };
   if (o.debugView != RenderOptions::DebugView::none && !linearOut_) {
     const output::DebugPalette palette = o.debugView == RenderOptions::DebugView::overdraw
                                              ? output::DebugPalette::count
@@ -53,7 +63,7 @@ TileSink ResolveSink::finishTile(int tilesX) {
 }
 
 double ResolveSink::finish(core::ThreadPool& pool) {
-  if (linearOut_ || options_.filter != RenderOptions::Filter::tent3) return 0;
+  if (linearOut_ || imageOut_ || options_.filter != RenderOptions::Filter::tent3) return 0;
   const auto t0 = core::Clock::now();
   constexpr int kBand = 16;  // rows per task
   const int height = options_.height;

@@ -18,9 +18,12 @@ class ResolveSink {
   // box-resolved into that target and nothing else is done (no filter, no gamma, `linear` and
   // `image` untouched): a caller that composes views in linear light (render/warped.h) takes it
   // from there.
+  // With `imageOut` (supersampling 1, no debug view), every tile is box-resolved, blended as it
+  // says and put through the table into that rectangle, and nothing else is done.
   ResolveSink(const RenderOptions& options, const output::GammaTable& gamma,
               output::LinearImage& linear, Image& image,
-              const output::LinearTarget* linearOut = nullptr);
+              const output::LinearTarget* linearOut = nullptr,
+              const output::ImageTarget* imageOut = nullptr);
   // The sinks finishTile hands out refer to this object: it stays where it is.
   ResolveSink(const ResolveSink&) = delete;
   ResolveSink& operator=(const ResolveSink&) = delete;
@@ -40,6 +43,7 @@ class ResolveSink {
   output::LinearImage& linear_;
   Image& image_;
   bool linearOut_;
+  const output::ImageTarget* imageOut_;
   output::LinearTarget target_;  // where linear tiles go: linearOut's, or the whole of `linear`
 };
 

@@ -89,24 +89,36 @@ Status ViewRenderer::renderPacketsLinear(const scene::Scene& scene, const Render
                      core::Clock::now());
 }
 
+Status ViewRenderer::renderPacketsImage(const scene::Scene& scene, const RenderOptions& o,
+                                        const FrameCamera& camera, const DrawPackets& packets,
+                                        const ShadingTables& shading,
+                                        const output::ImageTarget& target, FrameStats& stats) {
+  SV_CHECK(target.width == o.width && target.height == o.height && target.x >= 0 && target.y >= 0 &&
+           target.x + target.width <= target.image->width &&
+           target.y + target.height <= target.image->height && o.supersample == 1);
+  return drawPackets(scene, o, camera, packets, shading, unused_, nullptr, stats, {},
+                     core::Clock::now(), &target);
+}
+
 Status ViewRenderer::drawPackets(const scene::Scene& scene, const RenderOptions& o,
                                  const FrameCamera& camera, const DrawPackets& packets,
                                  const ShadingTables& shading, Image& image,
                                  const output::LinearTarget* linearOut, FrameStats& stats,
-                                 const TileShare& share, core::Clock::time_point start) {
+                                 const TileShare& share, core::Clock::time_point start,
+                                 const output::ImageTarget* imageOut) {
   const bool pixelShading = shading.any && o.debugView == RenderOptions::DebugView::none;
   // Stages 3–5: setup and the tiles, with the frame's passes, each tile resolved when finished.
   Result<FrameSettings> settings = makeFrameSettings(o, scene.background, shading.environment,
                                                      pixelShading, packets.indices.size() / 3);
   if (!settings.ok()) return settings.error();
   FrameSettings& fs = settings.value();
-  ResolveSink sink(o, gamma_, linear_, image, linearOut);
+  ResolveSink sink(o, gamma_, linear_, image, linearOut, imageOut);
   fs.finishTile = sink.finishTile((fs.width + raster::kTileSize - 1) >> raster::kTileLog2);
   fs.depthToSink = false;  // the resolve reads colour alone
   fs.colorSums = sink.takesColorSums();
   fs.passes = passes_.compose(scene, o, camera, shading);
   fs.share = share;
-  if (!linearOut) output::prepareImage(o.width, o.height, image);
+  if (!linearOut && !imageOut) output::prepareImage(o.width, o.height, image);
   if (Status s = frame_.render(packets, fs, stats); !s) return s;
   if (share.shared()) {
     // Part 0 assembles the image: the finished pixels, or for the tent filter, which reads

@@ -54,6 +54,12 @@ class ViewRenderer {
                              const FrameCamera& camera, const DrawPackets& packets,
                              const ShadingTables& shading, const output::LinearTarget& target,
                              FrameStats& stats);
+  // The same resolved through the gamma table (and blended, as the target says) into a rectangle
+  // of a larger image: a cell whose display frame is not kept in linear light. Supersampling 1.
+  Status renderPacketsImage(const scene::Scene& scene, const RenderOptions& o,
+                            const FrameCamera& camera, const DrawPackets& packets,
+                            const ShadingTables& shading, const output::ImageTarget& target,
+                            FrameStats& stats);
 
   core::ThreadPool& pool() { return frame_.pool(); }
   const output::GammaTable& gamma() const { return gamma_; }
@@ -69,7 +75,8 @@ class ViewRenderer {
   Status drawPackets(const scene::Scene& scene, const RenderOptions& o, const FrameCamera& camera,
                      const DrawPackets& packets, const ShadingTables& shading, Image& image,
                      const output::LinearTarget* linearOut, FrameStats& stats,
-                     const TileShare& share, core::Clock::time_point start);
+                     const TileShare& share, core::Clock::time_point start,
+                     const output::ImageTarget* imageOut = nullptr);
 
   FrameRenderer frame_;
   SegmentRenderer segments_;

@@ -299,17 +299,25 @@ Status SubFrustumRenderer::render(const scene::Scene& scene, const RenderOptions
              (finish->blend->width == o.width && finish->blend->height == o.height));
     output::prepareImage(o.width, o.height, *finish->image);
   }
+  // Straight into the image (Finish::linear false): the stage's cells, unsupersampled.
+  const bool direct = stage && finish && !finish->linear && o.supersample == 1;
   // The cell's rectangle blended and encoded (Finish).
   const auto finishRect = [&](int x0, int y0, int x1, int y1) {
-    if (!finish) return;
+    if (!finish || direct) return;
     if (finish->blend) display::applyBlend(*finish->blend, out.rgb.data(), x0, y0, x1, y1);
     output::encodeRect(out, *finish->gamma, x0, y0, x1, y1, *finish->image);
   };
-  for (const PlanState::Run& r : plan_.uncovered) {
-    std::fill_n(&out.rgb[(size_t(r.y) * size_t(o.width) + size_t(r.x0)) * 3],
-                size_t(r.x1 - r.x0) * 3, uint16_t(0));
-    finishRect(r.x0, r.y, r.x1, r.y + 1);
-  }
+  // A rectangle black, in whichever frame the cells draw into.
+  const auto black = [&](int x0, int y0, int x1, int y1) {
+    for (int y = y0; y < y1; ++y)
+      if (direct)
+        std::fill_n(finish->image->pixel(x0, y), size_t(x1 - x0) * 3, uint8_t(0));
+      else
+        std::fill_n(&out.rgb[(size_t(y) * size_t(o.width) + size_t(x0)) * 3], size_t(x1 - x0) * 3,
+                    uint16_t(0));
+    finishRect(x0, y0, x1, y1);
+  };
+  for (const PlanState::Run& r : plan_.uncovered) black(r.x0, r.y, r.x1, r.y + 1);
   cellStats_.assign(n, FrameStats{});
   cellErrors_.assign(n, Status{});
   const bool lights = !scene.lightPoints.empty() || !scene.stars.stars.empty();
@@ -329,10 +337,7 @@ Status SubFrustumRenderer::render(const scene::Scene& scene, const RenderOptions
   pool_.parallelFor(n, [&](size_t i, int worker) {
     const display::SubFrustumCell& cell = plan.cells[i];
     if (!cell.fitted) {
-      for (int y = cell.y0; y < cell.y1; ++y)
-        std::fill_n(&out.rgb[(size_t(y) * size_t(o.width) + size_t(cell.x0)) * 3],
-                    size_t(cell.x1 - cell.x0) * 3, uint16_t(0));
-      finishRect(cell.x0, cell.y0, cell.x1, cell.y1);
+      black(cell.x0, cell.y0, cell.x1, cell.y1);
       return;
     }
     RenderOptions co = o;
@@ -343,7 +348,20 @@ Status SubFrustumRenderer::render(const scene::Scene& scene, const RenderOptions
     if (lights) camera.lightSubset = &cellLights_[i];
     if (!scene.lightPoints.empty()) camera.lightLaws = &laws_;
     const output::LinearTarget target{&out, cell.x0, cell.y0, co.width, co.height};
-    if (stage) {
+    if (direct) {
+      CellScratch& scratch = cellScratch_[size_t(worker)];
+      cellPackets(i, scratch);
+      const display::BlendWeights* blend = finish->blend;
+      const output::ImageTarget into{finish->image,
+                                     cell.x0,
+                                     cell.y0,
+                                     co.width,
+                                     co.height,
+                                     blend ? blend->alpha.data() : nullptr,
+                                     blend ? blend->beta.data() : nullptr};
+      cellErrors_[i] = workers_[size_t(worker)]->renderPacketsImage(
+          scene, co, camera, scratch.packets, shading_, into, cellStats_[i]);
+    } else if (stage) {
       CellScratch& scratch = cellScratch_[size_t(worker)];
       cellPackets(i, scratch);
       cellErrors_[i] = workers_[size_t(worker)]->renderPacketsLinear(
@@ -357,7 +375,11 @@ Status SubFrustumRenderer::render(const scene::Scene& scene, const RenderOptions
       for (int y = cell.y0; y < cell.y1; ++y)
         for (int x = cell.x0; x < cell.x1; ++x) {
           const size_t k = size_t(y) * size_t(o.width) + size_t(x);
-          if (!valid[k]) out.rgb[3 * k] = out.rgb[3 * k + 1] = out.rgb[3 * k + 2] = 0;
+          if (valid[k]) continue;
+          if (direct)
+            std::fill_n(finish->image->pixel(x, y), 3, uint8_t(0));
+          else
+            out.rgb[3 * k] = out.rgb[3 * k + 1] = out.rgb[3 * k + 2] = 0;
         }
     if (cellErrors_[i]) finishRect(cell.x0, cell.y0, cell.x1, cell.y1);
   });

@@ -67,10 +67,14 @@ class SubFrustumRenderer {
   // `out` too) and put through the gamma table into finish->image (sized here): the display's
   // frame with no pass over it after the cells (issue 61: "resolved through the ordinary tile
   // path, gamma inline").
+  // Without `linear`, the cells drawn as a stage resolve through the table straight into the
+  // image (blend inline; no supersampling) and `out` is left as it was: the frame is not kept in
+  // linear light.
   struct Finish {
     const display::BlendWeights* blend = nullptr;  // the display's size, or none
     const output::GammaTable* gamma = nullptr;
     Image* image = nullptr;
+    bool linear = true;
   };
   Status render(const scene::Scene& scene, const RenderOptions& o, const FrameCamera& base,
                 Vec3d eye, const display::SubFrustumPlan& plan, const std::vector<uint8_t>& valid,

@@ -541,7 +541,8 @@ TEST(SubFrusta, TheStageDrawsWhatEachCellAsAViewOfItsOwnDrew) {
 }
 
 // The frame's finish in the cells (each cell blended and put through the gamma table while in
-// cache) gives the bytes of a blend and a gamma pass over the whole frame after.
+// cache), or the cells resolved through the table straight into the image, blend inline, give
+// the bytes of a blend and a gamma pass over the whole frame after.
 TEST(SubFrusta, BlendedAndEncodedCellByCellAsOverTheWholeFrame) {
   const scene::Scene s = parallaxWalls();
   const render::DisplaySetup d = render::cylinderDisplay(200, 120);
@@ -567,6 +568,13 @@ TEST(SubFrusta, BlendedAndEncodedCellByCellAsOverTheWholeFrame) {
     renderer.encode(b, o, after);
     EXPECT_EQ(a.rgb, b.rgb) << p.name;
     EXPECT_EQ(fused.rgb, after.rgb) << p.name;
+    // Not kept in linear light: the cells resolve through the table into the image, blended as
+    // they are drawn — the same bytes.
+    output::LinearImage untouched;
+    Image direct;
+    ASSERT_TRUE(render::renderCorrected(renderer, s, o, base.value(), view, untouched, stats, cs,
+                                        &direct, false));
+    EXPECT_EQ(direct.rgb, after.rgb) << p.name;
   }
 }
 
