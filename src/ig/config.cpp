@@ -38,6 +38,44 @@ void known(const Json& object, const char* what, std::initializer_list<const cha
   }
 }
 
+// "display": a curved screen instead of channels (docs/ig.md, "A curved screen").
+void readDisplay(const Json& display, const Json& root, const std::string& path, IgConfig& c) {
+  known(display, "display", {"cylinder", "mpcdi", "correction"});
+  IgConfig::DisplayConfig d;
+  if (display.contains("cylinder") == display.contains("mpcdi"))
+    bad("display: either \"cylinder\" (the demo rig) or \"mpcdi\" (a file) expected");
+  if (const auto cyl = display.find("cylinder"); cyl != display.end()) {
+    known(*cyl, "display.cylinder", {"width", "height", "overlap"});
+    if (cyl->contains("width"))
+      d.width = integer((*cyl)["width"], "display.cylinder.width", 16, kMaxRasterSize);
+    if (cyl->contains("height"))
+      d.height = integer((*cyl)["height"], "display.cylinder.height", 16, kMaxRasterSize);
+    if (cyl->contains("overlap"))
+      d.overlapDegrees = number((*cyl)["overlap"], "display.cylinder.overlap", 0, 30);
+  } else {
+    const Json& f = display["mpcdi"];
+    if (!f.is_string() || f.get<std::string>().empty())
+      bad("display.mpcdi: an MPCDI file name expected");
+    d.mpcdi = core::resolvePath(core::directoryOf(path), f.get<std::string>());
+  }
+  if (display.contains("correction")) {
+    const Json& m = display["correction"];
+    const std::string name = m.is_string() ? m.get<std::string>() : "";
+    if (name == "subfrusta")
+      c.render.correction = RenderOptions::Correction::subFrusta;
+    else if (name == "bilinear")
+      c.render.correction = RenderOptions::Correction::bilinear;
+    else if (name == "bicubic")
+      c.render.correction = RenderOptions::Correction::bicubic;
+    else
+      bad("display.correction: subfrusta, bilinear or bicubic");
+  }
+  if (root.contains("channels"))
+    bad("display: a display's projectors are the channels (not with \"channels\")");
+  if (!c.splits.empty()) bad("display: a projector is drawn by one rank (not with cluster.split)");
+  c.display = d;
+}
+
 IgConfig read(const Json& root, const std::string& path) {
   known(root, "configuration",
         {"synthvis-ig", "scene", "rate", "channels", "width", "height", "models", "origin", "port",
@@ -162,43 +200,7 @@ IgConfig read(const Json& root, const std::string& path) {
       }
     }
   }
-  if (const auto it = root.find("display"); it != root.end()) {
-    known(*it, "display", {"cylinder", "mpcdi", "correction"});
-    IgConfig::DisplayConfig d;
-    if (it->contains("cylinder") == it->contains("mpcdi"))
-      bad("display: either \"cylinder\" (the demo rig) or \"mpcdi\" (a file) expected");
-    if (const auto cyl = it->find("cylinder"); cyl != it->end()) {
-      known(*cyl, "display.cylinder", {"width", "height", "overlap"});
-      if (cyl->contains("width"))
-        d.width = integer((*cyl)["width"], "display.cylinder.width", 16, kMaxRasterSize);
-      if (cyl->contains("height"))
-        d.height = integer((*cyl)["height"], "display.cylinder.height", 16, kMaxRasterSize);
-      if (cyl->contains("overlap"))
-        d.overlapDegrees = number((*cyl)["overlap"], "display.cylinder.overlap", 0, 30);
-    } else {
-      const Json& f = (*it)["mpcdi"];
-      if (!f.is_string() || f.get<std::string>().empty())
-        bad("display.mpcdi: an MPCDI file name expected");
-      d.mpcdi = core::resolvePath(core::directoryOf(path), f.get<std::string>());
-    }
-    if (it->contains("correction")) {
-      const Json& m = (*it)["correction"];
-      const std::string name = m.is_string() ? m.get<std::string>() : "";
-      if (name == "subfrusta")
-        c.render.correction = RenderOptions::Correction::subFrusta;
-      else if (name == "bilinear")
-        c.render.correction = RenderOptions::Correction::bilinear;
-      else if (name == "bicubic")
-        c.render.correction = RenderOptions::Correction::bicubic;
-      else
-        bad("display.correction: subfrusta, bilinear or bicubic");
-    }
-    if (root.contains("channels"))
-      bad("display: a display's projectors are the channels (not with \"channels\")");
-    if (!c.splits.empty())
-      bad("display: a projector is drawn by one rank (not with cluster.split)");
-    c.display = d;
-  }
+  if (const auto it = root.find("display"); it != root.end()) readDisplay(*it, root, path, c);
   c.render.width = c.width;
   c.render.height = c.height;
   return c;

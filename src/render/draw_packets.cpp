@@ -221,6 +221,17 @@ Status layOutCalls(const scene::Scene& scene, const RenderOptions& o, const Fram
 
 }  // namespace
 
+void addTraversalCounts(const traversal::Traversal& t, FrameStats& stats) {
+  stats.trianglesIn += t.culledTriangles;
+  stats.culledOutside += t.culledTriangles;
+  stats.culledInstances += t.culledInstances;
+  for (int i = 0; i < FrameStats::kLodLevels; ++i) stats.lodDrawn[i] += t.lodDrawn[i];
+  stats.lodDissolving += t.lodDissolving;
+  stats.mergedCells += t.mergedCells;
+  stats.mergedInstances += t.mergedInstances;
+  stats.lodBeyond += t.lodBeyond;
+}
+
 float nearestEyeDepth(const Mat4& toEye, Vec3 lo, Vec3 hi) {
   float near = std::numeric_limits<float>::infinity();
   for (int c = 0; c < 8; ++c) {

@@ -66,6 +66,10 @@ Status buildDrawPackets(const scene::Scene& scene, const RenderOptions& options,
 traversal::View traversalView(const FrameCamera& camera);
 traversal::Options traversalOptions(const RenderOptions& options);
 
+// What a traversal chose and culled, added to a frame's counts (the triangles it culled among
+// those in).
+void addTraversalCounts(const traversal::Traversal& t, FrameStats& stats);
+
 // The smallest view depth of the corners of the box [lo, hi] placed by `toEye`.
 float nearestEyeDepth(const Mat4& toEye, Vec3 lo, Vec3 hi);
 

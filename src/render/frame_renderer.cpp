@@ -211,15 +211,8 @@ Status FrameRenderer::render(const DrawPackets& packets, const FrameSettings& se
     for (int i = 0; i < f.tiles; ++i)
       drawnTiles_[size_t(i)] = (i % f.tilesY) * f.tilesX + i / f.tilesY;
   preparePasses(settings, f);
-  const traversal::Traversal& t = packets.traversal;
-  stats.trianglesIn += f.triangles + t.culledTriangles;
-  stats.culledOutside += t.culledTriangles;
-  stats.culledInstances += t.culledInstances;
-  for (int i = 0; i < FrameStats::kLodLevels; ++i) stats.lodDrawn[i] += t.lodDrawn[i];
-  stats.lodDissolving += t.lodDissolving;
-  stats.mergedCells += t.mergedCells;
-  stats.mergedInstances += t.mergedInstances;
-  stats.lodBeyond += t.lodBeyond;
+  stats.trianglesIn += f.triangles;
+  addTraversalCounts(packets.traversal, stats);
   // Always run at least one (empty) batch, so the tiles get cleared.
   for (uint32_t begin = 0; begin == 0 || begin < f.triangles; begin += f.batchTriangles) {
     Batch batch;

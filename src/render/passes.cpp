@@ -60,7 +60,10 @@ std::vector<raster::TilePass*> FramePasses::compose(const scene::Scene& scene,
     volumes_.setVolumes(in);
     passes.push_back(&volumes_);
   }
-  if (!scene.lightPoints.empty() || !scene.stars.stars.empty()) {
+  // A view given a subset of no light (a sub-frustum cell no light reaches) has no light pass:
+  // no visibility kept a tile, no wavefront.
+  const bool noLight = camera.lightSubset && camera.lightSubset->empty();
+  if ((!scene.lightPoints.empty() || !scene.stars.stars.empty()) && !noLight) {
     lights_.setLights(lightInput(scene, camera));
     passes.push_back(&lights_);
   }

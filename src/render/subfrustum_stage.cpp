@@ -40,6 +40,13 @@ Mat4d frustum(double l, double r, double b, double t, double n, double f) {
 
 }  // namespace
 
+std::array<int16_t, 4> SubFrustumRenderer::Stage::bins(const std::array<float, 4>& b) const {
+  const float sx = kBins / (grid[2] - grid[0]), sy = kBins / (grid[3] - grid[1]);
+  const auto bin = [](float v) { return int16_t(std::clamp(int(std::floor(v)), 0, kBins - 1)); };
+  return {bin((b[0] - grid[0]) * sx), bin((b[1] - grid[1]) * sy), bin((b[2] - grid[0]) * sx),
+          bin((b[3] - grid[1]) * sy)};
+}
+
 void SubFrustumRenderer::prepareStage(const display::SubFrustumPlan& plan, double znear,
                                       double zfar) {
   Stage& st = stage_;
@@ -133,7 +140,6 @@ void SubFrustumRenderer::binLights(const scene::Scene& scene, const FrameCamera&
   }
   // Every light's place on the cover's grid (the triangles' grid: a light beyond it is beyond
   // every cell's box widened by less than two pixels; its bins clamp the rest), in light order.
-  const float sx = kBins / (st.grid[2] - st.grid[0]), sy = kBins / (st.grid[3] - st.grid[1]);
   const size_t lights = lightDirections_.size();
   lightPlace_.resize(lights);
   std::vector<int32_t> binOf(lights, -1);
@@ -145,9 +151,8 @@ void SubFrustumRenderer::binLights(const scene::Scene& scene, const FrameCamera&
     if (!(q.w > 0)) continue;  // beyond 90° of the cover's axis: no cell is within reach
     const float x = q.x / q.w, y = q.y / q.w;
     lightPlace_[k] = {x, y};
-    const int bx = std::clamp(int(std::floor((x - st.grid[0]) * sx)), 0, kBins - 1);
-    const int by = std::clamp(int(std::floor((y - st.grid[1]) * sy)), 0, kBins - 1);
-    binOf[k] = by * kBins + bx;
+    const std::array<int16_t, 4> b = st.bins({x, y, x, y});
+    binOf[k] = b[1] * kBins + b[0];
     ++lightBinStart_[size_t(binOf[k]) + 1];
   }
   for (size_t b = 1; b < lightBinStart_.size(); ++b) lightBinStart_[b] += lightBinStart_[b - 1];
@@ -164,10 +169,8 @@ void SubFrustumRenderer::cellLightsOf(size_t i, const display::SubFrustumPlan& p
   std::vector<uint32_t>& list = cellLights_[i];
   list.clear();
   const std::array<float, 4>& box = lightBox_[i];
-  const float sx = kBins / (st.grid[2] - st.grid[0]), sy = kBins / (st.grid[3] - st.grid[1]);
-  const auto bin = [](float v) { return std::clamp(int(std::floor(v)), 0, kBins - 1); };
-  const int bx0 = bin((box[0] - st.grid[0]) * sx), by0 = bin((box[1] - st.grid[1]) * sy);
-  const int bx1 = bin((box[2] - st.grid[0]) * sx), by1 = bin((box[3] - st.grid[1]) * sy);
+  const std::array<int16_t, 4> cb = st.bins(box);
+  const int bx0 = cb[0], by0 = cb[1], bx1 = cb[2], by1 = cb[3];
   const double reach = lightReach_;
   for (int y = by0; y <= by1; ++y)
     for (int x = bx0; x <= bx1; ++x) {
@@ -195,8 +198,6 @@ void SubFrustumRenderer::binTriangles() {
   triangleBox_.resize(triangles);
   triangleBins_.resize(triangles);
   everywhere_.clear();
-  const float sx = kBins / (st.grid[2] - st.grid[0]), sy = kBins / (st.grid[3] - st.grid[1]);
-  const auto bin = [](float v) { return int16_t(std::clamp(int(std::floor(v)), 0, kBins - 1)); };
   binStart_.assign(size_t(kBins) * kBins + 1, 0);
   for (size_t t = 0; t < triangles; ++t) {
     std::array<float, 4> box{1e30f, 1e30f, -1e30f, -1e30f};
@@ -222,8 +223,7 @@ void SubFrustumRenderer::binTriangles() {
       triangleBins_[t] = {0, 0, -1, -1};  // beyond every cell: no bin
       continue;
     }
-    const std::array<int16_t, 4> b{bin((box[0] - st.grid[0]) * sx), bin((box[1] - st.grid[1]) * sy),
-                                   bin((box[2] - st.grid[0]) * sx), bin((box[3] - st.grid[1]) * sy)};
+    const std::array<int16_t, 4> b = st.bins(box);
     triangleBins_[t] = b;
     for (int y = b[1]; y <= b[3]; ++y)
       for (int x = b[0]; x <= b[2]; ++x) ++binStart_[size_t(y * kBins + x) + 1];
@@ -241,10 +241,8 @@ void SubFrustumRenderer::binTriangles() {
 void SubFrustumRenderer::cellPackets(size_t i, CellScratch& s) {
   const Stage& st = stage_;
   const std::array<float, 4>& box = st.box[i];
-  const float sx = kBins / (st.grid[2] - st.grid[0]), sy = kBins / (st.grid[3] - st.grid[1]);
-  const auto bin = [](float v) { return std::clamp(int(std::floor(v)), 0, kBins - 1); };
-  const int bx0 = bin((box[0] - st.grid[0]) * sx), by0 = bin((box[1] - st.grid[1]) * sy);
-  const int bx1 = bin((box[2] - st.grid[0]) * sx), by1 = bin((box[3] - st.grid[1]) * sy);
+  const std::array<int16_t, 4> cb = st.bins(box);
+  const int bx0 = cb[0], by0 = cb[1], bx1 = cb[2], by1 = cb[3];
   // The triangles whose boxes meet the cell's, each once: from the first of the cell's bins it
   // lies in.
   s.triangles.assign(everywhere_.begin(), everywhere_.end());

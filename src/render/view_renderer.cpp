@@ -39,12 +39,21 @@ Status ViewRenderer::renderLinear(const scene::Scene& scene, const RenderOptions
   return run(scene, o, camera, unused_, &target, stats, {});
 }
 
+namespace {
+
+// A target rectangle of the view's size, inside its image.
+template <class Target>
+bool fits(const Target& t, const RenderOptions& o) {
+  return t.width == o.width && t.height == o.height && t.x >= 0 && t.y >= 0 &&
+         t.x + t.width <= t.image->width && t.y + t.height <= t.image->height;
+}
+
+}  // namespace
+
 Status ViewRenderer::renderLinear(const scene::Scene& scene, const RenderOptions& o,
                                   const FrameCamera& camera, const output::LinearTarget& target,
                                   FrameStats& stats) {
-  SV_CHECK(target.width == o.width && target.height == o.height && target.x >= 0 && target.y >= 0 &&
-           target.x + target.width <= target.image->width &&
-           target.y + target.height <= target.image->height);
+  SV_CHECK(fits(target, o));
   return run(scene, o, camera, unused_, &target, stats, {});
 }
 
@@ -82,9 +91,7 @@ Status ViewRenderer::renderPacketsLinear(const scene::Scene& scene, const Render
                                          const FrameCamera& camera, const DrawPackets& packets,
                                          const ShadingTables& shading,
                                          const output::LinearTarget& target, FrameStats& stats) {
-  SV_CHECK(target.width == o.width && target.height == o.height && target.x >= 0 && target.y >= 0 &&
-           target.x + target.width <= target.image->width &&
-           target.y + target.height <= target.image->height);
+  SV_CHECK(fits(target, o));
   return drawPackets(scene, o, camera, packets, shading, unused_, &target, stats, {},
                      core::Clock::now());
 }
@@ -93,9 +100,7 @@ Status ViewRenderer::renderPacketsImage(const scene::Scene& scene, const RenderO
                                         const FrameCamera& camera, const DrawPackets& packets,
                                         const ShadingTables& shading,
                                         const output::ImageTarget& target, FrameStats& stats) {
-  SV_CHECK(target.width == o.width && target.height == o.height && target.x >= 0 && target.y >= 0 &&
-           target.x + target.width <= target.image->width &&
-           target.y + target.height <= target.image->height && o.supersample == 1);
+  SV_CHECK(fits(target, o) && o.supersample == 1);
   return drawPackets(scene, o, camera, packets, shading, unused_, nullptr, stats, {},
                      core::Clock::now(), &target);
 }

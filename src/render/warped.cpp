@@ -280,15 +280,7 @@ Status SubFrustumRenderer::render(const scene::Scene& scene, const RenderOptions
     binTriangles();
     cellScratch_.resize(workers_.size());
     stats.vertexMs += core::msSince(t0);
-    const traversal::Traversal& t = cover_.traversal;
-    stats.trianglesIn += t.culledTriangles;
-    stats.culledOutside += t.culledTriangles;
-    stats.culledInstances += t.culledInstances;
-    for (int k = 0; k < FrameStats::kLodLevels; ++k) stats.lodDrawn[k] += t.lodDrawn[k];
-    stats.lodDissolving += t.lodDissolving;
-    stats.mergedCells += t.mergedCells;
-    stats.mergedInstances += t.mergedInstances;
-    stats.lodBeyond += t.lodBeyond;
+    addTraversalCounts(cover_.traversal, stats);
   }
   // Every pixel is written: a fitted cell's by its view; an unfitted cell's, and one that is
   // invalid, black. Pixels outside every cell are invalid (the plan's cells hold every valid one):

@@ -134,6 +134,7 @@ class SubFrustumRenderer {
   // every cell; each triangle binned to the cells whose rectangles its box meets; each cell's
   // triangles taken to its own clip space by one 4 × 4 map (its projection after the cover's
   // inverse) and drawn through its own raster. What depends on the plan and the depth range:
+  static constexpr int kBins = 32;  // a side of the grid of bins over the cover's NDC
   struct Stage {
     bool ok = false;  // a cover exists (every cell within 84° of their mean direction)
     double znear = 0, zfar = 0;
@@ -142,10 +143,11 @@ class SubFrustumRenderer {
     // Per cell: its rectangle widened by two pixels, as a box of the cover's NDC (x0, y0, x1, y1).
     std::vector<std::array<float, 4>> box;
     float grid[4] = {-1, -1, 1, 1};  // the bins' domain: the union of the boxes
+    // The bins a box of the cover's NDC lies in (x0, y0, x1, y1, inclusive; clamped to the grid).
+    std::array<int16_t, 4> bins(const std::array<float, 4>& b) const;
   };
   Stage stage_;
   bool useStage_ = true;
-  static constexpr int kBins = 32;  // a side of the grid of bins over the cover's NDC
   // This frame's: the shading tables and packets in the cover's clip space; each triangle's NDC box
   // and range of bins (empty for one in no bin); the triangles every cell tries (a vertex at or
   // behind the eye plane); the bins' triangles (CSR: binStart, binTriangles).
