@@ -2,11 +2,14 @@
 // docs/display.md "At an IG's rate"), on BENCH.md's display figure — scenes/airport.json on the
 // demo cylinder's centre projector at 1920×1080 — on one thread (/1), so that a figure is ns of a
 // core, and on two (/2, the figure):
-//   the unwarped frame (the scene camera's view)                          → ms a frame
-//   the same through the projector's sub-frusta (the plan made once)     → ms a frame, and
-//     (sub-frusta − unwarped) / cells                                     → µs of a core a cell
-//   the two alternating in one run, their medians and ratio              → the ratio
-//   the plan refitted for a moved eye (the cells fixed)                   → µs a cell
+//   BM_UnwarpedFrame: the scene camera's view, through the gamma table    → ms a frame
+//   BM_SubFrustaFrame: the same through the projector's sub-frusta (the plan made once), each
+//     cell resolved through the table into the image, as the IG draws it → ms a frame
+//   BM_SubFrustaOverUnwarped/threads/mode: the two alternating in one run, their medians, ratio
+//     and (sub-frusta − unwarped) / cells in µs of the threads' time; mode 0 both in linear
+//     light, 1 as `bench --renderer display` times them (the figure), 2 the display
+//     frame in linear light against the unwarped one through the table
+//   BM_RefitPlan: the plan refitted for a (2, 1, −1) cm move (the cells fixed) → ms, /904 a cell
 // The budget: ≤ 3 µs of a core a cell for the frame (the 1.3× target), ≤ 4 µs a cell for the
 // refit (2 ms on 2 threads). Run: build/bench/sv_display_bench (SV_BENCH_TARGET=avx2 for the AVX2
 // kernels on an AVX-512 machine).
