@@ -42,7 +42,10 @@ Mat4d frustum(double l, double r, double b, double t, double n, double f) {
 
 std::array<int16_t, 4> SubFrustumRenderer::Stage::bins(const std::array<float, 4>& b) const {
   const float sx = kBins / (grid[2] - grid[0]), sy = kBins / (grid[3] - grid[1]);
-  const auto bin = [](float v) { return int16_t(std::clamp(int(std::floor(v)), 0, kBins - 1)); };
+  // Clamped before the conversion: a place far off the grid is a bin at its edge.
+  const auto bin = [](float v) {
+    return int16_t(std::floor(std::clamp(v, 0.0f, float(kBins - 1))));
+  };
   return {bin((b[0] - grid[0]) * sx), bin((b[1] - grid[1]) * sy), bin((b[2] - grid[0]) * sx),
           bin((b[3] - grid[1]) * sy)};
 }
@@ -148,7 +151,9 @@ void SubFrustumRenderer::binLights(const scene::Scene& scene, const FrameCamera&
   for (size_t k = 0; k < lights; ++k) {
     const Vec3d& d = lightDirections_[k].direction;
     const Vec4 q = m * Vec4{float(d.x), float(d.y), float(d.z), 1};
-    if (!(q.w > 0)) continue;  // beyond 90° of the cover's axis: no cell is within reach
+    // Beyond 90° of the cover's axis, or so near it that its place is off the grid by a
+    // thousand widths: no cell is within reach.
+    if (!(q.w > 1e-3f * (std::abs(q.x) + std::abs(q.y)))) continue;
     const float x = q.x / q.w, y = q.y / q.w;
     lightPlace_[k] = {x, y};
     const std::array<int16_t, 4> b = st.bins({x, y, x, y});
