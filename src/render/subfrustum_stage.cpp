@@ -11,6 +11,7 @@
 #include <cmath>
 
 #include "core/quadric.h"
+#include "core/timing.h"
 #include "render/warped.h"
 
 namespace sv::render {
@@ -202,6 +203,25 @@ void SubFrustumRenderer::cellLightsOf(size_t i, const display::SubFrustumPlan& p
   // In light order (the bins hold each light once); then the lights' own indices.
   std::sort(list.begin(), list.end());
   for (uint32_t& l : list) l = lightDirections_[l].index;
+}
+
+Status SubFrustumRenderer::drawCover(const scene::Scene& scene, const RenderOptions& o,
+                                     const FrameCamera& base, Vec3d eye, FrameStats& stats) {
+  const auto t0 = core::Clock::now();
+  FrameCamera cover = base;
+  cover.view = Mat4::translation(Vec3{float(-eye.x), float(-eye.y), float(-eye.z)}) * base.view;
+  cover.projection = stage_.cover;
+  cover.projective = true;
+  buildShading(scene, o, cover.view, shading_);
+  if (Status s =
+          buildDrawPackets(scene, o, cover, shading_.any ? &shading_ : nullptr, pool_, cover_);
+      !s)
+    return s;
+  binTriangles();
+  cellScratch_.resize(workers_.size());
+  stats.vertexMs += core::msSince(t0);
+  addTraversalCounts(cover_.traversal, stats);
+  return {};
 }
 
 void SubFrustumRenderer::binTriangles() {

@@ -266,22 +266,8 @@ Status SubFrustumRenderer::render(const scene::Scene& scene, const RenderOptions
   const double znear = base.camera.znear, zfar = base.camera.zfar;
   if (stage_.znear != znear || stage_.zfar != zfar) prepareStage(plan, znear, zfar);
   const bool stage = useStage_ && stage_.ok && o.pipeline == RenderOptions::Pipeline::tiles;
-  if (stage) {
-    const auto t0 = core::Clock::now();
-    FrameCamera cover = base;
-    cover.view = Mat4::translation(Vec3{float(-eye.x), float(-eye.y), float(-eye.z)}) * base.view;
-    cover.projection = stage_.cover;
-    cover.projective = true;
-    buildShading(scene, o, cover.view, shading_);
-    if (Status s =
-            buildDrawPackets(scene, o, cover, shading_.any ? &shading_ : nullptr, pool_, cover_);
-        !s)
-      return s;
-    binTriangles();
-    cellScratch_.resize(workers_.size());
-    stats.vertexMs += core::msSince(t0);
-    addTraversalCounts(cover_.traversal, stats);
-  }
+  if (stage)
+    if (Status s = drawCover(scene, o, base, eye, stats); !s) return s;
   // Every pixel is written: a fitted cell's by its view; an unfitted cell's, and one that is
   // invalid, black. Pixels outside every cell are invalid (the plan's cells hold every valid one):
   // black.

@@ -173,6 +173,9 @@ class SubFrustumRenderer {
                  const display::SubFrustumPlan& plan);
   void cellLightsOf(size_t i, const display::SubFrustumPlan& plan);
   void prepareStage(const display::SubFrustumPlan& plan, double znear, double zfar);
+  // This frame's stages 2–3 in the cover's clip space, and its triangles binned.
+  Status drawCover(const scene::Scene& scene, const RenderOptions& o, const FrameCamera& base,
+                   Vec3d eye, FrameStats& stats);
   void binTriangles();
   // Cell i's triangles of cover_, in draw order, taken to its clip space (scratch.packets).
   void cellPackets(size_t i, CellScratch& scratch);
