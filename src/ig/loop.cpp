@@ -410,12 +410,13 @@ struct IgLoop::Session {
                            patternImages);
     }
     if (m.options.overlay) {
-      // Room for four lines of 72 characters, centred at the top of the field.
+      // Room for four lines of 72 characters, centred near the top of the field (below the
+      // top edge, where the projectors' upper rows curve off the screen).
       const present::TextSize text =
           present::measureText(std::string(72, 'M') + "\n\n\n", overlayScale);
       const int w = text.width + 8 * overlayScale, h = text.height + 8 * overlayScale;
-      overlayPatch =
-          render::panoramaPatch(d, view, std::max(0, (view.width - w) / 2), 2 * overlayScale, w, h);
+      overlayPatch = render::panoramaPatch(d, view, std::max(0, (view.width - w) / 2),
+                                           std::max(2 * overlayScale, view.height / 16), w, h);
     }
   }
 
