@@ -394,7 +394,12 @@ Status renderDisplay(CorrectionRenderer& renderer, const scene::Scene& scene,
 display::PanoramaView displayPanorama(const DisplaySetup& display, double pixelDegrees) {
   std::vector<const display::DirectionTable*> tables;
   for (const ProjectorSetup& p : display.projectors) tables.push_back(&p.table);
-  return display::panoramaOf(tables, pixelDegrees);
+  display::PanoramaView view = display::panoramaOf(tables, pixelDegrees);
+  // At most kMaxRasterSize a side (a picture of 8192² is 200 MB): coarser pixels beyond.
+  const int side = std::max(view.width, view.height);
+  if (side > kMaxRasterSize)
+    view = display::panoramaOf(tables, pixelDegrees * double(side) / (kMaxRasterSize - 2));
+  return view;
 }
 
 namespace {

@@ -173,6 +173,7 @@ Status renderDisplay(CorrectionRenderer& renderer, const scene::Scene& scene,
 // overlay, docs/display.md "Pictures on the screen"): a panorama around the display's eye
 // (display::panoramaOf its projectors' directions) that each projector pixel samples in its own
 // direction, so that the picture comes out undistorted and continuous across the projectors.
+// Pixels of `pixelDegrees`, coarser where that would make a side over kMaxRasterSize.
 display::PanoramaView displayPanorama(const DisplaySetup& display, double pixelDegrees);
 // `picture` (codes as `gamma` encodes them, the panorama's size) on every projector: bilinear in
 // linear light, blended, through `gamma`; invalid pixels black. In bands of rows on `pool`.

@@ -669,6 +669,10 @@ TEST(DisplayPictures, EachProjectorPixelShowsThePanoramaInItsOwnDirection) {
   for (render::ProjectorSetup& p : d.projectors) p.blend.reset();
   const display::PanoramaView view = render::displayPanorama(d, 0.5);
   EXPECT_GT(view.width, 360);  // 180° and the overlaps at half a degree
+  // Pixels too fine for a picture of the field: coarser ones, at most kMaxRasterSize a side.
+  const display::PanoramaView fine = render::displayPanorama(d, 1e-4);
+  EXPECT_LE(std::max(fine.width, fine.height), kMaxRasterSize);
+  EXPECT_GT(fine.width, kMaxRasterSize / 2);
   Image picture;
   output::prepareImage(view.width, view.height, picture);
   for (int y = 0; y < view.height; ++y)
