@@ -425,8 +425,11 @@ struct IgLoop::Session {
   Status renderFrame(int level, const QualityLevel& q, const scene::Scene& scene) {
     Renderer& renderer = m.rendererFor(level, q.options);
     if (!m.display) return renderer.renderChannels(scene, images, &stats, only);
-    if (!scene.channels.empty())
-      for (int k = 0; k < 3; ++k) displayView.eyeOffset[k] = (&scene.channels[0].offset.x)[k];
+    if (!scene.channels.empty()) {
+      const Vec3 e = scene.channels[0].offset;
+      displayView.eyeOffset[0] = e.x, displayView.eyeOffset[1] = e.y,
+      displayView.eyeOffset[2] = e.z;
+    }
     return renderer.renderDisplay(scene, m.displayAt(q.replication), images, &stats, nullptr,
                                   displayView);
   }

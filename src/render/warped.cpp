@@ -258,7 +258,6 @@ Status SubFrustumRenderer::render(const scene::Scene& scene, const RenderOptions
                              plan.width, plan.height, o.width, o.height)};
   if (!valid.empty() && valid.size() != size_t(o.width) * size_t(o.height))
     return Error{"", "", "the display's valid-pixel mask does not match its size"};
-  out.resize(o.width, o.height);
   const size_t n = plan.cells.size();
   preparePlan(plan);
   // The stage (subfrustum_stage.cpp) where it can run: the tile pipeline, and a flat cover for
@@ -279,6 +278,7 @@ Status SubFrustumRenderer::render(const scene::Scene& scene, const RenderOptions
   }
   // Straight into the image (Finish::linear false): the stage's cells, unsupersampled.
   const bool direct = stage && finish && !finish->linear && o.supersample == 1;
+  if (!direct) out.resize(o.width, o.height);  // direct: no linear frame is written, or held
   // The cell's rectangle blended and encoded (Finish).
   const auto finishRect = [&](int x0, int y0, int x1, int y1) {
     if (!finish || direct) return;

@@ -11,6 +11,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <random>
 #include <set>
 #include <thread>
@@ -124,13 +125,16 @@ struct Session {
   HostLog host;
 };
 
-Session runSession(const IgRunOptions& options, uint64_t hostFrames, double appear) {
-  Result<std::unique_ptr<IgLoop>> loop = IgLoop::create(config(), options);
+// An IG of configuration `c` driven by the script `scriptFor` makes for its port, to the script's
+// end.
+Session runSession(const IgConfig& c, const IgRunOptions& options,
+                   const std::function<HostScript(uint16_t port)>& scriptFor) {
+  Result<std::unique_ptr<IgLoop>> loop = IgLoop::create(c, options);
   EXPECT_TRUE(loop.ok()) << loop.error().str();
   Session s;
   std::optional<Result<IgRunReport>> report;
   std::thread ig([&] { report.emplace(loop.value()->run()); });
-  Result<HostLog> host = runHost(script(loop.value()->port(), hostFrames, appear));
+  Result<HostLog> host = runHost(scriptFor(loop.value()->port()));
   loop.value()->stop();
   ig.join();
   EXPECT_TRUE(host.ok()) << host.error().str();
@@ -138,6 +142,11 @@ Session runSession(const IgRunOptions& options, uint64_t hostFrames, double appe
   if (host.ok()) s.host = host.value();
   if (report->ok()) s.report = report->value();
   return s;
+}
+
+Session runSession(const IgRunOptions& options, uint64_t hostFrames, double appear) {
+  return runSession(config(), options,
+                    [&](uint16_t port) { return script(port, hostFrames, appear); });
 }
 
 TEST(IgLoop, HostDrivenEntitiesAppearInTheNextFrameAndTheSessionReplaysBitForBit) {
@@ -288,23 +297,17 @@ TEST(IgLoop, ACurvedScreensProjectorsAreTheChannelsAndAMovedEyeReplaysBitForBit)
   IgRunOptions options;
   options.output = "png:" + frames.string();
   options.record = capture.string();
-  Result<std::unique_ptr<IgLoop>> loop = IgLoop::create(cylinderConfig(), options);
-  ASSERT_TRUE(loop.ok()) << loop.error().str();
-  std::optional<Result<IgRunReport>> report;
-  std::thread ig([&] { report.emplace(loop.value()->run()); });
-  HostScript sc = script(loop.value()->port(), 20, 100);  // no box this session
-  cigi::ViewControl vc;
-  vc.view = 0;
-  vc.entity = 0;
-  vc.enable = 1 | 2 | 4;
-  vc.x = 0.3f, vc.y = 0.2f, vc.z = -0.8f;  // forward, right and up, metres
-  sc.events.push_back({0.2, {vc}});
-  Result<HostLog> host = runHost(sc);
-  loop.value()->stop();
-  ig.join();
-  ASSERT_TRUE(host.ok()) << host.error().str();
-  ASSERT_TRUE(report->ok()) << report->error().str();
-  const uint64_t drawn = report->value().frames;
+  const Session session = runSession(cylinderConfig(), options, [](uint16_t port) {
+    HostScript sc = script(port, 20, 100);  // no box this session
+    cigi::ViewControl vc;
+    vc.view = 0;
+    vc.entity = 0;
+    vc.enable = 1 | 2 | 4;
+    vc.x = 0.3f, vc.y = 0.2f, vc.z = -0.8f;  // forward, right and up, metres
+    sc.events.push_back({0.2, {vc}});
+    return sc;
+  });
+  const uint64_t drawn = session.report.frames;
   ASSERT_GE(drawn, 20u);
   // Three projectors a frame at their own size; the eye's move changes the centre one's view of
   // the ground.
